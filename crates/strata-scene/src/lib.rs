@@ -1,0 +1,30 @@
+//! strata-scene: the scene model shared by the GPU renderer and the CPU reference.
+//!
+//! - [`model`]: meshes, materials, textures, lights, objects with rigid animation;
+//! - [`camera`]: the one camera model (pixel centres, camera-space depth);
+//! - [`path`]: camera paths;
+//! - [`load`]: glTF 2.0, OBJ/MTL and TOML scene files;
+//! - [`procedural`]: built-in scenes (`cornell`, `atrium`, `warehouse`, …).
+
+pub mod camera;
+pub mod error;
+pub mod image_buf;
+pub mod load;
+pub mod model;
+pub mod normals;
+pub mod path;
+pub mod procedural;
+
+pub use camera::Camera;
+pub use error::SceneError;
+pub use image_buf::ImageBuf;
+pub use model::*;
+pub use path::{CameraPath, Keyframe};
+
+/// Loads a scene by built-in name or file path (.gltf, .glb, .obj, .toml).
+pub fn load_scene(name_or_path: &str) -> Result<Scene, SceneError> {
+    if let Some(s) = procedural::builtin(name_or_path) {
+        return Ok(s);
+    }
+    load::load_path(std::path::Path::new(name_or_path))
+}
