@@ -1,1 +1,30 @@
-fn main() {}
+//! `strata` — layered screen-space global illumination, measured against ground truth.
+
+mod args;
+mod bench;
+mod info;
+mod output;
+mod reference;
+mod render;
+
+use clap::Parser;
+
+fn main() {
+    tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG").unwrap_or_else(|_| "warn".into()))
+        .with_writer(std::io::stderr)
+        .init();
+    let cli = args::Cli::parse();
+    let result = match cli.command {
+        args::Command::Info(a) => info::run(&a),
+        args::Command::Render(a) => render::run(&a),
+        args::Command::Reference(a) => reference::run(&a),
+        args::Command::Bench(a) => bench::run(&a),
+    };
+    if let Err(e) = result {
+        // One line: what is wrong and what is valid.
+        let msg = format!("{e:#}").replace('\n', " ");
+        eprintln!("strata: error: {msg}");
+        std::process::exit(1);
+    }
+}

@@ -24,13 +24,25 @@ pub struct Camera {
 
 impl Default for Camera {
     fn default() -> Self {
-        Self { eye: Vec3::new(0.0, 1.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0, near: 0.05 }
+        Self {
+            eye: Vec3::new(0.0, 1.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_deg: 60.0,
+            near: 0.05,
+        }
     }
 }
 
 impl Camera {
     pub fn new(eye: Vec3, target: Vec3, up: Vec3, fov_y_deg: f32, near: f32) -> Self {
-        Self { eye, target, up, fov_y_deg, near }
+        Self {
+            eye,
+            target,
+            up,
+            fov_y_deg,
+            near,
+        }
     }
 
     /// Unit view direction.
@@ -91,7 +103,10 @@ impl Camera {
     /// Checks the parameters; the error names the parameter and its valid range.
     pub fn validate(&self) -> Result<(), String> {
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
-            return Err(format!("camera fov {} is out of range: vertical field of view must be in (0, 180) degrees", self.fov_y_deg));
+            return Err(format!(
+                "camera fov {} is out of range: vertical field of view must be in (0, 180) degrees",
+                self.fov_y_deg
+            ));
         }
         if !(self.near > 0.0) || !self.near.is_finite() {
             return Err(format!("camera near {} is out of range: must be > 0", self.near));

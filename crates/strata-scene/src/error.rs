@@ -13,6 +13,9 @@ pub enum SceneError {
 
 impl SceneError {
     pub fn file(path: impl Into<PathBuf>, message: impl std::fmt::Display) -> Self {
-        SceneError::File { path: path.into(), message: message.to_string() }
+        SceneError::File {
+            path: path.into(),
+            message: message.to_string(),
+        }
     }
 }

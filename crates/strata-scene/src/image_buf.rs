@@ -15,7 +15,12 @@ pub struct ImageBuf {
 
 impl ImageBuf {
     pub fn new(width: u32, height: u32, channels: u32) -> Self {
-        Self { width, height, channels, data: vec![0.0; (width * height * channels) as usize] }
+        Self {
+            width,
+            height,
+            channels,
+            data: vec![0.0; (width * height * channels) as usize],
+        }
     }
 
     pub fn pixel(&self, x: u32, y: u32) -> &[f32] {
@@ -30,8 +35,17 @@ impl ImageBuf {
 
     /// One channel as a new single-channel image.
     pub fn channel(&self, c: u32) -> ImageBuf {
-        let data = self.data.chunks_exact(self.channels as usize).map(|p| p[c as usize]).collect();
-        ImageBuf { width: self.width, height: self.height, channels: 1, data }
+        let data = self
+            .data
+            .chunks_exact(self.channels as usize)
+            .map(|p| p[c as usize])
+            .collect();
+        ImageBuf {
+            width: self.width,
+            height: self.height,
+            channels: 1,
+            data,
+        }
     }
 
     fn to_rgba32(&self) -> Vec<[f32; 4]> {
@@ -49,7 +63,10 @@ impl ImageBuf {
     /// Writes by extension: `.png` (values clamped to [0, 1], sRGB-encoded unless
     /// `srgb` is false) or `.exr` (linear float RGBA).
     pub fn save(&self, path: &Path, srgb: bool) -> Result<(), String> {
-        let ext = path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
         match ext.as_deref() {
             Some("png") => {
                 let px = self.to_rgba32();
@@ -63,7 +80,8 @@ impl ImageBuf {
                     bytes.push((p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
                 }
                 let img = image::RgbaImage::from_raw(self.width, self.height, bytes).expect("size matches");
-                img.save(path).map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
+                img.save(path)
+                    .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
             }
             Some("exr") => {
                 let px: Vec<f32> = self.to_rgba32().into_iter().flatten().collect();
@@ -72,7 +90,10 @@ impl ImageBuf {
                     .save(path)
                     .map_err(|e| format!("{}: cannot write EXR: {e}", path.display()))
             }
-            _ => Err(format!("{}: unsupported output format: use .png or .exr", path.display())),
+            _ => Err(format!(
+                "{}: unsupported output format: use .png or .exr",
+                path.display()
+            )),
         }
     }
 
@@ -90,7 +111,12 @@ impl ImageBuf {
                 }
             }
         }
-        Ok(ImageBuf { width: w, height: h, channels: 4, data })
+        Ok(ImageBuf {
+            width: w,
+            height: h,
+            channels: 4,
+            data,
+        })
     }
 }
 

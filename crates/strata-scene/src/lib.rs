@@ -4,7 +4,9 @@
 //! - [`camera`]: the one camera model (pixel centres, camera-space depth);
 //! - [`path`]: camera paths;
 //! - [`load`]: glTF 2.0, OBJ/MTL and TOML scene files;
-//! - [`procedural`]: built-in scenes (`cornell`, `atrium`, `warehouse`, …).
+//! - [`procedural`]: built-in scenes (`cornell`, `atrium`, `warehouse`, …);
+//! - [`shapes`]: mesh builders (boxes, quads, cylinders, arches) for procedural scenes;
+//! - [`normals`]: smooth/flat normal generation.
 
 pub mod camera;
 pub mod error;
@@ -14,6 +16,7 @@ pub mod model;
 pub mod normals;
 pub mod path;
 pub mod procedural;
+pub mod shapes;
 
 pub use camera::Camera;
 pub use error::SceneError;
@@ -22,9 +25,16 @@ pub use model::*;
 pub use path::{CameraPath, Keyframe};
 
 /// Loads a scene by built-in name or file path (.gltf, .glb, .obj, .toml).
+///
+/// A name that is neither a built-in scene nor an existing file and has no
+/// extension gives [`SceneError::Unknown`] (listing the built-in names).
 pub fn load_scene(name_or_path: &str) -> Result<Scene, SceneError> {
     if let Some(s) = procedural::builtin(name_or_path) {
         return Ok(s);
     }
-    load::load_path(std::path::Path::new(name_or_path))
+    let path = std::path::Path::new(name_or_path);
+    if path.extension().is_none() && !path.exists() {
+        return Err(SceneError::Unknown(name_or_path.to_string()));
+    }
+    load::load_path(path)
 }

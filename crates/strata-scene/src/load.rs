@@ -1,1 +1,1287 @@
-pub fn load_path(p:&std::path::Path)->Result<crate::Scene,crate::SceneError>{Err(crate::SceneError::file(p,"todo"))}
+//! Scene files: glTF 2.0 (`.gltf`, `.glb`), Wavefront OBJ/MTL (`.obj`) and
+//! TOML scene descriptions (`.toml`). Every error names the file concerned.
+//!
+//! # Mesh files (glTF, OBJ)
+//!
+//! - **glTF 2.0** (`gltf::import`: embedded or external buffers and images,
+//!   `.glb`): each triangle primitive (mode TRIANGLES, TRIANGLE_STRIP or
+//!   TRIANGLE_FAN; points and lines are skipped with a warning) becomes a
+//!   [`Mesh`]; every node of the default scene that has a mesh becomes one
+//!   [`Object`] per primitive, with the node hierarchy's world transform.
+//!   Materials: `baseColorFactor` (linear RGB; its alpha is the opacity unless
+//!   `alphaMode` is OPAQUE), `baseColorTexture` (converted to RGBA8),
+//!   `emissiveFactor` × `KHR_materials_emissive_strength`, roughness, metallic.
+//!   The first perspective camera node becomes the camera. `KHR_lights_punctual`
+//!   is not read.
+//! - **OBJ/MTL** (`tobj`, triangulated, single index): one [`Mesh`] per
+//!   object/group and material. `Kd` → base colour, `map_Kd` → texture
+//!   (relative to the MTL file's folder; a missing file is an error naming it),
+//!   `Ke` → emission, `d` (or `1 − Tr`) → opacity, `Ns` → roughness
+//!   `sqrt(2 / (Ns + 2))`, metallic 0. OBJ texture coordinates are flipped
+//!   (`v → 1 − v`) to the top-down convention of [`Texture`] and glTF.
+//!   Face indices are checked: an out-of-range index is an error.
+//!
+//! Both: missing normals are generated (area-weighted smooth), missing UVs are
+//! zeros. Without a camera in the file, [`default_camera`] frames the bounds;
+//! without lights, [`default_sun`] is added. Settings are scaled to the scene
+//! ([`default_settings`]).
+//!
+//! # TOML scene files
+//!
+//! A TOML file wraps one mesh file (or a built-in scene) and sets its camera,
+//! lights, camera path, settings and animations. Paths are relative to the
+//! TOML file. Unknown keys are errors; every value is range-checked and errors
+//! name the file, the key and the valid range.
+//!
+//! ```toml
+//! name = "cornell (shared OBJ)"        # optional, default: the file stem
+//! mesh = "../../shared/scenes/cornell_box/cornell_box.obj"  # .obj, .gltf or .glb
+//! # builtin = "atrium"                  # instead of `mesh`: a built-in scene
+//! scale = 0.001                         # optional uniform scale (> 0) of the mesh
+//! translate = [0.0, 0.0, 0.0]           # optional translation applied after scaling
+//!
+//! [camera]                # optional; default: the file's camera or one framing the bounds
+//! eye = [0.278, 0.273, -0.8]
+//! target = [0.278, 0.273, -0.799]
+//! up = [0.0, 1.0, 0.0]    # optional, default +Y
+//! fov = 39.3077           # vertical degrees in (0, 180), default 60
+//! near = 0.01             # > 0, default: the base scene's near
+//!
+//! [[light]]               # any number; when present they replace the base scene's lights
+//! type = "sun"            # "sun" | "point" | "spot" | "rect"
+//! direction = [-0.3, -1.0, -0.4]   # sun, spot: the way photons travel
+//! color = [1.0, 1.0, 1.0] # optional, default white, components >= 0
+//! illuminance = 3.0       # sun (> 0)
+//! # point / spot: position = [x, y, z], intensity = 100.0 (> 0)
+//! # spot: inner_deg = 20.0, outer_deg = 30.0 (0 < inner <= outer < 90)
+//! # rect: center, half_u, half_v (normal = half_u × half_v), radiance = [r, g, b],
+//! #       emitter = true to also add matching emissive geometry
+//!
+//! [camera_path]           # optional; frames strictly increasing after sorting
+//! keyframes = [
+//!   { frame = 0, eye = [0.0, 1.0, 5.0], target = [0.0, 1.0, 0.0] },
+//!   { frame = 60, eye = [2.0, 1.0, 5.0], target = [0.0, 1.0, 0.0] },
+//! ]
+//!
+//! [settings]              # any subset; the rest keeps the base scene's values
+//! ao_radius = 1.0         # > 0
+//! min_separation = 0.5    # > 0
+//! exposure = 1.0          # > 0
+//! sky = [0.3, 0.45, 0.75] # >= 0
+//! ambient = [0.03, 0.03, 0.03]  # >= 0
+//!
+//! [ground]                # optional horizontal ground quad (object and material "ground")
+//! y = 0.0                 # default: the scene's lowest point
+//! size = 10.0             # edge length (> 0), default 3 × the bounds' diagonal
+//! color = [0.5, 0.5, 0.5] # albedo, default 0.5 grey
+//!
+//! [[animate]]             # rigid animation of every object with this name
+//! object = "statue"
+//! type = "slide"          # "slide": amplitude = [x, y, z], period_frames (> 0)
+//! amplitude = [0.0, 0.0, 1.5]
+//! period_frames = 60.0
+//! # type = "swing": pivot = [x, y, z], axis = [x, y, z], amplitude_deg, period_frames
+//! ```
+//!
+//! A `[camera]` without `[camera_path]` removes a built-in scene's camera path
+//! (which would otherwise override the camera). `scale`/`translate` also move
+//! the base scene's own camera and lights, but not the TOML's (those are in
+//! final world units).
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec3};
+use serde::Deserialize;
+
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::model::{Animation, Light, Material, Mesh, Object, Scene, SceneSettings, Texture};
+use crate::normals::ensure_normals;
+use crate::path::{CameraPath, Keyframe};
+use crate::shapes::MeshBuilder;
+
+/// File extensions [`load_path`] accepts.
+pub const EXTENSIONS: &[&str] = &["gltf", "glb", "obj", "toml"];
+
+/// Loads a scene file, dispatching on its extension (case-insensitive):
+/// `.gltf`/`.glb` → [`load_gltf`], `.obj` → [`load_obj`], `.toml` → [`load_toml`].
+pub fn load_path(path: &Path) -> Result<Scene, SceneError> {
+    match extension(path).as_deref() {
+        Some("gltf" | "glb") => load_gltf(path),
+        Some("obj") => load_obj(path),
+        Some("toml") => load_toml(path),
+        _ => Err(unsupported_extension(path)),
+    }
+}
+
+fn extension(path: &Path) -> Option<String> {
+    path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase)
+}
+
+fn unsupported_extension(path: &Path) -> SceneError {
+    let ext = extension(path)
+        .map(|e| format!("'.{e}'"))
+        .unwrap_or_else(|| "(none)".into());
+    SceneError::file(
+        path,
+        format!("unsupported file extension {ext}: use .gltf, .glb, .obj or .toml"),
+    )
+}
+
+/// Loads a glTF 2.0 file (`.gltf` or `.glb`) with default camera/light/settings
+/// where the file has none (see the module docs).
+pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
+    load_mesh_file(path).map(|m| m.into_scene())
+}
+
+/// Loads an OBJ file and its MTL libraries with default camera/light/settings
+/// (see the module docs).
+pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
+    load_mesh_file(path).map(|m| m.into_scene())
+}
+
+/// Loads a TOML scene description (format in the module docs).
+pub fn load_toml(path: &Path) -> Result<Scene, SceneError> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| SceneError::file(path, format!("cannot read scene file: {e}")))?;
+    load_toml_str(&text, path)
+}
+
+/// Parses a TOML scene description. `path` is used for error messages and to
+/// resolve the relative `mesh` path (against its folder).
+pub fn load_toml_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    let doc: TomlScene = toml::from_str(text)
+        .map_err(|e| SceneError::file(path, format!("invalid scene file: {}", e.to_string().trim_end())))?;
+    build_toml_scene(doc, path)
+}
+
+/// A camera on the +Z side of the bounds' centre looking down −Z, far enough
+/// back that the bounding sphere fits a 60° vertical field of view; near =
+/// diagonal × 1e-3.
+pub fn default_camera(lo: Vec3, hi: Vec3) -> Camera {
+    let centre = 0.5 * (lo + hi);
+    let diag = (hi - lo).length().max(1e-6);
+    let fov = 60.0f32;
+    let dist = 0.5 * diag / (0.5 * fov.to_radians()).sin();
+    Camera::new(centre + Vec3::Z * dist, centre, Vec3::Y, fov, diag * 1e-3)
+}
+
+/// The default light of mesh files without lights: a white sun from above-front,
+/// direction normalize(−0.3, −1, −0.4), illuminance 3.
+pub fn default_sun() -> Light {
+    Light::Sun {
+        direction: Vec3::new(-0.3, -1.0, -0.4).normalize(),
+        color: [1.0; 3],
+        illuminance: 3.0,
+    }
+}
+
+/// Settings for a mesh file with the given bounds: AO radius 2.5 % and minimum
+/// separation 1.25 % of the bounds' diagonal, a dim bluish sky, exposure 1.
+pub fn default_settings(lo: Vec3, hi: Vec3) -> SceneSettings {
+    let diag = (hi - lo).length();
+    let diag = if diag.is_finite() && diag > 0.0 { diag } else { 1.0 };
+    SceneSettings {
+        ao_radius: 0.025 * diag,
+        min_separation: 0.0125 * diag,
+        exposure: 1.0,
+        sky: [0.15, 0.18, 0.22],
+        ..SceneSettings::default()
+    }
+}
+
+/// A loaded mesh file: the scene plus what the file itself provided.
+struct MeshFile {
+    scene: Scene,
+    has_camera: bool,
+    has_lights: bool,
+}
+
+impl MeshFile {
+    /// Fills in the defaults (camera, sun, settings) the file lacks.
+    fn into_scene(mut self) -> Scene {
+        let (lo, hi) = self.scene.bounds(0.0);
+        if !self.has_camera {
+            self.scene.camera = default_camera(lo, hi);
+        }
+        if !self.has_lights {
+            self.scene.lights = vec![default_sun()];
+        }
+        self.scene.settings = default_settings(lo, hi);
+        self.scene
+    }
+}
+
+/// Loads a glTF or OBJ file without applying defaults.
+fn load_mesh_file(path: &Path) -> Result<MeshFile, SceneError> {
+    let mut file = match extension(path).as_deref() {
+        Some("gltf" | "glb") => gltf_file(path)?,
+        Some("obj") => obj_file(path)?,
+        _ => {
+            return Err(SceneError::file(
+                path,
+                "unsupported mesh file extension: use .gltf, .glb or .obj",
+            ));
+        }
+    };
+    if file.scene.triangle_count() == 0 {
+        return Err(SceneError::file(path, "the file contains no triangles"));
+    }
+    for m in &mut file.scene.meshes {
+        ensure_normals(m);
+        if m.uvs.len() != m.positions.len() {
+            m.uvs = vec![[0.0; 2]; m.positions.len()];
+        }
+    }
+    if file.scene.name.is_empty() {
+        file.scene.name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+    }
+    Ok(file)
+}
+
+/// Checks every index of `indices` against `vertex_count`.
+fn check_indices(path: &Path, what: &str, indices: &[u32], vertex_count: usize) -> Result<(), SceneError> {
+    if let Some(&bad) = indices.iter().find(|&&i| i as usize >= vertex_count) {
+        return Err(SceneError::file(
+            path,
+            format!("{what}: vertex index {bad} is out of range (the mesh has {vertex_count} vertices)"),
+        ));
+    }
+    if indices.len() % 3 != 0 {
+        return Err(SceneError::file(
+            path,
+            format!("{what}: index count {} is not a multiple of 3", indices.len()),
+        ));
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------
+// glTF
+
+fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
+    let (doc, buffers, images) =
+        gltf::import(path).map_err(|e| SceneError::file(path, format!("cannot load glTF: {e}")))?;
+    let mut scene = Scene::default();
+
+    // Materials (+ base colour textures, one per referenced image).
+    let mut image_to_texture: HashMap<usize, usize> = HashMap::new();
+    let mut material_uv_set: Vec<u32> = Vec::new();
+    for (mi, m) in doc.materials().enumerate() {
+        let pbr = m.pbr_metallic_roughness();
+        let f = pbr.base_color_factor();
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let mut mat = Material {
+            name: m.name().map(str::to_owned).unwrap_or_else(|| format!("material{mi}")),
+            base_color: [f[0], f[1], f[2]],
+            base_color_texture: None,
+            emission: m.emissive_factor().map(|e| e * strength),
+            opacity: if m.alpha_mode() == gltf::material::AlphaMode::Opaque {
+                1.0
+            } else {
+                f[3]
+            },
+            roughness: pbr.roughness_factor(),
+            metallic: pbr.metallic_factor(),
+        };
+        let mut uv_set = 0;
+        if let Some(info) = pbr.base_color_texture() {
+            let image = info.texture().source().index();
+            uv_set = info.tex_coord();
+            let ti = match image_to_texture.get(&image) {
+                Some(&ti) => ti,
+                None => {
+                    let data = images
+                        .get(image)
+                        .ok_or_else(|| SceneError::file(path, format!("material {mi}: image {image} is missing")))?;
+                    let name = info
+                        .texture()
+                        .source()
+                        .name()
+                        .map(str::to_owned)
+                        .unwrap_or_else(|| format!("image{image}"));
+                    scene.textures.push(gltf_texture(path, name, data)?);
+                    image_to_texture.insert(image, scene.textures.len() - 1);
+                    scene.textures.len() - 1
+                }
+            };
+            mat.base_color_texture = Some(ti);
+        }
+        scene.materials.push(mat);
+        material_uv_set.push(uv_set);
+    }
+    let default_material = scene.materials.len();
+    let mut default_used = false;
+
+    // Meshes: one of ours per triangle primitive.
+    let mut mesh_map: Vec<Vec<usize>> = Vec::new();
+    for gm in doc.meshes() {
+        let mut ours = Vec::new();
+        for prim in gm.primitives() {
+            let what = format!(
+                "mesh {} ('{}') primitive {}",
+                gm.index(),
+                gm.name().unwrap_or(""),
+                prim.index()
+            );
+            use gltf::mesh::Mode;
+            let mode = prim.mode();
+            if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+                eprintln!(
+                    "warning: {}: {what}: skipping non-triangle primitive ({mode:?})",
+                    path.display()
+                );
+                continue;
+            }
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let positions: Vec<[f32; 3]> = reader
+                .read_positions()
+                .ok_or_else(|| SceneError::file(path, format!("{what}: no readable POSITION attribute")))?
+                .collect();
+            let material = match prim.material().index() {
+                Some(i) if i < default_material => i,
+                _ => {
+                    default_used = true;
+                    default_material
+                }
+            };
+            let uv_set = material_uv_set.get(material).copied().unwrap_or(0);
+            let normals: Vec<[f32; 3]> = reader.read_normals().map(|n| n.collect()).unwrap_or_default();
+            let uvs: Vec<[f32; 2]> = reader
+                .read_tex_coords(uv_set)
+                .or_else(|| reader.read_tex_coords(0))
+                .map(|t| t.into_f32().collect())
+                .unwrap_or_default();
+            let raw: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None if prim.indices().is_some() => {
+                    return Err(SceneError::file(
+                        path,
+                        format!("{what}: indices are not readable (truncated buffer?)"),
+                    ));
+                }
+                None => (0..positions.len() as u32).collect(),
+            };
+            let indices = match mode {
+                Mode::TriangleStrip => strip_to_list(&raw),
+                Mode::TriangleFan => fan_to_list(&raw),
+                _ => raw,
+            };
+            check_indices(path, &what, &indices, positions.len())?;
+            let name = gm
+                .name()
+                .map(str::to_owned)
+                .unwrap_or_else(|| format!("mesh{}", gm.index()));
+            let name = if gm.primitives().len() > 1 {
+                format!("{name}.{}", prim.index())
+            } else {
+                name
+            };
+            scene.meshes.push(Mesh {
+                name,
+                positions,
+                normals,
+                uvs,
+                indices,
+                material,
+            });
+            ours.push(scene.meshes.len() - 1);
+        }
+        mesh_map.push(ours);
+    }
+    if default_used {
+        scene.materials.push(Material::default());
+    }
+
+    // Nodes of the default scene (or all root nodes when there is no scene).
+    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => {
+            let mut is_child = vec![false; doc.nodes().len()];
+            for n in doc.nodes() {
+                for c in n.children() {
+                    is_child[c.index()] = true;
+                }
+            }
+            doc.nodes().filter(|n| !is_child[n.index()]).collect()
+        }
+    };
+    let mut camera = None;
+    let mut flipped: HashMap<usize, usize> = HashMap::new();
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        if depth > 256 {
+            return Err(SceneError::file(path, "node hierarchy is too deep (cyclic?)"));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(gm) = node.mesh() {
+            let name = node
+                .name()
+                .map(str::to_owned)
+                .unwrap_or_else(|| format!("node{}", node.index()));
+            for &mi in mesh_map.get(gm.index()).map(Vec::as_slice).unwrap_or(&[]) {
+                // A mirroring transform turns counter-clockwise faces clockwise:
+                // use a copy of the mesh with reversed winding.
+                let mesh = if world.determinant() < 0.0 {
+                    *flipped.entry(mi).or_insert_with(|| {
+                        let mut m = scene.meshes[mi].clone();
+                        for t in m.indices.chunks_exact_mut(3) {
+                            t.swap(1, 2);
+                        }
+                        m.name.push_str(".mirrored");
+                        scene.meshes.push(m);
+                        scene.meshes.len() - 1
+                    })
+                } else {
+                    mi
+                };
+                scene.objects.push(Object {
+                    name: name.clone(),
+                    mesh,
+                    transform: world,
+                    animation: None,
+                });
+            }
+        }
+        if camera.is_none() {
+            if let Some(cam) = node.camera() {
+                if let gltf::camera::Projection::Perspective(p) = cam.projection() {
+                    let eye = world.transform_point3(Vec3::ZERO);
+                    let fwd = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+                    let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+                    let c = Camera::new(eye, eye + fwd, up, p.yfov().to_degrees(), p.znear());
+                    if c.validate().is_ok() {
+                        camera = Some(c);
+                    }
+                }
+            }
+        }
+        for c in node.children() {
+            stack.push((c, world, depth + 1));
+        }
+    }
+    let has_camera = camera.is_some();
+    if let Some(c) = camera {
+        scene.camera = c;
+    }
+    Ok(MeshFile {
+        scene,
+        has_camera,
+        has_lights: false,
+    })
+}
+
+fn strip_to_list(s: &[u32]) -> Vec<u32> {
+    let mut out = Vec::new();
+    for i in 2..s.len() {
+        if i % 2 == 0 {
+            out.extend_from_slice(&[s[i - 2], s[i - 1], s[i]]);
+        } else {
+            out.extend_from_slice(&[s[i - 1], s[i - 2], s[i]]);
+        }
+    }
+    out
+}
+
+fn fan_to_list(s: &[u32]) -> Vec<u32> {
+    let mut out = Vec::new();
+    for i in 2..s.len() {
+        out.extend_from_slice(&[s[0], s[i - 1], s[i]]);
+    }
+    out
+}
+
+/// Converts decoded glTF image data to an RGBA8 [`Texture`].
+fn gltf_texture(path: &Path, name: String, d: &gltf::image::Data) -> Result<Texture, SceneError> {
+    use gltf::image::Format;
+    let n = d.width as usize * d.height as usize;
+    let (channels, bytes_per_channel) = match d.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    if d.pixels.len() < n * channels * bytes_per_channel || n == 0 {
+        return Err(SceneError::file(path, format!("image '{name}' has inconsistent size")));
+    }
+    let value = |i: usize| -> u8 {
+        let b = &d.pixels[i * bytes_per_channel..(i + 1) * bytes_per_channel];
+        match bytes_per_channel {
+            1 => b[0],
+            2 => (u16::from_ne_bytes([b[0], b[1]]) >> 8) as u8,
+            _ => {
+                let f = f32::from_ne_bytes([b[0], b[1], b[2], b[3]]);
+                (f.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+            }
+        }
+    };
+    let mut rgba8 = Vec::with_capacity(n * 4);
+    for p in 0..n {
+        let c = |k: usize| value(p * channels + k);
+        let px = match channels {
+            1 => [c(0), c(0), c(0), 255],
+            2 => [c(0), c(0), c(0), c(1)],
+            3 => [c(0), c(1), c(2), 255],
+            _ => [c(0), c(1), c(2), c(3)],
+        };
+        rgba8.extend_from_slice(&px);
+    }
+    Ok(Texture {
+        name,
+        width: d.width,
+        height: d.height,
+        rgba8,
+    })
+}
+
+// ---------------------------------------------------------------------------
+// OBJ / MTL
+
+fn obj_file(path: &Path) -> Result<MeshFile, SceneError> {
+    let bytes = std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot read OBJ file: {e}")))?;
+    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    // MTL libraries in load order: (path, number of materials or the error).
+    let libraries: RefCell<Vec<(PathBuf, Result<usize, tobj::LoadError>)>> = RefCell::new(Vec::new());
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |mtl| {
+        let full = dir.join(mtl);
+        let result = tobj::load_mtl(&full);
+        libraries
+            .borrow_mut()
+            .push((full, result.as_ref().map(|(m, _)| m.len()).map_err(|e| *e)));
+        result
+    })
+    .map_err(|e| SceneError::file(path, format!("invalid OBJ file: {e}")))?;
+    let libraries = libraries.into_inner();
+    for (lib, result) in &libraries {
+        if let Err(e) = result {
+            let why = if *e == tobj::LoadError::OpenFileFailed {
+                "cannot open it".to_string()
+            } else {
+                e.to_string()
+            };
+            return Err(SceneError::file(
+                path,
+                format!("material library {}: {why}", lib.display()),
+            ));
+        }
+    }
+    let materials = materials.unwrap_or_default();
+    // Folder of the MTL each material came from (for its texture paths).
+    let mut material_dirs = Vec::with_capacity(materials.len());
+    let mut material_libs = Vec::with_capacity(materials.len());
+    for (lib, result) in &libraries {
+        for _ in 0..*result.as_ref().unwrap_or(&0) {
+            material_dirs.push(lib.parent().unwrap_or(Path::new("")).to_path_buf());
+            material_libs.push(lib.clone());
+        }
+    }
+
+    let mut scene = Scene::default();
+    let mut textures: HashMap<PathBuf, usize> = HashMap::new();
+    for (i, m) in materials.iter().enumerate() {
+        let mut mat = Material {
+            name: m.name.clone(),
+            ..Default::default()
+        };
+        if let Some(kd) = m.diffuse {
+            mat.base_color = kd;
+        }
+        if let Some(ke) = m.emissive {
+            mat.emission = ke;
+        }
+        if let Some(d) = m.dissolve {
+            mat.opacity = d.clamp(0.0, 1.0);
+        } else if let Some(tr) = m.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok()) {
+            mat.opacity = (1.0 - tr).clamp(0.0, 1.0);
+        }
+        if let Some(ns) = m.shininess {
+            mat.roughness = (2.0 / (ns.max(0.0) + 2.0)).sqrt();
+        }
+        mat.metallic = 0.0;
+        if let Some(tex) = &m.diffuse_texture {
+            let rel = texture_file_name(tex);
+            let base = material_dirs.get(i).cloned().unwrap_or_else(|| dir.clone());
+            let full = base.join(&rel);
+            let ti = match textures.get(&full) {
+                Some(&ti) => ti,
+                None => {
+                    let lib = material_libs
+                        .get(i)
+                        .map(|l| l.display().to_string())
+                        .unwrap_or_default();
+                    let texture = load_texture(&full).map_err(|e| {
+                        SceneError::file(
+                            path,
+                            format!(
+                                "material '{}' in {lib}: texture {} (map_Kd {rel}): {e}",
+                                m.name,
+                                full.display()
+                            ),
+                        )
+                    })?;
+                    scene.textures.push(texture);
+                    textures.insert(full, scene.textures.len() - 1);
+                    scene.textures.len() - 1
+                }
+            };
+            mat.base_color_texture = Some(ti);
+        }
+        scene.materials.push(mat);
+    }
+    let default_material = scene.materials.len();
+    let mut default_used = false;
+
+    for model in models {
+        let m = model.mesh;
+        if m.indices.is_empty() {
+            continue;
+        }
+        let what = format!("object '{}'", model.name);
+        if m.positions.len() % 3 != 0 {
+            return Err(SceneError::file(path, format!("{what}: malformed positions")));
+        }
+        let n = m.positions.len() / 3;
+        check_indices(path, &what, &m.indices, n)?;
+        let positions: Vec<[f32; 3]> = m.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        let normals: Vec<[f32; 3]> = if m.normals.len() == 3 * n {
+            m.normals.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
+        } else {
+            Vec::new()
+        };
+        let uvs: Vec<[f32; 2]> = if m.texcoords.len() == 2 * n {
+            m.texcoords.chunks_exact(2).map(|t| [t[0], 1.0 - t[1]]).collect()
+        } else {
+            Vec::new()
+        };
+        let material = match m.material_id {
+            Some(i) if i < default_material => i,
+            _ => {
+                default_used = true;
+                default_material
+            }
+        };
+        scene.meshes.push(Mesh {
+            name: model.name.clone(),
+            positions,
+            normals,
+            uvs,
+            indices: m.indices,
+            material,
+        });
+        scene.objects.push(Object {
+            name: model.name,
+            mesh: scene.meshes.len() - 1,
+            transform: Mat4::IDENTITY,
+            animation: None,
+        });
+    }
+    if default_used {
+        scene.materials.push(Material::default());
+    }
+    Ok(MeshFile {
+        scene,
+        has_camera: false,
+        has_lights: false,
+    })
+}
+
+/// The file name in a `map_Kd` value: options (`-s 1 1 1 file.png`) are
+/// skipped by taking the last word; backslashes become slashes.
+fn texture_file_name(value: &str) -> String {
+    let v = value.trim();
+    let v = if v.starts_with('-') {
+        v.split_whitespace().last().unwrap_or(v)
+    } else {
+        v
+    };
+    v.replace('\\', "/")
+}
+
+/// Loads an image file as an RGBA8 [`Texture`] (8-bit texels kept as stored,
+/// i.e. sRGB-encoded for colour maps).
+pub fn load_texture(path: &Path) -> Result<Texture, String> {
+    if !path.is_file() {
+        return Err("file not found".into());
+    }
+    let img = image::open(path)
+        .map_err(|e| format!("cannot decode image: {e}"))?
+        .to_rgba8();
+    let (width, height) = img.dimensions();
+    if width == 0 || height == 0 {
+        return Err("image is empty".into());
+    }
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok(Texture {
+        name,
+        width,
+        height,
+        rgba8: img.into_raw(),
+    })
+}
+
+// ---------------------------------------------------------------------------
+// TOML
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlScene {
+    name: Option<String>,
+    mesh: Option<String>,
+    builtin: Option<String>,
+    scale: Option<f32>,
+    translate: Option<[f32; 3]>,
+    camera: Option<TomlCamera>,
+    #[serde(default)]
+    light: Vec<TomlLight>,
+    camera_path: Option<TomlPath>,
+    settings: Option<TomlSettings>,
+    ground: Option<TomlGround>,
+    #[serde(default)]
+    animate: Vec<TomlAnimate>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlCamera {
+    eye: [f32; 3],
+    target: [f32; 3],
+    up: Option<[f32; 3]>,
+    fov: Option<f32>,
+    near: Option<f32>,
+}
+
+fn white() -> [f32; 3] {
+    [1.0; 3]
+}
+
+fn default_inner() -> f32 {
+    20.0
+}
+
+fn default_outer() -> f32 {
+    30.0
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum TomlLight {
+    Sun {
+        direction: [f32; 3],
+        #[serde(default = "white")]
+        color: [f32; 3],
+        illuminance: f32,
+    },
+    Point {
+        position: [f32; 3],
+        #[serde(default = "white")]
+        color: [f32; 3],
+        intensity: f32,
+    },
+    Spot {
+        position: [f32; 3],
+        direction: [f32; 3],
+        #[serde(default = "white")]
+        color: [f32; 3],
+        intensity: f32,
+        #[serde(default = "default_inner")]
+        inner_deg: f32,
+        #[serde(default = "default_outer")]
+        outer_deg: f32,
+    },
+    Rect {
+        center: [f32; 3],
+        half_u: [f32; 3],
+        half_v: [f32; 3],
+        radiance: [f32; 3],
+        #[serde(default)]
+        emitter: bool,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlPath {
+    keyframes: Vec<TomlKeyframe>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlKeyframe {
+    frame: f32,
+    eye: [f32; 3],
+    target: [f32; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlSettings {
+    ao_radius: Option<f32>,
+    min_separation: Option<f32>,
+    exposure: Option<f32>,
+    sky: Option<[f32; 3]>,
+    ambient: Option<[f32; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlGround {
+    y: Option<f32>,
+    size: Option<f32>,
+    color: Option<[f32; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+enum TomlAnimate {
+    Swing {
+        object: String,
+        pivot: [f32; 3],
+        axis: [f32; 3],
+        amplitude_deg: f32,
+        period_frames: f32,
+    },
+    Slide {
+        object: String,
+        amplitude: [f32; 3],
+        period_frames: f32,
+    },
+}
+
+/// Range checks with messages naming the key and the valid range.
+struct Check<'a> {
+    path: &'a Path,
+}
+
+impl Check<'_> {
+    fn err(&self, key: &str, msg: impl std::fmt::Display) -> SceneError {
+        SceneError::file(self.path, format!("{key}: {msg}"))
+    }
+
+    fn positive(&self, key: &str, x: f32) -> Result<f32, SceneError> {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(key, format!("{x} is out of range: must be finite and > 0")))
+        }
+    }
+
+    fn finite(&self, key: &str, x: f32) -> Result<f32, SceneError> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.err(key, format!("{x} is out of range: must be finite")))
+        }
+    }
+
+    fn vec(&self, key: &str, v: [f32; 3]) -> Result<Vec3, SceneError> {
+        let v = Vec3::from(v);
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(key, format!("{v} is out of range: components must be finite")))
+        }
+    }
+
+    fn direction(&self, key: &str, v: [f32; 3]) -> Result<Vec3, SceneError> {
+        let v = self.vec(key, v)?;
+        if v.length() > 1e-12 {
+            Ok(v.normalize())
+        } else {
+            Err(self.err(key, "must be a non-zero vector"))
+        }
+    }
+
+    fn color(&self, key: &str, c: [f32; 3]) -> Result<[f32; 3], SceneError> {
+        if c.iter().all(|x| x.is_finite() && *x >= 0.0) {
+            Ok(c)
+        } else {
+            Err(self.err(
+                key,
+                format!("{c:?} is out of range: components must be finite and >= 0"),
+            ))
+        }
+    }
+}
+
+fn build_toml_scene(doc: TomlScene, path: &Path) -> Result<Scene, SceneError> {
+    let ck = Check { path };
+    let dir = path.parent().unwrap_or(Path::new(""));
+
+    // Base scene.
+    let (mut scene, has_camera, from_file) = match (&doc.mesh, &doc.builtin) {
+        (Some(_), Some(_)) => return Err(ck.err("mesh", "give either `mesh` or `builtin`, not both")),
+        (None, None) => {
+            return Err(ck.err(
+                "mesh",
+                "missing: give `mesh = \"file.obj|.gltf|.glb\"` or `builtin = \"name\"`",
+            ));
+        }
+        (None, Some(name)) => {
+            let s = crate::procedural::builtin(name).ok_or_else(|| {
+                ck.err(
+                    "builtin",
+                    format!(
+                        "unknown built-in scene '{name}': use one of {}",
+                        crate::procedural::BUILTIN_NAMES.join(", ")
+                    ),
+                )
+            })?;
+            (s, true, false)
+        }
+        (Some(mesh), None) => {
+            let mesh_path = dir.join(mesh);
+            if !matches!(extension(&mesh_path).as_deref(), Some("obj" | "gltf" | "glb")) {
+                return Err(ck.err("mesh", format!("'{mesh}' must be a .obj, .gltf or .glb file")));
+            }
+            let f = load_mesh_file(&mesh_path).map_err(|e| ck.err("mesh", format!("cannot load '{mesh}': {e}")))?;
+            let has_camera = f.has_camera;
+            let mut s = f.scene;
+            if !f.has_lights {
+                s.lights = vec![default_sun()];
+            }
+            (s, has_camera, true)
+        }
+    };
+
+    // Placement of the base scene.
+    let scale = match doc.scale {
+        Some(s) => ck.positive("scale", s)?,
+        None => 1.0,
+    };
+    let translate = match doc.translate {
+        Some(t) => ck.vec("translate", t)?,
+        None => Vec3::ZERO,
+    };
+    let place = Mat4::from_translation(translate) * Mat4::from_scale(Vec3::splat(scale));
+    if place != Mat4::IDENTITY {
+        transform_scene(&mut scene, place, scale);
+    }
+
+    // Ground quad.
+    if let Some(g) = &doc.ground {
+        let (lo, hi) = scene.bounds(0.0);
+        let y = match g.y {
+            Some(y) => ck.finite("ground.y", y)?,
+            None => lo.y,
+        };
+        let size = match g.size {
+            Some(s) => ck.positive("ground.size", s)?,
+            None => 3.0 * (hi - lo).length().max(1e-3),
+        };
+        let color = ck.color("ground.color", g.color.unwrap_or([0.5; 3]))?;
+        let c = 0.5 * (lo + hi);
+        let mut b = MeshBuilder::new();
+        b.rect(Vec3::new(c.x, y, c.z), Vec3::Z * (0.5 * size), Vec3::X * (0.5 * size)); // z × x = +y
+        add_object(&mut scene, "ground", b, Material::diffuse("ground", color));
+    }
+
+    // Defaults that depend on the final geometry.
+    let (lo, hi) = scene.bounds(0.0);
+    if from_file {
+        scene.settings = default_settings(lo, hi);
+        if !has_camera {
+            scene.camera = default_camera(lo, hi);
+        }
+    }
+
+    // Camera.
+    if let Some(c) = &doc.camera {
+        let cam = Camera::new(
+            ck.vec("camera.eye", c.eye)?,
+            ck.vec("camera.target", c.target)?,
+            ck.vec("camera.up", c.up.unwrap_or([0.0, 1.0, 0.0]))?,
+            c.fov.unwrap_or(60.0),
+            c.near.unwrap_or(scene.camera.near),
+        );
+        if !(cam.fov_y_deg > 0.0 && cam.fov_y_deg < 180.0) {
+            return Err(ck.err(
+                "camera.fov",
+                format!("{} is out of range: must be in (0, 180) degrees", cam.fov_y_deg),
+            ));
+        }
+        if !(cam.near.is_finite() && cam.near > 0.0) {
+            return Err(ck.err("camera.near", format!("{} is out of range: must be > 0", cam.near)));
+        }
+        cam.validate().map_err(|e| ck.err("camera", e))?;
+        scene.camera = cam;
+        scene.camera_path = None;
+    }
+
+    // Camera path.
+    if let Some(p) = &doc.camera_path {
+        let mut keys = Vec::with_capacity(p.keyframes.len());
+        for (i, k) in p.keyframes.iter().enumerate() {
+            let key = format!("camera_path.keyframes[{i}]");
+            let frame = ck.finite(&format!("{key}.frame"), k.frame)?;
+            let eye = ck.vec(&format!("{key}.eye"), k.eye)?;
+            let target = ck.vec(&format!("{key}.target"), k.target)?;
+            Camera {
+                eye,
+                target,
+                ..scene.camera
+            }
+            .validate()
+            .map_err(|e| ck.err(&key, e))?;
+            keys.push(Keyframe { frame, eye, target });
+        }
+        scene.camera_path = Some(CameraPath::new(keys).map_err(|e| ck.err("camera_path.keyframes", e))?);
+    }
+
+    // Lights.
+    if !doc.light.is_empty() {
+        let mut lights = Vec::with_capacity(doc.light.len());
+        for (i, l) in doc.light.iter().enumerate() {
+            let k = |f: &str| format!("light[{i}].{f}");
+            let light = match l {
+                TomlLight::Sun {
+                    direction,
+                    color,
+                    illuminance,
+                } => Light::Sun {
+                    direction: ck.direction(&k("direction"), *direction)?,
+                    color: ck.color(&k("color"), *color)?,
+                    illuminance: ck.positive(&k("illuminance"), *illuminance)?,
+                },
+                TomlLight::Point {
+                    position,
+                    color,
+                    intensity,
+                } => Light::Point {
+                    position: ck.vec(&k("position"), *position)?,
+                    color: ck.color(&k("color"), *color)?,
+                    intensity: ck.positive(&k("intensity"), *intensity)?,
+                },
+                TomlLight::Spot {
+                    position,
+                    direction,
+                    color,
+                    intensity,
+                    inner_deg,
+                    outer_deg,
+                } => {
+                    if !(*outer_deg > 0.0 && *outer_deg < 90.0) {
+                        return Err(ck.err(
+                            &k("outer_deg"),
+                            format!("{outer_deg} is out of range: must be in (0, 90) degrees"),
+                        ));
+                    }
+                    if !(*inner_deg > 0.0 && inner_deg <= outer_deg) {
+                        return Err(ck.err(
+                            &k("inner_deg"),
+                            format!("{inner_deg} is out of range: must be in (0, outer_deg = {outer_deg}] degrees"),
+                        ));
+                    }
+                    Light::Spot {
+                        position: ck.vec(&k("position"), *position)?,
+                        direction: ck.direction(&k("direction"), *direction)?,
+                        color: ck.color(&k("color"), *color)?,
+                        intensity: ck.positive(&k("intensity"), *intensity)?,
+                        inner_deg: *inner_deg,
+                        outer_deg: *outer_deg,
+                    }
+                }
+                TomlLight::Rect {
+                    center,
+                    half_u,
+                    half_v,
+                    radiance,
+                    emitter,
+                } => {
+                    let center = ck.vec(&k("center"), *center)?;
+                    let half_u = ck.vec(&k("half_u"), *half_u)?;
+                    let half_v = ck.vec(&k("half_v"), *half_v)?;
+                    if half_u.cross(half_v).length() <= 1e-12 {
+                        return Err(ck.err(&k("half_u"), "half_u and half_v must be non-zero and not parallel"));
+                    }
+                    let radiance = ck.color(&k("radiance"), *radiance)?;
+                    if radiance.iter().all(|&r| r == 0.0) {
+                        return Err(ck.err(&k("radiance"), "is out of range: must have a component > 0"));
+                    }
+                    if *emitter {
+                        let mut b = MeshBuilder::new();
+                        b.rect(center, half_u, half_v);
+                        add_object(
+                            &mut scene,
+                            &format!("light{i}"),
+                            b,
+                            Material::emissive(&format!("light{i}"), radiance),
+                        );
+                    }
+                    Light::Rect {
+                        center,
+                        half_u,
+                        half_v,
+                        radiance,
+                    }
+                }
+            };
+            lights.push(light);
+        }
+        scene.lights = lights;
+    }
+
+    // Settings.
+    if let Some(s) = &doc.settings {
+        let st = &mut scene.settings;
+        if let Some(x) = s.ao_radius {
+            st.ao_radius = ck.positive("settings.ao_radius", x)?;
+        }
+        if let Some(x) = s.min_separation {
+            st.min_separation = ck.positive("settings.min_separation", x)?;
+        }
+        if let Some(x) = s.exposure {
+            st.exposure = ck.positive("settings.exposure", x)?;
+        }
+        if let Some(c) = s.sky {
+            st.sky = ck.color("settings.sky", c)?;
+        }
+        if let Some(c) = s.ambient {
+            st.ambient = ck.color("settings.ambient", c)?;
+        }
+    }
+
+    // Animations.
+    for (i, a) in doc.animate.iter().enumerate() {
+        let k = |f: &str| format!("animate[{i}].{f}");
+        let (object, animation) = match a {
+            TomlAnimate::Swing {
+                object,
+                pivot,
+                axis,
+                amplitude_deg,
+                period_frames,
+            } => (
+                object,
+                Animation::Swing {
+                    pivot: ck.vec(&k("pivot"), *pivot)?,
+                    axis: ck.direction(&k("axis"), *axis)?,
+                    amplitude_deg: ck.finite(&k("amplitude_deg"), *amplitude_deg)?,
+                    period_frames: ck.positive(&k("period_frames"), *period_frames)?,
+                },
+            ),
+            TomlAnimate::Slide {
+                object,
+                amplitude,
+                period_frames,
+            } => (
+                object,
+                Animation::Slide {
+                    amplitude: ck.vec(&k("amplitude"), *amplitude)?,
+                    period_frames: ck.positive(&k("period_frames"), *period_frames)?,
+                },
+            ),
+        };
+        let mut found = false;
+        for o in scene.objects.iter_mut().filter(|o| &o.name == object) {
+            o.animation = Some(animation.clone());
+            found = true;
+        }
+        if !found {
+            let mut names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+            names.sort_unstable();
+            names.dedup();
+            let more = if names.len() > 20 {
+                format!(", … ({} in all)", names.len())
+            } else {
+                String::new()
+            };
+            names.truncate(20);
+            return Err(ck.err(
+                &k("object"),
+                format!("no object named '{object}' (objects: {}{more})", names.join(", ")),
+            ));
+        }
+    }
+
+    if let Some(n) = doc.name {
+        scene.name = n;
+    } else if let Some(stem) = path.file_stem() {
+        scene.name = stem.to_string_lossy().into_owned();
+    }
+    Ok(scene)
+}
+
+/// Adds a static object with its own mesh and material.
+fn add_object(scene: &mut Scene, name: &str, b: MeshBuilder, material: Material) {
+    scene.materials.push(material);
+    let mi = scene.meshes.len();
+    scene.meshes.push(b.build(name, scene.materials.len() - 1));
+    scene.objects.push(Object {
+        name: name.into(),
+        mesh: mi,
+        transform: Mat4::IDENTITY,
+        animation: None,
+    });
+}
+
+/// Applies a uniform similarity transform `xf` (uniform scale `scale`) to the
+/// objects, camera, camera path, lights and length settings of `scene`.
+fn transform_scene(scene: &mut Scene, xf: Mat4, scale: f32) {
+    for o in &mut scene.objects {
+        o.transform = xf * o.transform;
+        o.animation = o.animation.take().map(|a| match a {
+            Animation::Swing {
+                pivot,
+                axis,
+                amplitude_deg,
+                period_frames,
+            } => Animation::Swing {
+                pivot: xf.transform_point3(pivot),
+                axis,
+                amplitude_deg,
+                period_frames,
+            },
+            Animation::Slide {
+                amplitude,
+                period_frames,
+            } => Animation::Slide {
+                amplitude: amplitude * scale,
+                period_frames,
+            },
+        });
+    }
+    let c = &mut scene.camera;
+    c.eye = xf.transform_point3(c.eye);
+    c.target = xf.transform_point3(c.target);
+    c.near *= scale;
+    if let Some(p) = &mut scene.camera_path {
+        for k in &mut p.keyframes {
+            k.eye = xf.transform_point3(k.eye);
+            k.target = xf.transform_point3(k.target);
+        }
+    }
+    for l in &mut scene.lights {
+        match l {
+            Light::Sun { .. } => {}
+            Light::Point { position, .. } | Light::Spot { position, .. } => *position = xf.transform_point3(*position),
+            Light::Rect {
+                center, half_u, half_v, ..
+            } => {
+                *center = xf.transform_point3(*center);
+                *half_u *= scale;
+                *half_v *= scale;
+            }
+        }
+    }
+    scene.settings.ao_radius *= scale;
+    scene.settings.min_separation *= scale;
+}

@@ -46,7 +46,12 @@ impl Texture {
         let y = ((v * self.height as f32) as u32).min(self.height - 1);
         let i = ((y * self.width + x) * 4) as usize;
         let t = &self.rgba8[i..i + 4];
-        [srgb_to_linear(t[0]), srgb_to_linear(t[1]), srgb_to_linear(t[2]), t[3] as f32 / 255.0]
+        [
+            srgb_to_linear(t[0]),
+            srgb_to_linear(t[1]),
+            srgb_to_linear(t[2]),
+            t[3] as f32 / 255.0,
+        ]
     }
 }
 
@@ -91,10 +96,19 @@ impl Default for Material {
 
 impl Material {
     pub fn diffuse(name: &str, rgb: [f32; 3]) -> Self {
-        Self { name: name.into(), base_color: rgb, ..Default::default() }
+        Self {
+            name: name.into(),
+            base_color: rgb,
+            ..Default::default()
+        }
     }
     pub fn emissive(name: &str, radiance: [f32; 3]) -> Self {
-        Self { name: name.into(), base_color: [0.0; 3], emission: radiance, ..Default::default() }
+        Self {
+            name: name.into(),
+            base_color: [0.0; 3],
+            emission: radiance,
+            ..Default::default()
+        }
     }
     pub fn is_emissive(&self) -> bool {
         self.emission.iter().any(|&e| e > 0.0)
@@ -108,16 +122,36 @@ impl Material {
 pub enum Light {
     /// Directional light. `direction` points *from the light* (the way photons travel).
     /// `illuminance` is the irradiance on a surface facing the sun (per colour channel × `color`).
-    Sun { direction: Vec3, color: [f32; 3], illuminance: f32 },
+    Sun {
+        direction: Vec3,
+        color: [f32; 3],
+        illuminance: f32,
+    },
     /// Isotropic point light with radiant intensity `intensity` × `color` (per steradian).
-    Point { position: Vec3, color: [f32; 3], intensity: f32 },
+    Point {
+        position: Vec3,
+        color: [f32; 3],
+        intensity: f32,
+    },
     /// Spot light: point light restricted to a cone with smooth falloff between the
     /// inner and outer half-angles (degrees).
-    Spot { position: Vec3, direction: Vec3, color: [f32; 3], intensity: f32, inner_deg: f32, outer_deg: f32 },
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        color: [f32; 3],
+        intensity: f32,
+        inner_deg: f32,
+        outer_deg: f32,
+    },
     /// One-sided rectangular area light (centre, two half-edge vectors, emitted radiance).
     /// Its normal is `normalize(cross(half_u, half_v))`. The scene must also contain
     /// matching emissive geometry for the reference to see it.
-    Rect { center: Vec3, half_u: Vec3, half_v: Vec3, radiance: [f32; 3] },
+    Rect {
+        center: Vec3,
+        half_u: Vec3,
+        half_v: Vec3,
+        radiance: [f32; 3],
+    },
 }
 
 /// Rigid animation of an object, evaluated at a (fractional) frame index.
@@ -125,7 +159,12 @@ pub enum Light {
 #[serde(tag = "type", rename_all = "lowercase")]
 pub enum Animation {
     /// Pendulum swing about `axis` through `pivot`: angle = amplitude · sin(2π frame / period).
-    Swing { pivot: Vec3, axis: Vec3, amplitude_deg: f32, period_frames: f32 },
+    Swing {
+        pivot: Vec3,
+        axis: Vec3,
+        amplitude_deg: f32,
+        period_frames: f32,
+    },
     /// Back-and-forth translation: offset = amplitude · sin(2π frame / period).
     Slide { amplitude: Vec3, period_frames: f32 },
 }
@@ -135,13 +174,21 @@ impl Animation {
     pub fn transform_at(&self, frame: f32) -> Mat4 {
         use std::f32::consts::TAU;
         match *self {
-            Animation::Swing { pivot, axis, amplitude_deg, period_frames } => {
+            Animation::Swing {
+                pivot,
+                axis,
+                amplitude_deg,
+                period_frames,
+            } => {
                 let a = amplitude_deg.to_radians() * (TAU * frame / period_frames).sin();
-                Mat4::from_translation(pivot) * Mat4::from_axis_angle(axis.normalize(), a) * Mat4::from_translation(-pivot)
+                Mat4::from_translation(pivot)
+                    * Mat4::from_axis_angle(axis.normalize(), a)
+                    * Mat4::from_translation(-pivot)
             }
-            Animation::Slide { amplitude, period_frames } => {
-                Mat4::from_translation(amplitude * (TAU * frame / period_frames).sin())
-            }
+            Animation::Slide {
+                amplitude,
+                period_frames,
+            } => Mat4::from_translation(amplitude * (TAU * frame / period_frames).sin()),
         }
     }
 }
@@ -184,7 +231,13 @@ pub struct SceneSettings {
 
 impl Default for SceneSettings {
     fn default() -> Self {
-        Self { ao_radius: 1.0, min_separation: 0.5, exposure: 1.0, sky: [0.0; 3], ambient: [0.03; 3] }
+        Self {
+            ao_radius: 1.0,
+            min_separation: 0.5,
+            exposure: 1.0,
+            sky: [0.0; 3],
+            ambient: [0.03; 3],
+        }
     }
 }
 

@@ -58,8 +58,20 @@ impl CameraPath {
         let (f0, f1) = (k[i].frame, k[i + 1].frame);
         let t = (frame - f0) / (f1 - f0);
         // Neighbours, mirrored at the ends.
-        let prev = |sel: fn(&Keyframe) -> Vec3| if i > 0 { sel(&k[i - 1]) } else { 2.0 * sel(&k[i]) - sel(&k[i + 1]) };
-        let next = |sel: fn(&Keyframe) -> Vec3| if i + 2 < k.len() { sel(&k[i + 2]) } else { 2.0 * sel(&k[i + 1]) - sel(&k[i]) };
+        let prev = |sel: fn(&Keyframe) -> Vec3| {
+            if i > 0 {
+                sel(&k[i - 1])
+            } else {
+                2.0 * sel(&k[i]) - sel(&k[i + 1])
+            }
+        };
+        let next = |sel: fn(&Keyframe) -> Vec3| {
+            if i + 2 < k.len() {
+                sel(&k[i + 2])
+            } else {
+                2.0 * sel(&k[i + 1]) - sel(&k[i])
+            }
+        };
         let eye = catmull_rom(prev(|k| k.eye), k[i].eye, k[i + 1].eye, next(|k| k.eye), t);
         let target = catmull_rom(prev(|k| k.target), k[i].target, k[i + 1].target, next(|k| k.target), t);
         (eye, target)
@@ -70,5 +82,8 @@ impl CameraPath {
 fn catmull_rom(p0: Vec3, p1: Vec3, p2: Vec3, p3: Vec3, t: f32) -> Vec3 {
     let t2 = t * t;
     let t3 = t2 * t;
-    0.5 * ((2.0 * p1) + (-p0 + p2) * t + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2 + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3)
+    0.5 * ((2.0 * p1)
+        + (-p0 + p2) * t
+        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
+        + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3)
 }

@@ -1,1 +1,526 @@
-pub const BUILTIN_NAMES: &[&str] = &[]; pub fn builtin(_n:&str)->Option<crate::Scene>{None}
+//! Built-in procedural scenes, usable with no files. Metres, +Y up.
+//!
+//! | name | what |
+//! |---|---|
+//! | `cornell` | the measured Cornell box (Cornell's published data), light quad + matching [`Light::Rect`] |
+//! | `atrium` | Sponza-like two-storey colonnade, open roof, coloured banners hidden behind columns, camera path, sliding statue |
+//! | `warehouse` | room whose spot-lit red floor patch is hidden behind a foreground partition wall |
+//! | `plane` | one 40 × 40 m grey Lambertian plane under a sun (analytic tests) |
+//! | `column-wall` | a column standing 0.5 m in front of a wall (AO tests) |
+//!
+//! Static geometry is merged into one object per material, named after the
+//! material (e.g. `banner_red`); animated parts are separate objects.
+
+use glam::{Mat4, Vec3};
+
+use crate::camera::Camera;
+use crate::model::{Animation, Light, Material, Object, Scene, SceneSettings};
+use crate::path::{CameraPath, Keyframe};
+use crate::shapes::MeshBuilder;
+
+/// Names accepted by [`builtin`].
+pub const BUILTIN_NAMES: &[&str] = &["cornell", "atrium", "warehouse", "plane", "column-wall"];
+
+/// The built-in scene called `name`, or `None` when there is none.
+pub fn builtin(name: &str) -> Option<Scene> {
+    match name {
+        "cornell" => Some(cornell()),
+        "atrium" => Some(atrium()),
+        "warehouse" => Some(warehouse()),
+        "plane" => Some(plane()),
+        "column-wall" => Some(column_wall()),
+        _ => None,
+    }
+}
+
+/// Collects geometry per material and turns it into a [`Scene`].
+struct SceneBuilder {
+    scene: Scene,
+    /// Static geometry, one builder per material index.
+    statics: Vec<MeshBuilder>,
+}
+
+impl SceneBuilder {
+    fn new(name: &str) -> Self {
+        Self {
+            scene: Scene {
+                name: name.into(),
+                ..Default::default()
+            },
+            statics: Vec::new(),
+        }
+    }
+
+    /// Adds a material, returning its index.
+    fn material(&mut self, m: Material) -> usize {
+        self.scene.materials.push(m);
+        self.statics.push(MeshBuilder::new());
+        self.scene.materials.len() - 1
+    }
+
+    /// The static geometry builder of material `m`.
+    fn geo(&mut self, m: usize) -> &mut MeshBuilder {
+        &mut self.statics[m]
+    }
+
+    /// Adds a separate (possibly animated) object.
+    fn object(
+        &mut self,
+        name: &str,
+        mesh: MeshBuilder,
+        material: usize,
+        transform: Mat4,
+        animation: Option<Animation>,
+    ) {
+        let mi = self.scene.meshes.len();
+        self.scene.meshes.push(mesh.build(name, material));
+        self.scene.objects.push(Object {
+            name: name.into(),
+            mesh: mi,
+            transform,
+            animation,
+        });
+    }
+
+    fn finish(mut self, camera: Camera, lights: Vec<Light>, settings: SceneSettings) -> Scene {
+        for (mi, b) in std::mem::take(&mut self.statics).into_iter().enumerate() {
+            if b.is_empty() {
+                continue;
+            }
+            let name = self.scene.materials[mi].name.clone();
+            self.object(&name, b, mi, Mat4::IDENTITY, None);
+        }
+        self.scene.camera = camera;
+        self.scene.lights = lights;
+        self.scene.settings = settings;
+        self.scene
+    }
+}
+
+fn v(x: f32, y: f32, z: f32) -> Vec3 {
+    Vec3::new(x, y, z)
+}
+
+/// Cornell box white / red / green (common RGB fits of the measured spectra).
+const CORNELL_WHITE: [f32; 3] = [0.725, 0.71, 0.68];
+const CORNELL_RED: [f32; 3] = [0.63, 0.065, 0.05];
+const CORNELL_GREEN: [f32; 3] = [0.14, 0.45, 0.091];
+/// Radiance of the Cornell light.
+const CORNELL_LIGHT: [f32; 3] = [17.0, 12.0, 4.0];
+
+/// The measured Cornell box (www.graphics.cornell.edu/online/box/data.html), in metres.
+///
+/// Floor 556 × 559.2 mm, height 548.8 mm, the short and tall blocks at their
+/// published rotated coordinates (closed with bottom faces), red wall at
+/// x ≈ 556, green wall at x = 0, open front (z = 0), light quad x 213..343,
+/// z 227..332 at y = 548.7 facing −Y with radiance (17, 12, 4) plus a matching
+/// [`Light::Rect`]. Camera: eye (0.278, 0.273, −0.8) looking along +Z, vertical
+/// fov 39.3077° (square images). Black sky, no ambient.
+pub fn cornell() -> Scene {
+    let mm = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * 1e-3;
+    let mut b = SceneBuilder::new("cornell");
+    let white = b.material(Material::diffuse("white", CORNELL_WHITE));
+    let red = b.material(Material::diffuse("red", CORNELL_RED));
+    let green = b.material(Material::diffuse("green", CORNELL_GREEN));
+    let light = b.material(Material::emissive("light", CORNELL_LIGHT));
+
+    let room_centre = mm(278.0, 274.4, 279.6);
+    let wall = |b: &mut SceneBuilder, m: usize, q: [Vec3; 4]| {
+        let fc = q.iter().sum::<Vec3>() / 4.0;
+        b.geo(m).quad_facing(q, room_centre - fc);
+    };
+    // Floor, ceiling, back wall (white); the walls face the room's interior.
+    wall(
+        &mut b,
+        white,
+        [
+            mm(552.8, 0.0, 0.0),
+            mm(0.0, 0.0, 0.0),
+            mm(0.0, 0.0, 559.2),
+            mm(549.6, 0.0, 559.2),
+        ],
+    );
+    wall(
+        &mut b,
+        white,
+        [
+            mm(556.0, 548.8, 0.0),
+            mm(556.0, 548.8, 559.2),
+            mm(0.0, 548.8, 559.2),
+            mm(0.0, 548.8, 0.0),
+        ],
+    );
+    wall(
+        &mut b,
+        white,
+        [
+            mm(549.6, 0.0, 559.2),
+            mm(0.0, 0.0, 559.2),
+            mm(0.0, 548.8, 559.2),
+            mm(556.0, 548.8, 559.2),
+        ],
+    );
+    // Green wall at x = 0, red wall at x ≈ 556.
+    wall(
+        &mut b,
+        green,
+        [
+            mm(0.0, 0.0, 559.2),
+            mm(0.0, 0.0, 0.0),
+            mm(0.0, 548.8, 0.0),
+            mm(0.0, 548.8, 559.2),
+        ],
+    );
+    wall(
+        &mut b,
+        red,
+        [
+            mm(552.8, 0.0, 0.0),
+            mm(549.6, 0.0, 559.2),
+            mm(556.0, 548.8, 559.2),
+            mm(556.0, 548.8, 0.0),
+        ],
+    );
+    // Short block (165 mm) and tall block (330 mm).
+    let block = |xz: [[f32; 2]; 4], h: f32| {
+        let bottom = xz.map(|p| mm(p[0], 0.0, p[1]));
+        let top = xz.map(|p| mm(p[0], h, p[1]));
+        (bottom, top)
+    };
+    let (sb, st) = block([[130.0, 65.0], [82.0, 225.0], [240.0, 272.0], [290.0, 114.0]], 165.0);
+    b.geo(white).hexahedron(sb, st);
+    let (tb, tt) = block([[423.0, 247.0], [265.0, 296.0], [314.0, 456.0], [472.0, 406.0]], 330.0);
+    b.geo(white).hexahedron(tb, tt);
+    // Light quad, facing down.
+    let centre = mm(278.0, 548.7, 279.5);
+    let half_u = mm(65.0, 0.0, 0.0);
+    let half_v = mm(0.0, 0.0, 52.5);
+    b.geo(light).rect(centre, half_u, half_v); // x × z = −y: faces down
+    let lights = vec![Light::Rect {
+        center: centre,
+        half_u,
+        half_v,
+        radiance: CORNELL_LIGHT,
+    }];
+
+    let camera = Camera::new(v(0.278, 0.273, -0.800), v(0.278, 0.273, -0.799), Vec3::Y, 39.3077, 0.01);
+    let settings = SceneSettings {
+        ao_radius: 0.1,
+        min_separation: 0.05,
+        exposure: 1.0,
+        sky: [0.0; 3],
+        ambient: [0.0; 3],
+    };
+    b.finish(camera, lights, settings)
+}
+
+/// Atrium dimensions (metres): the court spans x ∈ [−15, 15], z ∈ [−7, 7].
+mod atrium_dims {
+    pub const HALF_LEN: f32 = 15.0;
+    pub const HALF_WIDTH: f32 = 7.0;
+    pub const HEIGHT: f32 = 14.0;
+    /// |z| of the two colonnades.
+    pub const COLONNADE_Z: f32 = 4.0;
+    /// Half depth (z) of the arcade panels.
+    pub const ARCADE_HALF_DEPTH: f32 = 0.45;
+    /// Ground-floor column spacing along x (columns at −12, −9, …, 12).
+    pub const SPACING: f32 = 3.0;
+    pub const FIRST_COLUMN_X: f32 = -12.0;
+    pub const COLUMNS: usize = 9;
+    /// Gallery floor slab (y range) and aisle roof slab (y range).
+    pub const GALLERY_FLOOR: (f32, f32) = (5.8, 6.1);
+    pub const AISLE_ROOF: (f32, f32) = (10.8, 11.1);
+    /// |z| of the banners (1.5 m behind the colonnade line).
+    pub const BANNER_Z: f32 = 5.5;
+}
+
+/// A Sponza-like two-storey colonnade, 30 m long (x), 14 m wide (z), 14 m high,
+/// open to the sky between the aisle roofs.
+///
+/// Each long side has a ground-floor arcade (9 columns, 3 m apart, with square
+/// plinths and capitals, semicircular arches) carrying a gallery floor, and an
+/// upper arcade with twice as many slimmer columns. Saturated banners (red,
+/// green, blue, yellow) hang in the upper galleries 1.5 m behind the columns,
+/// so from the default camera they are mostly hidden by the columns (the
+/// deep G-buffer paper's Fig. 16 case). A warm sun falls through the open roof,
+/// sky is bluish. The camera path (frames 0–120) moves fast sideways past the
+/// +z colonnade; a statue in the court slides back and forth (object `statue`).
+pub fn atrium() -> Scene {
+    use atrium_dims::*;
+    let mut b = SceneBuilder::new("atrium");
+    let stone_floor = b.material(Material::diffuse("floor", [0.45, 0.42, 0.36]));
+    let wall = b.material(Material::diffuse("wall", [0.62, 0.57, 0.48]));
+    let column = b.material(Material::diffuse("column", [0.68, 0.64, 0.56]));
+    let arcade = b.material(Material::diffuse("arcade", [0.6, 0.55, 0.46]));
+    let banner_colors: [(&str, [f32; 3]); 4] = [
+        ("banner_red", [0.75, 0.04, 0.03]),
+        ("banner_green", [0.05, 0.55, 0.06]),
+        ("banner_blue", [0.04, 0.1, 0.7]),
+        ("banner_yellow", [0.8, 0.65, 0.03]),
+    ];
+    let banners: Vec<usize> = banner_colors
+        .iter()
+        .map(|&(n, c)| b.material(Material::diffuse(n, c)))
+        .collect();
+    let statue_mat = b.material(Material::diffuse("statue", [0.8, 0.78, 0.74]));
+
+    let (hl, hw, h) = (HALF_LEN, HALF_WIDTH, HEIGHT);
+    // Floor and the enclosing walls (0.5 m thick boxes outside the court).
+    b.geo(stone_floor)
+        .rect(v(0.0, 0.0, 0.0), v(0.0, 0.0, hw), v(hl, 0.0, 0.0)); // z × x = +y
+    b.geo(wall).cuboid(v(-hl - 0.5, 0.0, -hw - 0.5), v(hl + 0.5, h, -hw));
+    b.geo(wall).cuboid(v(-hl - 0.5, 0.0, hw), v(hl + 0.5, h, hw + 0.5));
+    b.geo(wall).cuboid(v(-hl - 0.5, 0.0, -hw), v(-hl, h, hw));
+    b.geo(wall).cuboid(v(hl, 0.0, -hw), v(hl + 0.5, h, hw));
+
+    let last_x = FIRST_COLUMN_X + SPACING * (COLUMNS - 1) as f32;
+    for side in [-1.0f32, 1.0] {
+        let zc = side * COLONNADE_Z;
+        let (za, zb) = (zc - ARCADE_HALF_DEPTH, zc + ARCADE_HALF_DEPTH);
+        // Slabs span from the arcade's court face to the outer wall.
+        let (slab_z0, slab_z1) = if side > 0.0 { (za, hw) } else { (-hw, zb) };
+
+        // Ground floor: columns, arches, end piers, gallery floor.
+        for i in 0..COLUMNS {
+            let x = FIRST_COLUMN_X + SPACING * i as f32;
+            b.geo(column)
+                .cuboid(v(x - 0.5, 0.0, zc - 0.5), v(x + 0.5, 0.4, zc + 0.5));
+            b.geo(column).cylinder(v(x, 0.4, zc), 0.35, 3.2, 20, false);
+            b.geo(column)
+                .cuboid(v(x - 0.55, 3.6, zc - 0.55), v(x + 0.55, 4.0, zc + 0.55));
+        }
+        for i in 0..COLUMNS - 1 {
+            let x = FIRST_COLUMN_X + SPACING * (i as f32 + 0.5);
+            b.geo(arcade)
+                .arch_panel(x, 4.0, SPACING / 2.0, GALLERY_FLOOR.0, za, zb, 16);
+        }
+        b.geo(arcade)
+            .cuboid(v(-hl, 0.0, za), v(FIRST_COLUMN_X - 0.5, GALLERY_FLOOR.0, zb));
+        b.geo(arcade)
+            .cuboid(v(last_x + 0.5, 0.0, za), v(hl, GALLERY_FLOOR.0, zb));
+        b.geo(arcade)
+            .cuboid(v(-hl, GALLERY_FLOOR.0, slab_z0), v(hl, GALLERY_FLOOR.1, slab_z1));
+
+        // Upper storey: twice as many, slimmer columns, smaller arches, aisle roof.
+        let y0 = GALLERY_FLOOR.1;
+        let upper_spacing = SPACING / 2.0;
+        let upper_count = 2 * (COLUMNS - 1) + 1;
+        for i in 0..upper_count {
+            let x = FIRST_COLUMN_X + upper_spacing * i as f32;
+            b.geo(column)
+                .cuboid(v(x - 0.4, y0, zc - 0.4), v(x + 0.4, y0 + 0.3, zc + 0.4));
+            b.geo(column).cylinder(v(x, y0 + 0.3, zc), 0.25, 2.6, 16, false);
+            b.geo(column)
+                .cuboid(v(x - 0.42, y0 + 2.9, zc - 0.42), v(x + 0.42, y0 + 3.2, zc + 0.42));
+        }
+        let spring = y0 + 3.2;
+        for i in 0..upper_count - 1 {
+            let x = FIRST_COLUMN_X + upper_spacing * (i as f32 + 0.5);
+            b.geo(arcade)
+                .arch_panel(x, spring, upper_spacing / 2.0, AISLE_ROOF.0, za + 0.05, zb - 0.05, 12);
+        }
+        b.geo(arcade)
+            .cuboid(v(-hl, y0, za + 0.05), v(FIRST_COLUMN_X - 0.4, AISLE_ROOF.0, zb - 0.05));
+        b.geo(arcade)
+            .cuboid(v(last_x + 0.4, y0, za + 0.05), v(hl, AISLE_ROOF.0, zb - 0.05));
+        b.geo(arcade)
+            .cuboid(v(-hl, AISLE_ROOF.0, slab_z0), v(hl, AISLE_ROOF.1, slab_z1));
+
+        // Banners in the upper gallery, 1.5 m behind the columns, centred
+        // between ground-floor columns: thin boxes hanging from the aisle roof.
+        let bz = side * BANNER_Z;
+        for i in 0..COLUMNS - 1 {
+            let x = FIRST_COLUMN_X + SPACING * (i as f32 + 0.5);
+            let m = banners[(i + if side > 0.0 { 0 } else { 2 }) % banners.len()];
+            b.geo(m)
+                .cuboid(v(x - 0.6, 7.0, bz - 0.03), v(x + 0.6, AISLE_ROOF.0, bz + 0.03));
+        }
+    }
+
+    // The sliding statue in the court: pedestal, body, head.
+    let mut statue = MeshBuilder::new();
+    statue.cuboid(v(-0.5, 0.0, -0.5), v(0.5, 1.0, 0.5));
+    statue.cylinder(v(0.0, 1.0, 0.0), 0.3, 1.5, 20, true);
+    statue.cuboid(v(-0.2, 2.5, -0.2), v(0.2, 2.9, 0.2));
+    let slide = Animation::Slide {
+        amplitude: v(0.0, 0.0, 1.5),
+        period_frames: 60.0,
+    };
+    b.object(
+        "statue",
+        statue,
+        statue_mat,
+        Mat4::from_translation(v(-2.0, 0.0, 0.5)),
+        Some(slide),
+    );
+
+    let sun = Light::Sun {
+        direction: v(0.3, -1.0, 0.75).normalize(),
+        color: [1.0, 0.88, 0.7],
+        illuminance: 8.0,
+    };
+    let keyframes = atrium_keyframes();
+    let camera = Camera::new(keyframes[0].eye, keyframes[0].target, Vec3::Y, 60.0, 0.05);
+    let path = CameraPath::new(keyframes).ok();
+    let settings = SceneSettings {
+        ao_radius: 1.0,
+        min_separation: 0.5,
+        exposure: 0.5,
+        sky: [0.3, 0.45, 0.75],
+        ambient: [0.03; 3],
+    };
+    let mut scene = b.finish(camera, vec![sun], settings);
+    scene.camera_path = path;
+    scene
+}
+
+/// The atrium's camera path: 120 frames, sideways along the court past the +z
+/// colonnade (about 0.2 m per frame), looking diagonally at it.
+fn atrium_keyframes() -> Vec<Keyframe> {
+    let look = v(12.0, 4.2, 6.5);
+    [
+        (0.0, v(-13.0, 2.2, -2.0)),
+        (30.0, v(-7.0, 2.6, -1.0)),
+        (60.0, v(-1.0, 3.0, -1.8)),
+        (90.0, v(5.0, 2.6, -1.0)),
+        (120.0, v(11.0, 2.2, -2.0)),
+    ]
+    .into_iter()
+    .map(|(frame, eye)| Keyframe {
+        frame,
+        eye,
+        target: eye + look,
+    })
+    .collect()
+}
+
+/// Warehouse dimensions: room x ∈ [−8, 8], z ∈ [−6, 6], 5 m high.
+mod warehouse_dims {
+    /// The red floor patch (x range, z range).
+    pub const PATCH_X: (f32, f32) = (-2.6, 0.4);
+    pub const PATCH_Z: (f32, f32) = (-3.5, -0.5);
+    /// The partition wall (x range, z range, height).
+    pub const PARTITION_X: (f32, f32) = (-3.0, -2.8);
+    pub const PARTITION_Z: (f32, f32) = (-6.0, 1.0);
+    pub const PARTITION_H: f32 = 2.5;
+}
+
+/// A closed room whose brightly spot-lit, saturated red floor patch is seen by
+/// the default camera only behind the edge of a foreground partition wall (the
+/// deep G-buffer paper's Fig. 15 case): the patch is hidden in the first layer
+/// but should bleed red light onto the visible floor, walls and partition around it.
+pub fn warehouse() -> Scene {
+    use warehouse_dims::*;
+    let mut b = SceneBuilder::new("warehouse");
+    let floor = b.material(Material::diffuse("floor", [0.6, 0.6, 0.58]));
+    let wall = b.material(Material::diffuse("wall", [0.75, 0.75, 0.73]));
+    let red = b.material(Material::diffuse("red_patch", [0.85, 0.04, 0.03]));
+    let crate_mat = b.material(Material::diffuse("crates", [0.7, 0.68, 0.62]));
+
+    let (x0, x1, z0, z1, h) = (-8.0f32, 8.0f32, -6.0f32, 6.0f32, 5.0f32);
+    // Floor tiles around the patch (no overlap with it), then the patch.
+    let floor_rect = |b: &mut SceneBuilder, m: usize, xa: f32, xb: f32, za: f32, zb: f32| {
+        b.geo(m).quad_facing(
+            [v(xa, 0.0, za), v(xb, 0.0, za), v(xb, 0.0, zb), v(xa, 0.0, zb)],
+            Vec3::Y,
+        );
+    };
+    floor_rect(&mut b, floor, x0, PATCH_X.0, z0, z1);
+    floor_rect(&mut b, floor, PATCH_X.1, x1, z0, z1);
+    floor_rect(&mut b, floor, PATCH_X.0, PATCH_X.1, z0, PATCH_Z.0);
+    floor_rect(&mut b, floor, PATCH_X.0, PATCH_X.1, PATCH_Z.1, z1);
+    floor_rect(&mut b, red, PATCH_X.0, PATCH_X.1, PATCH_Z.0, PATCH_Z.1);
+    // Walls and ceiling: 0.3 m boxes outside the room.
+    let t = 0.3;
+    b.geo(wall).cuboid(v(x0 - t, 0.0, z0 - t), v(x1 + t, h, z0));
+    b.geo(wall).cuboid(v(x0 - t, 0.0, z1), v(x1 + t, h, z1 + t));
+    b.geo(wall).cuboid(v(x0 - t, 0.0, z0), v(x0, h, z1));
+    b.geo(wall).cuboid(v(x1, 0.0, z0), v(x1 + t, h, z1));
+    b.geo(wall).cuboid(v(x0 - t, h, z0 - t), v(x1 + t, h + t, z1 + t));
+    // Foreground partition whose edge (z = 1) hides the patch from the camera.
+    b.geo(wall).cuboid(
+        v(PARTITION_X.0, 0.0, PARTITION_Z.0),
+        v(PARTITION_X.1, PARTITION_H, PARTITION_Z.1),
+    );
+    // A few crates.
+    b.geo(crate_mat).cuboid(v(3.0, 0.0, -4.5), v(4.5, 1.5, -3.0));
+    b.geo(crate_mat).cuboid(v(3.3, 1.5, -4.2), v(4.3, 2.5, -3.2));
+    b.geo(crate_mat).cuboid(v(5.0, 0.0, 2.5), v(6.2, 1.2, 3.7));
+
+    let patch_centre = v(0.5 * (PATCH_X.0 + PATCH_X.1), 0.0, 0.5 * (PATCH_Z.0 + PATCH_Z.1));
+    let lights = vec![
+        Light::Spot {
+            position: patch_centre + Vec3::Y * 4.7,
+            direction: -Vec3::Y,
+            color: [1.0, 0.96, 0.9],
+            intensity: 300.0,
+            inner_deg: 15.0,
+            outer_deg: 19.0,
+        },
+        Light::Point {
+            position: v(4.5, 4.2, 3.0),
+            color: [1.0, 1.0, 1.0],
+            intensity: 25.0,
+        },
+    ];
+    let camera = Camera::new(v(-7.0, 1.6, 2.5), v(0.0, 1.0, -2.0), Vec3::Y, 60.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.8,
+        min_separation: 0.3,
+        exposure: 0.8,
+        sky: [0.0; 3],
+        ambient: [0.02; 3],
+    };
+    b.finish(camera, lights, settings)
+}
+
+/// A single 40 × 40 m Lambertian plane (albedo 0.5) at y = 0 under one sun
+/// (direction normalize(−0.4, −1, −0.2), illuminance π, so a white Lambertian
+/// surface has radiance cos θ), seen obliquely. Black sky, no ambient: the
+/// direct-light and "AO of an unoccluded plane is 1" test scene.
+pub fn plane() -> Scene {
+    let mut b = SceneBuilder::new("plane");
+    let grey = b.material(Material::diffuse("grey", [0.5, 0.5, 0.5]));
+    b.geo(grey).rect(Vec3::ZERO, v(0.0, 0.0, 20.0), v(20.0, 0.0, 0.0));
+    let sun = Light::Sun {
+        direction: v(-0.4, -1.0, -0.2).normalize(),
+        color: [1.0, 1.0, 1.0],
+        illuminance: std::f32::consts::PI,
+    };
+    let camera = Camera::new(v(0.0, 4.0, 5.0), v(0.0, 0.0, -1.0), Vec3::Y, 45.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 1.0,
+        min_separation: 0.5,
+        exposure: 1.0,
+        sky: [0.0; 3],
+        ambient: [0.0; 3],
+    };
+    b.finish(camera, vec![sun], settings)
+}
+
+/// A 3 m column (radius 0.3 m, 32 segments) standing 0.5 m in front of a 4 m
+/// wall (front face z = −1) on a 12 × 12 m floor, sun from the front-left
+/// above, seen from the front so the column hides part of the wall.
+pub fn column_wall() -> Scene {
+    let mut b = SceneBuilder::new("column-wall");
+    let floor = b.material(Material::diffuse("floor", [0.6, 0.6, 0.6]));
+    let wall = b.material(Material::diffuse("wall", [0.7, 0.7, 0.7]));
+    let column = b.material(Material::diffuse("column", [0.75, 0.73, 0.7]));
+    b.geo(floor).rect(Vec3::ZERO, v(0.0, 0.0, 6.0), v(6.0, 0.0, 0.0));
+    b.geo(wall).cuboid(v(-4.0, 0.0, -1.3), v(4.0, 4.0, -1.0));
+    b.geo(column).cylinder(v(0.0, 0.0, -0.2), 0.3, 3.0, 32, true);
+    let sun = Light::Sun {
+        direction: v(-0.3, -1.0, -0.6).normalize(),
+        color: [1.0, 0.97, 0.92],
+        illuminance: 3.0,
+    };
+    let camera = Camera::new(v(1.0, 1.6, 4.0), v(0.0, 1.2, -0.6), Vec3::Y, 50.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 1.0,
+        min_separation: 0.25,
+        exposure: 1.0,
+        sky: [0.2, 0.25, 0.35],
+        ambient: [0.03; 3],
+    };
+    b.finish(camera, vec![sun], settings)
+}

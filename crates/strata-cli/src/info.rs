@@ -1,0 +1,40 @@
+//! `strata info`.
+
+use anyhow::Result;
+use strata_render::gpu::STRATA_FEATURES;
+
+use crate::args::InfoArgs;
+
+pub fn run(a: &InfoArgs) -> Result<()> {
+    let gpu = strata_render::GpuContext::new(&strata_render::GpuOptions {
+        adapter: a.gpu.adapter.clone(),
+    })?;
+    let i = gpu.adapter.get_info();
+    if a.json {
+        let feats: serde_json::Map<String, serde_json::Value> = STRATA_FEATURES
+            .iter()
+            .map(|(n, f, _)| (n.to_string(), gpu.has(*f).into()))
+            .collect();
+        let v = serde_json::json!({
+            "adapter": i.name, "backend": format!("{:?}", i.backend), "device_type": format!("{:?}", i.device_type),
+            "driver": i.driver, "driver_info": i.driver_info, "features": feats,
+            "max_multiview_view_count": gpu.device.limits().max_multiview_view_count,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!("adapter      {}", i.name);
+    println!("backend      {:?}", i.backend);
+    println!("device type  {:?}", i.device_type);
+    println!("driver       {} {}", i.driver, i.driver_info);
+    println!(
+        "multiview    up to {} views",
+        gpu.device.limits().max_multiview_view_count
+    );
+    println!();
+    println!("{:<34} {:<8} used for", "feature", "present");
+    for (name, f, why) in STRATA_FEATURES {
+        println!("{:<34} {:<8} {}", name, if gpu.has(*f) { "yes" } else { "no" }, why);
+    }
+    Ok(())
+}

@@ -1,0 +1,72 @@
+//! `strata render`.
+
+use anyhow::Result;
+use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+
+use crate::args::RenderArgs;
+use crate::output::{check_output, save, scene_and_camera};
+
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let (scene, camera, prev) = scene_and_camera(&a.scene)?;
+    let settings = RenderSettings {
+        width: a.scene.width,
+        height: a.scene.height,
+        shadow: strata_render::passes::shadow::ShadowSettings {
+            resolution: a.shadow_resolution,
+        },
+        exposure: a.exposure,
+        ..Default::default()
+    };
+    settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(out) = &a.out {
+        check_output(out, a.force)?;
+    }
+    let gpu = GpuContext::new(&GpuOptions {
+        adapter: a.gpu.adapter.clone(),
+    })?;
+    let mut r = Renderer::new(&gpu, &scene, settings)?;
+    if a.list_passes {
+        println!("frame of '{}' ({:?}):", scene.name, a.technique);
+        for p in r.pass_infos() {
+            println!(
+                "  {:<10} reads [{}] writes [{}]",
+                p.name,
+                p.inputs.join(", "),
+                p.outputs.join(", ")
+            );
+        }
+        println!("debug views: {}", r.debug_view_names().join(", "));
+        return Ok(());
+    }
+    let out = a.out.as_ref().expect("clap requires --out");
+    let exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if let Some(v) = &a.debug_view {
+        if !r.debug_view_names().iter().any(|n| n == v) {
+            anyhow::bail!(
+                "--debug-view '{v}' is unknown: valid views are {}",
+                r.debug_view_names().join(", ")
+            );
+        }
+    }
+    let t = r.render(&gpu, &scene, &camera, &prev, a.scene.frame)?;
+    let img = match (&a.debug_view, exr) {
+        (Some(v), _) => r.debug_view(&gpu, v, exr)?,
+        (None, true) => r.read_target(&gpu, "hdr")?,
+        (None, false) => r.read_target(&gpu, "ldr")?,
+    };
+    // ldr/albedo are already linear after read-back decode; PNG re-encodes sRGB.
+    save(&img, out, true)?;
+    if a.timings {
+        for (n, ms) in &t.passes {
+            eprintln!("{n:<10} {ms:8.3} ms");
+        }
+    }
+    eprintln!(
+        "wrote {} ({}x{}, {} triangles)",
+        out.display(),
+        a.scene.width,
+        a.scene.height,
+        scene.triangle_count()
+    );
+    Ok(())
+}

@@ -1,0 +1,238 @@
+//! Ambient occlusion oracles.
+//!
+//! Both estimators start from the primary hit X through each pixel centre, with
+//! normal n = the interpolated shading normal flipped to face the viewer. Pixels
+//! whose primary ray hits nothing get ambient visibility 1.
+//!
+//! - **Binary visibility** ([`Reference::ao_binary`]): `AV(X) = 1 − H/N`, where
+//!   H of the N cosine-weighted hemisphere rays around n hit any surface within
+//!   `radius` of X. Ray origins are offset by [`Reference::epsilon`] along the
+//!   viewer-facing geometric normal. Directions are the R2 low-discrepancy
+//!   sequence with a per-pixel Cranley–Patterson rotation.
+//! - **DGB obscurance** ([`Reference::ao_obscurance`]): DGB Eq. 1–2 evaluated on
+//!   the true geometry with *all* layers (see [`ObscuranceSettings`]).
+
+use glam::Vec3;
+use strata_scene::{Camera, ImageBuf};
+
+use crate::sampling::{cosine_hemisphere, hash, pixel_offset, r2};
+use crate::Reference;
+
+/// Settings of the binary ambient-visibility oracle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AoBinarySettings {
+    /// World-space occlusion radius: only hits closer than this occlude.
+    pub radius: f32,
+    /// Hemisphere rays per pixel.
+    pub spp: u32,
+    /// Seed of the per-pixel sample rotations.
+    pub seed: u64,
+}
+
+impl AoBinarySettings {
+    pub fn new(radius: f32) -> Self {
+        Self {
+            radius,
+            ..Self::default()
+        }
+    }
+}
+
+impl Default for AoBinarySettings {
+    /// radius 1, 256 rays per pixel, seed 0.
+    fn default() -> Self {
+        Self {
+            radius: 1.0,
+            spp: 256,
+            seed: 0,
+        }
+    }
+}
+
+/// Radial distribution of the obscurance sample disk.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DiskSampling {
+    /// Uniform over the disk area (radius `r·√u`).
+    #[default]
+    UniformArea,
+    /// Radius `r·u`, uniform in u: the density of the paper's spiral taps
+    /// (`h_i = r_p·κ_i`, κ_i = (i + 0.5)/N, DGB §3.4), which concentrates samples
+    /// towards the centre. Use it to compare with the GPU's spiral term by term.
+    SpiralRadius,
+}
+
+/// Settings of the DGB obscurance oracle (Eq. 1–2).
+///
+/// For pixel X at camera-space depth z, each of the N samples picks a point P
+/// in the disk of radius `radius` centred on X in the camera plane at depth z
+/// (offsets along camera right/up — the world-space disk whose projection is
+/// the GPU's screen-space sample disk), casts the camera ray from the eye
+/// through P and collects **every** surface Y_j along it (all layers, back
+/// faces included). Then
+///
+/// - `O(X, Y) = (1 − v·v/r²) · max((v·n − β)/√(v·v + ε), 0)` for |v| < r, else 0,
+///   with v = Y − X;
+/// - `A_i = max(0, max_j O(X, Y_j))`;
+/// - `AV = max(0, 1 − √(π/N · Σ A_i))`.
+///
+/// An unoccluded plane gives exactly 1 (v·n = 0 on the plane and β > 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ObscuranceSettings {
+    /// Sample radius r (world units).
+    pub radius: f32,
+    /// Bias β (world units), subtracted from v·n. Default `0.01·r`.
+    pub beta: f32,
+    /// ε (world units squared) in the denominator. Default `0.01·r²`.
+    pub epsilon: f32,
+    /// Samples N per pixel.
+    pub spp: u32,
+    pub seed: u64,
+    pub disk: DiskSampling,
+}
+
+impl ObscuranceSettings {
+    /// Defaults scaled to `radius`: β = 0.01·r, ε = 0.01·r², 256 samples.
+    pub fn new(radius: f32) -> Self {
+        Self {
+            radius,
+            beta: 0.01 * radius,
+            epsilon: 0.01 * radius * radius,
+            spp: 256,
+            seed: 0,
+            disk: DiskSampling::UniformArea,
+        }
+    }
+
+    /// DGB Eq. 2: the obscurance at X (unit normal `n`) due to a surface point at
+    /// offset `v = Y − X`.
+    pub fn occlusion(&self, v: Vec3, n: Vec3) -> f32 {
+        let vv = v.dot(v);
+        let r2 = self.radius * self.radius;
+        if !(vv < r2) {
+            return 0.0;
+        }
+        (1.0 - vv / r2) * ((v.dot(n) - self.beta) / (vv + self.epsilon).sqrt()).max(0.0)
+    }
+}
+
+impl Default for ObscuranceSettings {
+    fn default() -> Self {
+        Self::new(1.0)
+    }
+}
+
+impl Reference<'_> {
+    /// Binary ambient visibility per pixel (1 channel, in [0, 1]; background = 1).
+    pub fn ao_binary(&self, camera: &Camera, width: u32, height: u32, settings: &AoBinarySettings) -> ImageBuf {
+        let values = self.for_each_pixel("AO binary", width, height, |x, y, rays| {
+            let dir = camera.pixel_dir(x, y, width, height);
+            *rays += 1;
+            let Some(h) = self.bvh.intersect(camera.eye, dir, camera.near, f32::INFINITY) else {
+                return 1.0;
+            };
+            let s = self.bvh.surface(&h, dir);
+            let (n, ng) = s.facing_normals(dir);
+            *rays += settings.spp as u64;
+            self.ao_binary_at(s.position, n, ng, settings, pixel_key(settings.seed, x, y, width))
+        });
+        ImageBuf {
+            width,
+            height,
+            channels: 1,
+            data: values,
+        }
+    }
+
+    /// Binary ambient visibility at a surface point: `p`, unit shading normal `n`
+    /// (sampling hemisphere) and unit geometric normal `ng` (ray offset), both on
+    /// the side being evaluated. `key` selects the sample rotation. Returns 1
+    /// when `spp` is 0.
+    pub fn ao_binary_at(&self, p: Vec3, n: Vec3, ng: Vec3, settings: &AoBinarySettings, key: u64) -> f32 {
+        if settings.spp == 0 {
+            return 1.0;
+        }
+        let origin = p + ng * self.epsilon;
+        let offset = pixel_offset(key);
+        let mut hits = 0u32;
+        for i in 0..settings.spp {
+            let d = cosine_hemisphere(n, r2(i, offset));
+            if self.bvh.occluded(origin, d, 0.0, settings.radius) {
+                hits += 1;
+            }
+        }
+        1.0 - hits as f32 / settings.spp as f32
+    }
+
+    /// DGB obscurance ambient visibility (Eq. 1–2 over all layers) per pixel
+    /// (1 channel, in [0, 1]; background = 1). See [`ObscuranceSettings`].
+    pub fn ao_obscurance(&self, camera: &Camera, width: u32, height: u32, settings: &ObscuranceSettings) -> ImageBuf {
+        let values = self.for_each_pixel("AO DGB", width, height, |x, y, rays| {
+            let dir = camera.pixel_dir(x, y, width, height);
+            *rays += 1;
+            let Some(h) = self.bvh.intersect(camera.eye, dir, camera.near, f32::INFINITY) else {
+                return 1.0;
+            };
+            let s = self.bvh.surface(&h, dir);
+            let (n, _) = s.facing_normals(dir);
+            *rays += settings.spp as u64;
+            self.ao_obscurance_at(camera, s.position, n, settings, pixel_key(settings.seed, x, y, width))
+                .0
+        });
+        ImageBuf {
+            width,
+            height,
+            channels: 1,
+            data: values,
+        }
+    }
+
+    /// DGB obscurance at point `x` with unit normal `n` seen from `camera`.
+    /// Returns (AV, mean A_i) — the second value is `Σ A_i / N` before Eq. 1's
+    /// square root, for term-by-term comparison. (1, 0) when `spp` is 0.
+    pub fn ao_obscurance_at(
+        &self,
+        camera: &Camera,
+        x: Vec3,
+        n: Vec3,
+        settings: &ObscuranceSettings,
+        key: u64,
+    ) -> (f32, f32) {
+        if settings.spp == 0 {
+            return (1.0, 0.0);
+        }
+        let (right, up, _) = camera.basis();
+        let z = camera.depth_of(x);
+        let r = settings.radius;
+        let offset = pixel_offset(key);
+        let mut hits = Vec::new();
+        let mut sum = 0.0f64;
+        for i in 0..settings.spp {
+            let [u, w] = r2(i, offset);
+            let rho = match settings.disk {
+                DiskSampling::UniformArea => r * u.sqrt(),
+                DiskSampling::SpiralRadius => r * u,
+            };
+            let phi = std::f32::consts::TAU * w;
+            let p = x + right * (rho * phi.cos()) + up * (rho * phi.sin());
+            // Direction with unit forward component: t along it is camera-space depth.
+            let dir = (p - camera.eye) / z;
+            // |Y − X| ≥ |t − z|, so only depths in (z − r, z + r) can contribute.
+            let tmin = camera.near.max(z - r);
+            self.bvh.intersect_all(camera.eye, dir, tmin, z + r, &mut hits);
+            let mut a = 0.0f32;
+            for h in &hits {
+                let y = camera.eye + dir * h.t;
+                a = a.max(settings.occlusion(y - x, n));
+            }
+            sum += a as f64;
+        }
+        let mean = (sum / settings.spp as f64) as f32;
+        let av = (1.0 - (std::f32::consts::PI * mean).sqrt()).max(0.0);
+        (av, mean)
+    }
+}
+
+/// Per-pixel key for sample rotations.
+pub(crate) fn pixel_key(seed: u64, x: u32, y: u32, width: u32) -> u64 {
+    hash(&[seed, y as u64 * width as u64 + x as u64])
+}

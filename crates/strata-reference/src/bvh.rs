@@ -1,0 +1,567 @@
+//! A binned-SAH bounding volume hierarchy over world-space triangles with
+//! watertight ray–triangle intersection.
+//!
+//! - **Build**: top-down, 16 SAH bins per axis over triangle centroids, leaves of
+//!   at most [`MAX_LEAF`] triangles; nodes are flattened in depth-first order
+//!   (left child = next node) into 32-byte records.
+//! - **Intersection**: the watertight algorithm of Woop, Benthin and Wald
+//!   (JCGT 2013): the ray is sheared so it runs along +Z, the edge functions are
+//!   evaluated in 2D and recomputed in `f64` when one is exactly zero. A ray
+//!   through a shared edge or vertex of a closed mesh never slips between
+//!   triangles, and the result does not depend on traversal order.
+//! - **Traversal**: the box test scales the far distance by `1 + 2γ₃` (Ize 2013)
+//!   so boxes are never culled by rounding; closest-hit visits the nearer child
+//!   first.
+//!
+//! `t` is measured in units of the ray direction as given (directions need not be
+//! normalised: primary rays use [`strata_scene::Camera::pixel_dir`], so `t` is the
+//! camera-space depth).
+
+use glam::Vec3;
+use strata_scene::WorldTriangle;
+
+/// Most triangles in one leaf.
+pub const MAX_LEAF: usize = 4;
+/// SAH bins per axis.
+pub const BINS: usize = 16;
+/// Depth beyond which the build switches to balanced median splits, bounding the
+/// traversal stack.
+const MAX_SAH_DEPTH: usize = 96;
+const STACK: usize = 128;
+/// `1 + 2γ₃` with γₙ = nε/(1 − nε), ε = 2⁻²⁴: conservative slab-test scale.
+const BOX_SCALE: f32 = 1.000_000_4;
+
+/// A ray–triangle hit: parametric distance, triangle index into the triangle
+/// list the BVH was built from, and barycentric weights of vertices 1 and 2
+/// (vertex 0 has weight `1 − b1 − b2`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub triangle: u32,
+    pub b1: f32,
+    pub b2: f32,
+}
+
+/// Surface attributes at a hit, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    pub t: f32,
+    pub triangle: u32,
+    /// Interpolated from the triangle's vertices with the hit's barycentrics.
+    pub position: Vec3,
+    /// Unit normal of the triangle plane, oriented by the counter-clockwise
+    /// winding (`(p1 − p0) × (p2 − p0)`), not flipped towards the ray.
+    pub geometric_normal: Vec3,
+    /// Interpolated, normalised vertex normal, not flipped towards the ray; the
+    /// geometric normal when the vertex normals are degenerate.
+    pub shading_normal: Vec3,
+    /// True when the ray arrives at the counter-clockwise (front) side.
+    pub front_face: bool,
+    pub uv: [f32; 2],
+    pub material: u32,
+    pub object: u32,
+}
+
+impl SurfaceHit {
+    /// (shading, geometric) normals, each flipped independently to the side the
+    /// ray `dir` came from (so both have a non-positive dot product with `dir`).
+    pub fn facing_normals(&self, dir: Vec3) -> (Vec3, Vec3) {
+        let flip = |n: Vec3| if n.dot(dir) > 0.0 { -n } else { n };
+        (flip(self.shading_normal), flip(self.geometric_normal))
+    }
+}
+
+/// Flattened node: a leaf when `count > 0` (triangles `first..first + count` of
+/// the reordered list), else an interior node whose left child is the next node
+/// and whose right child is `first`.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+struct Node {
+    min: [f32; 3],
+    first: u32,
+    max: [f32; 3],
+    count: u32,
+}
+
+/// Precomputed per-ray data for the slab and watertight tests.
+struct Ray {
+    org: Vec3,
+    inv: [f32; 3],
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
+
+impl Ray {
+    fn new(org: Vec3, dir: Vec3) -> Self {
+        let a = dir.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        Self {
+            org,
+            inv: [1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z],
+            kx,
+            ky,
+            kz,
+            sx: dir[kx] / dir[kz],
+            sy: dir[ky] / dir[kz],
+            sz: 1.0 / dir[kz],
+        }
+    }
+
+    /// Entry distance into the node's box if the ray overlaps it within
+    /// `[tmin, tmax]`, else `f32::INFINITY`. NaNs (origin on a slab of a flat
+    /// box, direction parallel to it) are ignored by `f32::min`/`max`, which
+    /// keeps the test conservative.
+    #[inline]
+    fn hit_box(&self, n: &Node, tmin: f32, tmax: f32) -> f32 {
+        let mut near = tmin;
+        let mut far = tmax;
+        for k in 0..3 {
+            let t0 = (n.min[k] - self.org[k]) * self.inv[k];
+            let t1 = (n.max[k] - self.org[k]) * self.inv[k];
+            near = near.max(t0.min(t1));
+            far = far.min(t0.max(t1) * BOX_SCALE);
+        }
+        if near <= far {
+            near
+        } else {
+            f32::INFINITY
+        }
+    }
+
+    /// Watertight ray–triangle test; returns (t, b1, b2) for `tmin < t < tmax`.
+    #[inline]
+    fn hit_triangle(&self, p: &[Vec3; 3], tmin: f32, tmax: f32) -> Option<(f32, f32, f32)> {
+        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let a = p[0] - self.org;
+        let b = p[1] - self.org;
+        let c = p[2] - self.org;
+        let ax = a[kx] - self.sx * a[kz];
+        let ay = a[ky] - self.sy * a[kz];
+        let bx = b[kx] - self.sx * b[kz];
+        let by = b[ky] - self.sy * b[kz];
+        let cx = c[kx] - self.sx * c[kz];
+        let cy = c[ky] - self.sy * c[kz];
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            let (ax, ay, bx, by, cx, cy) = (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
+            u = (cx * by - cy * bx) as f32;
+            v = (ax * cy - ay * cx) as f32;
+            w = (bx * ay - by * ax) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let t_scaled = u * (self.sz * a[kz]) + v * (self.sz * b[kz]) + w * (self.sz * c[kz]);
+        let rcp = 1.0 / det;
+        let t = t_scaled * rcp;
+        if t > tmin && t < tmax {
+            Some((t, v * rcp, w * rcp))
+        } else {
+            None
+        }
+    }
+}
+
+/// The watertight ray–triangle test used by the BVH, for brute-force checks:
+/// `Some(Hit)` with `triangle: 0` when the ray hits `p` at `tmin < t < tmax`.
+pub fn intersect_triangle(p: &[Vec3; 3], origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
+    Ray::new(origin, dir)
+        .hit_triangle(p, tmin, tmax)
+        .map(|(t, b1, b2)| Hit { t, triangle: 0, b1, b2 })
+}
+
+/// A BVH over a list of world-space triangles. Triangles with non-finite
+/// vertices are left out; zero-area triangles are kept but never hit.
+pub struct Bvh {
+    nodes: Vec<Node>,
+    /// Vertex positions in leaf order.
+    verts: Vec<[Vec3; 3]>,
+    /// Leaf order → index into `triangles`.
+    ids: Vec<u32>,
+    triangles: Vec<WorldTriangle>,
+}
+
+struct BuildPrim {
+    lo: Vec3,
+    hi: Vec3,
+    centroid: Vec3,
+    id: u32,
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    lo: Vec3,
+    hi: Vec3,
+    count: usize,
+}
+
+impl Bin {
+    const EMPTY: Bin = Bin {
+        lo: Vec3::INFINITY,
+        hi: Vec3::NEG_INFINITY,
+        count: 0,
+    };
+}
+
+fn half_area(lo: Vec3, hi: Vec3) -> f32 {
+    let d = (hi - lo).max(Vec3::ZERO);
+    d.x * d.y + d.y * d.z + d.z * d.x
+}
+
+impl Bvh {
+    /// Builds the hierarchy (single-threaded, O(n log n)).
+    pub fn build(triangles: Vec<WorldTriangle>) -> Self {
+        let mut prims: Vec<BuildPrim> = triangles
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.p.iter().all(|p| p.is_finite()))
+            .map(|(i, t)| {
+                let lo = t.p[0].min(t.p[1]).min(t.p[2]);
+                let hi = t.p[0].max(t.p[1]).max(t.p[2]);
+                BuildPrim {
+                    lo,
+                    hi,
+                    centroid: 0.5 * (lo + hi),
+                    id: i as u32,
+                }
+            })
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * prims.len() / MAX_LEAF + 1);
+        if !prims.is_empty() {
+            build_node(&mut nodes, &mut prims, 0, 0);
+        }
+        let ids: Vec<u32> = prims.iter().map(|p| p.id).collect();
+        let verts = ids.iter().map(|&i| triangles[i as usize].p).collect();
+        Self {
+            nodes,
+            verts,
+            ids,
+            triangles,
+        }
+    }
+
+    /// The triangles, in the order given to [`Bvh::build`] (hit indices refer to it).
+    pub fn triangles(&self) -> &[WorldTriangle] {
+        &self.triangles
+    }
+
+    /// Number of flattened nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// World bounds of everything in the hierarchy, or `None` when empty.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.nodes.first().map(|n| (Vec3::from(n.min), Vec3::from(n.max)))
+    }
+
+    /// Closest hit with `tmin < t < tmax`; ties at equal `t` go to the lowest triangle index.
+    pub fn intersect(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut tmax = tmax;
+        self.traverse(origin, dir, tmin, &mut tmax, true, |hit, tmax| {
+            let better = match best {
+                None => true,
+                Some(b) => hit.t < b.t || (hit.t == b.t && hit.triangle < b.triangle),
+            };
+            if better {
+                best = Some(hit);
+                // Keep equal-t candidates reachable for the tie-break.
+                *tmax = next_up(hit.t);
+            }
+            false
+        });
+        best
+    }
+
+    /// Any hit with `tmin < t < tmax` (shadow / visibility rays).
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> bool {
+        let mut found = false;
+        let mut tmax = tmax;
+        self.traverse(origin, dir, tmin, &mut tmax, false, |_, _| {
+            found = true;
+            true
+        });
+        found
+    }
+
+    /// All hits with `tmin < t < tmax`, sorted by (t, triangle), into `out` (cleared
+    /// first). A ray through an edge shared by two triangles may report both.
+    pub fn intersect_all(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, out: &mut Vec<Hit>) {
+        out.clear();
+        let mut tmax = tmax;
+        self.traverse(origin, dir, tmin, &mut tmax, false, |hit, _| {
+            out.push(hit);
+            false
+        });
+        out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.triangle.cmp(&b.triangle)));
+    }
+
+    /// The nearest hit strictly beyond `t_after` (and below `tmax`): step through
+    /// the surfaces along a ray one at a time. Surfaces at exactly `t_after` are
+    /// skipped, so coplanar duplicates never stall the walk.
+    pub fn next_hit(&self, origin: Vec3, dir: Vec3, t_after: f32, tmax: f32) -> Option<Hit> {
+        self.intersect(origin, dir, t_after, tmax)
+    }
+
+    /// Shared traversal: calls `on_hit(hit, &mut tmax)` for every triangle hit in
+    /// range (the callback may shrink `tmax`); stops when it returns true.
+    #[inline]
+    fn traverse(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        tmin: f32,
+        tmax: &mut f32,
+        ordered: bool,
+        mut on_hit: impl FnMut(Hit, &mut f32) -> bool,
+    ) {
+        if self.nodes.is_empty() || !(tmin <= *tmax) {
+            return;
+        }
+        let ray = Ray::new(origin, dir);
+        if ray.hit_box(&self.nodes[0], tmin, *tmax) == f32::INFINITY {
+            return;
+        }
+        let mut stack = [(0u32, 0f32); STACK];
+        let mut sp = 0usize;
+        let mut node = 0usize;
+        let mut node_near = tmin;
+        loop {
+            if node_near <= *tmax {
+                let n = &self.nodes[node];
+                if n.count > 0 {
+                    let first = n.first as usize;
+                    for i in first..first + n.count as usize {
+                        if let Some((t, b1, b2)) = ray.hit_triangle(&self.verts[i], tmin, *tmax) {
+                            let hit = Hit {
+                                t,
+                                triangle: self.ids[i],
+                                b1,
+                                b2,
+                            };
+                            if on_hit(hit, tmax) {
+                                return;
+                            }
+                        }
+                    }
+                } else {
+                    let (l, r) = (node + 1, n.first as usize);
+                    let tl = ray.hit_box(&self.nodes[l], tmin, *tmax);
+                    let tr = ray.hit_box(&self.nodes[r], tmin, *tmax);
+                    let (mut a, mut ta, mut b, mut tb) = (l, tl, r, tr);
+                    if ordered && tr < tl {
+                        std::mem::swap(&mut a, &mut b);
+                        std::mem::swap(&mut ta, &mut tb);
+                    }
+                    match (ta < f32::INFINITY, tb < f32::INFINITY) {
+                        (true, true) => {
+                            stack[sp] = (b as u32, tb);
+                            sp += 1;
+                            node = a;
+                            node_near = ta;
+                            continue;
+                        }
+                        (true, false) => {
+                            node = a;
+                            node_near = ta;
+                            continue;
+                        }
+                        (false, true) => {
+                            node = b;
+                            node_near = tb;
+                            continue;
+                        }
+                        (false, false) => {}
+                    }
+                }
+            }
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            node = stack[sp].0 as usize;
+            node_near = stack[sp].1;
+        }
+    }
+
+    /// Surface attributes of `hit` for a ray travelling along `dir`.
+    pub fn surface(&self, hit: &Hit, dir: Vec3) -> SurfaceHit {
+        let tri = &self.triangles[hit.triangle as usize];
+        let (b1, b2) = (hit.b1, hit.b2);
+        let b0 = 1.0 - b1 - b2;
+        let position = tri.p[0] * b0 + tri.p[1] * b1 + tri.p[2] * b2;
+        let cross = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]);
+        let geometric_normal = cross.normalize_or_zero();
+        let shading = (tri.n[0] * b0 + tri.n[1] * b1 + tri.n[2] * b2).normalize_or_zero();
+        let shading_normal = if shading == Vec3::ZERO || !shading.is_finite() {
+            geometric_normal
+        } else {
+            shading
+        };
+        let uv = [
+            tri.uv[0][0] * b0 + tri.uv[1][0] * b1 + tri.uv[2][0] * b2,
+            tri.uv[0][1] * b0 + tri.uv[1][1] * b1 + tri.uv[2][1] * b2,
+        ];
+        SurfaceHit {
+            t: hit.t,
+            triangle: hit.triangle,
+            position,
+            geometric_normal,
+            shading_normal,
+            front_face: cross.dot(dir) < 0.0,
+            uv,
+            material: tri.material,
+            object: tri.object,
+        }
+    }
+}
+
+/// The smallest float greater than finite `x`.
+fn next_up(x: f32) -> f32 {
+    if x == 0.0 {
+        f32::from_bits(1)
+    } else if x > 0.0 {
+        f32::from_bits(x.to_bits() + 1)
+    } else {
+        f32::from_bits(x.to_bits() - 1)
+    }
+}
+
+/// Recursively builds the subtree over `prims`, appending nodes depth-first and
+/// reordering `prims` into leaf order. Returns the node index.
+fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, depth: usize) -> usize {
+    let index = nodes.len();
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    let (mut clo, mut chi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for p in prims.iter() {
+        lo = lo.min(p.lo);
+        hi = hi.max(p.hi);
+        clo = clo.min(p.centroid);
+        chi = chi.max(p.centroid);
+    }
+    nodes.push(Node {
+        min: lo.into(),
+        first: offset as u32,
+        max: hi.into(),
+        count: prims.len() as u32,
+    });
+    let n = prims.len();
+    if n <= 1 {
+        return index;
+    }
+
+    let split = if depth > MAX_SAH_DEPTH {
+        None
+    } else {
+        sah_split(prims, lo, hi, clo, chi)
+    };
+    let mid = match split {
+        Some(None) => return index, // SAH prefers a leaf and it is small enough
+        Some(Some(mid)) => mid,
+        None => {
+            if n <= MAX_LEAF {
+                return index;
+            }
+            // Median split along the widest centroid axis (degenerate centroids
+            // or deep recursion): always balanced, so depth stays logarithmic.
+            let axis = (chi - clo).max_position();
+            prims.select_nth_unstable_by(n / 2, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
+            n / 2
+        }
+    };
+    let (left, right) = prims.split_at_mut(mid);
+    nodes[index].count = 0;
+    build_node(nodes, left, offset, depth + 1);
+    let r = build_node(nodes, right, offset + mid, depth + 1);
+    nodes[index].first = r as u32;
+    index
+}
+
+/// Binned SAH over centroids. `None`: no usable split (degenerate centroids);
+/// `Some(None)`: make a leaf; `Some(Some(mid))`: prims partitioned at `mid`.
+fn sah_split(prims: &mut [BuildPrim], lo: Vec3, hi: Vec3, clo: Vec3, chi: Vec3) -> Option<Option<usize>> {
+    let n = prims.len();
+    let extent = chi - clo;
+    let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, bin)
+    for axis in 0..3 {
+        if !(extent[axis] > 0.0) {
+            continue;
+        }
+        let scale = BINS as f32 / extent[axis];
+        let bin_of = |c: f32| (((c - clo[axis]) * scale) as usize).min(BINS - 1);
+        let mut bins = [Bin::EMPTY; BINS];
+        for p in prims.iter() {
+            let b = &mut bins[bin_of(p.centroid[axis])];
+            b.lo = b.lo.min(p.lo);
+            b.hi = b.hi.max(p.hi);
+            b.count += 1;
+        }
+        // Sweep from the right to get right-side areas, then from the left.
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0usize; BINS];
+        let (mut rlo, mut rhi, mut rc) = (Vec3::INFINITY, Vec3::NEG_INFINITY, 0);
+        for i in (1..BINS).rev() {
+            rlo = rlo.min(bins[i].lo);
+            rhi = rhi.max(bins[i].hi);
+            rc += bins[i].count;
+            right_area[i] = half_area(rlo, rhi);
+            right_count[i] = rc;
+        }
+        let (mut llo, mut lhi, mut lc) = (Vec3::INFINITY, Vec3::NEG_INFINITY, 0);
+        for i in 0..BINS - 1 {
+            llo = llo.min(bins[i].lo);
+            lhi = lhi.max(bins[i].hi);
+            lc += bins[i].count;
+            let rc = right_count[i + 1];
+            if lc == 0 || rc == 0 {
+                continue;
+            }
+            let cost = lc as f32 * half_area(llo, lhi) + rc as f32 * right_area[i + 1];
+            if best.is_none_or(|b| cost < b.0) {
+                best = Some((cost, axis, i + 1));
+            }
+        }
+    }
+    let (cost, axis, split_bin) = best?;
+    // Costs relative to the parent's area: traversal 1, intersection 1 per triangle.
+    let parent = half_area(lo, hi).max(f32::MIN_POSITIVE);
+    let split_cost = 1.0 + cost / parent;
+    if n <= MAX_LEAF && split_cost >= n as f32 {
+        return Some(None);
+    }
+    let scale = BINS as f32 / extent[axis];
+    let mut mid = 0;
+    for i in 0..n {
+        let b = (((prims[i].centroid[axis] - clo[axis]) * scale) as usize).min(BINS - 1);
+        if b < split_bin {
+            prims.swap(i, mid);
+            mid += 1;
+        }
+    }
+    if mid == 0 || mid == n {
+        return None;
+    }
+    Some(Some(mid))
+}

@@ -1,0 +1,339 @@
+//! Path-traced diffuse global illumination.
+//!
+//! Every surface is Lambertian with albedo ρ = `base_color × texture.rgb`
+//! (metallic, roughness, opacity and texture alpha are ignored). Light comes
+//! from:
+//!
+//! - `Light::Sun`: irradiance `illuminance × color` on a surface facing it,
+//!   arriving from `−direction`; a shadow ray to infinity;
+//! - `Light::Point`: `intensity × color / d²`;
+//! - `Light::Spot`: as a point light × `smoothstep(cos outer, cos inner, cos θ)`;
+//! - emissive triangles (materials with `emission`): radiance `emission` from the
+//!   front (counter-clockwise) face, sampled by next-event estimation with
+//!   probability ∝ area × luminance;
+//! - the sky: constant radiance `settings.sky` for every ray that leaves the scene.
+//!
+//! `Light::Rect` entries are hints for the GPU and are ignored: the reference
+//! sees the matching emissive geometry instead.
+//!
+//! Estimator (per pixel, `spp` paths through the pixel centre): vertex 0 is the
+//! primary hit. At each vertex k ≤ N (N = `bounces`) all analytic lights are
+//! evaluated with shadow rays and one emissive-triangle sample is taken (NEE),
+//! and a cosine-weighted bounce ray is traced; if it escapes it adds the sky
+//! (the environment light), if it hits a surface that surface becomes vertex
+//! k + 1 (when k < N). Emission is added only where the camera ray hits an
+//! emitter — everywhere else NEE accounts for it, so nothing is counted twice.
+//! Bounce directions below the geometric surface end the path.
+//!
+//! Split of the result: **direct** = emission seen by the camera ray + sky seen
+//! by the camera ray + all light reaching the primary hit straight from an
+//! emitter (NEE at vertex 0 and the sky through vertex 0's bounce ray);
+//! **indirect** = everything reflected at least once more (vertices ≥ 1);
+//! **total** = direct + indirect. N = 0 gives direct only.
+
+use glam::Vec3;
+use strata_scene::{Camera, ImageBuf, Light, Material};
+
+use crate::bvh::Bvh;
+use crate::sampling::{cosine_hemisphere, hash, triangle_barycentrics, Rng};
+use crate::Reference;
+
+/// Settings of the path tracer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GiSettings {
+    /// Paths per pixel (all through the pixel centre).
+    pub spp: u32,
+    /// Indirect bounces N (0 = direct lighting only).
+    pub bounces: u32,
+    pub seed: u64,
+    /// Russian roulette from vertex 3 on (unbiased; survival probability =
+    /// max throughput component, capped at 0.95).
+    pub russian_roulette: bool,
+}
+
+impl Default for GiSettings {
+    /// 64 paths per pixel, 4 bounces, seed 0, Russian roulette on.
+    fn default() -> Self {
+        Self {
+            spp: 64,
+            bounces: 4,
+            seed: 0,
+            russian_roulette: true,
+        }
+    }
+}
+
+/// The three linear-radiance RGB images of [`Reference::gi`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct GiImages {
+    pub total: ImageBuf,
+    pub direct: ImageBuf,
+    pub indirect: ImageBuf,
+}
+
+/// Emissive triangles with a CDF ∝ area × luminance(emission).
+pub(crate) struct EmissiveLights {
+    /// (triangle index, area, emitted radiance)
+    tris: Vec<(u32, f32, Vec3)>,
+    /// Inclusive prefix sums of the weights, normalised to end at 1.
+    cdf: Vec<f32>,
+    /// Σ weights.
+    total: f64,
+}
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+impl EmissiveLights {
+    pub(crate) fn new(bvh: &Bvh, materials: &[Material]) -> Self {
+        let mut tris = Vec::new();
+        let mut weights = Vec::new();
+        for (i, t) in bvh.triangles().iter().enumerate() {
+            let Some(m) = materials.get(t.material as usize) else {
+                continue;
+            };
+            let e = Vec3::from(m.emission).max(Vec3::ZERO);
+            let area = 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).length();
+            let w = area as f64 * luminance(e) as f64;
+            if w > 0.0 && w.is_finite() {
+                tris.push((i as u32, area, e));
+                weights.push(w);
+            }
+        }
+        let total: f64 = weights.iter().sum();
+        let mut acc = 0.0f64;
+        let cdf = weights
+            .iter()
+            .map(|w| {
+                acc += w;
+                (acc / total) as f32
+            })
+            .collect();
+        Self { tris, cdf, total }
+    }
+
+    /// Picks a light triangle for uniform `u`: (index into `tris`, probability).
+    fn pick(&self, u: f32) -> (usize, f32) {
+        let i = self.cdf.partition_point(|&c| c <= u).min(self.tris.len() - 1);
+        let w = self.tris[i].1 as f64 * luminance(self.tris[i].2) as f64;
+        (i, (w / self.total) as f32)
+    }
+
+    pub(crate) fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+}
+
+fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    if e1 <= e0 {
+        return if x >= e1 { 1.0 } else { 0.0 };
+    }
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+impl Reference<'_> {
+    /// Path-traced diffuse GI (linear RGB radiance): total, direct and indirect.
+    pub fn gi(&self, camera: &Camera, width: u32, height: u32, settings: &GiSettings) -> GiImages {
+        let px = self.for_each_pixel("GI", width, height, |x, y, rays| {
+            let dir = camera.pixel_dir(x, y, width, height);
+            let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
+            for s in 0..settings.spp {
+                let mut rng = Rng::new(hash(&[settings.seed, y as u64 * width as u64 + x as u64, s as u64]));
+                let (d, i) = self.trace_path(camera, dir, settings, &mut rng, rays);
+                direct += d;
+                indirect += i;
+            }
+            let k = 1.0 / settings.spp.max(1) as f32;
+            [direct * k, indirect * k]
+        });
+        let mut out = GiImages {
+            total: ImageBuf::new(width, height, 3),
+            direct: ImageBuf::new(width, height, 3),
+            indirect: ImageBuf::new(width, height, 3),
+        };
+        for (i, [d, ind]) in px.iter().enumerate() {
+            let t = *d + *ind;
+            out.direct.data[3 * i..3 * i + 3].copy_from_slice(&d.to_array());
+            out.indirect.data[3 * i..3 * i + 3].copy_from_slice(&ind.to_array());
+            out.total.data[3 * i..3 * i + 3].copy_from_slice(&t.to_array());
+        }
+        out
+    }
+
+    /// One path through the pixel-centre direction `dir`: (direct, indirect).
+    fn trace_path(
+        &self,
+        camera: &Camera,
+        dir: Vec3,
+        settings: &GiSettings,
+        rng: &mut Rng,
+        rays: &mut u64,
+    ) -> (Vec3, Vec3) {
+        let sky = Vec3::from(self.scene.settings.sky);
+        let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
+        *rays += 1;
+        let Some(h) = self.bvh.intersect(camera.eye, dir, camera.near, f32::INFINITY) else {
+            return (sky, indirect);
+        };
+        let mut hit = self.bvh.surface(&h, dir);
+        if hit.front_face {
+            direct += Vec3::from(self.material(hit.material).emission).max(Vec3::ZERO);
+        }
+        let mut wo = dir;
+        let mut throughput = Vec3::ONE;
+        for depth in 0..=settings.bounces {
+            let sink = if depth == 0 { &mut direct } else { &mut indirect };
+            let (n, ng) = hit.facing_normals(wo);
+            let albedo = self.albedo(&hit);
+            let p = hit.position + ng * self.epsilon;
+            *sink += throughput * albedo * self.direct_irradiance(p, n, ng, rng, rays) * std::f32::consts::FRAC_1_PI;
+
+            // Bounce: at the last vertex only to collect the sky.
+            let last = depth == settings.bounces;
+            if last && sky == Vec3::ZERO {
+                break;
+            }
+            let wi = cosine_hemisphere(n, rng.next_2d());
+            if wi.dot(ng) <= 0.0 {
+                break;
+            }
+            throughput *= albedo;
+            if throughput.max_element() <= 0.0 {
+                break;
+            }
+            *rays += 1;
+            let Some(next) = self.bvh.intersect(p, wi, 0.0, f32::INFINITY) else {
+                *sink += throughput * sky;
+                break;
+            };
+            if last {
+                break;
+            }
+            if settings.russian_roulette && depth >= 2 {
+                let q = throughput.max_element().min(0.95);
+                if rng.next_f32() >= q {
+                    break;
+                }
+                throughput /= q;
+            }
+            hit = self.bvh.surface(&next, wi);
+            wo = wi;
+        }
+        (direct, indirect)
+    }
+
+    /// Irradiance-like sum at `p` (already offset) from all lights, with shading
+    /// normal `n` and geometric normal `ng`: Σ E·max(n·l, 0)·V, to be multiplied
+    /// by ρ/π. Emissive triangles contribute one NEE sample.
+    fn direct_irradiance(&self, p: Vec3, n: Vec3, ng: Vec3, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+        let mut e = Vec3::ZERO;
+        for light in &self.scene.lights {
+            match *light {
+                Light::Sun {
+                    direction,
+                    color,
+                    illuminance,
+                } => {
+                    let l = -direction.normalize_or_zero();
+                    let c = n.dot(l);
+                    if c > 0.0 && l.dot(ng) > 0.0 {
+                        *rays += 1;
+                        if !self.bvh.occluded(p, l, 0.0, f32::INFINITY) {
+                            e += Vec3::from(color) * illuminance * c;
+                        }
+                    }
+                }
+                Light::Point {
+                    position,
+                    color,
+                    intensity,
+                } => {
+                    e += self.point_light(p, n, ng, position, Vec3::from(color) * intensity, rays, |_| 1.0);
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    color,
+                    intensity,
+                    inner_deg,
+                    outer_deg,
+                } => {
+                    let axis = direction.normalize_or_zero();
+                    let (ci, co) = (inner_deg.to_radians().cos(), outer_deg.to_radians().cos());
+                    e += self.point_light(p, n, ng, position, Vec3::from(color) * intensity, rays, |to_p| {
+                        smoothstep(co, ci, axis.dot(to_p))
+                    });
+                }
+                Light::Rect { .. } => {}
+            }
+        }
+        if !self.lights.is_empty() {
+            e += self.sample_emissive(p, n, ng, rng, rays);
+        }
+        e
+    }
+
+    /// Point-like light at `pos` with intensity `i`, times `cone(unit dir light→p)`.
+    #[allow(clippy::too_many_arguments)]
+    fn point_light(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        ng: Vec3,
+        pos: Vec3,
+        i: Vec3,
+        rays: &mut u64,
+        cone: impl Fn(Vec3) -> f32,
+    ) -> Vec3 {
+        let to_light = pos - p;
+        let d2 = to_light.length_squared();
+        if !(d2 > 0.0) {
+            return Vec3::ZERO;
+        }
+        let d = d2.sqrt();
+        let l = to_light / d;
+        let c = n.dot(l);
+        if c <= 0.0 || l.dot(ng) <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let k = cone(-l);
+        if k <= 0.0 {
+            return Vec3::ZERO;
+        }
+        *rays += 1;
+        if self.bvh.occluded(p, l, 0.0, d - self.epsilon) {
+            return Vec3::ZERO;
+        }
+        i * (k * c / d2)
+    }
+
+    /// One next-event-estimation sample of the emissive triangles.
+    fn sample_emissive(&self, p: Vec3, n: Vec3, ng: Vec3, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+        let (i, prob) = self.lights.pick(rng.next_f32());
+        let (tri_index, area, le) = self.lights.tris[i];
+        let tri = &self.bvh.triangles()[tri_index as usize];
+        let (b1, b2) = triangle_barycentrics(rng.next_2d());
+        let q = tri.p[0] * (1.0 - b1 - b2) + tri.p[1] * b1 + tri.p[2] * b2;
+        let nl = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize_or_zero();
+        let to_light = q - p;
+        let d2 = to_light.length_squared();
+        if !(d2 > 0.0) {
+            return Vec3::ZERO;
+        }
+        let d = d2.sqrt();
+        let l = to_light / d;
+        let c = n.dot(l);
+        let cl = -nl.dot(l); // one-sided: the light's front face must see p
+        if c <= 0.0 || cl <= 0.0 || l.dot(ng) <= 0.0 {
+            return Vec3::ZERO;
+        }
+        *rays += 1;
+        if self.bvh.occluded(p, l, 0.0, d - self.epsilon) {
+            return Vec3::ZERO;
+        }
+        // pdf over area = prob / area.
+        le * (c * cl / d2 * area / prob)
+    }
+}

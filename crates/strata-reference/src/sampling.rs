@@ -1,0 +1,139 @@
+//! Deterministic random numbers and sample warps.
+//!
+//! Every estimator seeds its generator from `(seed, pixel, sample, stream)`
+//! through a 64-bit hash, so results depend only on those inputs and never on
+//! how rayon schedules rows onto threads.
+
+use glam::Vec3;
+
+/// SplitMix64 finaliser: a bijective 64-bit mixer with good avalanche.
+#[inline]
+pub fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// Hashes a few integers into one 64-bit value (order-dependent).
+#[inline]
+pub fn hash(values: &[u64]) -> u64 {
+    let mut h = 0x243f_6a88_85a3_08d3u64;
+    for &v in values {
+        h = mix64(h ^ v.wrapping_add(0x9e37_79b9_7f4a_7c15));
+    }
+    h
+}
+
+/// Converts the top 24 bits of `bits` to a float in [0, 1).
+#[inline]
+pub fn unit_f32(bits: u64) -> f32 {
+    (bits >> 40) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// Small, fast SplitMix64 generator for path tracing.
+#[derive(Clone, Debug)]
+pub struct Rng {
+    state: u64,
+}
+
+impl Rng {
+    /// A generator whose stream is a pure function of `key` (use [`hash`]).
+    pub fn new(key: u64) -> Self {
+        Self { state: mix64(key) }
+    }
+
+    #[inline]
+    pub fn next_u64(&mut self) -> u64 {
+        self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        mix64(self.state)
+    }
+
+    /// Uniform float in [0, 1).
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        unit_f32(self.next_u64())
+    }
+
+    #[inline]
+    pub fn next_2d(&mut self) -> [f32; 2] {
+        [self.next_f32(), self.next_f32()]
+    }
+}
+
+/// Sample `i` of the R2 low-discrepancy sequence (Roberts 2018), rotated by
+/// `offset` (Cranley–Patterson rotation, toroidal shift in [0, 1)²).
+#[inline]
+pub fn r2(i: u32, offset: [f32; 2]) -> [f32; 2] {
+    const A1: f64 = 0.754_877_666_246_692_8; // 1/g, g = plastic number
+    const A2: f64 = 0.569_840_290_998_053_3; // 1/g²
+    let i = i as f64;
+    let u = (0.5 + A1 * i + offset[0] as f64).fract();
+    let v = (0.5 + A2 * i + offset[1] as f64).fract();
+    [u as f32, v as f32]
+}
+
+/// Per-pixel Cranley–Patterson offset for [`r2`].
+#[inline]
+pub fn pixel_offset(key: u64) -> [f32; 2] {
+    let h = mix64(key);
+    [unit_f32(h), unit_f32(mix64(h))]
+}
+
+/// An orthonormal basis (t, b) completing unit vector `n` (Duff et al. 2017).
+#[inline]
+pub fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let t = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let bt = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+    (t, bt)
+}
+
+/// Cosine-weighted direction on the hemisphere around unit `n` (pdf = cos θ / π),
+/// by Malley's method: a uniform disk point lifted to the hemisphere.
+#[inline]
+pub fn cosine_hemisphere(n: Vec3, u: [f32; 2]) -> Vec3 {
+    let r = u[0].sqrt();
+    let phi = std::f32::consts::TAU * u[1];
+    let (x, y) = (r * phi.cos(), r * phi.sin());
+    let z = (1.0 - u[0]).max(0.0).sqrt();
+    let (t, b) = basis(n);
+    (t * x + b * y + n * z).normalize()
+}
+
+/// Uniform point on a triangle as barycentric weights (b1, b2) of vertices 1 and 2.
+#[inline]
+pub fn triangle_barycentrics(u: [f32; 2]) -> (f32, f32) {
+    let s = u[0].sqrt();
+    (u[1] * s, 1.0 - s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cosine_samples_are_unit_and_above() {
+        let n = Vec3::new(0.3, -0.8, 0.52).normalize();
+        let mut rng = Rng::new(7);
+        let mut mean_cos = 0.0;
+        for _ in 0..20_000 {
+            let d = cosine_hemisphere(n, rng.next_2d());
+            assert!((d.length() - 1.0).abs() < 1e-5);
+            assert!(d.dot(n) >= -1e-6);
+            mean_cos += d.dot(n) as f64;
+        }
+        // E[cos θ] under pdf cos θ / π is 2/3.
+        assert!((mean_cos / 20_000.0 - 2.0 / 3.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn basis_is_orthonormal() {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(1.0, 2.0, -3.0).normalize()] {
+            let (t, b) = basis(n);
+            assert!(t.dot(n).abs() < 1e-6 && b.dot(n).abs() < 1e-6 && t.dot(b).abs() < 1e-6);
+            assert!((t.length() - 1.0).abs() < 1e-6 && (b.length() - 1.0).abs() < 1e-6);
+        }
+    }
+}

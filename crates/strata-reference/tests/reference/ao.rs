@@ -1,0 +1,206 @@
+use glam::Vec3;
+use strata_reference::{AoBinarySettings, DiskSampling, ObscuranceSettings, Reference};
+use strata_scene::{Camera, Material, Scene};
+
+use crate::scenes::*;
+
+fn plane_scene() -> Scene {
+    let mut s = scene_with(vec![Material::diffuse("white", [0.8; 3])], top_camera(3.0, 60.0));
+    add_triangles(&mut s, "floor", &floor(50.0), 0);
+    s
+}
+
+/// Floor (y = 0, x ∈ [−H, H]) and a wall in the plane x = 0 rising from it,
+/// facing +X (front faces towards the open side x > 0).
+fn corner_scene(h: f32) -> Scene {
+    let mut s = scene_with(
+        vec![Material::diffuse("white", [0.8; 3])],
+        Camera::new(Vec3::new(4.0, 3.0, 0.0), Vec3::new(0.0, 0.0, 0.0), Vec3::Y, 60.0, 0.05),
+    );
+    add_triangles(&mut s, "floor", &floor(h), 0);
+    add_triangles(
+        &mut s,
+        "wall",
+        &quad(Vec3::new(0.0, h, 0.0), Vec3::new(0.0, h, 0.0), Vec3::new(0.0, 0.0, h)),
+        0,
+    );
+    s
+}
+
+#[test]
+fn unoccluded_plane_has_full_visibility() {
+    let scene = plane_scene();
+    let r = Reference::new(&scene, 0.0);
+    let cam = r.camera();
+    let a = r.ao_binary(
+        &cam,
+        32,
+        32,
+        &AoBinarySettings {
+            radius: 2.0,
+            spp: 32,
+            seed: 1,
+        },
+    );
+    assert!(
+        a.data.iter().all(|&v| v == 1.0),
+        "binary AO of a lone plane is exactly 1"
+    );
+    for disk in [DiskSampling::UniformArea, DiskSampling::SpiralRadius] {
+        let o = r.ao_obscurance(
+            &cam,
+            32,
+            32,
+            &ObscuranceSettings {
+                spp: 32,
+                disk,
+                ..ObscuranceSettings::new(2.0)
+            },
+        );
+        assert!(
+            o.data.iter().all(|&v| v == 1.0),
+            "DGB obscurance of a lone plane is exactly 1"
+        );
+    }
+}
+
+#[test]
+fn empty_scene_is_background_everywhere() {
+    let scene = Scene::default();
+    let r = Reference::new(&scene, 0.0);
+    let cam = r.camera();
+    assert!(r
+        .ao_binary(&cam, 8, 8, &AoBinarySettings::default())
+        .data
+        .iter()
+        .all(|&v| v == 1.0));
+    assert!(r
+        .ao_obscurance(&cam, 8, 8, &ObscuranceSettings::default())
+        .data
+        .iter()
+        .all(|&v| v == 1.0));
+    let gi = r.gi(&cam, 8, 8, &Default::default());
+    assert!(gi.total.data.iter().all(|&v| v == 0.0)); // default sky is black
+    let l = r.layers(&cam, 8, 8, &Default::default());
+    assert!(l.layers.iter().all(|l| l.depth.data.iter().all(|d| d.is_infinite())));
+    let _ = r.ao_binary(&cam, 0, 0, &AoBinarySettings::default());
+}
+
+#[test]
+fn corner_is_darker_than_open_floor() {
+    let scene = corner_scene(20.0);
+    let r = Reference::new(&scene, 0.0);
+    let s = AoBinarySettings {
+        radius: 1.0,
+        spp: 256,
+        seed: 3,
+    };
+    let at = |x: f32| r.ao_binary_at(Vec3::new(x, 0.0, 0.0), Vec3::Y, Vec3::Y, &s, 11);
+    let (near, mid, far) = (at(0.05), at(0.4), at(3.0));
+    assert!(near < mid && mid < far, "near {near} mid {mid} far {far}");
+    assert_eq!(far, 1.0);
+
+    // Image version: pixels whose primary hit is close to the wall are darker.
+    let cam = r.camera();
+    let img = r.ao_binary(
+        &cam,
+        48,
+        48,
+        &AoBinarySettings {
+            radius: 1.0,
+            spp: 64,
+            seed: 3,
+        },
+    );
+    let (mut close, mut open) = (Vec::new(), Vec::new());
+    for y in 0..48 {
+        for x in 0..48 {
+            if let Some(h) = r.primary_hit(&cam, x, y, 48, 48) {
+                if h.position.y.abs() < 1e-4 && h.position.z.abs() < 2.0 {
+                    let v = img.pixel(x, y)[0];
+                    if h.position.x < 0.2 {
+                        close.push(v);
+                    } else if h.position.x > 1.5 {
+                        open.push(v);
+                    }
+                }
+            }
+        }
+    }
+    let avg = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
+    assert!(!close.is_empty() && !open.is_empty());
+    assert!(
+        avg(&close) < avg(&open) - 0.1,
+        "close {} open {}",
+        avg(&close),
+        avg(&open)
+    );
+
+    // Obscurance estimator: also darker near the wall, 1 far from it.
+    let o = ObscuranceSettings {
+        spp: 128,
+        ..ObscuranceSettings::new(1.0)
+    };
+    let oat = |x: f32| r.ao_obscurance_at(&cam, Vec3::new(x, 0.0, 0.0), Vec3::Y, &o, 5).0;
+    assert!(oat(0.05) < oat(0.5), "{} {}", oat(0.05), oat(0.5));
+    assert_eq!(oat(3.0), 1.0);
+}
+
+#[test]
+fn corner_edge_visibility_is_one_half() {
+    // At the inner edge of a 90° wedge, cosine-weighted visibility is 1/2 for a
+    // large radius (the wall removes exactly the half-hemisphere x < 0).
+    let scene = corner_scene(1000.0);
+    let r = Reference::new(&scene, 0.0);
+    let s = AoBinarySettings {
+        radius: 500.0,
+        spp: 4096,
+        seed: 9,
+    };
+    let v = r.ao_binary_at(Vec3::new(1e-3, 0.0, 0.0), Vec3::Y, Vec3::Y, &s, 1);
+    assert!((v - 0.5).abs() < 0.05, "visibility at the edge {v}");
+}
+
+#[test]
+fn ao_is_deterministic_across_thread_counts() {
+    let scene = corner_scene(20.0);
+    let r = Reference::new(&scene, 0.0);
+    let cam = r.camera();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            (
+                r.ao_binary(
+                    &cam,
+                    24,
+                    24,
+                    &AoBinarySettings {
+                        radius: 1.0,
+                        spp: 16,
+                        seed: 5,
+                    },
+                ),
+                r.ao_obscurance(
+                    &cam,
+                    24,
+                    24,
+                    &ObscuranceSettings {
+                        spp: 16,
+                        ..ObscuranceSettings::new(1.0)
+                    },
+                ),
+                r.gi(
+                    &cam,
+                    12,
+                    12,
+                    &strata_reference::GiSettings {
+                        spp: 4,
+                        ..Default::default()
+                    },
+                ),
+            )
+        })
+    };
+    assert_eq!(run(1), run(2));
+    assert!(r.stats().rays > 0);
+}

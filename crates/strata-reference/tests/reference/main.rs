@@ -1,0 +1,8 @@
+//! Property tests of the CPU reference against brute force and analytic results.
+//! One test binary (faster to link); one module per oracle.
+
+mod ao;
+mod bvh;
+mod gi;
+mod layers;
+mod scenes;

@@ -1,0 +1,179 @@
+//! A frame: per-frame uniforms, the render targets, and the visible list of
+//! passes with their declared inputs and outputs.
+
+use std::collections::BTreeMap;
+
+use strata_scene::{Camera, Scene};
+
+use crate::gpu::GpuContext;
+
+/// Mirrors `shaders/common/frame.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FrameUniforms {
+    pub view: [[f32; 4]; 4],
+    pub proj: [[f32; 4]; 4],
+    pub view_proj: [[f32; 4]; 4],
+    pub inv_view_proj: [[f32; 4]; 4],
+    pub prev_view_proj: [[f32; 4]; 4],
+    pub eye: [f32; 4],
+    pub cam_right: [f32; 4],
+    pub cam_up: [f32; 4],
+    pub cam_forward: [f32; 4],
+    pub size: [f32; 4],
+    pub sky: [f32; 4],
+    pub ambient: [f32; 4],
+}
+
+impl FrameUniforms {
+    pub fn new(
+        scene: &Scene,
+        camera: &Camera,
+        prev: &Camera,
+        width: u32,
+        height: u32,
+        frame: f32,
+        exposure: f32,
+    ) -> Self {
+        let aspect = width as f32 / height as f32;
+        let vp = camera.view_projection(aspect);
+        let (r, u, f) = camera.basis();
+        let t = (0.5 * camera.fov_y_deg.to_radians()).tan();
+        let s = &scene.settings;
+        Self {
+            view: camera.view().to_cols_array_2d(),
+            proj: camera.projection(aspect).to_cols_array_2d(),
+            view_proj: vp.to_cols_array_2d(),
+            inv_view_proj: vp.inverse().to_cols_array_2d(),
+            prev_view_proj: prev.view_projection(aspect).to_cols_array_2d(),
+            eye: camera.eye.extend(camera.near).to_array(),
+            cam_right: (r * t * aspect).extend(0.0).to_array(),
+            cam_up: (u * t).extend(0.0).to_array(),
+            cam_forward: f.extend(0.0).to_array(),
+            size: [width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32],
+            sky: [s.sky[0], s.sky[1], s.sky[2], exposure],
+            ambient: [s.ambient[0], s.ambient[1], s.ambient[2], frame],
+        }
+    }
+}
+
+/// How a target's texels read back as floats (for debug views and tests).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Decode {
+    /// Raw float channels.
+    Float,
+    /// UNORM8 channels → [0,1] (sRGB formats are decoded to linear).
+    Unorm,
+}
+
+/// Declaration of a render target a pass writes.
+#[derive(Clone, Copy, Debug)]
+pub struct TargetDesc {
+    pub name: &'static str,
+    pub format: wgpu::TextureFormat,
+    pub layers: u32,
+    pub doc: &'static str,
+}
+
+/// A created render target.
+pub struct Target {
+    pub desc: TargetDesc,
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+}
+
+/// All targets of a frame, by name.
+#[derive(Default)]
+pub struct Targets {
+    pub width: u32,
+    pub height: u32,
+    map: BTreeMap<&'static str, Target>,
+}
+
+impl Targets {
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            map: BTreeMap::new(),
+        }
+    }
+
+    pub fn create(&mut self, gpu: &GpuContext, desc: TargetDesc) {
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(desc.name),
+            size: wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: desc.layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: desc.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(if desc.layers > 1 {
+                wgpu::TextureViewDimension::D2Array
+            } else {
+                wgpu::TextureViewDimension::D2
+            }),
+            ..Default::default()
+        });
+        self.map.insert(desc.name, Target { desc, texture, view });
+    }
+
+    pub fn get(&self, name: &str) -> &Target {
+        self.map
+            .get(name)
+            .unwrap_or_else(|| panic!("render target '{name}' was not declared by any pass"))
+    }
+
+    pub fn try_get(&self, name: &str) -> Option<&Target> {
+        self.map.get(name)
+    }
+
+    pub fn names(&self) -> impl Iterator<Item = &&'static str> {
+        self.map.keys()
+    }
+}
+
+/// What a pass reads and writes, shown by `strata render --list-passes` and checked
+/// when the frame is built (every input must be written by an earlier pass).
+#[derive(Clone, Debug)]
+pub struct PassInfo {
+    pub name: &'static str,
+    pub inputs: Vec<&'static str>,
+    pub outputs: Vec<&'static str>,
+}
+
+/// One technique's pass in the frame.
+pub trait Pass {
+    fn info(&self) -> PassInfo;
+    /// Records the pass's GPU work for the current frame.
+    fn encode(
+        &self,
+        gpu: &GpuContext,
+        scene: &crate::scene_gpu::GpuScene,
+        targets: &Targets,
+        encoder: &mut wgpu::CommandEncoder,
+    );
+}
+
+/// Checks the declared data flow of an ordered pass list.
+pub fn validate_pass_order(infos: &[PassInfo]) -> Result<(), String> {
+    let mut written: Vec<&str> = vec!["scene"];
+    for p in infos {
+        for i in &p.inputs {
+            if !written.contains(i) {
+                return Err(format!("pass '{}' reads '{}' before any pass writes it", p.name, i));
+            }
+        }
+        written.extend(p.outputs.iter().copied());
+    }
+    Ok(())
+}

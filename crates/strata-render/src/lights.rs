@@ -1,0 +1,154 @@
+//! Lights as the GPU sees them, with shadow-map matrices.
+//!
+//! Shadowed: the sun (orthographic map fitted to the scene bounds), spot lights and
+//! rectangular area lights (perspective maps). Point lights are unshadowed.
+//! A `Rect` light is shaded as a point light with a cosine emission lobe
+//! (intensity L·A·cosθ) at its centre — the analytic direct term; its true area
+//! is integrated by the CPU reference and later by radiosity.
+
+use glam::camera::rh::proj::directx;
+use glam::{Mat4, Vec3};
+use strata_scene::{Light, Scene};
+
+pub const KIND_SUN: u32 = 0;
+pub const KIND_POINT: u32 = 1;
+pub const KIND_SPOT: u32 = 2;
+pub const KIND_RECT: u32 = 3;
+
+/// `GpuLight` in `lighting.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuLight {
+    /// kind, shadow layer (u32::MAX = none), 0, 0
+    pub kind: [u32; 4],
+    /// xyz position (point/spot/rect)
+    pub position: [f32; 4],
+    /// xyz: direction light travels (sun, spot axis) or the rect's normal
+    pub direction: [f32; 4],
+    /// rgb intensity × colour (sun: irradiance; point/spot: W/sr; rect: radiance × area)
+    pub color: [f32; 4],
+    /// cos(outer), cos(inner), shadow texel size in world units at distance 1 (or absolute for sun), 0
+    pub cone: [f32; 4],
+    pub shadow_view_proj: [[f32; 4]; 4],
+}
+
+pub const NO_SHADOW: u32 = u32::MAX;
+
+/// Converts the scene's lights, assigning shadow-map layers in order.
+pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuLight> {
+    let (lo, hi) = scene.bounds(frame);
+    let (center, radius) = if lo.is_finite() && hi.is_finite() {
+        ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3))
+    } else {
+        (Vec3::ZERO, 1.0)
+    };
+    let mut layer = 0u32;
+    let mut next_layer = || {
+        layer += 1;
+        layer - 1
+    };
+    let res = shadow_resolution as f32;
+    scene
+        .lights
+        .iter()
+        .map(|l| match *l {
+            Light::Sun {
+                direction,
+                color,
+                illuminance,
+            } => {
+                let d = direction.normalize();
+                let eye = center - d * radius * 2.0;
+                let view = look_at(eye, center, d);
+                let proj = directx::orthographic(-radius, radius, -radius, radius, radius * 0.5, radius * 3.5);
+                GpuLight {
+                    kind: [KIND_SUN, next_layer(), 0, 0],
+                    position: [0.0; 4],
+                    direction: d.extend(0.0).to_array(),
+                    color: [
+                        color[0] * illuminance,
+                        color[1] * illuminance,
+                        color[2] * illuminance,
+                        0.0,
+                    ],
+                    cone: [0.0, 0.0, 2.0 * radius / res, 0.0],
+                    shadow_view_proj: (proj * view).to_cols_array_2d(),
+                }
+            }
+            Light::Point {
+                position,
+                color,
+                intensity,
+            } => GpuLight {
+                kind: [KIND_POINT, NO_SHADOW, 0, 0],
+                position: position.extend(1.0).to_array(),
+                direction: [0.0; 4],
+                color: [color[0] * intensity, color[1] * intensity, color[2] * intensity, 0.0],
+                cone: [-2.0, -1.0, 0.0, 0.0],
+                shadow_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
+            },
+            Light::Spot {
+                position,
+                direction,
+                color,
+                intensity,
+                inner_deg,
+                outer_deg,
+            } => {
+                let d = direction.normalize();
+                let fov = (2.0 * outer_deg).clamp(1.0, 150.0).to_radians();
+                let (view, proj) = perspective_shadow(position, d, fov, radius, center);
+                GpuLight {
+                    kind: [KIND_SPOT, next_layer(), 0, 0],
+                    position: position.extend(1.0).to_array(),
+                    direction: d.extend(0.0).to_array(),
+                    color: [color[0] * intensity, color[1] * intensity, color[2] * intensity, 0.0],
+                    cone: [
+                        outer_deg.to_radians().cos(),
+                        inner_deg.to_radians().cos(),
+                        2.0 * (fov * 0.5).tan() / res,
+                        0.0,
+                    ],
+                    shadow_view_proj: (proj * view).to_cols_array_2d(),
+                }
+            }
+            Light::Rect {
+                center: c,
+                half_u,
+                half_v,
+                radiance,
+            } => {
+                let n = half_u.cross(half_v);
+                let area = 4.0 * n.length();
+                let n = n.normalize();
+                let fov = 150f32.to_radians();
+                let pos = c + n * 1e-4 * radius;
+                let (view, proj) = perspective_shadow(pos, n, fov, radius, center);
+                GpuLight {
+                    kind: [KIND_RECT, next_layer(), 0, 0],
+                    position: pos.extend(1.0).to_array(),
+                    direction: n.extend(0.0).to_array(),
+                    color: [radiance[0] * area, radiance[1] * area, radiance[2] * area, 0.0],
+                    cone: [0.0, 0.0, 2.0 * (fov * 0.5).tan() / res, 0.0],
+                    shadow_view_proj: (proj * view).to_cols_array_2d(),
+                }
+            }
+        })
+        .collect()
+}
+
+fn look_at(eye: Vec3, target: Vec3, dir: Vec3) -> Mat4 {
+    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    glam::camera::rh::view::look_at_mat4(eye, target, up)
+}
+
+fn perspective_shadow(pos: Vec3, dir: Vec3, fov: f32, scene_radius: f32, scene_center: Vec3) -> (Mat4, Mat4) {
+    let far = (pos - scene_center).length() + scene_radius * 1.01;
+    let near = (far * 1e-4).max(1e-4);
+    (look_at(pos, pos + dir, dir), directx::perspective(fov, 1.0, near, far))
+}
+
+/// Number of shadow-map layers the lights need.
+pub fn shadow_layer_count(lights: &[GpuLight]) -> u32 {
+    lights.iter().filter(|l| l.kind[1] != NO_SHADOW).count() as u32
+}

@@ -1,0 +1,168 @@
+// Deferred direct lighting: Lambert + a GGX specular lobe, shadows, emission,
+// a constant ambient term and the sky behind everything.
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
+#import "common/fullscreen.wgsl"
+
+struct GpuLight {
+    // kind, shadow layer (0xffffffff = none)
+    kind: vec4u,
+    position: vec4f,
+    // direction light travels (sun, spot axis) or rect normal
+    direction: vec4f,
+    // intensity x colour
+    color: vec4f,
+    // cos outer, cos inner, shadow texel size, 0
+    cone: vec4f,
+    shadow_view_proj: mat4x4f,
+}
+
+struct LightingParams {
+    light_count: u32,
+    // 1 = add the specular lobe to `hdr`
+    specular: u32,
+    // PCF kernel radius in texels (0 = single bilinear comparison)
+    pcf_radius: i32,
+    shadow_size: f32,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var csz_tex: texture_2d<f32>;
+@group(1) @binding(1) var normal_tex: texture_2d<f32>;
+@group(1) @binding(2) var albedo_tex: texture_2d<f32>;
+@group(1) @binding(3) var emission_tex: texture_2d<f32>;
+@group(1) @binding(4) var<storage, read> lights: array<GpuLight>;
+@group(1) @binding(5) var shadow_maps: texture_depth_2d_array;
+@group(1) @binding(6) var shadow_sampler: sampler_comparison;
+@group(1) @binding(7) var<uniform> params: LightingParams;
+
+const PI: f32 = 3.14159265358979;
+const NO_SHADOW: u32 = 0xffffffffu;
+
+fn shadow_visibility(l: GpuLight, p: vec3f, n: vec3f, dist: f32) -> f32 {
+    if (l.kind.y == NO_SHADOW) {
+        return 1.0;
+    }
+    // Normal offset of ~1.5 shadow texels (texel size grows with distance for perspective maps).
+    var texel = l.cone.z;
+    if (l.kind.x != 0u) {
+        texel = texel * dist;
+    }
+    let q = p + n * texel * 1.5;
+    let c = l.shadow_view_proj * vec4f(q, 1.0);
+    let ndc = c.xyz / c.w;
+    if (c.w <= 0.0 || any(abs(ndc.xy) > vec2f(1.0)) || ndc.z > 1.0) {
+        return 1.0;
+    }
+    let uv = vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    let r = params.pcf_radius;
+    var sum = 0.0;
+    var count = 0.0;
+    for (var y = -r; y <= r; y++) {
+        for (var x = -r; x <= r; x++) {
+            let o = vec2f(f32(x), f32(y)) / params.shadow_size;
+            sum += textureSampleCompareLevel(shadow_maps, shadow_sampler, uv + o, i32(l.kind.y), ndc.z);
+            count += 1.0;
+        }
+    }
+    return sum / count;
+}
+
+// GGX / Smith-correlated specular BRDF times cos, Schlick Fresnel.
+fn specular_brdf(n: vec3f, v: vec3f, l: vec3f, roughness: f32, f0: vec3f) -> vec3f {
+    let h = normalize(v + l);
+    let a = max(roughness * roughness, 0.002);
+    let a2 = a * a;
+    let nh = max(dot(n, h), 0.0);
+    let nv = max(dot(n, v), 1e-4);
+    let nl = max(dot(n, l), 0.0);
+    let d = a2 / (PI * pow(nh * nh * (a2 - 1.0) + 1.0, 2.0));
+    let gv = nl * sqrt(nv * nv * (1.0 - a2) + a2);
+    let gl = nv * sqrt(nl * nl * (1.0 - a2) + a2);
+    let vis = 0.5 / max(gv + gl, 1e-5);
+    let f = f0 + (1.0 - f0) * pow(1.0 - max(dot(v, h), 0.0), 5.0);
+    return d * vis * f;
+}
+
+struct LightingOut {
+    // total HDR radiance
+    @location(0) hdr: vec4f,
+    // Lambertian direct outgoing radiance (the radiosity pass's initial B)
+    @location(1) direct_diffuse: vec4f,
+    // visibility of light 0 (shadow debug view)
+    @location(2) shadow: vec4f,
+}
+
+@fragment
+fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
+    let px = vec2i(frag.xy);
+    let z = textureLoad(csz_tex, px, 0).r;
+    var o: LightingOut;
+    if (z <= 0.0) {
+        o.hdr = vec4f(frame.sky.rgb, 1.0);
+        o.direct_diffuse = vec4f(0.0);
+        o.shadow = vec4f(1.0);
+        return o;
+    }
+    let p = world_from_csz(frame, frag.xy, z);
+    let nrm = textureLoad(normal_tex, px, 0);
+    let n = oct_decode(nrm.xy);
+    let roughness = nrm.z;
+    let metallic = nrm.w;
+    let albedo = textureLoad(albedo_tex, px, 0).rgb;
+    let emission = textureLoad(emission_tex, px, 0).rgb;
+    let v = normalize(frame.eye.xyz - p);
+    let diffuse_albedo = albedo * (1.0 - metallic);
+    let f0 = mix(vec3f(0.04), albedo, metallic);
+
+    var diffuse = vec3f(0.0);
+    var spec = vec3f(0.0);
+    var shadow0 = 1.0;
+    for (var i = 0u; i < params.light_count; i++) {
+        let li = lights[i];
+        var l: vec3f;
+        var e: vec3f;
+        var dist = 1.0;
+        switch li.kind.x {
+            case 0u: {
+                l = -li.direction.xyz;
+                e = li.color.rgb;
+            }
+            default: {
+                let d = li.position.xyz - p;
+                dist = length(d);
+                l = d / dist;
+                var falloff = 1.0 / (dist * dist);
+                if (li.kind.x == 2u) {
+                    falloff *= smoothstep(li.cone.x, li.cone.y, dot(-l, li.direction.xyz));
+                } else if (li.kind.x == 3u) {
+                    falloff *= max(dot(-l, li.direction.xyz), 0.0);
+                }
+                e = li.color.rgb * falloff;
+            }
+        }
+        let nl = dot(n, l);
+        var vis = 0.0;
+        if (nl > 0.0) {
+            vis = shadow_visibility(li, p, n, dist);
+        }
+        if (i == 0u) {
+            shadow0 = vis;
+        }
+        if (nl <= 0.0) {
+            continue;
+        }
+        let irradiance = e * nl * vis;
+        diffuse += irradiance;
+        spec += specular_brdf(n, v, l, roughness, f0) * irradiance;
+    }
+    let lambert = diffuse_albedo / PI * diffuse;
+    var total = lambert + emission + frame.ambient.rgb * diffuse_albedo;
+    if (params.specular == 1u) {
+        total += spec;
+    }
+    o.hdr = vec4f(total, 1.0);
+    o.direct_diffuse = vec4f(lambert, 1.0);
+    o.shadow = vec4f(shadow0, shadow0, shadow0, 1.0);
+    return o;
+}

@@ -1,0 +1,254 @@
+//! Deferred direct lighting over the G-buffer: Lambert + GGX specular, shadow
+//! maps with PCF, emission, constant ambient, sky.
+
+use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::lights::GpuLight;
+use crate::passes::shadow::ShadowPass;
+use crate::scene_gpu::GpuScene;
+
+/// Lighting settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightingSettings {
+    /// Add the GGX specular lobe to the HDR output (default true).
+    pub specular: bool,
+    /// PCF kernel radius in shadow texels (default 1 → 3×3 bilinear comparisons).
+    pub pcf_radius: i32,
+}
+
+impl Default for LightingSettings {
+    fn default() -> Self {
+        Self {
+            specular: true,
+            pcf_radius: 1,
+        }
+    }
+}
+
+pub const OUTPUTS: &[TargetDesc] = &[
+    TargetDesc {
+        name: "hdr",
+        format: wgpu::TextureFormat::Rgba16Float,
+        layers: 1,
+        doc: "direct + emission + ambient (linear)",
+    },
+    TargetDesc {
+        name: "direct-diffuse",
+        format: wgpu::TextureFormat::Rgba16Float,
+        layers: 1,
+        doc: "Lambertian direct outgoing radiance",
+    },
+    TargetDesc {
+        name: "shadow",
+        format: wgpu::TextureFormat::R16Float,
+        layers: 1,
+        doc: "visibility of light 0",
+    },
+];
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    light_count: u32,
+    specular: u32,
+    pcf_radius: i32,
+    shadow_size: f32,
+}
+
+pub struct LightingPass {
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    lights: wgpu::Buffer,
+}
+
+impl LightingPass {
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        shadow: &ShadowPass,
+        lights: &[GpuLight],
+        shadow_resolution: u32,
+        settings: &LightingSettings,
+    ) -> Self {
+        let device = &gpu.device;
+        let tex = |b: u32, filterable: bool| wgpu::BindGroupLayoutEntry {
+            binding: b,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lighting"),
+            entries: &[
+                tex(0, false),
+                tex(1, false),
+                tex(2, false),
+                tex(3, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 6,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let mut light_data = lights.to_vec();
+        if light_data.is_empty() {
+            light_data.push(bytemuck::Zeroable::zeroed());
+        }
+        let lights_buf = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("lights"),
+                contents: bytemuck::cast_slice(&light_data),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            },
+        );
+        let params = Params {
+            light_count: lights.len() as u32,
+            specular: settings.specular as u32,
+            pcf_radius: settings.pcf_radius.clamp(0, 4),
+            shadow_size: shadow_resolution as f32,
+        };
+        let params_buf = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("lighting params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            },
+        );
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let view = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).view);
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lighting"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: view("csz"),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: view("normal"),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: view("albedo"),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: view("emission"),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: lights_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&shadow.array_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: params_buf.as_entire_binding(),
+                },
+            ],
+        });
+        let module = crate::shader::module(device, "lighting", include_str!("lighting.wgsl"));
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lighting"),
+            bind_group_layouts: &[Some(&scene.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let targets_fmt: Vec<Option<wgpu::ColorTargetState>> = OUTPUTS
+            .iter()
+            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
+            .collect();
+        let pipeline = crate::passes::fullscreen_pipeline(device, "lighting", &pl, &module, &targets_fmt);
+        Self {
+            pipeline,
+            group,
+            lights: lights_buf,
+        }
+    }
+
+    pub fn update_lights(&self, gpu: &GpuContext, lights: &[GpuLight]) {
+        if !lights.is_empty() {
+            gpu.queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));
+        }
+    }
+}
+
+impl Pass for LightingPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: "lighting",
+            inputs: vec!["csz", "normal", "albedo", "emission", "shadow-maps"],
+            outputs: OUTPUTS.iter().map(|t| t.name).collect(),
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let att: Vec<_> = OUTPUTS
+            .iter()
+            .map(|t| crate::passes::clear_attachment(&targets.get(t.name).view))
+            .collect();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("lighting"),
+            color_attachments: &att,
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

@@ -1,0 +1,40 @@
+//! Shared helpers for GPU tests (run on lavapipe when no GPU is present).
+#![allow(dead_code)]
+
+use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+use strata_scene::{Camera, Scene};
+
+/// Opens the GPU. Tests fail (never skip) without one: `scripts/test.sh` installs lavapipe.
+pub fn gpu() -> GpuContext {
+    GpuContext::new(&GpuOptions::default()).expect("a Vulkan adapter (scripts/test.sh installs Mesa lavapipe)")
+}
+
+/// Renders `scene` with `camera` at frame 0; panics on any wgpu validation error.
+pub fn render(gpu: &GpuContext, scene: &Scene, camera: &Camera, w: u32, h: u32) -> Renderer {
+    let mut r = Renderer::new(
+        gpu,
+        scene,
+        RenderSettings {
+            width: w,
+            height: h,
+            ..Default::default()
+        },
+    )
+    .expect("renderer builds without validation errors");
+    r.render(gpu, scene, camera, camera, 0.0)
+        .expect("frame renders without validation errors");
+    r
+}
+
+/// `../shared/scenes/<rel>` next to the repository, if present.
+pub fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/scenes")
+        .join(rel);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!("skipping: shared scene not found at {}", p.display());
+        None
+    }
+}

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The main job: renders the default scene (atrium) and writes images + a report
+# to out/demo/ (override with OUT=dir). Re-running replaces that folder's files.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source scripts/setup.sh
+OUT="${OUT:-out/demo}"
+W="${W:-640}"; H="${H:-360}"
+mkdir -p "$OUT"
+echo "[strata demo] building the strata CLI (release)" >&2
+cargo build --release -q -p strata-cli
+S=target/release/strata
+echo "[strata demo] device:" >&2
+$S info | tee "$OUT/info.txt"
+echo "[strata demo] rendering atrium ${W}x${H}" >&2
+$S render --scene atrium --width "$W" --height "$H" --out "$OUT/atrium.png" --force --timings
+$S render --scene atrium --width "$W" --height "$H" --out "$OUT/atrium.exr" --force
+for v in csz normal albedo emission direct-diffuse shadow; do
+  $S render --scene atrium --width "$W" --height "$H" --debug-view "$v" --out "$OUT/atrium-$v.png" --force
+done
+$S render --scene cornell --width 256 --height 256 --out "$OUT/cornell.png" --force
+$S render --scene warehouse --width "$W" --height "$H" --out "$OUT/warehouse.png" --force
+echo "[strata demo] CPU reference (ray-traced AO and GI, small sizes)" >&2
+$S reference --scene atrium --kind ao --spp 16 --width 160 --height 90 --out "$OUT/atrium-ref-ao.png" --force --quiet
+$S reference --scene cornell --kind gi --spp 64 --bounces 3 --width 96 --height 96 --out "$OUT/cornell-ref-gi.png" --force --quiet
+echo "[strata demo] GPU timings" >&2
+$S bench gbuffer --scene atrium --width "$W" --height "$H" --frames 5 --json > "$OUT/bench-gbuffer.json"
+cat "$OUT/bench-gbuffer.json"
+{
+  echo "<!doctype html><meta charset=utf-8><title>strata demo</title>"
+  echo "<style>body{font-family:sans-serif;max-width:1400px;margin:auto}img{max-width:45%;margin:4px;image-rendering:pixelated}figure{display:inline-block;margin:4px}</style>"
+  echo "<h1>strata demo report</h1><p>$(date -u +%Y-%m-%dT%H:%MZ)</p><pre>$(cat "$OUT/info.txt")</pre>"
+  echo "<h2>Renders</h2>"
+  for f in atrium cornell warehouse; do echo "<figure><img src=$f.png><figcaption>$f</figcaption></figure>"; done
+  echo "<h2>atrium G-buffer and lighting targets</h2>"
+  for v in csz normal albedo emission direct-diffuse shadow; do echo "<figure><img src=atrium-$v.png><figcaption>$v</figcaption></figure>"; done
+  echo "<h2>CPU reference</h2><figure><img src=atrium-ref-ao.png><figcaption>atrium AO (binary visibility)</figcaption></figure>"
+  echo "<figure><img src=cornell-ref-gi.png><figcaption>cornell path-traced GI</figcaption></figure>"
+  echo "<h2>GPU timings (strata bench gbuffer)</h2><pre>$(cat "$OUT/bench-gbuffer.json")</pre>"
+} > "$OUT/report.html"
+echo "[strata demo] wrote $OUT/report.html and images in $OUT/" >&2

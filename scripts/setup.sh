@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs what strata needs on a Debian machine: a Vulkan loader + driver
+# (Mesa lavapipe, software Vulkan) when none is present, and a Rust toolchain
+# when cargo is missing. Idempotent; prints what it does.
+set -euo pipefail
+
+say() { echo "[strata setup] $*" >&2; }
+as_root() { if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else say "need root for: $*"; return 1; fi; }
+
+has_vulkan() {
+  ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' || return 1
+  ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 || return 1
+}
+
+if has_vulkan; then
+  say "Vulkan loader and driver found"
+else
+  say "no Vulkan driver found: installing Mesa's lavapipe (mesa-vulkan-drivers, libvulkan1)"
+  as_root apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null
+  has_vulkan || { say "Vulkan still not found after install"; exit 1; }
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+  if [ -x "$HOME/.cargo/bin/cargo" ]; then
+    export PATH="$HOME/.cargo/bin:$PATH"
+  else
+    say "cargo not found: installing a stable Rust toolchain with rustup"
+    as_root apt-get install -y -qq curl ca-certificates build-essential >/dev/null
+    curl -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal >&2
+    export PATH="$HOME/.cargo/bin:$PATH"
+  fi
+fi
+say "$(cargo --version)"
+
+# Mesa's loader wants a runtime dir; headless machines often lack one.
+if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
+  export XDG_RUNTIME_DIR="${TMPDIR:-/tmp}/strata-xdg-$(id -u)"
+  mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
+fi
