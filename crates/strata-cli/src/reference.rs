@@ -1,13 +1,181 @@
-//! `strata reference` and `strata bench reference` (filled in once strata-reference lands).
+//! `strata reference` (CPU ground truth images) and `strata bench reference`
+//! (ray throughput).
 
-use anyhow::Result;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
 
-use crate::args::{BenchReferenceArgs, ReferenceArgs};
+use anyhow::{bail, Result};
+use serde_json::json;
+use strata_reference::ao::{AoBinarySettings, ObscuranceSettings};
+use strata_reference::gi::GiSettings;
+use strata_reference::layers::LayerSettings;
+use strata_reference::Reference;
+use strata_scene::ImageBuf;
 
-pub fn run(_a: &ReferenceArgs) -> Result<()> {
-    anyhow::bail!("not yet wired")
+use crate::args::{BenchReferenceArgs, ReferenceArgs, ReferenceKind};
+use crate::output::{check_output, save, scene_and_camera};
+
+pub fn run(a: &ReferenceArgs) -> Result<()> {
+    let (scene, camera, _) = scene_and_camera(&a.scene)?;
+    let (w, h) = (a.scene.width, a.scene.height);
+    if !(1..=65536).contains(&a.spp) {
+        bail!("--spp {} is out of range: must be in 1..=65536", a.spp);
+    }
+    if a.bounces > 64 {
+        bail!("--bounces {} is out of range: must be in 0..=64", a.bounces);
+    }
+    if !(1..=8).contains(&a.layers) {
+        bail!("--layers {} is out of range: must be in 1..=8", a.layers);
+    }
+    let radius = a.ao_radius.unwrap_or(scene.settings.ao_radius);
+    if !(radius > 0.0 && radius.is_finite()) {
+        bail!("--ao-radius {radius} is out of range: must be > 0");
+    }
+    let dz = a.min_separation.unwrap_or(scene.settings.min_separation);
+    if !(dz >= 0.0 && dz.is_finite()) {
+        bail!("--min-separation {dz} is out of range: must be >= 0");
+    }
+    let reference = Reference::new(&scene, a.scene.frame).with_progress(!a.quiet);
+    let outputs: Vec<(PathBuf, ImageBuf)> = match a.kind {
+        ReferenceKind::Ao => {
+            check_output(&a.out, a.force)?;
+            let s = AoBinarySettings {
+                radius,
+                spp: a.spp,
+                ..AoBinarySettings::new(radius)
+            };
+            vec![(a.out.clone(), reference.ao_binary(&camera, w, h, &s))]
+        }
+        ReferenceKind::Obscurance => {
+            check_output(&a.out, a.force)?;
+            let s = ObscuranceSettings {
+                spp: a.spp,
+                ..ObscuranceSettings::new(radius)
+            };
+            vec![(a.out.clone(), reference.ao_obscurance(&camera, w, h, &s))]
+        }
+        ReferenceKind::Gi | ReferenceKind::Indirect => {
+            check_output(&a.out, a.force)?;
+            let s = GiSettings {
+                spp: a.spp,
+                bounces: a.bounces,
+                ..Default::default()
+            };
+            let g = reference.gi(&camera, w, h, &s);
+            let img = if a.kind == ReferenceKind::Gi {
+                g.total
+            } else {
+                g.indirect
+            };
+            let img = if is_png(&a.out) {
+                tonemap(&img, scene.settings.exposure)
+            } else {
+                img
+            };
+            vec![(a.out.clone(), img)]
+        }
+        ReferenceKind::Layers => {
+            let deep = reference.layers(&camera, w, h, &LayerSettings::new(a.layers as usize, dz));
+            let mut v = Vec::new();
+            for (j, l) in deep.layers.iter().enumerate() {
+                let png = is_png(&a.out);
+                let mut depth = l.depth.clone();
+                if png {
+                    let max = depth
+                        .data
+                        .iter()
+                        .filter(|z| z.is_finite())
+                        .fold(0.0f32, |m, &z| m.max(z))
+                        .max(1e-9);
+                    depth
+                        .data
+                        .iter_mut()
+                        .for_each(|z| *z = if z.is_finite() { *z / max } else { 0.0 });
+                }
+                let mut normal = l.normal.clone();
+                if png {
+                    normal.data.iter_mut().for_each(|c| *c = 0.5 + 0.5 * *c);
+                }
+                v.push((sibling(&a.out, &format!("layer{j}-depth")), depth));
+                v.push((sibling(&a.out, &format!("layer{j}-normal")), normal));
+                v.push((sibling(&a.out, &format!("layer{j}-albedo")), l.albedo.clone()));
+            }
+            for (p, _) in &v {
+                check_output(p, a.force)?;
+            }
+            v
+        }
+    };
+    for (p, img) in &outputs {
+        save(img, p, true)?;
+        eprintln!("wrote {}", p.display());
+    }
+    let s = reference.stats();
+    eprintln!(
+        "{} triangles, BVH built in {:.2} s; {:.1} M rays in {:.2} s = {:.2} M rays/s",
+        scene.triangle_count(),
+        reference.build_seconds(),
+        s.rays as f64 * 1e-6,
+        s.seconds,
+        s.mrays_per_second()
+    );
+    Ok(())
 }
 
-pub fn bench(_a: &BenchReferenceArgs) -> Result<()> {
-    anyhow::bail!("not yet wired")
+fn is_png(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
+}
+
+/// `dir/stem.ext` → `dir/stem-suffix.ext`.
+fn sibling(p: &Path, suffix: &str) -> PathBuf {
+    let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("reference");
+    let ext = p.extension().and_then(|s| s.to_str()).unwrap_or("exr");
+    p.with_file_name(format!("{stem}-{suffix}.{ext}"))
+}
+
+/// Exposure + the GPU's ACES curve, for PNG output of radiance images.
+fn tonemap(img: &ImageBuf, exposure: f32) -> ImageBuf {
+    let aces = |x: f32| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
+    let mut o = img.clone();
+    o.data.iter_mut().for_each(|v| *v = aces(*v * exposure));
+    o
+}
+
+pub fn bench(a: &BenchReferenceArgs) -> Result<()> {
+    let (scene, camera, _) = scene_and_camera(&a.scene)?;
+    if !(a.mrays > 0.0 && a.mrays <= 10_000.0) {
+        bail!("--mrays {} is out of range: must be in (0, 10000]", a.mrays);
+    }
+    let reference = Reference::new(&scene, a.scene.frame).with_progress(false);
+    let t = reference.measure_throughput(
+        &camera,
+        a.scene.width,
+        a.scene.height,
+        (a.mrays * 1e6) as u64,
+        Duration::from_secs(600),
+    );
+    let threads = t.threads;
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&json!({
+                "bench": "reference", "scene": a.scene.scene, "triangles": scene.triangle_count(),
+                "width": a.scene.width, "height": a.scene.height, "threads": threads,
+                "bvh_build_s": reference.build_seconds(), "rays": t.rays, "seconds": t.seconds,
+                "mrays_per_s": t.mrays_per_second(),
+            }))?
+        );
+    } else {
+        println!(
+            "{}: {} triangles, BVH {:.2} s; {:.1} M rays (primary + 1 diffuse bounce) in {:.2} s on {} threads = {:.2} M rays/s",
+            a.scene.scene,
+            scene.triangle_count(),
+            reference.build_seconds(),
+            t.rays as f64 * 1e-6,
+            t.seconds,
+            threads,
+            t.mrays_per_second()
+        );
+    }
+    Ok(())
 }

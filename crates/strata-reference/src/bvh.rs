@@ -2,20 +2,25 @@
 //! watertight ray–triangle intersection.
 //!
 //! - **Build**: top-down, 16 SAH bins per axis over triangle centroids, leaves of
-//!   at most [`MAX_LEAF`] triangles; nodes are flattened in depth-first order
-//!   (left child = next node) into 32-byte records.
+//!   at most [`MAX_LEAF`] triangles (up to 2²⁸ triangles in all); interior nodes
+//!   are flattened depth-first into 64-byte records that hold *both* children's
+//!   boxes and references (a leaf is a packed reference in its parent), so each
+//!   visit touches one cache line.
 //! - **Intersection**: the watertight algorithm of Woop, Benthin and Wald
 //!   (JCGT 2013): the ray is sheared so it runs along +Z, the edge functions are
 //!   evaluated in 2D and recomputed in `f64` when one is exactly zero. A ray
 //!   through a shared edge or vertex of a closed mesh never slips between
 //!   triangles, and the result does not depend on traversal order.
 //! - **Traversal**: the box test scales the far distance by `1 + 2γ₃` (Ize 2013)
-//!   so boxes are never culled by rounding; closest-hit visits the nearer child
-//!   first.
+//!   so boxes are never culled by rounding; slabs are picked by the direction's
+//!   signs, and zero direction components use a finite ±1e30 reciprocal so no
+//!   NaN can arise; closest-hit visits the nearer child first.
 //!
 //! `t` is measured in units of the ray direction as given (directions need not be
 //! normalised: primary rays use [`strata_scene::Camera::pixel_dir`], so `t` is the
 //! camera-space depth).
+
+use std::mem::MaybeUninit;
 
 use glam::Vec3;
 use strata_scene::WorldTriangle;
@@ -71,22 +76,34 @@ impl SurfaceHit {
     }
 }
 
-/// Flattened node: a leaf when `count > 0` (triangles `first..first + count` of
-/// the reordered list), else an interior node whose left child is the next node
-/// and whose right child is `first`.
+/// A reference to a child: an interior node index, or (high bit set) a leaf
+/// holding `count ≤ MAX_LEAF` triangles starting at `first` in leaf order,
+/// packed as `LEAF | first << 3 | count`.
+type ChildRef = u32;
+const LEAF: u32 = 1 << 31;
+
+#[inline(always)]
+fn leaf_ref(first: usize, count: usize) -> ChildRef {
+    debug_assert!(count <= MAX_LEAF && first < (1 << 28));
+    LEAF | (first as u32) << 3 | count as u32
+}
+
+/// Interior node holding both children's boxes (one 64-byte cache line per
+/// visit), flattened depth-first.
 #[derive(Clone, Copy, Debug)]
-#[repr(C)]
+#[repr(C, align(64))]
 struct Node {
-    min: [f32; 3],
-    first: u32,
-    max: [f32; 3],
-    count: u32,
+    /// `[left, right]` child boxes.
+    min: [[f32; 3]; 2],
+    max: [[f32; 3]; 2],
+    child: [ChildRef; 2],
 }
 
 /// Precomputed per-ray data for the slab and watertight tests.
 struct Ray {
     org: Vec3,
     inv: [f32; 3],
+    neg: [bool; 3],
     kx: usize,
     ky: usize,
     kz: usize,
@@ -110,9 +127,14 @@ impl Ray {
         if dir[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        // A zero component becomes ±1e-30 so 1/d stays finite: slabs the ray
+        // runs parallel to then give ±huge distances (conservative) instead of
+        // 0·∞ = NaN. The triangle test uses the exact direction.
+        let inv = [safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z)];
         Self {
             org,
-            inv: [1.0 / dir.x, 1.0 / dir.y, 1.0 / dir.z],
+            inv,
+            neg: [inv[0] < 0.0, inv[1] < 0.0, inv[2] < 0.0],
             kx,
             ky,
             kz,
@@ -123,18 +145,23 @@ impl Ray {
     }
 
     /// Entry distance into the node's box if the ray overlaps it within
-    /// `[tmin, tmax]`, else `f32::INFINITY`. NaNs (origin on a slab of a flat
-    /// box, direction parallel to it) are ignored by `f32::min`/`max`, which
-    /// keeps the test conservative.
-    #[inline]
-    fn hit_box(&self, n: &Node, tmin: f32, tmax: f32) -> f32 {
+    /// `[tmin, tmax]`, else `f32::INFINITY`. The near/far slab planes are picked
+    /// by the direction's signs; `inv` is finite (see [`Ray::new`]), so no NaN
+    /// can arise, and the far distance is scaled by `1 + 2γ₃` to stay conservative.
+    #[inline(always)]
+    fn hit_box(&self, min: &[f32; 3], max: &[f32; 3], tmin: f32, tmax: f32) -> f32 {
         let mut near = tmin;
         let mut far = tmax;
         for k in 0..3 {
-            let t0 = (n.min[k] - self.org[k]) * self.inv[k];
-            let t1 = (n.max[k] - self.org[k]) * self.inv[k];
-            near = near.max(t0.min(t1));
-            far = far.min(t0.max(t1) * BOX_SCALE);
+            let (lo, hi) = if self.neg[k] {
+                (max[k], min[k])
+            } else {
+                (min[k], max[k])
+            };
+            let t0 = (lo - self.org[k]) * self.inv[k];
+            let t1 = (hi - self.org[k]) * self.inv[k] * BOX_SCALE;
+            near = if t0 > near { t0 } else { near };
+            far = if t1 < far { t1 } else { far };
         }
         if near <= far {
             near
@@ -195,6 +222,8 @@ pub fn intersect_triangle(p: &[Vec3; 3], origin: Vec3, dir: Vec3, tmin: f32, tma
 /// vertices are left out; zero-area triangles are kept but never hit.
 pub struct Bvh {
     nodes: Vec<Node>,
+    /// The root: a node or a leaf, with the world bounds (`None` when empty).
+    root: Option<(ChildRef, [f32; 3], [f32; 3])>,
     /// Vertex positions in leaf order.
     verts: Vec<[Vec3; 3]>,
     /// Leaf order → index into `triangles`.
@@ -247,14 +276,18 @@ impl Bvh {
                 }
             })
             .collect();
-        let mut nodes = Vec::with_capacity(2 * prims.len() / MAX_LEAF + 1);
-        if !prims.is_empty() {
-            build_node(&mut nodes, &mut prims, 0, 0);
-        }
+        let mut nodes = Vec::with_capacity(prims.len() / 2 + 1);
+        let root = if prims.is_empty() {
+            None
+        } else {
+            let (r, lo, hi) = build_node(&mut nodes, &mut prims, 0, 0);
+            Some((r, lo.into(), hi.into()))
+        };
         let ids: Vec<u32> = prims.iter().map(|p| p.id).collect();
         let verts = ids.iter().map(|&i| triangles[i as usize].p).collect();
         Self {
             nodes,
+            root,
             verts,
             ids,
             triangles,
@@ -266,14 +299,14 @@ impl Bvh {
         &self.triangles
     }
 
-    /// Number of flattened nodes.
+    /// Number of interior nodes (each holds both children's boxes).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
     /// World bounds of everything in the hierarchy, or `None` when empty.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        self.nodes.first().map(|n| (Vec3::from(n.min), Vec3::from(n.max)))
+        self.root.map(|(_, lo, hi)| (Vec3::from(lo), Vec3::from(hi)))
     }
 
     /// Closest hit with `tmin < t < tmax`; ties at equal `t` go to the lowest triangle index.
@@ -337,23 +370,28 @@ impl Bvh {
         ordered: bool,
         mut on_hit: impl FnMut(Hit, &mut f32) -> bool,
     ) {
-        if self.nodes.is_empty() || !(tmin <= *tmax) {
+        let Some((root, root_min, root_max)) = self.root else {
+            return;
+        };
+        if !(tmin <= *tmax) || !origin.is_finite() || !dir.is_finite() {
             return;
         }
         let ray = Ray::new(origin, dir);
-        if ray.hit_box(&self.nodes[0], tmin, *tmax) == f32::INFINITY {
+        let root_near = ray.hit_box(&root_min, &root_max, tmin, *tmax);
+        if root_near == f32::INFINITY {
             return;
         }
-        let mut stack = [(0u32, 0f32); STACK];
+        // Uninitialised: zeroing 1 KiB per ray costs a few percent of throughput.
+        let mut stack = [const { MaybeUninit::<(ChildRef, f32)>::uninit() }; STACK];
         let mut sp = 0usize;
-        let mut node = 0usize;
-        let mut node_near = tmin;
+        let mut cur = root;
+        let mut cur_near = root_near;
         loop {
-            if node_near <= *tmax {
-                let n = &self.nodes[node];
-                if n.count > 0 {
-                    let first = n.first as usize;
-                    for i in first..first + n.count as usize {
+            if cur_near <= *tmax {
+                if cur & LEAF != 0 {
+                    let first = ((cur & !LEAF) >> 3) as usize;
+                    let count = (cur & 7) as usize;
+                    for i in first..first + count {
                         if let Some((t, b1, b2)) = ray.hit_triangle(&self.verts[i], tmin, *tmax) {
                             let hit = Hit {
                                 t,
@@ -367,33 +405,27 @@ impl Bvh {
                         }
                     }
                 } else {
-                    let (l, r) = (node + 1, n.first as usize);
-                    let tl = ray.hit_box(&self.nodes[l], tmin, *tmax);
-                    let tr = ray.hit_box(&self.nodes[r], tmin, *tmax);
-                    let (mut a, mut ta, mut b, mut tb) = (l, tl, r, tr);
+                    let n = &self.nodes[cur as usize];
+                    let tl = ray.hit_box(&n.min[0], &n.max[0], tmin, *tmax);
+                    let tr = ray.hit_box(&n.min[1], &n.max[1], tmin, *tmax);
+                    let (mut a, mut ta, mut b, mut tb) = (n.child[0], tl, n.child[1], tr);
                     if ordered && tr < tl {
                         std::mem::swap(&mut a, &mut b);
                         std::mem::swap(&mut ta, &mut tb);
                     }
-                    match (ta < f32::INFINITY, tb < f32::INFINITY) {
-                        (true, true) => {
-                            stack[sp] = (b as u32, tb);
+                    if ta < f32::INFINITY {
+                        if tb < f32::INFINITY {
+                            stack[sp].write((b, tb));
                             sp += 1;
-                            node = a;
-                            node_near = ta;
-                            continue;
                         }
-                        (true, false) => {
-                            node = a;
-                            node_near = ta;
-                            continue;
-                        }
-                        (false, true) => {
-                            node = b;
-                            node_near = tb;
-                            continue;
-                        }
-                        (false, false) => {}
+                        cur = a;
+                        cur_near = ta;
+                        continue;
+                    }
+                    if tb < f32::INFINITY {
+                        cur = b;
+                        cur_near = tb;
+                        continue;
                     }
                 }
             }
@@ -401,8 +433,8 @@ impl Bvh {
                 return;
             }
             sp -= 1;
-            node = stack[sp].0 as usize;
-            node_near = stack[sp].1;
+            // SAFETY: entries below `sp` were written by the push above.
+            (cur, cur_near) = unsafe { stack[sp].assume_init() };
         }
     }
 
@@ -438,6 +470,15 @@ impl Bvh {
     }
 }
 
+/// `1/d`, with zero (and subnormal) `d` replaced by `±1e-30`: always finite.
+fn safe_inv(d: f32) -> f32 {
+    if d.abs() < 1e-30 {
+        1.0 / 1e-30f32.copysign(d)
+    } else {
+        1.0 / d
+    }
+}
+
 /// The smallest float greater than finite `x`.
 fn next_up(x: f32) -> f32 {
     if x == 0.0 {
@@ -449,10 +490,10 @@ fn next_up(x: f32) -> f32 {
     }
 }
 
-/// Recursively builds the subtree over `prims`, appending nodes depth-first and
-/// reordering `prims` into leaf order. Returns the node index.
-fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, depth: usize) -> usize {
-    let index = nodes.len();
+/// Recursively builds the subtree over `prims` (which start at `offset` in leaf
+/// order), appending interior nodes depth-first and reordering `prims` into
+/// leaf order. Returns the subtree's reference and bounds.
+fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, depth: usize) -> (ChildRef, Vec3, Vec3) {
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     let (mut clo, mut chi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     for p in prims.iter() {
@@ -461,28 +502,22 @@ fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, dep
         clo = clo.min(p.centroid);
         chi = chi.max(p.centroid);
     }
-    nodes.push(Node {
-        min: lo.into(),
-        first: offset as u32,
-        max: hi.into(),
-        count: prims.len() as u32,
-    });
     let n = prims.len();
+    let leaf = (leaf_ref(offset, n), lo, hi);
     if n <= 1 {
-        return index;
+        return leaf;
     }
-
     let split = if depth > MAX_SAH_DEPTH {
         None
     } else {
         sah_split(prims, lo, hi, clo, chi)
     };
     let mid = match split {
-        Some(None) => return index, // SAH prefers a leaf and it is small enough
+        Some(None) => return leaf, // SAH prefers a leaf and it is small enough
         Some(Some(mid)) => mid,
         None => {
             if n <= MAX_LEAF {
-                return index;
+                return leaf;
             }
             // Median split along the widest centroid axis (degenerate centroids
             // or deep recursion): always balanced, so depth stays logarithmic.
@@ -491,12 +526,21 @@ fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, dep
             n / 2
         }
     };
+    let index = nodes.len();
+    nodes.push(Node {
+        min: [[0.0; 3]; 2],
+        max: [[0.0; 3]; 2],
+        child: [0; 2],
+    });
     let (left, right) = prims.split_at_mut(mid);
-    nodes[index].count = 0;
-    build_node(nodes, left, offset, depth + 1);
-    let r = build_node(nodes, right, offset + mid, depth + 1);
-    nodes[index].first = r as u32;
-    index
+    let (l, llo, lhi) = build_node(nodes, left, offset, depth + 1);
+    let (r, rlo, rhi) = build_node(nodes, right, offset + mid, depth + 1);
+    nodes[index] = Node {
+        min: [llo.into(), rlo.into()],
+        max: [lhi.into(), rhi.into()],
+        child: [l, r],
+    };
+    (index as ChildRef, lo, hi)
 }
 
 /// Binned SAH over centroids. `None`: no usable split (degenerate centroids);

@@ -188,7 +188,13 @@ impl Reference<'_> {
             let (n, ng) = hit.facing_normals(wo);
             let albedo = self.albedo(&hit);
             let p = hit.position + ng * self.epsilon;
-            *sink += throughput * albedo * self.direct_irradiance(p, n, ng, rng, rays) * std::f32::consts::FRAC_1_PI;
+            let sp = ShadingPoint {
+                x: hit.position,
+                origin: p,
+                n,
+                ng,
+            };
+            *sink += throughput * albedo * self.direct_irradiance(&sp, rng, rays) * std::f32::consts::FRAC_1_PI;
 
             // Bounce: at the last vertex only to collect the sky.
             let last = depth == settings.bounces;
@@ -224,10 +230,9 @@ impl Reference<'_> {
         (direct, indirect)
     }
 
-    /// Irradiance-like sum at `p` (already offset) from all lights, with shading
-    /// normal `n` and geometric normal `ng`: Σ E·max(n·l, 0)·V, to be multiplied
-    /// by ρ/π. Emissive triangles contribute one NEE sample.
-    fn direct_irradiance(&self, p: Vec3, n: Vec3, ng: Vec3, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+    /// Irradiance-like sum at a shading point from all lights: Σ E·max(n·l, 0)·V,
+    /// to be multiplied by ρ/π. Emissive triangles contribute one NEE sample.
+    fn direct_irradiance(&self, sp: &ShadingPoint, rng: &mut Rng, rays: &mut u64) -> Vec3 {
         let mut e = Vec3::ZERO;
         for light in &self.scene.lights {
             match *light {
@@ -237,10 +242,10 @@ impl Reference<'_> {
                     illuminance,
                 } => {
                     let l = -direction.normalize_or_zero();
-                    let c = n.dot(l);
-                    if c > 0.0 && l.dot(ng) > 0.0 {
+                    let c = sp.cos(l);
+                    if c > 0.0 {
                         *rays += 1;
-                        if !self.bvh.occluded(p, l, 0.0, f32::INFINITY) {
+                        if !self.bvh.occluded(sp.origin, l, 0.0, f32::INFINITY) {
                             e += Vec3::from(color) * illuminance * c;
                         }
                     }
@@ -250,7 +255,7 @@ impl Reference<'_> {
                     color,
                     intensity,
                 } => {
-                    e += self.point_light(p, n, ng, position, Vec3::from(color) * intensity, rays, |_| 1.0);
+                    e += self.point_light(sp, position, Vec3::from(color) * intensity, rays, |_| 1.0);
                 }
                 Light::Spot {
                     position,
@@ -262,78 +267,91 @@ impl Reference<'_> {
                 } => {
                     let axis = direction.normalize_or_zero();
                     let (ci, co) = (inner_deg.to_radians().cos(), outer_deg.to_radians().cos());
-                    e += self.point_light(p, n, ng, position, Vec3::from(color) * intensity, rays, |to_p| {
-                        smoothstep(co, ci, axis.dot(to_p))
+                    e += self.point_light(sp, position, Vec3::from(color) * intensity, rays, |to_x| {
+                        smoothstep(co, ci, axis.dot(to_x))
                     });
                 }
                 Light::Rect { .. } => {}
             }
         }
         if !self.lights.is_empty() {
-            e += self.sample_emissive(p, n, ng, rng, rays);
+            e += self.sample_emissive(sp, rng, rays);
         }
         e
     }
 
-    /// Point-like light at `pos` with intensity `i`, times `cone(unit dir light→p)`.
-    #[allow(clippy::too_many_arguments)]
-    fn point_light(
-        &self,
-        p: Vec3,
-        n: Vec3,
-        ng: Vec3,
-        pos: Vec3,
-        i: Vec3,
-        rays: &mut u64,
-        cone: impl Fn(Vec3) -> f32,
-    ) -> Vec3 {
-        let to_light = pos - p;
+    /// Point-like light at `pos` with intensity `i`, times `cone(unit direction light → x)`.
+    fn point_light(&self, sp: &ShadingPoint, pos: Vec3, i: Vec3, rays: &mut u64, cone: impl Fn(Vec3) -> f32) -> Vec3 {
+        let to_light = pos - sp.x;
         let d2 = to_light.length_squared();
         if !(d2 > 0.0) {
             return Vec3::ZERO;
         }
-        let d = d2.sqrt();
-        let l = to_light / d;
-        let c = n.dot(l);
-        if c <= 0.0 || l.dot(ng) <= 0.0 {
+        let l = to_light / d2.sqrt();
+        let c = sp.cos(l);
+        if c <= 0.0 {
             return Vec3::ZERO;
         }
         let k = cone(-l);
-        if k <= 0.0 {
-            return Vec3::ZERO;
-        }
-        *rays += 1;
-        if self.bvh.occluded(p, l, 0.0, d - self.epsilon) {
+        if k <= 0.0 || !self.visible(sp.origin, pos, rays) {
             return Vec3::ZERO;
         }
         i * (k * c / d2)
     }
 
     /// One next-event-estimation sample of the emissive triangles.
-    fn sample_emissive(&self, p: Vec3, n: Vec3, ng: Vec3, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+    fn sample_emissive(&self, sp: &ShadingPoint, rng: &mut Rng, rays: &mut u64) -> Vec3 {
         let (i, prob) = self.lights.pick(rng.next_f32());
         let (tri_index, area, le) = self.lights.tris[i];
         let tri = &self.bvh.triangles()[tri_index as usize];
         let (b1, b2) = triangle_barycentrics(rng.next_2d());
         let q = tri.p[0] * (1.0 - b1 - b2) + tri.p[1] * b1 + tri.p[2] * b2;
         let nl = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize_or_zero();
-        let to_light = q - p;
+        let to_light = q - sp.x;
         let d2 = to_light.length_squared();
         if !(d2 > 0.0) {
             return Vec3::ZERO;
         }
-        let d = d2.sqrt();
-        let l = to_light / d;
-        let c = n.dot(l);
-        let cl = -nl.dot(l); // one-sided: the light's front face must see p
-        if c <= 0.0 || cl <= 0.0 || l.dot(ng) <= 0.0 {
+        let l = to_light / d2.sqrt();
+        let c = sp.cos(l);
+        let cl = -nl.dot(l); // one-sided: the light's front face must see x
+        if c <= 0.0 || cl <= 0.0 || !self.visible(sp.origin, q, rays) {
             return Vec3::ZERO;
+        }
+        // pdf over the light's area = prob / area.
+        le * (c * cl / d2 * area / prob)
+    }
+
+    /// Shadow ray from the offset origin `p` to the point `q`, stopping
+    /// [`Reference::epsilon`] short of it.
+    fn visible(&self, p: Vec3, q: Vec3, rays: &mut u64) -> bool {
+        let to = q - p;
+        let d = to.length();
+        if !(d > self.epsilon) {
+            return true;
         }
         *rays += 1;
-        if self.bvh.occluded(p, l, 0.0, d - self.epsilon) {
-            return Vec3::ZERO;
+        !self.bvh.occluded(p, to / d, 0.0, d - self.epsilon)
+    }
+}
+
+/// A path vertex as seen by the light sampling: the surface point `x` (for
+/// distances and angles), the shadow-ray origin (offset along `ng`), and the
+/// shading and geometric normals facing the incoming ray.
+struct ShadingPoint {
+    x: Vec3,
+    origin: Vec3,
+    n: Vec3,
+    ng: Vec3,
+}
+
+impl ShadingPoint {
+    /// `max(n·l, 0)`, and 0 when `l` points below the geometric surface.
+    fn cos(&self, l: Vec3) -> f32 {
+        if l.dot(self.ng) <= 0.0 {
+            0.0
+        } else {
+            self.n.dot(l).max(0.0)
         }
-        // pdf over area = prob / area.
-        le * (c * cl / d2 * area / prob)
     }
 }

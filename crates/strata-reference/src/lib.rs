@@ -33,6 +33,9 @@
 //! the layer and obscurance oracles need and general-purpose BVH crates rarely
 //! expose. A binned-SAH builder is ~300 lines and adds no dependency.
 
+// `!(a < b)` is used on purpose where NaN must take the "reject" branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod ao;
 pub mod bvh;
 pub mod gi;

@@ -382,14 +382,17 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
             } else {
                 name
             };
-            scene.meshes.push(Mesh {
+            let mut mesh = Mesh {
                 name,
                 positions,
                 normals,
                 uvs,
                 indices,
                 material,
-            });
+            };
+            // Before any mirrored copy is made (normals follow the original winding).
+            ensure_normals(&mut mesh);
+            scene.meshes.push(mesh);
             ours.push(scene.meshes.len() - 1);
         }
         mesh_map.push(ours);
@@ -976,9 +979,18 @@ fn build_toml_scene(doc: TomlScene, path: &Path) -> Result<Scene, SceneError> {
         transform_scene(&mut scene, place, scale);
     }
 
+    // Defaults that depend on the placed geometry (before the ground is added,
+    // so that the default camera frames the mesh, not the ground).
+    let (lo, hi) = scene.bounds(0.0);
+    if from_file {
+        scene.settings = default_settings(lo, hi);
+        if !has_camera {
+            scene.camera = default_camera(lo, hi);
+        }
+    }
+
     // Ground quad.
     if let Some(g) = &doc.ground {
-        let (lo, hi) = scene.bounds(0.0);
         let y = match g.y {
             Some(y) => ck.finite("ground.y", y)?,
             None => lo.y,
@@ -992,15 +1004,6 @@ fn build_toml_scene(doc: TomlScene, path: &Path) -> Result<Scene, SceneError> {
         let mut b = MeshBuilder::new();
         b.rect(Vec3::new(c.x, y, c.z), Vec3::Z * (0.5 * size), Vec3::X * (0.5 * size)); // z × x = +y
         add_object(&mut scene, "ground", b, Material::diffuse("ground", color));
-    }
-
-    // Defaults that depend on the final geometry.
-    let (lo, hi) = scene.bounds(0.0);
-    if from_file {
-        scene.settings = default_settings(lo, hi);
-        if !has_camera {
-            scene.camera = default_camera(lo, hi);
-        }
     }
 
     // Camera.

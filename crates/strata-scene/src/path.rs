@@ -1,5 +1,6 @@
-//! Camera paths: keyframes at frame indices, interpolated with a centripetal-free
-//! uniform Catmull–Rom spline (C¹-continuous, passes through every keyframe).
+//! Camera paths: keyframes at frame indices, interpolated with a Catmull–Rom
+//! spline whose tangents are measured per frame (C¹-continuous in frame time,
+//! passes through every keyframe; uniform Catmull–Rom for evenly spaced keys).
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -44,46 +45,55 @@ impl CameraPath {
         Camera { eye, target, ..*base }
     }
 
-    /// (eye, target) at `frame`.
+    /// (eye, target) at `frame`, clamped to the path's frame range (a NaN frame
+    /// gives the first keyframe).
+    ///
+    /// Catmull–Rom with tangents measured per frame, `m_i = (p_{i+1} − p_{i−1}) /
+    /// (f_{i+1} − f_{i−1})`, so the motion is C¹ in frame time even when the
+    /// keyframes are unevenly spaced (for even spacing this is the uniform
+    /// Catmull–Rom spline). The ends use mirrored neighbours.
     pub fn sample(&self, frame: f32) -> (Vec3, Vec3) {
         let k = &self.keyframes;
-        if k.len() == 1 || frame <= k[0].frame {
+        if k.len() == 1 || frame.is_nan() || frame <= k[0].frame {
             return (k[0].eye, k[0].target);
         }
         if frame >= self.last_frame() {
             let l = k[k.len() - 1];
             return (l.eye, l.target);
         }
-        let i = k.partition_point(|kf| kf.frame <= frame) - 1;
+        let i = k
+            .partition_point(|kf| kf.frame <= frame)
+            .saturating_sub(1)
+            .min(k.len() - 2);
         let (f0, f1) = (k[i].frame, k[i + 1].frame);
         let t = (frame - f0) / (f1 - f0);
-        // Neighbours, mirrored at the ends.
-        let prev = |sel: fn(&Keyframe) -> Vec3| {
-            if i > 0 {
-                sel(&k[i - 1])
-            } else {
-                2.0 * sel(&k[i]) - sel(&k[i + 1])
-            }
-        };
-        let next = |sel: fn(&Keyframe) -> Vec3| {
-            if i + 2 < k.len() {
-                sel(&k[i + 2])
-            } else {
-                2.0 * sel(&k[i + 1]) - sel(&k[i])
-            }
-        };
-        let eye = catmull_rom(prev(|k| k.eye), k[i].eye, k[i + 1].eye, next(|k| k.eye), t);
-        let target = catmull_rom(prev(|k| k.target), k[i].target, k[i + 1].target, next(|k| k.target), t);
+        let eye = self.hermite(i, t, |k| k.eye);
+        let target = self.hermite(i, t, |k| k.target);
         (eye, target)
     }
-}
 
-/// Uniform Catmull–Rom between p1 (t = 0) and p2 (t = 1).
-fn catmull_rom(p0: Vec3, p1: Vec3, p2: Vec3, p3: Vec3, t: f32) -> Vec3 {
-    let t2 = t * t;
-    let t3 = t2 * t;
-    0.5 * ((2.0 * p1)
-        + (-p0 + p2) * t
-        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
-        + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3)
+    /// Per-frame tangent of the selected quantity at keyframe `i`.
+    fn tangent(&self, i: usize, sel: fn(&Keyframe) -> Vec3) -> Vec3 {
+        let k = &self.keyframes;
+        let n = k.len();
+        if i == 0 {
+            // Mirrored neighbour before the start: m = (p1 − p0) / (f1 − f0).
+            (sel(&k[1]) - sel(&k[0])) / (k[1].frame - k[0].frame)
+        } else if i == n - 1 {
+            (sel(&k[n - 1]) - sel(&k[n - 2])) / (k[n - 1].frame - k[n - 2].frame)
+        } else {
+            (sel(&k[i + 1]) - sel(&k[i - 1])) / (k[i + 1].frame - k[i - 1].frame)
+        }
+    }
+
+    /// Cubic Hermite between keyframes `i` and `i + 1` at `t` ∈ [0, 1].
+    fn hermite(&self, i: usize, t: f32, sel: fn(&Keyframe) -> Vec3) -> Vec3 {
+        let k = &self.keyframes;
+        let len = k[i + 1].frame - k[i].frame;
+        let (p0, p1) = (sel(&k[i]), sel(&k[i + 1]));
+        let (m0, m1) = (self.tangent(i, sel) * len, self.tangent(i + 1, sel) * len);
+        let t2 = t * t;
+        let t3 = t2 * t;
+        p0 * (2.0 * t3 - 3.0 * t2 + 1.0) + m0 * (t3 - 2.0 * t2 + t) + p1 * (-2.0 * t3 + 3.0 * t2) + m1 * (t3 - t2)
+    }
 }

@@ -192,9 +192,10 @@ pub fn cornell() -> Scene {
     let (tb, tt) = block([[423.0, 247.0], [265.0, 296.0], [314.0, 456.0], [472.0, 406.0]], 330.0);
     b.geo(white).hexahedron(tb, tt);
     // Light quad, facing down.
-    let centre = mm(278.0, 548.7, 279.5);
-    let half_u = mm(65.0, 0.0, 0.0);
-    let half_v = mm(0.0, 0.0, 52.5);
+    // (x 213..343, z 227..332 mm at y = 548.7 mm, written in metres.)
+    let centre = v(0.278, 0.5487, 0.2795);
+    let half_u = v(0.065, 0.0, 0.0);
+    let half_v = v(0.0, 0.0, 0.0525);
     b.geo(light).rect(centre, half_u, half_v); // x × z = −y: faces down
     let lights = vec![Light::Rect {
         center: centre,
@@ -227,23 +228,25 @@ mod atrium_dims {
     pub const SPACING: f32 = 3.0;
     pub const FIRST_COLUMN_X: f32 = -12.0;
     pub const COLUMNS: usize = 9;
-    /// Gallery floor slab (y range) and aisle roof slab (y range).
+    /// Gallery floor slab (y range) and top of the upper arcade (the upper
+    /// galleries have no roof, so the sun reaches the banners).
     pub const GALLERY_FLOOR: (f32, f32) = (5.8, 6.1);
-    pub const AISLE_ROOF: (f32, f32) = (10.8, 11.1);
+    pub const GALLERY_TOP: f32 = 10.8;
     /// |z| of the banners (1.5 m behind the colonnade line).
     pub const BANNER_Z: f32 = 5.5;
 }
 
 /// A Sponza-like two-storey colonnade, 30 m long (x), 14 m wide (z), 14 m high,
-/// open to the sky between the aisle roofs.
+/// open to the sky.
 ///
 /// Each long side has a ground-floor arcade (9 columns, 3 m apart, with square
 /// plinths and capitals, semicircular arches) carrying a gallery floor, and an
-/// upper arcade with twice as many slimmer columns. Saturated banners (red,
-/// green, blue, yellow) hang in the upper galleries 1.5 m behind the columns,
-/// so from the default camera they are mostly hidden by the columns (the
-/// deep G-buffer paper's Fig. 16 case). A warm sun falls through the open roof,
-/// sky is bluish. The camera path (frames 0–120) moves fast sideways past the
+/// upper arcade with twice as many slimmer columns (top at 10.8 m; the upper
+/// galleries are unroofed). Saturated banners (red, green, blue, yellow) hang
+/// from rods in the upper galleries 1.5 m behind the columns, so from the
+/// default camera they are mostly hidden by the columns (the deep G-buffer
+/// paper's Fig. 16 case). A warm sun (about 60° high) lights a strip of the
+/// court floor, the +z colonnade and most of the +z banners; the sky is bluish. The camera path (frames 0–120) moves fast sideways past the
 /// +z colonnade; a statue in the court slides back and forth (object `statue`).
 pub fn atrium() -> Scene {
     use atrium_dims::*;
@@ -301,7 +304,7 @@ pub fn atrium() -> Scene {
         b.geo(arcade)
             .cuboid(v(-hl, GALLERY_FLOOR.0, slab_z0), v(hl, GALLERY_FLOOR.1, slab_z1));
 
-        // Upper storey: twice as many, slimmer columns, smaller arches, aisle roof.
+        // Upper storey: twice as many, slimmer columns, smaller arches, no roof.
         let y0 = GALLERY_FLOOR.1;
         let upper_spacing = SPACING / 2.0;
         let upper_count = 2 * (COLUMNS - 1) + 1;
@@ -317,23 +320,26 @@ pub fn atrium() -> Scene {
         for i in 0..upper_count - 1 {
             let x = FIRST_COLUMN_X + upper_spacing * (i as f32 + 0.5);
             b.geo(arcade)
-                .arch_panel(x, spring, upper_spacing / 2.0, AISLE_ROOF.0, za + 0.05, zb - 0.05, 12);
+                .arch_panel(x, spring, upper_spacing / 2.0, GALLERY_TOP, za + 0.05, zb - 0.05, 12);
         }
         b.geo(arcade)
-            .cuboid(v(-hl, y0, za + 0.05), v(FIRST_COLUMN_X - 0.4, AISLE_ROOF.0, zb - 0.05));
+            .cuboid(v(-hl, y0, za + 0.05), v(FIRST_COLUMN_X - 0.4, GALLERY_TOP, zb - 0.05));
         b.geo(arcade)
-            .cuboid(v(last_x + 0.4, y0, za + 0.05), v(hl, AISLE_ROOF.0, zb - 0.05));
-        b.geo(arcade)
-            .cuboid(v(-hl, AISLE_ROOF.0, slab_z0), v(hl, AISLE_ROOF.1, slab_z1));
+            .cuboid(v(last_x + 0.4, y0, za + 0.05), v(hl, GALLERY_TOP, zb - 0.05));
 
         // Banners in the upper gallery, 1.5 m behind the columns, centred
-        // between ground-floor columns: thin boxes hanging from the aisle roof.
+        // between ground-floor columns: thin boxes hanging from a rod that
+        // runs from end wall to end wall.
         let bz = side * BANNER_Z;
+        b.geo(arcade).cuboid(
+            v(-hl, GALLERY_TOP - 0.05, bz - 0.05),
+            v(hl, GALLERY_TOP + 0.05, bz + 0.05),
+        );
         for i in 0..COLUMNS - 1 {
             let x = FIRST_COLUMN_X + SPACING * (i as f32 + 0.5);
             let m = banners[(i + if side > 0.0 { 0 } else { 2 }) % banners.len()];
             b.geo(m)
-                .cuboid(v(x - 0.6, 7.0, bz - 0.03), v(x + 0.6, AISLE_ROOF.0, bz + 0.03));
+                .cuboid(v(x - 0.6, 7.0, bz - 0.03), v(x + 0.6, GALLERY_TOP - 0.05, bz + 0.03));
         }
     }
 
@@ -355,7 +361,7 @@ pub fn atrium() -> Scene {
     );
 
     let sun = Light::Sun {
-        direction: v(0.3, -1.0, 0.75).normalize(),
+        direction: v(0.35, -1.0, 0.5).normalize(),
         color: [1.0, 0.88, 0.7],
         illuminance: 8.0,
     };
@@ -398,17 +404,19 @@ fn atrium_keyframes() -> Vec<Keyframe> {
 mod warehouse_dims {
     /// The red floor patch (x range, z range).
     pub const PATCH_X: (f32, f32) = (-2.6, 0.4);
-    pub const PATCH_Z: (f32, f32) = (-3.5, -0.5);
+    pub const PATCH_Z: (f32, f32) = (-2.9, 0.1);
     /// The partition wall (x range, z range, height).
     pub const PARTITION_X: (f32, f32) = (-3.0, -2.8);
-    pub const PARTITION_Z: (f32, f32) = (-6.0, 1.0);
+    pub const PARTITION_Z: (f32, f32) = (-6.0, 0.5);
     pub const PARTITION_H: f32 = 2.5;
 }
 
-/// A closed room whose brightly spot-lit, saturated red floor patch is seen by
-/// the default camera only behind the edge of a foreground partition wall (the
-/// deep G-buffer paper's Fig. 15 case): the patch is hidden in the first layer
-/// but should bleed red light onto the visible floor, walls and partition around it.
+/// A closed room (16 × 12 × 5 m) whose brightly spot-lit, saturated red floor
+/// patch (3 × 3 m) lies just behind the edge of a 2.5 m partition wall in the
+/// foreground (the deep G-buffer paper's Fig. 15 case): from the default camera
+/// the patch is entirely hidden in the first layer, while the floor beside it
+/// (within ~0.1–0.5 m, past the partition's edge) is visible and should receive
+/// its red bounce light. A dim point light fills the rest of the room.
 pub fn warehouse() -> Scene {
     use warehouse_dims::*;
     let mut b = SceneBuilder::new("warehouse");
@@ -458,12 +466,12 @@ pub fn warehouse() -> Scene {
             outer_deg: 19.0,
         },
         Light::Point {
-            position: v(4.5, 4.2, 3.0),
+            position: v(4.0, 3.2, 2.5),
             color: [1.0, 1.0, 1.0],
-            intensity: 25.0,
+            intensity: 15.0,
         },
     ];
-    let camera = Camera::new(v(-7.0, 1.6, 2.5), v(0.0, 1.0, -2.0), Vec3::Y, 60.0, 0.05);
+    let camera = Camera::new(v(-7.0, 1.6, 0.8), v(0.0, 0.8, -1.2), Vec3::Y, 60.0, 0.05);
     let settings = SceneSettings {
         ao_radius: 0.8,
         min_separation: 0.3,
@@ -499,7 +507,7 @@ pub fn plane() -> Scene {
 }
 
 /// A 3 m column (radius 0.3 m, 32 segments) standing 0.5 m in front of a 4 m
-/// wall (front face z = −1) on a 12 × 12 m floor, sun from the front-left
+/// wall (front face z = −1) on a 12 × 12 m floor, sun from the front-right
 /// above, seen from the front so the column hides part of the wall.
 pub fn column_wall() -> Scene {
     let mut b = SceneBuilder::new("column-wall");
@@ -510,7 +518,7 @@ pub fn column_wall() -> Scene {
     b.geo(wall).cuboid(v(-4.0, 0.0, -1.3), v(4.0, 4.0, -1.0));
     b.geo(column).cylinder(v(0.0, 0.0, -0.2), 0.3, 3.0, 32, true);
     let sun = Light::Sun {
-        direction: v(-0.3, -1.0, -0.6).normalize(),
+        direction: v(0.5, -1.0, -0.6).normalize(),
         color: [1.0, 0.97, 0.92],
         illuminance: 3.0,
     };

@@ -150,10 +150,9 @@ fn cornell_matches_published_data() {
     assert_eq!(quad.len(), 2);
     for t in &quad {
         assert!(t.n[0].y < -0.999);
-        assert!(t
-            .p
-            .iter()
-            .all(|p| (p.y - 0.5487).abs() < 1e-6 && (0.213..=0.343).contains(&p.x) && (0.227..=0.332).contains(&p.z)));
+        assert!(t.p.iter().all(|p| (p.y - 0.5487).abs() < 1e-6
+            && (0.2129..=0.3431).contains(&p.x)
+            && (0.2269..=0.3321).contains(&p.z)));
     }
     let Light::Rect {
         center,
@@ -168,13 +167,15 @@ fn cornell_matches_published_data() {
     assert!(half_u.cross(*half_v).normalize().abs_diff_eq(-Vec3::Y, 1e-6));
     assert!(center.abs_diff_eq(Vec3::new(0.278, 0.5487, 0.2795), 1e-6));
     assert!((4.0 * half_u.cross(*half_v).length() - 0.130 * 0.105).abs() < 1e-7);
-    // The front (z = 0) is open: a ray from the camera reaches the back wall.
+    // The front (z = 0) is open: no triangle lies in the z = 0 plane, and the
+    // camera's central ray enters the box without hitting anything before z = 0.
     let tris = s.world_triangles(0.0);
-    let hits = tris
+    assert!(!tris.iter().any(|t| t.p.iter().all(|p| p.z.abs() < 1e-6)));
+    let first = tris
         .iter()
-        .filter(|t| common::intersect(s.camera.eye, s.camera.forward(), t).is_some())
-        .count();
-    assert_eq!(hits, 1, "camera ray should only hit the back wall");
+        .filter_map(|t| common::intersect(s.camera.eye, s.camera.forward(), t))
+        .fold(f32::INFINITY, f32::min);
+    assert!(first > 0.8 && first.is_finite(), "first hit at {first}");
 }
 
 #[test]
@@ -225,14 +226,14 @@ fn atrium_has_path_animation_and_open_roof() {
     assert!((100.0..=140.0).contains(&path.last_frame()));
     // Frame 0 of the path is the default camera.
     assert!(s.camera_at(0.0).eye.abs_diff_eq(s.camera.eye, 1e-6));
-    // Fast lateral motion: ≥ 0.1 m per frame sideways on average.
+    // Fast lateral motion: ≥ 0.08 m per frame sideways (perpendicular to the view) on average.
     let mut lateral = 0.0;
     for f in 0..path.last_frame() as u32 {
         let (a, b) = (s.camera_at(f as f32), s.camera_at(f as f32 + 1.0));
         lateral += (b.eye - a.eye).dot(a.basis().0).abs();
     }
     assert!(
-        lateral / path.last_frame() > 0.1,
+        lateral / path.last_frame() > 0.08,
         "lateral speed {}",
         lateral / path.last_frame()
     );
@@ -261,13 +262,34 @@ fn atrium_has_path_animation_and_open_roof() {
     let Light::Sun { direction, .. } = s.lights[0] else {
         panic!("sun")
     };
-    let lit = (0..200)
-        .filter(|i| {
-            let p = Vec3::new(-14.0 + 0.14 * *i as f32, 0.01, -3.5 + 0.035 * *i as f32);
-            !up(p, -direction)
-        })
-        .count();
-    assert!(lit > 20 && lit < 200, "sunlit floor samples {lit}/200");
+    let mut lit = 0;
+    let mut total = 0;
+    for i in 0..60 {
+        for j in 0..28 {
+            let p = Vec3::new(-14.75 + 0.5 * i as f32, 0.01, -6.75 + 0.5 * j as f32);
+            total += 1;
+            if !up(p, -direction) {
+                lit += 1;
+            }
+        }
+    }
+    eprintln!("sunlit floor samples {lit}/{total}");
+    assert!(
+        lit * 20 > total && lit * 20 < 19 * total,
+        "sunlit floor samples {lit}/{total}"
+    );
+    // The sun reaches part of the banners through the upper arcade.
+    let banner_pts: Vec<Vec3> = ["banner_red", "banner_green", "banner_blue", "banner_yellow"]
+        .iter()
+        .flat_map(|c| samples_facing(&s, c, &s.camera, 3, 1e-3))
+        .collect();
+    let sunlit = banner_pts.iter().filter(|p| !up(**p, -direction)).count();
+    eprintln!("sunlit banner samples {sunlit}/{}", banner_pts.len());
+    assert!(
+        sunlit * 10 > banner_pts.len(),
+        "sunlit banner samples {sunlit}/{}",
+        banner_pts.len()
+    );
     assert!(s.settings.sky.iter().any(|&c| c > 0.0) && s.settings.sky[2] > s.settings.sky[0]);
 }
 
@@ -299,6 +321,37 @@ fn atrium_banners_hide_behind_columns() {
         }
     }
     eprintln!("banner samples: {total}, in view {in_view}, visible {visible}");
+    // What hides them: the colonnade (columns, capitals, arch panels).
+    let column = s.materials.iter().position(|m| m.name == "column").unwrap() as u32;
+    let arcade = s.materials.iter().position(|m| m.name == "arcade").unwrap() as u32;
+    let mut by_colonnade = 0;
+    let mut hidden = 0;
+    let mut by_mat = std::collections::BTreeMap::new();
+    for colour in ["banner_red", "banner_green", "banner_blue", "banner_yellow"] {
+        for p in samples_facing(&s, colour, &cam, 3, 1e-3) {
+            if !in_frustum(&cam, p, ASPECT) {
+                continue;
+            }
+            let d = p - cam.eye;
+            let first = tris
+                .iter()
+                .filter_map(|t| common::intersect(cam.eye, d, t).map(|h| (h, t.material)))
+                .filter(|(h, _)| *h < 1.0 - 1e-2 / d.length())
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some((_, m)) = first {
+                hidden += 1;
+                *by_mat.entry(s.materials[m as usize].name.clone()).or_insert(0) += 1;
+                if m == column || m == arcade {
+                    by_colonnade += 1;
+                }
+            }
+        }
+    }
+    eprintln!("hidden {hidden}: by colonnade {by_colonnade}; {by_mat:?}");
+    assert!(
+        by_colonnade as f32 >= 0.9 * hidden as f32,
+        "banners hidden by other things: {by_mat:?}"
+    );
     assert!(in_view >= 50, "too few banner samples in view: {in_view}");
     assert!(
         (visible as f32) < 0.35 * in_view as f32,
@@ -330,13 +383,13 @@ fn warehouse_red_patch_is_hidden_behind_partition() {
         |(l, h), p| (l.min(p), h.max(p)),
     );
     let near_floor: Vec<Vec3> = (0..20)
-        .map(|i| Vec3::new(plo.x + (phi.x - plo.x) * (i as f32 + 0.5) / 20.0, 1e-3, phi.z + 0.5))
+        .map(|i| Vec3::new(plo.x + (phi.x - plo.x) * (i as f32 + 0.5) / 20.0, 1e-3, phi.z + 0.4))
         .collect();
     let seen = near_floor
         .iter()
         .filter(|p| in_frustum(&cam, **p, ASPECT) && !occluded(&tris, cam.eye, **p, 1e-2))
         .count();
-    assert!(seen >= 10, "floor next to the red patch not visible: {seen}/20");
+    assert!(seen == 20, "floor next to the red patch not visible: {seen}/20");
     // The spot light points at the patch and is bright.
     let Light::Spot {
         position,

@@ -204,3 +204,61 @@ fn ao_is_deterministic_across_thread_counts() {
     assert_eq!(run(1), run(2));
     assert!(r.stats().rays > 0);
 }
+
+#[test]
+fn obscurance_under_a_ceiling_matches_quadrature() {
+    // X on the floor below an infinite ceiling at height h, camera straight above
+    // at height H. A disk sample at radius ρ (camera plane at depth H) reaches the
+    // ceiling at horizontal offset ρ' = ρ (H − h)/H, so v = (ρ', h) and v·n = h;
+    // the floor itself contributes v·n = 0.
+    let (big_h, h) = (5.0f32, 0.8f32);
+    let mut scene = scene_with(vec![Material::diffuse("white", [0.8; 3])], top_camera(big_h, 60.0));
+    add_triangles(&mut scene, "floor", &floor(100.0), 0);
+    add_triangles(
+        &mut scene,
+        "ceiling",
+        &quad(Vec3::new(0.0, h, 0.0), Vec3::X * 100.0, Vec3::Z * 100.0),
+        0,
+    );
+    let r = Reference::new(&scene, 0.0);
+    let cam = r.camera();
+    for disk in [DiskSampling::UniformArea, DiskSampling::SpiralRadius] {
+        let s = ObscuranceSettings {
+            spp: 4096,
+            disk,
+            ..ObscuranceSettings::new(1.0)
+        };
+        let (rad, beta, eps) = (s.radius as f64, s.beta as f64, s.epsilon as f64);
+        let (hh, scale) = (h as f64, (big_h - h) as f64 / big_h as f64);
+        let occlusion = |rho: f64| {
+            let vv = (rho * scale).powi(2) + hh * hh;
+            if vv < rad * rad {
+                (1.0 - vv / (rad * rad)) * ((hh - beta) / (vv + eps).sqrt()).max(0.0)
+            } else {
+                0.0
+            }
+        };
+        // E[A] = ∫₀^r O(ρ) p(ρ) dρ with p = 2ρ/r² (uniform area) or 1/r (spiral radius).
+        let steps = 200_000;
+        let mut mean_a = 0.0;
+        for i in 0..steps {
+            let rho = (i as f64 + 0.5) / steps as f64 * rad;
+            let p = match disk {
+                DiskSampling::UniformArea => 2.0 * rho / (rad * rad),
+                DiskSampling::SpiralRadius => 1.0 / rad,
+            };
+            mean_a += occlusion(rho) * p * rad / steps as f64;
+        }
+        let want_av = (1.0 - (std::f64::consts::PI * mean_a).sqrt()).max(0.0);
+        let (av, got_a) = r.ao_obscurance_at(&cam, Vec3::ZERO, Vec3::Y, &s, 3);
+        assert!(
+            want_av > 0.1 && want_av < 0.9,
+            "test case should be non-trivial: {want_av}"
+        );
+        assert!(
+            (got_a as f64 - mean_a).abs() < 0.005 * mean_a,
+            "{disk:?}: mean A {got_a} vs {mean_a}"
+        );
+        assert!((av as f64 - want_av).abs() < 0.005, "{disk:?}: AV {av} vs {want_av}");
+    }
+}

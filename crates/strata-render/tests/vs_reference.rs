@@ -1,0 +1,141 @@
+//! The GPU G-buffer and shadows against the CPU reference (same camera model,
+//! same pixel centres).
+
+mod common;
+
+use glam::Vec3;
+use strata_reference::Reference;
+use strata_scene::{procedural, Light, Scene};
+
+/// Fraction of pixels where GPU and reference agree on coverage, camera-space depth
+/// (relative 1e-3) and normal (within 3°, Oct16 quantisation is ≤ 1.5°).
+fn gbuffer_agreement(scene: &Scene, w: u32, h: u32) -> f64 {
+    let gpu = common::gpu();
+    let cam = scene.camera;
+    let r = common::render(&gpu, scene, &cam, w, h);
+    let csz = r.read_target(&gpu, "csz").unwrap();
+    let normals = r.read_normals(&gpu).unwrap();
+    let reference = Reference::new(scene, 0.0).with_progress(false);
+    let layer = reference.primary_layer(&cam, w, h);
+    let mut agree = 0usize;
+    let mut first_bad = None;
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let zg = csz.data[i];
+            let zr = layer.depth.data[i];
+            let ok = if zg <= 0.0 || !zr.is_finite() {
+                zg <= 0.0 && !zr.is_finite()
+            } else {
+                let ng = Vec3::from_slice(&normals.data[i * 3..i * 3 + 3]);
+                let mut nr = Vec3::from_slice(&layer.normal.data[i * 3..i * 3 + 3]);
+                if !layer.front_face[i] {
+                    nr = -nr;
+                }
+                (zg - zr).abs() <= 1e-3 * zr && ng.dot(nr) >= 3f32.to_radians().cos()
+            };
+            if ok {
+                agree += 1;
+            } else if first_bad.is_none() {
+                first_bad = Some((x, y, zg, zr));
+            }
+        }
+    }
+    let frac = agree as f64 / (w * h) as f64;
+    eprintln!(
+        "{}: {:.3}% of pixels agree; first disagreement {:?}",
+        scene.name,
+        100.0 * frac,
+        first_bad
+    );
+    frac
+}
+
+#[test]
+fn gbuffer_matches_reference_cornell() {
+    let s = procedural::builtin("cornell").unwrap();
+    assert!(gbuffer_agreement(&s, 128, 128) >= 0.995);
+}
+
+#[test]
+fn gbuffer_matches_reference_atrium() {
+    let s = procedural::builtin("atrium").unwrap();
+    assert!(gbuffer_agreement(&s, 192, 108) >= 0.995);
+}
+
+#[test]
+fn gbuffer_matches_reference_sponza() {
+    if common::shared_scene("dabrovic_sponza/sponza.obj").is_none() {
+        return;
+    }
+    let toml = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/sponza.toml");
+    let s = match strata_scene::load::load_path(&toml) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("skipping: {e}");
+            return;
+        }
+    };
+    assert!(gbuffer_agreement(&s, 160, 90) >= 0.995);
+}
+
+/// Sun shadow-map visibility against reference shadow rays, on pixels facing the
+/// sun; PCF visibility is thresholded at 0.5.
+fn shadow_agreement(scene: &Scene, w: u32, h: u32) -> f64 {
+    let Some(Light::Sun { direction, .. }) = scene.lights.first().cloned() else {
+        panic!("{}: light 0 must be a sun", scene.name)
+    };
+    let to_sun = -direction.normalize();
+    let gpu = common::gpu();
+    let cam = scene.camera;
+    let r = common::render(&gpu, scene, &cam, w, h);
+    let vis = r.read_target(&gpu, "shadow").unwrap();
+    let reference = Reference::new(scene, 0.0).with_progress(false);
+    let (mut n, mut agree) = (0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let Some(hit) = reference.primary_hit(&cam, x, y, w, h) else {
+                continue;
+            };
+            let dir = cam.pixel_dir(x, y, w, h);
+            let (ns, ng) = hit.facing_normals(dir);
+            if ns.dot(to_sun) < 0.05 || ng.dot(to_sun) < 0.05 {
+                continue; // self-shadowed or grazing: not a shadow-map question
+            }
+            let lit_ref =
+                !reference
+                    .bvh()
+                    .occluded(hit.position + ng * reference.epsilon(), to_sun, 0.0, f32::INFINITY);
+            let lit_gpu = vis.data[(y * w + x) as usize] > 0.5;
+            n += 1;
+            agree += (lit_ref == lit_gpu) as usize;
+        }
+    }
+    assert!(
+        n > (w * h) as usize / 10,
+        "{}: too few sun-facing pixels ({n})",
+        scene.name
+    );
+    let frac = agree as f64 / n as f64;
+    eprintln!(
+        "{}: shadows agree on {:.3}% of {n} sun-facing pixels",
+        scene.name,
+        100.0 * frac
+    );
+    frac
+}
+
+#[test]
+fn sun_shadows_match_reference_visibility_atrium() {
+    let s = procedural::builtin("atrium").unwrap();
+    assert!(shadow_agreement(&s, 192, 108) >= 0.98);
+}
+
+#[test]
+fn sun_shadows_match_reference_visibility_column_wall() {
+    let s = procedural::builtin("column-wall").unwrap();
+    if !matches!(s.lights.first(), Some(Light::Sun { .. })) {
+        panic!("column-wall's first light must be a sun for this test");
+    }
+    assert!(shadow_agreement(&s, 128, 128) >= 0.98);
+}
