@@ -21,9 +21,20 @@ pub struct CameraPath {
 }
 
 impl CameraPath {
+    /// Sorts the keyframes by frame; errors when there are none, when two share
+    /// a frame index, or when a frame, eye or target is not finite.
     pub fn new(mut keyframes: Vec<Keyframe>) -> Result<Self, String> {
         if keyframes.is_empty() {
             return Err("camera path needs at least one keyframe".into());
+        }
+        if let Some(k) = keyframes
+            .iter()
+            .find(|k| !(k.frame.is_finite() && k.eye.is_finite() && k.target.is_finite()))
+        {
+            return Err(format!(
+                "camera path keyframe at frame {} has non-finite values",
+                k.frame
+            ));
         }
         keyframes.sort_by(|a, b| a.frame.total_cmp(&b.frame));
         if keyframes.windows(2).any(|w| w[1].frame <= w[0].frame) {

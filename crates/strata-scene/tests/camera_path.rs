@@ -87,6 +87,12 @@ fn single_keyframe_and_invalid_paths() {
     assert_eq!(p.sample(9.0), (Vec3::ONE, Vec3::ZERO));
     assert!(CameraPath::new(vec![]).is_err());
     assert!(CameraPath::new(vec![k, k]).is_err());
+    assert!(CameraPath::new(vec![Keyframe { frame: f32::NAN, ..k }]).is_err());
+    assert!(CameraPath::new(vec![Keyframe {
+        eye: Vec3::INFINITY,
+        ..k
+    }])
+    .is_err());
 }
 
 #[test]
