@@ -7,10 +7,20 @@ set -euo pipefail
 say() { echo "[strata setup] $*" >&2; }
 as_root() { if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else say "need root for: $*"; return 1; fi; }
 
-has_vulkan() {
-  ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' || return 1
-  ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 || return 1
+# The loader library may be found by ldconfig (not on PATH for every user, so
+# try /sbin too) or directly in the multiarch library directories.
+has_vulkan_loader() {
+  local ldc
+  for ldc in ldconfig /sbin/ldconfig /usr/sbin/ldconfig; do
+    if command -v "$ldc" >/dev/null 2>&1 && "$ldc" -p 2>/dev/null | grep -q 'libvulkan.so.1'; then return 0; fi
+  done
+  compgen -G '/usr/lib/*/libvulkan.so.1' >/dev/null || compgen -G '/usr/lib/libvulkan.so.1' >/dev/null \
+    || compgen -G '/lib/*/libvulkan.so.1' >/dev/null
 }
+has_vulkan_icd() {
+  compgen -G '/usr/share/vulkan/icd.d/*.json' >/dev/null || compgen -G '/etc/vulkan/icd.d/*.json' >/dev/null
+}
+has_vulkan() { has_vulkan_loader && has_vulkan_icd; }
 
 if has_vulkan; then
   say "Vulkan loader and driver found"
@@ -18,7 +28,11 @@ else
   say "no Vulkan driver found: installing Mesa's lavapipe (mesa-vulkan-drivers, libvulkan1)"
   as_root apt-get update -qq
   DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >/dev/null
-  has_vulkan || { say "Vulkan still not found after install"; exit 1; }
+  if ! has_vulkan; then
+    has_vulkan_loader || say "libvulkan.so.1 not found (ldconfig and /usr/lib/*/)"
+    has_vulkan_icd || say "no ICD json in /usr/share/vulkan/icd.d or /etc/vulkan/icd.d"
+    say "Vulkan still not found after install"; exit 1
+  fi
 fi
 
 if ! command -v cargo >/dev/null 2>&1; then
