@@ -4,13 +4,15 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
+use strata_render::renderer::GuardBand;
 
 #[derive(Parser)]
 #[command(
     name = "strata",
     version,
     about = "Layered screen-space global illumination (deep G-buffers and friends), measured against a CPU ray-traced reference",
-    after_help = "Scenes: a built-in name (cornell, atrium, warehouse, plane, column-wall) or a path to a .gltf, .glb, .obj or .toml file.\nExamples:\n  strata info\n  strata render --scene atrium --width 640 --height 360 --out atrium.png\n  strata reference --scene cornell --kind ao --spp 16 --width 64 --height 64 --out ao.exr\n  strata bench gbuffer --scene atrium --width 640 --height 360 --frames 5 --json"
+    after_help = "Scenes: a built-in name (cornell, atrium, warehouse, plane, column-wall) or a path to a .gltf, .glb, .obj or .toml file.\nExamples:\n  strata info\n  strata render --scene atrium --width 640 --height 360 --out atrium.png\n  strata reference --scene cornell --kind ao --spp 16 --width 64 --height 64 --out ao.exr\n  strata render --scene atrium --layers 2 --variant reproject --debug-view layer1-albedo --out l1.png\n  strata bench gbuffer --scene atrium --width 640 --height 360 --frames 5 --json\n  strata bench deep-gbuffer --scene atrium --width 640 --height 360 --frames 8 --json"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -74,6 +76,43 @@ pub struct SceneArgs {
     pub fov: Option<f32>,
 }
 
+/// Deep G-buffer construction (DGB §2).
+#[derive(Args, Clone)]
+pub struct DeepArgs {
+    /// Deep G-buffer layers k, 1..=4 (layer 0 is the visible surface).
+    #[arg(long, default_value_t = 1)]
+    pub layers: u32,
+    /// How layers ≥ 1 are built: peel (k passes, exact), delay (1 pass, exact, one frame of latency),
+    /// previous, predict, reproject (1 pass; the paper's choice).
+    #[arg(long, default_value = "reproject", value_parser = parse_variant)]
+    pub variant: Variant,
+    /// Minimum separation Δz between layers in scene units, >= 0 (default: the scene's; the paper uses 0.5 m).
+    #[arg(long)]
+    pub min_separation: Option<f32>,
+    /// Guard band rendered around the image and cropped: pixels per side (e.g. 32) or percent of the height (e.g. 10%).
+    #[arg(long, default_value = "0", value_parser = parse_guard_band)]
+    pub guard_band: GuardBand,
+}
+
+impl DeepArgs {
+    pub fn settings(&self) -> DeepGBufferSettings {
+        DeepGBufferSettings {
+            layers: self.layers,
+            variant: self.variant,
+            min_separation: self.min_separation,
+            ..Default::default()
+        }
+    }
+}
+
+fn parse_variant(s: &str) -> Result<Variant, String> {
+    s.parse()
+}
+
+fn parse_guard_band(s: &str) -> Result<GuardBand, String> {
+    s.parse()
+}
+
 #[derive(Copy, Clone, PartialEq, Eq, ValueEnum, Debug)]
 pub enum Technique {
     /// Direct light (sun/point/spot/area, shadows) + emission + ambient.
@@ -89,6 +128,8 @@ pub struct RenderArgs {
     /// Shading technique.
     #[arg(long, value_enum, default_value_t = Technique::Direct)]
     pub technique: Technique,
+    #[command(flatten)]
+    pub deep: DeepArgs,
     /// Write an intermediate target instead of the final image (e.g. csz, normal, albedo, emission, direct-diffuse, shadow, hdr). `--list-passes` shows them.
     #[arg(long)]
     pub debug_view: Option<String>,
@@ -169,6 +210,9 @@ pub struct BenchArgs {
 pub enum BenchWhat {
     /// Per-pass GPU time of the single-layer frame (shadow, gbuffer, lighting, tonemap).
     Gbuffer(BenchGbufferArgs),
+    /// Deep G-buffer construction, DGB Table 5 and Fig. 3: layer times per method and
+    /// second-layer mismatches against the exact peel along the camera path.
+    DeepGbuffer(BenchDeepArgs),
     /// CPU reference throughput (million rays per second).
     Reference(BenchReferenceArgs),
 }
@@ -182,6 +226,32 @@ pub struct BenchGbufferArgs {
     /// Frames to time (after one warm-up frame), 1..=10000.
     #[arg(long, default_value_t = 10)]
     pub frames: u32,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args)]
+pub struct BenchDeepArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// Frames along the camera path to time and compare (after one warm-up frame), 1..=10000.
+    #[arg(long, default_value_t = 8)]
+    pub frames: u32,
+    /// Deep G-buffer layers k, 2..=4 (delay and predict run only for k = 2).
+    #[arg(long, default_value_t = 2)]
+    pub layers: u32,
+    /// Minimum separation Δz in scene units (default: the scene's).
+    #[arg(long)]
+    pub min_separation: Option<f32>,
+    /// Write Fig. 3-style images (each method's layer 1 and its differences from the peel) into this folder.
+    #[arg(long)]
+    pub images: Option<PathBuf>,
+    /// Overwrite existing images in --images.
+    #[arg(long)]
+    pub force: bool,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,

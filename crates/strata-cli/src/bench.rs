@@ -5,11 +5,12 @@ use serde_json::json;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 
 use crate::args::{BenchArgs, BenchGbufferArgs, BenchWhat};
-use crate::output::scene_and_camera;
+use crate::output::{cameras_at, scene_and_camera};
 
 pub fn run(a: &BenchArgs) -> Result<()> {
     match &a.what {
         BenchWhat::Gbuffer(b) => gbuffer(b),
+        BenchWhat::DeepGbuffer(b) => crate::bench_deep::run(b),
         BenchWhat::Reference(b) => crate::reference::bench(b),
     }
 }
@@ -30,7 +31,7 @@ fn gbuffer(a: &BenchGbufferArgs) -> Result<()> {
     if !(1..=10000).contains(&a.frames) {
         anyhow::bail!("--frames {} is out of range: must be in 1..=10000", a.frames);
     }
-    let (scene, _, _) = scene_and_camera(&a.scene)?;
+    let (scene, _) = scene_and_camera(&a.scene)?;
     let gpu = GpuContext::new(&GpuOptions {
         adapter: a.gpu.adapter.clone(),
     })?;
@@ -45,30 +46,15 @@ fn gbuffer(a: &BenchGbufferArgs) -> Result<()> {
         ..Default::default()
     };
     let mut r = Renderer::new(&gpu, &scene, settings)?;
-    let cam_at = |f: f32| {
-        let mut c = scene.camera_at(f);
-        if let Some(e) = a.scene.eye {
-            c.eye = e;
-        }
-        if let Some(t) = a.scene.target {
-            c.target = t;
-        }
-        c
-    };
     // Warm-up frame (pipeline creation, first-use allocations).
-    r.render(
-        &gpu,
-        &scene,
-        &cam_at(a.scene.frame),
-        &cam_at(a.scene.frame - 1.0),
-        a.scene.frame,
-    )?;
+    let f0 = a.scene.frame;
+    r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f0), f0)?;
     let names: Vec<&str> = r.pass_infos().iter().map(|p| p.name).collect();
     let mut samples: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
     let mut totals = Vec::new();
     for i in 0..a.frames {
         let f = a.scene.frame + i as f32;
-        let t = r.render(&gpu, &scene, &cam_at(f), &cam_at(f - 1.0), f)?;
+        let t = r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f), f)?;
         for (k, n) in names.iter().enumerate() {
             samples[k].push(t.get(n).unwrap_or(f64::NAN));
         }
@@ -112,6 +98,6 @@ fn gbuffer(a: &BenchGbufferArgs) -> Result<()> {
     Ok(())
 }
 
-fn wgpu_ts() -> strata_render::gpu::Features {
+pub fn wgpu_ts() -> strata_render::gpu::Features {
     strata_render::gpu::Features::TIMESTAMP_QUERY | strata_render::gpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
 }

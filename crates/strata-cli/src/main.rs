@@ -2,6 +2,7 @@
 
 mod args;
 mod bench;
+mod bench_deep;
 mod info;
 mod output;
 mod reference;

@@ -3,33 +3,20 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
+use strata_render::frame::FrameCameras;
 use strata_scene::{Camera, ImageBuf, Scene};
 
 use crate::args::SceneArgs;
 
-/// Loads the scene and resolves the camera (scene path at --frame, then flag overrides).
-pub fn scene_and_camera(a: &SceneArgs) -> Result<(Scene, Camera, Camera)> {
+/// Loads the scene and resolves the cameras of frames --frame − 1, --frame and
+/// --frame + 1 (the scene's path, then flag overrides).
+pub fn scene_and_camera(a: &SceneArgs) -> Result<(Scene, FrameCameras)> {
     let scene = strata_scene::load_scene(&a.scene).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
     if !a.frame.is_finite() || a.frame < 0.0 {
         bail!("--frame {} is out of range: must be a finite number >= 0", a.frame);
     }
-    let apply = |mut c: Camera| {
-        if let Some(e) = a.eye {
-            c.eye = e;
-        }
-        if let Some(t) = a.target {
-            c.target = t;
-        }
-        if let Some(u) = a.up {
-            c.up = u;
-        }
-        if let Some(f) = a.fov {
-            c.fov_y_deg = f;
-        }
-        c
-    };
-    let camera = apply(scene.camera_at(a.frame));
-    let prev = apply(scene.camera_at(a.frame - 1.0));
+    let cams = cameras_at(&scene, a, a.frame);
+    let camera = cams.current;
     camera
         .validate()
         .map_err(|e| anyhow::anyhow!("--eye/--target/--up/--fov: {e}"))?;
@@ -42,7 +29,31 @@ pub fn scene_and_camera(a: &SceneArgs) -> Result<(Scene, Camera, Camera)> {
             );
         }
     }
-    Ok((scene, camera, prev))
+    Ok((scene, cams))
+}
+
+/// The cameras of frames `f − 1`, `f`, `f + 1` with the flag overrides applied.
+pub fn cameras_at(scene: &Scene, a: &SceneArgs, f: f32) -> FrameCameras {
+    let apply = |mut c: Camera| {
+        if let Some(e) = a.eye {
+            c.eye = e;
+        }
+        if let Some(t) = a.target {
+            c.target = t;
+        }
+        if let Some(u) = a.up {
+            c.up = u;
+        }
+        if let Some(fov) = a.fov {
+            c.fov_y_deg = fov;
+        }
+        c
+    };
+    FrameCameras {
+        previous: apply(scene.camera_at(f - 1.0)),
+        current: apply(scene.camera_at(f)),
+        next_view: apply(scene.camera_at(f + 1.0)).view(),
+    }
 }
 
 /// Refuses to overwrite an existing file unless `force`; creates parent folders.

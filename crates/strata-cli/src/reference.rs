@@ -16,7 +16,8 @@ use crate::args::{BenchReferenceArgs, ReferenceArgs, ReferenceKind};
 use crate::output::{check_output, save, scene_and_camera};
 
 pub fn run(a: &ReferenceArgs) -> Result<()> {
-    let (scene, camera, _) = scene_and_camera(&a.scene)?;
+    let (scene, cams) = scene_and_camera(&a.scene)?;
+    let camera = cams.current;
     let (w, h) = (a.scene.width, a.scene.height);
     if !(1..=65536).contains(&a.spp) {
         bail!("--spp {} is out of range: must be in 1..=65536", a.spp);
@@ -142,7 +143,8 @@ fn tonemap(img: &ImageBuf, exposure: f32) -> ImageBuf {
 }
 
 pub fn bench(a: &BenchReferenceArgs) -> Result<()> {
-    let (scene, camera, _) = scene_and_camera(&a.scene)?;
+    let (scene, cams) = scene_and_camera(&a.scene)?;
+    let camera = cams.current;
     if !(a.mrays > 0.0 && a.mrays <= 10_000.0) {
         bail!("--mrays {} is out of range: must be in (0, 10000]", a.mrays);
     }

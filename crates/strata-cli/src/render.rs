@@ -4,13 +4,15 @@ use anyhow::Result;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 
 use crate::args::RenderArgs;
-use crate::output::{check_output, save, scene_and_camera};
+use crate::output::{cameras_at, check_output, save, scene_and_camera};
 
 pub fn run(a: &RenderArgs) -> Result<()> {
-    let (scene, camera, prev) = scene_and_camera(&a.scene)?;
+    let (scene, cams) = scene_and_camera(&a.scene)?;
     let settings = RenderSettings {
         width: a.scene.width,
         height: a.scene.height,
+        deep: a.deep.settings(),
+        guard_band: a.deep.guard_band,
         shadow: strata_render::passes::shadow::ShadowSettings {
             resolution: a.shadow_resolution,
         },
@@ -29,7 +31,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         println!("frame of '{}' ({:?}):", scene.name, a.technique);
         for p in r.pass_infos() {
             println!(
-                "  {:<10} reads [{}] writes [{}]",
+                "  {:<12} reads [{}] writes [{}]",
                 p.name,
                 p.inputs.join(", "),
                 p.outputs.join(", ")
@@ -48,7 +50,12 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             );
         }
     }
-    let t = r.render(&gpu, &scene, &camera, &prev, a.scene.frame)?;
+    if r.settings.deep.uses_history() {
+        // Single-pass layers test against last frame's depths: render frame − 1 first.
+        let f = a.scene.frame - 1.0;
+        r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f), f)?;
+    }
+    let t = r.render(&gpu, &scene, &cams, a.scene.frame)?;
     let img = match (&a.debug_view, exr) {
         (Some(v), _) => r.debug_view(&gpu, v, exr)?,
         (None, true) => r.read_target(&gpu, "hdr")?,
@@ -58,7 +65,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     save(&img, out, true)?;
     if a.timings {
         for (n, ms) in &t.passes {
-            eprintln!("{n:<10} {ms:8.3} ms");
+            eprintln!("{n:<12} {ms:8.3} ms");
         }
     }
     eprintln!(

@@ -16,6 +16,9 @@ pub struct FrameUniforms {
     pub view_proj: [[f32; 4]; 4],
     pub inv_view_proj: [[f32; 4]; 4],
     pub prev_view_proj: [[f32; 4]; 4],
+    /// View-projection of frame t + 1 (exact for `Variant::Delay`, extrapolated
+    /// for `Variant::Predict`; equal to `view_proj` otherwise).
+    pub next_view_proj: [[f32; 4]; 4],
     pub eye: [f32; 4],
     pub cam_right: [f32; 4],
     pub cam_up: [f32; 4],
@@ -26,16 +29,9 @@ pub struct FrameUniforms {
 }
 
 impl FrameUniforms {
-    pub fn new(
-        scene: &Scene,
-        camera: &Camera,
-        prev: &Camera,
-        width: u32,
-        height: u32,
-        frame: f32,
-        exposure: f32,
-    ) -> Self {
+    pub fn new(scene: &Scene, cams: &FrameCameras, width: u32, height: u32, frame: f32, exposure: f32) -> Self {
         let aspect = width as f32 / height as f32;
+        let camera = &cams.current;
         let vp = camera.view_projection(aspect);
         let (r, u, f) = camera.basis();
         let t = (0.5 * camera.fov_y_deg.to_radians()).tan();
@@ -45,7 +41,8 @@ impl FrameUniforms {
             proj: camera.projection(aspect).to_cols_array_2d(),
             view_proj: vp.to_cols_array_2d(),
             inv_view_proj: vp.inverse().to_cols_array_2d(),
-            prev_view_proj: prev.view_projection(aspect).to_cols_array_2d(),
+            prev_view_proj: cams.previous.view_projection(aspect).to_cols_array_2d(),
+            next_view_proj: (camera.projection(aspect) * cams.next_view).to_cols_array_2d(),
             eye: camera.eye.extend(camera.near).to_array(),
             cam_right: (r * t * aspect).extend(0.0).to_array(),
             cam_up: (u * t).extend(0.0).to_array(),
@@ -53,6 +50,60 @@ impl FrameUniforms {
             size: [width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32],
             sky: [s.sky[0], s.sky[1], s.sky[2], exposure],
             ambient: [s.ambient[0], s.ambient[1], s.ambient[2], frame],
+        }
+    }
+}
+
+/// The cameras of frames t − 1, t and t + 1 that a frame's passes use: the
+/// previous one for reverse reprojection, the next one (as a view matrix, since
+/// an extrapolated camera is any rigid transform) for the depth oracle of the
+/// deep G-buffer's `Delay` and `Predict` variants.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameCameras {
+    pub previous: Camera,
+    pub current: Camera,
+    /// World → camera transform of frame t + 1.
+    pub next_view: glam::Mat4,
+}
+
+impl FrameCameras {
+    /// A camera that does not move.
+    pub fn fixed(camera: Camera) -> Self {
+        Self {
+            previous: camera,
+            current: camera,
+            next_view: camera.view(),
+        }
+    }
+
+    /// The scene's camera path at `frame − 1`, `frame` and (exactly) `frame + 1`.
+    pub fn along_path(scene: &Scene, frame: f32) -> Self {
+        Self {
+            previous: scene.camera_at(frame - 1.0),
+            current: scene.camera_at(frame),
+            next_view: scene.camera_at(frame + 1.0).view(),
+        }
+    }
+
+    /// `next_view` extrapolated from frames t − 1 and t at constant velocity
+    /// (DGB §2.2 PREDICT): V_{t+1} = V_t · V_{t−1}⁻¹ · V_t.
+    /// A camera at rest predicts itself exactly.
+    pub fn predicted(previous: Camera, current: Camera) -> Self {
+        let (vp, vc) = (previous.view(), current.view());
+        Self {
+            previous,
+            current,
+            next_view: if vp == vc { vc } else { vc * vp.inverse() * vc },
+        }
+    }
+
+    /// Replaces the current (and, consistently, previous/next) cameras by their
+    /// guard-band widened versions for an image of `height` rows and `g` guard pixels.
+    pub fn with_guard_band(&self, height: u32, g: u32) -> Self {
+        Self {
+            previous: self.previous.with_guard_band(height, g),
+            current: self.current.with_guard_band(height, g),
+            next_view: self.next_view,
         }
     }
 }
@@ -79,7 +130,19 @@ pub struct TargetDesc {
 pub struct Target {
     pub desc: TargetDesc,
     pub texture: wgpu::Texture,
+    /// The whole texture (`D2Array` when it has several layers).
     pub view: wgpu::TextureView,
+    /// The whole texture as a `D2Array` view (also when it has one layer).
+    pub array_view: wgpu::TextureView,
+    /// One `D2` view per array layer.
+    pub layer_views: Vec<wgpu::TextureView>,
+}
+
+impl Target {
+    /// A `D2` view of array layer `j`.
+    pub fn layer(&self, j: u32) -> &wgpu::TextureView {
+        &self.layer_views[j as usize]
+    }
 }
 
 /// All targets of a frame, by name.
@@ -113,7 +176,8 @@ impl Targets {
             format: desc.format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor {
@@ -124,7 +188,30 @@ impl Targets {
             }),
             ..Default::default()
         });
-        self.map.insert(desc.name, Target { desc, texture, view });
+        let array_view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let layer_views = (0..desc.layers)
+            .map(|j| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: j,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        self.map.insert(
+            desc.name,
+            Target {
+                desc,
+                texture,
+                view,
+                array_view,
+                layer_views,
+            },
+        );
     }
 
     pub fn get(&self, name: &str) -> &Target {
@@ -164,12 +251,18 @@ pub trait Pass {
     );
 }
 
-/// Checks the declared data flow of an ordered pass list.
+/// Checks the declared data flow of an ordered pass list: every input must be
+/// written by an earlier pass, except `…-history` inputs, which hold the
+/// previous frame's data and must be written by some pass of the frame.
 pub fn validate_pass_order(infos: &[PassInfo]) -> Result<(), String> {
     let mut written: Vec<&str> = vec!["scene"];
     for p in infos {
         for i in &p.inputs {
-            if !written.contains(i) {
+            if i.ends_with("-history") {
+                if !infos.iter().any(|q| q.outputs.contains(i)) {
+                    return Err(format!("pass '{}' reads '{}' but no pass keeps it", p.name, i));
+                }
+            } else if !written.contains(i) {
                 return Err(format!("pass '{}' reads '{}' before any pass writes it", p.name, i));
             }
         }

@@ -25,7 +25,8 @@ pub struct Profiler {
     resolve: Option<wgpu::Buffer>,
     readback: Option<wgpu::Buffer>,
     capacity: u32,
-    names: Vec<String>,
+    /// Pass names of the current frame (interior mutability: passes borrow the renderer).
+    names: std::cell::RefCell<Vec<String>>,
     period_ns: f64,
 }
 
@@ -61,7 +62,7 @@ impl Profiler {
             resolve,
             readback,
             capacity,
-            names: Vec::new(),
+            names: Default::default(),
             period_ns: gpu.queue.get_timestamp_period() as f64,
         }
     }
@@ -71,23 +72,24 @@ impl Profiler {
     }
 
     /// Starts a new frame's measurements.
-    pub fn reset(&mut self) {
-        self.names.clear();
+    pub fn reset(&self) {
+        self.names.borrow_mut().clear();
     }
 
     /// Marks the start of pass `name`; returns its slot for [`Profiler::end`].
-    pub fn begin(&mut self, encoder: &mut wgpu::CommandEncoder, name: &str) -> Option<u32> {
+    pub fn begin(&self, encoder: &mut wgpu::CommandEncoder, name: &str) -> Option<u32> {
         let qs = self.query_set.as_ref()?;
-        let slot = self.names.len() as u32;
+        let mut names = self.names.borrow_mut();
+        let slot = names.len() as u32;
         if (slot + 1) * 2 > self.capacity {
             return None;
         }
-        self.names.push(name.to_string());
+        names.push(name.to_string());
         encoder.write_timestamp(qs, slot * 2);
         Some(slot)
     }
 
-    pub fn end(&mut self, encoder: &mut wgpu::CommandEncoder, slot: Option<u32>) {
+    pub fn end(&self, encoder: &mut wgpu::CommandEncoder, slot: Option<u32>) {
         if let (Some(qs), Some(s)) = (self.query_set.as_ref(), slot) {
             encoder.write_timestamp(qs, s * 2 + 1);
         }
@@ -96,7 +98,7 @@ impl Profiler {
     /// Copies this frame's queries into the read-back buffer (call before `finish`).
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         if let (Some(qs), Some(r), Some(rb)) = (&self.query_set, &self.resolve, &self.readback) {
-            let n = self.names.len() as u32 * 2;
+            let n = self.names.borrow().len() as u32 * 2;
             if n > 0 {
                 encoder.resolve_query_set(qs, 0..n, r, 0);
                 encoder.copy_buffer_to_buffer(r, 0, rb, 0, n as u64 * 8);
@@ -109,13 +111,13 @@ impl Profiler {
         let Some(rb) = &self.readback else {
             return Ok(PassTimings::default());
         };
-        if self.names.is_empty() {
+        let names = self.names.borrow();
+        if names.is_empty() {
             return Ok(PassTimings::default());
         }
         let bytes = gpu.read_buffer(rb)?;
         let ticks: &[u64] = bytemuck::cast_slice(&bytes);
-        let passes = self
-            .names
+        let passes = names
             .iter()
             .enumerate()
             .map(|(i, n)| {

@@ -1,12 +1,14 @@
-//! The frame: shadow → G-buffer → lighting → tonemap, with every intermediate
-//! target readable as a debug view and every pass timed.
+//! The frame: shadow → deep G-buffer (one or more geometry passes) → Table-1
+//! packing → lighting → tonemap → history, with every intermediate target
+//! readable as a debug view and every pass timed.
 
-use strata_scene::{Camera, ImageBuf, Scene};
+use strata_scene::{ImageBuf, Scene};
 
-use crate::frame::{validate_pass_order, FrameUniforms, Pass, PassInfo, Targets};
+use crate::frame::{validate_pass_order, FrameCameras, FrameUniforms, Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
 use crate::lights::{gpu_lights, GpuLight};
-use crate::passes::{gbuffer, lighting, shadow, tonemap};
+use crate::passes::deep_gbuffer::{self, DeepGBufferSettings, Variant};
+use crate::passes::{lighting, shadow, tonemap};
 use crate::profiler::{PassTimings, Profiler};
 use crate::scene_gpu::GpuScene;
 use crate::RenderError;
@@ -15,11 +17,61 @@ use crate::RenderError;
 pub const MIN_SIZE: u32 = 8;
 pub const MAX_SIZE: u32 = 8192;
 
+/// A band of extra pixels rendered around the image and cropped at output, so
+/// screen-space passes see surfaces just outside the frame (DGB §3.5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GuardBand {
+    /// `g` pixels on every side.
+    Pixels(u32),
+    /// A fraction of the image height on every side (0.1 = 10 %).
+    Fraction(f32),
+}
+
+impl Default for GuardBand {
+    fn default() -> Self {
+        GuardBand::Pixels(0)
+    }
+}
+
+impl GuardBand {
+    /// Guard pixels per side for an image `height` rows tall.
+    pub fn pixels(&self, height: u32) -> u32 {
+        match *self {
+            GuardBand::Pixels(g) => g,
+            GuardBand::Fraction(f) => (f * height as f32).round() as u32,
+        }
+    }
+}
+
+impl std::str::FromStr for GuardBand {
+    type Err = String;
+    /// `N` (pixels) or `F%` (percent of the image height).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad =
+            || format!("guard band '{s}' is invalid: use pixels (e.g. 32) or a percentage of the height (e.g. 10%)");
+        if let Some(p) = s.strip_suffix('%') {
+            let f: f32 = p.trim().parse().map_err(|_| bad())?;
+            if !(0.0..=100.0).contains(&f) {
+                return Err(format!("guard band {s} is out of range: must be in 0%..=100%"));
+            }
+            Ok(GuardBand::Fraction(f / 100.0))
+        } else {
+            s.trim().parse().map(GuardBand::Pixels).map_err(|_| bad())
+        }
+    }
+}
+
 /// What to render and how.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
+    /// Deep G-buffer layers and construction variant (default: one layer).
+    pub deep: DeepGBufferSettings,
+    pub guard_band: GuardBand,
+    /// Run shadow, lighting and tonemap after the G-buffer (false: geometry only,
+    /// for G-buffer benchmarks and tests).
+    pub shade: bool,
     pub shadow: shadow::ShadowSettings,
     pub lighting: lighting::LightingSettings,
     /// Overrides the scene's exposure.
@@ -31,6 +83,9 @@ impl Default for RenderSettings {
         Self {
             width: 640,
             height: 360,
+            deep: DeepGBufferSettings::single_layer(),
+            guard_band: GuardBand::default(),
+            shade: true,
             shadow: Default::default(),
             lighting: Default::default(),
             exposure: None,
@@ -60,7 +115,32 @@ impl RenderSettings {
                 )));
             }
         }
-        Ok(())
+        if let GuardBand::Fraction(f) = self.guard_band {
+            if !(0.0..=1.0).contains(&f) {
+                return Err(RenderError::Parameter(format!(
+                    "guard band fraction {f} is out of range: must be in 0..=1"
+                )));
+            }
+        }
+        let (w, h) = self.internal_size();
+        if w > MAX_SIZE || h > MAX_SIZE {
+            return Err(RenderError::Parameter(format!(
+                "guard band {} px makes the rendered size {w}x{h}: must stay within {MAX_SIZE}",
+                self.guard_pixels()
+            )));
+        }
+        self.deep.validate()
+    }
+
+    /// Guard-band pixels per side.
+    pub fn guard_pixels(&self) -> u32 {
+        self.guard_band.pixels(self.height)
+    }
+
+    /// Size of every render target: the image plus the guard band.
+    pub fn internal_size(&self) -> (u32, u32) {
+        let g = self.guard_pixels();
+        (self.width + 2 * g, self.height + 2 * g)
     }
 }
 
@@ -68,10 +148,14 @@ pub struct Renderer {
     pub settings: RenderSettings,
     pub scene_gpu: GpuScene,
     pub targets: Targets,
-    shadow: shadow::ShadowPass,
-    gbuffer: gbuffer::GBufferPass,
-    lighting: lighting::LightingPass,
-    tonemap: tonemap::TonemapPass,
+    shadow: Option<shadow::ShadowPass>,
+    geometry: Vec<deep_gbuffer::GeometryPass>,
+    pack: deep_gbuffer::PackPass,
+    lighting: Option<lighting::LightingPass>,
+    tonemap: Option<tonemap::TonemapPass>,
+    history: Option<deep_gbuffer::HistoryPass>,
+    /// Last frame's depths are in `csz-history` (false before the first frame).
+    has_history: bool,
     profiler: Profiler,
     lights: Vec<GpuLight>,
     animated: bool,
@@ -87,23 +171,36 @@ impl Renderer {
             )));
         }
         let scene_gpu = GpuScene::new(gpu, scene);
-        let mut targets = Targets::new(settings.width, settings.height);
-        for d in gbuffer::OUTPUTS.iter().chain(lighting::OUTPUTS).chain(tonemap::OUTPUTS) {
-            targets.create(gpu, *d);
+        let (w, h) = settings.internal_size();
+        let mut targets = Targets::new(w, h);
+        for d in settings.deep.outputs() {
+            targets.create(gpu, d);
+        }
+        if settings.shade {
+            for d in lighting::OUTPUTS.iter().chain(tonemap::OUTPUTS) {
+                targets.create(gpu, *d);
+            }
         }
         let lights = gpu_lights(scene, 0.0, settings.shadow.resolution);
-        let shadow = shadow::ShadowPass::new(gpu, &scene_gpu, &lights, &settings.shadow);
-        let gbuffer = gbuffer::GBufferPass::new(gpu, &scene_gpu);
-        let lighting = lighting::LightingPass::new(
-            gpu,
-            &scene_gpu,
-            &targets,
-            &shadow,
-            &lights,
-            settings.shadow.resolution,
-            &settings.lighting,
-        );
-        let tonemap = tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, "hdr");
+        let geometry = deep_gbuffer::geometry_passes(gpu, &scene_gpu, &targets, &settings.deep)?;
+        let pack = deep_gbuffer::PackPass::new(gpu, &targets, &settings.deep);
+        let (shadow, lighting, tonemap) = if settings.shade {
+            let shadow = shadow::ShadowPass::new(gpu, &scene_gpu, &lights, &settings.shadow);
+            let lighting = lighting::LightingPass::new(
+                gpu,
+                &scene_gpu,
+                &targets,
+                &shadow,
+                &lights,
+                settings.shadow.resolution,
+                &settings.lighting,
+            );
+            let tonemap = tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, "hdr");
+            (Some(shadow), Some(lighting), Some(tonemap))
+        } else {
+            (None, None, None)
+        };
+        let history = settings.deep.uses_history().then_some(deep_gbuffer::HistoryPass);
         let profiler = Profiler::new(gpu, 16);
         let animated = scene.objects.iter().any(|o| o.animation.is_some());
         let r = Self {
@@ -111,9 +208,12 @@ impl Renderer {
             scene_gpu,
             targets,
             shadow,
-            gbuffer,
+            geometry,
+            pack,
             lighting,
             tonemap,
+            history,
+            has_history: false,
             profiler,
             lights,
             animated,
@@ -123,8 +223,22 @@ impl Renderer {
         Ok(r)
     }
 
-    fn passes(&self) -> [&dyn Pass; 4] {
-        [&self.shadow, &self.gbuffer, &self.lighting, &self.tonemap]
+    /// The frame's passes in execution order.
+    fn passes(&self) -> Vec<&dyn Pass> {
+        let mut v: Vec<&dyn Pass> = Vec::new();
+        if let Some(s) = &self.shadow {
+            v.push(s);
+        }
+        v.extend(self.geometry.iter().map(|p| p as &dyn Pass));
+        v.push(&self.pack);
+        if let (Some(l), Some(t)) = (&self.lighting, &self.tonemap) {
+            v.push(l);
+            v.push(t);
+        }
+        if let Some(h) = &self.history {
+            v.push(h);
+        }
+        v
     }
 
     /// The frame's passes in order, with declared inputs and outputs.
@@ -132,38 +246,55 @@ impl Renderer {
         self.passes().iter().map(|p| p.info()).collect()
     }
 
-    /// Renders one frame with `camera` at (fractional) frame index `frame`.
+    /// Forgets last frame's depths (a camera cut): the next frame's single-pass
+    /// layers have no oracle.
+    pub fn reset_history(&mut self) {
+        self.has_history = false;
+    }
+
+    /// Renders one frame at (fractional) frame index `frame`, seen by
+    /// `cams.current`; `cams.previous` drives reverse reprojection and
+    /// `cams.next_view` the DELAY oracle (PREDICT extrapolates its own).
     pub fn render(
         &mut self,
         gpu: &GpuContext,
         scene: &Scene,
-        camera: &Camera,
-        prev_camera: &Camera,
+        cams: &FrameCameras,
         frame: f32,
     ) -> Result<PassTimings, RenderError> {
-        camera.validate().map_err(RenderError::Parameter)?;
+        cams.current.validate().map_err(RenderError::Parameter)?;
+        let variant = self.settings.deep.variant;
+        let cams = if variant == Variant::Predict {
+            FrameCameras::predicted(cams.previous, cams.current)
+        } else {
+            *cams
+        };
+        let cams = cams.with_guard_band(self.settings.height, self.settings.guard_pixels());
         let exposure = self.settings.exposure.unwrap_or(scene.settings.exposure);
-        let u = FrameUniforms::new(
-            scene,
-            camera,
-            prev_camera,
-            self.settings.width,
-            self.settings.height,
-            frame,
-            exposure,
-        );
+        let (w, h) = self.settings.internal_size();
+        let u = FrameUniforms::new(scene, &cams, w, h, frame, exposure);
         self.scene_gpu.update_frame(gpu, &u);
-        self.scene_gpu.update_objects(gpu, frame);
+        self.scene_gpu.update_objects(gpu, frame, variant.next_transforms());
+        let dz = self
+            .settings
+            .deep
+            .min_separation
+            .unwrap_or(scene.settings.min_separation);
+        for g in &self.geometry {
+            g.set_frame(gpu, dz, self.has_history);
+        }
         if self.animated {
-            self.lights = gpu_lights(scene, frame, self.settings.shadow.resolution);
-            self.shadow.update(gpu, &self.lights);
-            self.lighting.update_lights(gpu, &self.lights);
+            if let (Some(s), Some(l)) = (&self.shadow, &self.lighting) {
+                self.lights = gpu_lights(scene, frame, self.settings.shadow.resolution);
+                s.update(gpu, &self.lights);
+                l.update_lights(gpu, &self.lights);
+            }
         }
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.profiler.reset();
-        let passes = [&self.shadow as &dyn Pass, &self.gbuffer, &self.lighting, &self.tonemap];
+        let passes = self.passes();
         for p in passes {
             let slot = self.profiler.begin(&mut encoder, p.info().name);
             p.encode(gpu, &self.scene_gpu, &self.targets, &mut encoder);
@@ -172,6 +303,7 @@ impl Renderer {
         self.profiler.resolve(&mut encoder);
         gpu.queue.submit([encoder.finish()]);
         gpu.check_errors()?;
+        self.has_history = self.history.is_some();
         self.profiler.read(gpu)
     }
 
@@ -180,22 +312,52 @@ impl Renderer {
         self.targets.names().copied().collect()
     }
 
-    /// Reads target `name` back as floats (sRGB targets decoded to linear).
+    /// Reads layer 0 of target `name`, cropped to the image (guard band removed),
+    /// as floats (sRGB targets decoded to linear).
     pub fn read_target(&self, gpu: &GpuContext, name: &str) -> Result<ImageBuf, RenderError> {
+        self.read_target_layer(gpu, name, 0)
+    }
+
+    /// Reads array layer `layer` of target `name`, cropped to the image.
+    pub fn read_target_layer(&self, gpu: &GpuContext, name: &str, layer: u32) -> Result<ImageBuf, RenderError> {
+        let full = self.read_target_full(gpu, name, layer)?;
+        let g = self.settings.guard_pixels();
+        Ok(crop(&full, g, g, self.settings.width, self.settings.height))
+    }
+
+    /// Reads array layer `layer` of target `name` including the guard band.
+    pub fn read_target_full(&self, gpu: &GpuContext, name: &str, layer: u32) -> Result<ImageBuf, RenderError> {
         let t = self.targets.try_get(name).ok_or_else(|| {
             RenderError::Parameter(format!(
                 "unknown target '{name}': valid names are {}",
                 self.target_names().join(", ")
             ))
         })?;
-        let bytes = gpu.read_texture(&t.texture, 0)?;
-        decode_texels(&bytes, t.desc.format, self.settings.width, self.settings.height)
+        if layer >= t.desc.layers {
+            return Err(RenderError::Parameter(format!(
+                "target '{name}' has {} layer(s): layer {layer} is out of range",
+                t.desc.layers
+            )));
+        }
+        let bytes = gpu.read_texture(&t.texture, layer)?;
+        decode_texels(&bytes, t.desc.format, self.targets.width, self.targets.height)
     }
 
-    /// Display-ready debug views: every target plus derived channels.
+    /// Display-ready debug views: every target (layer 0), every layer of the
+    /// per-layer G-buffer arrays as `layerJ-NAME` (J counts from 0 as in the
+    /// paper's Z[0], Z[1]), derived channels (roughness, metallic) and, for
+    /// DELAY/PREDICT, `predicted-csz` (the oracle for the next frame).
     pub fn debug_view_names(&self) -> Vec<String> {
         let mut v: Vec<String> = self.target_names().iter().map(|s| s.to_string()).collect();
         v.extend(["roughness", "metallic"].iter().map(|s| s.to_string()));
+        for j in 0..self.settings.deep.layers {
+            for n in PER_LAYER_VIEWS {
+                v.push(format!("layer{j}-{n}"));
+            }
+        }
+        if self.settings.deep.array_layers() > self.settings.deep.layers {
+            v.push("predicted-csz".into());
+        }
         v.sort();
         v
     }
@@ -203,9 +365,27 @@ impl Renderer {
     /// A debug view as an image: normals mapped to 0.5 + 0.5·n, depths normalised
     /// to [0, 1] by their maximum (`exr_raw` keeps raw values for EXR output).
     pub fn debug_view(&self, gpu: &GpuContext, name: &str, exr_raw: bool) -> Result<ImageBuf, RenderError> {
-        match name {
+        if !self.debug_view_names().iter().any(|n| n == name) {
+            return Err(RenderError::Parameter(format!(
+                "unknown debug view '{name}': valid views are {}",
+                self.debug_view_names().join(", ")
+            )));
+        }
+        let (layer, base) = match name.strip_prefix("layer").and_then(|r| r.split_once('-')) {
+            Some((j, n)) => (j.parse::<u32>().unwrap_or(0), n),
+            None if name == "predicted-csz" => (self.settings.deep.layers, "csz"),
+            None => (0, name),
+        };
+        let normalise = |mut img: ImageBuf| {
+            if !exr_raw {
+                let max = img.data.iter().cloned().fold(0.0f32, f32::max).max(1e-9);
+                img.data.iter_mut().for_each(|v| *v /= max);
+            }
+            img
+        };
+        match base {
             "normal" => {
-                let n = self.read_normals(gpu)?;
+                let n = self.read_normals_layer(gpu, layer)?;
                 let mut img = ImageBuf::new(n.width, n.height, 3);
                 for (o, p) in img.data.chunks_exact_mut(3).zip(n.data.chunks_exact(3)) {
                     for c in 0..3 {
@@ -215,43 +395,68 @@ impl Renderer {
                 Ok(img)
             }
             "roughness" | "metallic" => {
-                let t = self.read_target(gpu, "normal")?;
-                Ok(t.channel(if name == "roughness" { 2 } else { 3 }))
+                let t = self.read_target_layer(gpu, "normal", layer)?;
+                Ok(t.channel(if base == "roughness" { 2 } else { 3 }))
             }
-            "csz" | "depth" => {
-                let mut img = self.read_target(gpu, name)?.channel(0);
-                if !exr_raw {
-                    let max = img.data.iter().cloned().fold(0.0f32, f32::max).max(1e-9);
-                    img.data.iter_mut().for_each(|v| *v /= max);
-                }
-                Ok(img)
+            "csz" | "depth" | "csz-history" => Ok(normalise(self.read_target_layer(gpu, base, layer)?.channel(0))),
+            "zpack" | "zpack23" => {
+                let z = normalise(self.read_target(gpu, base)?);
+                Ok(pad_channels(&z, 3))
             }
-            _ => {
-                if !self.debug_view_names().iter().any(|n| n == name) {
-                    return Err(RenderError::Parameter(format!(
-                        "unknown debug view '{name}': valid views are {}",
-                        self.debug_view_names().join(", ")
-                    )));
-                }
-                self.read_target(gpu, name)
-            }
+            // Colours without their alpha: an empty pixel shows black, not transparent.
+            "albedo" | "emission" => Ok(pad_channels(&self.read_target_layer(gpu, base, layer)?, 3)),
+            _ => self.read_target_layer(gpu, base, layer),
         }
     }
 
-    /// World-space G-buffer normals (decoded Oct16), 3 channels; zero where no surface.
+    /// World-space normals of layer 0 (decoded Oct16), 3 channels; zero where no surface.
     pub fn read_normals(&self, gpu: &GpuContext) -> Result<ImageBuf, RenderError> {
-        let t = self.targets.get("normal");
-        let bytes = gpu.read_texture(&t.texture, 0)?;
-        let csz = self.read_target(gpu, "csz")?;
-        let mut img = ImageBuf::new(self.settings.width, self.settings.height, 3);
-        for (i, px) in bytes.chunks_exact(4).enumerate() {
+        self.read_normals_layer(gpu, 0)
+    }
+
+    /// World-space normals of layer `layer`, cropped; zero where no surface.
+    pub fn read_normals_layer(&self, gpu: &GpuContext, layer: u32) -> Result<ImageBuf, RenderError> {
+        let t = self.read_target_layer(gpu, "normal", layer)?;
+        let csz = self.read_target_layer(gpu, "csz", layer)?;
+        let mut img = ImageBuf::new(t.width, t.height, 3);
+        for (i, px) in t.data.chunks_exact(4).enumerate() {
             if csz.data[i] > 0.0 {
-                let n = crate::packing::oct16_unpack([px[0], px[1]]);
+                let q = |v: f32| (v * 255.0).round() as u8;
+                let n = crate::packing::oct16_unpack([q(px[0]), q(px[1])]);
                 img.data[i * 3..i * 3 + 3].copy_from_slice(&n.to_array());
             }
         }
         Ok(img)
     }
+}
+
+/// Per-layer debug views (`layerJ-NAME`).
+const PER_LAYER_VIEWS: [&str; 7] = ["csz", "depth", "normal", "albedo", "emission", "roughness", "metallic"];
+
+/// The `w`×`h` window of `img` starting at (`x0`, `y0`).
+pub fn crop(img: &ImageBuf, x0: u32, y0: u32, w: u32, h: u32) -> ImageBuf {
+    if x0 == 0 && y0 == 0 && w == img.width && h == img.height {
+        return img.clone();
+    }
+    let c = img.channels as usize;
+    let mut out = ImageBuf::new(w, h, img.channels);
+    for y in 0..h {
+        let src = ((y + y0) * img.width + x0) as usize * c;
+        let dst = (y * w) as usize * c;
+        out.data[dst..dst + w as usize * c].copy_from_slice(&img.data[src..src + w as usize * c]);
+    }
+    out
+}
+
+/// `img` with `channels` channels (extra ones zero).
+fn pad_channels(img: &ImageBuf, channels: u32) -> ImageBuf {
+    let mut out = ImageBuf::new(img.width, img.height, channels);
+    let (a, b) = (img.channels as usize, channels as usize);
+    for (o, p) in out.data.chunks_exact_mut(b).zip(img.data.chunks_exact(a)) {
+        let n = a.min(b);
+        o[..n].copy_from_slice(&p[..n]);
+    }
+    out
 }
 
 /// Decodes tightly packed texels of the formats strata renders into floats.
@@ -275,6 +480,14 @@ pub fn decode_texels(bytes: &[u8], format: wgpu::TextureFormat, w: u32, h: u32) 
                 .collect(),
         ),
         F::Rgba32Float => (4, bytemuck::cast_slice::<u8, f32>(bytes).to_vec()),
+        F::Rg32Float => (2, bytemuck::cast_slice::<u8, f32>(bytes).to_vec()),
+        F::Rg11b10Ufloat => (
+            3,
+            bytemuck::cast_slice::<u8, u32>(bytes)
+                .iter()
+                .flat_map(|&p| rg11b10_to_f32(p))
+                .collect(),
+        ),
         F::Rgba8Unorm => (4, bytes.iter().map(|&b| b as f32 / 255.0).collect()),
         F::Rgba8UnormSrgb => (
             4,
@@ -325,4 +538,30 @@ pub fn f16_to_f32(h: u16) -> f32 {
         (s << 31) | ((e + 127 - 15) << 23) | (m << 13)
     };
     f32::from_bits(bits)
+}
+
+/// Unpacks an `Rg11b10Ufloat` texel (r: bits 0–10, g: 11–21, b: 22–31; unsigned
+/// floats with a 5-bit exponent, bias 15, and 6/6/5 mantissa bits).
+pub fn rg11b10_to_f32(p: u32) -> [f32; 3] {
+    fn small_float(bits: u32, mantissa_bits: u32) -> f32 {
+        let m = bits & ((1 << mantissa_bits) - 1);
+        let e = bits >> mantissa_bits;
+        let scale = (1u32 << mantissa_bits) as f32;
+        match e {
+            0 => (m as f32 / scale) * 2f32.powi(-14),
+            31 => {
+                if m == 0 {
+                    f32::INFINITY
+                } else {
+                    f32::NAN
+                }
+            }
+            _ => 2f32.powi(e as i32 - 15) * (1.0 + m as f32 / scale),
+        }
+    }
+    [
+        small_float(p & 0x7ff, 6),
+        small_float((p >> 11) & 0x7ff, 6),
+        small_float(p >> 22, 5),
+    ]
 }

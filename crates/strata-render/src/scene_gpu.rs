@@ -2,7 +2,7 @@
 //! transforms for the current and previous frame, the per-frame uniform buffer.
 
 use glam::Mat4;
-use strata_scene::{Camera, Scene};
+use strata_scene::Scene;
 use wgpu::util::DeviceExt;
 
 use crate::frame::FrameUniforms;
@@ -31,7 +31,18 @@ pub struct ObjectUniforms {
     /// Inverse-transpose of the model matrix (upper 3×3 used).
     pub normal_matrix: [[f32; 4]; 4],
     pub prev_model: [[f32; 4]; 4],
-    pub _pad: [[f32; 4]; 4],
+    /// Transform at frame t + 1 (exact or extrapolated, see [`NextTransforms`]).
+    pub next_model: [[f32; 4]; 4],
+}
+
+/// How the frame-(t + 1) object transforms are obtained (DGB §2.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NextTransforms {
+    /// The animation's own transform at t + 1 (the DELAY variant knows the future).
+    Exact,
+    /// Constant-velocity extrapolation from t − 1 and t: M_{t+1} = M_t · M_{t−1}⁻¹ · M_t
+    /// (PREDICT).
+    Extrapolated,
 }
 pub const OBJECT_STRIDE: u64 = 256;
 
@@ -266,16 +277,23 @@ impl GpuScene {
         }
     }
 
-    /// Writes the object transforms for `frame` (and `frame − 1` as "previous").
-    pub fn update_objects(&self, gpu: &GpuContext, frame: f32) {
+    /// Writes the object transforms for `frame`, `frame − 1` ("previous") and
+    /// `frame + 1` ("next", exact or extrapolated).
+    pub fn update_objects(&self, gpu: &GpuContext, frame: f32, next: NextTransforms) {
         let mut bytes = vec![0u8; OBJECT_STRIDE as usize * self.objects_cpu.len().max(1)];
         for (i, o) in self.objects_cpu.iter().enumerate() {
             let m: Mat4 = o.transform_at(frame);
+            let prev = o.transform_at(frame - 1.0);
+            let next = match next {
+                NextTransforms::Exact => o.transform_at(frame + 1.0),
+                NextTransforms::Extrapolated if prev == m => m,
+                NextTransforms::Extrapolated => m * prev.inverse() * m,
+            };
             let u = ObjectUniforms {
                 model: m.to_cols_array_2d(),
                 normal_matrix: m.inverse().transpose().to_cols_array_2d(),
-                prev_model: o.transform_at(frame - 1.0).to_cols_array_2d(),
-                _pad: [[0.0; 4]; 4],
+                prev_model: prev.to_cols_array_2d(),
+                next_model: next.to_cols_array_2d(),
             };
             let s = i * OBJECT_STRIDE as usize;
             bytes[s..s + std::mem::size_of::<ObjectUniforms>()].copy_from_slice(bytemuck::bytes_of(&u));
@@ -354,9 +372,4 @@ fn upload_texture(gpu: &GpuContext, t: &strata_scene::Texture) -> wgpu::TextureV
         );
     }
     texture.create_view(&Default::default())
-}
-
-/// Previous-frame camera for a scene (the path's camera one frame earlier).
-pub fn previous_camera(scene: &Scene, frame: f32) -> Camera {
-    scene.camera_at(frame - 1.0)
 }

@@ -8,6 +8,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/camera.wgsl", include_str!("shaders/common/camera.wgsl")),
     ("common/color.wgsl", include_str!("shaders/common/color.wgsl")),
     ("common/fullscreen.wgsl", include_str!("shaders/common/fullscreen.wgsl")),
+    ("common/scene.wgsl", include_str!("shaders/common/scene.wgsl")),
 ];
 
 /// Expands `#import "…"` lines recursively; panics only on a missing module,

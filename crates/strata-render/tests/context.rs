@@ -38,9 +38,16 @@ fn profiler_times_every_pass() {
         },
     )
     .unwrap();
-    let t = r.render(&gpu, &scene, &scene.camera, &scene.camera, 0.0).unwrap();
+    let t = r
+        .render(
+            &gpu,
+            &scene,
+            &strata_render::frame::FrameCameras::fixed(scene.camera),
+            0.0,
+        )
+        .unwrap();
     let names: Vec<&str> = r.pass_infos().iter().map(|p| p.name).collect();
-    assert_eq!(names, ["shadow", "gbuffer", "lighting", "tonemap"]);
+    assert_eq!(names, ["shadow", "gbuffer", "pack", "lighting", "tonemap"]);
     assert!(
         gpu.has(wgpu::Features::TIMESTAMP_QUERY),
         "lavapipe exposes TIMESTAMP_QUERY"

@@ -74,7 +74,13 @@ fn exposure_scales_hdr_linearly() {
             },
         )
         .unwrap();
-        r.render(&gpu, &scene, &scene.camera, &scene.camera, 0.0).unwrap();
+        r.render(
+            &gpu,
+            &scene,
+            &strata_render::frame::FrameCameras::fixed(scene.camera),
+            0.0,
+        )
+        .unwrap();
         r.read_target(&gpu, "ldr").unwrap()
     };
     let a = mk(0.25);

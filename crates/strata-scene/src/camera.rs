@@ -95,6 +95,23 @@ impl Camera {
         f + r * (ndc_x * t * aspect) + u * (ndc_y * t)
     }
 
+    /// The camera for a `width`×`height` image widened by a guard band of `g`
+    /// pixels on every side: rendering `(width + 2g)`×`(height + 2g)` pixels with
+    /// it and cropping `g` pixels from each edge gives exactly the pixel centres
+    /// of `self` at `width`×`height` (the vertical and horizontal half-angle
+    /// tangents grow by `(height + 2g)/height` and `(width + 2g)/width`).
+    pub fn with_guard_band(&self, height: u32, g: u32) -> Camera {
+        if g == 0 {
+            return *self;
+        }
+        let t = (0.5 * self.fov_y_deg.to_radians()).tan() * (height + 2 * g) as f32 / height as f32;
+        // The wider aspect of the widened image carries the horizontal growth.
+        Camera {
+            fov_y_deg: 2.0 * t.atan().to_degrees(),
+            ..*self
+        }
+    }
+
     /// Camera-space depth of a world point.
     pub fn depth_of(&self, p: Vec3) -> f32 {
         (p - self.eye).dot(self.forward())

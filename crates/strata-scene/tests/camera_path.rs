@@ -150,3 +150,22 @@ fn evenly_spaced_keys_give_uniform_catmull_rom() {
         path.sample(13.0).0
     );
 }
+
+#[test]
+fn guard_band_camera_reproduces_the_cropped_pixel_centres() {
+    let cam = strata_scene::Camera::new(
+        glam::Vec3::new(1.0, 2.0, 3.0),
+        glam::Vec3::new(-2.0, 0.5, -4.0),
+        glam::Vec3::Y,
+        55.0,
+        0.1,
+    );
+    let (w, h, g) = (64u32, 40u32, 7u32);
+    let wide = cam.with_guard_band(h, g);
+    for (x, y) in [(0, 0), (63, 0), (0, 39), (63, 39), (31, 17)] {
+        let a = cam.pixel_dir(x, y, w, h);
+        let b = wide.pixel_dir(x + g, y + g, w + 2 * g, h + 2 * g);
+        assert!((a - b).length() < 1e-5, "pixel ({x}, {y}): {a} vs {b}");
+    }
+    assert_eq!(cam.with_guard_band(h, 0).fov_y_deg, cam.fov_y_deg);
+}

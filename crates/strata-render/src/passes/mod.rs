@@ -1,6 +1,6 @@
 //! One module per technique, each with its WGSL beside it.
 
-pub mod gbuffer;
+pub mod deep_gbuffer;
 pub mod lighting;
 pub mod shadow;
 pub mod tonemap;
@@ -12,6 +12,19 @@ pub(crate) fn fullscreen_pipeline(
     label: &str,
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
+    fullscreen_pipeline_with(device, label, layout, module, "fs_main", &[], targets)
+}
+
+/// As [`fullscreen_pipeline`] with a named fragment entry and override constants.
+pub(crate) fn fullscreen_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    fragment_entry: &str,
+    constants: &[(&str, f64)],
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -28,8 +41,11 @@ pub(crate) fn fullscreen_pipeline(
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
+            entry_point: Some(fragment_entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             targets,
         }),
         multiview_mask: None,

@@ -1,6 +1,7 @@
 //! Shared helpers for GPU tests (run on lavapipe when no GPU is present).
 #![allow(dead_code)]
 
+use strata_render::frame::FrameCameras;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, Scene};
 
@@ -21,7 +22,7 @@ pub fn render(gpu: &GpuContext, scene: &Scene, camera: &Camera, w: u32, h: u32) 
         },
     )
     .expect("renderer builds without validation errors");
-    r.render(gpu, scene, camera, camera, 0.0)
+    r.render(gpu, scene, &FrameCameras::fixed(*camera), 0.0)
         .expect("frame renders without validation errors");
     r
 }

@@ -91,6 +91,8 @@ struct LightingOut {
     @location(1) direct_diffuse: vec4f,
     // visibility of light 0 (shadow debug view)
     @location(2) shadow: vec4f,
+    // DGB Table 1 radiosity B of layer 0 (R11G11B10): Lambertian direct + emission
+    @location(3) radiosity: vec4f,
 }
 
 @fragment
@@ -102,6 +104,7 @@ fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
         o.hdr = vec4f(frame.sky.rgb, 1.0);
         o.direct_diffuse = vec4f(0.0);
         o.shadow = vec4f(1.0);
+        o.radiosity = vec4f(0.0);
         return o;
     }
     let p = world_from_csz(frame, frag.xy, z);
@@ -164,5 +167,6 @@ fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
     o.hdr = vec4f(total, 1.0);
     o.direct_diffuse = vec4f(lambert, 1.0);
     o.shadow = vec4f(shadow0, shadow0, shadow0, 1.0);
+    o.radiosity = vec4f(lambert + emission, 1.0);
     return o;
 }

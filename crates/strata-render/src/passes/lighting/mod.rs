@@ -44,6 +44,12 @@ pub const OUTPUTS: &[TargetDesc] = &[
         layers: 1,
         doc: "visibility of light 0",
     },
+    TargetDesc {
+        name: "radiosity0",
+        format: crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+        layers: 1,
+        doc: "DGB Table 1: layer 0 radiosity B, initialised with Lambertian direct light + emission",
+    },
 ];
 
 #[repr(C)]
@@ -160,7 +166,7 @@ impl LightingPass {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        let view = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).view);
+        let view = |n: &str| wgpu::BindingResource::TextureView(targets.get(n).layer(0));
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lighting"),
             layout: &layout,

@@ -1,15 +1,10 @@
 // Depth-only shadow map rendering for one light (light matrix at a dynamic offset).
+#import "common/scene.wgsl"
 
 struct ShadowView {
     view_proj: mat4x4f,
 }
 
-struct ObjectUniforms {
-    model: mat4x4f,
-    normal_matrix: mat4x4f,
-    prev_model: mat4x4f,
-    pad: mat4x4f,
-}
 
 @group(0) @binding(0) var<uniform> light: ShadowView;
 @group(1) @binding(0) var<uniform> object: ObjectUniforms;

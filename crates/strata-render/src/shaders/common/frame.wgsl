@@ -5,6 +5,8 @@ struct Frame {
     view_proj: mat4x4f,
     inv_view_proj: mat4x4f,
     prev_view_proj: mat4x4f,
+    // frame t + 1 (exact for Delay, extrapolated for Predict)
+    next_view_proj: mat4x4f,
     // xyz = eye, w = near plane
     eye: vec4f,
     // xyz = camera right * tan(fov_y/2) * aspect

@@ -1,0 +1,204 @@
+//! `strata bench deep-gbuffer`: DGB Table 5 (layer times per construction
+//! method) and Fig. 3 (second-layer surfaces that differ from the exact peel of
+//! the same frame, along the camera path).
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use serde_json::json;
+use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, LayerComparison, Variant};
+use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+use strata_scene::ImageBuf;
+
+use crate::args::BenchDeepArgs;
+use crate::bench::{median_min, wgpu_ts};
+use crate::output::{cameras_at, check_output, save, scene_and_camera};
+
+/// One construction method being measured.
+struct Method {
+    name: &'static str,
+    renderer: Renderer,
+    /// Per frame: (first layer ms, whole construction ms).
+    times: Vec<(f64, f64)>,
+    mismatched: u64,
+    counted: u64,
+}
+
+pub fn run(a: &BenchDeepArgs) -> Result<()> {
+    if !(1..=10000).contains(&a.frames) {
+        bail!("--frames {} is out of range: must be in 1..=10000", a.frames);
+    }
+    if !(2..=strata_render::passes::deep_gbuffer::MAX_LAYERS).contains(&a.layers) {
+        bail!("--layers {} is out of range: must be in 2..=4", a.layers);
+    }
+    let (scene, _) = scene_and_camera(&a.scene)?;
+    if let Some(dir) = &a.images {
+        for m in Variant::ALL {
+            check_output(&dir.join(format!("{m}-layer1.png")), a.force)?;
+            if m != Variant::Peel {
+                check_output(&dir.join(format!("{m}-diff.png")), a.force)?;
+            }
+        }
+    }
+    let gpu = GpuContext::new(&GpuOptions {
+        adapter: a.gpu.adapter.clone(),
+    })?;
+    if !gpu.has(wgpu_ts()) {
+        bail!("the adapter lacks TIMESTAMP_QUERY / TIMESTAMP_QUERY_INSIDE_ENCODERS, which `strata bench` needs");
+    }
+    let settings = |layers: u32, variant: Variant| RenderSettings {
+        width: a.scene.width,
+        height: a.scene.height,
+        deep: DeepGBufferSettings {
+            layers,
+            variant,
+            min_separation: a.min_separation,
+            ..Default::default()
+        },
+        shade: false,
+        ..Default::default()
+    };
+    let mut methods = vec![Method {
+        name: "single-layer",
+        renderer: Renderer::new(&gpu, &scene, settings(1, Variant::Reproject))?,
+        times: Vec::new(),
+        mismatched: 0,
+        counted: 0,
+    }];
+    for v in Variant::ALL {
+        if v.has_predicted_view() && a.layers != 2 {
+            continue;
+        }
+        methods.push(Method {
+            name: v.name(),
+            renderer: Renderer::new(&gpu, &scene, settings(a.layers, v))?,
+            times: Vec::new(),
+            mismatched: 0,
+            counted: 0,
+        });
+    }
+
+    let f0 = a.scene.frame;
+    let last = f0 + (a.frames - 1) as f32;
+    // Frame f0 − 1 is the warm-up (and gives the single-pass variants their first oracle).
+    for i in -1..a.frames as i32 {
+        let f = f0 + i as f32;
+        let cams = cameras_at(&scene, &a.scene, f);
+        let mut peel_layer1: Option<ImageBuf> = None;
+        for m in methods.iter_mut() {
+            let t = m.renderer.render(&gpu, &scene, &cams, f)?;
+            if i < 0 {
+                continue;
+            }
+            let first = t.get("gbuffer").unwrap_or(0.0);
+            let total = match m.name {
+                "single-layer" => first,
+                "peel" => {
+                    let peels: f64 = (1..a.layers).filter_map(|j| t.get(&format!("peel{j}"))).sum();
+                    first + peels
+                }
+                _ => t.get("deep_gbuffer").unwrap_or(f64::NAN),
+            };
+            m.times.push((first, total));
+            if m.name == "single-layer" {
+                continue;
+            }
+            let z1 = m.renderer.read_target_layer(&gpu, "csz", 1)?;
+            if m.name == "peel" {
+                peel_layer1 = Some(z1);
+                continue;
+            }
+            let exact = peel_layer1.as_ref().expect("peel runs before the single-pass methods");
+            let c = LayerComparison::new(&z1.data, &exact.data);
+            m.mismatched += c.mismatched;
+            m.counted += c.counted;
+            if let (Some(dir), true) = (&a.images, f == last) {
+                write_images(&gpu, &m.renderer, dir, m.name, Some(&c))?;
+            }
+        }
+        if let (Some(dir), true) = (&a.images, f == last) {
+            let peel = methods
+                .iter()
+                .find(|m| m.name == "peel")
+                .expect("peel is always measured");
+            write_images(&gpu, &peel.renderer, dir, "peel", None)?;
+        }
+    }
+
+    // Single-layer times of the same frames: the first-layer cost every method is compared with.
+    let mut single: Vec<f64> = methods[0].times.iter().map(|t| t.1).collect();
+    let (single_med, _) = median_min(&mut single);
+    let mut rows = Vec::new();
+    for m in &methods {
+        let mut totals: Vec<f64> = m.times.iter().map(|t| t.1).collect();
+        let (total, _) = median_min(&mut totals);
+        let (layer1, layer2) = match m.name {
+            "single-layer" => (single_med, 0.0),
+            "peel" => {
+                let mut firsts: Vec<f64> = m.times.iter().map(|t| t.0).collect();
+                let mut seconds: Vec<f64> = m.times.iter().map(|t| t.1 - t.0).collect();
+                (median_min(&mut firsts).0, median_min(&mut seconds).0)
+            }
+            _ => (single_med, total - single_med),
+        };
+        let mismatch = if m.counted == 0 {
+            0.0
+        } else {
+            100.0 * m.mismatched as f64 / m.counted as f64
+        };
+        rows.push((m.name, layer1, layer2, total, mismatch));
+    }
+
+    if a.json {
+        let v = json!({
+            "scene": a.scene.scene, "width": a.scene.width, "height": a.scene.height,
+            "layers": a.layers, "frames": a.frames, "triangles": scene.triangle_count(),
+            "device": gpu.describe(),
+            "rows": rows.iter().map(|(m, l1, l2, t, mm)| json!({
+                "method": m, "layer1_ms": l1, "layer2_ms": l2, "total_ms": t, "mismatch_pct": mm,
+            })).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string(&v)?);
+    } else {
+        println!(
+            "{} at {}x{}, {} layers, {} triangles, {} frames from frame {} on {}",
+            a.scene.scene,
+            a.scene.width,
+            a.scene.height,
+            a.layers,
+            scene.triangle_count(),
+            a.frames,
+            f0,
+            gpu.describe()
+        );
+        println!(
+            "{:<13} {:>10} {:>10} {:>10} {:>8} {:>10}",
+            "method", "layer1 ms", "layer2 ms", "total ms", "l2/l1", "mismatch %"
+        );
+        for (m, l1, l2, t, mm) in &rows {
+            println!("{m:<13} {l1:>10.3} {l2:>10.3} {t:>10.3} {:>8.2} {mm:>10.3}", l2 / l1);
+        }
+    }
+    Ok(())
+}
+
+/// Fig. 3 images of one method at the last frame: its layer-1 albedo and, with
+/// a comparison, the differences from the peel in red over grey layer-1 depth.
+fn write_images(gpu: &GpuContext, r: &Renderer, dir: &Path, name: &str, diff: Option<&LayerComparison>) -> Result<()> {
+    let albedo = r.debug_view(gpu, "layer1-albedo", false)?;
+    save(&albedo, &dir.join(format!("{name}-layer1.png")), true)?;
+    if let Some(c) = diff {
+        let z = r.debug_view(gpu, "layer1-csz", false)?;
+        let mut img = ImageBuf::new(z.width, z.height, 3);
+        for (i, px) in img.data.chunks_exact_mut(3).enumerate() {
+            if c.mask[i] {
+                px.copy_from_slice(&[1.0, 0.0, 0.0]);
+            } else {
+                let g = 0.15 + 0.6 * z.data[i];
+                px.copy_from_slice(&[g, g, g]);
+            }
+        }
+        save(&img, &dir.join(format!("{name}-diff.png")), true)?;
+    }
+    Ok(())
+}

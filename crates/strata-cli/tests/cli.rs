@@ -1,0 +1,251 @@
+//! End-to-end tests of the `strata` binary: exit codes, one-line errors that
+//! name the bad flag or file, the no-overwrite rule, and real outputs (on
+//! lavapipe when no GPU is present).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn strata(args: &[&str]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
+    cmd.args(args);
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = std::env::temp_dir().join("strata-xdg-cli-tests");
+        std::fs::create_dir_all(&dir).unwrap();
+        cmd.env("XDG_RUNTIME_DIR", dir);
+    }
+    cmd.output().expect("failed to start strata")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    let _ = std::fs::remove_file(&p);
+    p
+}
+
+/// A failing run: exit code ≠ 0 and exactly one line on stderr that contains
+/// every one of `needles`.
+fn assert_one_line_error(o: &Output, needles: &[&str]) {
+    assert!(
+        !o.status.success(),
+        "expected failure, got success; stderr: {}",
+        stderr(o)
+    );
+    let err = stderr(o);
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected a one-line error, got:\n{err}");
+    for n in needles {
+        assert!(lines[0].contains(n), "error line {:?} does not mention {n:?}", lines[0]);
+    }
+}
+
+#[test]
+fn out_of_range_width_names_flag_and_range() {
+    let out = scratch("tiny.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "plane",
+        "--width",
+        "4",
+        "--height",
+        "64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["--width", "8"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn out_of_range_fov_names_flag_and_range() {
+    let out = scratch("fov.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "plane",
+        "--fov",
+        "190",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["fov", "180"]);
+}
+
+#[test]
+fn unknown_scene_lists_valid_names() {
+    let out = scratch("unknown.png");
+    let o = strata(&["render", "--scene", "no-such-scene", "--out", out.to_str().unwrap()]);
+    assert_one_line_error(&o, &["no-such-scene", "cornell", "atrium"]);
+}
+
+#[test]
+fn malformed_toml_scene_names_the_file() {
+    let bad = scratch("bad_scene.toml");
+    std::fs::write(&bad, "[camera\neye = [0, 1, 2]\n").unwrap();
+    let out = scratch("bad_scene.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["bad_scene.toml"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn unsupported_output_extension_is_refused() {
+    let out = scratch("image.bmp");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "plane",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["--out"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn existing_output_is_not_overwritten_without_force() {
+    let out = scratch("keep.png");
+    std::fs::write(&out, b"precious").unwrap();
+    let o = strata(&[
+        "render",
+        "--scene",
+        "plane",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["keep.png", "--force"]);
+    assert_eq!(std::fs::read(&out).unwrap(), b"precious");
+
+    let o = strata(&[
+        "render",
+        "--scene",
+        "plane",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--force",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_ne!(std::fs::read(&out).unwrap(), b"precious");
+}
+
+#[test]
+fn info_lists_multiview_and_timestamps_present() {
+    let o = strata(&["info"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    for feature in ["MULTIVIEW", "TIMESTAMP_QUERY"] {
+        let line = text
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(feature))
+            .unwrap_or_else(|| panic!("{feature} missing from strata info:\n{text}"));
+        assert_eq!(
+            line.split_whitespace().nth(1),
+            Some("yes"),
+            "{feature} not present: {line}"
+        );
+    }
+}
+
+#[test]
+fn render_atrium_writes_a_non_uniform_png() {
+    let out = scratch("atrium.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "atrium",
+        "--width",
+        "160",
+        "--height",
+        "90",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (160, 90));
+    let lum: Vec<f32> = img
+        .pixels()
+        .map(|p| p.0.iter().map(|&c| c as f32).sum::<f32>() / 3.0)
+        .collect();
+    let mean = lum.iter().sum::<f32>() / lum.len() as f32;
+    let sd = (lum.iter().map(|l| (l - mean) * (l - mean)).sum::<f32>() / lum.len() as f32).sqrt();
+    assert!(
+        mean > 20.0 && mean < 235.0,
+        "mean grey {mean}: image is nearly black or white"
+    );
+    assert!(sd > 15.0, "standard deviation {sd}: image is nearly uniform");
+}
+
+#[test]
+fn reference_ao_of_cornell_is_a_visibility_image() {
+    let out = scratch("cornell_ao.exr");
+    let o = strata(&[
+        "reference",
+        "--scene",
+        "cornell",
+        "--kind",
+        "ao",
+        "--spp",
+        "16",
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_rgb32f();
+    let v: Vec<f32> = img.pixels().map(|p| p.0[0]).collect();
+    assert!(
+        v.iter().all(|&a| (0.0..=1.0).contains(&a)),
+        "ambient visibility outside [0, 1]"
+    );
+    // The box has corners and two blocks: some pixels are occluded, some open.
+    assert!(v.iter().any(|&a| a < 0.8) && v.iter().any(|&a| a > 0.95));
+}
+
+#[test]
+fn bench_gbuffer_json_has_per_pass_times() {
+    let o = strata(&[
+        "bench", "gbuffer", "--scene", "plane", "--width", "32", "--height", "32", "--frames", "2", "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("bench output is not JSON");
+    let passes = v["passes"].as_array().expect("passes array");
+    let names: Vec<&str> = passes.iter().filter_map(|p| p["name"].as_str()).collect();
+    assert!(names.contains(&"gbuffer") && names.contains(&"lighting"), "{names:?}");
+    for p in passes {
+        let (med, min) = (p["median_ms"].as_f64().unwrap(), p["min_ms"].as_f64().unwrap());
+        assert!(med > 0.0 && min > 0.0 && min <= med, "bad timing {p}");
+    }
+}

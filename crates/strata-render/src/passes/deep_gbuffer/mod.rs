@@ -1,0 +1,818 @@
+//! Deep G-buffer construction with minimum separation (DGB §2).
+//!
+//! Layer 0 is the ordinary G-buffer. Layer j ≥ 1 holds, per pixel, the nearest
+//! surface whose camera-space depth exceeds layer j − 1's by more than the
+//! minimum separation Δz. Knowing layer j − 1 *before* it is rendered needs an
+//! oracle; [`Variant`] picks it:
+//!
+//! | variant | passes | oracle for layer j (Listing 1 line 13 / Listing 2 line 22) |
+//! |---|---|---|
+//! | [`Variant::Peel`] | k geometry passes | this frame's layer j − 1, same pixel — exact |
+//! | [`Variant::Delay`] | 1 (k + 1 views) | layer 0 of frame t rendered with T_t during frame t − 1 — exact, one frame of latency |
+//! | [`Variant::Previous`] | 1 (k views) | last frame's layer j − 1, same pixel |
+//! | [`Variant::Predict`] | 1 (k + 1 views) | layer 0 rendered during frame t − 1 with T_t extrapolated from T_{t−2}, T_{t−1} |
+//! | [`Variant::Reproject`] | 1 (k views) | last frame's layer j − 1 at the fragment's position at t − 1 (reverse reprojection) |
+//!
+//! "No oracle" — a single-pass variant's first frame, or a comparison texel off
+//! screen or behind the old camera — accepts the fragment (the layer then holds
+//! the nearest surface there rather than a hole). An oracle texel without a
+//! surface counts as infinitely far and rejects it.
+//!
+//! **Submission.** Listing 2 renders all layers from one geometry submission;
+//! here that is one multiview pass (view j = layer j, plus the predicted
+//! layer). On Mesa lavapipe (22.3) multiview views ≥ 1 are not rasterised like
+//! view 0: on `atrium` at 96×64, a first frame where every view must equal
+//! layer 0 differs in 373 of 6144 view-1 pixels (nearer fragments lost). So
+//! [`Submission::Auto`] uses [`Submission::PerLayer`] on CPU adapters: the
+//! same oracles, one non-multiview submission per layer (and one for the
+//! predicted layer). [`Submission::Multiview`] keeps the one-pass form, whose
+//! cost `strata bench deep-gbuffer` still reports.
+//!
+//! DELAY and PREDICT are implemented for k = 2 (the paper's
+//! 2k − 1-view generalisation of PREDICT is not).
+//!
+//! Outputs: per-layer arrays (`csz`, `normal`, `albedo`, `emission`, `depth`;
+//! Delay/Predict add the depth-only predicted layer at index k) and the packed
+//! layout of DGB Table 1 (`zpack` = RG32F camera-space z of layers 0 and 1,
+//! `npack` = RGBA8 Oct16 normals of layers 0 and 1, `zpack23`/`npack23` for
+//! k > 2, `radiosity1…` R11G11B10 per-layer radiosity reserved for the
+//! radiosity pass; `radiosity0` is written by the lighting pass).
+
+use std::num::NonZeroU32;
+use std::str::FromStr;
+
+use wgpu::util::DeviceExt;
+
+use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::scene_gpu::{GpuScene, NextTransforms, VERTEX_LAYOUT};
+use crate::RenderError;
+
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Most layers a deep G-buffer can have (DGB §5 generalises to k layers).
+pub const MAX_LAYERS: u32 = 4;
+/// Format of the per-layer radiosity targets (DGB Table 1).
+pub const RADIOSITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg11b10Ufloat;
+
+/// How the second and later layers find the oracle depth (DGB §2.1–2.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Variant {
+    /// Listing 1: one geometry pass per layer, each tested against the layer
+    /// before it in the same frame. Exact; Δz = 0 is classic depth peeling.
+    Peel,
+    /// Listing 2 with the next frame's transforms known (one frame of latency). Exact.
+    Delay,
+    /// Listing 2 against last frame's layer at the same pixel.
+    Previous,
+    /// Listing 2 with T_{t+1} extrapolated from T_{t−1} and T_t (camera and objects).
+    Predict,
+    /// Listing 2 with reverse reprojection: the test point is the fragment's
+    /// position at t − 1, compared with last frame's layer. The paper's principal solution.
+    Reproject,
+}
+
+impl Variant {
+    pub const ALL: [Variant; 5] = [
+        Variant::Peel,
+        Variant::Delay,
+        Variant::Previous,
+        Variant::Predict,
+        Variant::Reproject,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Peel => "peel",
+            Variant::Delay => "delay",
+            Variant::Previous => "previous",
+            Variant::Predict => "predict",
+            Variant::Reproject => "reproject",
+        }
+    }
+
+    /// The shader's oracle code (`ORACLE_*` in `deep_gbuffer.wgsl`).
+    fn oracle(self) -> u32 {
+        match self {
+            Variant::Peel => 1,
+            Variant::Delay => 2,
+            Variant::Previous => 3,
+            Variant::Predict => 4,
+            Variant::Reproject => 5,
+        }
+    }
+
+    /// All layers in one geometry submission (Listing 2)?
+    pub fn is_single_pass(self) -> bool {
+        self != Variant::Peel
+    }
+
+    /// Renders the depth-only layer 0 of frame t + 1 as an extra view.
+    pub fn has_predicted_view(self) -> bool {
+        matches!(self, Variant::Delay | Variant::Predict)
+    }
+
+    /// Where the frame-(t + 1) transforms come from.
+    pub fn next_transforms(self) -> NextTransforms {
+        if self == Variant::Predict {
+            NextTransforms::Extrapolated
+        } else {
+            NextTransforms::Exact
+        }
+    }
+}
+
+impl FromStr for Variant {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Variant::ALL.into_iter().find(|v| v.name() == s).ok_or_else(|| {
+            format!(
+                "unknown deep G-buffer variant '{s}': valid variants are {}",
+                Variant::ALL.map(|v| v.name()).join(", ")
+            )
+        })
+    }
+}
+
+impl std::fmt::Display for Variant {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Deep G-buffer settings. `Default` is the paper's configuration: two layers
+/// built in one pass by REPROJECT, Δz from the scene (the paper uses 0.5 m for
+/// every result, DGB §4.2; [`strata_scene::SceneSettings`] defaults to that).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeepGBufferSettings {
+    /// Number of layers k, 1..=[`MAX_LAYERS`]. 1 = an ordinary G-buffer.
+    pub layers: u32,
+    pub variant: Variant,
+    /// Minimum separation Δz in scene units (≥ 0); `None` = the scene's setting.
+    pub min_separation: Option<f32>,
+    /// How the single-pass variants submit their layers (default [`Submission::Auto`]).
+    pub submission: Submission,
+}
+
+/// Geometry submissions of the single-pass variants (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Submission {
+    /// Multiview, except on CPU adapters (lavapipe), where it is unreliable.
+    Auto,
+    /// One multiview pass for every layer (Listing 2).
+    Multiview,
+    /// One submission per layer with the same last-frame oracles.
+    PerLayer,
+}
+
+impl Submission {
+    /// `Auto` resolved for an adapter.
+    pub fn resolve(self, gpu: &GpuContext) -> Submission {
+        match self {
+            Submission::Auto if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu => Submission::PerLayer,
+            Submission::Auto => Submission::Multiview,
+            s => s,
+        }
+    }
+}
+
+impl Default for DeepGBufferSettings {
+    fn default() -> Self {
+        Self {
+            layers: 2,
+            variant: Variant::Reproject,
+            min_separation: None,
+            submission: Submission::Auto,
+        }
+    }
+}
+
+impl DeepGBufferSettings {
+    /// An ordinary one-layer G-buffer.
+    pub fn single_layer() -> Self {
+        Self {
+            layers: 1,
+            ..Self::default()
+        }
+    }
+
+    pub fn validate(&self) -> Result<(), RenderError> {
+        if !(1..=MAX_LAYERS).contains(&self.layers) {
+            return Err(RenderError::Parameter(format!(
+                "layers {} is out of range: must be in 1..={MAX_LAYERS}",
+                self.layers
+            )));
+        }
+        if self.variant.has_predicted_view() && self.layers > 2 {
+            return Err(RenderError::Parameter(format!(
+                "variant {} supports 1 or 2 layers (got {}); use peel, previous or reproject for more",
+                self.variant, self.layers
+            )));
+        }
+        if let Some(dz) = self.min_separation {
+            if !(dz >= 0.0 && dz.is_finite()) {
+                return Err(RenderError::Parameter(format!(
+                    "min-separation {dz} is out of range: must be a finite number >= 0 (scene units)"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Layers of the per-layer arrays: k, plus the predicted layer for DELAY/PREDICT.
+    pub fn array_layers(&self) -> u32 {
+        self.layers + (self.layers >= 2 && self.variant.has_predicted_view()) as u32
+    }
+
+    /// Does the frame keep last frame's depths (single-pass variants with k ≥ 2)?
+    pub fn uses_history(&self) -> bool {
+        self.layers >= 2 && self.variant.is_single_pass()
+    }
+
+    /// The targets the deep G-buffer passes write.
+    pub fn outputs(&self) -> Vec<TargetDesc> {
+        let l = self.array_layers();
+        let desc = |name, format, layers, doc| TargetDesc {
+            name,
+            format,
+            layers,
+            doc,
+        };
+        use wgpu::TextureFormat as F;
+        let mut v = vec![
+            desc(
+                "depth",
+                DEPTH_FORMAT,
+                l,
+                "hardware depth per layer (reversed-Z, near/z)",
+            ),
+            desc("csz", F::R32Float, l, "camera-space depth z per layer (0 = no surface)"),
+            desc(
+                "normal",
+                F::Rgba8Unorm,
+                l,
+                "rg = Oct16 world normal, b = roughness, a = metallic",
+            ),
+            desc("albedo", F::Rgba8UnormSrgb, l, "base colour, a = opacity"),
+            desc("emission", F::Rgba16Float, l, "emitted radiance"),
+            desc(
+                "zpack",
+                F::Rg32Float,
+                1,
+                "DGB Table 1: camera-space z of layers 0 (r) and 1 (g)",
+            ),
+            desc(
+                "npack",
+                F::Rgba8Unorm,
+                1,
+                "DGB Table 1: Oct16 normals of layers 0 (rg) and 1 (ba)",
+            ),
+        ];
+        if self.layers > 2 {
+            v.push(desc(
+                "zpack23",
+                F::Rg32Float,
+                1,
+                "camera-space z of layers 2 (r) and 3 (g)",
+            ));
+            v.push(desc(
+                "npack23",
+                F::Rgba8Unorm,
+                1,
+                "Oct16 normals of layers 2 (rg) and 3 (ba)",
+            ));
+        }
+        if self.uses_history() {
+            v.push(desc(
+                "csz-history",
+                F::R32Float,
+                l,
+                "last frame's csz (the single-pass oracle)",
+            ));
+        }
+        const RADIOSITY: [&str; 4] = ["radiosity0", "radiosity1", "radiosity2", "radiosity3"];
+        for name in RADIOSITY.iter().take(self.layers as usize).skip(1) {
+            v.push(desc(
+                name,
+                RADIOSITY_FORMAT,
+                1,
+                "DGB Table 1 previous-bounce radiosity B (reserved)",
+            ));
+        }
+        v
+    }
+}
+
+/// Per-frame constants of a geometry pass (`DeepParams` in WGSL).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct DeepParams {
+    min_separation: f32,
+    has_history: u32,
+    _pad: [u32; 2],
+}
+
+/// One geometry submission of the deep G-buffer: the single-layer pass, one
+/// peel pass, or the single-pass multiview construction of all layers.
+pub struct GeometryPass {
+    name: &'static str,
+    pipeline: wgpu::RenderPipeline,
+    /// Layer written by view 0.
+    first_layer: u32,
+    /// Views rendered (1 = no multiview).
+    views: u32,
+    group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    inputs: Vec<&'static str>,
+}
+
+const PEEL_NAMES: [&str; 4] = ["gbuffer", "peel1", "peel2", "peel3"];
+/// Per-layer submissions of the single-pass variants ([`Submission::PerLayer`]).
+const LAYER_NAMES: [&str; 4] = ["gbuffer", "layer1", "layer2", "layer3"];
+
+/// The geometry passes for `settings`, in order.
+pub fn geometry_passes(
+    gpu: &GpuContext,
+    scene: &GpuScene,
+    targets: &Targets,
+    settings: &DeepGBufferSettings,
+) -> Result<Vec<GeometryPass>, RenderError> {
+    settings.validate()?;
+    let k = settings.layers;
+    let device = &gpu.device;
+    let module = crate::shader::module(device, "deep_gbuffer", include_str!("deep_gbuffer.wgsl"));
+    let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("deep_gbuffer oracle"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            },
+        ],
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("deep_gbuffer"),
+        bind_group_layouts: &[
+            Some(&scene.frame_layout),
+            Some(&scene.object_layout),
+            Some(&scene.material_layout),
+            Some(&group_layout),
+        ],
+        immediate_size: 0,
+    });
+    // Bound where a pipeline has no oracle (never read).
+    let no_oracle = device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("no oracle"),
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+    let csz = targets.get("csz");
+    let make = |name: &'static str,
+                oracle: u32,
+                first_layer: u32,
+                views: u32,
+                oracle_view: &wgpu::TextureView,
+                entry: Entry| {
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(name),
+            contents: bytemuck::bytes_of(&DeepParams {
+                min_separation: 0.0,
+                has_history: 0,
+                _pad: [0; 2],
+            }),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(name),
+            layout: &group_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(oracle_view),
+                },
+            ],
+        });
+        let constants = [
+            ("ORACLE", oracle as f64),
+            ("LAYER_BASE", first_layer as f64),
+            ("LAYERS", settings.layers as f64),
+        ];
+        let multiview = views > 1;
+        // The separate oracle pass writes array layer k.
+        let first_layer = if entry == Entry::Oracle {
+            settings.layers
+        } else {
+            first_layer
+        };
+        let (vs, fs) = match entry {
+            Entry::Single => ("vs_single", "fs_single"),
+            Entry::Multiview => ("vs_multiview", "fs_multiview"),
+            Entry::Oracle => ("vs_oracle", "fs_oracle"),
+        };
+        let options = wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            ..Default::default()
+        };
+        let color_targets: Vec<Option<wgpu::ColorTargetState>> = settings.outputs()[1..5]
+            .iter()
+            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
+            .collect();
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(name),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some(vs),
+                compilation_options: options.clone(),
+                buffers: &[Some(VERTEX_LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(fs),
+                compilation_options: options,
+                targets: &color_targets,
+            }),
+            multiview_mask: multiview.then(|| NonZeroU32::new((1u32 << views) - 1).expect("views > 0")),
+            cache: None,
+        });
+        let inputs = match (oracle, entry) {
+            (0, _) | (_, Entry::Oracle) => vec!["scene"],
+            (1, _) => vec!["scene", "csz"],
+            _ => vec!["scene", "csz-history"],
+        };
+        GeometryPass {
+            name,
+            pipeline,
+            first_layer,
+            views,
+            group,
+            params,
+            inputs,
+        }
+    };
+
+    if multiview_needed(settings)
+        && settings.submission.resolve(gpu) == Submission::Multiview
+        && !gpu.features.contains(wgpu::Features::MULTIVIEW)
+    {
+        return Err(RenderError::MissingFeature {
+            feature: "MULTIVIEW".into(),
+            pass: format!("deep_gbuffer ({})", settings.variant),
+        });
+    }
+    let passes = if k == 1 {
+        vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single)]
+    } else if settings.variant == Variant::Peel {
+        let mut v = vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single)];
+        for j in 1..k {
+            // This frame's layer j − 1 only: rendering into layer j while reading it.
+            let prev_layer = csz.texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                base_array_layer: j - 1,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            v.push(make(
+                PEEL_NAMES[j as usize],
+                settings.variant.oracle(),
+                j,
+                1,
+                &prev_layer,
+                Entry::Single,
+            ));
+        }
+        v
+    } else {
+        let history = &targets.get("csz-history").array_view;
+        let oracle = settings.variant.oracle();
+        match settings.submission.resolve(gpu) {
+            Submission::PerLayer => {
+                let mut v = vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single)];
+                for j in 1..k {
+                    v.push(make(LAYER_NAMES[j as usize], oracle, j, 1, history, Entry::Single));
+                }
+                if settings.variant.has_predicted_view() {
+                    v.push(make("oracle", oracle, 0, 1, &no_oracle, Entry::Oracle));
+                }
+                v
+            }
+            _ => vec![make(
+                "deep_gbuffer",
+                oracle,
+                0,
+                settings.array_layers(),
+                history,
+                Entry::Multiview,
+            )],
+        }
+    };
+    Ok(passes)
+}
+
+/// Which shader entry points a geometry pass uses.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Entry {
+    /// One layer (`LAYER_BASE`), no multiview.
+    Single,
+    /// Layers 0..views in one multiview pass.
+    Multiview,
+    /// The depth-only frame-(t + 1) layer k on its own.
+    Oracle,
+}
+
+fn multiview_needed(settings: &DeepGBufferSettings) -> bool {
+    settings.layers >= 2 && settings.variant.is_single_pass()
+}
+
+impl GeometryPass {
+    /// Sets Δz and whether last frame's oracle exists, before encoding a frame.
+    pub fn set_frame(&self, gpu: &GpuContext, min_separation: f32, has_history: bool) {
+        let p = DeepParams {
+            min_separation,
+            has_history: has_history as u32,
+            _pad: [0; 2],
+        };
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+    }
+}
+
+impl Pass for GeometryPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: self.name,
+            inputs: self.inputs.clone(),
+            outputs: vec!["depth", "csz", "normal", "albedo", "emission"],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        // Multiview: exactly layers first..first + views (a mask narrower than the
+        // attachment would need SELECTIVE_MULTIVIEW).
+        let names = ["csz", "normal", "albedo", "emission", "depth"];
+        let owned: Vec<Option<wgpu::TextureView>> = names
+            .iter()
+            .map(|n| {
+                let t = targets.get(n);
+                (self.views > 1 && t.desc.layers != self.views).then(|| {
+                    t.texture.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2Array),
+                        base_array_layer: self.first_layer,
+                        array_layer_count: Some(self.views),
+                        ..Default::default()
+                    })
+                })
+            })
+            .collect();
+        let view = |name: &str| {
+            let i = names.iter().position(|n| *n == name).expect("a G-buffer attachment");
+            let t = targets.get(name);
+            match (&owned[i], self.views > 1) {
+                (Some(v), _) => v,
+                (None, true) => &t.array_view,
+                (None, false) => t.layer(self.first_layer),
+            }
+        };
+        let color = |name: &str| crate::passes::clear_attachment(view(name));
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(self.name),
+            color_attachments: &[color("csz"), color("normal"), color("albedo"), color("emission")],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: view("depth"),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: (self.views > 1).then(|| NonZeroU32::new((1u32 << self.views) - 1).expect("views > 0")),
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+        pass.set_bind_group(3, &self.group, &[]);
+        scene.draw_all(&mut pass, 1, Some(2));
+    }
+}
+
+/// Packs the per-layer arrays into DGB Table 1's layout (`zpack`, `npack`, and
+/// `zpack23`, `npack23` for k > 2).
+pub struct PackPass {
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    outputs: Vec<&'static str>,
+}
+
+impl PackPass {
+    pub fn new(gpu: &GpuContext, targets: &Targets, settings: &DeepGBufferSettings) -> Self {
+        let device = &gpu.device;
+        let entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pack"),
+            entries: &[entry(0), entry(1)],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pack"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&targets.get("csz").array_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&targets.get("normal").array_view),
+                },
+            ],
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pack"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(device, "pack", include_str!("pack.wgsl"));
+        let outputs: Vec<&'static str> = if settings.layers > 2 {
+            vec!["zpack", "npack", "zpack23", "npack23"]
+        } else {
+            vec!["zpack", "npack"]
+        };
+        let formats: Vec<Option<wgpu::ColorTargetState>> = outputs
+            .iter()
+            .map(|n| Some(wgpu::ColorTargetState::from(targets.get(n).desc.format)))
+            .collect();
+        let entry_point = if settings.layers > 2 { "fs_pack4" } else { "fs_pack2" };
+        let pipeline = crate::passes::fullscreen_pipeline_with(
+            device,
+            "pack",
+            &pl,
+            &module,
+            entry_point,
+            &[("LAYERS", settings.layers as f64)],
+            &formats,
+        );
+        Self {
+            pipeline,
+            group,
+            outputs,
+        }
+    }
+}
+
+impl Pass for PackPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: "pack",
+            inputs: vec!["csz", "normal"],
+            outputs: self.outputs.clone(),
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let att: Vec<_> = self
+            .outputs
+            .iter()
+            .map(|n| crate::passes::clear_attachment(&targets.get(n).view))
+            .collect();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("pack"),
+            color_attachments: &att,
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// Keeps this frame's camera-space depths as next frame's oracle (`csz` →
+/// `csz-history`, every layer) at the end of the frame.
+pub struct HistoryPass;
+
+impl Pass for HistoryPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: "history",
+            inputs: vec!["csz"],
+            outputs: vec!["csz-history"],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let (src, dst) = (targets.get("csz"), targets.get("csz-history"));
+        encoder.copy_texture_to_texture(
+            src.texture.as_image_copy(),
+            dst.texture.as_image_copy(),
+            src.texture.size(),
+        );
+    }
+}
+
+/// Relative depth difference above which two layers hold different surfaces.
+pub const SURFACE_TOLERANCE: f32 = 1e-4;
+
+/// Per-pixel agreement of two camera-space depth images of the same layer (the
+/// DGB Fig. 3 measure): a pixel counts when either image has a surface there
+/// (z > 0); it mismatches when only one has a surface or the depths differ by
+/// more than [`SURFACE_TOLERANCE`] relative.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayerComparison {
+    /// Pixels with a surface in either image.
+    pub counted: u64,
+    /// Counted pixels whose surfaces differ.
+    pub mismatched: u64,
+    /// Per pixel: true where the surfaces differ.
+    pub mask: Vec<bool>,
+}
+
+impl LayerComparison {
+    pub fn new(a: &[f32], b: &[f32]) -> Self {
+        assert_eq!(a.len(), b.len(), "layer images differ in size");
+        let mut counted = 0;
+        let mut mismatched = 0;
+        let mask = a
+            .iter()
+            .zip(b)
+            .map(|(&za, &zb)| {
+                let (ha, hb) = (za > 0.0, zb > 0.0);
+                if !ha && !hb {
+                    return false;
+                }
+                counted += 1;
+                let differ = ha != hb || (za - zb).abs() > SURFACE_TOLERANCE * za.max(zb);
+                mismatched += differ as u64;
+                differ
+            })
+            .collect();
+        Self {
+            counted,
+            mismatched,
+            mask,
+        }
+    }
+
+    /// Mismatched share of counted pixels, in percent (0 when nothing is counted).
+    pub fn percent(&self) -> f64 {
+        if self.counted == 0 {
+            0.0
+        } else {
+            100.0 * self.mismatched as f64 / self.counted as f64
+        }
+    }
+}
