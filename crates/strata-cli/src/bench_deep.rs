@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use serde_json::json;
-use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, LayerComparison, Variant};
+use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, LayerComparison, Submission, Variant};
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::ImageBuf;
 
@@ -18,6 +18,10 @@ use crate::output::{cameras_at, check_output, save, scene_and_camera};
 struct Method {
     name: &'static str,
     renderer: Renderer,
+    /// Single-pass variants: the same variant forced into one multiview pass
+    /// (timed only; see `deep_gbuffer::Submission`).
+    multiview: Option<Renderer>,
+    multiview_totals: Vec<f64>,
     /// Per frame: (first layer ms, whole construction ms).
     times: Vec<(f64, f64)>,
     mismatched: u64,
@@ -46,21 +50,23 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
     if !gpu.has(wgpu_ts()) {
         bail!("the adapter lacks TIMESTAMP_QUERY / TIMESTAMP_QUERY_INSIDE_ENCODERS, which `strata bench` needs");
     }
-    let settings = |layers: u32, variant: Variant| RenderSettings {
+    let settings = |layers: u32, variant: Variant, submission: Submission| RenderSettings {
         width: a.scene.width,
         height: a.scene.height,
         deep: DeepGBufferSettings {
             layers,
             variant,
             min_separation: a.min_separation,
-            ..Default::default()
+            submission,
         },
         shade: false,
         ..Default::default()
     };
     let mut methods = vec![Method {
         name: "single-layer",
-        renderer: Renderer::new(&gpu, &scene, settings(1, Variant::Reproject))?,
+        renderer: Renderer::new(&gpu, &scene, settings(1, Variant::Reproject, Submission::Auto))?,
+        multiview: None,
+        multiview_totals: Vec::new(),
         times: Vec::new(),
         mismatched: 0,
         counted: 0,
@@ -69,9 +75,15 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
         if v.has_predicted_view() && a.layers != 2 {
             continue;
         }
+        let default = Renderer::new(&gpu, &scene, settings(a.layers, v, Submission::Auto))?;
+        let multiview = (v.is_single_pass() && default.settings.deep.submission.resolve(&gpu) != Submission::Multiview)
+            .then(|| Renderer::new(&gpu, &scene, settings(a.layers, v, Submission::Multiview)))
+            .transpose()?;
         methods.push(Method {
             name: v.name(),
-            renderer: Renderer::new(&gpu, &scene, settings(a.layers, v))?,
+            renderer: default,
+            multiview,
+            multiview_totals: Vec::new(),
             times: Vec::new(),
             mismatched: 0,
             counted: 0,
@@ -87,19 +99,18 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
         let mut peel_layer1: Option<ImageBuf> = None;
         for m in methods.iter_mut() {
             let t = m.renderer.render(&gpu, &scene, &cams, f)?;
+            let mv = match &mut m.multiview {
+                Some(r) => Some(r.render(&gpu, &scene, &cams, f)?),
+                None => None,
+            };
             if i < 0 {
                 continue;
             }
-            let first = t.get("gbuffer").unwrap_or(0.0);
-            let total = match m.name {
-                "single-layer" => first,
-                "peel" => {
-                    let peels: f64 = (1..a.layers).filter_map(|j| t.get(&format!("peel{j}"))).sum();
-                    first + peels
-                }
-                _ => t.get("deep_gbuffer").unwrap_or(f64::NAN),
-            };
-            m.times.push((first, total));
+            let first = t.get("gbuffer").unwrap_or(f64::NAN);
+            m.times.push((first, geometry_ms(&t)));
+            if let Some(mv) = mv {
+                m.multiview_totals.push(geometry_ms(&mv));
+            }
             if m.name == "single-layer" {
                 continue;
             }
@@ -146,17 +157,34 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
         } else {
             100.0 * m.mismatched as f64 / m.counted as f64
         };
-        rows.push((m.name, layer1, layer2, total, mismatch));
+        let mut mv: Vec<f64> = m.multiview_totals.clone();
+        let multiview_total = (!mv.is_empty()).then(|| median_min(&mut mv).0);
+        rows.push((m.name, layer1, layer2, total, mismatch, multiview_total));
     }
+    let submission = |name: &str| match name {
+        "single-layer" | "peel" => "per-layer",
+        _ => match rows.iter().find(|r| r.0 == name).and_then(|r| r.5) {
+            Some(_) => "per-layer",
+            None => "multiview",
+        },
+    };
 
     if a.json {
         let v = json!({
             "scene": a.scene.scene, "width": a.scene.width, "height": a.scene.height,
             "layers": a.layers, "frames": a.frames, "triangles": scene.triangle_count(),
             "device": gpu.describe(),
-            "rows": rows.iter().map(|(m, l1, l2, t, mm)| json!({
-                "method": m, "layer1_ms": l1, "layer2_ms": l2, "total_ms": t, "mismatch_pct": mm,
-            })).collect::<Vec<_>>(),
+            "rows": rows.iter().map(|(m, l1, l2, t, mm, mv)| {
+                let mut row = json!({
+                    "method": m, "layer1_ms": l1, "layer2_ms": l2, "total_ms": t, "mismatch_pct": mm,
+                    "submission": submission(m),
+                });
+                if let Some(mv) = mv {
+                    row["multiview_total_ms"] = json!(mv);
+                    row["multiview_layer2_ms"] = json!(mv - l1);
+                }
+                row
+            }).collect::<Vec<_>>(),
         });
         println!("{}", serde_json::to_string(&v)?);
     } else {
@@ -172,14 +200,29 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
             gpu.describe()
         );
         println!(
-            "{:<13} {:>10} {:>10} {:>10} {:>8} {:>10}",
-            "method", "layer1 ms", "layer2 ms", "total ms", "l2/l1", "mismatch %"
+            "{:<13} {:>10} {:>10} {:>10} {:>8} {:>10} {:>14}",
+            "method", "layer1 ms", "layer2 ms", "total ms", "l2/l1", "mismatch %", "multiview ms"
         );
-        for (m, l1, l2, t, mm) in &rows {
-            println!("{m:<13} {l1:>10.3} {l2:>10.3} {t:>10.3} {:>8.2} {mm:>10.3}", l2 / l1);
+        for (m, l1, l2, t, mm, mv) in &rows {
+            let mv = mv.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
+            println!("{m:<13} {l1:>10.3} {l2:>10.3} {t:>10.3} {:>8.2} {mm:>10.3} {mv:>14}", l2 / l1);
         }
+        println!("(peel, and single-pass methods with a multiview column, ran one submission per layer)");
     }
     Ok(())
+}
+
+/// GPU time of a frame's G-buffer construction: every geometry pass (layer 0,
+/// peels, per-layer submissions, the predicted-layer oracle, or the one
+/// multiview pass), not packing, history or shading.
+fn geometry_ms(t: &strata_render::PassTimings) -> f64 {
+    t.passes
+        .iter()
+        .filter(|(n, _)| {
+            n == "gbuffer" || n == "deep_gbuffer" || n == "oracle" || n.starts_with("peel") || n.starts_with("layer")
+        })
+        .map(|(_, ms)| ms)
+        .sum()
 }
 
 /// Fig. 3 images of one method at the last frame: its layer-1 albedo and, with

@@ -19,7 +19,7 @@ use crate::path::{CameraPath, Keyframe};
 use crate::shapes::MeshBuilder;
 
 /// Names accepted by [`builtin`].
-pub const BUILTIN_NAMES: &[&str] = &["cornell", "atrium", "warehouse", "plane", "column-wall"];
+pub const BUILTIN_NAMES: &[&str] = &["cornell", "atrium", "warehouse", "plane", "column-wall", "dense"];
 
 /// The built-in scene called `name`, or `None` when there is none.
 pub fn builtin(name: &str) -> Option<Scene> {
@@ -29,6 +29,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "warehouse" => Some(warehouse()),
         "plane" => Some(plane()),
         "column-wall" => Some(column_wall()),
+        "dense" => Some(dense()),
         _ => None,
     }
 }
@@ -526,6 +527,39 @@ pub fn column_wall() -> Scene {
     let settings = SceneSettings {
         ao_radius: 1.0,
         min_separation: 0.25,
+        exposure: 1.0,
+        sky: [0.2, 0.25, 0.35],
+        ambient: [0.03; 3],
+    };
+    b.finish(camera, vec![sun], settings)
+}
+
+/// A generated benchmark scene of about 1.05 M triangles: a 16 × 16 grid of
+/// finely tessellated columns (1024 segments, capped: 4096 triangles each) on a
+/// floor before a wall, seen along the rows so that most columns hide others
+/// (the DGB Table 5 "heavy geometry" case).
+pub fn dense() -> Scene {
+    let mut b = SceneBuilder::new("dense");
+    let floor = b.material(Material::diffuse("floor", [0.55, 0.55, 0.55]));
+    let wall = b.material(Material::diffuse("wall", [0.7, 0.3, 0.25]));
+    let column = b.material(Material::diffuse("column", [0.75, 0.73, 0.7]));
+    b.geo(floor).rect(v(0.0, 0.0, -8.0), v(0.0, 0.0, 12.0), v(12.0, 0.0, 0.0));
+    b.geo(wall).cuboid(v(-12.0, 0.0, -20.5), v(12.0, 6.0, -20.0));
+    for i in 0..16 {
+        for j in 0..16 {
+            let base = v(-7.5 + i as f32, 0.0, -1.0 - 1.1 * j as f32);
+            b.geo(column).cylinder(base, 0.2, 3.0, 1024, true);
+        }
+    }
+    let sun = Light::Sun {
+        direction: v(0.4, -1.0, -0.5).normalize(),
+        color: [1.0, 0.97, 0.92],
+        illuminance: 3.0,
+    };
+    let camera = Camera::new(v(0.6, 1.7, 3.5), v(0.0, 1.2, -10.0), Vec3::Y, 55.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.5,
+        min_separation: 0.5,
         exposure: 1.0,
         sky: [0.2, 0.25, 0.35],
         ambient: [0.03; 3],

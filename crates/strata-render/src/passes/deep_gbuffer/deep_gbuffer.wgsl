@@ -177,12 +177,12 @@ fn fs_multiview(in: VsOut, @builtin(view_index) view: u32, @builtin(front_facing
         o.csz = in.cam_z;
         return o;
     }
-    let keep = passes_min_separation(in, view);
-    let o = shade(in, front);
-    if (!keep) {
+    // Test first, shade only survivors (discard demotes to a helper invocation,
+    // so the texture fetch in `shade` keeps its derivatives).
+    if (!passes_min_separation(in, view)) {
         discard;
     }
-    return o;
+    return shade(in, front);
 }
 
 @fragment
@@ -194,10 +194,8 @@ fn fs_oracle(in: VsOut) -> GBufferOut {
 
 @fragment
 fn fs_single(in: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
-    let keep = passes_min_separation(in, LAYER_BASE);
-    let o = shade(in, front);
-    if (!keep) {
+    if (!passes_min_separation(in, LAYER_BASE)) {
         discard;
     }
-    return o;
+    return shade(in, front);
 }
