@@ -205,7 +205,10 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
         );
         for (m, l1, l2, t, mm, mv) in &rows {
             let mv = mv.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
-            println!("{m:<13} {l1:>10.3} {l2:>10.3} {t:>10.3} {:>8.2} {mm:>10.3} {mv:>14}", l2 / l1);
+            println!(
+                "{m:<13} {l1:>10.3} {l2:>10.3} {t:>10.3} {:>8.2} {mm:>10.3} {mv:>14}",
+                l2 / l1
+            );
         }
         println!("(peel, and single-pass methods with a multiview column, ran one submission per layer)");
     }

@@ -543,7 +543,8 @@ pub fn dense() -> Scene {
     let floor = b.material(Material::diffuse("floor", [0.55, 0.55, 0.55]));
     let wall = b.material(Material::diffuse("wall", [0.7, 0.3, 0.25]));
     let column = b.material(Material::diffuse("column", [0.75, 0.73, 0.7]));
-    b.geo(floor).rect(v(0.0, 0.0, -8.0), v(0.0, 0.0, 12.0), v(12.0, 0.0, 0.0));
+    b.geo(floor)
+        .rect(v(0.0, 0.0, -8.0), v(0.0, 0.0, 12.0), v(12.0, 0.0, 0.0));
     b.geo(wall).cuboid(v(-12.0, 0.0, -20.5), v(12.0, 6.0, -20.0));
     for i in 0..16 {
         for j in 0..16 {

@@ -64,3 +64,60 @@ pub(crate) fn clear_attachment(view: &wgpu::TextureView) -> Option<wgpu::RenderP
         },
     })
 }
+
+/// A fragment-stage float texture binding (`filterable` for sampled reads).
+pub(crate) fn texture_entry(
+    binding: u32,
+    dimension: wgpu::TextureViewDimension,
+    filterable: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable },
+            view_dimension: dimension,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A fragment-stage uniform buffer binding.
+pub(crate) fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Records a full-screen-triangle pass that clears and writes `outputs`, with
+/// `groups` bound at 0, 1, ….
+pub(crate) fn fullscreen_pass(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::RenderPipeline,
+    outputs: &[&wgpu::TextureView],
+    groups: &[&wgpu::BindGroup],
+) {
+    let att: Vec<_> = outputs.iter().map(|v| clear_attachment(v)).collect();
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &att,
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    for (i, g) in groups.iter().enumerate() {
+        pass.set_bind_group(i as u32, *g, &[]);
+    }
+    pass.draw(0..3, 0..1);
+}

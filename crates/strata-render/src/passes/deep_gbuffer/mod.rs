@@ -343,26 +343,8 @@ pub fn geometry_passes(
     let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("deep_gbuffer oracle"),
         entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
+            crate::passes::uniform_entry(0),
+            crate::passes::texture_entry(1, wgpu::TextureViewDimension::D2Array, false),
         ],
     });
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -651,16 +633,7 @@ pub struct PackPass {
 impl PackPass {
     pub fn new(gpu: &GpuContext, targets: &Targets, settings: &DeepGBufferSettings) -> Self {
         let device = &gpu.device;
-        let entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2Array,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let entry = |binding| crate::passes::texture_entry(binding, wgpu::TextureViewDimension::D2Array, false);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pack"),
             entries: &[entry(0), entry(1)],
@@ -722,22 +695,8 @@ impl Pass for PackPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let att: Vec<_> = self
-            .outputs
-            .iter()
-            .map(|n| crate::passes::clear_attachment(&targets.get(n).view))
-            .collect();
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("pack"),
-            color_attachments: &att,
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.group, &[]);
-        pass.draw(0..3, 0..1);
+        let outputs: Vec<_> = self.outputs.iter().map(|n| &targets.get(n).view).collect();
+        crate::passes::fullscreen_pass(encoder, "pack", &self.pipeline, &outputs, &[&self.group]);
     }
 }
 

@@ -78,16 +78,8 @@ impl LightingPass {
         settings: &LightingSettings,
     ) -> Self {
         let device = &gpu.device;
-        let tex = |b: u32, filterable: bool| wgpu::BindGroupLayoutEntry {
-            binding: b,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
+        let tex =
+            |b: u32, filterable: bool| crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, filterable);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lighting"),
             entries: &[
@@ -240,21 +232,13 @@ impl Pass for LightingPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let att: Vec<_> = OUTPUTS
-            .iter()
-            .map(|t| crate::passes::clear_attachment(&targets.get(t.name).view))
-            .collect();
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("lighting"),
-            color_attachments: &att,
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
-        pass.set_bind_group(1, &self.group, &[]);
-        pass.draw(0..3, 0..1);
+        let outputs: Vec<_> = OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
+        crate::passes::fullscreen_pass(
+            encoder,
+            "lighting",
+            &self.pipeline,
+            &outputs,
+            &[&scene.frame_bind_group, &self.group],
+        );
     }
 }
