@@ -36,7 +36,11 @@ fn every_builtin_is_well_formed() {
         let limit = if name == "dense" { 1_100_000 } else { 100_000 };
         assert!(s.triangle_count() < limit, "{name}: {} triangles", s.triangle_count());
         if name == "dense" {
-            assert!(s.triangle_count() >= 1_000_000, "dense: {} triangles", s.triangle_count());
+            assert!(
+                s.triangle_count() >= 1_000_000,
+                "dense: {} triangles",
+                s.triangle_count()
+            );
         }
         for m in &s.meshes {
             assert_eq!(m.normals.len(), m.positions.len(), "{name}/{}: normals", m.name);
