@@ -4,9 +4,12 @@ mod args;
 mod bench;
 mod bench_deep;
 mod info;
+mod metrics;
 mod output;
+mod ref_cache;
 mod reference;
 mod render;
+mod report;
 
 use clap::Parser;
 

@@ -123,7 +123,27 @@ pub struct TargetDesc {
     pub name: &'static str,
     pub format: wgpu::TextureFormat,
     pub layers: u32,
+    /// MIP levels (1 for render targets; more for MIP chains such as `zmip`).
+    pub mips: u32,
     pub doc: &'static str,
+}
+
+impl TargetDesc {
+    pub const fn new(name: &'static str, format: wgpu::TextureFormat, layers: u32, doc: &'static str) -> Self {
+        Self {
+            name,
+            format,
+            layers,
+            mips: 1,
+            doc,
+        }
+    }
+
+    /// The same target with `mips` MIP levels.
+    pub const fn with_mips(mut self, mips: u32) -> Self {
+        self.mips = mips;
+        self
+    }
 }
 
 /// A created render target.
@@ -134,8 +154,10 @@ pub struct Target {
     pub view: wgpu::TextureView,
     /// The whole texture as a `D2Array` view (also when it has one layer).
     pub array_view: wgpu::TextureView,
-    /// One `D2` view per array layer.
+    /// One `D2` view per array layer (all MIP levels).
     pub layer_views: Vec<wgpu::TextureView>,
+    /// One `D2` view of layer 0 per MIP level (render attachments of MIP passes).
+    pub mip_views: Vec<wgpu::TextureView>,
 }
 
 impl Target {
@@ -170,7 +192,7 @@ impl Targets {
                 height: self.height,
                 depth_or_array_layers: desc.layers,
             },
-            mip_level_count: 1,
+            mip_level_count: desc.mips,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: desc.format,
@@ -202,6 +224,17 @@ impl Targets {
                 })
             })
             .collect();
+        let mip_views = (0..desc.mips)
+            .map(|m| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_mip_level: m,
+                    mip_level_count: Some(1),
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
         self.map.insert(
             desc.name,
             Target {
@@ -210,6 +243,7 @@ impl Targets {
                 view,
                 array_view,
                 layer_views,
+                mip_views,
             },
         );
     }

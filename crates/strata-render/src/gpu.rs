@@ -205,12 +205,17 @@ impl GpuContext {
 
     /// Reads a whole 2D texture (one array layer, mip 0) back as raw texel bytes, rows tightly packed.
     pub fn read_texture(&self, texture: &wgpu::Texture, layer: u32) -> Result<Vec<u8>, RenderError> {
+        self.read_texture_level(texture, layer, 0)
+    }
+
+    /// Reads MIP level `mip` of one array layer (its size is the level's size).
+    pub fn read_texture_level(&self, texture: &wgpu::Texture, layer: u32, mip: u32) -> Result<Vec<u8>, RenderError> {
         let fmt = texture.format();
         let bpp = fmt
             .block_copy_size(Some(wgpu::TextureAspect::All))
             .or_else(|| fmt.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)))
             .ok_or_else(|| RenderError::Other(format!("cannot read back format {fmt:?}")))?;
-        let (w, h) = (texture.width(), texture.height());
+        let (w, h) = ((texture.width() >> mip).max(1), (texture.height() >> mip).max(1));
         let row = w * bpp;
         let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buf = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -228,7 +233,7 @@ impl GpuContext {
         enc.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
                 texture,
-                mip_level: 0,
+                mip_level: mip,
                 origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
                 aspect,
             },

@@ -14,6 +14,7 @@ pub mod profiler;
 pub mod renderer;
 pub mod scene_gpu;
 pub mod shader;
+pub mod spiral;
 
 pub use gpu::{GpuContext, GpuOptions};
 pub use profiler::PassTimings;

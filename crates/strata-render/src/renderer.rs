@@ -7,8 +7,12 @@ use strata_scene::{ImageBuf, Scene};
 use crate::frame::{validate_pass_order, FrameCameras, FrameUniforms, Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
 use crate::lights::{gpu_lights, GpuLight};
+use crate::passes::ao::{AoPass, AoSettings, AoUniforms};
+use crate::passes::bilateral::BilateralPass;
 use crate::passes::deep_gbuffer::{self, DeepGBufferSettings, Variant};
-use crate::passes::{lighting, shadow, tonemap};
+use crate::passes::depth_mip::DepthMipPass;
+use crate::passes::temporal::TemporalPass;
+use crate::passes::{lighting, shadow, tonemap, HistoryPass};
 use crate::profiler::{PassTimings, Profiler};
 use crate::scene_gpu::GpuScene;
 use crate::RenderError;
@@ -76,6 +80,8 @@ pub struct RenderSettings {
     pub lighting: lighting::LightingSettings,
     /// Overrides the scene's exposure.
     pub exposure: Option<f32>,
+    /// Deep-G-buffer ambient occlusion (DGB §3.1) into target `ao`; `None` = off.
+    pub ao: Option<AoSettings>,
 }
 
 impl Default for RenderSettings {
@@ -89,6 +95,7 @@ impl Default for RenderSettings {
             shadow: Default::default(),
             lighting: Default::default(),
             exposure: None,
+            ao: None,
         }
     }
 }
@@ -129,6 +136,9 @@ impl RenderSettings {
                 self.guard_pixels()
             )));
         }
+        if let Some(ao) = &self.ao {
+            ao.validate().map_err(RenderError::Parameter)?;
+        }
         self.deep.validate()
     }
 
@@ -153,7 +163,9 @@ pub struct Renderer {
     pack: deep_gbuffer::PackPass,
     lighting: Option<lighting::LightingPass>,
     tonemap: Option<tonemap::TonemapPass>,
-    history: Option<deep_gbuffer::HistoryPass>,
+    ao: Option<AoStage>,
+    history: Option<HistoryPass>,
+    last_frame: FrameUniforms,
     /// Last frame's depths are in `csz-history` (false before the first frame).
     has_history: bool,
     profiler: Profiler,
@@ -200,7 +212,18 @@ impl Renderer {
         } else {
             (None, None, None)
         };
-        let history = settings.deep.uses_history().then_some(deep_gbuffer::HistoryPass);
+        let ao = match &settings.ao {
+            Some(a) => Some(AoStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, a)),
+            None => None,
+        };
+        let mut copies = Vec::new();
+        if settings.deep.uses_history() || ao.as_ref().is_some_and(|a| a.temporal.is_some()) {
+            copies.push(("csz", "csz-history"));
+        }
+        if ao.as_ref().is_some_and(|a| a.temporal.is_some()) {
+            copies.push(("ao-temporal", "ao-temporal-history"));
+        }
+        let history = (!copies.is_empty()).then_some(HistoryPass { copies });
         let profiler = Profiler::new(gpu, 16);
         let animated = scene.objects.iter().any(|o| o.animation.is_some());
         let r = Self {
@@ -212,7 +235,9 @@ impl Renderer {
             pack,
             lighting,
             tonemap,
+            ao,
             history,
+            last_frame: bytemuck::Zeroable::zeroed(),
             has_history: false,
             profiler,
             lights,
@@ -231,6 +256,9 @@ impl Renderer {
         }
         v.extend(self.geometry.iter().map(|p| p as &dyn Pass));
         v.push(&self.pack);
+        if let Some(a) = &self.ao {
+            v.extend(a.passes());
+        }
         if let (Some(l), Some(t)) = (&self.lighting, &self.tonemap) {
             v.push(l);
             v.push(t);
@@ -274,6 +302,15 @@ impl Renderer {
         let (w, h) = self.settings.internal_size();
         let u = FrameUniforms::new(scene, &cams, w, h, frame, exposure);
         self.scene_gpu.update_frame(gpu, &u);
+        self.last_frame = u;
+        if let (Some(stage), Some(s)) = (&self.ao, &self.settings.ao) {
+            let max_mip = self.targets.get("zmip").desc.mips - 1;
+            let au = AoUniforms::new(s, scene, &u, max_mip, frame.max(0.0) as u32);
+            stage.ao.set_frame(gpu, au);
+            if let Some(t) = &stage.temporal {
+                t.set_frame(gpu, self.has_history);
+            }
+        }
         self.scene_gpu.update_objects(gpu, frame, variant.next_transforms());
         let dz = self
             .settings
@@ -305,6 +342,33 @@ impl Renderer {
         gpu.check_errors()?;
         self.has_history = self.history.is_some();
         self.profiler.read(gpu)
+    }
+
+    /// The frame uniforms of the last rendered frame (guard-banded camera).
+    pub fn frame_uniforms(&self) -> FrameUniforms {
+        self.last_frame
+    }
+
+    /// The AO pass's uniforms of the last rendered frame.
+    pub fn ao_uniforms(&self) -> Option<AoUniforms> {
+        self.ao.as_ref().map(|a| a.ao.uniforms())
+    }
+
+    /// MIP level `mip` of target `name` (layer 0, whole texture incl. guard band).
+    pub fn read_target_mip(&self, gpu: &GpuContext, name: &str, mip: u32) -> Result<ImageBuf, RenderError> {
+        let t = self
+            .targets
+            .try_get(name)
+            .ok_or_else(|| RenderError::Parameter(format!("unknown target '{name}'")))?;
+        if mip >= t.desc.mips {
+            return Err(RenderError::Parameter(format!(
+                "target '{name}' has {} MIP level(s): level {mip} is out of range",
+                t.desc.mips
+            )));
+        }
+        let bytes = gpu.read_texture_level(&t.texture, 0, mip)?;
+        let (w, h) = ((self.targets.width >> mip).max(1), (self.targets.height >> mip).max(1));
+        decode_texels(&bytes, t.desc.format, w, h)
     }
 
     /// Names of every readable target (each can be a debug view).
@@ -564,4 +628,86 @@ pub fn rg11b10_to_f32(p: u32) -> [f32; 3] {
         small_float((p >> 11) & 0x7ff, 6),
         small_float(p >> 22, 5),
     ]
+}
+
+/// The AO passes of a frame: depth MIP chain → Eq. 1 → temporal filter →
+/// bilateral (horizontal, vertical) into `ao`.
+struct AoStage {
+    mip: DepthMipPass,
+    ao: AoPass,
+    temporal: Option<TemporalPass>,
+    blur_h: BilateralPass,
+    blur_v: BilateralPass,
+}
+
+impl AoStage {
+    fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &mut Targets,
+        deep: &DeepGBufferSettings,
+        s: &AoSettings,
+    ) -> Self {
+        use crate::frame::TargetDesc;
+        use wgpu::TextureFormat as F;
+        let (w, h) = (targets.width, targets.height);
+        targets.create(gpu, s.mips.output(deep.layers, w, h));
+        targets.create(gpu, crate::passes::ao::OUTPUT);
+        let mut filtered = crate::passes::ao::OUTPUT.name;
+        if s.temporal.is_some() {
+            for (name, doc) in [
+                ("ao-temporal", "AO after the temporal filter (DGB §3.3)"),
+                ("ao-temporal-history", "last frame's ao-temporal"),
+            ] {
+                targets.create(gpu, TargetDesc::new(name, F::R32Float, 1, doc));
+            }
+            if targets.try_get("csz-history").is_none() {
+                let l = deep.array_layers();
+                targets.create(gpu, TargetDesc::new("csz-history", F::R32Float, l, "last frame's csz"));
+            }
+            filtered = "ao-temporal";
+        }
+        targets.create(
+            gpu,
+            TargetDesc::new("ao-blur-h", F::R16Float, 1, "AO after the horizontal bilateral pass"),
+        );
+        targets.create(
+            gpu,
+            TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
+        );
+        let mip = DepthMipPass::new(gpu, targets, deep.layers);
+        let ao = AoPass::new(gpu, scene, targets, deep.layers);
+        let temporal = s.temporal.as_ref().map(|t| {
+            TemporalPass::new(
+                gpu,
+                scene,
+                targets,
+                t,
+                "ao-temporal",
+                crate::passes::ao::OUTPUT.name,
+                "ao-temporal-history",
+                "ao-temporal",
+                deep.layers,
+            )
+        });
+        let blur_h = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-h", filtered, "ao-blur-h", false);
+        let blur_v = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-v", "ao-blur-h", "ao", true);
+        Self {
+            mip,
+            ao,
+            temporal,
+            blur_h,
+            blur_v,
+        }
+    }
+
+    fn passes(&self) -> Vec<&dyn Pass> {
+        let mut v: Vec<&dyn Pass> = vec![&self.mip, &self.ao];
+        if let Some(t) = &self.temporal {
+            v.push(t);
+        }
+        v.push(&self.blur_h);
+        v.push(&self.blur_v);
+        v
+    }
 }

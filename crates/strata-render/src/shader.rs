@@ -9,6 +9,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/color.wgsl", include_str!("shaders/common/color.wgsl")),
     ("common/fullscreen.wgsl", include_str!("shaders/common/fullscreen.wgsl")),
     ("common/scene.wgsl", include_str!("shaders/common/scene.wgsl")),
+    ("common/spiral.wgsl", include_str!("shaders/common/spiral.wgsl")),
 ];
 
 /// Expands `#import "…"` lines recursively; panics only on a missing module,

@@ -1,8 +1,12 @@
 //! One module per technique, each with its WGSL beside it.
 
+pub mod ao;
+pub mod bilateral;
 pub mod deep_gbuffer;
+pub mod depth_mip;
 pub mod lighting;
 pub mod shadow;
+pub mod temporal;
 pub mod tonemap;
 
 /// A full-screen-triangle pipeline (vertex entry `vs_fullscreen` from
@@ -120,4 +124,88 @@ pub(crate) fn fullscreen_pass(
         pass.set_bind_group(i as u32, *g, &[]);
     }
     pass.draw(0..3, 0..1);
+}
+
+/// A bind group binding `resources` at 0, 1, ….
+pub(crate) fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, r)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: r.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// A pipeline layout of the frame uniforms (group 0) and `groups` after it.
+pub(crate) fn frame_pipeline_layout(
+    device: &wgpu::Device,
+    label: &str,
+    scene: &crate::scene_gpu::GpuScene,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let mut layouts = vec![Some(&scene.frame_layout)];
+    layouts.extend(groups.iter().map(|g| Some(*g)));
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    })
+}
+
+/// A uniform buffer initialised with `value`.
+pub(crate) fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, value: &T) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::bytes_of(value),
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
+/// Keeps targets for the next frame at the end of this one: `csz` →
+/// `csz-history` (the single-pass deep G-buffer's oracle and the temporal
+/// filter's reprojection test) and each temporal filter's output →
+/// `<output>-history`.
+pub struct HistoryPass {
+    /// (source, destination) pairs of same-shaped targets.
+    pub copies: Vec<(&'static str, &'static str)>,
+}
+
+impl crate::frame::Pass for HistoryPass {
+    fn info(&self) -> crate::frame::PassInfo {
+        crate::frame::PassInfo {
+            name: "history",
+            inputs: self.copies.iter().map(|c| c.0).collect(),
+            outputs: self.copies.iter().map(|c| c.1).collect(),
+        }
+    }
+
+    fn encode(
+        &self,
+        _gpu: &crate::gpu::GpuContext,
+        _scene: &crate::scene_gpu::GpuScene,
+        targets: &crate::frame::Targets,
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
+        for (src, dst) in &self.copies {
+            let (src, dst) = (targets.get(src), targets.get(dst));
+            encoder.copy_texture_to_texture(
+                src.texture.as_image_copy(),
+                dst.texture.as_image_copy(),
+                src.texture.size(),
+            );
+        }
+    }
 }

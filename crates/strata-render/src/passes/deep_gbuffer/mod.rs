@@ -231,12 +231,7 @@ impl DeepGBufferSettings {
     /// The targets the deep G-buffer passes write.
     pub fn outputs(&self) -> Vec<TargetDesc> {
         let l = self.array_layers();
-        let desc = |name, format, layers, doc| TargetDesc {
-            name,
-            format,
-            layers,
-            doc,
-        };
+        let desc = TargetDesc::new;
         use wgpu::TextureFormat as F;
         let mut v = vec![
             desc(
@@ -697,29 +692,6 @@ impl Pass for PackPass {
     fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         let outputs: Vec<_> = self.outputs.iter().map(|n| &targets.get(n).view).collect();
         crate::passes::fullscreen_pass(encoder, "pack", &self.pipeline, &outputs, &[&self.group]);
-    }
-}
-
-/// Keeps this frame's camera-space depths as next frame's oracle (`csz` →
-/// `csz-history`, every layer) at the end of the frame.
-pub struct HistoryPass;
-
-impl Pass for HistoryPass {
-    fn info(&self) -> PassInfo {
-        PassInfo {
-            name: "history",
-            inputs: vec!["csz"],
-            outputs: vec!["csz-history"],
-        }
-    }
-
-    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let (src, dst) = (targets.get("csz"), targets.get("csz-history"));
-        encoder.copy_texture_to_texture(
-            src.texture.as_image_copy(),
-            dst.texture.as_image_copy(),
-            src.texture.size(),
-        );
     }
 }
 

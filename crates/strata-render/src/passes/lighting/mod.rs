@@ -26,30 +26,25 @@ impl Default for LightingSettings {
 }
 
 pub const OUTPUTS: &[TargetDesc] = &[
-    TargetDesc {
-        name: "hdr",
-        format: wgpu::TextureFormat::Rgba16Float,
-        layers: 1,
-        doc: "direct + emission + ambient (linear)",
-    },
-    TargetDesc {
-        name: "direct-diffuse",
-        format: wgpu::TextureFormat::Rgba16Float,
-        layers: 1,
-        doc: "Lambertian direct outgoing radiance",
-    },
-    TargetDesc {
-        name: "shadow",
-        format: wgpu::TextureFormat::R16Float,
-        layers: 1,
-        doc: "visibility of light 0",
-    },
-    TargetDesc {
-        name: "radiosity0",
-        format: crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
-        layers: 1,
-        doc: "DGB Table 1: layer 0 radiosity B, initialised with Lambertian direct light + emission",
-    },
+    TargetDesc::new(
+        "hdr",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "direct + emission + ambient (linear)",
+    ),
+    TargetDesc::new(
+        "direct-diffuse",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "Lambertian direct outgoing radiance",
+    ),
+    TargetDesc::new("shadow", wgpu::TextureFormat::R16Float, 1, "visibility of light 0"),
+    TargetDesc::new(
+        "radiosity0",
+        crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+        1,
+        "DGB Table 1: layer 0 radiosity B, initialised with Lambertian direct light + emission",
+    ),
 ];
 
 #[repr(C)]

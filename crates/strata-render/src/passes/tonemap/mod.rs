@@ -4,12 +4,12 @@ use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::scene_gpu::GpuScene;
 
-pub const OUTPUTS: &[TargetDesc] = &[TargetDesc {
-    name: "ldr",
-    format: wgpu::TextureFormat::Rgba8UnormSrgb,
-    layers: 1,
-    doc: "tonemapped display image (sRGB)",
-}];
+pub const OUTPUTS: &[TargetDesc] = &[TargetDesc::new(
+    "ldr",
+    wgpu::TextureFormat::Rgba8UnormSrgb,
+    1,
+    "tonemapped display image (sRGB)",
+)];
 
 pub struct TonemapPass {
     pipeline: wgpu::RenderPipeline,

@@ -1,0 +1,275 @@
+//! Image error metrics for `strata eval`: NVIDIA's LDR ꟻLIP (via the `nv-flip` crate), RMSE and MAE
+//! between a reference image and a test image, plus the ꟻLIP error map for the report.
+//!
+//! Both images are *display values* in [0, 1]: the caller decides the encoding (exposure, tonemap,
+//! sRGB or not) before calling [`compare`]; nothing here applies a transfer function.
+
+// Until `strata eval` (the only caller) lands; remove then.
+#![allow(dead_code)]
+
+use anyhow::{bail, Result};
+use serde::Serialize;
+use strata_scene::ImageBuf;
+
+/// Errors of a test image against a reference image.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ErrorStats {
+    /// Mean ꟻLIP error over all pixels (0 = identical, 1 = maximal), LDR ꟻLIP at
+    /// [`nv_flip::DEFAULT_PIXELS_PER_DEGREE`] on the 8-bit quantised images.
+    pub flip: f32,
+    /// Root mean squared difference over every channel of every pixel of the float data (unclamped).
+    pub rmse: f32,
+    /// Mean absolute difference over every channel of every pixel of the float data (unclamped).
+    pub mae: f32,
+    /// Number of pixels compared.
+    pub pixels: usize,
+}
+
+/// Compares `test` against `reference`; returns the error statistics and the ꟻLIP error map.
+///
+/// Both images must have the same size and the same channel count, 1 (grey) or 3 (RGB), with values
+/// meant for display in [0, 1]. RMSE and MAE use the float data as is. ꟻLIP uses each value
+/// quantised to 8 bits as `round(clamp(v, 0, 1) * 255)` (see [`ldr_bytes`]) with no transfer
+/// function; grey images are replicated to RGB. `nv-flip` treats the bytes as sRGB-encoded, so the
+/// caller should pass sRGB-encoded display values for a perceptually meaningful ꟻLIP.
+///
+/// The error map is a 3-channel image of the per-pixel ꟻLIP error coloured with ꟻLIP's magma LUT,
+/// each value an exact byte / 255. Save it with `ImageBuf::save(path, false)`: with `srgb = false`
+/// a PNG stores `round(v * 255)`, i.e. the LUT's bytes unchanged, whereas `srgb = true` would
+/// sRGB-encode the already display-ready colours a second time and wash them out.
+pub fn compare(reference: &ImageBuf, test: &ImageBuf) -> Result<(ErrorStats, ImageBuf)> {
+    if (reference.width, reference.height, reference.channels) != (test.width, test.height, test.channels) {
+        bail!(
+            "cannot compare images of different shapes: reference is {}x{} with {} channel(s), test is {}x{} with {} \
+             channel(s)",
+            reference.width,
+            reference.height,
+            reference.channels,
+            test.width,
+            test.height,
+            test.channels
+        );
+    }
+    for (name, img) in [("reference", reference), ("test", test)] {
+        check_image(name, img)?;
+    }
+
+    let (mut sum_abs, mut sum_sq) = (0.0f64, 0.0f64);
+    for (&r, &t) in reference.data.iter().zip(&test.data) {
+        let d = f64::from(t) - f64::from(r);
+        sum_abs += d.abs();
+        sum_sq += d * d;
+    }
+    let n = reference.data.len() as f64;
+    let (w, h) = (reference.width, reference.height);
+
+    let ref_flip = nv_flip::FlipImageRgb8::with_data(w, h, &ldr_bytes(reference));
+    let test_flip = nv_flip::FlipImageRgb8::with_data(w, h, &ldr_bytes(test));
+    let error = nv_flip::flip(ref_flip, test_flip, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    let flip = nv_flip::FlipPool::from_image(&error).mean();
+    let coloured = error.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    let map = ImageBuf {
+        width: w,
+        height: h,
+        channels: 3,
+        data: coloured.into_iter().map(|b| f32::from(b) / 255.0).collect(),
+    };
+
+    let stats = ErrorStats {
+        flip,
+        rmse: (sum_sq / n).sqrt() as f32,
+        mae: (sum_abs / n) as f32,
+        pixels: w as usize * h as usize,
+    };
+    Ok((stats, map))
+}
+
+/// Validates what `compare` (and `nv-flip`, which panics on short data) relies on.
+fn check_image(name: &str, img: &ImageBuf) -> Result<()> {
+    if img.channels != 1 && img.channels != 3 {
+        bail!(
+            "{name} image has {} channels: only 1 (grey) or 3 (RGB) can be compared",
+            img.channels
+        );
+    }
+    if img.width == 0 || img.height == 0 {
+        bail!(
+            "{name} image is empty ({}x{}): nothing to compare",
+            img.width,
+            img.height
+        );
+    }
+    let expected = img.width as usize * img.height as usize * img.channels as usize;
+    if img.data.len() != expected {
+        bail!(
+            "{name} image holds {} values but {}x{} with {} channel(s) needs {expected}",
+            img.data.len(),
+            img.width,
+            img.height,
+            img.channels
+        );
+    }
+    Ok(())
+}
+
+/// The image as tightly packed 8-bit RGB, each value `round(clamp(v, 0, 1) * 255)` with no transfer
+/// function (NaN becomes 0). Grey (1-channel) images are replicated to RGB; with 2 channels the
+/// third is 0, with 4 or more only the first three are used.
+pub fn ldr_bytes(img: &ImageBuf) -> Vec<u8> {
+    let c = img.channels.max(1) as usize;
+    let q = |v: f32| {
+        if v.is_nan() {
+            0
+        } else {
+            (v.clamp(0.0, 1.0) * 255.0).round() as u8
+        }
+    };
+    let mut out = Vec::with_capacity(img.data.len() / c * 3);
+    for p in img.data.chunks_exact(c) {
+        match p.len() {
+            1 => out.extend_from_slice(&[q(p[0]); 3]),
+            2 => out.extend_from_slice(&[q(p[0]), q(p[1]), 0]),
+            _ => out.extend_from_slice(&[q(p[0]), q(p[1]), q(p[2])]),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth RGB test pattern in [0.1, 0.7] so offsets up to 0.3 stay inside [0, 1].
+    fn pattern(w: u32, h: u32) -> ImageBuf {
+        let mut img = ImageBuf::new(w, h, 3);
+        for y in 0..h {
+            for x in 0..w {
+                let p = img.pixel_mut(x, y);
+                p[0] = 0.1 + 0.6 * x as f32 / (w - 1) as f32;
+                p[1] = 0.1 + 0.6 * y as f32 / (h - 1) as f32;
+                p[2] = 0.4;
+            }
+        }
+        img
+    }
+
+    fn offset(img: &ImageBuf, d: f32) -> ImageBuf {
+        let mut out = img.clone();
+        out.data.iter_mut().for_each(|v| *v += d);
+        out
+    }
+
+    #[test]
+    fn identical_images_have_zero_error() {
+        let a = pattern(32, 24);
+        let (s, map) = compare(&a, &a).unwrap();
+        assert_eq!(s.flip, 0.0);
+        assert_eq!(s.rmse, 0.0);
+        assert_eq!(s.mae, 0.0);
+        assert_eq!(s.pixels, 32 * 24);
+        assert_eq!((map.width, map.height, map.channels), (32, 24, 3));
+        assert_eq!(map.data.len(), 32 * 24 * 3);
+        // Zero error maps to the LUT's first entry everywhere.
+        let first = map.pixel(0, 0).to_vec();
+        assert!(map.data.chunks_exact(3).all(|p| p == first.as_slice()));
+    }
+
+    #[test]
+    fn constant_offset_gives_mae_and_rmse_equal_to_offset() {
+        let a = pattern(16, 16);
+        for d in [0.05f32, -0.1, 0.25] {
+            let b = offset(&a, d);
+            let (s, _) = compare(&a, &b).unwrap();
+            // The offset as actually stored after f32 rounding differs from d by a few ulps.
+            assert!((s.mae - d.abs()).abs() < 1e-6, "d = {d}: mae = {}", s.mae);
+            assert!((s.rmse - d.abs()).abs() < 1e-6, "d = {d}: rmse = {}", s.rmse);
+        }
+    }
+
+    #[test]
+    fn rmse_and_mae_use_unclamped_values() {
+        let a = ImageBuf {
+            width: 2,
+            height: 1,
+            channels: 1,
+            data: vec![1.0, 0.0],
+        };
+        let b = ImageBuf {
+            width: 2,
+            height: 1,
+            channels: 1,
+            data: vec![3.0, 0.0],
+        };
+        let (s, _) = compare(&a, &b).unwrap();
+        assert!((s.mae - 1.0).abs() < 1e-6);
+        assert!((s.rmse - 2.0f32.sqrt()).abs() < 1e-6);
+        // Both clamp to 1.0 before quantisation, so ꟻLIP sees identical images.
+        assert_eq!(s.flip, 0.0);
+    }
+
+    #[test]
+    fn larger_difference_gives_larger_flip() {
+        let a = pattern(48, 32);
+        let (small, small_map) = compare(&a, &offset(&a, 0.05)).unwrap();
+        let (large, _) = compare(&a, &offset(&a, 0.3)).unwrap();
+        assert!(small.flip > 0.0, "flip = {}", small.flip);
+        assert!(large.flip > small.flip, "{} <= {}", large.flip, small.flip);
+        assert!(large.flip <= 1.0);
+        assert!(small_map.data.iter().all(|v| (0.0..=1.0).contains(v)));
+    }
+
+    #[test]
+    fn grey_images_are_compared_like_replicated_rgb() {
+        let grey = pattern(20, 20).channel(0);
+        let grey_test = offset(&grey, 0.2);
+        let rgb = |g: &ImageBuf| ImageBuf {
+            width: g.width,
+            height: g.height,
+            channels: 3,
+            data: g.data.iter().flat_map(|&v| [v; 3]).collect(),
+        };
+        let (sg, mg) = compare(&grey, &grey_test).unwrap();
+        let (sc, mc) = compare(&rgb(&grey), &rgb(&grey_test)).unwrap();
+        assert!(sg.flip > 0.0);
+        assert_eq!(sg.flip, sc.flip);
+        assert_eq!(mg, mc);
+    }
+
+    #[test]
+    fn ldr_bytes_rounds_clamps_and_replicates() {
+        let g = ImageBuf {
+            width: 4,
+            height: 1,
+            channels: 1,
+            data: vec![-1.0, 0.5, 2.0, f32::NAN],
+        };
+        assert_eq!(ldr_bytes(&g), vec![0, 0, 0, 128, 128, 128, 255, 255, 255, 0, 0, 0]);
+        let c = ImageBuf {
+            width: 1,
+            height: 1,
+            channels: 3,
+            data: vec![1.0 / 255.0, 0.499 / 255.0, 0.2],
+        };
+        assert_eq!(ldr_bytes(&c), vec![1, 0, 51]);
+    }
+
+    #[test]
+    fn shape_mismatch_is_an_error() {
+        let a = pattern(16, 16);
+        let e = compare(&a, &pattern(16, 8)).unwrap_err().to_string();
+        assert!(e.contains("16x16") && e.contains("16x8"), "{e}");
+        let e = compare(&a.channel(0), &a).unwrap_err().to_string();
+        assert!(e.contains("1 channel") && e.contains("3 channel"), "{e}");
+    }
+
+    #[test]
+    fn unsupported_or_inconsistent_images_are_errors() {
+        let rgba = ImageBuf::new(4, 4, 4);
+        assert!(compare(&rgba, &rgba).unwrap_err().to_string().contains("4 channels"));
+        let empty = ImageBuf::new(0, 4, 3);
+        assert!(compare(&empty, &empty).is_err());
+        let mut short = ImageBuf::new(4, 4, 3);
+        short.data.pop();
+        assert!(compare(&short, &short).unwrap_err().to_string().contains("47 values"));
+    }
+}

@@ -1,0 +1,335 @@
+//! On-disk cache of CPU reference images for `strata eval`: a reference render takes minutes, so it
+//! is stored under a key derived from everything that determines it and reused while that is
+//! unchanged.
+//!
+//! Each entry is `<key>.bin` (magic `STRATAREF1`, then width, height, channels as little-endian
+//! `u32`, then the float data as little-endian `f32`, bit-exact) and `<key>.txt` holding the
+//! description the key was derived from, for humans.
+
+// Until `strata eval` (the only caller) lands; remove then.
+#![allow(dead_code)]
+
+use std::ffi::OsString;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use strata_scene::ImageBuf;
+
+const MAGIC: &[u8; 10] = b"STRATAREF1";
+const HEADER_LEN: usize = MAGIC.len() + 12;
+
+/// A directory of cached reference images.
+#[derive(Clone, Debug)]
+pub struct RefCache {
+    dir: PathBuf,
+}
+
+impl RefCache {
+    /// A cache in `dir` (created when the first entry is stored).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self { dir: dir.into() }
+    }
+
+    /// The cache's directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// `$STRATA_CACHE` if set, else `$XDG_CACHE_HOME/strata/reference`, else
+    /// `$HOME/.cache/strata/reference`, else `./.strata-cache`. Empty variables count as unset.
+    pub fn default_dir() -> PathBuf {
+        default_dir_from(|name| std::env::var_os(name))
+    }
+
+    /// The stable cache key of `description`: its 64-bit FNV-1a hash as 16 lowercase hex digits.
+    ///
+    /// The caller makes the description contain everything that determines the reference image:
+    /// the scene (a hash of the scene file's bytes, or the built-in scene's name), the camera, the
+    /// image size, the frame, every reference setting (kind, spp, bounces, seed, ...) and a format
+    /// version to bump when the renderer's output changes.
+    pub fn key(description: &str) -> String {
+        format!("{:016x}", fnv1a64(description.as_bytes()))
+    }
+
+    /// The cached image for `key`, or `None` when there is none or it cannot be used (a missing
+    /// entry is silent; an unreadable or corrupt one is logged with `tracing::warn!`).
+    pub fn load(&self, key: &str) -> Option<ImageBuf> {
+        if !valid_key(key) {
+            tracing::warn!("reference cache: invalid key {key:?}");
+            return None;
+        }
+        let path = self.bin_path(key);
+        let bytes = match fs::read(&path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return None,
+            Err(e) => {
+                tracing::warn!("reference cache: cannot read {}: {e}", path.display());
+                return None;
+            }
+        };
+        match decode(&bytes) {
+            Ok(img) => Some(img),
+            Err(e) => {
+                tracing::warn!("reference cache: ignoring corrupt {}: {e}", path.display());
+                None
+            }
+        }
+    }
+
+    /// Stores `img` under `key` (atomically: a temporary file renamed into place) with
+    /// `description` beside it; returns the path of the `.bin` file.
+    pub fn store(&self, key: &str, img: &ImageBuf, description: &str) -> Result<PathBuf> {
+        if !valid_key(key) {
+            bail!("reference cache: invalid key {key:?}: use ASCII letters, digits, '-' or '_'");
+        }
+        let expected = img.width as usize * img.height as usize * img.channels as usize;
+        if img.data.len() != expected {
+            bail!(
+                "reference cache: image holds {} values but {}x{} with {} channel(s) needs {expected}",
+                img.data.len(),
+                img.width,
+                img.height,
+                img.channels
+            );
+        }
+        fs::create_dir_all(&self.dir)
+            .with_context(|| format!("{}: cannot create the reference cache directory", self.dir.display()))?;
+
+        let path = self.bin_path(key);
+        let tmp = self.dir.join(format!("{key}.bin.tmp{}", std::process::id()));
+        fs::write(&tmp, encode(img)).with_context(|| format!("{}: cannot write cache entry", tmp.display()))?;
+        if let Err(e) = fs::rename(&tmp, &path) {
+            let _ = fs::remove_file(&tmp);
+            return Err(e).with_context(|| format!("{}: cannot move cache entry into place", path.display()));
+        }
+        let txt = self.dir.join(format!("{key}.txt"));
+        fs::write(&txt, description).with_context(|| format!("{}: cannot write description", txt.display()))?;
+        Ok(path)
+    }
+
+    fn bin_path(&self, key: &str) -> PathBuf {
+        self.dir.join(format!("{key}.bin"))
+    }
+}
+
+/// [`RefCache::default_dir`] with the environment given as a function (testable without touching
+/// the process environment).
+fn default_dir_from(var: impl Fn(&str) -> Option<OsString>) -> PathBuf {
+    let var = |name: &str| var(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    if let Some(dir) = var("STRATA_CACHE") {
+        dir
+    } else if let Some(dir) = var("XDG_CACHE_HOME") {
+        dir.join("strata").join("reference")
+    } else if let Some(home) = var("HOME") {
+        home.join(".cache").join("strata").join("reference")
+    } else {
+        PathBuf::from(".strata-cache")
+    }
+}
+
+/// 64-bit FNV-1a.
+fn fnv1a64(bytes: &[u8]) -> u64 {
+    const OFFSET_BASIS: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    bytes
+        .iter()
+        .fold(OFFSET_BASIS, |h, &b| (h ^ u64::from(b)).wrapping_mul(PRIME))
+}
+
+/// Keys become file names: keep them to a safe alphabet (no separators, no `..`).
+fn valid_key(key: &str) -> bool {
+    !key.is_empty() && key.len() <= 128 && key.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_')
+}
+
+fn encode(img: &ImageBuf) -> Vec<u8> {
+    let mut out = Vec::with_capacity(HEADER_LEN + img.data.len() * 4);
+    out.extend_from_slice(MAGIC);
+    for v in [img.width, img.height, img.channels] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for v in &img.data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+fn decode(bytes: &[u8]) -> std::result::Result<ImageBuf, String> {
+    if bytes.len() < HEADER_LEN {
+        return Err(format!(
+            "{} bytes is shorter than the {HEADER_LEN}-byte header",
+            bytes.len()
+        ));
+    }
+    if &bytes[..MAGIC.len()] != MAGIC {
+        return Err("wrong magic: not a STRATAREF1 file".into());
+    }
+    let u32_at = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    let (width, height, channels) = (u32_at(10), u32_at(14), u32_at(18));
+    if !(1..=4).contains(&channels) {
+        return Err(format!("{channels} channels: expected 1 to 4"));
+    }
+    let payload = &bytes[HEADER_LEN..];
+    let count = (width as usize)
+        .checked_mul(height as usize)
+        .and_then(|n| n.checked_mul(channels as usize))
+        .filter(|n| n.checked_mul(4) == Some(payload.len()))
+        .ok_or_else(|| {
+            format!(
+                "{width}x{height} with {channels} channel(s) does not match the {} data bytes",
+                payload.len()
+            )
+        })?;
+    let data = payload
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect::<Vec<_>>();
+    debug_assert_eq!(data.len(), count);
+    Ok(ImageBuf {
+        width,
+        height,
+        channels,
+        data,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fresh, empty directory under the system temp dir, removed when dropped.
+    struct TempDir(PathBuf);
+
+    impl TempDir {
+        fn new(name: &str) -> Self {
+            let nanos = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos());
+            let dir = std::env::temp_dir().join(format!("strata-ref-cache-{name}-{}-{nanos}", std::process::id()));
+            fs::create_dir_all(&dir).unwrap();
+            Self(dir)
+        }
+    }
+
+    impl Drop for TempDir {
+        fn drop(&mut self) {
+            let _ = fs::remove_dir_all(&self.0);
+        }
+    }
+
+    fn sample() -> ImageBuf {
+        let mut img = ImageBuf::new(5, 3, 3);
+        for (i, v) in img.data.iter_mut().enumerate() {
+            *v = (i as f32 * 0.377).sin() * 10.0;
+        }
+        // Values whose bits a lossy format would not keep.
+        img.data[0] = -0.0;
+        img.data[1] = f32::MIN_POSITIVE / 8.0;
+        img.data[2] = f32::INFINITY;
+        img.data[3] = f32::from_bits(0x7fc0_1234);
+        img
+    }
+
+    #[test]
+    fn round_trip_is_bit_exact() {
+        let tmp = TempDir::new("roundtrip");
+        let cache = RefCache::new(tmp.0.join("nested"));
+        let img = sample();
+        let key = RefCache::key("cornell ao 16spp 5x3");
+        assert!(cache.load(&key).is_none());
+        let path = cache.store(&key, &img, "cornell ao 16spp 5x3").unwrap();
+        assert_eq!(path, tmp.0.join("nested").join(format!("{key}.bin")));
+        assert_eq!(
+            fs::read_to_string(tmp.0.join("nested").join(format!("{key}.txt"))).unwrap(),
+            "cornell ao 16spp 5x3"
+        );
+        let back = cache.load(&key).unwrap();
+        assert_eq!((back.width, back.height, back.channels), (5, 3, 3));
+        let bits = |d: &[f32]| d.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back.data), bits(&img.data));
+        // No temporary file is left behind.
+        let names: Vec<_> = fs::read_dir(tmp.0.join("nested"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names.len(), 2, "{names:?}");
+    }
+
+    #[test]
+    fn truncated_or_corrupt_files_load_as_none() {
+        let tmp = TempDir::new("corrupt");
+        let cache = RefCache::new(&tmp.0);
+        let key = RefCache::key("x");
+        let path = cache.store(&key, &sample(), "x").unwrap();
+        let bytes = fs::read(&path).unwrap();
+        for cut in [0, 5, HEADER_LEN - 1, HEADER_LEN, bytes.len() - 1] {
+            fs::write(&path, &bytes[..cut]).unwrap();
+            assert!(cache.load(&key).is_none(), "truncated to {cut} bytes");
+        }
+        let mut bad_magic = bytes.clone();
+        bad_magic[0] = b'X';
+        fs::write(&path, &bad_magic).unwrap();
+        assert!(cache.load(&key).is_none());
+        let mut huge = bytes.clone();
+        huge[10..14].copy_from_slice(&u32::MAX.to_le_bytes());
+        huge[14..18].copy_from_slice(&u32::MAX.to_le_bytes());
+        fs::write(&path, &huge).unwrap();
+        assert!(cache.load(&key).is_none());
+        fs::write(&path, &bytes).unwrap();
+        assert!(cache.load(&key).is_some());
+    }
+
+    #[test]
+    fn keys_are_stable_fnv1a_and_distinguish_descriptions() {
+        assert_eq!(RefCache::key(""), "cbf29ce484222325");
+        assert_eq!(RefCache::key("a"), "af63dc4c8601ec8c");
+        assert_eq!(RefCache::key("foobar"), "85944171f73967e8");
+        let a = RefCache::key("scene=cornell spp=16 size=64x64 v1");
+        let b = RefCache::key("scene=cornell spp=17 size=64x64 v1");
+        assert_ne!(a, b);
+        assert_eq!(a, RefCache::key("scene=cornell spp=16 size=64x64 v1"));
+        assert_eq!(a.len(), 16);
+    }
+
+    #[test]
+    fn invalid_keys_and_images_are_rejected() {
+        let tmp = TempDir::new("invalid");
+        let cache = RefCache::new(&tmp.0);
+        assert!(cache.store("../escape", &sample(), "").is_err());
+        assert!(cache.store("", &sample(), "").is_err());
+        assert!(cache.load("../escape").is_none());
+        let mut short = sample();
+        short.data.pop();
+        assert!(cache.store("abc", &short, "").is_err());
+    }
+
+    #[test]
+    fn store_error_names_the_path() {
+        let tmp = TempDir::new("blocked");
+        let blocker = tmp.0.join("file");
+        fs::write(&blocker, b"not a directory").unwrap();
+        let cache = RefCache::new(blocker.join("sub"));
+        let e = format!("{:#}", cache.store("abc", &sample(), "").unwrap_err());
+        assert!(e.contains(&blocker.display().to_string()), "{e}");
+    }
+
+    #[test]
+    fn default_dir_precedence() {
+        let env = |vars: &'static [(&'static str, &'static str)]| {
+            move |name: &str| vars.iter().find(|(k, _)| *k == name).map(|(_, v)| OsString::from(v))
+        };
+        assert_eq!(
+            default_dir_from(env(&[("STRATA_CACHE", "/c"), ("XDG_CACHE_HOME", "/x"), ("HOME", "/h")])),
+            PathBuf::from("/c")
+        );
+        assert_eq!(
+            default_dir_from(env(&[("STRATA_CACHE", ""), ("XDG_CACHE_HOME", "/x"), ("HOME", "/h")])),
+            PathBuf::from("/x/strata/reference")
+        );
+        assert_eq!(
+            default_dir_from(env(&[("HOME", "/h")])),
+            PathBuf::from("/h/.cache/strata/reference")
+        );
+        assert_eq!(default_dir_from(env(&[])), PathBuf::from(".strata-cache"));
+    }
+}

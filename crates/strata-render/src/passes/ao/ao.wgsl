@@ -1,0 +1,98 @@
+// DGB §3.1 deep-G-buffer ambient visibility, Eq. 1–2, sampled with §3.4's
+// spiral (taps shared by all layers, per-tap MIP level).
+#import "common/fullscreen.wgsl"
+#import "common/frame.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
+#import "common/spiral.wgsl"
+
+override LAYERS: u32 = 2u;
+
+// Matches `ao::AoUniforms`.
+struct Ao {
+    // r (world units), β, ε, intensity
+    radius: f32,
+    bias: f32,
+    epsilon: f32,
+    intensity: f32,
+    // pixels spanned by 1 world unit at depth 1; q; τ
+    proj_scale: f32,
+    q: f32,
+    tau: f32,
+    // 1 = rotate the spiral per pixel (φ from the hash), 0 = φ = 0
+    rotate: u32,
+    samples: u32,
+    max_mip: u32,
+    seed: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> ao: Ao;
+@group(1) @binding(1) var zmip: texture_2d<f32>;
+@group(1) @binding(2) var npack: texture_2d<f32>;
+
+// The level-0 pixel that level-m texel t copies (depth_mip.wgsl's rotated
+// grid applied m times), so each tap is reconstructed where its depth was seen.
+fn mip_source_pixel(t: vec2i, m: u32) -> vec2i {
+    var c = t;
+    for (var l = m; l > 0u; l--) {
+        let last = vec2i(textureDimensions(zmip, l - 1u)) - 1;
+        c = min(c * 2 + vec2i((c.y & 1) ^ 1, (c.x & 1) ^ 1), last);
+    }
+    return c;
+}
+
+// Eq. 2: obscurance at X (normal n) due to a surface point at v = Y − X.
+fn obscurance(v: vec3f, n: vec3f) -> f32 {
+    let vv = dot(v, v);
+    let r2 = ao.radius * ao.radius;
+    if (!(vv < r2)) {
+        return 0.0;
+    }
+    return (1.0 - vv / r2) * max((dot(v, n) - ao.bias) / sqrt(vv + ao.epsilon), 0.0);
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let p = vec2i(pos.xy);
+    let z = textureLoad(zmip, p, 0).r;
+    if (z <= 0.0) {
+        // no surface: unoccluded
+        return vec4f(1.0);
+    }
+    let x = world_from_csz(frame, vec2f(p) + 0.5, z);
+    let n = oct_decode(textureLoad(npack, p, 0).rg);
+    // screen-space radius r_p of the world-space radius r at depth z
+    let r_p = ao.proj_scale * ao.radius / z;
+    var phi = 0.0;
+    if (ao.rotate != 0u) {
+        phi = pixel_angle(vec2u(p), ao.seed);
+    }
+    let size = vec2i(textureDimensions(zmip, 0));
+    var sum = 0.0;
+    for (var i = 0u; i < ao.samples; i++) {
+        let tap = spiral_tap(i, ao.samples, ao.tau, r_p, phi);
+        let q = p + tap_texel(tap.offset);
+        if (any(q < vec2i(0)) || any(q >= size)) {
+            // outside the (guard-banded) buffer: no occluder known
+            continue;
+        }
+        let m = spiral_mip(tap.radius, ao.q, ao.max_mip);
+        let t = q >> vec2u(m);
+        let zs = textureLoad(zmip, t, i32(m));
+        // the full-resolution pixel whose depth the MIP texel holds
+        let src = mip_source_pixel(t, m);
+        // Eq. 1: max over layers j of A_i^j = O(X, R(Z[j], i))
+        var a = 0.0;
+        for (var j = 0u; j < LAYERS; j++) {
+            if (zs[j] > 0.0) {
+                let y = world_from_csz(frame, vec2f(src) + 0.5, zs[j]);
+                a = max(a, obscurance(y - x, n));
+            }
+        }
+        sum += a;
+    }
+    let av = max(0.0, 1.0 - sqrt(ao.intensity * 3.14159265358979 / f32(ao.samples) * sum));
+    return vec4f(av);
+}

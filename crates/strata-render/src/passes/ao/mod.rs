@@ -1,0 +1,318 @@
+//! DGB §3.1 deep-G-buffer ambient occlusion: Eq. 1–2 over k layers with §3.4's
+//! spiral QMC taps on the `zmip` chain. Output `ao-raw`: ambient visibility
+//! AV ∈ [0, 1] (1 = unoccluded) before temporal and bilateral reconstruction.
+
+use glam::Vec3;
+use strata_scene::{ImageBuf, Scene};
+
+use crate::frame::{FrameUniforms, Pass, PassInfo, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::passes::bilateral::BilateralSettings;
+use crate::passes::depth_mip::DepthMipSettings;
+use crate::passes::temporal::TemporalSettings;
+use crate::scene_gpu::GpuScene;
+use crate::spiral::{self, SpiralTurns};
+
+/// Largest accepted sample count N.
+pub const MAX_SAMPLES: u32 = 256;
+
+/// AO settings. Defaults: N = 19 taps (SAO's and the DGB demo's default; the
+/// paper does not state its AO N), τ from Listing 3, φ from a per-pixel hash, the
+/// scene's radius r, β = 0.01·r and ε = 0.01·r² (those of the CPU reference),
+/// intensity 1 (Eq. 1 exactly), q = 8 px (SAO's first MIP step), 5 MIP levels,
+/// temporal α = 0.85 (§3.3), 4-tap-radius bilateral with step 2 (SAO).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AoSettings {
+    /// World-space radius r; `None` = the scene's `ao_radius`.
+    pub radius: Option<f32>,
+    /// Bias β (world units); `None` = 0.01·r.
+    pub bias: Option<f32>,
+    /// ε (world units²); `None` = 0.01·r².
+    pub epsilon: Option<f32>,
+    /// Multiplies the sum in Eq. 1 (1 = the equation as written).
+    pub intensity: f32,
+    /// Samples N per pixel.
+    pub samples: u32,
+    /// τ: Listing 3 or fixed.
+    pub turns: SpiralTurns,
+    /// Rotate each pixel's spiral by φ = hash(x, y) (false: φ = 0, Fig. 7 left).
+    pub rotate: bool,
+    /// Also hash the frame index into φ, so the temporal filter averages
+    /// different patterns (off by default: the paper's φ depends on (x, y) only).
+    pub temporal_noise: bool,
+    /// q: the tap radius in pixels at which the MIP level first increments.
+    pub q: f32,
+    pub mips: DepthMipSettings,
+    pub blur: BilateralSettings,
+    /// `None` disables the temporal filter.
+    pub temporal: Option<TemporalSettings>,
+}
+
+impl Default for AoSettings {
+    fn default() -> Self {
+        Self {
+            radius: None,
+            bias: None,
+            epsilon: None,
+            intensity: 1.0,
+            samples: 19,
+            turns: SpiralTurns::Optimal,
+            rotate: true,
+            temporal_noise: false,
+            q: 8.0,
+            mips: DepthMipSettings::default(),
+            blur: BilateralSettings::default(),
+            temporal: Some(TemporalSettings::default()),
+        }
+    }
+}
+
+impl AoSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = |name: &str, v: Option<f32>| match v {
+            Some(x) if !(x > 0.0 && x.is_finite()) => Err(format!("{name} {x} is out of range: must be > 0")),
+            _ => Ok(()),
+        };
+        positive("AO radius", self.radius)?;
+        positive("AO epsilon", self.epsilon)?;
+        if let Some(b) = self.bias {
+            if !(b >= 0.0 && b.is_finite()) {
+                return Err(format!("AO bias {b} is out of range: must be >= 0"));
+            }
+        }
+        if !(self.intensity >= 0.0 && self.intensity.is_finite()) {
+            return Err(format!("AO intensity {} is out of range: must be >= 0", self.intensity));
+        }
+        if !(1..=MAX_SAMPLES).contains(&self.samples) {
+            return Err(format!(
+                "AO samples {} is out of range: must be in 1..={MAX_SAMPLES}",
+                self.samples
+            ));
+        }
+        if let SpiralTurns::Fixed(t) = self.turns {
+            if !(t > 0.0 && t.is_finite()) {
+                return Err(format!("spiral turns {t} is out of range: must be > 0"));
+            }
+        }
+        if !(self.q >= 1.0 && self.q.is_finite()) {
+            return Err(format!("MIP radius q {} is out of range: must be >= 1 pixel", self.q));
+        }
+        self.mips.validate()?;
+        self.blur.validate()?;
+        if let Some(t) = &self.temporal {
+            t.validate()?;
+        }
+        Ok(())
+    }
+
+    /// r, β, ε for `scene`.
+    pub fn resolve(&self, scene: &Scene) -> (f32, f32, f32) {
+        let r = self.radius.unwrap_or(scene.settings.ao_radius);
+        (r, self.bias.unwrap_or(0.01 * r), self.epsilon.unwrap_or(0.01 * r * r))
+    }
+}
+
+/// Mirrors `Ao` in `ao.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct AoUniforms {
+    pub radius: f32,
+    pub bias: f32,
+    pub epsilon: f32,
+    pub intensity: f32,
+    pub proj_scale: f32,
+    pub q: f32,
+    pub tau: f32,
+    pub rotate: u32,
+    pub samples: u32,
+    pub max_mip: u32,
+    pub seed: u32,
+    pub _pad: u32,
+}
+
+impl AoUniforms {
+    /// The uniforms of one frame: `frame` is the (guard-banded) frame's uniforms.
+    pub fn new(s: &AoSettings, scene: &Scene, frame: &FrameUniforms, max_mip: u32, frame_index: u32) -> Self {
+        let (radius, bias, epsilon) = s.resolve(scene);
+        Self {
+            radius,
+            bias,
+            epsilon,
+            intensity: s.intensity,
+            proj_scale: proj_scale(frame),
+            q: s.q,
+            tau: s.turns.tau(s.samples),
+            rotate: s.rotate as u32,
+            samples: s.samples,
+            max_mip,
+            seed: if s.temporal_noise { frame_index } else { 0 },
+            _pad: 0,
+        }
+    }
+}
+
+/// Pixels spanned by an object of height 1 at camera-space depth 1 (the
+/// demo's `projScale`): image height / (2 tan(fov_y / 2)).
+pub fn proj_scale(frame: &FrameUniforms) -> f32 {
+    let up = Vec3::from_slice(&frame.cam_up[..3]).length();
+    frame.size[1] / (2.0 * up)
+}
+
+pub const OUTPUT: TargetDesc = TargetDesc::new(
+    "ao-raw",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "DGB Eq. 1 ambient visibility before reconstruction (1 = unoccluded)",
+);
+
+pub struct AoPass {
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    uniforms: wgpu::Buffer,
+    last: std::cell::Cell<AoUniforms>,
+}
+
+impl AoPass {
+    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32) -> Self {
+        use crate::passes::{texture_entry, uniform_entry};
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ao"),
+            entries: &[
+                uniform_entry(0),
+                texture_entry(1, wgpu::TextureViewDimension::D2, false),
+                texture_entry(2, wgpu::TextureViewDimension::D2, false),
+            ],
+        });
+        let zeroed = AoUniforms::zeroed();
+        let uniforms = crate::passes::uniform_buffer(device, "ao", &zeroed);
+        let group = crate::passes::bind_group(
+            device,
+            "ao",
+            &layout,
+            &[
+                uniforms.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&targets.get("zmip").view),
+                wgpu::BindingResource::TextureView(&targets.get("npack").view),
+            ],
+        );
+        let pl = crate::passes::frame_pipeline_layout(device, "ao", scene, &[&layout]);
+        let module = crate::shader::module(device, "ao", include_str!("ao.wgsl"));
+        let pipeline = crate::passes::fullscreen_pipeline_with(
+            device,
+            "ao",
+            &pl,
+            &module,
+            "fs_main",
+            &[("LAYERS", layers as f64)],
+            &[Some(wgpu::ColorTargetState::from(OUTPUT.format))],
+        );
+        Self {
+            pipeline,
+            group,
+            uniforms,
+            last: std::cell::Cell::new(zeroed),
+        }
+    }
+
+    pub fn set_frame(&self, gpu: &GpuContext, u: AoUniforms) {
+        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.last.set(u);
+    }
+
+    /// The uniforms of the last frame (for CPU re-evaluation).
+    pub fn uniforms(&self) -> AoUniforms {
+        self.last.get()
+    }
+}
+
+use bytemuck::Zeroable;
+
+impl Pass for AoPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: "ao",
+            inputs: vec!["zmip", "npack"],
+            outputs: vec![OUTPUT.name],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        crate::passes::fullscreen_pass(
+            encoder,
+            "ao",
+            &self.pipeline,
+            &[&targets.get(OUTPUT.name).view],
+            &[&scene.frame_bind_group, &self.group],
+        );
+    }
+}
+
+/// CPU evaluation of exactly what `ao.wgsl` computes at pixel (x, y), from
+/// read-back buffers: `zmip[m]` is MIP level m (channel j = layer j), `normals`
+/// the decoded layer-0 world normals (3 channels). Eq. 1–2 with the same
+/// spiral taps, texel rounding and MIP levels.
+pub fn ambient_visibility_cpu(
+    zmip: &[ImageBuf],
+    normals: &ImageBuf,
+    frame: &FrameUniforms,
+    u: &AoUniforms,
+    layers: u32,
+    x: u32,
+    y: u32,
+) -> f32 {
+    let z = zmip[0].pixel(x, y)[0];
+    if z <= 0.0 {
+        return 1.0;
+    }
+    let px = normals.pixel(x, y);
+    let n = Vec3::new(px[0], px[1], px[2]);
+    let pos = world_from_csz(frame, [x as f32 + 0.5, y as f32 + 0.5], z);
+    let r_p = u.proj_scale * u.radius / z;
+    let phi = if u.rotate != 0 {
+        spiral::pixel_angle(x, y, u.seed)
+    } else {
+        0.0
+    };
+    let (w, h) = (zmip[0].width as i32, zmip[0].height as i32);
+    let mut sum = 0.0f32;
+    for i in 0..u.samples {
+        let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
+        let d = spiral::tap_texel(tap.offset);
+        let (qx, qy) = (x as i32 + d[0], y as i32 + d[1]);
+        if qx < 0 || qy < 0 || qx >= w || qy >= h {
+            continue;
+        }
+        let m = spiral::mip_level(tap.radius, u.q, u.max_mip);
+        let (tx, ty) = ((qx >> m) as u32, (qy >> m) as u32);
+        let zs = zmip[m as usize].pixel(tx, ty);
+        let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
+        let mut a = 0.0f32;
+        for &zj in zs.iter().take(layers as usize) {
+            if zj > 0.0 {
+                let yv = world_from_csz(frame, [sx as f32 + 0.5, sy as f32 + 0.5], zj);
+                a = a.max(obscurance(u, yv - pos, n));
+            }
+        }
+        sum += a;
+    }
+    (1.0 - (u.intensity * std::f32::consts::PI / u.samples as f32 * sum).sqrt()).max(0.0)
+}
+
+/// DGB Eq. 2.
+pub fn obscurance(u: &AoUniforms, v: Vec3, n: Vec3) -> f32 {
+    let vv = v.dot(v);
+    let r2 = u.radius * u.radius;
+    if !(vv < r2) {
+        return 0.0;
+    }
+    (1.0 - vv / r2) * ((v.dot(n) - u.bias) / (vv + u.epsilon).sqrt()).max(0.0)
+}
+
+/// `camera.wgsl`'s `world_from_csz` on the CPU.
+pub fn world_from_csz(f: &FrameUniforms, pix: [f32; 2], z: f32) -> Vec3 {
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let ndc = [pix[0] * f.size[2] * 2.0 - 1.0, 1.0 - pix[1] * f.size[3] * 2.0];
+    let dir = v(f.cam_forward) + v(f.cam_right) * ndc[0] + v(f.cam_up) * ndc[1];
+    v(f.eye) + dir * z
+}

@@ -1,0 +1,69 @@
+// Separable bilateral reconstruction (DGB §3.1: "normal and plane weights"):
+// each tap's weight = spatial Gaussian × plane weight (distance of the tap's
+// surface from X's tangent plane, relative to X's depth) × normal weight.
+#import "common/fullscreen.wgsl"
+#import "common/frame.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
+
+// 0 = horizontal, 1 = vertical
+override DIRECTION: u32 = 0u;
+
+// Matches `bilateral::BilateralUniforms`.
+struct Bilateral {
+    radius: i32,
+    step: i32,
+    // Gaussian: exp(-k² / (2σ²)) with k in taps
+    inv_two_sigma2: f32,
+    plane_sharpness: f32,
+    normal_power: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> blur: Bilateral;
+@group(1) @binding(1) var src: texture_2d<f32>;
+@group(1) @binding(2) var zpack: texture_2d<f32>;
+@group(1) @binding(3) var npack: texture_2d<f32>;
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let p = vec2i(pos.xy);
+    let centre = textureLoad(src, p, 0);
+    let z = textureLoad(zpack, p, 0).r;
+    if (z <= 0.0 || blur.radius == 0) {
+        return centre;
+    }
+    let x = world_from_csz(frame, vec2f(p) + 0.5, z);
+    let n = oct_decode(textureLoad(npack, p, 0).rg);
+    let size = vec2i(textureDimensions(src));
+    var axis = vec2i(1, 0);
+    if (DIRECTION == 1u) {
+        axis = vec2i(0, 1);
+    }
+    var sum = centre;
+    var weight = 1.0;
+    for (var k = -blur.radius; k <= blur.radius; k++) {
+        if (k == 0) {
+            continue;
+        }
+        let q = p + axis * (k * blur.step);
+        if (any(q < vec2i(0)) || any(q >= size)) {
+            continue;
+        }
+        let zq = textureLoad(zpack, q, 0).r;
+        if (zq <= 0.0) {
+            continue;
+        }
+        let y = world_from_csz(frame, vec2f(q) + 0.5, zq);
+        let nq = oct_decode(textureLoad(npack, q, 0).rg);
+        let plane = max(0.0, 1.0 - blur.plane_sharpness * abs(dot(n, y - x)) / z);
+        let normal = pow(max(0.0, dot(n, nq)), blur.normal_power);
+        let w = exp(-f32(k * k) * blur.inv_two_sigma2) * plane * normal;
+        sum += w * textureLoad(src, q, 0);
+        weight += w;
+    }
+    return sum / weight;
+}

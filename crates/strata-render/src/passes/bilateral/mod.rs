@@ -1,0 +1,172 @@
+//! Separable bilateral reconstruction with normal and plane weights (DGB §3.1,
+//! [SGNS07]), reusable by every noisy screen-space estimate: a horizontal and a
+//! vertical [`BilateralPass`].
+
+use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::scene_gpu::GpuScene;
+
+/// Defaults: radius 4 taps with step 2 pixels (SAO's AO blur: 9 taps spanning
+/// ±8 px per direction), Gaussian σ = 0.75·radius taps (SAO's radius-4 kernel has
+/// σ ≈ 3), plane weight max(0, 1 − 100·d/z) (zero once the tap's surface is 1 % of
+/// X's depth off X's tangent plane), normal weight (n_X·n_Y)^8.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BilateralSettings {
+    /// Taps on each side (0 disables the filter).
+    pub radius: u32,
+    /// Pixels between taps.
+    pub step: u32,
+    pub plane_sharpness: f32,
+    pub normal_power: f32,
+}
+
+impl Default for BilateralSettings {
+    fn default() -> Self {
+        Self {
+            radius: 4,
+            step: 2,
+            plane_sharpness: 100.0,
+            normal_power: 8.0,
+        }
+    }
+}
+
+impl BilateralSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if self.radius > 32 {
+            return Err(format!(
+                "blur radius {} is out of range: must be in 0..=32",
+                self.radius
+            ));
+        }
+        if !(1..=8).contains(&self.step) {
+            return Err(format!("blur step {} is out of range: must be in 1..=8", self.step));
+        }
+        if !(self.plane_sharpness >= 0.0 && self.normal_power >= 0.0) {
+            return Err("blur plane sharpness and normal power must be >= 0".into());
+        }
+        Ok(())
+    }
+
+    /// Total taps per direction (the paper's "reconstruction filter taps").
+    pub fn taps(&self) -> u32 {
+        2 * self.radius + 1
+    }
+}
+
+/// Mirrors `Bilateral` in `bilateral.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BilateralUniforms {
+    radius: i32,
+    step: i32,
+    inv_two_sigma2: f32,
+    plane_sharpness: f32,
+    normal_power: f32,
+    _pad: [f32; 3],
+}
+
+impl BilateralUniforms {
+    pub fn new(s: &BilateralSettings) -> Self {
+        let sigma = (0.75 * s.radius as f32).max(0.5);
+        Self {
+            radius: s.radius as i32,
+            step: s.step as i32,
+            inv_two_sigma2: 1.0 / (2.0 * sigma * sigma),
+            plane_sharpness: s.plane_sharpness,
+            normal_power: s.normal_power,
+            _pad: [0.0; 3],
+        }
+    }
+}
+
+/// One direction of the separable filter, from target `input` into `output`.
+pub struct BilateralPass {
+    name: &'static str,
+    input: &'static str,
+    output: &'static str,
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+}
+
+impl BilateralPass {
+    /// `vertical` picks the direction; `output` must already exist in `targets`.
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        settings: &BilateralSettings,
+        name: &'static str,
+        input: &'static str,
+        output: &'static str,
+        vertical: bool,
+    ) -> Self {
+        use crate::passes::{texture_entry, uniform_entry};
+        let device = &gpu.device;
+        let d2 = wgpu::TextureViewDimension::D2;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(name),
+            entries: &[
+                uniform_entry(0),
+                texture_entry(1, d2, false),
+                texture_entry(2, d2, false),
+                texture_entry(3, d2, false),
+            ],
+        });
+        let uniforms = crate::passes::uniform_buffer(device, name, &BilateralUniforms::new(settings));
+        let group = crate::passes::bind_group(
+            device,
+            name,
+            &layout,
+            &[
+                uniforms.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&targets.get(input).view),
+                wgpu::BindingResource::TextureView(&targets.get("zpack").view),
+                wgpu::BindingResource::TextureView(&targets.get("npack").view),
+            ],
+        );
+        let pl = crate::passes::frame_pipeline_layout(device, name, scene, &[&layout]);
+        let module = crate::shader::module(device, "bilateral", include_str!("bilateral.wgsl"));
+        let pipeline = crate::passes::fullscreen_pipeline_with(
+            device,
+            name,
+            &pl,
+            &module,
+            "fs_main",
+            &[("DIRECTION", vertical as u32 as f64)],
+            &[Some(wgpu::ColorTargetState::from(targets.get(output).desc.format))],
+        );
+        Self {
+            name,
+            input,
+            output,
+            pipeline,
+            group,
+        }
+    }
+
+    /// An intermediate or output target of the filter, shaped like `like`.
+    pub fn target(name: &'static str, like: &TargetDesc, doc: &'static str) -> TargetDesc {
+        TargetDesc::new(name, like.format, 1, doc)
+    }
+}
+
+impl Pass for BilateralPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: self.name,
+            inputs: vec![self.input, "zpack", "npack"],
+            outputs: vec![self.output],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        crate::passes::fullscreen_pass(
+            encoder,
+            self.name,
+            &self.pipeline,
+            &[&targets.get(self.output).view],
+            &[&scene.frame_bind_group, &self.group],
+        );
+    }
+}

@@ -1,0 +1,48 @@
+// DGB §3.4 quasi-Monte Carlo spiral sampling and pixel hashing; mirrored on the
+// CPU by `strata_render::spiral` (same integer hash, same formulas). τ comes from
+// the pass's uniforms (Listing 3 is applied on the CPU).
+
+const SPIRAL_TWO_PI: f32 = 6.28318530717958647;
+
+// PCG hash (Jarzynski & Olano 2020).
+fn pcg_hash(v: u32) -> u32 {
+    let s = v * 747796405u + 2891336453u;
+    let w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    return (w >> 22u) ^ w;
+}
+
+// Per-pixel rotation φ in [0, 2π) from a hash of the pixel and `seed`
+// (0 = fixed pattern; the frame index for temporally varying noise).
+fn pixel_angle(p: vec2u, seed: u32) -> f32 {
+    let h = pcg_hash(p.x + pcg_hash(p.y + pcg_hash(seed)));
+    return f32(h >> 8u) * (1.0 / 16777216.0) * SPIRAL_TWO_PI;
+}
+
+struct SpiralTap {
+    // screen offset in pixels
+    offset: vec2f,
+    // h_i = r_p κ_i
+    radius: f32,
+}
+
+// The i-th of n taps: κ_i = (i + 0.5)/n, h_i = r_p κ_i, θ_i = 2π κ_i τ + φ.
+fn spiral_tap(i: u32, n: u32, tau: f32, r_p: f32, phi: f32) -> SpiralTap {
+    let kappa = (f32(i) + 0.5) / f32(n);
+    let h = r_p * kappa;
+    let theta = SPIRAL_TWO_PI * kappa * tau + phi;
+    return SpiralTap(vec2f(h * cos(theta), h * sin(theta)), h);
+}
+
+// m_i = ⌊log2(h_i / q)⌋ clamped to [0, max_level].
+fn spiral_mip(h: f32, q: f32, max_level: u32) -> u32 {
+    let m = floor(log2(h / q));
+    if (!(m >= 0.0)) {
+        return 0u;
+    }
+    return min(u32(m), max_level);
+}
+
+// Integer texel offset of a tap: ⌊offset + ½⌋ per axis.
+fn tap_texel(offset: vec2f) -> vec2i {
+    return vec2i(floor(offset + vec2f(0.5)));
+}
