@@ -4,15 +4,20 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::Vec3;
+use strata_render::passes::ao::AoSettings;
+use strata_render::passes::bilateral::BilateralSettings;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
+use strata_render::passes::depth_mip::DepthMipSettings;
+use strata_render::passes::temporal::TemporalSettings;
 use strata_render::renderer::GuardBand;
+use strata_render::spiral::SpiralTurns;
 
 #[derive(Parser)]
 #[command(
     name = "strata",
     version,
     about = "Layered screen-space global illumination (deep G-buffers and friends), measured against a CPU ray-traced reference",
-    after_help = "Scenes: a built-in name (cornell, atrium, warehouse, plane, column-wall) or a path to a .gltf, .glb, .obj or .toml file.\nExamples:\n  strata info\n  strata render --scene atrium --width 640 --height 360 --out atrium.png\n  strata reference --scene cornell --kind ao --spp 16 --width 64 --height 64 --out ao.exr\n  strata render --scene atrium --layers 2 --variant reproject --debug-view layer1-albedo --out l1.png\n  strata bench gbuffer --scene atrium --width 640 --height 360 --frames 5 --json\n  strata bench deep-gbuffer --scene atrium --width 640 --height 360 --frames 8 --json"
+    after_help = "Scenes: a built-in name (cornell, atrium, warehouse, plane, column-wall, dense) or a path to a .gltf, .glb, .obj or .toml file.\nExamples:\n  strata info\n  strata render --scene atrium --width 640 --height 360 --out atrium.png\n  strata reference --scene cornell --kind ao --spp 16 --width 64 --height 64 --out ao.exr\n  strata render --scene atrium --layers 2 --variant reproject --debug-view layer1-albedo --out l1.png\n  strata bench gbuffer --scene atrium --width 640 --height 360 --frames 5 --json\n  strata bench deep-gbuffer --scene atrium --width 640 --height 360 --frames 8 --json\n  strata render --scene atrium --technique ao --layers 2 --out ao.png\n  strata eval --scene atrium --technique ao --layers 2 --json --report report/\n  strata bench ao --scene atrium --width 640 --height 360 --layers 2 --frames 5 --json"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -29,6 +34,8 @@ pub enum Command {
     Reference(ReferenceArgs),
     /// GPU timestamp benchmarks (per-pass milliseconds).
     Bench(BenchArgs),
+    /// Compare a GPU technique with the CPU ground truth for the same camera (FLIP, RMSE, MAE; JSON; HTML report).
+    Eval(EvalArgs),
 }
 
 #[derive(Args, Clone)]
@@ -117,6 +124,139 @@ fn parse_guard_band(s: &str) -> Result<GuardBand, String> {
 pub enum Technique {
     /// Direct light (sun/point/spot/area, shadows) + emission + ambient.
     Direct,
+    /// Deep-G-buffer ambient visibility AV in [0, 1] (DGB §3.1; 1 = unoccluded): PNG grey (byte = 255·AV), EXR linear.
+    Ao,
+}
+
+/// Deep-G-buffer AO settings (DGB §3.1, §3.3, §3.4).
+#[derive(Args, Clone)]
+pub struct AoArgs {
+    /// AO world-space radius r, > 0 (default: the scene's).
+    #[arg(long)]
+    pub ao_radius: Option<f32>,
+    /// AO samples N per pixel, 1..=256 (spiral turns τ from DGB Listing 3 for N <= 98).
+    #[arg(long, default_value_t = 19)]
+    pub samples: u32,
+    /// Bias β in scene units, >= 0 (default: 0.01·r).
+    #[arg(long)]
+    pub ao_bias: Option<f32>,
+    /// Multiplies the sum in DGB Eq. 1, >= 0 (1 = the equation as written).
+    #[arg(long, default_value_t = 1.0)]
+    pub ao_intensity: f32,
+    /// Spiral turns: "optimal" (DGB Listing 3) or a fixed number (SAO used 7; DGB Fig. 7 left).
+    #[arg(long, default_value = "optimal", value_parser = parse_turns)]
+    pub spiral_turns: SpiralTurns,
+    /// Do not rotate each pixel's spiral (φ = 0; DGB Fig. 7 left).
+    #[arg(long)]
+    pub no_rotate: bool,
+    /// Hash the frame index into the spiral rotation (temporal accumulation of different patterns).
+    #[arg(long)]
+    pub temporal_noise: bool,
+    /// Temporal filter weight α in [0, 1) of the reprojected history (DGB §3.3; 0 disables the filter).
+    #[arg(long, default_value_t = 0.85)]
+    pub alpha: f32,
+    /// Temporal filter: reprojection accepted within this camera-space distance of either layer, > 0 (scene units; paper: 1 cm).
+    #[arg(long, default_value_t = 0.01)]
+    pub temporal_distance: f32,
+    /// Bilateral filter taps on each side, 0..=32 (0 = no spatial reconstruction).
+    #[arg(long, default_value_t = 4)]
+    pub blur_radius: u32,
+    /// Pixels between bilateral taps, 1..=8.
+    #[arg(long, default_value_t = 2)]
+    pub blur_step: u32,
+    /// Depth MIP levels, 1..=12.
+    #[arg(long, default_value_t = 5)]
+    pub mip_levels: u32,
+    /// Tap radius q in pixels at which the MIP level first increments, >= 1 (m = floor(log2(h/q))).
+    #[arg(long, default_value_t = 8.0)]
+    pub mip_q: f32,
+}
+
+impl AoArgs {
+    pub fn settings(&self) -> AoSettings {
+        let d = AoSettings::default();
+        AoSettings {
+            radius: self.ao_radius,
+            bias: self.ao_bias,
+            intensity: self.ao_intensity,
+            samples: self.samples,
+            turns: self.spiral_turns,
+            rotate: !self.no_rotate,
+            temporal_noise: self.temporal_noise,
+            q: self.mip_q,
+            mips: DepthMipSettings {
+                levels: self.mip_levels,
+            },
+            blur: BilateralSettings {
+                radius: self.blur_radius,
+                step: self.blur_step,
+                ..d.blur
+            },
+            temporal: (self.alpha != 0.0).then_some(TemporalSettings {
+                alpha: self.alpha,
+                max_distance: self.temporal_distance,
+            }),
+            ..d
+        }
+    }
+}
+
+fn parse_turns(s: &str) -> Result<SpiralTurns, String> {
+    if s.eq_ignore_ascii_case("optimal") {
+        return Ok(SpiralTurns::Optimal);
+    }
+    match s.parse::<f32>() {
+        Ok(t) if t > 0.0 && t.is_finite() => Ok(SpiralTurns::Fixed(t)),
+        _ => Err(format!(
+            "'{s}' is not a spiral turn count: use \"optimal\" or a number > 0"
+        )),
+    }
+}
+
+/// What `strata eval` compares.
+#[derive(Copy, Clone, PartialEq, Eq, ValueEnum, Debug)]
+pub enum EvalTechnique {
+    /// Deep-G-buffer AO against the ray-traced obscurance (same Eq. 2, same r, β, ε; all layers) and binary AO.
+    Ao,
+}
+
+#[derive(Args)]
+pub struct EvalArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// What to evaluate.
+    #[arg(long, value_enum, default_value_t = EvalTechnique::Ao)]
+    pub technique: EvalTechnique,
+    #[command(flatten)]
+    pub deep: DeepArgs,
+    #[command(flatten)]
+    pub ao: AoArgs,
+    /// Samples per pixel of the CPU reference, 1..=65536.
+    #[arg(long, default_value_t = 256)]
+    pub ref_spp: u32,
+    /// Folder of cached reference images (default: $STRATA_CACHE, else $XDG_CACHE_HOME/strata/reference, else ~/.cache/strata/reference).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Recompute the reference even when cached.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Also measure temporal instability over this many frames along the camera path, 2..=1000 ("flicker" in the output).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Write an HTML report with images (GPU, reference, FLIP maps, 1 layer vs k layers) into this folder.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Overwrite an existing report.
+    #[arg(long)]
+    pub force: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Hide progress bars.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 #[derive(Args)]
@@ -130,6 +270,8 @@ pub struct RenderArgs {
     pub technique: Technique,
     #[command(flatten)]
     pub deep: DeepArgs,
+    #[command(flatten)]
+    pub ao: AoArgs,
     /// Write an intermediate target instead of the final image (e.g. csz, normal, albedo, emission, direct-diffuse, shadow, hdr). `--list-passes` shows them.
     #[arg(long)]
     pub debug_view: Option<String>,
@@ -215,6 +357,31 @@ pub enum BenchWhat {
     DeepGbuffer(BenchDeepArgs),
     /// CPU reference throughput (million rays per second).
     Reference(BenchReferenceArgs),
+    /// Deep-G-buffer AO passes (DGB Table 4, AO column): per-pass GPU ms and the
+    /// 1st layer + 2nd layer increment split.
+    Ao(BenchAoArgs),
+}
+
+#[derive(Args)]
+pub struct BenchAoArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// Frames along the camera path to time (after one warm-up frame), 1..=10000.
+    #[arg(long, default_value_t = 5)]
+    pub frames: u32,
+    /// Deep G-buffer layers k, 1..=4 (compared with k = 1 for the increment).
+    #[arg(long, default_value_t = 2)]
+    pub layers: u32,
+    /// Deep G-buffer construction variant.
+    #[arg(long, default_value = "reproject", value_parser = parse_variant)]
+    pub variant: Variant,
+    #[command(flatten)]
+    pub ao: AoArgs,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args)]

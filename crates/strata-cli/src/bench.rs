@@ -12,6 +12,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         BenchWhat::Gbuffer(b) => gbuffer(b),
         BenchWhat::DeepGbuffer(b) => crate::bench_deep::run(b),
         BenchWhat::Reference(b) => crate::reference::bench(b),
+        BenchWhat::Ao(b) => crate::bench_ao::run(b),
     }
 }
 

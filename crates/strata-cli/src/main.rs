@@ -2,7 +2,9 @@
 
 mod args;
 mod bench;
+mod bench_ao;
 mod bench_deep;
+mod eval;
 mod info;
 mod metrics;
 mod output;
@@ -24,6 +26,7 @@ fn main() {
         args::Command::Render(a) => render::run(&a),
         args::Command::Reference(a) => reference::run(&a),
         args::Command::Bench(a) => bench::run(&a),
+        args::Command::Eval(a) => eval::run(&a),
     };
     if let Err(e) = result {
         // One line: what is wrong and what is valid.

@@ -4,9 +4,6 @@
 //! Both images are *display values* in [0, 1]: the caller decides the encoding (exposure, tonemap,
 //! sRGB or not) before calling [`compare`]; nothing here applies a transfer function.
 
-// Until `strata eval` (the only caller) lands; remove then.
-#![allow(dead_code)]
-
 use anyhow::{bail, Result};
 use serde::Serialize;
 use strata_scene::ImageBuf;

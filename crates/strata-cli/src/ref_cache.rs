@@ -6,9 +6,6 @@
 //! `u32`, then the float data as little-endian `f32`, bit-exact) and `<key>.txt` holding the
 //! description the key was derived from, for humans.
 
-// Until `strata eval` (the only caller) lands; remove then.
-#![allow(dead_code)]
-
 use std::ffi::OsString;
 use std::fs;
 use std::path::{Path, PathBuf};

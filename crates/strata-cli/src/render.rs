@@ -3,7 +3,7 @@
 use anyhow::Result;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 
-use crate::args::RenderArgs;
+use crate::args::{RenderArgs, Technique};
 use crate::output::{cameras_at, check_output, save, scene_and_camera};
 
 pub fn run(a: &RenderArgs) -> Result<()> {
@@ -17,6 +17,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             resolution: a.shadow_resolution,
         },
         exposure: a.exposure,
+        // AO alone needs no lighting passes
+        shade: a.technique == Technique::Direct,
+        ao: (a.technique == Technique::Ao).then(|| a.ao.settings()),
         ..Default::default()
     };
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -56,13 +59,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f), f)?;
     }
     let t = r.render(&gpu, &scene, &cams, a.scene.frame)?;
-    let img = match (&a.debug_view, exr) {
-        (Some(v), _) => r.debug_view(&gpu, v, exr)?,
-        (None, true) => r.read_target(&gpu, "hdr")?,
-        (None, false) => r.read_target(&gpu, "ldr")?,
+    let (img, srgb) = match (&a.debug_view, a.technique, exr) {
+        (Some(v), _, _) => (r.debug_view(&gpu, v, exr)?, true),
+        // AV itself: PNG byte = 255·AV (no transfer function), EXR linear
+        (None, Technique::Ao, _) => (r.read_target(&gpu, "ao")?, false),
+        (None, Technique::Direct, true) => (r.read_target(&gpu, "hdr")?, true),
+        (None, Technique::Direct, false) => (r.read_target(&gpu, "ldr")?, true),
     };
     // ldr/albedo are already linear after read-back decode; PNG re-encodes sRGB.
-    save(&img, out, true)?;
+    save(&img, out, srgb)?;
     if a.timings {
         for (n, ms) in &t.passes {
             eprintln!("{n:<12} {ms:8.3} ms");

@@ -2,9 +2,6 @@
 //! (flattened from JSON) and sections of side-by-side images with captions. No scripts, no
 //! external resources; images are referenced by paths relative to the report's directory.
 
-// Until `strata eval` (the only caller) lands; remove then.
-#![allow(dead_code)]
-
 use std::fmt::Write as _;
 use std::fs;
 use std::path::{Path, PathBuf};
