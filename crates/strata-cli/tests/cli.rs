@@ -249,3 +249,144 @@ fn bench_gbuffer_json_has_per_pass_times() {
         assert!(med > 0.0 && min > 0.0 && min <= med, "bad timing {p}");
     }
 }
+
+#[test]
+fn render_ao_writes_visibility_in_unit_range_darker_in_corners() {
+    let out = scratch("ao-cornell.exr");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--technique",
+        "ao",
+        "--layers",
+        "2",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = strata_scene::ImageBuf::load(&out).unwrap();
+    let av: Vec<f32> = img.data.chunks_exact(4).map(|p| p[0]).collect();
+    assert!(av.iter().all(|v| (0.0..=1.0).contains(v)), "AV outside [0, 1]");
+    let min = av.iter().cloned().fold(1.0f32, f32::min);
+    let max = av.iter().cloned().fold(0.0f32, f32::max);
+    assert!(max > 0.95 && min < 0.6, "AV range {min}..{max} is not an AO image");
+}
+
+#[test]
+fn eval_ao_prints_errors_and_caches_the_reference() {
+    let cache = scratch("ref-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let report = scratch("ao-report");
+    let _ = std::fs::remove_dir_all(&report);
+    let args = [
+        "eval",
+        "--scene",
+        "column-wall",
+        "--technique",
+        "ao",
+        "--layers",
+        "2",
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--ref-spp",
+        "16",
+        "--json",
+        "--quiet",
+        "--frames",
+        "3",
+        "--cache",
+        cache.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ];
+    let o = strata(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
+    assert_eq!(v["technique"], "ao");
+    assert_eq!(v["layers"], 2);
+    assert_eq!(v["ref_spp"], 16);
+    for key in ["flip", "rmse", "mae", "flicker"] {
+        let x = v[key].as_f64().unwrap_or_else(|| panic!("{key} missing: {v}"));
+        assert!((0.0..1.0).contains(&x), "{key} = {x}");
+    }
+    assert!(v["rmse"].as_f64().unwrap() >= v["mae"].as_f64().unwrap());
+    assert!(
+        v["layers_1"]["flip"].as_f64().is_some(),
+        "report run compares with 1 layer"
+    );
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    for f in ["gpu-k2.png", "gpu-k1.png", "reference-obscurance.png", "flip-k2.png"] {
+        assert!(
+            html.contains(f) && report.join(f).exists(),
+            "{f} missing from the report"
+        );
+    }
+    let cached = std::fs::read_dir(&cache).unwrap().count();
+    assert!(cached >= 2, "references not cached ({cached} files)");
+    // the second run reads the cache and gives the same reference, so the same
+    // numbers; the report is not overwritten without --force
+    let again = strata(&args);
+    assert_one_line_error(&again, &["--report", "--force"]);
+    let o2 = strata(&args[..args.len() - 2]);
+    let v2: serde_json::Value = serde_json::from_str(stdout(&o2).trim()).unwrap();
+    assert_eq!(v["flip"], v2["flip"]);
+}
+
+#[test]
+fn eval_rejects_out_of_range_parameters() {
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "plane",
+        "--samples",
+        "0",
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ]);
+    assert_one_line_error(&o, &["samples", "1..=256"]);
+    let o = strata(&[
+        "eval", "--scene", "plane", "--alpha", "1.5", "--width", "16", "--height", "16",
+    ]);
+    assert_one_line_error(&o, &["alpha", "[0, 1)"]);
+}
+
+#[test]
+fn bench_ao_splits_first_layer_and_increment() {
+    let o = strata(&[
+        "bench",
+        "ao",
+        "--scene",
+        "column-wall",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--layers",
+        "2",
+        "--frames",
+        "2",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    let names: Vec<&str> = v["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["depth-mip", "ao", "ao-temporal", "ao-blur-h", "ao-blur-v"]);
+    let total = v["ao_total_median_ms"].as_f64().unwrap();
+    let (first, inc) = (v["layer1_ms"].as_f64().unwrap(), v["increment_ms"].as_f64().unwrap());
+    assert!(total > 0.0 && first > 0.0);
+    assert!((first + inc - total).abs() < 1e-6, "{first} + {inc} != {total}");
+}
