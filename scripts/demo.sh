@@ -23,19 +23,27 @@ $S render --scene warehouse --width "$W" --height "$H" --out "$OUT/warehouse.png
 echo "[strata demo] CPU reference (ray-traced AO and GI, small sizes)" >&2
 $S reference --scene atrium --kind ao --spp 16 --width 160 --height 90 --out "$OUT/atrium-ref-ao.png" --force --quiet
 $S reference --scene cornell --kind gi --spp 64 --bounces 3 --width 96 --height 96 --out "$OUT/cornell-ref-gi.png" --force --quiet
+echo "[strata demo] deep-G-buffer AO (2 layers) and its evaluation against the ray-traced obscurance" >&2
+$S render --scene atrium --technique ao --layers 2 --width "$W" --height "$H" --out "$OUT/atrium-ao.png" --force
+$S eval --scene atrium --technique ao --layers 2 --width 320 --height 180 --ref-spp 128 --frames 4 \
+  --report "$OUT/ao-eval" --force --json --quiet > "$OUT/eval-ao.json"
+cat "$OUT/eval-ao.json"
 echo "[strata demo] GPU timings" >&2
 $S bench gbuffer --scene atrium --width "$W" --height "$H" --frames 5 --json > "$OUT/bench-gbuffer.json"
 cat "$OUT/bench-gbuffer.json"
+$S bench ao --scene atrium --width "$W" --height "$H" --layers 2 --frames 5 --json > "$OUT/bench-ao.json"
+cat "$OUT/bench-ao.json"
 {
   echo "<!doctype html><meta charset=utf-8><title>strata demo</title>"
   echo "<style>body{font-family:sans-serif;max-width:1400px;margin:auto}img{max-width:45%;margin:4px;image-rendering:pixelated}figure{display:inline-block;margin:4px}</style>"
   echo "<h1>strata demo report</h1><p>$(date -u +%Y-%m-%dT%H:%MZ)</p><pre>$(cat "$OUT/info.txt")</pre>"
   echo "<h2>Renders</h2>"
-  for f in atrium cornell warehouse; do echo "<figure><img src=$f.png><figcaption>$f</figcaption></figure>"; done
+  for f in atrium atrium-ao cornell warehouse; do echo "<figure><img src=$f.png><figcaption>$f</figcaption></figure>"; done
+  echo "<h2>Deep-G-buffer AO vs ray-traced obscurance</h2><p><a href=ao-eval/index.html>evaluation report</a></p><pre>$(cat "$OUT/eval-ao.json")</pre>"
   echo "<h2>atrium G-buffer and lighting targets</h2>"
   for v in csz normal albedo emission direct-diffuse shadow; do echo "<figure><img src=atrium-$v.png><figcaption>$v</figcaption></figure>"; done
   echo "<h2>CPU reference</h2><figure><img src=atrium-ref-ao.png><figcaption>atrium AO (binary visibility)</figcaption></figure>"
   echo "<figure><img src=cornell-ref-gi.png><figcaption>cornell path-traced GI</figcaption></figure>"
-  echo "<h2>GPU timings (strata bench gbuffer)</h2><pre>$(cat "$OUT/bench-gbuffer.json")</pre>"
+  echo "<h2>GPU timings (strata bench gbuffer, strata bench ao)</h2><pre>$(cat "$OUT/bench-gbuffer.json")</pre><pre>$(cat "$OUT/bench-ao.json")</pre>"
 } > "$OUT/report.html"
 echo "[strata demo] wrote $OUT/report.html and images in $OUT/" >&2

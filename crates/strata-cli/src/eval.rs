@@ -233,8 +233,36 @@ fn scene_fingerprint(scene: &Scene, frame: f32) -> String {
     format!("scene={} tris={} geometry={h:016x}", scene.name, scene.triangle_count(),)
 }
 
+/// Last frame's depth and AV at sub-pixel position (px, py): 1/z and AV
+/// interpolated bilinearly between the four nearest texel centres (1/z is
+/// exact on planes); `None` where any of the four has no surface.
+fn reproject(csz: &ImageBuf, av: &ImageBuf, px: f32, py: f32) -> Option<(f32, f32)> {
+    let (fx, fy) = (px - 0.5, py - 0.5);
+    let (x0, y0) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - x0, fy - y0);
+    let clampx = |x: f32| (x.max(0.0) as u32).min(csz.width - 1);
+    let clampy = |y: f32| (y.max(0.0) as u32).min(csz.height - 1);
+    let (mut inv, mut value) = (0.0f32, 0.0f32);
+    for (dx, dy, w) in [
+        (0.0, 0.0, (1.0 - tx) * (1.0 - ty)),
+        (1.0, 0.0, tx * (1.0 - ty)),
+        (0.0, 1.0, (1.0 - tx) * ty),
+        (1.0, 1.0, tx * ty),
+    ] {
+        let (x, y) = (clampx(x0 + dx), clampy(y0 + dy));
+        let z = csz.pixel(x, y)[0];
+        if z <= 0.0 {
+            return None;
+        }
+        inv += w / z;
+        value += w * av.pixel(x, y)[0];
+    }
+    Some((1.0 / inv, value))
+}
+
 /// Temporal instability: mean |AV_t(p) − AV_{t−1}(p')| over pixels whose surface
-/// reprojects (p' in frame t − 1) onto the same surface, averaged over frames.
+/// reprojects (p' in frame t − 1, interpolated) onto the same surface, averaged
+/// over consecutive frame pairs.
 struct Flicker {
     mean: f64,
     frames: u32,
@@ -278,11 +306,13 @@ fn flicker(gpu: &GpuContext, scene: &Scene, a: &EvalArgs, ao: &AoSettings, frame
                     if !(px >= 0.0 && py >= 0.0 && px < w as f32 && py < h as f32) {
                         continue;
                     }
-                    let (qx, qy) = (px as u32, py as u32);
-                    if (pcsz.pixel(qx, qy)[0] - clip.w).abs() >= threshold {
+                    let Some((zq, prev_av)) = reproject(pcsz, pav, px, py) else {
+                        continue;
+                    };
+                    if (zq - clip.w).abs() >= threshold {
                         continue;
                     }
-                    d += (av.pixel(x, y)[0] - pav.pixel(qx, qy)[0]).abs() as f64;
+                    d += (av.pixel(x, y)[0] - prev_av).abs() as f64;
                     n += 1;
                 }
             }

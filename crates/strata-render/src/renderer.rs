@@ -168,6 +168,9 @@ pub struct Renderer {
     last_frame: FrameUniforms,
     /// Last frame's depths are in `csz-history` (false before the first frame).
     has_history: bool,
+    /// Last frame's layers ≥ 1 had their oracle (false on a single-pass
+    /// variant's first frame), so its temporally filtered outputs are usable.
+    history_layers_valid: bool,
     profiler: Profiler,
     lights: Vec<GpuLight>,
     animated: bool,
@@ -239,6 +242,7 @@ impl Renderer {
             history,
             last_frame: bytemuck::Zeroable::zeroed(),
             has_history: false,
+            history_layers_valid: false,
             profiler,
             lights,
             animated,
@@ -308,7 +312,9 @@ impl Renderer {
             let au = AoUniforms::new(s, scene, &u, max_mip, frame.max(0.0) as u32);
             stage.ao.set_frame(gpu, au);
             if let Some(t) = &stage.temporal {
-                t.set_frame(gpu, self.has_history);
+                // history computed from oracle-less layers would linger for
+                // many frames (α^n): start the average afresh instead
+                t.set_frame(gpu, self.has_history && self.history_layers_valid);
             }
         }
         self.scene_gpu.update_objects(gpu, frame, variant.next_transforms());
@@ -340,6 +346,7 @@ impl Renderer {
         self.profiler.resolve(&mut encoder);
         gpu.queue.submit([encoder.finish()]);
         gpu.check_errors()?;
+        self.history_layers_valid = !self.settings.deep.uses_history() || self.has_history;
         self.has_history = self.history.is_some();
         self.profiler.read(gpu)
     }
