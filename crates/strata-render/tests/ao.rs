@@ -295,3 +295,48 @@ fn temporal_filter_blends_valid_and_rejects_failed_reprojections() {
         );
     }
 }
+
+/// A single-pass variant's first frame has no oracle, so its layer 1 (and the
+/// AO computed from it) is wrong; the next frame must not average it in.
+#[test]
+fn temporal_filter_ignores_history_from_an_oracle_less_first_frame() {
+    let gpu = common::gpu();
+    let scene = frozen("column-wall");
+    let mut r = Renderer::new(
+        &gpu,
+        &scene,
+        RenderSettings {
+            width: 64,
+            height: 48,
+            deep: DeepGBufferSettings {
+                layers: 2,
+                variant: Variant::Reproject,
+                ..Default::default()
+            },
+            shade: false,
+            ao: Some(temporal_settings(0.85)),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let cams = FrameCameras::fixed(scene.camera);
+    let mut outs = Vec::new();
+    for f in 0..3 {
+        r.render(&gpu, &scene, &cams, f as f32).unwrap();
+        outs.push((
+            r.read_target(&gpu, "ao-raw").unwrap().data,
+            r.read_target(&gpu, "ao-temporal").unwrap().data,
+        ));
+    }
+    // frame 1: history (frame 0) came from oracle-less layers → current value only
+    assert_eq!(outs[1].0, outs[1].1, "frame 1 averaged frame 0's oracle-less AO");
+    // frame 2: frame 1's layers were exact → blended
+    let blended = outs[2]
+        .0
+        .iter()
+        .zip(&outs[2].1)
+        .zip(&outs[1].1)
+        .filter(|((e, t), h)| (*t - (0.15 * *e + 0.85 * *h)).abs() < 1e-5 && (*e - *h).abs() > 1e-3)
+        .count();
+    assert!(blended > 100, "frame 2 did not blend ({blended} px)");
+}
