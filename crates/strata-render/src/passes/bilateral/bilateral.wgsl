@@ -13,13 +13,11 @@ override DIRECTION: u32 = 0u;
 struct Bilateral {
     radius: i32,
     step: i32,
-    // Gaussian: exp(-k² / (2σ²)) with k in taps
-    inv_two_sigma2: f32,
     plane_sharpness: f32,
-    normal_power: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
+    // integer exponent of the normal weight
+    normal_power: u32,
+    // Gaussian weight of tap |k| in gauss[k / 4][k % 4]
+    gauss: array<vec4f, 9>,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -60,8 +58,13 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         let y = world_from_csz(frame, vec2f(q) + 0.5, zq);
         let nq = oct_decode(textureLoad(npack, q, 0).rg);
         let plane = max(0.0, 1.0 - blur.plane_sharpness * abs(dot(n, y - x)) / z);
-        let normal = pow(max(0.0, dot(n, nq)), blur.normal_power);
-        let w = exp(-f32(k * k) * blur.inv_two_sigma2) * plane * normal;
+        var normal = 1.0;
+        let c = max(0.0, dot(n, nq));
+        for (var e = 0u; e < blur.normal_power; e++) {
+            normal *= c;
+        }
+        let a = u32(abs(k));
+        let w = blur.gauss[a / 4u][a % 4u] * plane * normal;
         sum += w * textureLoad(src, q, 0);
         weight += w;
     }

@@ -17,7 +17,8 @@ pub struct BilateralSettings {
     /// Pixels between taps.
     pub step: u32,
     pub plane_sharpness: f32,
-    pub normal_power: f32,
+    /// Exponent of the normal weight (n_X·n_Y)^p, 0..=32.
+    pub normal_power: u32,
 }
 
 impl Default for BilateralSettings {
@@ -26,7 +27,7 @@ impl Default for BilateralSettings {
             radius: 4,
             step: 2,
             plane_sharpness: 100.0,
-            normal_power: 8.0,
+            normal_power: 8,
         }
     }
 }
@@ -42,8 +43,17 @@ impl BilateralSettings {
         if !(1..=8).contains(&self.step) {
             return Err(format!("blur step {} is out of range: must be in 1..=8", self.step));
         }
-        if !(self.plane_sharpness >= 0.0 && self.normal_power >= 0.0) {
-            return Err("blur plane sharpness and normal power must be >= 0".into());
+        if !(self.plane_sharpness >= 0.0 && self.plane_sharpness.is_finite()) {
+            return Err(format!(
+                "blur plane sharpness {} is out of range: must be >= 0",
+                self.plane_sharpness
+            ));
+        }
+        if self.normal_power > 32 {
+            return Err(format!(
+                "blur normal power {} is out of range: must be in 0..=32",
+                self.normal_power
+            ));
         }
         Ok(())
     }
@@ -60,22 +70,22 @@ impl BilateralSettings {
 pub struct BilateralUniforms {
     radius: i32,
     step: i32,
-    inv_two_sigma2: f32,
     plane_sharpness: f32,
-    normal_power: f32,
-    _pad: [f32; 3],
+    normal_power: u32,
+    /// Gaussian weight of tap |k| (k ≤ 32, index k).
+    gauss: [f32; 36],
 }
 
 impl BilateralUniforms {
     pub fn new(s: &BilateralSettings) -> Self {
         let sigma = (0.75 * s.radius as f32).max(0.5);
+        let gauss = std::array::from_fn(|k| (-((k * k) as f32) / (2.0 * sigma * sigma)).exp());
         Self {
             radius: s.radius as i32,
             step: s.step as i32,
-            inv_two_sigma2: 1.0 / (2.0 * sigma * sigma),
             plane_sharpness: s.plane_sharpness,
             normal_power: s.normal_power,
-            _pad: [0.0; 3],
+            gauss,
         }
     }
 }
