@@ -21,19 +21,14 @@ pub const LISTING3_TAU: [u32; 98] = [
 const GOLDEN_TURN: f32 = 0.381_966_02;
 
 /// How many turns the spiral makes.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum SpiralTurns {
+    #[default]
     /// Listing 3's τ for N ≤ 98; beyond the table, Vogel's golden-angle spiral
     /// (τ = 0.381966·N: consecutive taps 137.5° apart), also low-discrepancy.
     Optimal,
     /// A fixed τ (SAO used τ = 7, tuned for N = 9; Fig. 7 left).
     Fixed(f32),
-}
-
-impl Default for SpiralTurns {
-    fn default() -> Self {
-        SpiralTurns::Optimal
-    }
 }
 
 impl SpiralTurns {

@@ -303,7 +303,7 @@ pub fn ambient_visibility_cpu(
 pub fn obscurance(u: &AoUniforms, v: Vec3, n: Vec3) -> f32 {
     let vv = v.dot(v);
     let r2 = u.radius * u.radius;
-    if !(vv < r2) {
+    if vv.partial_cmp(&r2) != Some(std::cmp::Ordering::Less) {
         return 0.0;
     }
     (1.0 - vv / r2) * ((v.dot(n) - u.bias) / (vv + u.epsilon).sqrt()).max(0.0)

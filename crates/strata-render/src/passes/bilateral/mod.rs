@@ -2,7 +2,7 @@
 //! [SGNS07]), reusable by every noisy screen-space estimate: a horizontal and a
 //! vertical [`BilateralPass`].
 
-use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::frame::{Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
 use crate::scene_gpu::GpuScene;
 
@@ -101,6 +101,7 @@ pub struct BilateralPass {
 
 impl BilateralPass {
     /// `vertical` picks the direction; `output` must already exist in `targets`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -153,11 +154,6 @@ impl BilateralPass {
             pipeline,
             group,
         }
-    }
-
-    /// An intermediate or output target of the filter, shaped like `like`.
-    pub fn target(name: &'static str, like: &TargetDesc, doc: &'static str) -> TargetDesc {
-        TargetDesc::new(name, like.format, 1, doc)
     }
 }
 
