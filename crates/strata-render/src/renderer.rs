@@ -209,6 +209,7 @@ impl Renderer {
                 &lights,
                 settings.shadow.resolution,
                 &settings.lighting,
+                settings.deep.layers,
             );
             let tonemap = tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, "hdr");
             (Some(shadow), Some(lighting), Some(tonemap))

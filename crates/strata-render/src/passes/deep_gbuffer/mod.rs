@@ -284,13 +284,16 @@ impl DeepGBufferSettings {
                 "last frame's csz (the single-pass oracle)",
             ));
         }
-        const RADIOSITY: [&str; 4] = ["radiosity0", "radiosity1", "radiosity2", "radiosity3"];
-        for name in RADIOSITY.iter().take(self.layers as usize).skip(1) {
+        for name in crate::passes::lighting::RADIOSITY
+            .iter()
+            .take(self.layers as usize)
+            .skip(1)
+        {
             v.push(desc(
                 name,
                 RADIOSITY_FORMAT,
                 1,
-                "DGB Table 1 previous-bounce radiosity B (reserved)",
+                "DGB Table 1 radiosity B of this layer: Lambertian direct + emission",
             ));
         }
         v

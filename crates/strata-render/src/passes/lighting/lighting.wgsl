@@ -95,25 +95,25 @@ struct LightingOut {
     @location(3) radiosity: vec4f,
 }
 
-@fragment
-fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
-    let px = vec2i(frag.xy);
-    let z = textureLoad(csz_tex, px, 0).r;
-    var o: LightingOut;
-    if (z <= 0.0) {
-        o.hdr = vec4f(frame.sky.rgb, 1.0);
-        o.direct_diffuse = vec4f(0.0);
-        o.shadow = vec4f(1.0);
-        o.radiosity = vec4f(0.0);
-        return o;
-    }
-    let p = world_from_csz(frame, frag.xy, z);
+// Direct light at the surface of pixel `px` of the bound layer (z > 0).
+struct Direct {
+    // Lambertian direct outgoing radiance
+    lambert: vec3f,
+    // GGX specular outgoing radiance
+    spec: vec3f,
+    emission: vec3f,
+    diffuse_albedo: vec3f,
+    // visibility of light 0
+    shadow0: f32,
+}
+
+fn direct_light(px: vec2i, frag: vec2f, z: f32) -> Direct {
+    let p = world_from_csz(frame, frag, z);
     let nrm = textureLoad(normal_tex, px, 0);
     let n = oct_decode(nrm.xy);
     let roughness = nrm.z;
     let metallic = nrm.w;
     let albedo = textureLoad(albedo_tex, px, 0).rgb;
-    let emission = textureLoad(emission_tex, px, 0).rgb;
     let v = normalize(frame.eye.xyz - p);
     let diffuse_albedo = albedo * (1.0 - metallic);
     let f0 = mix(vec3f(0.04), albedo, metallic);
@@ -159,14 +159,48 @@ fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
         diffuse += irradiance;
         spec += specular_brdf(n, v, l, roughness, f0) * irradiance;
     }
-    let lambert = diffuse_albedo / PI * diffuse;
-    var total = lambert + emission + frame.ambient.rgb * diffuse_albedo;
+    var d: Direct;
+    d.lambert = diffuse_albedo / PI * diffuse;
+    d.spec = spec;
+    d.emission = textureLoad(emission_tex, px, 0).rgb;
+    d.diffuse_albedo = diffuse_albedo;
+    d.shadow0 = shadow0;
+    return d;
+}
+
+@fragment
+fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
+    let px = vec2i(frag.xy);
+    let z = textureLoad(csz_tex, px, 0).r;
+    var o: LightingOut;
+    if (z <= 0.0) {
+        o.hdr = vec4f(frame.sky.rgb, 1.0);
+        o.direct_diffuse = vec4f(0.0);
+        o.shadow = vec4f(1.0);
+        o.radiosity = vec4f(0.0);
+        return o;
+    }
+    let d = direct_light(px, frag.xy, z);
+    var total = d.lambert + d.emission + frame.ambient.rgb * d.diffuse_albedo;
     if (params.specular == 1u) {
-        total += spec;
+        total += d.spec;
     }
     o.hdr = vec4f(total, 1.0);
-    o.direct_diffuse = vec4f(lambert, 1.0);
-    o.shadow = vec4f(shadow0, shadow0, shadow0, 1.0);
-    o.radiosity = vec4f(lambert + emission, 1.0);
+    o.direct_diffuse = vec4f(d.lambert, 1.0);
+    o.shadow = vec4f(d.shadow0, d.shadow0, d.shadow0, 1.0);
+    o.radiosity = vec4f(d.lambert + d.emission, 1.0);
     return o;
+}
+
+// DGB §3.2: the initial radiosity B of a deeper layer (bound instead of layer
+// 0) = its Lambertian direct light + emission.
+@fragment
+fn fs_layer_radiosity(@builtin(position) frag: vec4f) -> @location(0) vec4f {
+    let px = vec2i(frag.xy);
+    let z = textureLoad(csz_tex, px, 0).r;
+    if (z <= 0.0) {
+        return vec4f(0.0);
+    }
+    let d = direct_light(px, frag.xy, z);
+    return vec4f(d.lambert + d.emission, 1.0);
 }

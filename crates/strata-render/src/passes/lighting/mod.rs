@@ -60,9 +60,17 @@ pub struct LightingPass {
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
     lights: wgpu::Buffer,
+    /// Layers 1.. of the deep G-buffer: their initial radiosity B (DGB §3.2).
+    layer_pipeline: wgpu::RenderPipeline,
+    layer_groups: Vec<(&'static str, wgpu::BindGroup)>,
 }
 
+/// Per-layer radiosity targets (DGB Table 1: layer j's previous-bounce B).
+pub const RADIOSITY: [&str; 4] = ["radiosity0", "radiosity1", "radiosity2", "radiosity3"];
+
 impl LightingPass {
+    /// Shades layer 0 into `OUTPUTS` and layers 1..`layers` into `radiosityJ`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -71,6 +79,7 @@ impl LightingPass {
         lights: &[GpuLight],
         shadow_resolution: u32,
         settings: &LightingSettings,
+        layers: u32,
     ) -> Self {
         let device = &gpu.device;
         let tex =
@@ -144,45 +153,28 @@ impl LightingPass {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        let view = |n: &str| wgpu::BindingResource::TextureView(targets.get(n).layer(0));
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("lighting"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: view("csz"),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: view("normal"),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: view("albedo"),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: view("emission"),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: lights_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&shadow.array_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::Sampler(&sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: params_buf.as_entire_binding(),
-                },
-            ],
-        });
+        let group_for = |j: u32| {
+            let view = |n: &str| wgpu::BindingResource::TextureView(targets.get(n).layer(j));
+            crate::passes::bind_group(
+                device,
+                "lighting",
+                &layout,
+                &[
+                    view("csz"),
+                    view("normal"),
+                    view("albedo"),
+                    view("emission"),
+                    lights_buf.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&shadow.array_view),
+                    wgpu::BindingResource::Sampler(&sampler),
+                    params_buf.as_entire_binding(),
+                ],
+            )
+        };
+        let group = group_for(0);
+        let layer_groups = (1..layers.min(4))
+            .map(|j| (RADIOSITY[j as usize], group_for(j)))
+            .collect();
         let module = crate::shader::module(device, "lighting", include_str!("lighting.wgsl"));
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lighting"),
@@ -194,10 +186,23 @@ impl LightingPass {
             .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
             .collect();
         let pipeline = crate::passes::fullscreen_pipeline(device, "lighting", &pl, &module, &targets_fmt);
+        let layer_pipeline = crate::passes::fullscreen_pipeline_with(
+            device,
+            "lighting layer radiosity",
+            &pl,
+            &module,
+            "fs_layer_radiosity",
+            &[],
+            &[Some(wgpu::ColorTargetState::from(
+                crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+            ))],
+        );
         Self {
             pipeline,
             group,
             lights: lights_buf,
+            layer_pipeline,
+            layer_groups,
         }
     }
 
@@ -213,7 +218,11 @@ impl Pass for LightingPass {
         PassInfo {
             name: "lighting",
             inputs: vec!["csz", "normal", "albedo", "emission", "shadow-maps"],
-            outputs: OUTPUTS.iter().map(|t| t.name).collect(),
+            outputs: OUTPUTS
+                .iter()
+                .map(|t| t.name)
+                .chain(self.layer_groups.iter().map(|(n, _)| *n))
+                .collect(),
         }
     }
 
@@ -226,5 +235,14 @@ impl Pass for LightingPass {
             &outputs,
             &[&scene.frame_bind_group, &self.group],
         );
+        for (name, group) in &self.layer_groups {
+            crate::passes::fullscreen_pass(
+                encoder,
+                "lighting layer radiosity",
+                &self.layer_pipeline,
+                &[&targets.get(name).view],
+                &[&scene.frame_bind_group, group],
+            );
+        }
     }
 }
