@@ -11,7 +11,9 @@ use crate::passes::ao::{AoPass, AoSettings, AoUniforms};
 use crate::passes::bilateral::BilateralPass;
 use crate::passes::deep_gbuffer::{self, DeepGBufferSettings, Variant};
 use crate::passes::depth_mip::DepthMipPass;
-use crate::passes::temporal::TemporalPass;
+use crate::passes::depth_mip::DepthMipSettings;
+use crate::passes::radiosity::{RadiosityPass, RadiositySettings, RadiosityUniforms};
+use crate::passes::temporal::{TemporalPass, TemporalSettings};
 use crate::passes::{lighting, shadow, tonemap, HistoryPass};
 use crate::profiler::{PassTimings, Profiler};
 use crate::scene_gpu::GpuScene;
@@ -82,6 +84,9 @@ pub struct RenderSettings {
     pub exposure: Option<f32>,
     /// Deep-G-buffer ambient occlusion (DGB §3.1) into target `ao`; `None` = off.
     pub ao: Option<AoSettings>,
+    /// Deep-G-buffer radiosity (DGB §3.2) into target `indirect`; `None` = off.
+    /// Needs `shade` (the lighting pass writes the radiosity buffers B).
+    pub radiosity: Option<RadiositySettings>,
 }
 
 impl Default for RenderSettings {
@@ -96,6 +101,7 @@ impl Default for RenderSettings {
             lighting: Default::default(),
             exposure: None,
             ao: None,
+            radiosity: None,
         }
     }
 }
@@ -139,6 +145,14 @@ impl RenderSettings {
         if let Some(ao) = &self.ao {
             ao.validate().map_err(RenderError::Parameter)?;
         }
+        if let Some(r) = &self.radiosity {
+            r.validate().map_err(RenderError::Parameter)?;
+            if !self.shade {
+                return Err(RenderError::Parameter(
+                    "radiosity needs shading on: the lighting pass writes its radiosity buffers".into(),
+                ));
+            }
+        }
         self.deep.validate()
     }
 
@@ -163,7 +177,9 @@ pub struct Renderer {
     pack: deep_gbuffer::PackPass,
     lighting: Option<lighting::LightingPass>,
     tonemap: Option<tonemap::TonemapPass>,
+    mip: Option<DepthMipPass>,
     ao: Option<AoStage>,
+    radiosity: Option<RadiosityStage>,
     history: Option<HistoryPass>,
     last_frame: FrameUniforms,
     /// Last frame's depths are in `csz-history` (false before the first frame).
@@ -216,16 +232,44 @@ impl Renderer {
         } else {
             (None, None, None)
         };
+        // one depth MIP chain for every screen-space technique
+        let mip_levels = [
+            settings.ao.as_ref().map(|a| a.mips.levels),
+            settings.radiosity.as_ref().map(|r| r.mips.levels),
+        ]
+        .into_iter()
+        .flatten()
+        .max();
+        let mip = mip_levels.map(|levels| {
+            targets.create(gpu, DepthMipSettings { levels }.output(settings.deep.layers, w, h));
+            DepthMipPass::new(gpu, &targets, settings.deep.layers)
+        });
+        let temporal_on = settings.ao.as_ref().is_some_and(|a| a.temporal.is_some())
+            || settings.radiosity.as_ref().is_some_and(|r| r.temporal.is_some());
+        if temporal_on && targets.try_get("csz-history").is_none() {
+            let l = settings.deep.array_layers();
+            targets.create(
+                gpu,
+                crate::frame::TargetDesc::new("csz-history", wgpu::TextureFormat::R32Float, l, "last frame's csz"),
+            );
+        }
         let ao = match &settings.ao {
             Some(a) => Some(AoStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, a)),
             None => None,
         };
+        let radiosity = match &settings.radiosity {
+            Some(r) => Some(RadiosityStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, r)),
+            None => None,
+        };
         let mut copies = Vec::new();
-        if settings.deep.uses_history() || ao.as_ref().is_some_and(|a| a.temporal.is_some()) {
+        if settings.deep.uses_history() || temporal_on {
             copies.push(("csz", "csz-history"));
         }
         if ao.as_ref().is_some_and(|a| a.temporal.is_some()) {
             copies.push(("ao-temporal", "ao-temporal-history"));
+        }
+        if radiosity.as_ref().is_some_and(|r| r.temporal.is_some()) {
+            copies.push(("indirect-temporal", "indirect-temporal-history"));
         }
         let history = (!copies.is_empty()).then_some(HistoryPass { copies });
         let profiler = Profiler::new(gpu, 16);
@@ -239,7 +283,9 @@ impl Renderer {
             pack,
             lighting,
             tonemap,
+            mip,
             ao,
+            radiosity,
             history,
             last_frame: bytemuck::Zeroable::zeroed(),
             has_history: false,
@@ -261,11 +307,17 @@ impl Renderer {
         }
         v.extend(self.geometry.iter().map(|p| p as &dyn Pass));
         v.push(&self.pack);
+        if let Some(m) = &self.mip {
+            v.push(m);
+        }
         if let Some(a) = &self.ao {
             v.extend(a.passes());
         }
         if let (Some(l), Some(t)) = (&self.lighting, &self.tonemap) {
             v.push(l);
+            if let Some(r) = &self.radiosity {
+                v.extend(r.passes());
+            }
             v.push(t);
         }
         if let Some(h) = &self.history {
@@ -308,14 +360,22 @@ impl Renderer {
         let u = FrameUniforms::new(scene, &cams, w, h, frame, exposure);
         self.scene_gpu.update_frame(gpu, &u);
         self.last_frame = u;
+        // history computed from oracle-less layers would linger for many
+        // frames (α^n): temporal filters start the average afresh instead
+        let temporal_history = self.has_history && self.history_layers_valid;
+        let max_mip = self.targets.try_get("zmip").map_or(0, |t| t.desc.mips - 1);
         if let (Some(stage), Some(s)) = (&self.ao, &self.settings.ao) {
-            let max_mip = self.targets.get("zmip").desc.mips - 1;
             let au = AoUniforms::new(s, scene, &u, max_mip, frame.max(0.0) as u32);
             stage.ao.set_frame(gpu, au);
             if let Some(t) = &stage.temporal {
-                // history computed from oracle-less layers would linger for
-                // many frames (α^n): start the average afresh instead
-                t.set_frame(gpu, self.has_history && self.history_layers_valid);
+                t.set_frame(gpu, temporal_history);
+            }
+        }
+        if let (Some(stage), Some(s)) = (&self.radiosity, &self.settings.radiosity) {
+            let ru = RadiosityUniforms::new(s, &u, max_mip, frame.max(0.0) as u32);
+            stage.gather.set_frame(gpu, ru);
+            if let Some(t) = &stage.temporal {
+                t.set_frame(gpu, temporal_history);
             }
         }
         self.scene_gpu.update_objects(gpu, frame, variant.next_transforms());
@@ -355,6 +415,11 @@ impl Renderer {
     /// The frame uniforms of the last rendered frame (guard-banded camera).
     pub fn frame_uniforms(&self) -> FrameUniforms {
         self.last_frame
+    }
+
+    /// The radiosity pass's uniforms of the last rendered frame.
+    pub fn radiosity_uniforms(&self) -> Option<RadiosityUniforms> {
+        self.radiosity.as_ref().map(|r| r.gather.uniforms())
     }
 
     /// The AO pass's uniforms of the last rendered frame.
@@ -638,10 +703,9 @@ pub fn rg11b10_to_f32(p: u32) -> [f32; 3] {
     ]
 }
 
-/// The AO passes of a frame: depth MIP chain → Eq. 1 → temporal filter →
-/// bilateral (horizontal, vertical) into `ao`.
+/// The AO passes of a frame: Eq. 1 → temporal filter → bilateral
+/// (horizontal, vertical) into `ao` (after the shared depth MIP chain).
 struct AoStage {
-    mip: DepthMipPass,
     ao: AoPass,
     temporal: Option<TemporalPass>,
     blur_h: BilateralPass,
@@ -658,8 +722,6 @@ impl AoStage {
     ) -> Self {
         use crate::frame::TargetDesc;
         use wgpu::TextureFormat as F;
-        let (w, h) = (targets.width, targets.height);
-        targets.create(gpu, s.mips.output(deep.layers, w, h));
         targets.create(gpu, crate::passes::ao::OUTPUT);
         let mut filtered = crate::passes::ao::OUTPUT.name;
         if s.temporal.is_some() {
@@ -668,10 +730,6 @@ impl AoStage {
                 ("ao-temporal-history", "last frame's ao-temporal"),
             ] {
                 targets.create(gpu, TargetDesc::new(name, F::R32Float, 1, doc));
-            }
-            if targets.try_get("csz-history").is_none() {
-                let l = deep.array_layers();
-                targets.create(gpu, TargetDesc::new("csz-history", F::R32Float, l, "last frame's csz"));
             }
             filtered = "ao-temporal";
         }
@@ -683,7 +741,6 @@ impl AoStage {
             gpu,
             TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
         );
-        let mip = DepthMipPass::new(gpu, targets, deep.layers);
         let ao = AoPass::new(gpu, scene, targets, deep.layers);
         let temporal = s.temporal.as_ref().map(|t| {
             TemporalPass::new(
@@ -701,7 +758,6 @@ impl AoStage {
         let blur_h = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-h", filtered, "ao-blur-h", false);
         let blur_v = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-v", "ao-blur-h", "ao", true);
         Self {
-            mip,
             ao,
             temporal,
             blur_h,
@@ -710,7 +766,110 @@ impl AoStage {
     }
 
     fn passes(&self) -> Vec<&dyn Pass> {
-        let mut v: Vec<&dyn Pass> = vec![&self.mip, &self.ao];
+        let mut v: Vec<&dyn Pass> = vec![&self.ao];
+        if let Some(t) = &self.temporal {
+            v.push(t);
+        }
+        v.push(&self.blur_h);
+        v.push(&self.blur_v);
+        v
+    }
+}
+
+/// The radiosity passes: Eq. 4–5 gather → temporal filter → bilateral into
+/// `indirect` (layer 0's irradiance E, a = confidence).
+struct RadiosityStage {
+    gather: RadiosityPass,
+    temporal: Option<TemporalPass>,
+    blur_h: BilateralPass,
+    blur_v: BilateralPass,
+}
+
+impl RadiosityStage {
+    fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &mut Targets,
+        deep: &DeepGBufferSettings,
+        s: &RadiositySettings,
+    ) -> Self {
+        use crate::frame::TargetDesc;
+        use wgpu::TextureFormat as F;
+        for t in crate::passes::radiosity::OUTPUTS {
+            targets.create(gpu, t);
+        }
+        let mut filtered = "indirect-raw";
+        if s.temporal.is_some() {
+            for (name, doc) in [
+                ("indirect-temporal", "indirect E after the temporal filter (DGB §3.3)"),
+                ("indirect-temporal-history", "last frame's indirect-temporal"),
+            ] {
+                targets.create(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc));
+            }
+            filtered = "indirect-temporal";
+        }
+        targets.create(
+            gpu,
+            TargetDesc::new(
+                "indirect-blur-h",
+                F::Rgba16Float,
+                1,
+                "indirect E after the horizontal bilateral pass",
+            ),
+        );
+        targets.create(
+            gpu,
+            TargetDesc::new(
+                "indirect",
+                F::Rgba16Float,
+                1,
+                "indirect irradiance E of layer 0 (rgb), confidence (a)",
+            ),
+        );
+        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers);
+        let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
+            TemporalPass::new(
+                gpu,
+                scene,
+                targets,
+                t,
+                "indirect-temporal",
+                "indirect-raw",
+                "indirect-temporal-history",
+                "indirect-temporal",
+                deep.layers,
+            )
+        });
+        let blur_h = BilateralPass::new(
+            gpu,
+            scene,
+            targets,
+            &s.blur,
+            "indirect-blur-h",
+            filtered,
+            "indirect-blur-h",
+            false,
+        );
+        let blur_v = BilateralPass::new(
+            gpu,
+            scene,
+            targets,
+            &s.blur,
+            "indirect-blur-v",
+            "indirect-blur-h",
+            "indirect",
+            true,
+        );
+        Self {
+            gather,
+            temporal,
+            blur_h,
+            blur_v,
+        }
+    }
+
+    fn passes(&self) -> Vec<&dyn Pass> {
+        let mut v: Vec<&dyn Pass> = vec![&self.gather];
         if let Some(t) = &self.temporal {
             v.push(t);
         }

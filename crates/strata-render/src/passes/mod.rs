@@ -5,6 +5,7 @@ pub mod bilateral;
 pub mod deep_gbuffer;
 pub mod depth_mip;
 pub mod lighting;
+pub mod radiosity;
 pub mod shadow;
 pub mod temporal;
 pub mod tonemap;

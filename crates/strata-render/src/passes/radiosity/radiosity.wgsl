@@ -1,0 +1,162 @@
+// DGB §3.2 single-bounce diffuse indirect illumination, Eq. 4–5, gathered from
+// every deep-G-buffer layer with §3.4's spiral taps. Units: B is outgoing
+// radiance (the lighting pass's Lambertian direct light + emission), so
+// E(X) ≈ 2π/M · Σ B(Y) max(ω̂·n̂_X, 0) is irradiance (Eq. 4), M of N taps
+// passing Eq. 5. For k ≥ 2 the same taps also give layer 1's E (Fig. 5).
+#import "common/fullscreen.wgsl"
+#import "common/frame.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
+#import "common/spiral.wgsl"
+#import "common/color.wgsl"
+
+override LAYERS: u32 = 2u;
+
+// Matches `radiosity::RadiosityUniforms`.
+struct Radiosity {
+    radius: f32,
+    proj_scale: f32,
+    q: f32,
+    tau: f32,
+    samples: u32,
+    min_mip: u32,
+    max_mip: u32,
+    // 1 = apply Eq. 5's n̂_Y test
+    normal_test: u32,
+    seed: u32,
+    rotate: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> rad: Radiosity;
+@group(1) @binding(1) var zmip: texture_2d<f32>;
+@group(1) @binding(2) var npack: texture_2d<f32>;
+@group(1) @binding(3) var b0: texture_2d<f32>;
+@group(1) @binding(4) var b1: texture_2d<f32>;
+
+struct Out {
+    // rgb = E (layer 0), a = confidence M/N
+    @location(0) e0: vec4f,
+    // rgb = E (layer 1), a = confidence
+    @location(1) e1: vec4f,
+}
+
+fn mip_source_pixel(t: vec2i, m: u32) -> vec2i {
+    var c = t;
+    for (var l = m; l > 0u; l--) {
+        let last = vec2i(textureDimensions(zmip, l - 1u)) - 1;
+        c = min(c * 2 + vec2i((c.y & 1) ^ 1, (c.x & 1) ^ 1), last);
+    }
+    return c;
+}
+
+fn normal_of(p: vec2i, layer: u32) -> vec3f {
+    let n = textureLoad(npack, p, 0);
+    if (layer == 0u) {
+        return oct_decode(n.rg);
+    }
+    return oct_decode(n.ba);
+}
+
+fn radiosity_of(p: vec2i, layer: u32) -> vec3f {
+    if (layer == 0u) {
+        return textureLoad(b0, p, 0).rgb;
+    }
+    return textureLoad(b1, p, 0).rgb;
+}
+
+// Eq. 4–5 term of sample Y (layer j, pixel src) for receiver X (normal n):
+// rgb = B(Y) max(ω̂·n̂_X, 0), a = 1 when Y passes Eq. 5 (and lies within r).
+fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i) -> vec4f {
+    let v = y - x;
+    let vv = dot(v, v);
+    if (!(vv < rad.radius * rad.radius) || vv <= 0.0) {
+        return vec4f(0.0);
+    }
+    let w = v * inverseSqrt(vv);
+    let cos_x = dot(w, n);
+    if (cos_x <= 0.0) {
+        return vec4f(0.0);
+    }
+    if (rad.normal_test != 0u && dot(w, normal_of(src, j)) >= 0.0) {
+        return vec4f(0.0);
+    }
+    return vec4f(radiosity_of(src, j) * cos_x, 1.0);
+}
+
+// Of two candidate terms, the one with the larger contribution (the union of
+// layers, as for AO's max in Eq. 1).
+fn union_term(a: vec4f, b: vec4f) -> vec4f {
+    if (b.a > 0.0 && (a.a == 0.0 || luminance(b.rgb) > luminance(a.rgb))) {
+        return b;
+    }
+    return a;
+}
+
+fn estimate(sum: vec4f) -> vec4f {
+    if (sum.a == 0.0) {
+        return vec4f(0.0);
+    }
+    // Eq. 4: 2π/M Σ, confidence M/N
+    return vec4f(sum.rgb * (2.0 * 3.14159265358979 / sum.a), sum.a / f32(rad.samples));
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
+    let p = vec2i(pos.xy);
+    var o: Out;
+    let z = textureLoad(zmip, p, 0);
+    if (z.x <= 0.0) {
+        return o;
+    }
+    // receivers: layer 0 and (k ≥ 2) layer 1 at this pixel; one set of taps,
+    // sized by layer 0's depth, serves both (§3.3: propagation across layers
+    // shares the gathered samples)
+    let x0 = world_from_csz(frame, vec2f(p) + 0.5, z.x);
+    let n0 = normal_of(p, 0u);
+    let has1 = LAYERS > 1u && z.y > 0.0;
+    var x1 = x0;
+    var n1 = n0;
+    if (has1) {
+        x1 = world_from_csz(frame, vec2f(p) + 0.5, z.y);
+        n1 = normal_of(p, 1u);
+    }
+    let r_p = rad.proj_scale * rad.radius / z.x;
+    var phi = 0.0;
+    if (rad.rotate != 0u) {
+        phi = pixel_angle(vec2u(p), rad.seed);
+    }
+    let size = vec2i(textureDimensions(zmip, 0));
+    var sum0 = vec4f(0.0);
+    var sum1 = vec4f(0.0);
+    for (var i = 0u; i < rad.samples; i++) {
+        let tap = spiral_tap(i, rad.samples, rad.tau, r_p, phi);
+        let q = p + tap_texel(tap.offset);
+        if (any(q < vec2i(0)) || any(q >= size)) {
+            continue;
+        }
+        let m = max(spiral_mip(tap.radius, rad.q, rad.max_mip), min(rad.min_mip, rad.max_mip));
+        let t = q >> vec2u(m);
+        let zs = textureLoad(zmip, t, i32(m));
+        let src = mip_source_pixel(t, m);
+        var best0 = vec4f(0.0);
+        var best1 = vec4f(0.0);
+        for (var j = 0u; j < min(LAYERS, 2u); j++) {
+            if (zs[j] <= 0.0) {
+                continue;
+            }
+            let y = world_from_csz(frame, vec2f(src) + 0.5, zs[j]);
+            best0 = union_term(best0, term(x0, n0, y, j, src));
+            if (has1) {
+                best1 = union_term(best1, term(x1, n1, y, j, src));
+            }
+        }
+        sum0 += best0;
+        sum1 += best1;
+    }
+    o.e0 = estimate(sum0);
+    o.e1 = estimate(sum1);
+    return o;
+}

@@ -1,0 +1,198 @@
+//! Deep-G-buffer radiosity (DGB §3.2): the gather against a CPU evaluation of
+//! Eq. 4–5 over the same buffers, and light that only the second layer sees.
+
+mod common;
+
+use glam::{Mat4, Vec3};
+use strata_render::frame::FrameCameras;
+use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
+use strata_render::passes::radiosity::{irradiance_cpu, GatherInputs, RadiositySettings};
+use strata_render::{GpuContext, RenderSettings, Renderer};
+use strata_scene::shapes::MeshBuilder;
+use strata_scene::{procedural, Camera, ImageBuf, Material, Object, Scene, SceneSettings};
+
+fn renderer(gpu: &GpuContext, scene: &Scene, w: u32, h: u32, layers: u32, rs: RadiositySettings) -> Renderer {
+    Renderer::new(
+        gpu,
+        scene,
+        RenderSettings {
+            width: w,
+            height: h,
+            deep: DeepGBufferSettings {
+                layers,
+                variant: Variant::Peel,
+                min_separation: Some(scene.settings.min_separation),
+                ..Default::default()
+            },
+            radiosity: Some(rs),
+            ..Default::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{} k={layers}: {e}", scene.name))
+}
+
+fn frozen(name: &str) -> Scene {
+    let mut s = procedural::builtin(name).unwrap();
+    s.camera_path = None;
+    for o in &mut s.objects {
+        o.animation = None;
+    }
+    s
+}
+
+fn normals(npack: &ImageBuf, layer: usize) -> ImageBuf {
+    let mut out = ImageBuf::new(npack.width, npack.height, 3);
+    for (o, p) in out.data.chunks_exact_mut(3).zip(npack.data.chunks_exact(4)) {
+        let q = |v: f32| (v * 255.0).round() as u8;
+        let n = strata_render::packing::oct16_unpack([q(p[2 * layer]), q(p[2 * layer + 1])]);
+        o.copy_from_slice(&n.to_array());
+    }
+    out
+}
+
+/// One bounce on the GPU equals Eq. 4–5 evaluated on the CPU over the read-back
+/// depth chain, normals and radiosity buffers with the same taps, for layer 0
+/// and layer 1 receivers, with and without the n̂_Y test.
+#[test]
+fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
+    let gpu = common::gpu();
+    for (name, normal_test) in [("atrium", true), ("cornell", false), ("warehouse", true)] {
+        let scene = frozen(name);
+        let (w, h) = (96, 64);
+        let rs = RadiositySettings {
+            normal_test,
+            ..Default::default()
+        };
+        let mut r = renderer(&gpu, &scene, w, h, 2, rs);
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let u = r.radiosity_uniforms().unwrap();
+        let zmip: Vec<ImageBuf> = (0..=u.max_mip)
+            .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
+            .collect();
+        let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
+        let (n0, n1) = (normals(&npack, 0), normals(&npack, 1));
+        let b0 = r.read_target_full(&gpu, "radiosity0", 0).unwrap();
+        let b1 = r.read_target_full(&gpu, "radiosity1", 0).unwrap();
+        let f = r.frame_uniforms();
+        let inputs = GatherInputs {
+            zmip: &zmip,
+            normals: [&n0, &n1],
+            radiosity: [&b0, &b1],
+            frame: &f,
+            uniforms: &u,
+            layers: 2,
+        };
+        for (receiver, target) in [(0usize, "indirect-raw"), (1, "indirect1-raw")] {
+            let gpu_e = r.read_target_full(&gpu, target, 0).unwrap();
+            let (mut close, mut lit, mut worst) = (0usize, 0usize, 0.0f32);
+            for y in 0..h {
+                for x in 0..w {
+                    let (e, conf) = irradiance_cpu(&inputs, receiver, x, y);
+                    let g = gpu_e.pixel(x, y);
+                    // Rgba16Float output: 2^-11 relative
+                    let mut ok = (g[3] - conf).abs() < 1e-3;
+                    for c in 0..3 {
+                        let d = (g[c] - e[c]).abs();
+                        worst = worst.max(d / (e[c].abs() + 1e-3));
+                        ok &= d <= 2e-3 * e[c].abs() + 1e-4;
+                    }
+                    close += ok as usize;
+                    lit += (e.max_element() > 1e-3) as usize;
+                }
+            }
+            let n = (w * h) as usize;
+            eprintln!("{name} receiver {receiver}: {close}/{n} match, {lit} lit, worst rel {worst}");
+            assert!(
+                close as f32 >= 0.995 * n as f32,
+                "{name} layer {receiver}: {close}/{n} match"
+            );
+            assert!(lit > n / 20, "{name} layer {receiver}: weak test, {lit} lit pixels");
+        }
+    }
+}
+
+/// A floor, an emitter facing the camera and a larger board in front of it that
+/// hides it: no light source, black sky. Only the deep G-buffer's layer 1 sees
+/// the emitter, so only 2 layers light the floor.
+fn hidden_emitter_scene() -> Scene {
+    let v = Vec3::new;
+    let mut floor = MeshBuilder::new();
+    floor.rect(Vec3::ZERO, v(0.0, 0.0, 4.0), v(4.0, 0.0, 0.0));
+    let mut emitter = MeshBuilder::new();
+    emitter.quad_facing(
+        [
+            v(-0.5, 0.0, -1.0),
+            v(0.5, 0.0, -1.0),
+            v(0.5, 1.0, -1.0),
+            v(-0.5, 1.0, -1.0),
+        ],
+        v(0.0, 0.0, 1.0),
+    );
+    let mut board = MeshBuilder::new();
+    board.quad_facing(
+        [v(-0.9, 0.0, 0.0), v(0.9, 0.0, 0.0), v(0.9, 1.6, 0.0), v(-0.9, 1.6, 0.0)],
+        v(0.0, 0.0, 1.0),
+    );
+    let materials = vec![
+        Material::diffuse("floor", [0.7, 0.7, 0.7]),
+        Material::emissive("emitter", [4.0, 3.0, 2.0]),
+        Material::diffuse("board", [0.5, 0.5, 0.5]),
+    ];
+    let meshes = vec![
+        floor.build("floor", 0),
+        emitter.build("emitter", 1),
+        board.build("board", 2),
+    ];
+    let objects = (0..3)
+        .map(|i| Object {
+            name: materials[i].name.clone(),
+            mesh: i,
+            transform: Mat4::IDENTITY,
+            animation: None,
+        })
+        .collect();
+    Scene {
+        name: "hidden-emitter".into(),
+        meshes,
+        objects,
+        materials,
+        lights: vec![],
+        camera: Camera::new(v(0.0, 1.2, 4.0), v(0.0, 0.4, -0.5), Vec3::Y, 50.0, 0.05),
+        settings: SceneSettings {
+            min_separation: 0.5,
+            sky: [0.0; 3],
+            ambient: [0.0; 3],
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+#[test]
+fn light_seen_only_by_layer_1_reaches_the_floor_with_two_layers_only() {
+    let gpu = common::gpu();
+    let scene = hidden_emitter_scene();
+    let (w, h) = (96, 64);
+    let rs = RadiositySettings {
+        radius: 3.0,
+        temporal: None,
+        ..Default::default()
+    };
+    let mut results = Vec::new();
+    for layers in [1, 2] {
+        let mut r = renderer(&gpu, &scene, w, h, layers, rs.clone());
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
+        let b0 = r.read_target(&gpu, "radiosity0").unwrap();
+        assert!(
+            b0.data.iter().all(|&v| v < 1e-3),
+            "k={layers}: the emitter must be hidden from layer 0"
+        );
+        let e = r.read_target(&gpu, "indirect-raw").unwrap();
+        let total: f32 = e.data.chunks_exact(4).map(|p| p[0] + p[1] + p[2]).sum();
+        results.push(total / (w * h) as f32);
+    }
+    eprintln!("mean indirect E: k=1 {:.4}, k=2 {:.4}", results[0], results[1]);
+    assert!(results[0] < 1e-4, "1 layer found light it cannot see: {}", results[0]);
+    assert!(results[1] > 0.05, "2 layers did not light the floor: {}", results[1]);
+}
