@@ -8,6 +8,7 @@ use strata_render::passes::ao::AoSettings;
 use strata_render::passes::bilateral::BilateralSettings;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::depth_mip::DepthMipSettings;
+use strata_render::passes::radiosity::RadiositySettings;
 use strata_render::passes::temporal::TemporalSettings;
 use strata_render::renderer::GuardBand;
 use strata_render::spiral::SpiralTurns;
@@ -126,6 +127,56 @@ pub enum Technique {
     Direct,
     /// Deep-G-buffer ambient visibility AV in [0, 1] (DGB §3.1; 1 = unoccluded): PNG grey (byte = 255·AV), EXR linear.
     Ao,
+    /// Direct light + deep-G-buffer radiosity (DGB §3.2–3.3): the composed image.
+    Full,
+}
+
+/// Deep-G-buffer radiosity settings (DGB §3.2–3.5; defaults: Table 2's BALANCED).
+#[derive(Args, Clone)]
+pub struct RadiosityArgs {
+    /// Indirect samples N per pixel, 1..=256.
+    #[arg(long, default_value_t = 14)]
+    pub indirect_samples: u32,
+    /// World-space gather radius, > 0 (scene units).
+    #[arg(long, default_value_t = 4.0)]
+    pub radiosity_radius: f32,
+    /// Omit Eq. 5's n_Y test (cheaper, biased).
+    #[arg(long)]
+    pub no_normal_test: bool,
+    /// Minimum MIP level of the gather taps (below --mip-levels).
+    #[arg(long, default_value_t = 2)]
+    pub min_mip: u32,
+    /// Apply Eq. 7's boost to the reflected indirect light (off: energy-conserving).
+    #[arg(long)]
+    pub boost: bool,
+    /// Bilateral taps on each side for the indirect light, 0..=32 (Table 2 BALANCED: 11 taps = 5).
+    #[arg(long, default_value_t = 5)]
+    pub indirect_blur_radius: u32,
+    /// Temporal filter weight α of the indirect light, in [0, 1) (0 disables).
+    #[arg(long, default_value_t = 0.85)]
+    pub indirect_alpha: f32,
+}
+
+impl RadiosityArgs {
+    pub fn settings(&self) -> RadiositySettings {
+        let d = RadiositySettings::default();
+        RadiositySettings {
+            samples: self.indirect_samples,
+            radius: self.radiosity_radius,
+            normal_test: !self.no_normal_test,
+            min_mip: self.min_mip,
+            boost: self.boost,
+            blur: BilateralSettings {
+                radius: self.indirect_blur_radius,
+                ..d.blur
+            },
+            temporal: (self.indirect_alpha != 0.0).then_some(TemporalSettings {
+                alpha: self.indirect_alpha,
+                ..Default::default()
+            }),
+            ..d
+        }
+    }
 }
 
 /// Deep-G-buffer AO settings (DGB §3.1, §3.3, §3.4).
@@ -272,6 +323,8 @@ pub struct RenderArgs {
     pub deep: DeepArgs,
     #[command(flatten)]
     pub ao: AoArgs,
+    #[command(flatten)]
+    pub radiosity: RadiosityArgs,
     /// Write an intermediate target instead of the final image (e.g. csz, normal, albedo, emission, direct-diffuse, shadow, hdr). `--list-passes` shows them.
     #[arg(long)]
     pub debug_view: Option<String>,

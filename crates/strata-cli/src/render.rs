@@ -18,8 +18,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         },
         exposure: a.exposure,
         // AO alone needs no lighting passes
-        shade: a.technique == Technique::Direct,
+        shade: a.technique != Technique::Ao,
         ao: (a.technique == Technique::Ao).then(|| a.ao.settings()),
+        radiosity: (a.technique == Technique::Full).then(|| a.radiosity.settings()),
         ..Default::default()
     };
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -64,7 +65,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         // AV itself: PNG byte = 255·AV (no transfer function), EXR linear
         (None, Technique::Ao, _) => (r.read_target(&gpu, "ao")?, false),
         (None, Technique::Direct, true) => (r.read_target(&gpu, "hdr")?, true),
-        (None, Technique::Direct, false) => (r.read_target(&gpu, "ldr")?, true),
+        (None, Technique::Full, true) => (r.read_target(&gpu, "hdr-full")?, true),
+        (None, _, false) => (r.read_target(&gpu, "ldr")?, true),
     };
     // ldr/albedo are already linear after read-back decode; PNG re-encodes sRGB.
     save(&img, out, srgb)?;

@@ -261,6 +261,11 @@ impl Renderer {
             Some(r) => Some(RadiosityStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, r)),
             None => None,
         };
+        let tonemap = match (&radiosity, tonemap) {
+            // the tonemapper shows direct + indirect
+            (Some(_), Some(_)) => Some(tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, "hdr-full")),
+            (_, t) => t,
+        };
         let mut copies = Vec::new();
         if settings.deep.uses_history() || temporal_on {
             copies.push(("csz", "csz-history"));
@@ -783,6 +788,7 @@ struct RadiosityStage {
     temporal: Option<TemporalPass>,
     blur_h: BilateralPass,
     blur_v: BilateralPass,
+    compose: crate::passes::compose::ComposePass,
 }
 
 impl RadiosityStage {
@@ -860,11 +866,14 @@ impl RadiosityStage {
             "indirect",
             true,
         );
+        targets.create(gpu, crate::passes::compose::OUTPUT);
+        let compose = crate::passes::compose::ComposePass::new(gpu, targets, s.boost);
         Self {
             gather,
             temporal,
             blur_h,
             blur_v,
+            compose,
         }
     }
 
@@ -875,6 +884,7 @@ impl RadiosityStage {
         }
         v.push(&self.blur_h);
         v.push(&self.blur_v);
+        v.push(&self.compose);
         v
     }
 }
