@@ -10,6 +10,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/fullscreen.wgsl", include_str!("shaders/common/fullscreen.wgsl")),
     ("common/scene.wgsl", include_str!("shaders/common/scene.wgsl")),
     ("common/spiral.wgsl", include_str!("shaders/common/spiral.wgsl")),
+    ("common/reproject.wgsl", include_str!("shaders/common/reproject.wgsl")),
 ];
 
 /// Expands `#import "…"` lines recursively; panics only on a missing module,
