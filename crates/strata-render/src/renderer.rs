@@ -245,7 +245,10 @@ impl Renderer {
             DepthMipPass::new(gpu, &targets, settings.deep.layers)
         });
         let temporal_on = settings.ao.as_ref().is_some_and(|a| a.temporal.is_some())
-            || settings.radiosity.as_ref().is_some_and(|r| r.temporal.is_some());
+            || settings
+                .radiosity
+                .as_ref()
+                .is_some_and(|r| r.temporal.is_some() || r.delta > 0.0);
         if temporal_on && targets.try_get("csz-history").is_none() {
             let l = settings.deep.array_layers();
             targets.create(
@@ -275,6 +278,12 @@ impl Renderer {
         }
         if radiosity.as_ref().is_some_and(|r| r.temporal.is_some()) {
             copies.push(("indirect-temporal", "indirect-temporal-history"));
+        }
+        if radiosity.as_ref().is_some_and(|r| r.propagate.is_some()) {
+            copies.push(("indirect", "indirect-history"));
+            if settings.deep.layers > 1 {
+                copies.push(("indirect1-raw", "indirect1-history"));
+            }
         }
         let history = (!copies.is_empty()).then_some(HistoryPass { copies });
         let profiler = Profiler::new(gpu, 16);
@@ -379,6 +388,9 @@ impl Renderer {
         if let (Some(stage), Some(s)) = (&self.radiosity, &self.settings.radiosity) {
             let ru = RadiosityUniforms::new(s, &u, max_mip, frame.max(0.0) as u32);
             stage.gather.set_frame(gpu, ru);
+            if let Some(p) = &stage.propagate {
+                p.set_frame(gpu, temporal_history);
+            }
             if let Some(t) = &stage.temporal {
                 t.set_frame(gpu, temporal_history);
             }
@@ -784,6 +796,7 @@ impl AoStage {
 /// The radiosity passes: Eq. 4–5 gather → temporal filter → bilateral into
 /// `indirect` (layer 0's irradiance E, a = confidence).
 struct RadiosityStage {
+    propagate: Option<crate::passes::radiosity::PropagatePass>,
     gather: RadiosityPass,
     temporal: Option<TemporalPass>,
     blur_h: BilateralPass,
@@ -832,7 +845,25 @@ impl RadiosityStage {
                 "indirect irradiance E of layer 0 (rgb), confidence (a)",
             ),
         );
-        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers);
+        let propagate = (s.delta > 0.0).then(|| {
+            for t in crate::passes::radiosity::BOUNCE_OUTPUTS {
+                targets.create(gpu, t);
+            }
+            for (name, doc) in [
+                ("indirect-history", "last frame's final indirect E of layer 0"),
+                ("indirect1-history", "last frame's indirect E of layer 1"),
+            ] {
+                targets.create(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc));
+            }
+            let d = s.temporal.unwrap_or_default().max_distance;
+            crate::passes::radiosity::PropagatePass::new(gpu, scene, targets, deep.layers, s, d)
+        });
+        let b = if propagate.is_some() {
+            ["bounce0", "bounce1"]
+        } else {
+            ["radiosity0", "radiosity1"]
+        };
+        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers, b);
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
                 gpu,
@@ -869,6 +900,7 @@ impl RadiosityStage {
         targets.create(gpu, crate::passes::compose::OUTPUT);
         let compose = crate::passes::compose::ComposePass::new(gpu, targets, s.boost);
         Self {
+            propagate,
             gather,
             temporal,
             blur_h,
@@ -878,7 +910,11 @@ impl RadiosityStage {
     }
 
     fn passes(&self) -> Vec<&dyn Pass> {
-        let mut v: Vec<&dyn Pass> = vec![&self.gather];
+        let mut v: Vec<&dyn Pass> = Vec::new();
+        if let Some(p) = &self.propagate {
+            v.push(p);
+        }
+        v.push(&self.gather);
         if let Some(t) = &self.temporal {
             v.push(t);
         }

@@ -196,3 +196,103 @@ fn light_seen_only_by_layer_1_reaches_the_floor_with_two_layers_only() {
     assert!(results[0] < 1e-4, "1 layer found light it cannot see: {}", results[0]);
     assert!(results[1] > 0.05, "2 layers did not light the floor: {}", results[1]);
 }
+
+/// A closed grey box (albedo ρ) lit by a point light, seen from inside.
+fn closed_box(rho: f32) -> Scene {
+    let v = Vec3::new;
+    let mut walls = MeshBuilder::new();
+    walls.cuboid(v(-2.0, 0.0, -2.0), v(2.0, 3.0, 2.0));
+    let materials = vec![Material::diffuse("walls", [rho; 3])];
+    Scene {
+        name: "closed-box".into(),
+        meshes: vec![walls.build("walls", 0)],
+        objects: vec![Object {
+            name: "walls".into(),
+            mesh: 0,
+            transform: Mat4::IDENTITY,
+            animation: None,
+        }],
+        materials,
+        lights: vec![strata_scene::Light::Point {
+            position: v(0.5, 2.5, 0.5),
+            color: [1.0; 3],
+            intensity: 10.0,
+        }],
+        camera: Camera::new(v(1.5, 1.5, 1.5), v(-2.0, 1.0, -2.0), Vec3::Y, 80.0, 0.05),
+        settings: SceneSettings {
+            min_separation: 0.5,
+            sky: [0.0; 3],
+            ambient: [0.0; 3],
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+fn box_settings(delta: f32) -> RadiositySettings {
+    RadiositySettings {
+        radius: 10.0,
+        samples: 32,
+        min_mip: 0,
+        delta,
+        boost: false,
+        temporal: None,
+        blur: strata_render::passes::bilateral::BilateralSettings {
+            radius: 0,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// Mean of channel 0 of `indirect` after each of `frames` static frames.
+fn mean_indirect_per_frame(gpu: &GpuContext, scene: &Scene, rs: RadiositySettings, frames: u32) -> Vec<f64> {
+    let (w, h) = (64, 64);
+    let mut r = renderer(gpu, scene, w, h, 2, rs);
+    let cams = FrameCameras::fixed(scene.camera);
+    (0..frames)
+        .map(|f| {
+            r.render(gpu, scene, &cams, f as f32).unwrap();
+            let e = r.read_target(gpu, "indirect").unwrap();
+            e.data.chunks_exact(4).map(|p| p[0] as f64).sum::<f64>() / (w * h) as f64
+        })
+        .collect()
+}
+
+/// §3.3 progressive bounces with boost = 1 and δ = 1 in a closed box: each
+/// frame adds one bounce. The bounce operator is linear, so the per-bounce
+/// ratio must equal ρ · g, where g = E/(πL) is the gather's response to a
+/// uniformly radiant enclosure (1 for an unbiased estimator; Eq. 4–5 count
+/// only the M taps that pass Eq. 5, which over-weights steep directions, g > 1),
+/// and the total must stay below the geometric-series bound S_1 / (1 − ρ g).
+#[test]
+fn multi_bounce_in_a_closed_box_converges_below_the_geometric_bound() {
+    let gpu = common::gpu();
+    let rho = 0.6;
+    // g: every wall emits L = 1, no light, one bounce
+    let mut glowing = closed_box(0.0);
+    glowing.materials[0].emission = [1.0; 3];
+    glowing.lights.clear();
+    let g = mean_indirect_per_frame(&gpu, &glowing, box_settings(0.0), 1)[0] / std::f64::consts::PI;
+    let s = mean_indirect_per_frame(&gpu, &closed_box(rho), box_settings(1.0), 12);
+    let d: Vec<f64> = s.windows(2).map(|p| p[1] - p[0]).collect();
+    eprintln!("gather gain g = {g:.4}; mean E per frame: {s:?}");
+    eprintln!("increments: {d:?}");
+    assert!((0.8..1.6).contains(&g), "gather response to uniform radiance g = {g}");
+    assert!(s[0] > 0.01, "no first bounce: {}", s[0]);
+    assert!(d.iter().all(|&x| x > 0.0), "bounces decreased the total: {d:?}");
+    let r = rho as f64 * g;
+    let bound = s[0] / (1.0 - r);
+    assert!(
+        *s.last().unwrap() <= bound,
+        "{} exceeds the geometric bound {bound}",
+        s.last().unwrap()
+    );
+    for k in 3..8 {
+        let ratio = d[k] / d[k - 1];
+        assert!(
+            (ratio - r).abs() < 0.08 * r,
+            "bounce ratio {ratio} at {k}, expected ρ·g = {r}"
+        );
+    }
+}

@@ -24,7 +24,8 @@ use crate::spiral::{self, SpiralTurns};
 /// reconstruction taps, n̂_Y test on, minimum MIP level 2), radius 4 scene units
 /// (the paper gives none; the authors' demo scenes use 7.4 of their units),
 /// q = 8 px, boost off (energy-conserving, comparable with the path tracer),
-/// temporal α = 0.85.
+/// temporal α = 0.85, multi-bounce δ = 0.9 (the demo's "propagation damping"
+/// 0.1, documented as 1 − δ).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
     /// Samples N per pixel.
@@ -41,6 +42,9 @@ pub struct RadiositySettings {
     pub temporal_noise: bool,
     /// Eq. 7's boost(ρ) on the reflected bounce (false: boost = 1).
     pub boost: bool,
+    /// §3.3 progressive multi-bounce damping δ in [0, 1]: each frame feeds
+    /// δ · ρ/π · E_{t−1} back into B (0 = single bounce).
+    pub delta: f32,
     pub mips: DepthMipSettings,
     pub blur: BilateralSettings,
     pub temporal: Option<TemporalSettings>,
@@ -58,6 +62,7 @@ impl Default for RadiositySettings {
             rotate: true,
             temporal_noise: false,
             boost: false,
+            delta: 0.9,
             mips: DepthMipSettings::default(),
             blur: BilateralSettings {
                 radius: 5,
@@ -89,6 +94,12 @@ impl RadiositySettings {
         }
         if !(self.q >= 1.0 && self.q.is_finite()) {
             return Err(format!("MIP radius q {} is out of range: must be >= 1 pixel", self.q));
+        }
+        if !(0.0..=1.0).contains(&self.delta) {
+            return Err(format!(
+                "propagation damping δ {} is out of range: must be in [0, 1]",
+                self.delta
+            ));
         }
         self.mips.validate()?;
         self.blur.validate()?;
@@ -168,7 +179,8 @@ pub struct RadiosityPass {
 }
 
 impl RadiosityPass {
-    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32) -> Self {
+    /// Gathers from the radiosity buffers `b` (layer 0, layer 1).
+    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32, b: [&'static str; 2]) -> Self {
         use crate::passes::{texture_entry, uniform_entry};
         let device = &gpu.device;
         let d2 = wgpu::TextureViewDimension::D2;
@@ -184,7 +196,7 @@ impl RadiosityPass {
         });
         let zeroed: RadiosityUniforms = bytemuck::Zeroable::zeroed();
         let uniforms = crate::passes::uniform_buffer(device, "radiosity", &zeroed);
-        let b1 = if layers > 1 { "radiosity1" } else { "radiosity0" };
+        let b1 = if layers > 1 { b[1] } else { b[0] };
         let view = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).view);
         let group = crate::passes::bind_group(
             device,
@@ -194,7 +206,7 @@ impl RadiosityPass {
                 uniforms.as_entire_binding(),
                 view("zmip"),
                 view("npack"),
-                view("radiosity0"),
+                view(b[0]),
                 view(b1),
             ],
         );
@@ -213,9 +225,9 @@ impl RadiosityPass {
             &[("LAYERS", layers as f64)],
             &formats,
         );
-        let mut inputs = vec!["zmip", "npack", "radiosity0"];
+        let mut inputs = vec!["zmip", "npack", b[0]];
         if layers > 1 {
-            inputs.push("radiosity1");
+            inputs.push(b[1]);
         }
         Self {
             inputs,
@@ -250,6 +262,164 @@ impl Pass for RadiosityPass {
         crate::passes::fullscreen_pass(
             encoder,
             "radiosity",
+            &self.pipeline,
+            &outputs,
+            &[&scene.frame_bind_group, &self.group],
+        );
+    }
+}
+
+/// Mirrors `Propagate` in `propagate.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct PropagateUniforms {
+    pub delta: f32,
+    pub max_distance: f32,
+    pub has_history: u32,
+    pub boost: u32,
+}
+
+/// The radiosity inputs of this frame's gather (§3.3): `bounce0`/`bounce1` =
+/// direct + δ · ρ/π · boost · reprojected E_{t−1} of the same layer.
+pub const BOUNCE_OUTPUTS: [TargetDesc; 2] = [
+    TargetDesc::new(
+        "bounce0",
+        crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+        1,
+        "layer 0 radiosity B for this frame's gather: direct + δ·ρ/π·E(t−1)",
+    ),
+    TargetDesc::new(
+        "bounce1",
+        crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+        1,
+        "layer 1 radiosity B for this frame's gather: direct + δ·ρ/π·E(t−1)",
+    ),
+];
+
+pub struct PropagatePass {
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    uniforms: wgpu::Buffer,
+    settings: PropagateUniforms,
+    inputs: Vec<&'static str>,
+}
+
+impl PropagatePass {
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        layers: u32,
+        s: &RadiositySettings,
+        max_distance: f32,
+    ) -> Self {
+        use crate::passes::{texture_entry, uniform_entry};
+        let device = &gpu.device;
+        let (d2, arr) = (wgpu::TextureViewDimension::D2, wgpu::TextureViewDimension::D2Array);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("propagate"),
+            entries: &[
+                uniform_entry(0),
+                texture_entry(1, arr, false),
+                texture_entry(2, arr, false),
+                texture_entry(3, arr, false),
+                texture_entry(4, d2, false),
+                texture_entry(5, d2, false),
+                texture_entry(6, arr, false),
+                texture_entry(7, d2, false),
+                texture_entry(8, d2, false),
+            ],
+        });
+        let settings = PropagateUniforms {
+            delta: s.delta,
+            max_distance,
+            has_history: 0,
+            boost: s.boost as u32,
+        };
+        let uniforms = crate::passes::uniform_buffer(device, "propagate", &settings);
+        let direct1 = if layers > 1 { "radiosity1" } else { "radiosity0" };
+        let e1 = if layers > 1 {
+            "indirect1-history"
+        } else {
+            "indirect-history"
+        };
+        let view = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).view);
+        let array = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).array_view);
+        let group = crate::passes::bind_group(
+            device,
+            "propagate",
+            &layout,
+            &[
+                uniforms.as_entire_binding(),
+                array("csz"),
+                array("albedo"),
+                array("normal"),
+                view("radiosity0"),
+                view(direct1),
+                array("csz-history"),
+                view("indirect-history"),
+                view(e1),
+            ],
+        );
+        let pl = crate::passes::frame_pipeline_layout(device, "propagate", scene, &[&layout]);
+        let module = crate::shader::module(device, "propagate", include_str!("propagate.wgsl"));
+        let formats: Vec<_> = BOUNCE_OUTPUTS
+            .iter()
+            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
+            .collect();
+        let pipeline = crate::passes::fullscreen_pipeline_with(
+            device,
+            "propagate",
+            &pl,
+            &module,
+            "fs_main",
+            &[("LAYERS", layers as f64)],
+            &formats,
+        );
+        let mut inputs = vec![
+            "csz",
+            "albedo",
+            "normal",
+            "radiosity0",
+            "csz-history",
+            "indirect-history",
+        ];
+        if layers > 1 {
+            inputs.extend(["radiosity1", "indirect1-history"]);
+        }
+        Self {
+            pipeline,
+            group,
+            uniforms,
+            settings,
+            inputs,
+        }
+    }
+
+    /// Whether last frame's E is in the history targets.
+    pub fn set_frame(&self, gpu: &GpuContext, has_history: bool) {
+        let u = PropagateUniforms {
+            has_history: has_history as u32,
+            ..self.settings
+        };
+        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+}
+
+impl Pass for PropagatePass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: "propagate",
+            inputs: self.inputs.clone(),
+            outputs: BOUNCE_OUTPUTS.iter().map(|t| t.name).collect(),
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let outputs: Vec<_> = BOUNCE_OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
+        crate::passes::fullscreen_pass(
+            encoder,
+            "propagate",
             &self.pipeline,
             &outputs,
             &[&scene.frame_bind_group, &self.group],
