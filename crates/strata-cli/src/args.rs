@@ -346,6 +346,10 @@ pub struct RenderArgs {
     /// Print per-pass GPU times after rendering.
     #[arg(long)]
     pub timings: bool,
+    /// Frames rendered before the output frame (along the camera path), 0..=1000, so temporal
+    /// filters and progressive bounces (DGB §3.3) have history.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1000))]
+    pub warmup: u32,
 }
 
 #[derive(Copy, Clone, PartialEq, Eq, ValueEnum, Debug)]

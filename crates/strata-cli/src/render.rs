@@ -54,9 +54,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             );
         }
     }
-    if r.settings.deep.uses_history() {
-        // Single-pass layers test against last frame's depths: render frame − 1 first.
-        let f = a.scene.frame - 1.0;
+    // Frames before the output one: single-pass layers test against last
+    // frame's depths, temporal filters and progressive bounces accumulate.
+    let warmup = a.warmup.max(r.settings.deep.uses_history() as u32);
+    for i in (1..=warmup).rev() {
+        let f = a.scene.frame - i as f32;
         r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f), f)?;
     }
     let t = r.render(&gpu, &scene, &cams, a.scene.frame)?;
