@@ -137,9 +137,9 @@ pub struct RadiosityArgs {
     /// Indirect samples N per pixel, 1..=256.
     #[arg(long, default_value_t = 14)]
     pub indirect_samples: u32,
-    /// World-space gather radius, > 0 (scene units).
-    #[arg(long, default_value_t = 4.0)]
-    pub radiosity_radius: f32,
+    /// World-space gather radius, > 0 (scene units; default: the scene's `radiosity_radius`).
+    #[arg(long)]
+    pub radiosity_radius: Option<f32>,
     /// Omit Eq. 5's n_Y test (cheaper, biased).
     #[arg(long)]
     pub no_normal_test: bool,
@@ -269,6 +269,8 @@ fn parse_turns(s: &str) -> Result<SpiralTurns, String> {
 pub enum EvalTechnique {
     /// Deep-G-buffer AO against the ray-traced obscurance (same Eq. 2, same r, β, ε; all layers) and binary AO.
     Ao,
+    /// Deep-G-buffer radiosity (indirect diffuse, and direct + indirect) against the CPU path tracer.
+    Gi,
 }
 
 #[derive(Args)]
@@ -284,9 +286,18 @@ pub struct EvalArgs {
     pub deep: DeepArgs,
     #[command(flatten)]
     pub ao: AoArgs,
-    /// Samples per pixel of the CPU reference, 1..=65536.
-    #[arg(long, default_value_t = 256)]
-    pub ref_spp: u32,
+    #[command(flatten)]
+    pub radiosity: RadiosityArgs,
+    /// Samples per pixel of the CPU reference, 1..=65536 (default: 256 for ao, 64 for gi).
+    #[arg(long)]
+    pub ref_spp: Option<u32>,
+    /// Indirect bounces of the path-traced reference (gi), 1..=64.
+    #[arg(long, default_value_t = 4)]
+    pub bounces: u32,
+    /// Static frames rendered before the evaluated one (gi: progressive bounces and the
+    /// temporal filter converge), 0..=1000.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=1000))]
+    pub warmup: u32,
     /// Folder of cached reference images (default: $STRATA_CACHE, else $XDG_CACHE_HOME/strata/reference, else ~/.cache/strata/reference).
     #[arg(long)]
     pub cache: Option<PathBuf>,

@@ -21,6 +21,7 @@ use crate::report::{write_report, ReportImage, ReportSection};
 pub fn run(a: &EvalArgs) -> Result<()> {
     match a.technique {
         EvalTechnique::Ao => ao(a),
+        EvalTechnique::Gi => crate::eval_gi::run(a),
     }
 }
 
@@ -34,8 +35,9 @@ struct AoResult {
 }
 
 fn ao(a: &EvalArgs) -> Result<()> {
-    if !(1..=65536).contains(&a.ref_spp) {
-        bail!("--ref-spp {} is out of range: must be in 1..=65536", a.ref_spp);
+    let ref_spp = a.ref_spp.unwrap_or(256);
+    if !(1..=65536).contains(&ref_spp) {
+        bail!("--ref-spp {ref_spp} is out of range: must be in 1..=65536");
     }
     if let Some(n) = a.frames {
         if !(2..=1000).contains(&n) {
@@ -67,12 +69,12 @@ fn ao(a: &EvalArgs) -> Result<()> {
         radius,
         beta,
         epsilon,
-        spp: a.ref_spp,
+        spp: ref_spp,
         disk: DiskSampling::SpiralRadius,
         ..ObscuranceSettings::new(radius)
     };
     let binary_settings = AoBinarySettings {
-        spp: a.ref_spp,
+        spp: ref_spp,
         ..AoBinarySettings::new(radius)
     };
     let scene_id = scene_fingerprint(&scene, a.scene.frame);
@@ -126,7 +128,7 @@ fn ao(a: &EvalArgs) -> Result<()> {
         "width": w, "height": h, "frame": a.scene.frame,
         "samples": settings.samples, "radius": radius, "bias": beta, "epsilon": epsilon,
         "flip": main.obscurance.flip, "rmse": main.obscurance.rmse, "mae": main.obscurance.mae,
-        "ref_spp": a.ref_spp,
+        "ref_spp": ref_spp,
         "reference": "obscurance (DGB Eq. 2 over all surfaces, spiral radial density)",
         "binary": stats(&main.binary),
         "device": gpu.describe(),
@@ -153,7 +155,7 @@ fn ao(a: &EvalArgs) -> Result<()> {
             main.obscurance.flip,
             main.obscurance.rmse,
             main.obscurance.mae,
-            a.ref_spp,
+            ref_spp,
             main.binary.flip,
             main.binary.mae
         );
@@ -213,7 +215,7 @@ fn cached(cache: &RefCache, refresh: bool, description: &str, compute: impl FnOn
 /// Identifies a scene's content at one frame for the cache key: name, triangle
 /// and vertex counts, an FNV-1a hash of every vertex position and index, the
 /// materials, the object transforms at `frame`, and the scene settings.
-fn scene_fingerprint(scene: &Scene, frame: f32) -> String {
+pub(crate) fn scene_fingerprint(scene: &Scene, frame: f32) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut eat = |bytes: &[u8]| {
         for &b in bytes {
@@ -365,7 +367,7 @@ fn write_ao_report(
         title: format!("{k}-layer deep-G-buffer AO against the ray-traced obscurance"),
         text: format!(
             "AV = 1 − AO (white = unoccluded), {}×{} pixels, frame {}. The reference evaluates DGB Eq. 2 with the same r, β, ε over every surface along each sample ray ({} spp, spiral radial density). Values are shown as grey bytes 255·AV; FLIP maps use the magma scale.",
-            a.scene.width, a.scene.height, a.scene.frame, a.ref_spp
+            a.scene.width, a.scene.height, a.scene.frame, numbers["ref_spp"]
         ),
         images: vec![
             fig(&main.av, &format!("gpu-k{k}.png"), format!("GPU, k = {k}: FLIP {:.4}, MAE {:.4}", s.flip, s.mae))?,

@@ -5,6 +5,7 @@ mod bench;
 mod bench_ao;
 mod bench_deep;
 mod eval;
+mod eval_gi;
 mod info;
 mod metrics;
 mod output;

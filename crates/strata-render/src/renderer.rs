@@ -386,7 +386,7 @@ impl Renderer {
             }
         }
         if let (Some(stage), Some(s)) = (&self.radiosity, &self.settings.radiosity) {
-            let ru = RadiosityUniforms::new(s, &u, max_mip, frame.max(0.0) as u32);
+            let ru = RadiosityUniforms::new(s, scene, &u, max_mip, frame.max(0.0) as u32);
             stage.gather.set_frame(gpu, ru);
             if let Some(p) = &stage.propagate {
                 p.set_frame(gpu, temporal_history);

@@ -61,6 +61,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
         let (w, h) = (96, 64);
         let rs = RadiositySettings {
             normal_test,
+            radius: Some(4.0),
             ..Default::default()
         };
         let mut r = renderer(&gpu, &scene, w, h, 2, rs);
@@ -175,7 +176,7 @@ fn light_seen_only_by_layer_1_reaches_the_floor_with_two_layers_only() {
     let scene = hidden_emitter_scene();
     let (w, h) = (96, 64);
     let rs = RadiositySettings {
-        radius: 3.0,
+        radius: Some(3.0),
         temporal: None,
         ..Default::default()
     };
@@ -231,7 +232,7 @@ fn closed_box(rho: f32) -> Scene {
 
 fn box_settings(delta: f32) -> RadiositySettings {
     RadiositySettings {
-        radius: 10.0,
+        radius: Some(10.0),
         samples: 32,
         min_mip: 0,
         delta,

@@ -66,6 +66,7 @@
 //! [settings]              # any subset; the rest keeps the base scene's values
 //! ao_radius = 1.0         # > 0
 //! min_separation = 0.5    # > 0
+//! radiosity_radius = 8.0  # > 0
 //! exposure = 1.0          # > 0
 //! sky = [0.3, 0.45, 0.75] # >= 0
 //! ambient = [0.03, 0.03, 0.03]  # >= 0
@@ -178,14 +179,16 @@ pub fn default_sun() -> Light {
     }
 }
 
-/// Settings for a mesh file with the given bounds: AO radius 2.5 % and minimum
-/// separation 1.25 % of the bounds' diagonal, a dim bluish sky, exposure 1.
+/// Settings for a mesh file with the given bounds: AO radius 2.5 %, minimum
+/// separation 1.25 % and radiosity radius 20 % of the bounds' diagonal, a dim
+/// bluish sky, exposure 1.
 pub fn default_settings(lo: Vec3, hi: Vec3) -> SceneSettings {
     let diag = (hi - lo).length();
     let diag = if diag.is_finite() && diag > 0.0 { diag } else { 1.0 };
     SceneSettings {
         ao_radius: 0.025 * diag,
         min_separation: 0.0125 * diag,
+        radiosity_radius: 0.2 * diag,
         exposure: 1.0,
         sky: [0.15, 0.18, 0.22],
         ..SceneSettings::default()
@@ -839,6 +842,7 @@ struct TomlKeyframe {
 struct TomlSettings {
     ao_radius: Option<f32>,
     min_separation: Option<f32>,
+    radiosity_radius: Option<f32>,
     exposure: Option<f32>,
     sky: Option<[f32; 3]>,
     ambient: Option<[f32; 3]>,
@@ -1151,6 +1155,9 @@ fn build_toml_scene(doc: TomlScene, path: &Path) -> Result<Scene, SceneError> {
         if let Some(x) = s.min_separation {
             st.min_separation = ck.positive("settings.min_separation", x)?;
         }
+        if let Some(x) = s.radiosity_radius {
+            st.radiosity_radius = ck.positive("settings.radiosity_radius", x)?;
+        }
         if let Some(x) = s.exposure {
             st.exposure = ck.positive("settings.exposure", x)?;
         }
@@ -1287,4 +1294,5 @@ fn transform_scene(scene: &mut Scene, xf: Mat4, scale: f32) {
     }
     scene.settings.ao_radius *= scale;
     scene.settings.min_separation *= scale;
+    scene.settings.radiosity_radius *= scale;
 }

@@ -221,6 +221,8 @@ pub struct SceneSettings {
     pub ao_radius: f32,
     /// Deep G-buffer minimum separation Δz.
     pub min_separation: f32,
+    /// World-space gather radius of screen-space radiosity (DGB §3.2).
+    pub radiosity_radius: f32,
     /// Exposure multiplier applied before tonemapping.
     pub exposure: f32,
     /// Constant sky/environment radiance seen by rays that leave the scene.
@@ -234,6 +236,7 @@ impl Default for SceneSettings {
         Self {
             ao_radius: 1.0,
             min_separation: 0.5,
+            radiosity_radius: 8.0,
             exposure: 1.0,
             sky: [0.0; 3],
             ambient: [0.03; 3],

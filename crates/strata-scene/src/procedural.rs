@@ -209,6 +209,7 @@ pub fn cornell() -> Scene {
     let settings = SceneSettings {
         ao_radius: 0.1,
         min_separation: 0.05,
+        radiosity_radius: 8.0,
         exposure: 1.0,
         sky: [0.0; 3],
         ambient: [0.0; 3],
@@ -372,6 +373,7 @@ pub fn atrium() -> Scene {
     let settings = SceneSettings {
         ao_radius: 1.0,
         min_separation: 0.5,
+        radiosity_radius: 16.0,
         exposure: 0.5,
         sky: [0.3, 0.45, 0.75],
         ambient: [0.03; 3],
@@ -476,6 +478,7 @@ pub fn warehouse() -> Scene {
     let settings = SceneSettings {
         ao_radius: 0.8,
         min_separation: 0.3,
+        radiosity_radius: 16.0,
         exposure: 0.8,
         sky: [0.0; 3],
         ambient: [0.02; 3],
@@ -500,6 +503,7 @@ pub fn plane() -> Scene {
     let settings = SceneSettings {
         ao_radius: 1.0,
         min_separation: 0.5,
+        radiosity_radius: 8.0,
         exposure: 1.0,
         sky: [0.0; 3],
         ambient: [0.0; 3],
@@ -527,6 +531,7 @@ pub fn column_wall() -> Scene {
     let settings = SceneSettings {
         ao_radius: 1.0,
         min_separation: 0.25,
+        radiosity_radius: 8.0,
         exposure: 1.0,
         sky: [0.2, 0.25, 0.35],
         ambient: [0.03; 3],
@@ -561,6 +566,7 @@ pub fn dense() -> Scene {
     let settings = SceneSettings {
         ao_radius: 0.5,
         min_separation: 0.5,
+        radiosity_radius: 8.0,
         exposure: 1.0,
         sky: [0.2, 0.25, 0.35],
         ambient: [0.03; 3],

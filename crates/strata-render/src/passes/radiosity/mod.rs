@@ -21,7 +21,7 @@ use crate::scene_gpu::GpuScene;
 use crate::spiral::{self, SpiralTurns};
 
 /// Radiosity settings. Defaults: Table 2's BALANCED preset (N = 14, 11
-/// reconstruction taps, n̂_Y test on, minimum MIP level 2), radius 4 scene units
+/// reconstruction taps, n̂_Y test on, minimum MIP level 2), the scene's radius
 /// (the paper gives none; the authors' demo scenes use 7.4 of their units),
 /// q = 8 px, boost off (energy-conserving, comparable with the path tracer),
 /// temporal α = 0.85, multi-bounce δ = 0.9 (the demo's "propagation damping"
@@ -30,8 +30,8 @@ use crate::spiral::{self, SpiralTurns};
 pub struct RadiositySettings {
     /// Samples N per pixel.
     pub samples: u32,
-    /// World-space gather radius r.
-    pub radius: f32,
+    /// World-space gather radius r; `None` = the scene's `radiosity_radius`.
+    pub radius: Option<f32>,
     /// Eq. 5's second test, ω̂·n̂_Y < 0 (off: the paper's cheaper, biased variant).
     pub normal_test: bool,
     /// Lowest MIP level a tap reads (Table 2's "minimum MIP level").
@@ -54,7 +54,7 @@ impl Default for RadiositySettings {
     fn default() -> Self {
         Self {
             samples: 14,
-            radius: 4.0,
+            radius: None,
             normal_test: true,
             min_mip: 2,
             q: 8.0,
@@ -83,8 +83,10 @@ impl RadiositySettings {
                 crate::passes::ao::MAX_SAMPLES
             ));
         }
-        if !(self.radius > 0.0 && self.radius.is_finite()) {
-            return Err(format!("radiosity radius {} is out of range: must be > 0", self.radius));
+        if let Some(r) = self.radius {
+            if !(r > 0.0 && r.is_finite()) {
+                return Err(format!("radiosity radius {r} is out of range: must be > 0"));
+            }
         }
         if self.min_mip >= self.mips.levels {
             return Err(format!(
@@ -138,9 +140,15 @@ pub struct RadiosityUniforms {
 }
 
 impl RadiosityUniforms {
-    pub fn new(s: &RadiositySettings, frame: &FrameUniforms, max_mip: u32, frame_index: u32) -> Self {
+    pub fn new(
+        s: &RadiositySettings,
+        scene: &strata_scene::Scene,
+        frame: &FrameUniforms,
+        max_mip: u32,
+        frame_index: u32,
+    ) -> Self {
         Self {
-            radius: s.radius,
+            radius: s.radius.unwrap_or(scene.settings.radiosity_radius),
             proj_scale: crate::passes::ao::proj_scale(frame),
             q: s.q,
             tau: s.turns.tau(s.samples),
