@@ -8,7 +8,7 @@ use strata_render::passes::ao::AoSettings;
 use strata_render::passes::bilateral::BilateralSettings;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::depth_mip::DepthMipSettings;
-use strata_render::passes::radiosity::RadiositySettings;
+use strata_render::passes::radiosity::{Preset, RadiositySettings};
 use strata_render::passes::temporal::TemporalSettings;
 use strata_render::renderer::GuardBand;
 use strata_render::spiral::SpiralTurns;
@@ -131,51 +131,62 @@ pub enum Technique {
     Full,
 }
 
-/// Deep-G-buffer radiosity settings (DGB §3.2–3.5; defaults: Table 2's BALANCED).
+/// Deep-G-buffer radiosity settings (DGB §3.2–3.5): a Table 2 preset, then overrides.
 #[derive(Args, Clone)]
 pub struct RadiosityArgs {
-    /// Indirect samples N per pixel, 1..=256.
-    #[arg(long, default_value_t = 14)]
-    pub indirect_samples: u32,
+    /// DGB Table 2 parameter set (presets/*.toml): high-performance, balanced, high-quality.
+    #[arg(long, default_value = "balanced")]
+    pub preset: String,
+    /// Indirect samples N per pixel, 1..=256 (default: the preset's).
+    #[arg(long)]
+    pub indirect_samples: Option<u32>,
     /// World-space gather radius, > 0 (scene units; default: the scene's `radiosity_radius`).
     #[arg(long)]
     pub radiosity_radius: Option<f32>,
-    /// Omit Eq. 5's n_Y test (cheaper, biased).
+    /// Omit Eq. 5's n_Y test (cheaper, biased; default: the preset's choice).
     #[arg(long)]
     pub no_normal_test: bool,
-    /// Minimum MIP level of the gather taps (below --mip-levels).
-    #[arg(long, default_value_t = 2)]
-    pub min_mip: u32,
+    /// Minimum MIP level of the gather taps, below the MIP levels (default: the preset's).
+    #[arg(long)]
+    pub min_mip: Option<u32>,
     /// Apply Eq. 7's boost to the reflected indirect light (off: energy-conserving).
     #[arg(long)]
     pub boost: bool,
-    /// Bilateral taps on each side for the indirect light, 0..=32 (Table 2 BALANCED: 11 taps = 5).
-    #[arg(long, default_value_t = 5)]
-    pub indirect_blur_radius: u32,
+    /// Bilateral taps on each side for the indirect light, 0..=32 (default: the preset's taps / 2).
+    #[arg(long)]
+    pub indirect_blur_radius: Option<u32>,
     /// Temporal filter weight α of the indirect light, in [0, 1) (0 disables).
     #[arg(long, default_value_t = 0.85)]
     pub indirect_alpha: f32,
+    /// Progressive multi-bounce damping δ in [0, 1] (DGB §3.3; 0 = single bounce).
+    #[arg(long, default_value_t = 0.9)]
+    pub delta: f32,
 }
 
 impl RadiosityArgs {
-    pub fn settings(&self) -> RadiositySettings {
-        let d = RadiositySettings::default();
-        RadiositySettings {
-            samples: self.indirect_samples,
-            radius: self.radiosity_radius,
-            normal_test: !self.no_normal_test,
-            min_mip: self.min_mip,
-            boost: self.boost,
-            blur: BilateralSettings {
-                radius: self.indirect_blur_radius,
-                ..d.blur
-            },
-            temporal: (self.indirect_alpha != 0.0).then_some(TemporalSettings {
-                alpha: self.indirect_alpha,
-                ..Default::default()
-            }),
-            ..d
+    pub fn settings(&self) -> Result<RadiositySettings, String> {
+        let preset = Preset::named(&self.preset).map_err(|e| format!("--preset: {e}"))?;
+        let mut s = preset.apply(RadiositySettings::default());
+        if let Some(n) = self.indirect_samples {
+            s.samples = n;
         }
+        s.radius = self.radiosity_radius;
+        if self.no_normal_test {
+            s.normal_test = false;
+        }
+        if let Some(m) = self.min_mip {
+            s.min_mip = m;
+        }
+        s.boost = self.boost;
+        if let Some(r) = self.indirect_blur_radius {
+            s.blur.radius = r;
+        }
+        s.temporal = (self.indirect_alpha != 0.0).then_some(TemporalSettings {
+            alpha: self.indirect_alpha,
+            ..Default::default()
+        });
+        s.delta = self.delta;
+        Ok(s)
     }
 }
 

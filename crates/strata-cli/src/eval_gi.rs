@@ -11,6 +11,7 @@ use strata_reference::gi::GiSettings;
 use strata_reference::Reference;
 use strata_render::passes::deep_gbuffer::DeepGBufferSettings;
 use strata_render::passes::lighting::LightingSettings;
+use strata_render::passes::radiosity::RadiositySettings;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::ImageBuf;
 
@@ -55,7 +56,8 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     scene.settings.sky = [0.0; 3];
     let (w, h) = (a.scene.width, a.scene.height);
     let camera = cams.current;
-    render_settings(a, a.deep.layers)
+    let rs = a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
+    render_settings(a, a.deep.layers, &rs)
         .validate()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
 
@@ -97,7 +99,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     let ref_full_ldr = display(&ref_total, exposure);
     let ref_indirect_ldr = display(&ref_indirect, exposure);
     let evaluate = |layers: u32| -> Result<GiResult> {
-        let mut r = Renderer::new(&gpu, &scene, render_settings(a, layers))?;
+        let mut r = Renderer::new(&gpu, &scene, render_settings(a, layers, &rs))?;
         let f = a.scene.frame;
         // static warm-up at the evaluated camera: bounces and temporal history
         let fixed = strata_render::frame::FrameCameras::fixed(cameras_at(&scene, &a.scene, f).current);
@@ -133,7 +135,6 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         None
     };
     let stats = |s: &ErrorStats| json!({"flip": s.flip, "rmse": s.rmse, "mae": s.mae});
-    let rs = a.radiosity.settings();
     let mut out = json!({
         "scene": a.scene.scene,
         "technique": "gi",
@@ -173,7 +174,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     Ok(())
 }
 
-fn render_settings(a: &EvalArgs, layers: u32) -> RenderSettings {
+fn render_settings(a: &EvalArgs, layers: u32, radiosity: &RadiositySettings) -> RenderSettings {
     RenderSettings {
         width: a.scene.width,
         height: a.scene.height,
@@ -187,7 +188,7 @@ fn render_settings(a: &EvalArgs, layers: u32) -> RenderSettings {
             specular: false,
             ..Default::default()
         },
-        radiosity: Some(a.radiosity.settings()),
+        radiosity: Some(radiosity.clone()),
         ..Default::default()
     }
 }

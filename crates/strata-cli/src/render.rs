@@ -8,6 +8,10 @@ use crate::output::{cameras_at, check_output, save, scene_and_camera};
 
 pub fn run(a: &RenderArgs) -> Result<()> {
     let (scene, cams) = scene_and_camera(&a.scene)?;
+    let radiosity = match a.technique {
+        Technique::Full => Some(a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?),
+        _ => None,
+    };
     let settings = RenderSettings {
         width: a.scene.width,
         height: a.scene.height,
@@ -20,7 +24,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         // AO alone needs no lighting passes
         shade: a.technique != Technique::Ao,
         ao: (a.technique == Technique::Ao).then(|| a.ao.settings()),
-        radiosity: (a.technique == Technique::Full).then(|| a.radiosity.settings()),
+        radiosity,
         ..Default::default()
     };
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;

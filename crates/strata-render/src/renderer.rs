@@ -261,7 +261,14 @@ impl Renderer {
             None => None,
         };
         let radiosity = match &settings.radiosity {
-            Some(r) => Some(RadiosityStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, r)),
+            Some(r) => Some(RadiosityStage::new(
+                gpu,
+                &scene_gpu,
+                &mut targets,
+                &settings.deep,
+                r,
+                settings.guard_pixels(),
+            )),
             None => None,
         };
         let tonemap = match (&radiosity, tonemap) {
@@ -811,6 +818,7 @@ impl RadiosityStage {
         targets: &mut Targets,
         deep: &DeepGBufferSettings,
         s: &RadiositySettings,
+        guard: u32,
     ) -> Self {
         use crate::frame::TargetDesc;
         use wgpu::TextureFormat as F;
@@ -863,7 +871,8 @@ impl RadiosityStage {
         } else {
             ["radiosity0", "radiosity1"]
         };
-        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers, b);
+        let region = crate::passes::radiosity::shaded_region(targets.width, targets.height, guard, s.guard_band_shaded);
+        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers, b, region);
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
                 gpu,

@@ -297,3 +297,53 @@ fn multi_bounce_in_a_closed_box_converges_below_the_geometric_bound() {
         );
     }
 }
+
+/// Table 2's "fraction of guard band shaded": outside it the gather leaves
+/// E = 0 and confidence 0; inside (and in the whole image) it runs.
+#[test]
+fn gather_shades_only_the_requested_fraction_of_the_guard_band() {
+    let gpu = common::gpu();
+    let scene = frozen("cornell");
+    let (w, h, g) = (64, 64, 16);
+    let mut r = Renderer::new(
+        &gpu,
+        &scene,
+        RenderSettings {
+            width: w,
+            height: h,
+            guard_band: strata_render::renderer::GuardBand::Pixels(g),
+            deep: DeepGBufferSettings {
+                layers: 2,
+                variant: Variant::Peel,
+                ..Default::default()
+            },
+            radiosity: Some(RadiositySettings {
+                guard_band_shaded: 0.5,
+                ..Default::default()
+            }),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
+    let e = r.read_target_full(&gpu, "indirect-raw", 0).unwrap();
+    let (fw, fh) = (w + 2 * g, h + 2 * g);
+    let inset = g / 2;
+    let (mut outside_nonzero, mut inside_conf) = (0, 0);
+    for y in 0..fh {
+        for x in 0..fw {
+            let p = e.pixel(x, y);
+            let inside = x >= inset && y >= inset && x < fw - inset && y < fh - inset;
+            if inside {
+                inside_conf += (p[3] > 0.0) as u32;
+            } else {
+                outside_nonzero += (p.iter().any(|&v| v != 0.0)) as u32;
+            }
+        }
+    }
+    assert_eq!(outside_nonzero, 0, "the unshaded guard band was written");
+    assert!(
+        inside_conf > (w * h) / 2,
+        "the shaded region has too few gathered pixels ({inside_conf})"
+    );
+}

@@ -209,7 +209,7 @@ pub fn cornell() -> Scene {
     let settings = SceneSettings {
         ao_radius: 0.1,
         min_separation: 0.05,
-        radiosity_radius: 8.0,
+        radiosity_radius: 0.5,
         exposure: 1.0,
         sky: [0.0; 3],
         ambient: [0.0; 3],

@@ -112,6 +112,19 @@ pub(crate) fn fullscreen_pass(
     outputs: &[&wgpu::TextureView],
     groups: &[&wgpu::BindGroup],
 ) {
+    fullscreen_pass_in(encoder, label, pipeline, outputs, groups, None)
+}
+
+/// As [`fullscreen_pass`], shading only inside `scissor` = [x, y, w, h] (the
+/// rest of the outputs is cleared to zero).
+pub(crate) fn fullscreen_pass_in(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::RenderPipeline,
+    outputs: &[&wgpu::TextureView],
+    groups: &[&wgpu::BindGroup],
+    scissor: Option<[u32; 4]>,
+) {
     let att: Vec<_> = outputs.iter().map(|v| clear_attachment(v)).collect();
     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
@@ -124,6 +137,9 @@ pub(crate) fn fullscreen_pass(
     pass.set_pipeline(pipeline);
     for (i, g) in groups.iter().enumerate() {
         pass.set_bind_group(i as u32, *g, &[]);
+    }
+    if let Some([x, y, w, h]) = scissor {
+        pass.set_scissor_rect(x, y, w, h);
     }
     pass.draw(0..3, 0..1);
 }

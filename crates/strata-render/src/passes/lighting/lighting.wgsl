@@ -24,6 +24,11 @@ struct LightingParams {
     // PCF kernel radius in texels (0 = single bilinear comparison)
     pcf_radius: i32,
     shadow_size: f32,
+    // 1 = emission enters the radiosity B (0 when emitters are Rect lights)
+    emission_in_radiosity: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -188,12 +193,12 @@ fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
     o.hdr = vec4f(total, 1.0);
     o.direct_diffuse = vec4f(d.lambert, 1.0);
     o.shadow = vec4f(d.shadow0, d.shadow0, d.shadow0, 1.0);
-    o.radiosity = vec4f(d.lambert + d.emission, 1.0);
+    o.radiosity = vec4f(d.lambert + d.emission * f32(params.emission_in_radiosity), 1.0);
     return o;
 }
 
 // DGB §3.2: the initial radiosity B of a deeper layer (bound instead of layer
-// 0) = its Lambertian direct light + emission.
+// 0) = its Lambertian direct light + emission (unless emitters are Rect lights).
 @fragment
 fn fs_layer_radiosity(@builtin(position) frag: vec4f) -> @location(0) vec4f {
     let px = vec2i(frag.xy);
@@ -202,5 +207,5 @@ fn fs_layer_radiosity(@builtin(position) frag: vec4f) -> @location(0) vec4f {
         return vec4f(0.0);
     }
     let d = direct_light(px, frag.xy, z);
-    return vec4f(d.lambert + d.emission, 1.0);
+    return vec4f(d.lambert + d.emission * f32(params.emission_in_radiosity), 1.0);
 }

@@ -54,6 +54,8 @@ struct Params {
     specular: u32,
     pcf_radius: i32,
     shadow_size: f32,
+    emission_in_radiosity: u32,
+    _pad: [u32; 3],
 }
 
 pub struct LightingPass {
@@ -137,6 +139,11 @@ impl LightingPass {
             specular: settings.specular as u32,
             pcf_radius: settings.pcf_radius.clamp(0, 4),
             shadow_size: shadow_resolution as f32,
+            // Emitters light the scene through the radiosity buffers, unless
+            // they are also analytic `Rect` lights: then the direct term
+            // already carries their light (no double counting).
+            emission_in_radiosity: !lights.iter().any(|l| l.kind[0] == crate::lights::KIND_RECT) as u32,
+            _pad: [0; 3],
         };
         let params_buf = wgpu::util::DeviceExt::create_buffer_init(
             device,

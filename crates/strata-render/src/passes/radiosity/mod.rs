@@ -48,6 +48,79 @@ pub struct RadiositySettings {
     pub mips: DepthMipSettings,
     pub blur: BilateralSettings,
     pub temporal: Option<TemporalSettings>,
+    /// Fraction of the guard band (DGB §3.5) in which the gather runs, in
+    /// [0, 1]; outside it E = 0 and confidence 0.
+    pub guard_band_shaded: f32,
+}
+
+/// DGB Table 2's parameter sets, read from `presets/*.toml` (embedded).
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Preset {
+    pub name: String,
+    /// Indirect samples N.
+    pub samples: u32,
+    /// Reconstruction filter taps per direction (odd: 2·radius + 1).
+    pub reconstruction_taps: u32,
+    /// Eq. 5's n̂_Y test.
+    pub normal_test: bool,
+    pub min_mip: u32,
+    /// Fraction of the guard band shaded.
+    pub guard_band_shaded: f32,
+}
+
+/// The preset files, by name.
+pub const PRESETS: [(&str, &str); 3] = [
+    (
+        "high-performance",
+        include_str!("../../../../../presets/high-performance.toml"),
+    ),
+    ("balanced", include_str!("../../../../../presets/balanced.toml")),
+    ("high-quality", include_str!("../../../../../presets/high-quality.toml")),
+];
+
+impl Preset {
+    /// The preset called `name` (high-performance, balanced, high-quality).
+    pub fn named(name: &str) -> Result<Self, String> {
+        let (_, text) = PRESETS.iter().find(|(n, _)| *n == name).ok_or_else(|| {
+            let names: Vec<_> = PRESETS.iter().map(|(n, _)| *n).collect();
+            format!("unknown preset '{name}': valid presets are {}", names.join(", "))
+        })?;
+        Self::parse(text).map_err(|e| format!("presets/{name}.toml: {e}"))
+    }
+
+    /// Parses and checks a preset file's text.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let p: Preset = toml::from_str(text).map_err(|e| e.to_string())?;
+        if p.reconstruction_taps % 2 == 0 {
+            return Err(format!(
+                "reconstruction_taps {} must be odd (2·radius + 1)",
+                p.reconstruction_taps
+            ));
+        }
+        if !(0.0..=1.0).contains(&p.guard_band_shaded) {
+            return Err(format!(
+                "guard_band_shaded {} is out of range: must be in [0, 1]",
+                p.guard_band_shaded
+            ));
+        }
+        Ok(p)
+    }
+
+    /// Settings with this preset's values (the rest from `base`).
+    pub fn apply(&self, base: RadiositySettings) -> RadiositySettings {
+        RadiositySettings {
+            samples: self.samples,
+            normal_test: self.normal_test,
+            min_mip: self.min_mip,
+            guard_band_shaded: self.guard_band_shaded,
+            blur: BilateralSettings {
+                radius: self.reconstruction_taps / 2,
+                ..base.blur
+            },
+            ..base
+        }
+    }
 }
 
 impl Default for RadiositySettings {
@@ -70,6 +143,7 @@ impl Default for RadiositySettings {
                 ..Default::default()
             },
             temporal: Some(TemporalSettings::default()),
+            guard_band_shaded: 0.5,
         }
     }
 }
@@ -96,6 +170,12 @@ impl RadiositySettings {
         }
         if !(self.q >= 1.0 && self.q.is_finite()) {
             return Err(format!("MIP radius q {} is out of range: must be >= 1 pixel", self.q));
+        }
+        if !(0.0..=1.0).contains(&self.guard_band_shaded) {
+            return Err(format!(
+                "fraction of the guard band shaded {} is out of range: must be in [0, 1]",
+                self.guard_band_shaded
+            ));
         }
         if !(0.0..=1.0).contains(&self.delta) {
             return Err(format!(
@@ -180,6 +260,8 @@ pub const OUTPUTS: [TargetDesc; 2] = [
 
 pub struct RadiosityPass {
     inputs: Vec<&'static str>,
+    /// Shaded region (the image plus the shaded part of the guard band).
+    scissor: Option<[u32; 4]>,
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
     uniforms: wgpu::Buffer,
@@ -187,8 +269,16 @@ pub struct RadiosityPass {
 }
 
 impl RadiosityPass {
-    /// Gathers from the radiosity buffers `b` (layer 0, layer 1).
-    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32, b: [&'static str; 2]) -> Self {
+    /// Gathers from the radiosity buffers `b` (layer 0, layer 1) inside the
+    /// `scissor` rectangle [x, y, w, h] (`None`: everywhere).
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        layers: u32,
+        b: [&'static str; 2],
+        scissor: Option<[u32; 4]>,
+    ) -> Self {
         use crate::passes::{texture_entry, uniform_entry};
         let device = &gpu.device;
         let d2 = wgpu::TextureViewDimension::D2;
@@ -239,6 +329,7 @@ impl RadiosityPass {
         }
         Self {
             inputs,
+            scissor,
             pipeline,
             group,
             uniforms,
@@ -267,12 +358,13 @@ impl Pass for RadiosityPass {
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         let outputs: Vec<_> = OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
-        crate::passes::fullscreen_pass(
+        crate::passes::fullscreen_pass_in(
             encoder,
             "radiosity",
             &self.pipeline,
             &outputs,
             &[&scene.frame_bind_group, &self.group],
+            self.scissor,
         );
     }
 }
@@ -519,4 +611,67 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         sum * (2.0 * std::f32::consts::PI / m_count as f32),
         m_count as f32 / u.samples as f32,
     )
+}
+
+/// The gather's scissor for a `w`×`h` target with `guard` pixels of guard band
+/// on each side, of which the fraction `shaded` is shaded (Table 2).
+pub fn shaded_region(w: u32, h: u32, guard: u32, shaded: f32) -> Option<[u32; 4]> {
+    let inset = (guard as f32 * (1.0 - shaded.clamp(0.0, 1.0))).round() as u32;
+    (inset > 0).then(|| [inset, inset, w - 2 * inset, h - 2 * inset])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The preset files reproduce DGB Table 2 and change the settings they name.
+    #[test]
+    fn presets_are_table_2() {
+        // (name, N, taps, n̂_Y test, minimum MIP, guard band shaded)
+        let table2 = [
+            ("high-performance", 13, 9, false, 3, 0.10),
+            ("balanced", 14, 11, true, 2, 0.50),
+            ("high-quality", 30, 13, true, 0, 0.80),
+        ];
+        for (name, n, taps, ny, mip, guard) in table2 {
+            let p = Preset::named(name).unwrap();
+            assert_eq!(p.name, name);
+            let base = RadiositySettings {
+                samples: 99,
+                normal_test: !ny,
+                min_mip: 4,
+                guard_band_shaded: 0.33,
+                ..Default::default()
+            };
+            let s = p.apply(base);
+            assert_eq!(s.samples, n, "{name}");
+            assert_eq!(s.blur.taps(), taps, "{name}");
+            assert_eq!(s.normal_test, ny, "{name}");
+            assert_eq!(s.min_mip, mip, "{name}");
+            assert_eq!(s.guard_band_shaded, guard, "{name}");
+            s.validate().unwrap();
+        }
+        assert!(Preset::named("ultra")
+            .unwrap_err()
+            .contains("high-performance, balanced, high-quality"));
+        assert!(Preset::parse("name = 'x'\nsamples = 1\nreconstruction_taps = 4\nnormal_test = true\nmin_mip = 0\nguard_band_shaded = 0.5")
+            .unwrap_err()
+            .contains("odd"));
+        assert!(Preset::parse("samples = 'many'").is_err());
+    }
+
+    #[test]
+    fn boost_is_eq7() {
+        assert_eq!(boost(Vec3::splat(0.5)), 0.0);
+        assert!((boost(Vec3::new(0.8, 0.2, 0.4)) - 0.75).abs() < 1e-6);
+        assert_eq!(boost(Vec3::ZERO), 0.0);
+    }
+
+    #[test]
+    fn shaded_region_insets_the_unshaded_guard_band() {
+        assert_eq!(shaded_region(100, 80, 10, 1.0), None);
+        assert_eq!(shaded_region(100, 80, 10, 0.5), Some([5, 5, 90, 70]));
+        assert_eq!(shaded_region(100, 80, 10, 0.0), Some([10, 10, 80, 60]));
+        assert_eq!(shaded_region(100, 80, 0, 0.1), None);
+    }
 }
