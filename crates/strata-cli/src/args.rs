@@ -439,6 +439,31 @@ pub enum BenchWhat {
     /// Deep-G-buffer AO passes (DGB Table 4, AO column): per-pass GPU ms and the
     /// 1st layer + 2nd layer increment split.
     Ao(BenchAoArgs),
+    /// Deep-G-buffer radiosity passes (DGB Table 4, indirect columns): per-pass GPU ms and
+    /// the 1st layer + 2nd layer increment split, for a Table 2 preset.
+    Radiosity(BenchRadiosityArgs),
+}
+
+#[derive(Args)]
+pub struct BenchRadiosityArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// Frames along the camera path to time (after one warm-up frame), 1..=10000.
+    #[arg(long, default_value_t = 5)]
+    pub frames: u32,
+    /// Deep G-buffer layers k, 1..=4 (compared with k = 1 for the increment).
+    #[arg(long, default_value_t = 2)]
+    pub layers: u32,
+    /// Deep G-buffer construction variant.
+    #[arg(long, default_value = "reproject", value_parser = parse_variant)]
+    pub variant: Variant,
+    #[command(flatten)]
+    pub radiosity: RadiosityArgs,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args)]

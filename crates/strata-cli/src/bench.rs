@@ -12,7 +12,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         BenchWhat::Gbuffer(b) => gbuffer(b),
         BenchWhat::DeepGbuffer(b) => crate::bench_deep::run(b),
         BenchWhat::Reference(b) => crate::reference::bench(b),
-        BenchWhat::Ao(b) => crate::bench_ao::run(b),
+        BenchWhat::Ao(b) => crate::bench_gi::ao(b),
+        BenchWhat::Radiosity(b) => crate::bench_gi::radiosity(b),
     }
 }
 

@@ -2,8 +2,8 @@
 
 mod args;
 mod bench;
-mod bench_ao;
 mod bench_deep;
+mod bench_gi;
 mod eval;
 mod eval_gi;
 mod info;
