@@ -127,7 +127,7 @@ pub enum Technique {
     Direct,
     /// Deep-G-buffer ambient visibility AV in [0, 1] (DGB §3.1; 1 = unoccluded): PNG grey (byte = 255·AV), EXR linear.
     Ao,
-    /// Direct light + deep-G-buffer radiosity (DGB §3.2–3.3): the composed image.
+    /// Direct light + deep-G-buffer radiosity (DGB §3.2–3.3) + mirror reflections (§3.6): the composed image.
     Full,
 }
 

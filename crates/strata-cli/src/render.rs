@@ -24,6 +24,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         // AO alone needs no lighting passes
         shade: a.technique != Technique::Ao,
         ao: (a.technique == Technique::Ao).then(|| a.ao.settings()),
+        reflections: (a.technique == Technique::Full).then(Default::default),
         radiosity,
         ..Default::default()
     };
@@ -71,7 +72,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         // AV itself: PNG byte = 255·AV (no transfer function), EXR linear
         (None, Technique::Ao, _) => (r.read_target(&gpu, "ao")?, false),
         (None, Technique::Direct, true) => (r.read_target(&gpu, "hdr")?, true),
-        (None, Technique::Full, true) => (r.read_target(&gpu, "hdr-full")?, true),
+        (None, Technique::Full, true) => (r.read_target(&gpu, "hdr-reflected")?, true),
         (None, _, false) => (r.read_target(&gpu, "ldr")?, true),
     };
     // ldr/albedo are already linear after read-back decode; PNG re-encodes sRGB.

@@ -87,6 +87,8 @@ pub struct RenderSettings {
     /// Deep-G-buffer radiosity (DGB §3.2) into target `indirect`; `None` = off.
     /// Needs `shade` (the lighting pass writes the radiosity buffers B).
     pub radiosity: Option<RadiositySettings>,
+    /// Deep-G-buffer mirror reflections (DGB §3.6) into `hdr-reflected`; needs `shade`.
+    pub reflections: Option<crate::passes::reflections::ReflectionSettings>,
 }
 
 impl Default for RenderSettings {
@@ -102,6 +104,7 @@ impl Default for RenderSettings {
             exposure: None,
             ao: None,
             radiosity: None,
+            reflections: None,
         }
     }
 }
@@ -145,6 +148,14 @@ impl RenderSettings {
         if let Some(ao) = &self.ao {
             ao.validate().map_err(RenderError::Parameter)?;
         }
+        if let Some(r) = &self.reflections {
+            r.validate().map_err(RenderError::Parameter)?;
+            if !self.shade {
+                return Err(RenderError::Parameter(
+                    "reflections need shading on: they reflect the shaded image".into(),
+                ));
+            }
+        }
         if let Some(r) = &self.radiosity {
             r.validate().map_err(RenderError::Parameter)?;
             if !self.shade {
@@ -180,6 +191,7 @@ pub struct Renderer {
     mip: Option<DepthMipPass>,
     ao: Option<AoStage>,
     radiosity: Option<RadiosityStage>,
+    reflections: Option<crate::passes::reflections::ReflectionPass>,
     history: Option<HistoryPass>,
     last_frame: FrameUniforms,
     /// Last frame's depths are in `csz-history` (false before the first frame).
@@ -271,10 +283,18 @@ impl Renderer {
             )),
             None => None,
         };
-        let tonemap = match (&radiosity, tonemap) {
-            // the tonemapper shows direct + indirect
-            (Some(_), Some(_)) => Some(tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, "hdr-full")),
-            (_, t) => t,
+        let shaded = if radiosity.is_some() { "hdr-full" } else { "hdr" };
+        let reflections = settings.reflections.as_ref().map(|rs| {
+            for t in crate::passes::reflections::OUTPUTS {
+                targets.create(gpu, t);
+            }
+            crate::passes::reflections::ReflectionPass::new(gpu, &scene_gpu, &targets, settings.deep.layers, shaded, rs)
+        });
+        let shown = if reflections.is_some() { "hdr-reflected" } else { shaded };
+        let tonemap = match tonemap {
+            // the tonemapper shows direct + indirect + reflections
+            Some(_) if shown != "hdr" => Some(tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, shown)),
+            t => t,
         };
         let mut copies = Vec::new();
         if settings.deep.uses_history() || temporal_on {
@@ -307,6 +327,7 @@ impl Renderer {
             mip,
             ao,
             radiosity,
+            reflections,
             history,
             last_frame: bytemuck::Zeroable::zeroed(),
             has_history: false,
@@ -338,6 +359,9 @@ impl Renderer {
             v.push(l);
             if let Some(r) = &self.radiosity {
                 v.extend(r.passes());
+            }
+            if let Some(r) = &self.reflections {
+                v.push(r);
             }
             v.push(t);
         }
@@ -410,6 +434,9 @@ impl Renderer {
             .unwrap_or(scene.settings.min_separation);
         for g in &self.geometry {
             g.set_frame(gpu, dz, self.has_history);
+        }
+        if let Some(r) = &self.reflections {
+            r.set_frame(gpu, dz);
         }
         if self.animated {
             if let (Some(s), Some(l)) = (&self.shadow, &self.lighting) {

@@ -7,6 +7,7 @@
 //! | `warehouse` | room whose spot-lit red floor patch is hidden behind a foreground partition wall |
 //! | `plane` | one 40 × 40 m grey Lambertian plane under a sun (analytic tests) |
 //! | `column-wall` | a column standing 0.5 m in front of a wall (AO tests) |
+//! | `mirror` | a mirror floor before a grey board that hides a red panel from the camera but not from the mirror (DGB §3.6) |
 //!
 //! Static geometry is merged into one object per material, named after the
 //! material (e.g. `banner_red`); animated parts are separate objects.
@@ -19,7 +20,15 @@ use crate::path::{CameraPath, Keyframe};
 use crate::shapes::MeshBuilder;
 
 /// Names accepted by [`builtin`].
-pub const BUILTIN_NAMES: &[&str] = &["cornell", "atrium", "warehouse", "plane", "column-wall", "dense"];
+pub const BUILTIN_NAMES: &[&str] = &[
+    "cornell",
+    "atrium",
+    "warehouse",
+    "plane",
+    "column-wall",
+    "dense",
+    "mirror",
+];
 
 /// The built-in scene called `name`, or `None` when there is none.
 pub fn builtin(name: &str) -> Option<Scene> {
@@ -30,6 +39,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "plane" => Some(plane()),
         "column-wall" => Some(column_wall()),
         "dense" => Some(dense()),
+        "mirror" => Some(mirror()),
         _ => None,
     }
 }
@@ -569,6 +579,56 @@ pub fn dense() -> Scene {
         radiosity_radius: 8.0,
         exposure: 1.0,
         sky: [0.2, 0.25, 0.35],
+        ambient: [0.03; 3],
+    };
+    b.finish(camera, vec![sun], settings)
+}
+
+/// DGB §3.6 test scene: a mirror floor (metallic 1, roughness 0) in front of a
+/// grey board standing 0.3 m above the floor; 0.3 m behind the board a red
+/// emissive panel is hidden from the camera but seen in the mirror under the
+/// board's lower edge — only a second deep-G-buffer layer holds it. A blue
+/// back wall, a sun from above, a sky for rays that leave.
+pub fn mirror() -> Scene {
+    let mut b = SceneBuilder::new("mirror");
+    let floor = b.material(Material {
+        roughness: 0.0,
+        metallic: 1.0,
+        ..Material::diffuse("mirror_floor", [0.9, 0.9, 0.9])
+    });
+    let board = b.material(Material::diffuse("board", [0.5, 0.5, 0.5]));
+    let panel = b.material(Material {
+        emission: [3.0, 0.2, 0.1],
+        ..Material::diffuse("red_panel", [0.8, 0.1, 0.05])
+    });
+    let wall = b.material(Material::diffuse("back_wall", [0.3, 0.4, 0.7]));
+    b.geo(floor).rect(v(0.0, 0.0, 1.0), v(0.0, 0.0, 5.0), v(4.0, 0.0, 0.0));
+    b.geo(board).quad_facing(
+        [v(-1.2, 0.3, 0.0), v(1.2, 0.3, 0.0), v(1.2, 1.6, 0.0), v(-1.2, 1.6, 0.0)],
+        v(0.0, 0.0, 1.0),
+    );
+    b.geo(panel).quad_facing(
+        [
+            v(-0.8, 0.3, -0.3),
+            v(0.8, 0.3, -0.3),
+            v(0.8, 1.3, -0.3),
+            v(-0.8, 1.3, -0.3),
+        ],
+        v(0.0, 0.0, 1.0),
+    );
+    b.geo(wall).rect(v(0.0, 2.0, -3.0), v(4.0, 0.0, 0.0), v(0.0, 2.0, 0.0));
+    let sun = Light::Sun {
+        direction: v(0.2, -1.0, -0.3).normalize(),
+        color: [1.0, 1.0, 1.0],
+        illuminance: 2.0,
+    };
+    let camera = Camera::new(v(0.0, 1.0, 4.0), v(0.0, 0.5, 0.0), Vec3::Y, 50.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.5,
+        min_separation: 0.2,
+        radiosity_radius: 4.0,
+        exposure: 1.0,
+        sky: [0.4, 0.5, 0.7],
         ambient: [0.03; 3],
     };
     b.finish(camera, vec![sun], settings)

@@ -7,6 +7,7 @@ pub mod deep_gbuffer;
 pub mod depth_mip;
 pub mod lighting;
 pub mod radiosity;
+pub mod reflections;
 pub mod shadow;
 pub mod temporal;
 pub mod tonemap;

@@ -1,0 +1,162 @@
+// DGB §3.6 mirror reflections traced through the deep G-buffer: march the
+// reflection ray in world space, project each step into the layers, and hit
+// when the ray lies within [z, z + Δz] of a layer's surface; the reflected
+// radiance is that surface's outgoing radiance. After `max_distance` or when
+// the ray leaves the (guard-banded) buffer: the environment (the sky).
+#import "common/fullscreen.wgsl"
+#import "common/frame.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
+
+override LAYERS: u32 = 2u;
+
+// Matches `reflections::ReflectionUniforms`.
+struct Reflections {
+    max_distance: f32,
+    steps: u32,
+    // thickness Δz of a layer's surface
+    thickness: f32,
+    max_roughness: f32,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> refl: Reflections;
+@group(1) @binding(1) var csz: texture_2d_array<f32>;
+@group(1) @binding(2) var normal: texture_2d_array<f32>;
+@group(1) @binding(3) var albedo: texture_2d_array<f32>;
+// outgoing radiance of layer 0 (the shaded image) and of layer 1 (its B)
+@group(1) @binding(4) var radiance0: texture_2d<f32>;
+@group(1) @binding(5) var radiance1: texture_2d<f32>;
+
+struct Out {
+    // rgb = reflected radiance, a = 0 not a mirror, 1 environment, 2 layer 0, 3 layer 1
+    @location(0) reflection: vec4f,
+    // the input image with F · reflected radiance added on mirrors
+    @location(1) hdr: vec4f,
+}
+
+// Screen position (xy), camera-space depth (z) of world point q; w = -1 when
+// behind the near plane or outside the buffer.
+fn project(q: vec3f) -> vec4f {
+    let clip = frame.view_proj * vec4f(q, 1.0);
+    if (clip.w <= frame.eye.w) {
+        return vec4f(0.0, 0.0, 0.0, -1.0);
+    }
+    let ndc = clip.xy / clip.w;
+    let c = vec2f((ndc.x * 0.5 + 0.5) * frame.size.x, (0.5 - 0.5 * ndc.y) * frame.size.y);
+    if (c.x < 0.0 || c.y < 0.0 || c.x >= frame.size.x || c.y >= frame.size.y) {
+        return vec4f(c, 0.0, -1.0);
+    }
+    return vec4f(c, dot(q - frame.eye.xyz, frame.cam_forward.xyz), 1.0);
+}
+
+fn layer_depths(s: vec4f) -> vec2f {
+    let t = vec2i(s.xy);
+    var z = vec2f(0.0);
+    for (var j = 0u; j < min(LAYERS, 2u); j++) {
+        z[j] = textureLoad(csz, t, i32(j), 0).r;
+    }
+    return z;
+}
+
+// The first layer whose surface the ray sample `s` lies behind by at most the
+// allowance: Δz, or — when the previous sample (depth prev_z, surface depths
+// prev_zl) was in front of that layer — the depth the ray and the surface
+// moved apart over the step, so no step jumps over a layer. -1: none.
+fn hit_layer(s: vec4f, prev_z: f32, prev_zl: vec2f) -> i32 {
+    let zl = layer_depths(s);
+    for (var j = 0u; j < min(LAYERS, 2u); j++) {
+        let zj = zl[j];
+        var allowance = refl.thickness;
+        if (prev_z < prev_zl[j]) {
+            allowance = max(allowance, abs(s.z - prev_z) + abs(zj - prev_zl[j]));
+        }
+        if (zj > 0.0 && s.z >= zj && s.z <= zj + allowance) {
+            return i32(j);
+        }
+    }
+    return -1;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
+    let p = vec2i(pos.xy);
+    var o: Out;
+    let base = textureLoad(radiance0, p, 0);
+    o.hdr = base;
+    let z = textureLoad(csz, p, 0, 0).r;
+    let nrm = textureLoad(normal, p, 0, 0);
+    if (z <= 0.0 || nrm.a < 0.5 || nrm.b > refl.max_roughness) {
+        return o;
+    }
+    let x = world_from_csz(frame, vec2f(p) + 0.5, z);
+    let n = oct_decode(nrm.rg);
+    let v = normalize(x - frame.eye.xyz);
+    let r = reflect(v, n);
+    var l = frame.sky.rgb;
+    var code = 1.0;
+    let step = refl.max_distance / f32(refl.steps);
+    var prev_z = z;
+    var prev_zl = layer_depths(vec4f(vec2f(p) + 0.5, z, 1.0));
+    // start one step out so the mirror does not hit itself
+    for (var i = 1u; i <= refl.steps; i++) {
+        var q = x + r * (step * f32(i));
+        var s = project(q);
+        var leaving = false;
+        if (s.w < 0.0) {
+            // leaving the buffer (or passing the near plane) within this step:
+            // test the last point still inside, then take the environment
+            var lo = step * f32(i - 1u);
+            var hi = step * f32(i);
+            for (var k = 0; k < 6; k++) {
+                let mid = 0.5 * (lo + hi);
+                if (project(x + r * mid).w >= 0.0) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            q = x + r * lo;
+            s = project(q);
+            leaving = true;
+            if (s.w < 0.0) {
+                break;
+            }
+        }
+        let hit = hit_layer(s, prev_z, prev_zl);
+        if (hit >= 0) {
+            // refine between the previous and this step: the first point behind
+            var lo = step * f32(i - 1u);
+            var hi = length(q - x);
+            for (var k = 0; k < 5; k++) {
+                let mid = 0.5 * (lo + hi);
+                let sm = project(x + r * mid);
+                if (sm.w >= 0.0 && hit_layer(sm, prev_z, prev_zl) == hit) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            let sh = project(x + r * hi);
+            let t = vec2i(sh.xy);
+            if (hit == 0) {
+                l = textureLoad(radiance0, t, 0).rgb;
+                code = 2.0;
+            } else {
+                l = textureLoad(radiance1, t, 0).rgb;
+                code = 3.0;
+            }
+            break;
+        }
+        if (leaving) {
+            break;
+        }
+        prev_z = s.z;
+        prev_zl = layer_depths(s);
+    }
+    // Fresnel at normal incidence: the metal's albedo (F0)
+    let f0 = mix(vec3f(0.04), textureLoad(albedo, p, 0, 0).rgb, nrm.a);
+    o.reflection = vec4f(l, code);
+    o.hdr = vec4f(base.rgb + f0 * l, base.a);
+    return o;
+}
