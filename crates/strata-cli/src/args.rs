@@ -442,6 +442,35 @@ pub enum BenchWhat {
     /// Deep-G-buffer radiosity passes (DGB Table 4, indirect columns): per-pass GPU ms and
     /// the 1st layer + 2nd layer increment split, for a Table 2 preset.
     Radiosity(BenchRadiosityArgs),
+    /// Deep-G-buffer mirror reflections (DGB §3.6; Table 4's ray-tracing footnote): GPU ms of
+    /// the ray march, 1st layer + 2nd layer.
+    Reflections(BenchReflectionsArgs),
+}
+
+#[derive(Args)]
+pub struct BenchReflectionsArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// Frames along the camera path to time (after one warm-up frame), 1..=10000.
+    #[arg(long, default_value_t = 5)]
+    pub frames: u32,
+    /// Deep G-buffer layers k, 1..=4 (compared with k = 1 for the increment).
+    #[arg(long, default_value_t = 2)]
+    pub layers: u32,
+    /// Deep G-buffer construction variant.
+    #[arg(long, default_value = "reproject", value_parser = parse_variant)]
+    pub variant: Variant,
+    /// Ray-march steps, 1..=1024.
+    #[arg(long, default_value_t = 64)]
+    pub steps: u32,
+    /// Maximum ray distance in scene units, > 0.
+    #[arg(long, default_value_t = 16.0)]
+    pub max_distance: f32,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args)]

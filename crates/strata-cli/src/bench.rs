@@ -14,6 +14,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         BenchWhat::Reference(b) => crate::reference::bench(b),
         BenchWhat::Ao(b) => crate::bench_gi::ao(b),
         BenchWhat::Radiosity(b) => crate::bench_gi::radiosity(b),
+        BenchWhat::Reflections(b) => crate::bench_gi::reflections(b),
     }
 }
 

@@ -9,7 +9,7 @@ use strata_render::passes::deep_gbuffer::DeepGBufferSettings;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::Scene;
 
-use crate::args::{BenchAoArgs, BenchRadiosityArgs, SceneArgs};
+use crate::args::{BenchAoArgs, BenchRadiosityArgs, BenchReflectionsArgs, SceneArgs};
 use crate::bench::{median_min, wgpu_ts};
 use crate::output::{cameras_at, scene_and_camera};
 
@@ -75,6 +75,38 @@ struct Timing {
     passes: Vec<(String, f64, f64)>,
     total_median_ms: f64,
     total_min_ms: f64,
+}
+
+pub fn reflections(a: &BenchReflectionsArgs) -> Result<()> {
+    let rs = strata_render::passes::reflections::ReflectionSettings {
+        steps: a.steps,
+        max_distance: a.max_distance,
+        ..Default::default()
+    };
+    let extra = json!({"steps": rs.steps, "max_distance": rs.max_distance, "variant": a.variant.to_string()});
+    run_bench(
+        &a.gpu.adapter,
+        a.json,
+        Bench {
+            name: "reflections",
+            scene: &a.scene,
+            frames: a.frames,
+            layers: a.layers,
+            passes: &["reflections"],
+            settings: Box::new(move |layers| RenderSettings {
+                width: a.scene.width,
+                height: a.scene.height,
+                deep: DeepGBufferSettings {
+                    layers,
+                    variant: a.variant,
+                    ..Default::default()
+                },
+                reflections: Some(rs),
+                ..Default::default()
+            }),
+            extra,
+        },
+    )
 }
 
 pub fn ao(a: &BenchAoArgs) -> Result<()> {
