@@ -141,7 +141,7 @@ impl Reference<'_> {
             let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
             for s in 0..settings.spp {
                 let mut rng = Rng::new(hash(&[settings.seed, y as u64 * width as u64 + x as u64, s as u64]));
-                let (d, i) = self.trace_path(camera, dir, settings, &mut rng, rays);
+                let (d, i) = self.trace_path(camera.eye, camera.near, dir, settings, &mut rng, rays);
                 direct += d;
                 indirect += i;
             }
@@ -162,10 +162,19 @@ impl Reference<'_> {
         out
     }
 
-    /// One path through the pixel-centre direction `dir`: (direct, indirect).
+    /// Radiance arriving at `origin` from direction −`dir` (one path sample):
+    /// emission and direct light of the first surface along `dir`, plus what it
+    /// reflects of further bounces, or the sky. Used to bake light probes.
+    pub fn radiance(&self, origin: Vec3, dir: Vec3, settings: &GiSettings, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+        let (d, i) = self.trace_path(origin, 0.0, dir, settings, rng, rays);
+        d + i
+    }
+
+    /// One path from `origin` (hits beyond `t_min`) along `dir`: (direct, indirect).
     fn trace_path(
         &self,
-        camera: &Camera,
+        origin: Vec3,
+        t_min: f32,
         dir: Vec3,
         settings: &GiSettings,
         rng: &mut Rng,
@@ -174,7 +183,7 @@ impl Reference<'_> {
         let sky = Vec3::from(self.scene.settings.sky);
         let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
         *rays += 1;
-        let Some(h) = self.bvh.intersect(camera.eye, dir, camera.near, f32::INFINITY) else {
+        let Some(h) = self.bvh.intersect(origin, dir, t_min, f32::INFINITY) else {
             return (sky, indirect);
         };
         let mut hit = self.bvh.surface(&h, dir);

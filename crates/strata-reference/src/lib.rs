@@ -40,6 +40,7 @@ pub mod ao;
 pub mod bvh;
 pub mod gi;
 pub mod layers;
+pub mod probes;
 pub mod sampling;
 
 use std::io::IsTerminal;
@@ -183,6 +184,11 @@ impl<'s> Reference<'s> {
     }
 
     /// Rays traced and seconds spent so far.
+    /// Counts rays traced outside `for_each_pixel` (e.g. probe baking).
+    pub(crate) fn add_rays(&self, n: u64) {
+        self.rays.fetch_add(n, Ordering::Relaxed);
+    }
+
     pub fn stats(&self) -> Stats {
         Stats {
             rays: self.rays.load(Ordering::Relaxed),

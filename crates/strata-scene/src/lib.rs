@@ -15,6 +15,7 @@ pub mod load;
 pub mod model;
 pub mod normals;
 pub mod path;
+pub mod probes;
 pub mod procedural;
 pub mod shapes;
 

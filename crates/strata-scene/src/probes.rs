@@ -1,0 +1,140 @@
+//! Irradiance light probes (the coarse, static fallback of DGB §3.2 / Fig. 9):
+//! a regular 3D grid of probes, each holding irradiance as order-2 (9-term)
+//! real spherical harmonics per colour channel. Baked by the CPU reference,
+//! evaluated on the GPU and here with the same formulas.
+
+use glam::Vec3;
+
+/// Cosine-lobe convolution of SH band l (Ramamoorthi & Hanrahan 2001): Â_0 = π,
+/// Â_1 = 2π/3, Â_2 = π/4.
+pub const COSINE_LOBE: [f32; 3] = [std::f32::consts::PI, 2.0 * std::f32::consts::PI / 3.0, std::f32::consts::FRAC_PI_4];
+
+/// The 9 real SH basis functions at unit direction `d` (order l = 0, 1, 2).
+pub fn sh9(d: Vec3) -> [f32; 9] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [
+        0.282_095,
+        0.488_603 * y,
+        0.488_603 * z,
+        0.488_603 * x,
+        1.092_548 * x * y,
+        1.092_548 * y * z,
+        0.315_392 * (3.0 * z * z - 1.0),
+        1.092_548 * x * z,
+        0.546_274 * (x * x - y * y),
+    ]
+}
+
+/// Band of coefficient i.
+pub fn sh_band(i: usize) -> usize {
+    match i {
+        0 => 0,
+        1..=3 => 1,
+        _ => 2,
+    }
+}
+
+/// A grid of irradiance probes over an axis-aligned box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IrradianceProbes {
+    /// Position of probe (0, 0, 0).
+    pub origin: Vec3,
+    /// Distance between neighbouring probes per axis.
+    pub spacing: Vec3,
+    /// Probes per axis (each ≥ 1).
+    pub dims: [u32; 3],
+    /// Per probe (x fastest, then y, then z): irradiance SH coefficients
+    /// E_i = Â_l · L_i, so E(n) = Σ_i E_i · Y_i(n).
+    pub coeffs: Vec<[[f32; 3]; 9]>,
+}
+
+impl IrradianceProbes {
+    /// Probe positions of a grid spanning `lo`..`hi` with `dims` probes per axis.
+    pub fn grid(lo: Vec3, hi: Vec3, dims: [u32; 3]) -> Self {
+        let d = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32);
+        let spacing = ((hi - lo) / (d - 1.0).max(Vec3::ONE)).max(Vec3::splat(1e-6));
+        Self {
+            origin: lo,
+            spacing,
+            dims,
+            coeffs: vec![[[0.0; 3]; 9]; (dims[0] * dims[1] * dims[2]) as usize],
+        }
+    }
+
+    pub fn count(&self) -> usize {
+        self.coeffs.len()
+    }
+
+    /// Position of probe `index`.
+    pub fn position(&self, index: usize) -> Vec3 {
+        let [dx, dy, _] = self.dims;
+        let i = index as u32;
+        let (x, y, z) = (i % dx, (i / dx) % dy, i / (dx * dy));
+        self.origin + self.spacing * Vec3::new(x as f32, y as f32, z as f32)
+    }
+
+    /// Irradiance of one probe for normal `n`: Σ E_i Y_i(n), clamped at 0.
+    pub fn probe_irradiance(&self, index: usize, n: Vec3) -> Vec3 {
+        let y = sh9(n);
+        let c = &self.coeffs[index];
+        let mut e = Vec3::ZERO;
+        for i in 0..9 {
+            e += Vec3::from(c[i]) * y[i];
+        }
+        e.max(Vec3::ZERO)
+    }
+
+    /// Irradiance at `p` for normal `n`: trilinear blend of the 8 surrounding
+    /// probes (positions clamped to the grid).
+    pub fn irradiance(&self, p: Vec3, n: Vec3) -> Vec3 {
+        let g = ((p - self.origin) / self.spacing).max(Vec3::ZERO);
+        let max = Vec3::new(
+            (self.dims[0] - 1) as f32,
+            (self.dims[1] - 1) as f32,
+            (self.dims[2] - 1) as f32,
+        );
+        let g = g.min(max);
+        let i0 = g.floor();
+        let t = g - i0;
+        let mut e = Vec3::ZERO;
+        for corner in 0..8u32 {
+            let o = Vec3::new((corner & 1) as f32, ((corner >> 1) & 1) as f32, ((corner >> 2) & 1) as f32);
+            let c = (i0 + o).min(max);
+            let w = (if o.x > 0.0 { t.x } else { 1.0 - t.x })
+                * (if o.y > 0.0 { t.y } else { 1.0 - t.y })
+                * (if o.z > 0.0 { t.z } else { 1.0 - t.z });
+            let index = (c.x as u32 + self.dims[0] * (c.y as u32 + self.dims[1] * c.z as u32)) as usize;
+            e += self.probe_irradiance(index, n) * w;
+        }
+        e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A probe of uniform radiance L gives irradiance πL for every normal.
+    #[test]
+    fn uniform_radiance_gives_pi_l() {
+        let mut p = IrradianceProbes::grid(Vec3::ZERO, Vec3::ONE, [1, 1, 1]);
+        // L_00 = L · √(4π) (projection of a constant), E_00 = π L_00
+        let l = 0.7;
+        p.coeffs[0][0] = [COSINE_LOBE[0] * l * (4.0 * std::f32::consts::PI).sqrt(); 3];
+        for n in [Vec3::X, Vec3::Y, -Vec3::Z, Vec3::new(1.0, 1.0, 0.0).normalize()] {
+            let e = p.irradiance(Vec3::splat(0.3), n);
+            assert!((e.x - std::f32::consts::PI * l).abs() < 1e-3, "{e}");
+        }
+    }
+
+    #[test]
+    fn trilinear_blend_between_probes() {
+        let mut p = IrradianceProbes::grid(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), [2, 1, 1]);
+        p.coeffs[0][0] = [1.0; 3];
+        p.coeffs[1][0] = [3.0; 3];
+        let y0 = sh9(Vec3::Y)[0];
+        assert!((p.irradiance(Vec3::new(0.5, 0.0, 0.0), Vec3::Y).x - 1.5 * y0).abs() < 1e-5);
+        assert!((p.irradiance(Vec3::new(9.0, 0.0, 0.0), Vec3::Y).x - 3.0 * y0).abs() < 1e-5);
+        assert_eq!(p.position(1), Vec3::new(2.0, 0.0, 0.0));
+    }
+}
