@@ -368,6 +368,10 @@ pub struct RenderArgs {
     /// Print per-pass GPU times after rendering.
     #[arg(long)]
     pub timings: bool,
+    /// --technique full: no light-probe fallback (the probes are baked once per scene by the CPU
+    /// path tracer and cached in $STRATA_CACHE).
+    #[arg(long)]
+    pub no_probes: bool,
     /// Frames rendered before the output frame (along the camera path), 0..=1000, so temporal
     /// filters and progressive bounces (DGB §3.3) have history.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1000))]

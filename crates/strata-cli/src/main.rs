@@ -9,6 +9,7 @@ mod eval_gi;
 mod info;
 mod metrics;
 mod output;
+mod probes;
 mod ref_cache;
 mod reference;
 mod render;

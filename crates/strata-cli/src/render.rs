@@ -12,6 +12,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         Technique::Full => Some(a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?),
         _ => None,
     };
+    // the full image: radiosity blended with baked light probes (modulated by AO), reflections
+    let probes = match a.technique {
+        Technique::Full if !a.no_probes => Some(crate::probes::scene_probes(
+            &scene,
+            &crate::ref_cache::RefCache::new(crate::ref_cache::RefCache::default_dir()),
+            false,
+        )?),
+        _ => None,
+    };
     let settings = RenderSettings {
         width: a.scene.width,
         height: a.scene.height,
@@ -23,7 +32,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         exposure: a.exposure,
         // AO alone needs no lighting passes
         shade: a.technique != Technique::Ao,
-        ao: (a.technique == Technique::Ao).then(|| a.ao.settings()),
+        ao: (a.technique != Technique::Direct).then(|| a.ao.settings()),
+        probes,
         reflections: (a.technique == Technique::Full).then(Default::default),
         radiosity,
         ..Default::default()

@@ -89,6 +89,9 @@ pub struct RenderSettings {
     pub radiosity: Option<RadiositySettings>,
     /// Deep-G-buffer mirror reflections (DGB §3.6) into `hdr-reflected`; needs `shade`.
     pub reflections: Option<crate::passes::reflections::ReflectionSettings>,
+    /// Static irradiance probes blended with the radiosity by confidence
+    /// (Fig. 9); they replace the scene's constant ambient term.
+    pub probes: Option<strata_scene::probes::IrradianceProbes>,
 }
 
 impl Default for RenderSettings {
@@ -105,6 +108,7 @@ impl Default for RenderSettings {
             ao: None,
             radiosity: None,
             reflections: None,
+            probes: None,
         }
     }
 }
@@ -280,6 +284,7 @@ impl Renderer {
                 &settings.deep,
                 r,
                 settings.guard_pixels(),
+                settings.probes.as_ref(),
             )),
             None => None,
         };
@@ -402,7 +407,11 @@ impl Renderer {
         let cams = cams.with_guard_band(self.settings.height, self.settings.guard_pixels());
         let exposure = self.settings.exposure.unwrap_or(scene.settings.exposure);
         let (w, h) = self.settings.internal_size();
-        let u = FrameUniforms::new(scene, &cams, w, h, frame, exposure);
+        let mut u = FrameUniforms::new(scene, &cams, w, h, frame, exposure);
+        if self.settings.probes.is_some() && self.settings.radiosity.is_some() {
+            // the probes carry the ambient light
+            u.ambient[..3].copy_from_slice(&[0.0; 3]);
+        }
         self.scene_gpu.update_frame(gpu, &u);
         self.last_frame = u;
         // history computed from oracle-less layers would linger for many
@@ -546,6 +555,10 @@ impl Renderer {
         if self.settings.deep.array_layers() > self.settings.deep.layers {
             v.push("predicted-csz".into());
         }
+        if self.radiosity.is_some() {
+            // Fig. 9's views: confidence, G-buffer-only, probe-only, blended
+            v.extend(["confidence", "gbuffer-only", "probe-only", "blended"].map(String::from));
+        }
         v.sort();
         v
     }
@@ -572,6 +585,10 @@ impl Renderer {
             img
         };
         match base {
+            "confidence" => Ok(self.read_target(gpu, "indirect")?.channel(3)),
+            "gbuffer-only" => Ok(pad_channels(&self.read_target(gpu, "indirect")?, 3)),
+            "probe-only" => Ok(pad_channels(&self.read_target(gpu, "probe-irradiance")?, 3)),
+            "blended" => Ok(pad_channels(&self.read_target(gpu, "indirect-blended")?, 3)),
             "normal" => {
                 let n = self.read_normals_layer(gpu, layer)?;
                 let mut img = ImageBuf::new(n.width, n.height, 3);
@@ -846,6 +863,7 @@ impl RadiosityStage {
         deep: &DeepGBufferSettings,
         s: &RadiositySettings,
         guard: u32,
+        probes: Option<&strata_scene::probes::IrradianceProbes>,
     ) -> Self {
         use crate::frame::TargetDesc;
         use wgpu::TextureFormat as F;
@@ -933,8 +951,10 @@ impl RadiosityStage {
             "indirect",
             true,
         );
-        targets.create(gpu, crate::passes::compose::OUTPUT);
-        let compose = crate::passes::compose::ComposePass::new(gpu, targets, s.boost);
+        for t in crate::passes::compose::OUTPUTS {
+            targets.create(gpu, t);
+        }
+        let compose = crate::passes::compose::ComposePass::new(gpu, scene, targets, s.boost, probes);
         Self {
             propagate,
             gather,

@@ -7,7 +7,11 @@ use glam::Vec3;
 
 /// Cosine-lobe convolution of SH band l (Ramamoorthi & Hanrahan 2001): Â_0 = π,
 /// Â_1 = 2π/3, Â_2 = π/4.
-pub const COSINE_LOBE: [f32; 3] = [std::f32::consts::PI, 2.0 * std::f32::consts::PI / 3.0, std::f32::consts::FRAC_PI_4];
+pub const COSINE_LOBE: [f32; 3] = [
+    std::f32::consts::PI,
+    2.0 * std::f32::consts::PI / 3.0,
+    std::f32::consts::FRAC_PI_4,
+];
 
 /// The 9 real SH basis functions at unit direction `d` (order l = 0, 1, 2).
 pub fn sh9(d: Vec3) -> [f32; 9] {
@@ -98,7 +102,11 @@ impl IrradianceProbes {
         let t = g - i0;
         let mut e = Vec3::ZERO;
         for corner in 0..8u32 {
-            let o = Vec3::new((corner & 1) as f32, ((corner >> 1) & 1) as f32, ((corner >> 2) & 1) as f32);
+            let o = Vec3::new(
+                (corner & 1) as f32,
+                ((corner >> 1) & 1) as f32,
+                ((corner >> 2) & 1) as f32,
+            );
             let c = (i0 + o).min(max);
             let w = (if o.x > 0.0 { t.x } else { 1.0 - t.x })
                 * (if o.y > 0.0 { t.y } else { 1.0 - t.y })

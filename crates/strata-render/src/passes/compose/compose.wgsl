@@ -1,21 +1,49 @@
-// Final composition (DGB §3.2, Eq. 6): direct light (+ emission, ambient, sky)
-// plus the Lambertian reflection of the deep-G-buffer indirect irradiance,
-// ρ/π · E · boost(ρ).
+// Final composition (DGB §3.2, Eq. 6, Fig. 9): direct light (+ emission, sky)
+// plus the Lambertian reflection ρ/π · E · boost(ρ) of the indirect
+// irradiance E. With light probes, E = c · E_dgb + (1 − c) · AV · E_probe: the
+// deep-G-buffer result where its confidence c = M/N is high, the static
+// probes (modulated by AO when it runs) where it is not.
 #import "common/fullscreen.wgsl"
+#import "common/frame.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
 
 struct Compose {
     // 1 = Eq. 7's boost on the reflected indirect light
     boost: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1 = blend with the light probes
+    use_probes: u32,
+    // 1 = modulate the probe term by AO
+    use_ao: u32,
+    _pad: u32,
+    // probe grid: origin (xyz), spacing (xyz), probes per axis
+    origin: vec4f,
+    spacing: vec4f,
+    dims: vec4u,
 }
 
-@group(0) @binding(0) var<uniform> compose: Compose;
-@group(0) @binding(1) var hdr: texture_2d<f32>;
-@group(0) @binding(2) var albedo: texture_2d<f32>;
-@group(0) @binding(3) var normal: texture_2d<f32>;
-@group(0) @binding(4) var indirect: texture_2d<f32>;
+struct Probe {
+    // irradiance SH coefficients E_i (rgb), i = 0..8
+    c: array<vec4f, 9>,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> compose: Compose;
+@group(1) @binding(1) var hdr: texture_2d<f32>;
+@group(1) @binding(2) var albedo: texture_2d<f32>;
+@group(1) @binding(3) var normal: texture_2d<f32>;
+@group(1) @binding(4) var indirect: texture_2d<f32>;
+@group(1) @binding(5) var csz: texture_2d<f32>;
+@group(1) @binding(6) var ao: texture_2d<f32>;
+@group(1) @binding(7) var<storage, read> probes: array<Probe>;
+
+struct Out {
+    @location(0) hdr: vec4f,
+    // blended E (rgb), confidence (a)
+    @location(1) blended: vec4f,
+    // probe irradiance × AV (rgb), AV (a)
+    @location(2) probe: vec4f,
+}
 
 // Eq. 7
 fn boost(rho: vec3f) -> f32 {
@@ -26,16 +54,77 @@ fn boost(rho: vec3f) -> f32 {
     return (mx - min(rho.r, min(rho.g, rho.b))) / mx;
 }
 
+fn sh9(d: vec3f) -> array<f32, 9> {
+    return array<f32, 9>(
+        0.282095,
+        0.488603 * d.y,
+        0.488603 * d.z,
+        0.488603 * d.x,
+        1.092548 * d.x * d.y,
+        1.092548 * d.y * d.z,
+        0.315392 * (3.0 * d.z * d.z - 1.0),
+        1.092548 * d.x * d.z,
+        0.546274 * (d.x * d.x - d.y * d.y),
+    );
+}
+
+fn probe_irradiance(index: u32, n: vec3f) -> vec3f {
+    let y = sh9(n);
+    var e = vec3f(0.0);
+    for (var i = 0u; i < 9u; i++) {
+        e += probes[index].c[i].rgb * y[i];
+    }
+    return max(e, vec3f(0.0));
+}
+
+// Trilinear blend of the 8 probes around p (as `IrradianceProbes::irradiance`).
+fn probe_field(p: vec3f, n: vec3f) -> vec3f {
+    let dims = compose.dims.xyz;
+    let mx = vec3f(dims) - 1.0;
+    let g = min(max((p - compose.origin.xyz) / compose.spacing.xyz, vec3f(0.0)), mx);
+    let i0 = floor(g);
+    let t = g - i0;
+    var e = vec3f(0.0);
+    for (var corner = 0u; corner < 8u; corner++) {
+        let o = vec3f(f32(corner & 1u), f32((corner >> 1u) & 1u), f32((corner >> 2u) & 1u));
+        let c = vec3u(min(i0 + o, mx));
+        let w3 = mix(1.0 - t, t, o);
+        let index = c.x + dims.x * (c.y + dims.y * c.z);
+        e += probe_irradiance(index, n) * (w3.x * w3.y * w3.z);
+    }
+    return e;
+}
+
 @fragment
-fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let p = vec2i(pos.xy);
+    var o: Out;
     let direct = textureLoad(hdr, p, 0);
-    let metallic = textureLoad(normal, p, 0).a;
-    let rho = textureLoad(albedo, p, 0).rgb * (1.0 - metallic);
+    o.hdr = direct;
+    let z = textureLoad(csz, p, 0).r;
+    if (z <= 0.0) {
+        return o;
+    }
+    let nrm = textureLoad(normal, p, 0);
+    let rho = textureLoad(albedo, p, 0).rgb * (1.0 - nrm.a);
     var k = 1.0;
     if (compose.boost != 0u) {
         k = boost(rho);
     }
-    let e = textureLoad(indirect, p, 0).rgb;
-    return vec4f(direct.rgb + rho / 3.14159265358979 * e * k, 1.0);
+    let g = textureLoad(indirect, p, 0);
+    var e = g.rgb;
+    let c = clamp(g.a, 0.0, 1.0);
+    if (compose.use_probes != 0u) {
+        var av = 1.0;
+        if (compose.use_ao != 0u) {
+            av = textureLoad(ao, p, 0).r;
+        }
+        let x = world_from_csz(frame, vec2f(p) + 0.5, z);
+        let ep = probe_field(x, oct_decode(nrm.rg)) * av;
+        o.probe = vec4f(ep, av);
+        e = c * g.rgb + (1.0 - c) * ep;
+    }
+    o.blended = vec4f(e, c);
+    o.hdr = vec4f(direct.rgb + rho / 3.14159265358979 * e * k, direct.a);
+    return o;
 }

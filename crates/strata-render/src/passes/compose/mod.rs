@@ -1,32 +1,64 @@
-//! Final composition: `hdr` (direct light, emission, ambient, sky) plus the
-//! Lambertian reflection ρ/π · E · boost(ρ) of the deep-G-buffer indirect
-//! irradiance (DGB Eq. 6) into `hdr-full`, which the tonemapper then reads.
+//! Final composition (DGB Eq. 6, Fig. 9): `hdr` (direct light, emission, sky)
+//! plus the Lambertian reflection ρ/π · E · boost(ρ) of the indirect irradiance,
+//! where E blends the deep-G-buffer result with static irradiance probes by the
+//! gather's confidence c = M/N (the probe term modulated by AO when it runs):
+//! E = c · E_dgb + (1 − c) · AV · E_probe. Outputs `hdr-full`,
+//! `indirect-blended` (E, c) and `probe-irradiance` (AV · E_probe, AV).
+
+use strata_scene::probes::IrradianceProbes;
 
 use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::scene_gpu::GpuScene;
 
-pub const OUTPUT: TargetDesc = TargetDesc::new(
-    "hdr-full",
-    wgpu::TextureFormat::Rgba16Float,
-    1,
-    "direct + indirect diffuse (linear HDR)",
-);
+pub const OUTPUTS: [TargetDesc; 3] = [
+    TargetDesc::new(
+        "hdr-full",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "direct + indirect diffuse (linear HDR)",
+    ),
+    TargetDesc::new(
+        "indirect-blended",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "E blended from the deep G-buffer and the probes (rgb), confidence M/N (a)",
+    ),
+    TargetDesc::new(
+        "probe-irradiance",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "light-probe irradiance × AV (rgb), AV (a)",
+    ),
+];
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct ComposeUniforms {
     boost: u32,
-    _pad: [u32; 3],
+    use_probes: u32,
+    use_ao: u32,
+    _pad: u32,
+    origin: [f32; 4],
+    spacing: [f32; 4],
+    dims: [u32; 4],
 }
 
 pub struct ComposePass {
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
+    inputs: Vec<&'static str>,
 }
 
 impl ComposePass {
-    pub fn new(gpu: &GpuContext, targets: &Targets, boost: bool) -> Self {
+    /// `probes`: the static fallback (Fig. 9); AO modulates it when target `ao` exists.
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        boost: bool,
+        probes: Option<&IrradianceProbes>,
+    ) -> Self {
         use crate::passes::{texture_entry, uniform_entry};
         let device = &gpu.device;
         let d2 = wgpu::TextureViewDimension::D2;
@@ -38,14 +70,49 @@ impl ComposePass {
                 texture_entry(2, d2, false),
                 texture_entry(3, d2, false),
                 texture_entry(4, d2, false),
+                texture_entry(5, d2, false),
+                texture_entry(6, d2, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 7,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
             ],
         });
+        let use_ao = probes.is_some() && targets.try_get("ao").is_some();
         let u = ComposeUniforms {
             boost: boost as u32,
-            _pad: [0; 3],
+            use_probes: probes.is_some() as u32,
+            use_ao: use_ao as u32,
+            _pad: 0,
+            origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
+            spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(0.0).to_array()),
+            dims: probes.map_or([1, 1, 1, 0], |p| [p.dims[0], p.dims[1], p.dims[2], 0]),
         };
         let buffer = crate::passes::uniform_buffer(device, "compose", &u);
+        let data: Vec<[f32; 4]> = match probes {
+            Some(p) => p
+                .coeffs
+                .iter()
+                .flat_map(|c| c.iter().map(|rgb| [rgb[0], rgb[1], rgb[2], 0.0]))
+                .collect(),
+            None => vec![[0.0; 4]; 9],
+        };
+        let probe_buf = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("light probes"),
+                contents: bytemuck::cast_slice(&data),
+                usage: wgpu::BufferUsages::STORAGE,
+            },
+        );
         let layer0 = |n: &str| wgpu::BindingResource::TextureView(targets.get(n).layer(0));
+        let ao = if use_ao { "ao" } else { "indirect" };
         let group = crate::passes::bind_group(
             device,
             "compose",
@@ -56,22 +123,27 @@ impl ComposePass {
                 layer0("albedo"),
                 layer0("normal"),
                 layer0("indirect"),
+                layer0("csz"),
+                layer0(ao),
+                probe_buf.as_entire_binding(),
             ],
         );
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("compose"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pl = crate::passes::frame_pipeline_layout(device, "compose", scene, &[&layout]);
         let module = crate::shader::module(device, "compose", include_str!("compose.wgsl"));
-        let pipeline = crate::passes::fullscreen_pipeline(
-            device,
-            "compose",
-            &pl,
-            &module,
-            &[Some(wgpu::ColorTargetState::from(OUTPUT.format))],
-        );
-        Self { pipeline, group }
+        let formats: Vec<_> = OUTPUTS
+            .iter()
+            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
+            .collect();
+        let pipeline = crate::passes::fullscreen_pipeline(device, "compose", &pl, &module, &formats);
+        let mut inputs = vec!["hdr", "albedo", "normal", "indirect", "csz"];
+        if use_ao {
+            inputs.push("ao");
+        }
+        Self {
+            pipeline,
+            group,
+            inputs,
+        }
     }
 }
 
@@ -79,18 +151,19 @@ impl Pass for ComposePass {
     fn info(&self) -> PassInfo {
         PassInfo {
             name: "compose",
-            inputs: vec!["hdr", "albedo", "normal", "indirect"],
-            outputs: vec![OUTPUT.name],
+            inputs: self.inputs.clone(),
+            outputs: OUTPUTS.iter().map(|t| t.name).collect(),
         }
     }
 
-    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let outputs: Vec<_> = OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
         crate::passes::fullscreen_pass(
             encoder,
             "compose",
             &self.pipeline,
-            &[&targets.get(OUTPUT.name).view],
-            &[&self.group],
+            &outputs,
+            &[&scene.frame_bind_group, &self.group],
         );
     }
 }

@@ -1,0 +1,95 @@
+//! Light probes for `--technique full` (DGB Fig. 9's static fallback): baked
+//! once per scene with the CPU path tracer and cached next to the reference
+//! images.
+
+use anyhow::Result;
+use glam::Vec3;
+use strata_reference::gi::GiSettings;
+use strata_reference::Reference;
+use strata_scene::probes::IrradianceProbes;
+use strata_scene::{ImageBuf, Scene};
+
+use crate::ref_cache::RefCache;
+
+/// Probes per axis, rays per probe, path bounces.
+pub const GRID: [u32; 3] = [8, 4, 8];
+pub const RAYS: u32 = 512;
+pub const BOUNCES: u32 = 3;
+
+/// The scene's probes at animation frame 0 (static lighting), from the cache or baked.
+pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
+    let description = format!(
+        "v1 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
+        crate::eval::scene_fingerprint(scene, 0.0)
+    );
+    let key = RefCache::key(&description);
+    if let Some(img) = cache.load(&key) {
+        if let Some(p) = decode(&img) {
+            return Ok(p);
+        }
+    }
+    if !quiet {
+        eprintln!(
+            "baking {} light probes ({RAYS} paths each)…",
+            GRID.iter().product::<u32>()
+        );
+    }
+    let settings = GiSettings {
+        bounces: BOUNCES,
+        ..Default::default()
+    };
+    let probes = Reference::new(scene, 0.0).bake_probes(GRID, RAYS, &settings);
+    if let Err(e) = cache.store(&key, &encode(&probes), &description) {
+        tracing::warn!("could not cache the light probes: {e:#}");
+    }
+    Ok(probes)
+}
+
+/// Row 0: origin, spacing, dims; row 1 + i: probe i's 27 coefficients.
+fn encode(p: &IrradianceProbes) -> ImageBuf {
+    let mut img = ImageBuf::new(27, p.count() as u32 + 1, 1);
+    let head = [p.origin.to_array(), p.spacing.to_array(), p.dims.map(|d| d as f32)].concat();
+    img.data[..9].copy_from_slice(&head);
+    for (i, c) in p.coeffs.iter().enumerate() {
+        let row = 27 * (i + 1);
+        img.data[row..row + 27].copy_from_slice(&c.concat());
+    }
+    img
+}
+
+fn decode(img: &ImageBuf) -> Option<IrradianceProbes> {
+    if img.width != 27 || img.channels != 1 || img.height < 2 {
+        return None;
+    }
+    let d = &img.data;
+    let dims = [d[6] as u32, d[7] as u32, d[8] as u32];
+    let count = (dims[0] * dims[1] * dims[2]) as usize;
+    if count + 1 != img.height as usize {
+        return None;
+    }
+    let coeffs = (0..count)
+        .map(|i| std::array::from_fn(|k| std::array::from_fn(|c| d[27 * (i + 1) + 3 * k + c])))
+        .collect();
+    Some(IrradianceProbes {
+        origin: Vec3::new(d[0], d[1], d[2]),
+        spacing: Vec3::new(d[3], d[4], d[5]),
+        dims,
+        coeffs,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cache_encoding_round_trips() {
+        let mut p = IrradianceProbes::grid(Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 2.0, 5.0), [3, 2, 2]);
+        for (i, c) in p.coeffs.iter_mut().enumerate() {
+            for (k, rgb) in c.iter_mut().enumerate() {
+                *rgb = [i as f32, k as f32, 0.5 * (i + k) as f32];
+            }
+        }
+        assert_eq!(decode(&encode(&p)), Some(p));
+    }
+}
