@@ -116,7 +116,11 @@ fn ao(a: &EvalArgs) -> Result<()> {
         None
     };
     let flicker = match a.frames {
-        Some(n) => Some(flicker(&gpu, &scene, a, &settings, n)?),
+        Some(n) => {
+            let threshold = settings.temporal.map_or(0.01, |t| t.max_distance);
+            let rs = render_settings(a, a.deep.layers, &settings);
+            Some(flicker(&gpu, &scene, a, rs, "ao", threshold, n)?)
+        }
         None => None,
     };
     let stats = |s: &ErrorStats| json!({"flip": s.flip, "rmse": s.rmse, "mae": s.mae});
@@ -265,16 +269,25 @@ fn reproject(csz: &ImageBuf, av: &ImageBuf, px: f32, py: f32) -> Option<(f32, f3
 /// Temporal instability: mean |AV_t(p) − AV_{t−1}(p')| over pixels whose surface
 /// reprojects (p' in frame t − 1, interpolated) onto the same surface, averaged
 /// over consecutive frame pairs.
-struct Flicker {
-    mean: f64,
-    frames: u32,
-    valid_fraction: f64,
+pub(crate) struct Flicker {
+    pub mean: f64,
+    pub frames: u32,
+    pub valid_fraction: f64,
 }
 
-fn flicker(gpu: &GpuContext, scene: &Scene, a: &EvalArgs, ao: &AoSettings, frames: u32) -> Result<Flicker> {
-    let mut r = Renderer::new(gpu, scene, render_settings(a, a.deep.layers, ao))?;
+/// Flicker of channel 0 of target `target` rendered with `settings` along the
+/// camera path from `--frame` (reprojection accepted within `threshold`).
+pub(crate) fn flicker(
+    gpu: &GpuContext,
+    scene: &Scene,
+    a: &EvalArgs,
+    settings: RenderSettings,
+    target: &str,
+    threshold: f32,
+    frames: u32,
+) -> Result<Flicker> {
+    let mut r = Renderer::new(gpu, scene, settings)?;
     let (w, h) = (a.scene.width, a.scene.height);
-    let threshold = ao.temporal.map_or(0.01, |t| t.max_distance);
     let mut prev: Option<(Camera, ImageBuf, ImageBuf)> = None;
     let (mut sum, mut pairs, mut valid, mut counted) = (0.0f64, 0u32, 0u64, 0u64);
     // one warm-up frame so the first measured pair already has history
@@ -284,7 +297,7 @@ fn flicker(gpu: &GpuContext, scene: &Scene, a: &EvalArgs, ao: &AoSettings, frame
         let f = f0 + i as f32;
         let cams = cameras_at(scene, &a.scene, f);
         r.render(gpu, scene, &cams, f)?;
-        let av = r.read_target(gpu, "ao")?;
+        let av = r.read_target(gpu, target)?.channel(0);
         let csz = r.read_target(gpu, "csz")?;
         if let Some((pcam, pav, pcsz)) = &prev {
             let vp = pcam.view_projection(w as f32 / h as f32);

@@ -37,6 +37,11 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     if !(1..=65536).contains(&spp) {
         bail!("--ref-spp {spp} is out of range: must be in 1..=65536");
     }
+    if let Some(n) = a.frames {
+        if !(2..=1000).contains(&n) {
+            bail!("--frames {n} is out of range: must be in 2..=1000");
+        }
+    }
     if !(1..=64).contains(&a.bounces) {
         bail!("--bounces {} is out of range: must be in 1..=64", a.bounces);
     }
@@ -152,6 +157,14 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     if let Some(o) = &one {
         out["layers_1"] = json!({"flip": o.indirect_stats.flip, "rmse": o.indirect_stats.rmse,
             "mae": o.indirect_stats.mae, "full": stats(&o.full_stats)});
+    }
+    if let Some(n) = a.frames {
+        // temporal stability of the indirect irradiance (red channel) along the path
+        let threshold = rs.temporal.map_or(0.01, |t| t.max_distance);
+        let f = crate::eval::flicker(&gpu, &scene, a, render_settings(a, k, &rs), "indirect", threshold, n)?;
+        out["flicker"] = json!(f.mean);
+        out["flicker_frames"] = json!(f.frames);
+        out["flicker_valid_fraction"] = json!(f.valid_fraction);
     }
     if let Some(dir) = &a.report {
         write_gi_report(dir, a, &main, one.as_ref(), &ref_total, &ref_indirect, exposure, &out)?;
