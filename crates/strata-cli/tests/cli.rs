@@ -390,3 +390,176 @@ fn bench_ao_splits_first_layer_and_increment() {
     assert!(total > 0.0 && first > 0.0);
     assert!((first + inc - total).abs() < 1e-6, "{first} + {inc} != {total}");
 }
+
+#[test]
+fn render_full_is_brighter_than_direct_in_shadow_and_lists_its_passes() {
+    let cache = scratch("probe-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let run = |technique: &str, out: &Path| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
+        cmd.args([
+            "render",
+            "--scene",
+            "mirror",
+            "--technique",
+            technique,
+            "--layers",
+            "2",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--warmup",
+            "2",
+            "--force",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        cmd.env("STRATA_CACHE", &cache);
+        if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+            cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+        }
+        cmd.output().unwrap()
+    };
+    let (direct, full) = (scratch("mirror-direct.exr"), scratch("mirror-full.exr"));
+    let o = run("direct", &direct);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run("full", &full);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (d, f) = (
+        strata_scene::ImageBuf::load(&direct).unwrap(),
+        strata_scene::ImageBuf::load(&full).unwrap(),
+    );
+    let sum = |img: &strata_scene::ImageBuf| img.data.chunks_exact(4).map(|p| p[0] + p[1] + p[2]).sum::<f32>();
+    assert!(
+        sum(&f) > 1.05 * sum(&d),
+        "indirect light, probes and reflections add light"
+    );
+    assert!(
+        std::fs::read_dir(&cache).unwrap().count() >= 1,
+        "the probes were not cached"
+    );
+    let o = strata(&[
+        "render",
+        "--scene",
+        "mirror",
+        "--technique",
+        "full",
+        "--layers",
+        "2",
+        "--list-passes",
+    ]);
+    let text = stdout(&o);
+    for p in [
+        "depth-mip",
+        "ao",
+        "propagate",
+        "radiosity",
+        "compose",
+        "reflections",
+        "tonemap",
+    ] {
+        assert!(text.contains(&format!("  {p} ")), "pass {p} missing:\n{text}");
+    }
+}
+
+#[test]
+fn unknown_preset_lists_the_valid_ones() {
+    let o = strata(&[
+        "render",
+        "--scene",
+        "plane",
+        "--technique",
+        "full",
+        "--preset",
+        "ultra",
+        "--out",
+        "x.png",
+    ]);
+    assert_one_line_error(&o, &["--preset", "high-performance, balanced, high-quality"]);
+}
+
+#[test]
+fn eval_gi_reports_indirect_and_full_errors() {
+    let cache = scratch("gi-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        "gi",
+        "--layers",
+        "2",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--ref-spp",
+        "4",
+        "--bounces",
+        "2",
+        "--warmup",
+        "2",
+        "--json",
+        "--quiet",
+        "--cache",
+        cache.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(v["technique"], "gi");
+    for key in ["flip", "rmse", "mae"] {
+        assert!(v[key].as_f64().is_some_and(|x| x >= 0.0), "{key}: {v}");
+        assert!(v["full"][key].as_f64().is_some_and(|x| x >= 0.0), "full.{key}: {v}");
+    }
+    assert_eq!(v["ref_spp"], 4);
+}
+
+#[test]
+fn bench_radiosity_and_reflections_time_their_passes() {
+    let o = strata(&[
+        "bench",
+        "radiosity",
+        "--scene",
+        "cornell",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+        "--preset",
+        "high-performance",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    let names: Vec<&str> = v["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert!(
+        names.contains(&"radiosity") && names.contains(&"propagate"),
+        "{names:?}"
+    );
+    assert_eq!(v["samples"], 13, "high-performance preset: N = 13");
+    let o = strata(&[
+        "bench",
+        "reflections",
+        "--scene",
+        "mirror",
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--frames",
+        "2",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert!(v["total_median_ms"].as_f64().unwrap() > 0.0);
+}
