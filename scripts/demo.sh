@@ -12,8 +12,15 @@ cargo build --release -q -p strata-cli
 S=target/release/strata
 echo "[strata demo] device:" >&2
 $S info | tee "$OUT/info.txt"
-echo "[strata demo] rendering atrium ${W}x${H}" >&2
-$S render --scene atrium --width "$W" --height "$H" --out "$OUT/atrium.png" --force --timings
+echo "[strata demo] rendering atrium ${W}x${H}: direct + deep-G-buffer radiosity + probes + AO + reflections" >&2
+$S render --scene atrium --technique full --preset balanced --layers 2 --frame 10 --warmup 8 \
+  --width "$W" --height "$H" --out "$OUT/atrium-full.png" --force --timings
+for v in confidence gbuffer-only probe-only blended; do
+  $S render --scene atrium --technique full --preset balanced --layers 2 --frame 10 --warmup 8 \
+    --width "$W" --height "$H" --debug-view "$v" --out "$OUT/atrium-$v.png" --force
+done
+$S render --scene mirror --technique full --layers 2 --warmup 4 --width "$W" --height "$H" --out "$OUT/mirror-full.png" --force
+$S render --scene atrium --width "$W" --height "$H" --out "$OUT/atrium.png" --force
 $S render --scene atrium --width "$W" --height "$H" --out "$OUT/atrium.exr" --force
 for v in csz normal albedo emission direct-diffuse shadow; do
   $S render --scene atrium --width "$W" --height "$H" --debug-view "$v" --out "$OUT/atrium-$v.png" --force
@@ -28,22 +35,31 @@ $S render --scene atrium --technique ao --layers 2 --width "$W" --height "$H" --
 $S eval --scene atrium --technique ao --layers 2 --width 320 --height 180 --ref-spp 128 --frames 4 \
   --report "$OUT/ao-eval" --force --json --quiet > "$OUT/eval-ao.json"
 cat "$OUT/eval-ao.json"
+echo "[strata demo] deep-G-buffer radiosity against the path tracer" >&2
+$S eval --scene warehouse --technique gi --layers 2 --width 320 --height 180 \
+  --report "$OUT/gi-eval" --force --json --quiet > "$OUT/eval-gi.json"
+cat "$OUT/eval-gi.json"
 echo "[strata demo] GPU timings" >&2
 $S bench gbuffer --scene atrium --width "$W" --height "$H" --frames 5 --json > "$OUT/bench-gbuffer.json"
 cat "$OUT/bench-gbuffer.json"
 $S bench ao --scene atrium --width "$W" --height "$H" --layers 2 --frames 5 --json > "$OUT/bench-ao.json"
 cat "$OUT/bench-ao.json"
+$S bench radiosity --scene atrium --width "$W" --height "$H" --layers 2 --frames 5 --preset balanced --json > "$OUT/bench-radiosity.json"
+cat "$OUT/bench-radiosity.json"
 {
   echo "<!doctype html><meta charset=utf-8><title>strata demo</title>"
   echo "<style>body{font-family:sans-serif;max-width:1400px;margin:auto}img{max-width:45%;margin:4px;image-rendering:pixelated}figure{display:inline-block;margin:4px}</style>"
   echo "<h1>strata demo report</h1><p>$(date -u +%Y-%m-%dT%H:%MZ)</p><pre>$(cat "$OUT/info.txt")</pre>"
   echo "<h2>Renders</h2>"
-  for f in atrium atrium-ao cornell warehouse; do echo "<figure><img src=$f.png><figcaption>$f</figcaption></figure>"; done
+  for f in atrium-full mirror-full atrium atrium-ao cornell warehouse; do echo "<figure><img src=$f.png><figcaption>$f</figcaption></figure>"; done
+  echo "<h2>Fig. 9 views (atrium, full)</h2>"
+  for v in confidence gbuffer-only probe-only blended; do echo "<figure><img src=atrium-$v.png><figcaption>$v</figcaption></figure>"; done
+  echo "<h2>Deep-G-buffer radiosity vs path tracer</h2><p><a href=gi-eval/index.html>evaluation report</a></p><pre>$(cat "$OUT/eval-gi.json")</pre>"
   echo "<h2>Deep-G-buffer AO vs ray-traced obscurance</h2><p><a href=ao-eval/index.html>evaluation report</a></p><pre>$(cat "$OUT/eval-ao.json")</pre>"
   echo "<h2>atrium G-buffer and lighting targets</h2>"
   for v in csz normal albedo emission direct-diffuse shadow; do echo "<figure><img src=atrium-$v.png><figcaption>$v</figcaption></figure>"; done
   echo "<h2>CPU reference</h2><figure><img src=atrium-ref-ao.png><figcaption>atrium AO (binary visibility)</figcaption></figure>"
   echo "<figure><img src=cornell-ref-gi.png><figcaption>cornell path-traced GI</figcaption></figure>"
-  echo "<h2>GPU timings (strata bench gbuffer, strata bench ao)</h2><pre>$(cat "$OUT/bench-gbuffer.json")</pre><pre>$(cat "$OUT/bench-ao.json")</pre>"
+  echo "<h2>GPU timings (strata bench gbuffer, strata bench ao)</h2><pre>$(cat "$OUT/bench-gbuffer.json")</pre><pre>$(cat "$OUT/bench-ao.json")</pre><pre>$(cat "$OUT/bench-radiosity.json")</pre>"
 } > "$OUT/report.html"
 echo "[strata demo] wrote $OUT/report.html and images in $OUT/" >&2
