@@ -122,11 +122,7 @@ fn gpu_ao_equals_cpu_eq1_eq2_over_the_same_buffers() {
             .collect();
         assert_eq!(zmip.len(), 5, "default chain has 5 levels");
         let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
-        let mut normals = ImageBuf::new(w, h, 3);
-        for (o, p) in normals.data.chunks_exact_mut(3).zip(npack.data.chunks_exact(4)) {
-            let q = |v: f32| (v * 255.0).round() as u8;
-            o.copy_from_slice(&strata_render::packing::oct16_unpack([q(p[0]), q(p[1])]).to_array());
-        }
+        let normals = common::npack_normals(&npack, 0);
         let f = r.frame_uniforms();
         let (mut close, mut occluded, mut worst) = (0usize, 0usize, 0.0f32);
         for y in 0..h {

@@ -40,16 +40,6 @@ fn frozen(name: &str) -> Scene {
     s
 }
 
-fn normals(npack: &ImageBuf, layer: usize) -> ImageBuf {
-    let mut out = ImageBuf::new(npack.width, npack.height, 3);
-    for (o, p) in out.data.chunks_exact_mut(3).zip(npack.data.chunks_exact(4)) {
-        let q = |v: f32| (v * 255.0).round() as u8;
-        let n = strata_render::packing::oct16_unpack([q(p[2 * layer]), q(p[2 * layer + 1])]);
-        o.copy_from_slice(&n.to_array());
-    }
-    out
-}
-
 /// One bounce on the GPU equals Eq. 4–5 evaluated on the CPU over the read-back
 /// depth chain, normals and radiosity buffers with the same taps, for layer 0
 /// and layer 1 receivers, with and without the n̂_Y test.
@@ -72,7 +62,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
             .collect();
         let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
-        let (n0, n1) = (normals(&npack, 0), normals(&npack, 1));
+        let (n0, n1) = (common::npack_normals(&npack, 0), common::npack_normals(&npack, 1));
         let b0 = r.read_target_full(&gpu, "radiosity0", 0).unwrap();
         let b1 = r.read_target_full(&gpu, "radiosity1", 0).unwrap();
         let f = r.frame_uniforms();

@@ -39,3 +39,15 @@ pub fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
         None
     }
 }
+
+/// World normals of layer `layer` (0 or 1) decoded from a read-back `npack`
+/// (Oct16, RGBA8) exactly as the shaders decode them.
+pub fn npack_normals(npack: &strata_scene::ImageBuf, layer: usize) -> strata_scene::ImageBuf {
+    let mut out = strata_scene::ImageBuf::new(npack.width, npack.height, 3);
+    for (o, p) in out.data.chunks_exact_mut(3).zip(npack.data.chunks_exact(4)) {
+        let q = |v: f32| (v * 255.0).round() as u8;
+        let n = strata_render::packing::oct16_unpack([q(p[2 * layer]), q(p[2 * layer + 1])]);
+        o.copy_from_slice(&n.to_array());
+    }
+    out
+}

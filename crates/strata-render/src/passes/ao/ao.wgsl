@@ -32,17 +32,6 @@ struct Ao {
 @group(1) @binding(1) var zmip: texture_2d<f32>;
 @group(1) @binding(2) var npack: texture_2d<f32>;
 
-// The level-0 pixel that level-m texel t copies (depth_mip.wgsl's rotated
-// grid applied m times), so each tap is reconstructed where its depth was seen.
-fn mip_source_pixel(t: vec2i, m: u32) -> vec2i {
-    var c = t;
-    for (var l = m; l > 0u; l--) {
-        let last = vec2i(textureDimensions(zmip, l - 1u)) - 1;
-        c = min(c * 2 + vec2i((c.y & 1) ^ 1, (c.x & 1) ^ 1), last);
-    }
-    return c;
-}
-
 // Eq. 2: obscurance at X (normal n) due to a surface point at v = Y − X.
 fn obscurance(v: vec3f, n: vec3f) -> f32 {
     let vv = dot(v, v);
@@ -82,7 +71,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         let t = q >> vec2u(m);
         let zs = textureLoad(zmip, t, i32(m));
         // the full-resolution pixel whose depth the MIP texel holds
-        let src = mip_source_pixel(t, m);
+        let src = mip_source_pixel(zmip, t, m);
         // Eq. 1: max over layers j of A_i^j = O(X, R(Z[j], i))
         var a = 0.0;
         for (var j = 0u; j < LAYERS; j++) {

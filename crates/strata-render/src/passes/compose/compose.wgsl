@@ -4,6 +4,7 @@
 // deep-G-buffer result where its confidence c = M/N is high, the static
 // probes (modulated by AO when it runs) where it is not.
 #import "common/fullscreen.wgsl"
+#import "common/color.wgsl"
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
@@ -43,15 +44,6 @@ struct Out {
     @location(1) blended: vec4f,
     // probe irradiance × AV (rgb), AV (a)
     @location(2) probe: vec4f,
-}
-
-// Eq. 7
-fn boost(rho: vec3f) -> f32 {
-    let mx = max(rho.r, max(rho.g, rho.b));
-    if (mx <= 0.0) {
-        return 0.0;
-    }
-    return (mx - min(rho.r, min(rho.g, rho.b))) / mx;
 }
 
 fn sh9(d: vec3f) -> array<f32, 9> {

@@ -4,6 +4,7 @@
 // and damped by δ: B = B_direct + δ · ρ/π · boost(ρ) · E_{t−1}. Propagating to
 // layer 1 too (Fig. 5) uses layer 1's own E_{t−1}.
 #import "common/fullscreen.wgsl"
+#import "common/color.wgsl"
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
 #import "common/reproject.wgsl"
@@ -33,14 +34,6 @@ struct Propagate {
 struct Out {
     @location(0) b0: vec4f,
     @location(1) b1: vec4f,
-}
-
-fn boost(rho: vec3f) -> f32 {
-    let mx = max(rho.r, max(rho.g, rho.b));
-    if (mx <= 0.0) {
-        return 0.0;
-    }
-    return (mx - min(rho.r, min(rho.g, rho.b))) / mx;
 }
 
 fn bounce_input(p: vec2i, j: i32, direct: vec3f) -> vec3f {

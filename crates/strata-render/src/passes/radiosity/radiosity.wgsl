@@ -43,15 +43,6 @@ struct Out {
     @location(1) e1: vec4f,
 }
 
-fn mip_source_pixel(t: vec2i, m: u32) -> vec2i {
-    var c = t;
-    for (var l = m; l > 0u; l--) {
-        let last = vec2i(textureDimensions(zmip, l - 1u)) - 1;
-        c = min(c * 2 + vec2i((c.y & 1) ^ 1, (c.x & 1) ^ 1), last);
-    }
-    return c;
-}
-
 fn normal_of(p: vec2i, layer: u32) -> vec3f {
     let n = textureLoad(npack, p, 0);
     if (layer == 0u) {
@@ -140,7 +131,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         let m = max(spiral_mip(tap.radius, rad.q, rad.max_mip), min(rad.min_mip, rad.max_mip));
         let t = q >> vec2u(m);
         let zs = textureLoad(zmip, t, i32(m));
-        let src = mip_source_pixel(t, m);
+        let src = mip_source_pixel(zmip, t, m);
         var best0 = vec4f(0.0);
         var best1 = vec4f(0.0);
         for (var j = 0u; j < min(LAYERS, 2u); j++) {

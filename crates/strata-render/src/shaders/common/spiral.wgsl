@@ -46,3 +46,15 @@ fn spiral_mip(h: f32, q: f32, max_level: u32) -> u32 {
 fn tap_texel(offset: vec2f) -> vec2i {
     return vec2i(floor(offset + vec2f(0.5)));
 }
+
+// The level-0 pixel whose depth level-m texel t of the depth MIP chain `zmip`
+// holds (depth_mip.wgsl's rotated grid applied m times, children clamped to
+// each level), so a tap is reconstructed where its depth was seen.
+fn mip_source_pixel(zmip: texture_2d<f32>, t: vec2i, m: u32) -> vec2i {
+    var c = t;
+    for (var l = m; l > 0u; l--) {
+        let last = vec2i(textureDimensions(zmip, l - 1u)) - 1;
+        c = min(c * 2 + vec2i((c.y & 1) ^ 1, (c.x & 1) ^ 1), last);
+    }
+    return c;
+}
