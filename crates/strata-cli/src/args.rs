@@ -305,6 +305,10 @@ pub struct EvalArgs {
     /// Indirect bounces of the path-traced reference (gi), 1..=64.
     #[arg(long, default_value_t = 4)]
     pub bounces: u32,
+    /// gi: also run DGB Fig. 10's error-source study — single-bounce GPU radiosity with and
+    /// without the n_Y test against single-bounce references with and without visibility.
+    #[arg(long)]
+    pub fig10: bool,
     /// Static frames rendered before the evaluated one (gi: progressive bounces and the
     /// temporal filter converge), 0..=1000.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=1000))]

@@ -158,6 +158,9 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         out["layers_1"] = json!({"flip": o.indirect_stats.flip, "rmse": o.indirect_stats.rmse,
             "mae": o.indirect_stats.mae, "full": stats(&o.full_stats)});
     }
+    if a.fig10 {
+        out["fig10"] = fig10(a, &gpu, &scene, &rs, &cache, spp)?;
+    }
     if let Some(n) = a.frames {
         // temporal stability of the indirect irradiance (red channel) along the path
         let threshold = rs.temporal.map_or(0.01, |t| t.max_distance);
@@ -310,4 +313,76 @@ fn write_gi_report(
         numbers,
     )?;
     Ok(())
+}
+
+/// DGB Fig. 10's error sources: one GPU bounce (δ = 0) with and without the n̂_Y
+/// test, each against single-bounce references with traced visibility and with
+/// mutual visibility assumed (indirect radiance; FLIP on tonemapped images).
+fn fig10(
+    a: &EvalArgs,
+    gpu: &GpuContext,
+    scene: &strata_scene::Scene,
+    rs: &RadiositySettings,
+    cache: &RefCache,
+    spp: u32,
+) -> Result<serde_json::Value> {
+    use strata_reference::gi::OneBounceSettings;
+    let (w, h) = (a.scene.width, a.scene.height);
+    let camera = cameras_at(scene, &a.scene, a.scene.frame).current;
+    let reference = Reference::new(scene, a.scene.frame).with_progress(!a.quiet);
+    let mut refs = Vec::new();
+    for visibility in [true, false] {
+        let s = OneBounceSettings {
+            spp,
+            visibility,
+            ..Default::default()
+        };
+        let d = format!(
+            "v1 one-bounce {} {camera:?} {w}x{h} {s:?}",
+            scene_fingerprint(scene, a.scene.frame)
+        );
+        let key = RefCache::key(&d);
+        let img = match cache.load(&key).filter(|_| !a.no_cache) {
+            Some(img) => img,
+            None => {
+                let img = reference.one_bounce(&camera, w, h, &s);
+                if let Err(e) = cache.store(&key, &img, &d) {
+                    tracing::warn!("could not cache the reference: {e:#}");
+                }
+                img
+            }
+        };
+        refs.push(img);
+    }
+    let exposure = scene.settings.exposure;
+    let mut out = serde_json::Map::new();
+    for normal_test in [true, false] {
+        let settings = RadiositySettings {
+            normal_test,
+            delta: 0.0,
+            ..rs.clone()
+        };
+        let mut r = Renderer::new(gpu, scene, render_settings(a, a.deep.layers, &settings))?;
+        let fixed = strata_render::frame::FrameCameras::fixed(camera);
+        for _ in 0..=a.warmup {
+            r.render(gpu, scene, &fixed, a.scene.frame)?;
+        }
+        let full = rgb(&r.read_target(gpu, "hdr-full")?);
+        let direct = rgb(&r.read_target(gpu, "hdr")?);
+        let mut indirect = full;
+        for (o, d) in indirect.data.iter_mut().zip(&direct.data) {
+            *o = (*o - d).max(0.0);
+        }
+        let mut row = serde_json::Map::new();
+        for (name, reference) in [("vs_visibility", &refs[0]), ("vs_mutual_visibility", &refs[1])] {
+            let (mut st, _) = compare(&display(reference, exposure), &display(&indirect, exposure))?;
+            (st.rmse, st.mae) = linear_errors(reference, &indirect);
+            row.insert(name.into(), json!({"flip": st.flip, "rmse": st.rmse, "mae": st.mae}));
+        }
+        out.insert(
+            if normal_test { "normal_test" } else { "no_normal_test" }.into(),
+            serde_json::Value::Object(row),
+        );
+    }
+    Ok(serde_json::Value::Object(out))
 }

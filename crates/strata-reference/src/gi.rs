@@ -364,3 +364,160 @@ impl ShadingPoint {
         }
     }
 }
+
+/// Settings of [`Reference::one_bounce`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OneBounceSettings {
+    /// Surface samples per pixel.
+    pub spp: u32,
+    /// Trace X–Y visibility (false: assume mutual visibility, as screen-space
+    /// radiosity does — DGB Fig. 10's "no visibility" reference).
+    pub visibility: bool,
+    pub seed: u64,
+}
+
+impl Default for OneBounceSettings {
+    fn default() -> Self {
+        Self {
+            spp: 256,
+            visibility: true,
+            seed: 0,
+        }
+    }
+}
+
+impl Reference<'_> {
+    /// Single-bounce indirect radiance at each pixel's primary hit X:
+    /// ρ_X/π · ∫_A B(Y) cosθ_X cosθ_Y / d² · V(X, Y) dA, where B(Y) = ρ_Y/π ·
+    /// E_direct(Y) is Y's Lambertian direct light toward X (emission excluded:
+    /// the emitters' own light at X is direct light). Y is sampled uniformly by
+    /// area over every triangle, so V can be traced or assumed 1 (DGB Fig. 10).
+    pub fn one_bounce(&self, camera: &Camera, width: u32, height: u32, settings: &OneBounceSettings) -> ImageBuf {
+        let tris = self.bvh.triangles();
+        let mut cdf = Vec::with_capacity(tris.len());
+        let mut total = 0.0f64;
+        for t in tris {
+            total += 0.5 * (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).length() as f64;
+            cdf.push(total);
+        }
+        let label = if settings.visibility {
+            "one bounce"
+        } else {
+            "one bounce, no visibility"
+        };
+        let px = self.for_each_pixel(label, width, height, |x, y, rays| {
+            let dir = camera.pixel_dir(x, y, width, height);
+            *rays += 1;
+            let Some(h) = self.bvh.intersect(camera.eye, dir, camera.near, f32::INFINITY) else {
+                return Vec3::ZERO;
+            };
+            if total <= 0.0 {
+                return Vec3::ZERO;
+            }
+            let hx = self.bvh.surface(&h, dir);
+            let (nx, ngx) = hx.facing_normals(dir);
+            let origin = hx.position + ngx * self.epsilon;
+            let mut e = Vec3::ZERO;
+            for s in 0..settings.spp {
+                let mut rng = Rng::new(hash(&[settings.seed, (y * width + x) as u64, s as u64, 0x0b]));
+                let u = rng.next_f32() as f64 * total;
+                let ti = cdf.partition_point(|&c| c < u).min(tris.len() - 1);
+                let t = &tris[ti];
+                let (b1, b2) = triangle_barycentrics(rng.next_2d());
+                let q = t.p[0] * (1.0 - b1 - b2) + t.p[1] * b1 + t.p[2] * b2;
+                let d = q - hx.position;
+                let d2 = d.length_squared();
+                if !(d2 > 1e-12) {
+                    continue;
+                }
+                let w = d / d2.sqrt();
+                let cos_x = nx.dot(w);
+                if cos_x <= 0.0 || ngx.dot(w) <= 0.0 {
+                    continue;
+                }
+                let hy = self.bvh.surface(
+                    &crate::bvh::Hit {
+                        t: 0.0,
+                        triangle: ti as u32,
+                        b1,
+                        b2,
+                    },
+                    w,
+                );
+                let (ny, ngy) = hy.facing_normals(w);
+                let cos_y = ny.dot(-w);
+                if cos_y <= 0.0 {
+                    continue;
+                }
+                if settings.visibility && !self.visible(origin, q, rays) {
+                    continue;
+                }
+                let sp = ShadingPoint {
+                    x: q,
+                    origin: q + ngy * self.epsilon,
+                    n: ny,
+                    ng: ngy,
+                };
+                let b = self.albedo(&hy) * self.direct_irradiance(&sp, &mut rng, rays) * std::f32::consts::FRAC_1_PI;
+                e += b * (cos_x * cos_y / d2);
+            }
+            e * (total as f32 / settings.spp.max(1) as f32) * self.albedo(&hx) * std::f32::consts::FRAC_1_PI
+        });
+        let mut img = ImageBuf::new(width, height, 3);
+        for (o, v) in img.data.chunks_exact_mut(3).zip(&px) {
+            o.copy_from_slice(&v.to_array());
+        }
+        img
+    }
+}
+
+#[cfg(test)]
+mod one_bounce_tests {
+    use super::*;
+
+    /// Area sampling with traced visibility integrates the same single bounce
+    /// as the path tracer's second vertex (Cornell box: no sky); dropping
+    /// visibility can only add light.
+    #[test]
+    fn one_bounce_matches_the_path_tracer_and_visibility_removes_light() {
+        let scene = strata_scene::procedural::builtin("cornell").unwrap();
+        let r = Reference::new(&scene, 0.0);
+        let cam = scene.camera;
+        let (w, h) = (24, 24);
+        let mean = |img: &ImageBuf| img.data.iter().map(|&v| v as f64).sum::<f64>() / img.data.len() as f64;
+        let traced = r.one_bounce(
+            &cam,
+            w,
+            h,
+            &OneBounceSettings {
+                spp: 512,
+                ..Default::default()
+            },
+        );
+        let path = r.gi(
+            &cam,
+            w,
+            h,
+            &GiSettings {
+                spp: 512,
+                bounces: 1,
+                russian_roulette: false,
+                ..Default::default()
+            },
+        );
+        let blind = r.one_bounce(
+            &cam,
+            w,
+            h,
+            &OneBounceSettings {
+                spp: 512,
+                visibility: false,
+                ..Default::default()
+            },
+        );
+        let (a, b, c) = (mean(&traced), mean(&path.indirect), mean(&blind));
+        eprintln!("one bounce: area-sampled {a:.5}, path-traced {b:.5}, no visibility {c:.5}");
+        assert!((a - b).abs() < 0.05 * b, "area-sampled {a} vs path-traced {b}");
+        assert!(c > a * 1.02, "assuming visibility should add light: {c} vs {a}");
+    }
+}
