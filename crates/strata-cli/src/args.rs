@@ -161,6 +161,10 @@ pub struct RadiosityArgs {
     /// Progressive multi-bounce damping δ in [0, 1] (DGB §3.3; 0 = single bounce).
     #[arg(long, default_value_t = 0.9)]
     pub delta: f32,
+    /// Hash the frame index into the gather's spiral rotation too, so the temporal filter
+    /// averages different tap patterns (the paper hashes the pixel only).
+    #[arg(long)]
+    pub indirect_temporal_noise: bool,
 }
 
 impl RadiosityArgs {
@@ -186,6 +190,7 @@ impl RadiosityArgs {
             ..Default::default()
         });
         s.delta = self.delta;
+        s.temporal_noise = self.indirect_temporal_noise;
         Ok(s)
     }
 }

@@ -203,6 +203,9 @@ pub struct Renderer {
     /// Last frame's layers ≥ 1 had their oracle (false on a single-pass
     /// variant's first frame), so its temporally filtered outputs are usable.
     history_layers_valid: bool,
+    /// Frames rendered so far: the seed of per-frame rotated sampling patterns
+    /// (independent of the animation frame, so a static view also varies).
+    frames_rendered: u32,
     profiler: Profiler,
     lights: Vec<GpuLight>,
     animated: bool,
@@ -337,6 +340,7 @@ impl Renderer {
             last_frame: bytemuck::Zeroable::zeroed(),
             has_history: false,
             history_layers_valid: false,
+            frames_rendered: 0,
             profiler,
             lights,
             animated,
@@ -419,14 +423,14 @@ impl Renderer {
         let temporal_history = self.has_history && self.history_layers_valid;
         let max_mip = self.targets.try_get("zmip").map_or(0, |t| t.desc.mips - 1);
         if let (Some(stage), Some(s)) = (&self.ao, &self.settings.ao) {
-            let au = AoUniforms::new(s, scene, &u, max_mip, frame.max(0.0) as u32);
+            let au = AoUniforms::new(s, scene, &u, max_mip, self.frames_rendered);
             stage.ao.set_frame(gpu, au);
             if let Some(t) = &stage.temporal {
                 t.set_frame(gpu, temporal_history);
             }
         }
         if let (Some(stage), Some(s)) = (&self.radiosity, &self.settings.radiosity) {
-            let ru = RadiosityUniforms::new(s, scene, &u, max_mip, frame.max(0.0) as u32);
+            let ru = RadiosityUniforms::new(s, scene, &u, max_mip, self.frames_rendered);
             stage.gather.set_frame(gpu, ru);
             if let Some(p) = &stage.propagate {
                 p.set_frame(gpu, temporal_history);
@@ -468,6 +472,7 @@ impl Renderer {
         gpu.queue.submit([encoder.finish()]);
         gpu.check_errors()?;
         self.history_layers_valid = !self.settings.deep.uses_history() || self.has_history;
+        self.frames_rendered = self.frames_rendered.wrapping_add(1);
         self.has_history = self.history.is_some();
         self.profiler.read(gpu)
     }

@@ -37,8 +37,9 @@ pub struct AoSettings {
     pub turns: SpiralTurns,
     /// Rotate each pixel's spiral by φ = hash(x, y) (false: φ = 0, Fig. 7 left).
     pub rotate: bool,
-    /// Also hash the frame index into φ, so the temporal filter averages
-    /// different patterns (off by default: the paper's φ depends on (x, y) only).
+    /// Also hash the renderer's frame count into φ, so the temporal filter
+    /// averages different patterns (off by default: the paper's φ depends on
+    /// (x, y) only).
     pub temporal_noise: bool,
     /// q: the tap radius in pixels at which the MIP level first increments.
     pub q: f32,
