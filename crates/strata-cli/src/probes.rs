@@ -19,7 +19,7 @@ pub const BOUNCES: u32 = 3;
 /// The scene's probes at animation frame 0 (static lighting), from the cache or baked.
 pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v1 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
+        "v2 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
         crate::eval::scene_fingerprint(scene, 0.0)
     );
     let key = RefCache::key(&description);
@@ -45,20 +45,21 @@ pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<Irra
     Ok(probes)
 }
 
-/// Row 0: origin, spacing, dims; row 1 + i: probe i's 27 coefficients.
+/// Row 0: origin, spacing, dims; row 1 + i: probe i's 27 coefficients and its validity.
 fn encode(p: &IrradianceProbes) -> ImageBuf {
-    let mut img = ImageBuf::new(27, p.count() as u32 + 1, 1);
+    let mut img = ImageBuf::new(28, p.count() as u32 + 1, 1);
     let head = [p.origin.to_array(), p.spacing.to_array(), p.dims.map(|d| d as f32)].concat();
     img.data[..9].copy_from_slice(&head);
     for (i, c) in p.coeffs.iter().enumerate() {
-        let row = 27 * (i + 1);
+        let row = 28 * (i + 1);
         img.data[row..row + 27].copy_from_slice(&c.concat());
+        img.data[row + 27] = p.valid[i] as u32 as f32;
     }
     img
 }
 
 fn decode(img: &ImageBuf) -> Option<IrradianceProbes> {
-    if img.width != 27 || img.channels != 1 || img.height < 2 {
+    if img.width != 28 || img.channels != 1 || img.height < 2 {
         return None;
     }
     let d = &img.data;
@@ -68,13 +69,15 @@ fn decode(img: &ImageBuf) -> Option<IrradianceProbes> {
         return None;
     }
     let coeffs = (0..count)
-        .map(|i| std::array::from_fn(|k| std::array::from_fn(|c| d[27 * (i + 1) + 3 * k + c])))
+        .map(|i| std::array::from_fn(|k| std::array::from_fn(|c| d[28 * (i + 1) + 3 * k + c])))
         .collect();
+    let valid = (0..count).map(|i| d[28 * (i + 1) + 27] > 0.5).collect();
     Some(IrradianceProbes {
         origin: Vec3::new(d[0], d[1], d[2]),
         spacing: Vec3::new(d[3], d[4], d[5]),
         dims,
         coeffs,
+        valid,
     })
 }
 
@@ -90,6 +93,7 @@ mod tests {
                 *rgb = [i as f32, k as f32, 0.5 * (i + k) as f32];
             }
         }
+        p.valid[3] = false;
         assert_eq!(decode(&encode(&p)), Some(p));
     }
 }

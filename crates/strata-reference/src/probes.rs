@@ -13,21 +13,28 @@ use crate::Reference;
 impl Reference<'_> {
     /// Bakes a `dims` grid of probes spanning the scene's bounds (inset by 5 %
     /// per axis), `rays` paths per probe (Fibonacci-sphere directions, each a
-    /// path of `settings.bounces` bounces).
+    /// path of `settings.bounces` bounces). Probes whose rays hit back faces
+    /// more than [`INSIDE_BACKFACE_FRACTION`] of the time lie inside geometry
+    /// and are marked invalid.
     pub fn bake_probes(&self, dims: [u32; 3], rays: u32, settings: &GiSettings) -> IrradianceProbes {
         let (lo, hi) = self.bvh().bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
         let inset = (hi - lo) * 0.05;
         let mut probes = IrradianceProbes::grid(lo + inset, hi - inset, dims);
         let positions: Vec<Vec3> = (0..probes.count()).map(|i| probes.position(i)).collect();
         let rays = rays.max(1);
-        probes.coeffs = positions
+        let baked: Vec<([[f32; 3]; 9], bool)> = positions
             .par_iter()
             .enumerate()
             .map(|(index, &p)| {
                 let mut sum = [[0.0f32; 3]; 9];
                 let mut traced = 0u64;
+                let mut back = 0u32;
                 for k in 0..rays {
                     let d = fibonacci_sphere(k, rays);
+                    traced += 1;
+                    if let Some(h) = self.bvh().intersect(p, d, 0.0, f32::INFINITY) {
+                        back += !self.bvh().surface(&h, d).front_face as u32;
+                    }
                     let mut rng = Rng::new(hash(&[settings.seed, index as u64, k as u64]));
                     let l = self.radiance(p, d, settings, &mut rng, &mut traced);
                     let y = sh9(d);
@@ -40,12 +47,19 @@ impl Reference<'_> {
                 self.add_rays(traced);
                 // L_i = 4π/M Σ L Y_i; stored as irradiance E_i = Â_l L_i
                 let scale = 4.0 * std::f32::consts::PI / rays as f32;
-                std::array::from_fn(|i| sum[i].map(|v| v * scale * COSINE_LOBE[sh_band(i)]))
+                let coeffs = std::array::from_fn(|i| sum[i].map(|v| v * scale * COSINE_LOBE[sh_band(i)]));
+                // inside geometry: most rays leave through back faces
+                (coeffs, (back as f32) < INSIDE_BACKFACE_FRACTION * rays as f32)
             })
             .collect();
+        probes.coeffs = baked.iter().map(|b| b.0).collect();
+        probes.valid = baked.iter().map(|b| b.1).collect();
         probes
     }
 }
+
+/// A probe whose rays hit back faces this often is inside geometry (invalid).
+pub const INSIDE_BACKFACE_FRACTION: f32 = 0.25;
 
 /// The k-th of n nearly uniform unit directions (spherical Fibonacci).
 fn fibonacci_sphere(k: u32, n: u32) -> Vec3 {
@@ -95,6 +109,10 @@ mod tests {
         scene.settings.sky = [0.0; 3];
         let r = Reference::new(&scene, 0.0);
         let probes = r.bake_probes([2, 2, 2], 256, &GiSettings::default());
+        assert!(
+            probes.valid.iter().all(|&v| v),
+            "inward-facing walls: every probe is outside geometry"
+        );
         for i in 0..probes.count() {
             for n in [Vec3::X, -Vec3::Y, Vec3::new(0.3, 0.4, -0.866).normalize()] {
                 let e = probes.probe_irradiance(i, n);

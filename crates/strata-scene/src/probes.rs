@@ -50,6 +50,9 @@ pub struct IrradianceProbes {
     /// Per probe (x fastest, then y, then z): irradiance SH coefficients
     /// E_i = Â_l · L_i, so E(n) = Σ_i E_i · Y_i(n).
     pub coeffs: Vec<[[f32; 3]; 9]>,
+    /// Per probe: false when it lies inside geometry (most of its rays hit back
+    /// faces); invalid probes get no weight in the interpolation.
+    pub valid: Vec<bool>,
 }
 
 impl IrradianceProbes {
@@ -62,6 +65,7 @@ impl IrradianceProbes {
             spacing,
             dims,
             coeffs: vec![[[0.0; 3]; 9]; (dims[0] * dims[1] * dims[2]) as usize],
+            valid: vec![true; (dims[0] * dims[1] * dims[2]) as usize],
         }
     }
 
@@ -88,8 +92,9 @@ impl IrradianceProbes {
         e.max(Vec3::ZERO)
     }
 
-    /// Irradiance at `p` for normal `n`: trilinear blend of the 8 surrounding
-    /// probes (positions clamped to the grid).
+    /// Irradiance at `p` for normal `n`: trilinear blend of the valid ones of
+    /// the 8 surrounding probes (positions clamped to the grid), weights
+    /// renormalised; all 8 when none is valid.
     pub fn irradiance(&self, p: Vec3, n: Vec3) -> Vec3 {
         let g = ((p - self.origin) / self.spacing).max(Vec3::ZERO);
         let max = Vec3::new(
@@ -100,7 +105,8 @@ impl IrradianceProbes {
         let g = g.min(max);
         let i0 = g.floor();
         let t = g - i0;
-        let mut e = Vec3::ZERO;
+        let (mut e, mut sum) = (Vec3::ZERO, 0.0f32);
+        let (mut e_all, mut sum_all) = (Vec3::ZERO, 0.0f32);
         for corner in 0..8u32 {
             let o = Vec3::new(
                 (corner & 1) as f32,
@@ -112,9 +118,19 @@ impl IrradianceProbes {
                 * (if o.y > 0.0 { t.y } else { 1.0 - t.y })
                 * (if o.z > 0.0 { t.z } else { 1.0 - t.z });
             let index = (c.x as u32 + self.dims[0] * (c.y as u32 + self.dims[1] * c.z as u32)) as usize;
-            e += self.probe_irradiance(index, n) * w;
+            let pe = self.probe_irradiance(index, n);
+            e_all += pe * w;
+            sum_all += w;
+            if self.valid[index] {
+                e += pe * w;
+                sum += w;
+            }
         }
-        e
+        if sum > 1e-6 {
+            e / sum
+        } else {
+            e_all / sum_all.max(1e-6)
+        }
     }
 }
 
@@ -144,5 +160,8 @@ mod tests {
         assert!((p.irradiance(Vec3::new(0.5, 0.0, 0.0), Vec3::Y).x - 1.5 * y0).abs() < 1e-5);
         assert!((p.irradiance(Vec3::new(9.0, 0.0, 0.0), Vec3::Y).x - 3.0 * y0).abs() < 1e-5);
         assert_eq!(p.position(1), Vec3::new(2.0, 0.0, 0.0));
+        // an invalid probe gets no weight
+        p.valid[1] = false;
+        assert!((p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::Y).x - y0).abs() < 1e-5);
     }
 }

@@ -24,7 +24,7 @@ struct Compose {
 }
 
 struct Probe {
-    // irradiance SH coefficients E_i (rgb), i = 0..8
+    // irradiance SH coefficients E_i (rgb), i = 0..8; c[0].w = 1 valid, 0 inside geometry
     c: array<vec4f, 9>,
 }
 
@@ -69,7 +69,8 @@ fn probe_irradiance(index: u32, n: vec3f) -> vec3f {
     return max(e, vec3f(0.0));
 }
 
-// Trilinear blend of the 8 probes around p (as `IrradianceProbes::irradiance`).
+// Trilinear blend of the valid ones of the 8 probes around p (as
+// `IrradianceProbes::irradiance`).
 fn probe_field(p: vec3f, n: vec3f) -> vec3f {
     let dims = compose.dims.xyz;
     let mx = vec3f(dims) - 1.0;
@@ -77,14 +78,27 @@ fn probe_field(p: vec3f, n: vec3f) -> vec3f {
     let i0 = floor(g);
     let t = g - i0;
     var e = vec3f(0.0);
+    var sum = 0.0;
+    var e_all = vec3f(0.0);
+    var sum_all = 0.0;
     for (var corner = 0u; corner < 8u; corner++) {
         let o = vec3f(f32(corner & 1u), f32((corner >> 1u) & 1u), f32((corner >> 2u) & 1u));
         let c = vec3u(min(i0 + o, mx));
         let w3 = mix(1.0 - t, t, o);
+        let w = w3.x * w3.y * w3.z;
         let index = c.x + dims.x * (c.y + dims.y * c.z);
-        e += probe_irradiance(index, n) * (w3.x * w3.y * w3.z);
+        let pe = probe_irradiance(index, n);
+        e_all += pe * w;
+        sum_all += w;
+        // probes inside geometry (validity in coefficient 0's w) get no weight
+        let v = probes[index].c[0].w;
+        e += pe * (w * v);
+        sum += w * v;
     }
-    return e;
+    if (sum > 1e-6) {
+        return e / sum;
+    }
+    return e_all / max(sum_all, 1e-6);
 }
 
 @fragment

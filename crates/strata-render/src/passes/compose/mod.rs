@@ -99,7 +99,12 @@ impl ComposePass {
             Some(p) => p
                 .coeffs
                 .iter()
-                .flat_map(|c| c.iter().map(|rgb| [rgb[0], rgb[1], rgb[2], 0.0]))
+                .zip(&p.valid)
+                .flat_map(|(c, &valid)| {
+                    c.iter()
+                        .enumerate()
+                        .map(move |(i, rgb)| [rgb[0], rgb[1], rgb[2], if i == 0 { valid as u32 as f32 } else { 0.0 }])
+                })
                 .collect(),
             None => vec![[0.0; 4]; 9],
         };
