@@ -113,6 +113,16 @@ mod tests {
             probes.valid.iter().all(|&v| v),
             "inward-facing walls: every probe is outside geometry"
         );
+        // the same box with outward faces is a solid: every probe is inside it
+        let mut solid = scene.clone();
+        for t in solid.meshes[0].indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
+        }
+        let inside = Reference::new(&solid, 0.0).bake_probes([2, 2, 2], 64, &GiSettings::default());
+        assert!(
+            inside.valid.iter().all(|&v| !v),
+            "probes inside a solid must be invalid"
+        );
         for i in 0..probes.count() {
             for n in [Vec3::X, -Vec3::Y, Vec3::new(0.3, 0.4, -0.866).normalize()] {
                 let e = probes.probe_irradiance(i, n);
