@@ -35,8 +35,8 @@
 //! Delay/Predict add the depth-only predicted layer at index k) and the packed
 //! layout of DGB Table 1 (`zpack` = RG32F camera-space z of layers 0 and 1,
 //! `npack` = RGBA8 Oct16 normals of layers 0 and 1, `zpack23`/`npack23` for
-//! k > 2, `radiosity1…` R11G11B10 per-layer radiosity reserved for the
-//! radiosity pass; `radiosity0` is written by the lighting pass).
+//! k > 2, `radiosity0…` R11G11B10 per-layer radiosity B, written by the
+//! lighting pass).
 
 use std::num::NonZeroU32;
 use std::str::FromStr;
