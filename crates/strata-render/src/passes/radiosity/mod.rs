@@ -92,7 +92,7 @@ impl Preset {
     /// Parses and checks a preset file's text.
     pub fn parse(text: &str) -> Result<Self, String> {
         let p: Preset = toml::from_str(text).map_err(|e| e.to_string())?;
-        if p.reconstruction_taps % 2 == 0 {
+        if p.reconstruction_taps.is_multiple_of(2) {
             return Err(format!(
                 "reconstruction_taps {} must be odd (2·radius + 1)",
                 p.reconstruction_taps
@@ -576,11 +576,11 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         let zs = g.zmip[m as usize].pixel(tx, ty);
         let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
         let mut best: Option<Vec3> = None;
-        for j in 0..(g.layers.min(2) as usize) {
-            if zs[j] <= 0.0 {
+        for (j, &zj) in zs.iter().enumerate().take(g.layers.min(2) as usize) {
+            if zj <= 0.0 {
                 continue;
             }
-            let yv = world(sx as f32, sy as f32, zs[j]);
+            let yv = world(sx as f32, sy as f32, zj);
             let v = yv - pos;
             let vv = v.dot(v);
             if vv.partial_cmp(&(u.radius * u.radius)) != Some(std::cmp::Ordering::Less) || vv <= 0.0 {
