@@ -922,7 +922,7 @@ impl RadiosityStage {
             ["radiosity0", "radiosity1"]
         };
         let region = crate::passes::radiosity::shaded_region(targets.width, targets.height, guard, s.guard_band_shaded);
-        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers, b, region);
+        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers, b, region, propagate.is_some());
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
                 gpu,

@@ -270,7 +270,8 @@ pub struct RadiosityPass {
 
 impl RadiosityPass {
     /// Gathers from the radiosity buffers `b` (layer 0, layer 1) inside the
-    /// `scissor` rectangle [x, y, w, h] (`None`: everywhere).
+    /// `scissor` rectangle [x, y, w, h] (`None`: everywhere); `receiver1`: also
+    /// for layer 1's surfaces (only multi-bounce propagation reads them).
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -278,6 +279,7 @@ impl RadiosityPass {
         layers: u32,
         b: [&'static str; 2],
         scissor: Option<[u32; 4]>,
+        receiver1: bool,
     ) -> Self {
         use crate::passes::{texture_entry, uniform_entry};
         let device = &gpu.device;
@@ -320,7 +322,7 @@ impl RadiosityPass {
             &pl,
             &module,
             "fs_main",
-            &[("LAYERS", layers as f64)],
+            &[("LAYERS", layers as f64), ("RECEIVER1", receiver1 as u32 as f64)],
             &formats,
         );
         let mut inputs = vec!["zmip", "npack", b[0]];

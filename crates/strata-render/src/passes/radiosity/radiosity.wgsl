@@ -11,6 +11,9 @@
 #import "common/color.wgsl"
 
 override LAYERS: u32 = 2u;
+// 1 = also gather for layer 1's receiver (needed only to propagate bounces
+// through layer 1, §3.3 / Fig. 5)
+override RECEIVER1: u32 = 1u;
 
 // Matches `radiosity::RadiosityUniforms`.
 struct Radiosity {
@@ -107,7 +110,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     // shares the gathered samples)
     let x0 = world_from_csz(frame, vec2f(p) + 0.5, z.x);
     let n0 = normal_of(p, 0u);
-    let has1 = LAYERS > 1u && z.y > 0.0;
+    let has1 = RECEIVER1 != 0u && LAYERS > 1u && z.y > 0.0;
     var x1 = x0;
     var n1 = n0;
     if (has1) {
