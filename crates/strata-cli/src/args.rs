@@ -463,31 +463,26 @@ pub enum BenchWhat {
 #[derive(Args)]
 pub struct BenchReflectionsArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
-    #[command(flatten)]
-    pub gpu: GpuArgs,
-    /// Frames along the camera path to time (after one warm-up frame), 1..=10000.
-    #[arg(long, default_value_t = 5)]
-    pub frames: u32,
-    /// Deep G-buffer layers k, 1..=4 (compared with k = 1 for the increment).
-    #[arg(long, default_value_t = 2)]
-    pub layers: u32,
-    /// Deep G-buffer construction variant.
-    #[arg(long, default_value = "reproject", value_parser = parse_variant)]
-    pub variant: Variant,
+    pub stage: BenchStageArgs,
     /// Ray-march steps, 1..=1024.
     #[arg(long, default_value_t = 64)]
     pub steps: u32,
     /// Maximum ray distance in scene units, > 0.
     #[arg(long, default_value_t = 16.0)]
     pub max_distance: f32,
-    /// Print one JSON object on stdout.
-    #[arg(long)]
-    pub json: bool,
 }
 
 #[derive(Args)]
 pub struct BenchRadiosityArgs {
+    #[command(flatten)]
+    pub stage: BenchStageArgs,
+    #[command(flatten)]
+    pub radiosity: RadiosityArgs,
+}
+
+/// What every `bench` of a deep-G-buffer technique takes: scene, frames, layers.
+#[derive(Args)]
+pub struct BenchStageArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     #[command(flatten)]
@@ -501,8 +496,6 @@ pub struct BenchRadiosityArgs {
     /// Deep G-buffer construction variant.
     #[arg(long, default_value = "reproject", value_parser = parse_variant)]
     pub variant: Variant,
-    #[command(flatten)]
-    pub radiosity: RadiosityArgs,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
@@ -511,23 +504,9 @@ pub struct BenchRadiosityArgs {
 #[derive(Args)]
 pub struct BenchAoArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
-    #[command(flatten)]
-    pub gpu: GpuArgs,
-    /// Frames along the camera path to time (after one warm-up frame), 1..=10000.
-    #[arg(long, default_value_t = 5)]
-    pub frames: u32,
-    /// Deep G-buffer layers k, 1..=4 (compared with k = 1 for the increment).
-    #[arg(long, default_value_t = 2)]
-    pub layers: u32,
-    /// Deep G-buffer construction variant.
-    #[arg(long, default_value = "reproject", value_parser = parse_variant)]
-    pub variant: Variant,
+    pub stage: BenchStageArgs,
     #[command(flatten)]
     pub ao: AoArgs,
-    /// Print one JSON object on stdout.
-    #[arg(long)]
-    pub json: bool,
 }
 
 #[derive(Args)]

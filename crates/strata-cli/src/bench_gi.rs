@@ -43,22 +43,22 @@ struct Bench<'a> {
 pub fn radiosity(a: &BenchRadiosityArgs) -> Result<()> {
     let rs = a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
     let extra = json!({"preset": a.radiosity.preset, "samples": rs.samples, "blur_taps": rs.blur.taps(),
-        "normal_test": rs.normal_test, "min_mip": rs.min_mip, "variant": a.variant.to_string()});
+        "normal_test": rs.normal_test, "min_mip": rs.min_mip, "variant": a.stage.variant.to_string()});
     run_bench(
-        &a.gpu.adapter,
-        a.json,
+        &a.stage.gpu.adapter,
+        a.stage.json,
         Bench {
             name: "radiosity",
-            scene: &a.scene,
-            frames: a.frames,
-            layers: a.layers,
+            scene: &a.stage.scene,
+            frames: a.stage.frames,
+            layers: a.stage.layers,
             passes: &RADIOSITY_PASSES,
             settings: Box::new(move |layers| RenderSettings {
-                width: a.scene.width,
-                height: a.scene.height,
+                width: a.stage.scene.width,
+                height: a.stage.scene.height,
                 deep: DeepGBufferSettings {
                     layers,
-                    variant: a.variant,
+                    variant: a.stage.variant,
                     ..Default::default()
                 },
                 radiosity: Some(rs.clone()),
@@ -83,22 +83,22 @@ pub fn reflections(a: &BenchReflectionsArgs) -> Result<()> {
         max_distance: a.max_distance,
         ..Default::default()
     };
-    let extra = json!({"steps": rs.steps, "max_distance": rs.max_distance, "variant": a.variant.to_string()});
+    let extra = json!({"steps": rs.steps, "max_distance": rs.max_distance, "variant": a.stage.variant.to_string()});
     run_bench(
-        &a.gpu.adapter,
-        a.json,
+        &a.stage.gpu.adapter,
+        a.stage.json,
         Bench {
             name: "reflections",
-            scene: &a.scene,
-            frames: a.frames,
-            layers: a.layers,
+            scene: &a.stage.scene,
+            frames: a.stage.frames,
+            layers: a.stage.layers,
             passes: &["reflections"],
             settings: Box::new(move |layers| RenderSettings {
-                width: a.scene.width,
-                height: a.scene.height,
+                width: a.stage.scene.width,
+                height: a.stage.scene.height,
                 deep: DeepGBufferSettings {
                     layers,
-                    variant: a.variant,
+                    variant: a.stage.variant,
                     ..Default::default()
                 },
                 reflections: Some(rs),
@@ -112,22 +112,22 @@ pub fn reflections(a: &BenchReflectionsArgs) -> Result<()> {
 pub fn ao(a: &BenchAoArgs) -> Result<()> {
     let s = a.ao.settings();
     let extra = json!({"samples": s.samples, "blur_taps": s.blur.taps(),
-        "temporal_alpha": s.temporal.map_or(0.0, |t| t.alpha), "variant": a.variant.to_string()});
+        "temporal_alpha": s.temporal.map_or(0.0, |t| t.alpha), "variant": a.stage.variant.to_string()});
     run_bench(
-        &a.gpu.adapter,
-        a.json,
+        &a.stage.gpu.adapter,
+        a.stage.json,
         Bench {
             name: "ao",
-            scene: &a.scene,
-            frames: a.frames,
-            layers: a.layers,
+            scene: &a.stage.scene,
+            frames: a.stage.frames,
+            layers: a.stage.layers,
             passes: &AO_PASSES,
             settings: Box::new(move |layers| RenderSettings {
-                width: a.scene.width,
-                height: a.scene.height,
+                width: a.stage.scene.width,
+                height: a.stage.scene.height,
                 deep: DeepGBufferSettings {
                     layers,
-                    variant: a.variant,
+                    variant: a.stage.variant,
                     ..Default::default()
                 },
                 shade: false,

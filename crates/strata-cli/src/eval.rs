@@ -34,10 +34,12 @@ struct AoResult {
     binary_map: ImageBuf,
 }
 
-fn ao(a: &EvalArgs) -> Result<()> {
-    let ref_spp = a.ref_spp.unwrap_or(256);
-    if !(1..=65536).contains(&ref_spp) {
-        bail!("--ref-spp {ref_spp} is out of range: must be in 1..=65536");
+/// Checks the flags every technique shares and returns the reference's samples
+/// per pixel (`default_spp` unless `--ref-spp`).
+pub(crate) fn check_common(a: &EvalArgs, default_spp: u32) -> Result<u32> {
+    let spp = a.ref_spp.unwrap_or(default_spp);
+    if !(1..=65536).contains(&spp) {
+        bail!("--ref-spp {spp} is out of range: must be in 1..=65536");
     }
     if let Some(n) = a.frames {
         if !(2..=1000).contains(&n) {
@@ -52,6 +54,11 @@ fn ao(a: &EvalArgs) -> Result<()> {
             );
         }
     }
+    Ok(spp)
+}
+
+fn ao(a: &EvalArgs) -> Result<()> {
+    let ref_spp = check_common(a, 256)?;
     let (scene, cams) = scene_and_camera(&a.scene)?;
     let settings = a.ao.settings();
     render_settings(a, a.deep.layers, &settings)
@@ -123,7 +130,7 @@ fn ao(a: &EvalArgs) -> Result<()> {
         }
         None => None,
     };
-    let stats = |s: &ErrorStats| json!({"flip": s.flip, "rmse": s.rmse, "mae": s.mae});
+    let stats = ErrorStats::json;
     let mut out = json!({
         "scene": a.scene.scene,
         "technique": "ao",

@@ -33,25 +33,9 @@ struct GiResult {
 }
 
 pub fn run(a: &EvalArgs) -> Result<()> {
-    let spp = a.ref_spp.unwrap_or(64);
-    if !(1..=65536).contains(&spp) {
-        bail!("--ref-spp {spp} is out of range: must be in 1..=65536");
-    }
-    if let Some(n) = a.frames {
-        if !(2..=1000).contains(&n) {
-            bail!("--frames {n} is out of range: must be in 2..=1000");
-        }
-    }
+    let spp = crate::eval::check_common(a, 64)?;
     if !(1..=64).contains(&a.bounces) {
         bail!("--bounces {} is out of range: must be in 1..=64", a.bounces);
-    }
-    if let Some(dir) = &a.report {
-        if dir.join("index.html").exists() && !a.force {
-            bail!(
-                "--report {}: a report exists there; pass --force to overwrite it",
-                dir.display()
-            );
-        }
     }
     let (mut scene, cams) = scene_and_camera(&a.scene)?;
     // Compare like with like: the reference is Lambertian with no ambient
@@ -139,7 +123,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     } else {
         None
     };
-    let stats = |s: &ErrorStats| json!({"flip": s.flip, "rmse": s.rmse, "mae": s.mae});
+    let stats = ErrorStats::json;
     let mut out = json!({
         "scene": a.scene.scene,
         "technique": "gi",
@@ -377,7 +361,7 @@ fn fig10(
         for (name, reference) in [("vs_visibility", &refs[0]), ("vs_mutual_visibility", &refs[1])] {
             let (mut st, _) = compare(&display(reference, exposure), &display(&indirect, exposure))?;
             (st.rmse, st.mae) = linear_errors(reference, &indirect);
-            row.insert(name.into(), json!({"flip": st.flip, "rmse": st.rmse, "mae": st.mae}));
+            row.insert(name.into(), st.json());
         }
         out.insert(
             if normal_test { "normal_test" } else { "no_normal_test" }.into(),

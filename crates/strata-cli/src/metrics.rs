@@ -22,6 +22,13 @@ pub struct ErrorStats {
     pub pixels: usize,
 }
 
+impl ErrorStats {
+    /// `{"flip", "rmse", "mae"}` for reports.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({"flip": self.flip, "rmse": self.rmse, "mae": self.mae})
+    }
+}
+
 /// Compares `test` against `reference`; returns the error statistics and the ꟻLIP error map.
 ///
 /// Both images must have the same size and the same channel count, 1 (grey) or 3 (RGB), with values

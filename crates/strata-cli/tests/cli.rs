@@ -24,6 +24,22 @@ fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
+/// The one JSON object a successful run printed.
+fn json_of(o: &Output) -> serde_json::Value {
+    assert!(o.status.success(), "{}", stderr(o));
+    serde_json::from_str(stdout(o).trim()).expect("one JSON object on stdout")
+}
+
+/// Pass names of a `bench` JSON object.
+fn pass_names(v: &serde_json::Value) -> Vec<&str> {
+    v["passes"]
+        .as_array()
+        .expect("passes")
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect()
+}
+
 fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli");
     std::fs::create_dir_all(&dir).unwrap();
@@ -307,8 +323,7 @@ fn eval_ao_prints_errors_and_caches_the_reference() {
         report.to_str().unwrap(),
     ];
     let o = strata(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
+    let v = json_of(&o);
     assert_eq!(v["technique"], "ao");
     assert_eq!(v["layers"], 2);
     assert_eq!(v["ref_spp"], 16);
@@ -376,14 +391,8 @@ fn bench_ao_splits_first_layer_and_increment() {
         "2",
         "--json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
-    let names: Vec<&str> = v["passes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| p["name"].as_str().unwrap())
-        .collect();
+    let v = json_of(&o);
+    let names = pass_names(&v);
     assert_eq!(names, ["depth-mip", "ao", "ao-temporal", "ao-blur-h", "ao-blur-v"]);
     let total = v["total_median_ms"].as_f64().unwrap();
     let (first, inc) = (v["layer1_ms"].as_f64().unwrap(), v["increment_ms"].as_f64().unwrap());
@@ -506,8 +515,7 @@ fn eval_gi_reports_indirect_and_full_errors() {
         "--cache",
         cache.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    let v = json_of(&o);
     assert_eq!(v["technique"], "gi");
     for key in ["flip", "rmse", "mae"] {
         assert!(v[key].as_f64().is_some_and(|x| x >= 0.0), "{key}: {v}");
@@ -533,14 +541,8 @@ fn bench_radiosity_and_reflections_time_their_passes() {
         "high-performance",
         "--json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
-    let names: Vec<&str> = v["passes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| p["name"].as_str().unwrap())
-        .collect();
+    let v = json_of(&o);
+    let names = pass_names(&v);
     assert!(
         names.contains(&"radiosity") && names.contains(&"propagate"),
         "{names:?}"
@@ -559,7 +561,6 @@ fn bench_radiosity_and_reflections_time_their_passes() {
         "2",
         "--json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    let v = json_of(&o);
     assert!(v["total_median_ms"].as_f64().unwrap() > 0.0);
 }

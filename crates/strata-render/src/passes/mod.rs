@@ -228,3 +228,19 @@ impl crate::frame::Pass for HistoryPass {
         }
     }
 }
+
+/// Colour-target states for writing the targets `descs` (in order).
+pub(crate) fn color_targets(descs: &[crate::frame::TargetDesc]) -> Vec<Option<wgpu::ColorTargetState>> {
+    descs
+        .iter()
+        .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
+        .collect()
+}
+
+/// The views of the targets `descs` (in order), as a pass's attachments.
+pub(crate) fn output_views<'a>(
+    targets: &'a crate::frame::Targets,
+    descs: &[crate::frame::TargetDesc],
+) -> Vec<&'a wgpu::TextureView> {
+    descs.iter().map(|t| &targets.get(t.name).view).collect()
+}

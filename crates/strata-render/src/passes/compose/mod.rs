@@ -135,10 +135,7 @@ impl ComposePass {
         );
         let pl = crate::passes::frame_pipeline_layout(device, "compose", scene, &[&layout]);
         let module = crate::shader::module(device, "compose", include_str!("compose.wgsl"));
-        let formats: Vec<_> = OUTPUTS
-            .iter()
-            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
-            .collect();
+        let formats = crate::passes::color_targets(&OUTPUTS);
         let pipeline = crate::passes::fullscreen_pipeline(device, "compose", &pl, &module, &formats);
         let mut inputs = vec!["hdr", "albedo", "normal", "indirect", "csz"];
         if use_ao {
@@ -162,7 +159,7 @@ impl Pass for ComposePass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs: Vec<_> = OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
+        let outputs = crate::passes::output_views(targets, &OUTPUTS);
         crate::passes::fullscreen_pass(
             encoder,
             "compose",

@@ -426,10 +426,7 @@ pub fn geometry_passes(
             constants: &constants,
             ..Default::default()
         };
-        let color_targets: Vec<Option<wgpu::ColorTargetState>> = settings.outputs()[1..5]
-            .iter()
-            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
-            .collect();
+        let color_targets = crate::passes::color_targets(&settings.outputs()[1..5]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(name),
             layout: Some(&layout),

@@ -188,10 +188,7 @@ impl LightingPass {
             bind_group_layouts: &[Some(&scene.frame_layout), Some(&layout)],
             immediate_size: 0,
         });
-        let targets_fmt: Vec<Option<wgpu::ColorTargetState>> = OUTPUTS
-            .iter()
-            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
-            .collect();
+        let targets_fmt = crate::passes::color_targets(&OUTPUTS);
         let pipeline = crate::passes::fullscreen_pipeline(device, "lighting", &pl, &module, &targets_fmt);
         let layer_pipeline = crate::passes::fullscreen_pipeline_with(
             device,
@@ -234,7 +231,7 @@ impl Pass for LightingPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs: Vec<_> = OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
+        let outputs = crate::passes::output_views(targets, &OUTPUTS);
         crate::passes::fullscreen_pass(
             encoder,
             "lighting",

@@ -312,10 +312,7 @@ impl RadiosityPass {
         );
         let pl = crate::passes::frame_pipeline_layout(device, "radiosity", scene, &[&layout]);
         let module = crate::shader::module(device, "radiosity", include_str!("radiosity.wgsl"));
-        let formats: Vec<_> = OUTPUTS
-            .iter()
-            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
-            .collect();
+        let formats = crate::passes::color_targets(&OUTPUTS);
         let pipeline = crate::passes::fullscreen_pipeline_with(
             device,
             "radiosity",
@@ -359,7 +356,7 @@ impl Pass for RadiosityPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs: Vec<_> = OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
+        let outputs = crate::passes::output_views(targets, &OUTPUTS);
         crate::passes::fullscreen_pass_in(
             encoder,
             "radiosity",
@@ -465,10 +462,7 @@ impl PropagatePass {
         );
         let pl = crate::passes::frame_pipeline_layout(device, "propagate", scene, &[&layout]);
         let module = crate::shader::module(device, "propagate", include_str!("propagate.wgsl"));
-        let formats: Vec<_> = BOUNCE_OUTPUTS
-            .iter()
-            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
-            .collect();
+        let formats = crate::passes::color_targets(&BOUNCE_OUTPUTS);
         let pipeline = crate::passes::fullscreen_pipeline_with(
             device,
             "propagate",
@@ -518,7 +512,7 @@ impl Pass for PropagatePass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs: Vec<_> = BOUNCE_OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
+        let outputs = crate::passes::output_views(targets, &BOUNCE_OUTPUTS);
         crate::passes::fullscreen_pass(
             encoder,
             "propagate",

@@ -137,10 +137,7 @@ impl ReflectionPass {
         );
         let pl = crate::passes::frame_pipeline_layout(device, "reflections", scene, &[&layout]);
         let module = crate::shader::module(device, "reflections", include_str!("reflections.wgsl"));
-        let formats: Vec<_> = OUTPUTS
-            .iter()
-            .map(|t| Some(wgpu::ColorTargetState::from(t.format)))
-            .collect();
+        let formats = crate::passes::color_targets(&OUTPUTS);
         let pipeline = crate::passes::fullscreen_pipeline_with(
             device,
             "reflections",
@@ -185,7 +182,7 @@ impl Pass for ReflectionPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs: Vec<_> = OUTPUTS.iter().map(|t| &targets.get(t.name).view).collect();
+        let outputs = crate::passes::output_views(targets, &OUTPUTS);
         crate::passes::fullscreen_pass(
             encoder,
             "reflections",
