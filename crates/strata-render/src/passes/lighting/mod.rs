@@ -188,7 +188,7 @@ impl LightingPass {
             bind_group_layouts: &[Some(&scene.frame_layout), Some(&layout)],
             immediate_size: 0,
         });
-        let targets_fmt = crate::passes::color_targets(&OUTPUTS);
+        let targets_fmt = crate::passes::color_targets(OUTPUTS);
         let pipeline = crate::passes::fullscreen_pipeline(device, "lighting", &pl, &module, &targets_fmt);
         let layer_pipeline = crate::passes::fullscreen_pipeline_with(
             device,
@@ -231,7 +231,7 @@ impl Pass for LightingPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs = crate::passes::output_views(targets, &OUTPUTS);
+        let outputs = crate::passes::output_views(targets, OUTPUTS);
         crate::passes::fullscreen_pass(
             encoder,
             "lighting",
