@@ -2,6 +2,8 @@
 //! spiral QMC taps on the `zmip` chain. Output `ao-raw`: ambient visibility
 //! AV ∈ [0, 1] (1 = unoccluded) before temporal and bilateral reconstruction.
 
+pub(crate) mod stage;
+
 use glam::Vec3;
 use strata_scene::{ImageBuf, Scene};
 

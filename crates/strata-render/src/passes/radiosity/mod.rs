@@ -9,6 +9,8 @@
 //! and the reflected radiance of the bounce is ρ_X/π · E(X) · boost(ρ_X)
 //! (Eq. 6 with the Lambertian 1/π made explicit).
 
+pub(crate) mod stage;
+
 use glam::Vec3;
 use strata_scene::ImageBuf;
 

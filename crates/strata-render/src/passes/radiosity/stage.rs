@@ -1,0 +1,146 @@
+//! The radiosity stage of a frame: propagate (§3.3) → Eq. 4–5 gather →
+//! temporal filter → bilateral → compose (with the light probes).
+
+use crate::frame::{Pass, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::passes::bilateral::BilateralPass;
+use crate::passes::deep_gbuffer::DeepGBufferSettings;
+use crate::passes::radiosity::{RadiosityPass, RadiositySettings};
+use crate::passes::temporal::{TemporalPass, TemporalSettings};
+use crate::scene_gpu::GpuScene;
+
+/// The radiosity passes: Eq. 4–5 gather → temporal filter → bilateral into
+/// `indirect` (layer 0's irradiance E, a = confidence).
+pub(crate) struct RadiosityStage {
+    pub(crate) propagate: Option<crate::passes::radiosity::PropagatePass>,
+    pub(crate) gather: RadiosityPass,
+    pub(crate) temporal: Option<TemporalPass>,
+    pub(crate) blur_h: BilateralPass,
+    pub(crate) blur_v: BilateralPass,
+    pub(crate) compose: crate::passes::compose::ComposePass,
+}
+
+impl RadiosityStage {
+    pub(crate) fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &mut Targets,
+        deep: &DeepGBufferSettings,
+        s: &RadiositySettings,
+        guard: u32,
+        probes: Option<&strata_scene::probes::IrradianceProbes>,
+    ) -> Self {
+        use wgpu::TextureFormat as F;
+        for t in crate::passes::radiosity::OUTPUTS {
+            targets.create(gpu, t);
+        }
+        let mut filtered = "indirect-raw";
+        if s.temporal.is_some() {
+            for (name, doc) in [
+                ("indirect-temporal", "indirect E after the temporal filter (DGB §3.3)"),
+                ("indirect-temporal-history", "last frame's indirect-temporal"),
+            ] {
+                targets.create(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc));
+            }
+            filtered = "indirect-temporal";
+        }
+        targets.create(
+            gpu,
+            TargetDesc::new(
+                "indirect-blur-h",
+                F::Rgba16Float,
+                1,
+                "indirect E after the horizontal bilateral pass",
+            ),
+        );
+        targets.create(
+            gpu,
+            TargetDesc::new(
+                "indirect",
+                F::Rgba16Float,
+                1,
+                "indirect irradiance E of layer 0 (rgb), confidence (a)",
+            ),
+        );
+        let propagate = (s.delta > 0.0).then(|| {
+            for t in crate::passes::radiosity::BOUNCE_OUTPUTS {
+                targets.create(gpu, t);
+            }
+            for (name, doc) in [
+                ("indirect-history", "last frame's final indirect E of layer 0"),
+                ("indirect1-history", "last frame's indirect E of layer 1"),
+            ] {
+                targets.create(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc));
+            }
+            let d = s.temporal.unwrap_or_default().max_distance;
+            crate::passes::radiosity::PropagatePass::new(gpu, scene, targets, deep.layers, s, d)
+        });
+        let b = if propagate.is_some() {
+            ["bounce0", "bounce1"]
+        } else {
+            ["radiosity0", "radiosity1"]
+        };
+        let region = crate::passes::radiosity::shaded_region(targets.width, targets.height, guard, s.guard_band_shaded);
+        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers, b, region, propagate.is_some());
+        let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
+            TemporalPass::new(
+                gpu,
+                scene,
+                targets,
+                t,
+                "indirect-temporal",
+                "indirect-raw",
+                "indirect-temporal-history",
+                "indirect-temporal",
+                deep.layers,
+            )
+        });
+        let blur_h = BilateralPass::new(
+            gpu,
+            scene,
+            targets,
+            &s.blur,
+            "indirect-blur-h",
+            filtered,
+            "indirect-blur-h",
+            false,
+        );
+        let blur_v = BilateralPass::new(
+            gpu,
+            scene,
+            targets,
+            &s.blur,
+            "indirect-blur-v",
+            "indirect-blur-h",
+            "indirect",
+            true,
+        );
+        for t in crate::passes::compose::OUTPUTS {
+            targets.create(gpu, t);
+        }
+        let compose = crate::passes::compose::ComposePass::new(gpu, scene, targets, s.boost, probes);
+        Self {
+            propagate,
+            gather,
+            temporal,
+            blur_h,
+            blur_v,
+            compose,
+        }
+    }
+
+    pub(crate) fn passes(&self) -> Vec<&dyn Pass> {
+        let mut v: Vec<&dyn Pass> = Vec::new();
+        if let Some(p) = &self.propagate {
+            v.push(p);
+        }
+        v.push(&self.gather);
+        if let Some(t) = &self.temporal {
+            v.push(t);
+        }
+        v.push(&self.blur_h);
+        v.push(&self.blur_v);
+        v.push(&self.compose);
+        v
+    }
+}
