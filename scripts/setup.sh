@@ -35,6 +35,31 @@ else
   fi
 fi
 
+# Debian 12's lavapipe (Mesa 22.3) leaks about 1 KB per triangle drawn by every
+# deep-G-buffer pass of layer >= 1 (about 5 MB per frame on atrium with two
+# layers; docs/reliability.md). Mesa 25 from bookworm-backports does not: on
+# bookworm, install it from there (same apt mirror as the system's).
+apt_mirror() {
+  local uri
+  uri=$(grep -h -E '^URIs:' /etc/apt/sources.list.d/*.sources 2>/dev/null | awk '{print $2}' | grep -v security | head -n 1)
+  [ -n "$uri" ] || uri=$(grep -h -E '^deb ' /etc/apt/sources.list 2>/dev/null | awk '$3 == "bookworm" {print $2; exit}')
+  printf '%s' "$uri"
+}
+codename=$( (. /etc/os-release 2>/dev/null && printf '%s' "${VERSION_CODENAME:-}") || true)
+mesa_version=$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || true)
+if [ "$codename" = bookworm ] && [ -n "$mesa_version" ] && dpkg --compare-versions "$mesa_version" lt 23; then
+  mirror=$(apt_mirror)
+  if [ -z "$mirror" ]; then
+    say "lavapipe $mesa_version leaks memory with >= 2 deep-G-buffer layers, and no apt mirror was found to fetch Mesa from bookworm-backports"
+  else
+    say "lavapipe $mesa_version leaks memory with >= 2 deep-G-buffer layers: installing Mesa from bookworm-backports"
+    echo "deb $mirror bookworm-backports main" | as_root tee /etc/apt/sources.list.d/strata-bookworm-backports.list >/dev/null
+    as_root apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq -t bookworm-backports mesa-vulkan-drivers >/dev/null
+    say "lavapipe now $(dpkg-query -W -f='${Version}' mesa-vulkan-drivers)"
+  fi
+fi
+
 if ! command -v cargo >/dev/null 2>&1; then
   if [ -x "$HOME/.cargo/bin/cargo" ]; then
     export PATH="$HOME/.cargo/bin:$PATH"

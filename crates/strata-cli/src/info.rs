@@ -19,6 +19,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             "adapter": i.name, "backend": format!("{:?}", i.backend), "device_type": format!("{:?}", i.device_type),
             "driver": i.driver, "driver_info": i.driver_info, "features": feats,
             "max_multiview_view_count": gpu.device.limits().max_multiview_view_count,
+            "driver_issue": gpu.driver_issue(),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -31,6 +32,9 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         "multiview    up to {} views",
         gpu.device.limits().max_multiview_view_count
     );
+    if let Some(w) = gpu.driver_issue() {
+        println!("warning      {w}");
+    }
     println!();
     println!("{:<34} {:<8} used for", "feature", "present");
     for (name, f, why) in STRATA_FEATURES {

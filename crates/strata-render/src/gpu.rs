@@ -91,7 +91,7 @@ impl GpuContext {
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         if adapters.is_empty() {
             return Err(RenderError::NoAdapter(
-                "no GPU adapter found: install a Vulkan driver (on Debian: apt-get install mesa-vulkan-drivers libvulkan1)"
+                "no GPU adapter found: install a Vulkan driver (run scripts/setup.sh; on Debian it installs mesa-vulkan-drivers and libvulkan1)"
                     .into(),
             ));
         }
@@ -148,6 +148,9 @@ impl GpuContext {
             ..Default::default()
         }))
         .map_err(|e| RenderError::NoAdapter(format!("cannot open device: {e}")))?;
+        if let Some(w) = known_driver_issue(&adapter.get_info()) {
+            tracing::warn!("{w}");
+        }
         let errors = Arc::new(Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
@@ -161,6 +164,11 @@ impl GpuContext {
             features,
             errors,
         })
+    }
+
+    /// A known defect of this adapter's driver that affects strata (see [`known_driver_issue`]).
+    pub fn driver_issue(&self) -> Option<String> {
+        known_driver_issue(&self.adapter.get_info())
     }
 
     /// Errors if `feature` is missing, naming it and the pass that needs it.
@@ -278,5 +286,56 @@ impl GpuContext {
         buf.unmap();
         self.check_errors()?;
         Ok(data)
+    }
+}
+
+/// The Mesa version in a driver string such as "Mesa 22.3.6" or
+/// "Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)": (major, minor).
+pub fn mesa_version(driver_info: &str) -> Option<(u32, u32)> {
+    let rest = &driver_info[driver_info.find("Mesa ")? + 5..];
+    let mut parts = rest.split(|c: char| !c.is_ascii_digit());
+    let major = parts.next()?.parse().ok()?;
+    let minor = parts.next()?.parse().ok()?;
+    Some((major, minor))
+}
+
+/// Driver defects that change what strata does, as a one-line warning.
+///
+/// lavapipe from Mesa 22.x (Debian 12's) leaks about 1 KB per triangle drawn by a
+/// deep-G-buffer pass of layer >= 1 whose fragment shader reads the depth oracle
+/// at a computed position (about 5 MB per frame on `atrium` with two layers);
+/// Mesa 25.0 does not (docs/reliability.md).
+pub fn known_driver_issue(info: &wgpu::AdapterInfo) -> Option<String> {
+    let lavapipe = info.device_type == wgpu::DeviceType::Cpu && info.name.contains("llvmpipe");
+    lavapipe_issue(lavapipe, &info.driver_info)
+}
+
+fn lavapipe_issue(lavapipe: bool, driver_info: &str) -> Option<String> {
+    match mesa_version(driver_info) {
+        Some((major, _)) if lavapipe && major < 23 => Some(format!(
+            "lavapipe from Mesa {major}.x leaks about 1 KB per triangle of every deep-G-buffer layer >= 1 \
+             (memory grows each frame with --layers >= 2); run scripts/setup.sh to install Mesa 25 \
+             (docs/reliability.md)"
+        )),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mesa_versions_parse() {
+        assert_eq!(mesa_version("Mesa 22.3.6 (LLVM 15.0.6)"), Some((22, 3)));
+        assert_eq!(mesa_version("Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)"), Some((25, 0)));
+        assert_eq!(mesa_version("NVIDIA 550.1"), None);
+    }
+
+    #[test]
+    fn leaky_lavapipe_is_flagged() {
+        assert!(lavapipe_issue(true, "Mesa 22.3.6 (LLVM 15.0.6)").is_some());
+        assert!(lavapipe_issue(true, "Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)").is_none());
+        assert!(lavapipe_issue(false, "Mesa 22.3.6").is_none());
     }
 }
