@@ -35,6 +35,8 @@ pub enum Command {
     Reference(ReferenceArgs),
     /// GPU timestamp benchmarks (per-pass milliseconds).
     Bench(BenchArgs),
+    /// Render many frames along the camera path and sample resident memory and wgpu's allocations (JSON).
+    Soak(SoakArgs),
     /// Compare a GPU technique with the CPU ground truth for the same camera (FLIP, RMSE, MAE; JSON; HTML report).
     Eval(EvalArgs),
 }
@@ -62,7 +64,7 @@ pub struct SceneArgs {
     #[arg(long, default_value = "atrium")]
     pub scene: String,
     /// Frame index along the scene's camera path / animation.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub frame: f32,
     /// Image width in pixels.
     #[arg(long, default_value_t = 640)]
@@ -71,16 +73,16 @@ pub struct SceneArgs {
     #[arg(long, default_value_t = 360)]
     pub height: u32,
     /// Camera position "x,y,z" (overrides the scene camera and its path).
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
     /// Camera look-at point "x,y,z".
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub target: Option<Vec3>,
     /// Camera up vector "x,y,z".
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees, in (0, 180).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub fov: Option<f32>,
 }
 
@@ -95,7 +97,7 @@ pub struct DeepArgs {
     #[arg(long, default_value = "reproject", value_parser = parse_variant)]
     pub variant: Variant,
     /// Minimum separation Δz between layers in scene units, >= 0 (default: the scene's; the paper uses 0.5 m).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub min_separation: Option<f32>,
     /// Guard band rendered around the image and cropped: pixels per side (e.g. 32) or percent of the height (e.g. 10%).
     #[arg(long, default_value = "0", value_parser = parse_guard_band)]
@@ -344,27 +346,10 @@ pub struct EvalArgs {
 #[derive(Args)]
 pub struct RenderArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
-    #[command(flatten)]
-    pub gpu: GpuArgs,
-    /// Shading technique.
-    #[arg(long, value_enum, default_value_t = Technique::Direct)]
-    pub technique: Technique,
-    #[command(flatten)]
-    pub deep: DeepArgs,
-    #[command(flatten)]
-    pub ao: AoArgs,
-    #[command(flatten)]
-    pub radiosity: RadiosityArgs,
+    pub frame: FrameArgs,
     /// Write an intermediate target instead of the final image (e.g. csz, normal, albedo, emission, direct-diffuse, shadow, hdr). `--list-passes` shows them.
     #[arg(long)]
     pub debug_view: Option<String>,
-    /// Exposure multiplier before tonemapping (default: the scene's).
-    #[arg(long)]
-    pub exposure: Option<f32>,
-    /// Shadow map resolution per light, 64..=8192.
-    #[arg(long, default_value_t = 2048)]
-    pub shadow_resolution: u32,
     /// Output file: .png (tonemapped, sRGB) or .exr (linear HDR).
     #[arg(long, required_unless_present = "list_passes")]
     pub out: Option<PathBuf>,
@@ -377,14 +362,59 @@ pub struct RenderArgs {
     /// Print per-pass GPU times after rendering.
     #[arg(long)]
     pub timings: bool,
-    /// --technique full: no light-probe fallback (the probes are baked once per scene by the CPU
-    /// path tracer and cached in $STRATA_CACHE).
-    #[arg(long)]
-    pub no_probes: bool,
     /// Frames rendered before the output frame (along the camera path), 0..=1000, so temporal
     /// filters and progressive bounces (DGB §3.3) have history.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1000))]
     pub warmup: u32,
+}
+
+/// What a frame renders: scene, camera, technique and its settings (shared by
+/// `render` and `soak`).
+#[derive(Args)]
+pub struct FrameArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// Shading technique.
+    #[arg(long, value_enum, default_value_t = Technique::Direct)]
+    pub technique: Technique,
+    #[command(flatten)]
+    pub deep: DeepArgs,
+    #[command(flatten)]
+    pub ao: AoArgs,
+    #[command(flatten)]
+    pub radiosity: RadiosityArgs,
+    /// Exposure multiplier before tonemapping (default: the scene's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+    /// Shadow map resolution per light, 64..=8192.
+    #[arg(long, default_value_t = 2048)]
+    pub shadow_resolution: u32,
+    /// --technique full: no light-probe fallback (the probes are baked once per scene by the CPU
+    /// path tracer and cached in $STRATA_CACHE).
+    #[arg(long)]
+    pub no_probes: bool,
+}
+
+/// `strata soak`: a long run along the camera path that samples memory.
+#[derive(Args)]
+pub struct SoakArgs {
+    #[command(flatten)]
+    pub frame: FrameArgs,
+    /// Frames to render along the camera path (scene animation included), 1..=10000000.
+    #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
+    pub frames: u32,
+    /// Sample memory every N frames, 1..=1000000.
+    #[arg(long, default_value_t = 500, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub sample_every: u32,
+    /// Fail (exit 1) when resident memory grows by more than this percentage between the
+    /// first sample and the last, 0..=1000.
+    #[arg(long, allow_negative_numbers = true)]
+    pub max_growth_percent: Option<f64>,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Copy, Clone, PartialEq, Eq, ValueEnum, Debug)]
@@ -421,7 +451,7 @@ pub struct ReferenceArgs {
     #[arg(long, default_value_t = 2)]
     pub layers: u32,
     /// Minimum separation Δz for --kind layers (default: the scene's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub min_separation: Option<f32>,
     /// Output file (.exr linear or .png). For layers: one file per layer and attachment, named from this stem.
     #[arg(long)]
@@ -536,7 +566,7 @@ pub struct BenchDeepArgs {
     #[arg(long, default_value_t = 2)]
     pub layers: u32,
     /// Minimum separation Δz in scene units (default: the scene's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub min_separation: Option<f32>,
     /// Write Fig. 3-style images (each method's layer 1 and its differences from the peel) into this folder.
     #[arg(long)]

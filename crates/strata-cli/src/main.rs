@@ -14,6 +14,7 @@ mod ref_cache;
 mod reference;
 mod render;
 mod report;
+mod soak;
 
 use clap::Parser;
 
@@ -22,12 +23,26 @@ fn main() {
         .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG").unwrap_or_else(|_| "warn".into()))
         .with_writer(std::io::stderr)
         .init();
-    let cli = args::Cli::parse();
+    let cli = match args::Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) if !e.use_stderr() => e.exit(), // --help, --version
+        Err(e) => {
+            // One line like every other error: clap's first line names the flag and the valid values.
+            let text = e.render().to_string();
+            let first = text
+                .lines()
+                .find(|l| !l.trim().is_empty())
+                .unwrap_or("invalid arguments");
+            eprintln!("strata: {}", first.trim_start_matches("error: ").trim());
+            std::process::exit(2);
+        }
+    };
     let result = match cli.command {
         args::Command::Info(a) => info::run(&a),
         args::Command::Render(a) => render::run(&a),
         args::Command::Reference(a) => reference::run(&a),
         args::Command::Bench(a) => bench::run(&a),
+        args::Command::Soak(a) => soak::run(&a),
         args::Command::Eval(a) => eval::run(&a),
     };
     if let Err(e) = result {

@@ -3,18 +3,22 @@
 use anyhow::Result;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 
-use crate::args::{RenderArgs, Technique};
+use strata_render::frame::FrameCameras;
+use strata_scene::Scene;
+
+use crate::args::{FrameArgs, RenderArgs, Technique};
 use crate::output::{cameras_at, check_output, save, scene_and_camera};
 
-pub fn run(a: &RenderArgs) -> Result<()> {
-    let (scene, cams) = scene_and_camera(&a.scene)?;
-    let radiosity = match a.technique {
-        Technique::Full => Some(a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?),
+/// The scene, its cameras and the render settings that `f` asks for (validated).
+pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
+    let (scene, cams) = scene_and_camera(&f.scene)?;
+    let radiosity = match f.technique {
+        Technique::Full => Some(f.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?),
         _ => None,
     };
     // the full image: radiosity blended with baked light probes (modulated by AO), reflections
-    let probes = match a.technique {
-        Technique::Full if !a.no_probes => Some(crate::probes::scene_probes(
+    let probes = match f.technique {
+        Technique::Full if !f.no_probes => Some(crate::probes::scene_probes(
             &scene,
             &crate::ref_cache::RefCache::new(crate::ref_cache::RefCache::default_dir()),
             false,
@@ -22,32 +26,38 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         _ => None,
     };
     let settings = RenderSettings {
-        width: a.scene.width,
-        height: a.scene.height,
-        deep: a.deep.settings(),
-        guard_band: a.deep.guard_band,
+        width: f.scene.width,
+        height: f.scene.height,
+        deep: f.deep.settings(),
+        guard_band: f.deep.guard_band,
         shadow: strata_render::passes::shadow::ShadowSettings {
-            resolution: a.shadow_resolution,
+            resolution: f.shadow_resolution,
         },
-        exposure: a.exposure,
+        exposure: f.exposure,
         // AO alone needs no lighting passes
-        shade: a.technique != Technique::Ao,
-        ao: (a.technique != Technique::Direct).then(|| a.ao.settings()),
+        shade: f.technique != Technique::Ao,
+        ao: (f.technique != Technique::Direct).then(|| f.ao.settings()),
         probes,
-        reflections: (a.technique == Technique::Full).then(Default::default),
+        reflections: (f.technique == Technique::Full).then(Default::default),
         radiosity,
         ..Default::default()
     };
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok((scene, cams, settings))
+}
+
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let f = &a.frame;
+    let (scene, cams, settings) = prepare(f)?;
     if let Some(out) = &a.out {
         check_output(out, a.force)?;
     }
     let gpu = GpuContext::new(&GpuOptions {
-        adapter: a.gpu.adapter.clone(),
+        adapter: f.gpu.adapter.clone(),
     })?;
     let mut r = Renderer::new(&gpu, &scene, settings)?;
     if a.list_passes {
-        println!("frame of '{}' ({:?}):", scene.name, a.technique);
+        println!("frame of '{}' ({:?}):", scene.name, f.technique);
         for p in r.pass_infos() {
             println!(
                 "  {:<12} reads [{}] writes [{}]",
@@ -73,11 +83,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     // frame's depths, temporal filters and progressive bounces accumulate.
     let warmup = a.warmup.max(r.settings.deep.uses_history() as u32);
     for i in (1..=warmup).rev() {
-        let f = a.scene.frame - i as f32;
-        r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f), f)?;
+        let t = f.scene.frame - i as f32;
+        r.render(&gpu, &scene, &cameras_at(&scene, &f.scene, t), t)?;
     }
-    let t = r.render(&gpu, &scene, &cams, a.scene.frame)?;
-    let (img, srgb) = match (&a.debug_view, a.technique, exr) {
+    let t = r.render(&gpu, &scene, &cams, f.scene.frame)?;
+    let (img, srgb) = match (&a.debug_view, f.technique, exr) {
         (Some(v), _, _) => (r.debug_view(&gpu, v, exr)?, true),
         // AV itself: PNG byte = 255·AV (no transfer function), EXR linear
         (None, Technique::Ao, _) => (r.read_target(&gpu, "ao")?, false),
@@ -95,8 +105,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     eprintln!(
         "wrote {} ({}x{}, {} triangles)",
         out.display(),
-        a.scene.width,
-        a.scene.height,
+        f.scene.width,
+        f.scene.height,
         scene.triangle_count()
     );
     Ok(())
