@@ -15,6 +15,7 @@ pub mod renderer;
 pub mod scene_gpu;
 pub mod shader;
 pub mod spiral;
+pub mod technique;
 
 pub use gpu::{GpuContext, GpuOptions};
 pub use profiler::PassTimings;

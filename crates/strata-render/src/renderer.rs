@@ -509,6 +509,11 @@ impl Renderer {
         decode_texels(&bytes, t.desc.format, w, h)
     }
 
+    /// The declaration of target `name` (format, layers, MIP levels), if the frame has it.
+    pub fn target_desc(&self, name: &str) -> Option<crate::frame::TargetDesc> {
+        self.targets.try_get(name).map(|t| t.desc)
+    }
+
     /// Names of every readable target (each can be a debug view).
     pub fn target_names(&self) -> Vec<&'static str> {
         self.targets.names().copied().collect()
