@@ -132,8 +132,15 @@ impl Camera {
         if !f.is_finite() || f.length() < 1e-6 {
             return Err("camera eye and target must be finite and distinct".into());
         }
-        if f.normalize().cross(self.up).length() < 1e-4 {
-            return Err("camera up vector must not be parallel to the view direction".into());
+        if !self.up.is_finite() || self.up.length() < 1e-12 {
+            return Err(format!("camera up vector {} is out of range: must be finite and non-zero", self.up));
+        }
+        if f.normalize().cross(self.up.normalize()).length() < 1e-4 {
+            return Err(format!(
+                "camera up vector {} is parallel to the view direction {}: it must make an angle of at least 0.006 degrees with it",
+                self.up,
+                f.normalize()
+            ));
         }
         Ok(())
     }
