@@ -227,10 +227,13 @@ impl Target {
                     .map_err(|e| check_err(e.to_string(), "in.obj"))?;
                 scene.validate().map_err(|e| format!("INVARIANT: loaded scene is invalid: {e}"))
             }
+            #[cfg(feature = "preset")]
             Format::Preset => {
                 let text = std::str::from_utf8(input).map_err(|e| e.to_string())?;
                 strata_render::passes::radiosity::Preset::parse(text).map(|_| ())
             }
+            #[cfg(not(feature = "preset"))]
+            Format::Preset => Err("preset target not built (feature `preset`)".into()),
             Format::Png | Format::Jpeg | Format::Exr => {
                 let t = load::decode_texture(input, &file_name)?;
                 if t.rgba8.len() as u64 != t.width as u64 * t.height as u64 * 4 || t.width == 0 || t.height == 0 {

@@ -147,7 +147,9 @@ const INTS: &[i64] = &[
 pub fn generate(format: Format, seeds: &[Vec<u8>], seed: u64, index: u64) -> Vec<u8> {
     let mut rng = Rng::for_input(seed, format, index);
     let mut data = rng.pick(seeds).clone();
-    let n = 1 + rng.below(6);
+    // Mostly one or two mutations (inputs stay close to valid and reach deep
+    // code), sometimes up to six.
+    let n = if rng.chance(3, 4) { 1 + rng.below(2) } else { 1 + rng.below(6) };
     for _ in 0..n {
         mutate(format, &mut data, seeds, &mut rng);
         data.truncate(MAX_INPUT);
@@ -159,6 +161,8 @@ pub fn generate(format: Format, seeds: &[Vec<u8>], seed: u64, index: u64) -> Vec
 pub fn mutate(format: Format, data: &mut Vec<u8>, seeds: &[Vec<u8>], rng: &mut Rng) {
     let text = format.is_text();
     let k = rng.below(if text { 12 } else { 10 });
+    // glTF/GLB: half of all mutations are structure-aware.
+    let k = if matches!(format, Format::Gltf | Format::Glb) && rng.chance(1, 2) { 6 } else { k };
     match k {
         0 => bit_flip(data, rng),
         1 => set_byte(data, rng),

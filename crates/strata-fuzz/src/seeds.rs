@@ -377,12 +377,14 @@ fn repo_toml_scenes(notes: &mut Vec<String>) -> Vec<Vec<u8>> {
 }
 
 fn repo_presets(notes: &mut Vec<String>) -> Vec<Vec<u8>> {
-    let mut out: Vec<Vec<u8>> = strata_render::passes::radiosity::PRESETS
-        .iter()
-        .map(|(_, t)| t.as_bytes().to_vec())
-        .collect();
+    let dir = repo_root().join("presets");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|rd| rd.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    paths.sort();
+    let mut out: Vec<Vec<u8>> = paths.iter().filter_map(|p| std::fs::read(p).ok()).collect();
     if out.is_empty() {
-        notes.push("no presets".into());
+        notes.push(format!("no presets in {}", dir.display()));
     }
     out.push(b"name = \"x\"\nsamples = 3\nreconstruction_taps = 1\nnormal_test = false\nmin_mip = 0\nguard_band_shaded = 0.0\n".to_vec());
     out

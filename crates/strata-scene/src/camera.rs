@@ -128,6 +128,13 @@ impl Camera {
         if !(self.near > 0.0) || !self.near.is_finite() {
             return Err(format!("camera near {} is out of range: must be > 0", self.near));
         }
+        let m = crate::model::MAX_COORDINATE;
+        if !(self.eye.abs().max_element() <= m && self.target.abs().max_element() <= m) {
+            return Err(format!(
+                "camera eye {} or target {} is out of range: coordinates must be finite and within ±{m:e}",
+                self.eye, self.target
+            ));
+        }
         let f = self.target - self.eye;
         if !f.is_finite() || f.length() < 1e-6 {
             return Err("camera eye and target must be finite and distinct".into());

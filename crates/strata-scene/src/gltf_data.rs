@@ -34,6 +34,25 @@ pub fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+/// Checks that every mesh primitive's attribute (and morph target) accessor
+/// index is in range.
+pub fn check_attribute_indices(root: &gltf::json::Root) -> Result<(), String> {
+    let n = root.accessors.len();
+    for (mi, m) in root.meshes.iter().enumerate() {
+        for (pi, p) in m.primitives.iter().enumerate() {
+            let targets = p.targets.iter().flatten().flat_map(|t| [t.positions, t.normals, t.tangents]);
+            let attrs = p.attributes.values().map(|i| Some(*i));
+            if let Some(bad) = attrs.chain(targets).flatten().find(|i| i.value() >= n) {
+                return Err(format!(
+                    "mesh {mi} primitive {pi}: accessor index {} is out of range (the file has {n} accessors)",
+                    bad.value()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Decodes standard or URL-safe base64 (padding optional, whitespace ignored).
 pub fn base64_decode(s: &str) -> Result<Vec<u8>, String> {
     fn value(c: u8) -> Option<u32> {
@@ -369,16 +388,31 @@ pub fn read_indices(acc: &gltf::Accessor, buffers: &[Cow<'_, [u8]>]) -> Result<V
     read_accessor(acc, buffers, |t, _, b| index_u32(t, b))
 }
 
-/// The encoded bytes of a glTF image.
+/// The encoded bytes of glTF image `index` (read from the JSON: `gltf`'s
+/// `Image::source` panics on an image without a `uri` or a buffer view
+/// without a `mimeType`).
 pub fn image_bytes<'b>(
-    image: &gltf::Image,
+    doc: &gltf::Document,
+    index: usize,
     buffers: &'b [Cow<'_, [u8]>],
     base: &Path,
     files: &dyn FileSource,
 ) -> Result<Cow<'b, [u8]>, String> {
-    match image.source() {
-        gltf::image::Source::View { view, .. } => view_bytes(&view, buffers).map(Cow::Borrowed),
-        gltf::image::Source::Uri { uri, .. } => uri_bytes(uri, base, files).map(Cow::Owned),
+    let image = doc
+        .as_json()
+        .images
+        .get(index)
+        .ok_or_else(|| format!("image {index} is missing"))?;
+    if let Some(v) = image.buffer_view {
+        let view = doc
+            .views()
+            .nth(v.value())
+            .ok_or_else(|| format!("buffer view {} is missing", v.value()))?;
+        view_bytes(&view, buffers).map(Cow::Borrowed)
+    } else if let Some(uri) = &image.uri {
+        uri_bytes(uri, base, files).map(Cow::Owned)
+    } else {
+        Err("the image has neither a bufferView nor a uri".into())
     }
 }
 

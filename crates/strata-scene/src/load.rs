@@ -442,8 +442,14 @@ fn check_indices(path: &Path, what: &str, indices: &[u32], vertex_count: usize) 
 fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFile, SceneError> {
     let fail = |m: String| SceneError::file(path, m);
     gltf_data::check_glb_header(bytes).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
-    let doc = &gltf.document;
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
+    // gltf-json's validation indexes the accessors with each primitive's
+    // POSITION index before checking it (a panic when out of range): check
+    // attribute indices first.
+    let json = gltf.document.into_json();
+    gltf_data::check_attribute_indices(&json).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
+    let document = gltf::Document::from_json(json).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
+    let doc = &document;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers =
         gltf_data::load_buffers(doc, gltf.blob.as_deref(), base, files).map_err(|e| fail(format!("glTF {e}")))?;
@@ -479,7 +485,7 @@ fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFi
                 Some(&ti) => ti,
                 None => {
                     let name = source.name().map(str::to_owned).unwrap_or_else(|| format!("image{image}"));
-                    let texture = gltf_data::image_bytes(&source, &buffers, base, files)
+                    let texture = gltf_data::image_bytes(doc, image, &buffers, base, files)
                         .and_then(|data| decode_texture(&data, &name))
                         .map_err(|e| fail(format!("material {mi}: image {image} ('{}'): {e}", gltf_data::short(&name))))?;
                     scene.textures.push(texture);
@@ -657,12 +663,18 @@ fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFi
             }
         }
         if camera.is_none() {
-            if let Some(cam) = node.camera() {
-                if let gltf::camera::Projection::Perspective(p) = cam.projection() {
+            // From the JSON: `gltf`'s `Camera::projection` panics when `type`
+            // names a projection whose object is missing.
+            let perspective = node
+                .camera()
+                .and_then(|cam| doc.as_json().cameras.get(cam.index()))
+                .and_then(|c| c.perspective.as_ref());
+            if let Some(p) = perspective {
+                {
                     let eye = world.transform_point3(Vec3::ZERO);
                     let fwd = world.transform_vector3(-Vec3::Z).normalize_or_zero();
                     let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-                    let c = Camera::new(eye, eye + fwd, up, p.yfov().to_degrees(), p.znear());
+                    let c = Camera::new(eye, eye + fwd, up, p.yfov.to_degrees(), p.znear);
                     if c.validate().is_ok() {
                         camera = Some(c);
                     }
@@ -738,6 +750,27 @@ fn obj_check_numbers(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// Checks what `tobj` would panic on in an MTL file: a colour (`Ka`, `Kd`,
+/// `Ks`, `Ke`) with fewer than 3 numbers.
+fn check_mtl(bytes: &[u8]) -> Result<(), String> {
+    for (li, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let Ok(line) = std::str::from_utf8(line) else {
+            continue;
+        };
+        let mut words = line.split_whitespace();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
+            let n = words.count();
+            if n < 3 {
+                return Err(format!(
+                    "line {}: '{key}' has {n} values: it needs 3 numbers (r g b)",
+                    li + 1
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn obj_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFile, SceneError> {
     obj_check_numbers(path, bytes)?;
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -751,7 +784,11 @@ fn obj_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFil
     let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |mtl| {
         let full = dir.join(mtl);
         let result = match files.read(&full) {
-            Ok(text) => tobj::load_mtl_buf(&mut std::io::Cursor::new(text)).map_err(|e| (e, e.to_string())),
+            Ok(text) => match check_mtl(&text) {
+                // tobj panics on a colour line with fewer than 3 numbers.
+                Err(why) => Err((tobj::LoadError::MaterialParseError, why)),
+                Ok(()) => tobj::load_mtl_buf(&mut std::io::Cursor::new(text)).map_err(|e| (e, e.to_string())),
+            },
             Err(why) => Err((tobj::LoadError::OpenFileFailed, format!("cannot open it: {why}"))),
         };
         libraries

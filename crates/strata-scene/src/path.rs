@@ -22,17 +22,18 @@ pub struct CameraPath {
 
 impl CameraPath {
     /// Sorts the keyframes by frame; errors when there are none, when two share
-    /// a frame index, or when a frame, eye or target is not finite.
+    /// a frame index, or when a frame, eye or target is not finite (or a
+    /// coordinate is beyond ±[`crate::model::MAX_COORDINATE`]).
     pub fn new(mut keyframes: Vec<Keyframe>) -> Result<Self, String> {
         if keyframes.is_empty() {
             return Err("camera path needs at least one keyframe".into());
         }
-        if let Some(k) = keyframes
-            .iter()
-            .find(|k| !(k.frame.is_finite() && k.eye.is_finite() && k.target.is_finite()))
-        {
+        let m = crate::model::MAX_COORDINATE;
+        if let Some(k) = keyframes.iter().find(|k| {
+            !(k.frame.is_finite() && k.eye.abs().max_element() <= m && k.target.abs().max_element() <= m)
+        }) {
             return Err(format!(
-                "camera path keyframe at frame {} has non-finite values",
+                "camera path keyframe at frame {} is out of range: frame, eye and target must be finite, coordinates within ±{m:e}",
                 k.frame
             ));
         }
