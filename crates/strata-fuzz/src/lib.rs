@@ -81,11 +81,16 @@ impl Format {
     }
 
     pub fn parse(s: &str) -> Option<Format> {
-        Format::ALL.into_iter().find(|f| f.name() == s || (s == "jpg" && *f == Format::Jpeg))
+        Format::ALL
+            .into_iter()
+            .find(|f| f.name() == s || (s == "jpg" && *f == Format::Jpeg))
     }
 
     pub fn is_text(self) -> bool {
-        matches!(self, Format::Obj | Format::Mtl | Format::Toml | Format::Preset | Format::Path | Format::Gltf)
+        matches!(
+            self,
+            Format::Obj | Format::Mtl | Format::Toml | Format::Preset | Format::Path | Format::Gltf
+        )
     }
 }
 
@@ -206,14 +211,29 @@ impl Target {
         };
         match format {
             Format::Gltf | Format::Glb | Format::Obj | Format::Toml | Format::Path => {
-                let scene = load::load_slice(input, &path, &self.files).map_err(|e| check_err(e.to_string(), &file_name))?;
-                scene.validate().map_err(|e| format!("INVARIANT: loaded scene is invalid: {e}"))?;
+                let scene =
+                    load::load_slice(input, &path, &self.files).map_err(|e| check_err(e.to_string(), &file_name))?;
+                scene
+                    .validate()
+                    .map_err(|e| format!("INVARIANT: loaded scene is invalid: {e}"))?;
                 if let Some(p) = &scene.camera_path {
                     let (a, b) = (p.first_frame(), p.last_frame());
-                    for f in [a, b, 0.5 * (a + b), a + 0.25 * (b - a), a + 1e-3, b - 1e-3, f32::NAN, f32::INFINITY, -1e30] {
+                    for f in [
+                        a,
+                        b,
+                        0.5 * (a + b),
+                        a + 0.25 * (b - a),
+                        a + 1e-3,
+                        b - 1e-3,
+                        f32::NAN,
+                        f32::INFINITY,
+                        -1e30,
+                    ] {
                         let c = scene.camera_at(f);
                         if !(c.eye.is_finite() && c.target.is_finite()) {
-                            return Err(format!("INVARIANT: camera path gives a non-finite camera at frame {f}: {c:?}"));
+                            return Err(format!(
+                                "INVARIANT: camera path gives a non-finite camera at frame {f}: {c:?}"
+                            ));
                         }
                     }
                 }
@@ -225,7 +245,9 @@ impl Target {
                 let obj_path = seeds::input_dir().join("in.obj");
                 let scene = load::load_slice(&self.obj_for_mtl, &obj_path, &files)
                     .map_err(|e| check_err(e.to_string(), "in.obj"))?;
-                scene.validate().map_err(|e| format!("INVARIANT: loaded scene is invalid: {e}"))
+                scene
+                    .validate()
+                    .map_err(|e| format!("INVARIANT: loaded scene is invalid: {e}"))
             }
             #[cfg(feature = "preset")]
             Format::Preset => {
@@ -237,7 +259,12 @@ impl Target {
             Format::Png | Format::Jpeg | Format::Exr => {
                 let t = load::decode_texture(input, &file_name)?;
                 if t.rgba8.len() as u64 != t.width as u64 * t.height as u64 * 4 || t.width == 0 || t.height == 0 {
-                    return Err(format!("INVARIANT: texture {}×{} with {} bytes", t.width, t.height, t.rgba8.len()));
+                    return Err(format!(
+                        "INVARIANT: texture {}×{} with {} bytes",
+                        t.width,
+                        t.height,
+                        t.rgba8.len()
+                    ));
                 }
                 Ok(())
             }
@@ -259,7 +286,10 @@ pub fn install_quiet_panic_hook() {
             } else {
                 "panic".into()
             };
-            let loc = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+            let loc = info
+                .location()
+                .map(|l| format!(" at {}:{}", l.file(), l.line()))
+                .unwrap_or_default();
             if let Ok(mut m) = PANIC_MSG.lock() {
                 *m = Some(format!("{msg}{loc}"));
             }
@@ -276,7 +306,13 @@ pub fn run_input(target: &Target, format: Format, input: &[u8], limits: &Limits)
     let elapsed = t0.elapsed();
     let peak_bytes = alloc::peak().saturating_sub(base);
     let verdict = match r {
-        Err(_) => Verdict::Crash(PANIC_MSG.lock().ok().and_then(|mut m| m.take()).unwrap_or_else(|| "panic".into())),
+        Err(_) => Verdict::Crash(
+            PANIC_MSG
+                .lock()
+                .ok()
+                .and_then(|mut m| m.take())
+                .unwrap_or_else(|| "panic".into()),
+        ),
         Ok(_) if elapsed > limits.max_time => Verdict::Hang(elapsed),
         Ok(_) if peak_bytes > limits.max_alloc => Verdict::Alloc(peak_bytes),
         Ok(Err(e)) if e.starts_with("INVARIANT: ") => Verdict::Invariant(e["INVARIANT: ".len()..].to_string()),

@@ -16,7 +16,9 @@ use std::process::{Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use strata_fuzz::{alloc, minimise, run_input, save_finding, Campaign, Finding, Format, Limits, Stats, Target, Verdict};
+use strata_fuzz::{
+    alloc, minimise, run_input, save_finding, Campaign, Finding, Format, Limits, Stats, Target, Verdict,
+};
 
 #[global_allocator]
 static ALLOC: alloc::Counting = alloc::Counting;
@@ -67,7 +69,10 @@ fn parse_args() -> Result<Args, String> {
     let (mut wstart, mut wend, mut wprog) = (None, None, None);
     while let Some(arg) = it.next() {
         let mut val = |name: &str| it.next().ok_or_else(|| format!("{name} needs a value"));
-        let num = |s: String, name: &str| s.parse::<u64>().map_err(|_| format!("{name}: '{s}' is not a non-negative integer"));
+        let num = |s: String, name: &str| {
+            s.parse::<u64>()
+                .map_err(|_| format!("{name}: '{s}' is not a non-negative integer"))
+        };
         match arg.as_str() {
             "--format" => {
                 let v = val("--format")?;
@@ -151,7 +156,10 @@ fn worker(args: &Args, start: u64, end: u64, progress: &Path) -> i32 {
     let format = args.formats[0];
     let mut c = Campaign::new(format, args.seed);
     c.limits = args.limits;
-    let pf = std::fs::OpenOptions::new().write(true).open(progress).expect("open progress file");
+    let pf = std::fs::OpenOptions::new()
+        .write(true)
+        .open(progress)
+        .expect("open progress file");
     let stdout = std::io::stdout();
     let mut total = Stats::default();
     let mut i = start;
@@ -236,7 +244,11 @@ fn supervise(args: &Args, format: Format, start: u64, end: u64, records: &Mutex<
     let exe = std::env::current_exe().expect("current exe");
     let mut total = Stats::default();
     let mut cur = start;
-    let progress = std::env::temp_dir().join(format!("strata-fuzz-{}-{}-{start}.progress", std::process::id(), format.name()));
+    let progress = std::env::temp_dir().join(format!(
+        "strata-fuzz-{}-{}-{start}.progress",
+        std::process::id(),
+        format.name()
+    ));
     while cur < end {
         std::fs::write(&progress, cur.to_le_bytes()).expect("progress file");
         let mut child = Command::new(&exe)
@@ -268,7 +280,10 @@ fn supervise(args: &Args, format: Format, start: u64, end: u64, records: &Mutex<
                         }
                         Some("FINDING") if w.len() == 4 => {
                             let detail: String = serde_json::from_str(w[3]).unwrap_or_else(|_| w[3].to_string());
-                            found.lock().unwrap().push((w[1].parse().unwrap_or(0), w[2].to_string(), detail));
+                            found
+                                .lock()
+                                .unwrap()
+                                .push((w[1].parse().unwrap_or(0), w[2].to_string(), detail));
                         }
                         _ => {}
                     }
@@ -346,7 +361,11 @@ fn supervise(args: &Args, format: Format, start: u64, end: u64, records: &Mutex<
                 }
             });
             if !args.json {
-                eprintln!("finding: {} #{index} {kind}: {detail} ({})", format.name(), file.as_ref().map(|p| p.display().to_string()).unwrap_or_default());
+                eprintln!(
+                    "finding: {} #{index} {kind}: {detail} ({})",
+                    format.name(),
+                    file.as_ref().map(|p| p.display().to_string()).unwrap_or_default()
+                );
             }
             records.lock().unwrap().push(Record {
                 format,
@@ -374,19 +393,29 @@ fn campaign(args: &Args) -> i32 {
         let stats = if args.no_fork {
             let mut c = Campaign::new(format, args.seed);
             c.limits = args.limits;
-            c.run(start..end, |_| {}, |f| {
-                let file = save_finding(&args.corpus, &f).ok();
-                if !args.json {
-                    eprintln!("finding: {} #{} {}: {}", format.name(), f.index, f.verdict.kind(), f.verdict.detail());
-                }
-                records.lock().unwrap().push(Record {
-                    format,
-                    index: f.index,
-                    kind: f.verdict.kind().into(),
-                    detail: f.verdict.detail(),
-                    file,
-                });
-            })
+            c.run(
+                start..end,
+                |_| {},
+                |f| {
+                    let file = save_finding(&args.corpus, &f).ok();
+                    if !args.json {
+                        eprintln!(
+                            "finding: {} #{} {}: {}",
+                            format.name(),
+                            f.index,
+                            f.verdict.kind(),
+                            f.verdict.detail()
+                        );
+                    }
+                    records.lock().unwrap().push(Record {
+                        format,
+                        index: f.index,
+                        kind: f.verdict.kind().into(),
+                        detail: f.verdict.detail(),
+                        file,
+                    });
+                },
+            )
         } else {
             let w = args.workers.min(args.inputs.max(1));
             let per = args.inputs.div_ceil(w);

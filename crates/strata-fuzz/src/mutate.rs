@@ -149,7 +149,11 @@ pub fn generate(format: Format, seeds: &[Vec<u8>], seed: u64, index: u64) -> Vec
     let mut data = rng.pick(seeds).clone();
     // Mostly one or two mutations (inputs stay close to valid and reach deep
     // code), sometimes up to six.
-    let n = if rng.chance(3, 4) { 1 + rng.below(2) } else { 1 + rng.below(6) };
+    let n = if rng.chance(3, 4) {
+        1 + rng.below(2)
+    } else {
+        1 + rng.below(6)
+    };
     for _ in 0..n {
         mutate(format, &mut data, seeds, &mut rng);
         data.truncate(MAX_INPUT);
@@ -162,7 +166,11 @@ pub fn mutate(format: Format, data: &mut Vec<u8>, seeds: &[Vec<u8>], rng: &mut R
     let text = format.is_text();
     let k = rng.below(if text { 12 } else { 10 });
     // glTF/GLB: half of all mutations are structure-aware.
-    let k = if matches!(format, Format::Gltf | Format::Glb) && rng.chance(1, 2) { 6 } else { k };
+    let k = if matches!(format, Format::Gltf | Format::Glb) && rng.chance(1, 2) {
+        6
+    } else {
+        k
+    };
     match k {
         0 => bit_flip(data, rng),
         1 => set_byte(data, rng),
@@ -206,7 +214,9 @@ fn set_byte(data: &mut [u8], rng: &mut Rng) {
         return;
     }
     let i = rng.below(data.len());
-    data[i] = *rng.pick(&[0u8, 0xff, 0x7f, 0x80, b'0', b'9', b'-', b'.', b'"', b'[', b'{', b'\n', b' ', b'e']);
+    data[i] = *rng.pick(&[
+        0u8, 0xff, 0x7f, 0x80, b'0', b'9', b'-', b'.', b'"', b'[', b'{', b'\n', b' ', b'e',
+    ]);
 }
 
 fn insert_bytes(data: &mut Vec<u8>, rng: &mut Rng) {
@@ -265,7 +275,11 @@ fn overwrite_int(data: &mut [u8], rng: &mut Rng) {
     }
     let at = rng.below(data.len() - w + 1);
     let v = *rng.pick(INTS) as u64;
-    let v = if rng.chance(1, 8) { v.wrapping_add(rng.below(3) as u64).wrapping_sub(1) } else { v };
+    let v = if rng.chance(1, 8) {
+        v.wrapping_add(rng.below(3) as u64).wrapping_sub(1)
+    } else {
+        v
+    };
     data[at..at + w].copy_from_slice(&v.to_le_bytes()[..w]);
 }
 
@@ -495,12 +509,23 @@ fn mutate_value(root: &mut Value, rng: &mut Rng) {
                 let k = m.keys().nth(rng.below(m.len())).cloned().expect("key");
                 m.remove(&k);
             } else {
-                let key = *rng.pick(&["children", "mesh", "indices", "sparse", "byteStride", "uri", "bufferView", "matrix"]);
+                let key = *rng.pick(&[
+                    "children",
+                    "mesh",
+                    "indices",
+                    "sparse",
+                    "byteStride",
+                    "uri",
+                    "bufferView",
+                    "matrix",
+                ]);
                 let val = match key {
                     "children" => Value::from(vec![Value::from(rng.below(4) as i64)]),
                     "uri" => Value::from(*rng.pick(URIS)),
                     "matrix" => serde_json::json!([1e30, 0, 0, 0, 0, 1e30, 0, 0, 0, 0, 1e30, 0, 0, 0, 0, 1]),
-                    "sparse" => serde_json::json!({"count": 1, "indices": {"bufferView": 0, "componentType": 5123}, "values": {"bufferView": 0}}),
+                    "sparse" => {
+                        serde_json::json!({"count": 1, "indices": {"bufferView": 0, "componentType": 5123}, "values": {"bufferView": 0}})
+                    }
                     _ => Value::from(*rng.pick(INTS)),
                 };
                 m.insert(key.to_string(), val);
@@ -523,7 +548,22 @@ pub fn crc32(parts: &[&[u8]]) -> u32 {
     !c
 }
 
-const DIMS: &[u32] = &[0, 1, 2, 3, 255, 4096, 16384, 16385, 30000, 65535, 65536, 1 << 24, 0x7fff_ffff, 0xffff_ffff];
+const DIMS: &[u32] = &[
+    0,
+    1,
+    2,
+    3,
+    255,
+    4096,
+    16384,
+    16385,
+    30000,
+    65535,
+    65536,
+    1 << 24,
+    0x7fff_ffff,
+    0xffff_ffff,
+];
 
 /// Rewrites the declared width/height of an embedded PNG (IHDR, CRC fixed),
 /// JPEG (SOFn) or EXR (dataWindow/displayWindow) header.
@@ -579,14 +619,15 @@ mod tests {
         for i in 0..50 {
             assert_eq!(generate(Format::Obj, &seeds, 7, i), generate(Format::Obj, &seeds, 7, i));
         }
-        let distinct: std::collections::HashSet<Vec<u8>> = (0..50).map(|i| generate(Format::Obj, &seeds, 7, i)).collect();
+        let distinct: std::collections::HashSet<Vec<u8>> =
+            (0..50).map(|i| generate(Format::Obj, &seeds, 7, i)).collect();
         assert!(distinct.len() > 25, "{}", distinct.len());
     }
 
     #[test]
     fn numeric_tokens_found() {
         let t = numeric_tokens(b"a = -1.5e3\nTEXCOORD_0 x 42");
-        assert_eq!(t, vec![(4, 10), (25, 27)]);
+        assert_eq!(t, vec![(4, 10), (24, 26)]);
     }
 
     #[test]

@@ -82,28 +82,42 @@ fn encode(img: image::DynamicImage, format: image::ImageFormat) -> Vec<u8> {
 }
 
 fn gradient_rgba(w: u32, h: u32) -> image::RgbaImage {
-    image::RgbaImage::from_fn(w, h, |x, y| image::Rgba([(x * 60) as u8, (y * 60) as u8, ((x + y) * 30) as u8, 200]))
+    image::RgbaImage::from_fn(w, h, |x, y| {
+        image::Rgba([(x * 60) as u8, (y * 60) as u8, ((x + y) * 30) as u8, 200])
+    })
 }
 
 /// A 2×2 RGBA PNG.
 pub fn tiny_png() -> Vec<u8> {
-    encode(image::DynamicImage::ImageRgba8(gradient_rgba(2, 2)), image::ImageFormat::Png)
+    encode(
+        image::DynamicImage::ImageRgba8(gradient_rgba(2, 2)),
+        image::ImageFormat::Png,
+    )
 }
 
 pub fn png_seeds() -> Vec<Vec<u8>> {
     vec![
         tiny_png(),
-        encode(image::DynamicImage::ImageRgba8(gradient_rgba(5, 3)), image::ImageFormat::Png),
         encode(
-            image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(4, 4, |x, y| image::Rgb([x as u8 * 50, y as u8 * 50, 7]))),
+            image::DynamicImage::ImageRgba8(gradient_rgba(5, 3)),
             image::ImageFormat::Png,
         ),
         encode(
-            image::DynamicImage::ImageLuma16(image::ImageBuffer::from_fn(3, 3, |x, y| image::Luma([(x * 9000 + y * 300) as u16]))),
+            image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(4, 4, |x, y| {
+                image::Rgb([x as u8 * 50, y as u8 * 50, 7])
+            })),
             image::ImageFormat::Png,
         ),
         encode(
-            image::DynamicImage::ImageLumaA8(image::ImageBuffer::from_fn(2, 5, |x, y| image::LumaA([(x * 90 + y) as u8, 99]))),
+            image::DynamicImage::ImageLuma16(image::ImageBuffer::from_fn(3, 3, |x, y| {
+                image::Luma([(x * 9000 + y * 300) as u16])
+            })),
+            image::ImageFormat::Png,
+        ),
+        encode(
+            image::DynamicImage::ImageLumaA8(image::ImageBuffer::from_fn(2, 5, |x, y| {
+                image::LumaA([(x * 90 + y) as u8, 99])
+            })),
             image::ImageFormat::Png,
         ),
     ]
@@ -112,15 +126,21 @@ pub fn png_seeds() -> Vec<Vec<u8>> {
 pub fn jpeg_seeds() -> Vec<Vec<u8>> {
     vec![
         encode(
-            image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([x as u8 * 30, y as u8 * 30, 90]))),
+            image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(8, 8, |x, y| {
+                image::Rgb([x as u8 * 30, y as u8 * 30, 90])
+            })),
             image::ImageFormat::Jpeg,
         ),
         encode(
-            image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(17, 9, |x, y| image::Rgb([(x * y) as u8, 200, x as u8]))),
+            image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(17, 9, |x, y| {
+                image::Rgb([(x * y) as u8, 200, x as u8])
+            })),
             image::ImageFormat::Jpeg,
         ),
         encode(
-            image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(16, 16, |x, y| image::Luma([(x ^ y) as u8 * 16]))),
+            image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(16, 16, |x, y| {
+                image::Luma([(x ^ y) as u8 * 16])
+            })),
             image::ImageFormat::Jpeg,
         ),
     ]
@@ -135,7 +155,9 @@ pub fn exr_seeds() -> Vec<Vec<u8>> {
             image::ImageFormat::OpenExr,
         ),
         encode(
-            image::DynamicImage::ImageRgb32F(image::Rgb32FImage::from_fn(3, 2, |x, y| image::Rgb([x as f32, y as f32, 0.5]))),
+            image::DynamicImage::ImageRgb32F(image::Rgb32FImage::from_fn(3, 2, |x, y| {
+                image::Rgb([x as f32, y as f32, 0.5])
+            })),
             image::ImageFormat::OpenExr,
         ),
     ]
@@ -243,7 +265,19 @@ pub fn companion_files() -> Vec<(&'static str, Vec<u8>)> {
         ("tex.png", tiny_png()),
         ("in.mtl", TINY_MTL.as_bytes().to_vec()),
         ("tiny.obj", TINY_OBJ.as_bytes().to_vec()),
-        ("tiny.glb", glb(quad_json(bin.len(), png_len, r#"{"byteLength":LEN}"#, r#"{"bufferView":4,"mimeType":"image/png"}"#).as_bytes(), Some(&bin))),
+        (
+            "tiny.glb",
+            glb(
+                quad_json(
+                    bin.len(),
+                    png_len,
+                    r#"{"byteLength":LEN}"#,
+                    r#"{"bufferView":4,"mimeType":"image/png"}"#,
+                )
+                .as_bytes(),
+                Some(&bin),
+            ),
+        ),
     ]
 }
 
@@ -322,9 +356,12 @@ pub fn repo_root() -> PathBuf {
 
 /// The shared scenes folder, `<repo>/../shared/scenes` or `/work/shared/scenes`.
 pub fn shared_scenes() -> Option<PathBuf> {
-    [repo_root().join("../shared/scenes"), PathBuf::from("/work/shared/scenes")]
-        .into_iter()
-        .find(|p| p.is_dir())
+    [
+        repo_root().join("../shared/scenes"),
+        PathBuf::from("/work/shared/scenes"),
+    ]
+    .into_iter()
+    .find(|p| p.is_dir())
 }
 
 /// A small shared file, or `None` with the reason on stderr (once per call).

@@ -140,7 +140,10 @@ impl Camera {
             return Err("camera eye and target must be finite and distinct".into());
         }
         if !self.up.is_finite() || self.up.length() < 1e-12 {
-            return Err(format!("camera up vector {} is out of range: must be finite and non-zero", self.up));
+            return Err(format!(
+                "camera up vector {} is out of range: must be finite and non-zero",
+                self.up
+            ));
         }
         if f.normalize().cross(self.up.normalize()).length() < 1e-4 {
             return Err(format!(

@@ -91,7 +91,10 @@ impl MemFiles {
 
 impl FileSource for MemFiles {
     fn read(&self, path: &Path) -> Result<Vec<u8>, String> {
-        self.files.get(path).cloned().ok_or_else(|| "file not found".to_string())
+        self.files
+            .get(path)
+            .cloned()
+            .ok_or_else(|| "file not found".to_string())
     }
 }
 
@@ -122,15 +125,25 @@ pub fn check_exr_header(bytes: &[u8]) -> Result<(), String> {
             break;
         }
         let Some(_ty) = cstr(&mut at) else { break };
-        let Some(size) = bytes.get(at..at + 4).map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]])) else {
+        let Some(size) = bytes
+            .get(at..at + 4)
+            .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        else {
             break;
         };
         at += 4;
-        let Some(value) = usize::try_from(size).ok().and_then(|n| bytes.get(at..at.checked_add(n)?)) else {
+        let Some(value) = usize::try_from(size)
+            .ok()
+            .and_then(|n| bytes.get(at..at.checked_add(n)?))
+        else {
             break;
         };
         at += value.len();
-        let i32_at = |k: usize| value.get(4 * k..4 * k + 4).map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i64);
+        let i32_at = |k: usize| {
+            value
+                .get(4 * k..4 * k + 4)
+                .map(|b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i64)
+        };
         match name {
             b"dataWindow" => {
                 if let (Some(x0), Some(y0), Some(x1), Some(y1)) = (i32_at(0), i32_at(1), i32_at(2), i32_at(3)) {

@@ -40,7 +40,11 @@ pub fn check_attribute_indices(root: &gltf::json::Root) -> Result<(), String> {
     let n = root.accessors.len();
     for (mi, m) in root.meshes.iter().enumerate() {
         for (pi, p) in m.primitives.iter().enumerate() {
-            let targets = p.targets.iter().flatten().flat_map(|t| [t.positions, t.normals, t.tangents]);
+            let targets = p
+                .targets
+                .iter()
+                .flatten()
+                .flat_map(|t| [t.positions, t.normals, t.tangents]);
             let attrs = p.attributes.values().map(|i| Some(*i));
             if let Some(bad) = attrs.chain(targets).flatten().find(|i| i.value() >= n) {
                 return Err(format!(
@@ -154,9 +158,9 @@ pub fn load_buffers<'a>(
     let mut out = Vec::with_capacity(doc.buffers().len());
     for b in doc.buffers() {
         let data: Cow<'a, [u8]> = match b.source() {
-            gltf::buffer::Source::Bin => {
-                Cow::Borrowed(blob.ok_or_else(|| format!("buffer {}: refers to a GLB BIN chunk but there is none", b.index()))?)
-            }
+            gltf::buffer::Source::Bin => Cow::Borrowed(
+                blob.ok_or_else(|| format!("buffer {}: refers to a GLB BIN chunk but there is none", b.index()))?,
+            ),
             gltf::buffer::Source::Uri(uri) => {
                 Cow::Owned(uri_bytes(uri, base, files).map_err(|e| format!("buffer {}: {e}", b.index()))?)
             }
@@ -328,24 +332,46 @@ fn read_accessor<T: Copy + Default>(
         };
         let idata = view_bytes(&iv.view(), buffers).map_err(|e| format!("{what}: sparse indices: {e}"))?;
         let mut indices = Vec::new();
-        for_each_element(&format!("{what} sparse indices"), idata, iv.offset(), it.size(), it.size(), n, |_, _| {})?;
+        for_each_element(
+            &format!("{what} sparse indices"),
+            idata,
+            iv.offset(),
+            it.size(),
+            it.size(),
+            n,
+            |_, _| {},
+        )?;
         indices.reserve(n);
-        for_each_element(&format!("{what} sparse indices"), idata, iv.offset(), it.size(), it.size(), n, |_, b| {
-            indices.push(index_u32(it, b) as usize)
-        })?;
+        for_each_element(
+            &format!("{what} sparse indices"),
+            idata,
+            iv.offset(),
+            it.size(),
+            it.size(),
+            n,
+            |_, b| indices.push(index_u32(it, b) as usize),
+        )?;
         let vv = sparse.values();
         let vdata = view_bytes(&vv.view(), buffers).map_err(|e| format!("{what}: sparse values: {e}"))?;
         let mut bad = None;
-        for_each_element(&format!("{what} sparse values"), vdata, vv.offset(), elem, elem, n, |k, e| {
-            let i = indices[k];
-            if i >= count {
-                bad.get_or_insert(i);
-                return;
-            }
-            for c in 0..comps {
-                out[i * comps + c] = conv(t, normalized, &e[c * csize..(c + 1) * csize]);
-            }
-        })?;
+        for_each_element(
+            &format!("{what} sparse values"),
+            vdata,
+            vv.offset(),
+            elem,
+            elem,
+            n,
+            |k, e| {
+                let i = indices[k];
+                if i >= count {
+                    bad.get_or_insert(i);
+                    return;
+                }
+                for c in 0..comps {
+                    out[i * comps + c] = conv(t, normalized, &e[c * csize..(c + 1) * csize]);
+                }
+            },
+        )?;
         if let Some(i) = bad {
             return Err(format!("{what}: sparse index {i} is out of range (count {count})"));
         }
@@ -368,10 +394,7 @@ pub fn read_vectors<const N: usize>(acc: &gltf::Accessor, buffers: &[Cow<'_, [u8
         ));
     }
     let flat = read_accessor(acc, buffers, component_f32)?;
-    Ok(flat
-        .chunks_exact(N)
-        .map(|c| std::array::from_fn(|k| c[k]))
-        .collect())
+    Ok(flat.chunks_exact(N).map(|c| std::array::from_fn(|k| c[k])).collect())
 }
 
 /// Reads an index accessor (SCALAR, UNSIGNED_BYTE/SHORT/INT).

@@ -371,11 +371,18 @@ fn check_vertices(path: &Path, what: &str, m: &Mesh) -> Result<(), SceneError> {
         if !p.iter().all(|c| c.abs() <= MAX_COORDINATE) {
             return Err(SceneError::file(
                 path,
-                format!("{what}: vertex {i} position {p:?} is out of range: coordinates must be within ±{MAX_COORDINATE:e}"),
+                format!(
+                    "{what}: vertex {i} position {p:?} is out of range: coordinates must be within ±{MAX_COORDINATE:e}"
+                ),
             ));
         }
     }
-    if let Some((i, n)) = m.normals.iter().enumerate().find(|(_, n)| !n.iter().all(|c| c.is_finite())) {
+    if let Some((i, n)) = m
+        .normals
+        .iter()
+        .enumerate()
+        .find(|(_, n)| !n.iter().all(|c| c.is_finite()))
+    {
         return Err(SceneError::file(
             path,
             format!("{what}: vertex {i} has a non-finite normal {n:?}"),
@@ -397,7 +404,10 @@ fn check_material(path: &Path, m: &mut Material) -> Result<(), SceneError> {
     let named = |field: &str, v: &dyn std::fmt::Debug| {
         SceneError::file(
             path,
-            format!("material '{}': {field} {v:?} is out of range: must be finite", gltf_data::short(&m.name)),
+            format!(
+                "material '{}': {field} {v:?} is out of range: must be finite",
+                gltf_data::short(&m.name)
+            ),
         )
     };
     if !m.base_color.iter().all(|c| c.is_finite()) {
@@ -406,7 +416,11 @@ fn check_material(path: &Path, m: &mut Material) -> Result<(), SceneError> {
     if !m.emission.iter().all(|c| c.is_finite()) {
         return Err(named("emission", &m.emission));
     }
-    for (field, v) in [("opacity", m.opacity), ("roughness", m.roughness), ("metallic", m.metallic)] {
+    for (field, v) in [
+        ("opacity", m.opacity),
+        ("roughness", m.roughness),
+        ("metallic", m.metallic),
+    ] {
         if !v.is_finite() {
             return Err(named(field, &v));
         }
@@ -484,10 +498,18 @@ fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFi
             let ti = match image_to_texture.get(&image) {
                 Some(&ti) => ti,
                 None => {
-                    let name = source.name().map(str::to_owned).unwrap_or_else(|| format!("image{image}"));
+                    let name = source
+                        .name()
+                        .map(str::to_owned)
+                        .unwrap_or_else(|| format!("image{image}"));
                     let texture = gltf_data::image_bytes(doc, image, &buffers, base, files)
                         .and_then(|data| decode_texture(&data, &name))
-                        .map_err(|e| fail(format!("material {mi}: image {image} ('{}'): {e}", gltf_data::short(&name))))?;
+                        .map_err(|e| {
+                            fail(format!(
+                                "material {mi}: image {image} ('{}'): {e}",
+                                gltf_data::short(&name)
+                            ))
+                        })?;
                     scene.textures.push(texture);
                     image_to_texture.insert(image, scene.textures.len() - 1);
                     scene.textures.len() - 1
@@ -525,8 +547,8 @@ fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFi
             let pos_acc = prim
                 .get(&Semantic::Positions)
                 .ok_or_else(|| fail(format!("{what}: no POSITION attribute")))?;
-            let positions = gltf_data::read_vectors::<3>(&pos_acc, &buffers)
-                .map_err(|e| fail(format!("{what}: POSITION: {e}")))?;
+            let positions =
+                gltf_data::read_vectors::<3>(&pos_acc, &buffers).map_err(|e| fail(format!("{what}: POSITION: {e}")))?;
             let n = positions.len();
             let material = match prim.material().index() {
                 Some(i) if i < default_material => i,
@@ -546,8 +568,9 @@ fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFi
                 .get(&Semantic::TexCoords(uv_set))
                 .or_else(|| prim.get(&Semantic::TexCoords(0)));
             let uvs = match uv_acc {
-                Some(a) => gltf_data::read_vectors::<2>(&a, &buffers)
-                    .map_err(|e| fail(format!("{what}: TEXCOORD: {e}")))?,
+                Some(a) => {
+                    gltf_data::read_vectors::<2>(&a, &buffers).map_err(|e| fail(format!("{what}: TEXCOORD: {e}")))?
+                }
                 None => Vec::new(),
             };
             for (label, len) in [("NORMAL", normals.len()), ("TEXCOORD", uvs.len())] {
@@ -606,7 +629,10 @@ fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFi
                     is_child[c.index()] = true;
                 }
             }
-            doc.nodes().filter(|n| !is_child[n.index()]).map(|n| n.index()).collect()
+            doc.nodes()
+                .filter(|n| !is_child[n.index()])
+                .map(|n| n.index())
+                .collect()
         }
     };
     {
@@ -791,9 +817,10 @@ fn obj_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFil
             },
             Err(why) => Err((tobj::LoadError::OpenFileFailed, format!("cannot open it: {why}"))),
         };
-        libraries
-            .borrow_mut()
-            .push((full, result.as_ref().map(|(m, _)| m.len()).map_err(|(_, why)| why.clone())));
+        libraries.borrow_mut().push((
+            full,
+            result.as_ref().map(|(m, _)| m.len()).map_err(|(_, why)| why.clone()),
+        ));
         result.map_err(|(e, _)| e)
     })
     .map_err(|e| SceneError::file(path, format!("invalid OBJ file: {e}")))?;
@@ -1172,7 +1199,8 @@ fn build_toml_scene(doc: TomlScene, path: &Path, files: &dyn FileSource) -> Resu
             if !matches!(extension(&mesh_path).as_deref(), Some("obj" | "gltf" | "glb")) {
                 return Err(ck.err("mesh", format!("'{mesh}' must be a .obj, .gltf or .glb file")));
             }
-            let f = load_mesh_file(&mesh_path, files).map_err(|e| ck.err("mesh", format!("cannot load '{mesh}': {e}")))?;
+            let f =
+                load_mesh_file(&mesh_path, files).map_err(|e| ck.err("mesh", format!("cannot load '{mesh}': {e}")))?;
             let has_camera = f.has_camera;
             let mut s = f.scene;
             if !f.has_lights {

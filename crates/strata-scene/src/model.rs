@@ -359,7 +359,10 @@ impl Scene {
                 return Err(format!("{what}: vertex {i} has a non-finite texture coordinate {t:?}"));
             }
             if m.indices.len() % 3 != 0 {
-                return Err(format!("{what}: index count {} is not a multiple of 3", m.indices.len()));
+                return Err(format!(
+                    "{what}: index count {} is not a multiple of 3",
+                    m.indices.len()
+                ));
             }
             if let Some(&i) = m.indices.iter().find(|&&i| i as usize >= m.positions.len()) {
                 return Err(format!(
@@ -373,7 +376,11 @@ impl Scene {
         }
         for (i, o) in self.objects.iter().enumerate() {
             if o.mesh >= self.meshes.len() {
-                return Err(format!("object {i} ('{}'): mesh {} is out of range", short(&o.name), o.mesh));
+                return Err(format!(
+                    "object {i} ('{}'): mesh {} is out of range",
+                    short(&o.name),
+                    o.mesh
+                ));
             }
             if !o.transform.is_finite() {
                 return Err(format!("object {i} ('{}'): transform is not finite", short(&o.name)));
@@ -461,7 +468,9 @@ impl Scene {
         if !(pos(st.ao_radius) && pos(st.min_separation) && pos(st.radiosity_radius) && pos(st.exposure))
             || !(fin3(&st.sky) && fin3(&st.ambient))
         {
-            return Err(format!("settings {st:?} are out of range: lengths and exposure finite and > 0, colours finite"));
+            return Err(format!(
+                "settings {st:?} are out of range: lengths and exposure finite and > 0, colours finite"
+            ));
         }
         if !self.objects.is_empty() {
             let (lo, hi) = self.bounds(0.0);

@@ -29,9 +29,10 @@ impl CameraPath {
             return Err("camera path needs at least one keyframe".into());
         }
         let m = crate::model::MAX_COORDINATE;
-        if let Some(k) = keyframes.iter().find(|k| {
-            !(k.frame.is_finite() && k.eye.abs().max_element() <= m && k.target.abs().max_element() <= m)
-        }) {
+        if let Some(k) = keyframes
+            .iter()
+            .find(|k| !(k.frame.is_finite() && k.eye.abs().max_element() <= m && k.target.abs().max_element() <= m))
+        {
             return Err(format!(
                 "camera path keyframe at frame {} is out of range: frame, eye and target must be finite, coordinates within ±{m:e}",
                 k.frame
@@ -112,7 +113,8 @@ impl CameraPath {
         let (m0, m1) = (self.tangent(i, sel) * len, self.tangent(i + 1, sel) * len);
         let t2 = t * t;
         let t3 = t2 * t;
-        let p = p0 * (2.0 * t3 - 3.0 * t2 + 1.0) + m0 * (t3 - 2.0 * t2 + t) + p1 * (-2.0 * t3 + 3.0 * t2) + m1 * (t3 - t2);
+        let p =
+            p0 * (2.0 * t3 - 3.0 * t2 + 1.0) + m0 * (t3 - 2.0 * t2 + t) + p1 * (-2.0 * t3 + 3.0 * t2) + m1 * (t3 - t2);
         let m = f32::MAX as f64;
         p.clamp(DVec3::splat(-m), DVec3::splat(m)).as_vec3()
     }
