@@ -112,6 +112,9 @@ const URIS: &[&str] = &[
     "data:application/octet-stream,plain",
 ];
 
+/// Floats for structure-aware JSON mutations.
+const FLOATS: &[&str] = &["1e39", "-1e39", "3.4e38", "1e-45", "-0.0", "0.5", "1e300"];
+
 /// Interesting integers for structure-aware JSON mutations.
 const INTS: &[i64] = &[
     0,
@@ -475,8 +478,10 @@ fn mutate_value(root: &mut Value, rng: &mut Rng) {
                 0 => Value::from(cur.wrapping_add(1)),
                 1 => Value::from(cur.wrapping_sub(1)),
                 2 => Value::from(cur.wrapping_mul(2 + rng.below(1000) as i64)),
-                3 => serde_json::from_str(*rng.pick(&["1e39", "-1e39", "3.4e38", "1e-45", "-0.0", "0.5", "1e300"]))
-                    .unwrap_or(Value::Null),
+                3 => {
+                    let f = *rng.pick(FLOATS);
+                    serde_json::from_str(f).unwrap_or(Value::Null)
+                }
                 _ => Value::from(*rng.pick(INTS)),
             };
         }

@@ -33,12 +33,12 @@ pub fn base64_encode(data: &[u8]) -> String {
 /// Packs JSON and a binary chunk into a GLB container.
 pub fn glb(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
     let mut j = json.to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.map(<[u8]>::to_vec);
     if let Some(b) = &mut b {
-        while b.len() % 4 != 0 {
+        while !b.len().is_multiple_of(4) {
             b.push(0);
         }
     }

@@ -119,8 +119,7 @@ pub fn check_exr_header(bytes: &[u8]) -> Result<(), String> {
         *at += end + 1;
         Some(s)
     };
-    loop {
-        let Some(name) = cstr(&mut at) else { break };
+    while let Some(name) = cstr(&mut at) {
         if name.is_empty() {
             break;
         }

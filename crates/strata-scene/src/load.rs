@@ -343,7 +343,7 @@ fn load_mesh_slice(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<
     }
     let (lo, hi) = file.scene.bounds(0.0);
     let extent = (hi - lo).abs().max(lo.abs()).max(hi.abs()).max_element();
-    if !(extent <= MAX_COORDINATE) {
+    if extent.is_nan() || extent > MAX_COORDINATE {
         return Err(SceneError::file(
             path,
             format!("the scene's world-space bounds {lo}..{hi} are out of range: coordinates must be within ±{MAX_COORDINATE:e}"),
@@ -441,7 +441,7 @@ fn check_indices(path: &Path, what: &str, indices: &[u32], vertex_count: usize) 
             format!("{what}: vertex index {bad} is out of range (the mesh has {vertex_count} vertices)"),
         ));
     }
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(SceneError::file(
             path,
             format!("{what}: index count {} is not a multiple of 3", indices.len()),

@@ -465,8 +465,12 @@ impl Scene {
         }
         let st = &self.settings;
         let pos = |x: f32| x.is_finite() && x > 0.0;
-        if !(pos(st.ao_radius) && pos(st.min_separation) && pos(st.radiosity_radius) && pos(st.exposure))
-            || !(fin3(&st.sky) && fin3(&st.ambient))
+        if !(pos(st.ao_radius)
+            && pos(st.min_separation)
+            && pos(st.radiosity_radius)
+            && pos(st.exposure)
+            && fin3(&st.sky)
+            && fin3(&st.ambient))
         {
             return Err(format!(
                 "settings {st:?} are out of range: lengths and exposure finite and > 0, colours finite"
@@ -475,7 +479,7 @@ impl Scene {
         if !self.objects.is_empty() {
             let (lo, hi) = self.bounds(0.0);
             let extent = lo.abs().max(hi.abs()).max_element();
-            if !(extent <= MAX_COORDINATE) && self.triangle_count() > 0 {
+            if (extent.is_nan() || extent > MAX_COORDINATE) && self.triangle_count() > 0 {
                 return Err(format!(
                     "the world-space bounds {lo}..{hi} are out of range: coordinates must be within ±{MAX_COORDINATE:e}"
                 ));
