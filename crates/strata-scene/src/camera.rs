@@ -128,12 +128,29 @@ impl Camera {
         if !(self.near > 0.0) || !self.near.is_finite() {
             return Err(format!("camera near {} is out of range: must be > 0", self.near));
         }
+        let m = crate::model::MAX_COORDINATE;
+        if !(self.eye.abs().max_element() <= m && self.target.abs().max_element() <= m) {
+            return Err(format!(
+                "camera eye {} or target {} is out of range: coordinates must be finite and within ±{m:e}",
+                self.eye, self.target
+            ));
+        }
         let f = self.target - self.eye;
         if !f.is_finite() || f.length() < 1e-6 {
             return Err("camera eye and target must be finite and distinct".into());
         }
-        if f.normalize().cross(self.up).length() < 1e-4 {
-            return Err("camera up vector must not be parallel to the view direction".into());
+        if !self.up.is_finite() || self.up.length() < 1e-12 {
+            return Err(format!(
+                "camera up vector {} is out of range: must be finite and non-zero",
+                self.up
+            ));
+        }
+        if f.normalize().cross(self.up.normalize()).length() < 1e-4 {
+            return Err(format!(
+                "camera up vector {} is parallel to the view direction {}: it must make an angle of at least 0.006 degrees with it",
+                self.up,
+                f.normalize()
+            ));
         }
         Ok(())
     }

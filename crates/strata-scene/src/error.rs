@@ -12,10 +12,25 @@ pub enum SceneError {
 }
 
 impl SceneError {
+    /// An error about `path`. The message is made one line (line breaks and
+    /// other control characters become "; " or spaces).
     pub fn file(path: impl Into<PathBuf>, message: impl std::fmt::Display) -> Self {
         SceneError::File {
             path: path.into(),
-            message: message.to_string(),
+            message: one_line(&message.to_string()),
         }
     }
+}
+
+/// `s` on one line: non-empty lines joined with "; ", other control
+/// characters replaced by spaces.
+pub fn one_line(s: &str) -> String {
+    s.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect()
 }

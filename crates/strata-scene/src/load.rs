@@ -26,6 +26,37 @@
 //! without lights, [`default_sun`] is added. Settings are scaled to the scene
 //! ([`default_settings`]).
 //!
+//! # Malformed and degenerate input
+//!
+//! Any input gives a scene or a one-line error naming the file (and the
+//! element and valid range where there is one); the loaders are fuzzed
+//! (`crates/strata-fuzz`, `docs/reliability.md`).
+//!
+//! - Sizes read from a file are checked against the bytes that are there
+//!   before anything is allocated: glTF accessor counts, offsets and strides
+//!   against their buffer views, views against buffers, buffers against their
+//!   `byteLength`; an accessor without a buffer view (sparse only) may have at
+//!   most [`MAX_ZERO_ACCESSOR`] elements. Textures: see
+//!   [`crate::files::decode_texture`] (at most 16384 texels a side, decoded
+//!   size bounded by the encoded size).
+//! - Referenced files (MTL, textures, glTF buffers and images) must be regular
+//!   files ([`DiskFiles`]); `data:` URIs are decoded.
+//! - A non-finite vertex position, normal or texture coordinate, or a position
+//!   coordinate outside ±[`MAX_COORDINATE`], is an error naming the mesh and the
+//!   vertex (OBJ: the line and the `v`/`vn`/`vt` number). A non-finite material
+//!   value or node transform is an error naming the material or node; finite
+//!   material values are clamped to their ranges (colours and factors to
+//!   [0, 1], emission to >= 0).
+//! - Zero-length normals in a file are replaced by the generated smooth normal
+//!   of that vertex; missing UVs become zeros.
+//! - Zero-area and duplicate triangles are kept as they are: they rasterise to
+//!   nothing (zero area) or to the same pixels, add nothing to the
+//!   area-weighted normals, and the reference's ray test rejects zero-area
+//!   triangles; keeping them keeps the triangle counts of the file.
+//! - glTF node hierarchies must be trees: a node reached twice (a cycle or a
+//!   node with two parents) is an error.
+//! - Every loaded scene passes [`Scene::validate`].
+//!
 //! # TOML scene files
 //!
 //! A TOML file wraps one mesh file (or a built-in scene) and sets its camera,
@@ -98,6 +129,10 @@ use serde::Deserialize;
 
 use crate::camera::Camera;
 use crate::error::SceneError;
+pub use crate::files::{decode_texture, DiskFiles, FileSource, MemFiles};
+use crate::gltf_data;
+pub use crate::gltf_data::MAX_ZERO_ACCESSOR;
+pub use crate::model::MAX_COORDINATE;
 use crate::model::{Animation, Light, Material, Mesh, Object, Scene, SceneSettings, Texture};
 use crate::normals::ensure_normals;
 use crate::path::{CameraPath, Keyframe};
@@ -109,12 +144,40 @@ pub const EXTENSIONS: &[&str] = &["gltf", "glb", "obj", "toml"];
 /// Loads a scene file, dispatching on its extension (case-insensitive):
 /// `.gltf`/`.glb` → [`load_gltf`], `.obj` → [`load_obj`], `.toml` → [`load_toml`].
 pub fn load_path(path: &Path) -> Result<Scene, SceneError> {
+    if !matches!(extension(path).as_deref(), Some("gltf" | "glb" | "obj" | "toml")) {
+        return Err(unsupported_extension(path));
+    }
+    let bytes = read_file(path, &DiskFiles, "scene file")?;
+    load_slice(&bytes, path, &DiskFiles)
+}
+
+/// Loads a scene file's contents `bytes`, dispatching on the extension of
+/// `path` like [`load_path`]. `path` names the file in errors and locates the
+/// files it refers to (MTL libraries, textures, glTF buffers and images, a TOML
+/// scene's mesh), which are read through `files`.
+pub fn load_slice(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     match extension(path).as_deref() {
-        Some("gltf" | "glb") => load_gltf(path),
-        Some("obj") => load_obj(path),
-        Some("toml") => load_toml(path),
+        Some("gltf" | "glb" | "obj") => load_mesh_slice(bytes, path, files).map(|m| m.into_scene(path))?,
+        Some("toml") => load_toml_slice(bytes, path, files),
         _ => Err(unsupported_extension(path)),
     }
+}
+
+/// Loads glTF/GLB contents (see [`load_slice`]; external files from disk).
+pub fn load_gltf_slice(bytes: &[u8], path: &Path) -> Result<Scene, SceneError> {
+    load_mesh_slice(bytes, path, &DiskFiles).map(|m| m.into_scene(path))?
+}
+
+/// Loads OBJ text (see [`load_slice`]; MTL libraries and textures from disk).
+pub fn load_obj_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    load_mesh_slice(text.as_bytes(), path, &DiskFiles).map(|m| m.into_scene(path))?
+}
+
+/// Reads `path` through `files`; the error names the file and what it is.
+fn read_file(path: &Path, files: &dyn FileSource, what: &str) -> Result<Vec<u8>, SceneError> {
+    files
+        .read(path)
+        .map_err(|e| SceneError::file(path, format!("cannot read {what}: {e}")))
 }
 
 fn extension(path: &Path) -> Option<String> {
@@ -134,28 +197,54 @@ fn unsupported_extension(path: &Path) -> SceneError {
 /// Loads a glTF 2.0 file (`.gltf` or `.glb`) with default camera/light/settings
 /// where the file has none (see the module docs).
 pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
-    load_mesh_file(path).map(|m| m.into_scene())
+    load_mesh_file(path, &DiskFiles).map(|m| m.into_scene(path))?
 }
 
 /// Loads an OBJ file and its MTL libraries with default camera/light/settings
 /// (see the module docs).
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
-    load_mesh_file(path).map(|m| m.into_scene())
+    load_mesh_file(path, &DiskFiles).map(|m| m.into_scene(path))?
 }
 
 /// Loads a TOML scene description (format in the module docs).
 pub fn load_toml(path: &Path) -> Result<Scene, SceneError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| SceneError::file(path, format!("cannot read scene file: {e}")))?;
-    load_toml_str(&text, path)
+    let bytes = read_file(path, &DiskFiles, "scene file")?;
+    load_toml_slice(&bytes, path, &DiskFiles)
 }
 
 /// Parses a TOML scene description. `path` is used for error messages and to
 /// resolve the relative `mesh` path (against its folder).
 pub fn load_toml_str(text: &str, path: &Path) -> Result<Scene, SceneError> {
-    let doc: TomlScene = toml::from_str(text)
-        .map_err(|e| SceneError::file(path, format!("invalid scene file: {}", e.to_string().trim_end())))?;
-    build_toml_scene(doc, path)
+    load_toml_text(text, path, &DiskFiles)
+}
+
+/// [`load_toml_str`] on bytes (must be UTF-8), reading the mesh through `files`.
+pub fn load_toml_slice(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        SceneError::file(
+            path,
+            format!("invalid scene file: not UTF-8 (byte {})", e.valid_up_to()),
+        )
+    })?;
+    load_toml_text(text, path, files)
+}
+
+fn load_toml_text(text: &str, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
+    let doc: TomlScene = toml::from_str(text).map_err(|e| {
+        let at = e
+            .span()
+            .map(|s| {
+                let upto = &text.as_bytes()[..s.start.min(text.len())];
+                let line = upto.iter().filter(|&&b| b == b'\n').count() + 1;
+                let col = upto.iter().rev().take_while(|&&b| b != b'\n').count() + 1;
+                format!("line {line}, column {col}: ")
+            })
+            .unwrap_or_default();
+        SceneError::file(path, format!("invalid scene file: {at}{}", e.message().trim()))
+    })?;
+    let scene = build_toml_scene(doc, path, files)?;
+    scene.validate().map_err(|e| SceneError::file(path, e))?;
+    Ok(scene)
 }
 
 /// A camera on the +Z side of the bounds' centre looking down −Z, far enough
@@ -203,8 +292,9 @@ struct MeshFile {
 }
 
 impl MeshFile {
-    /// Fills in the defaults (camera, sun, settings) the file lacks.
-    fn into_scene(mut self) -> Scene {
+    /// Fills in the defaults (camera, sun, settings) the file lacks and checks
+    /// the result ([`Scene::validate`]).
+    fn into_scene(mut self, path: &Path) -> Result<Scene, SceneError> {
         let (lo, hi) = self.scene.bounds(0.0);
         if !self.has_camera {
             self.scene.camera = default_camera(lo, hi);
@@ -213,15 +303,28 @@ impl MeshFile {
             self.scene.lights = vec![default_sun()];
         }
         self.scene.settings = default_settings(lo, hi);
-        self.scene
+        self.scene.validate().map_err(|e| SceneError::file(path, e))?;
+        Ok(self.scene)
     }
 }
 
 /// Loads a glTF or OBJ file without applying defaults.
-fn load_mesh_file(path: &Path) -> Result<MeshFile, SceneError> {
+fn load_mesh_file(path: &Path, files: &dyn FileSource) -> Result<MeshFile, SceneError> {
+    if !matches!(extension(path).as_deref(), Some("gltf" | "glb" | "obj")) {
+        return Err(SceneError::file(
+            path,
+            "unsupported mesh file extension: use .gltf, .glb or .obj",
+        ));
+    }
+    let bytes = read_file(path, files, "mesh file")?;
+    load_mesh_slice(&bytes, path, files)
+}
+
+/// Loads glTF or OBJ contents without applying defaults.
+fn load_mesh_slice(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFile, SceneError> {
     let mut file = match extension(path).as_deref() {
-        Some("gltf" | "glb") => gltf_file(path)?,
-        Some("obj") => obj_file(path)?,
+        Some("gltf" | "glb") => gltf_file(bytes, path, files)?,
+        Some("obj") => obj_file(bytes, path, files)?,
         _ => {
             return Err(SceneError::file(
                 path,
@@ -238,6 +341,14 @@ fn load_mesh_file(path: &Path) -> Result<MeshFile, SceneError> {
             m.uvs = vec![[0.0; 2]; m.positions.len()];
         }
     }
+    let (lo, hi) = file.scene.bounds(0.0);
+    let extent = (hi - lo).abs().max(lo.abs()).max(hi.abs()).max_element();
+    if extent.is_nan() || extent > MAX_COORDINATE {
+        return Err(SceneError::file(
+            path,
+            format!("the scene's world-space bounds {lo}..{hi} are out of range: coordinates must be within ±{MAX_COORDINATE:e}"),
+        ));
+    }
     if file.scene.name.is_empty() {
         file.scene.name = path
             .file_stem()
@@ -245,6 +356,81 @@ fn load_mesh_file(path: &Path) -> Result<MeshFile, SceneError> {
             .unwrap_or_default();
     }
     Ok(file)
+}
+
+/// Checks a mesh's vertex data: positions finite and within ±[`MAX_COORDINATE`],
+/// normals and UVs finite. `what` names the mesh.
+fn check_vertices(path: &Path, what: &str, m: &Mesh) -> Result<(), SceneError> {
+    for (i, p) in m.positions.iter().enumerate() {
+        if !p.iter().all(|c| c.is_finite()) {
+            return Err(SceneError::file(
+                path,
+                format!("{what}: vertex {i} has a non-finite position {p:?}"),
+            ));
+        }
+        if !p.iter().all(|c| c.abs() <= MAX_COORDINATE) {
+            return Err(SceneError::file(
+                path,
+                format!(
+                    "{what}: vertex {i} position {p:?} is out of range: coordinates must be within ±{MAX_COORDINATE:e}"
+                ),
+            ));
+        }
+    }
+    if let Some((i, n)) = m
+        .normals
+        .iter()
+        .enumerate()
+        .find(|(_, n)| !n.iter().all(|c| c.is_finite()))
+    {
+        return Err(SceneError::file(
+            path,
+            format!("{what}: vertex {i} has a non-finite normal {n:?}"),
+        ));
+    }
+    if let Some((i, t)) = m.uvs.iter().enumerate().find(|(_, t)| !t.iter().all(|c| c.is_finite())) {
+        return Err(SceneError::file(
+            path,
+            format!("{what}: vertex {i} has a non-finite texture coordinate {t:?}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks a material's values (an error for non-finite ones) and clamps them
+/// to their ranges: base colour, opacity, roughness, metallic to [0, 1],
+/// emission to >= 0.
+fn check_material(path: &Path, m: &mut Material) -> Result<(), SceneError> {
+    let named = |field: &str, v: &dyn std::fmt::Debug| {
+        SceneError::file(
+            path,
+            format!(
+                "material '{}': {field} {v:?} is out of range: must be finite",
+                gltf_data::short(&m.name)
+            ),
+        )
+    };
+    if !m.base_color.iter().all(|c| c.is_finite()) {
+        return Err(named("base colour", &m.base_color));
+    }
+    if !m.emission.iter().all(|c| c.is_finite()) {
+        return Err(named("emission", &m.emission));
+    }
+    for (field, v) in [
+        ("opacity", m.opacity),
+        ("roughness", m.roughness),
+        ("metallic", m.metallic),
+    ] {
+        if !v.is_finite() {
+            return Err(named(field, &v));
+        }
+    }
+    m.base_color = m.base_color.map(|c| c.clamp(0.0, 1.0));
+    m.emission = m.emission.map(|c| c.max(0.0));
+    m.opacity = m.opacity.clamp(0.0, 1.0);
+    m.roughness = m.roughness.clamp(0.0, 1.0);
+    m.metallic = m.metallic.clamp(0.0, 1.0);
+    Ok(())
 }
 
 /// Checks every index of `indices` against `vertex_count`.
@@ -255,7 +441,7 @@ fn check_indices(path: &Path, what: &str, indices: &[u32], vertex_count: usize) 
             format!("{what}: vertex index {bad} is out of range (the mesh has {vertex_count} vertices)"),
         ));
     }
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(SceneError::file(
             path,
             format!("{what}: index count {} is not a multiple of 3", indices.len()),
@@ -267,9 +453,20 @@ fn check_indices(path: &Path, what: &str, indices: &[u32], vertex_count: usize) 
 // ---------------------------------------------------------------------------
 // glTF
 
-fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
-    let (doc, buffers, images) =
-        gltf::import(path).map_err(|e| SceneError::file(path, format!("cannot load glTF: {e}")))?;
+fn gltf_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFile, SceneError> {
+    let fail = |m: String| SceneError::file(path, m);
+    gltf_data::check_glb_header(bytes).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
+    // gltf-json's validation indexes the accessors with each primitive's
+    // POSITION index before checking it (a panic when out of range): check
+    // attribute indices first.
+    let json = gltf.document.into_json();
+    gltf_data::check_attribute_indices(&json).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
+    let document = gltf::Document::from_json(json).map_err(|e| fail(format!("cannot load glTF: {e}")))?;
+    let doc = &document;
+    let base = path.parent().unwrap_or(Path::new(""));
+    let buffers =
+        gltf_data::load_buffers(doc, gltf.blob.as_deref(), base, files).map_err(|e| fail(format!("glTF {e}")))?;
     let mut scene = Scene::default();
 
     // Materials (+ base colour textures, one per referenced image).
@@ -292,23 +489,28 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
             roughness: pbr.roughness_factor(),
             metallic: pbr.metallic_factor(),
         };
+        check_material(path, &mut mat)?;
         let mut uv_set = 0;
         if let Some(info) = pbr.base_color_texture() {
-            let image = info.texture().source().index();
+            let source = info.texture().source();
+            let image = source.index();
             uv_set = info.tex_coord();
             let ti = match image_to_texture.get(&image) {
                 Some(&ti) => ti,
                 None => {
-                    let data = images
-                        .get(image)
-                        .ok_or_else(|| SceneError::file(path, format!("material {mi}: image {image} is missing")))?;
-                    let name = info
-                        .texture()
-                        .source()
+                    let name = source
                         .name()
                         .map(str::to_owned)
                         .unwrap_or_else(|| format!("image{image}"));
-                    scene.textures.push(gltf_texture(path, name, data)?);
+                    let texture = gltf_data::image_bytes(doc, image, &buffers, base, files)
+                        .and_then(|data| decode_texture(&data, &name))
+                        .map_err(|e| {
+                            fail(format!(
+                                "material {mi}: image {image} ('{}'): {e}",
+                                gltf_data::short(&name)
+                            ))
+                        })?;
+                    scene.textures.push(texture);
                     image_to_texture.insert(image, scene.textures.len() - 1);
                     scene.textures.len() - 1
                 }
@@ -329,10 +531,11 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
             let what = format!(
                 "mesh {} ('{}') primitive {}",
                 gm.index(),
-                gm.name().unwrap_or(""),
+                gltf_data::short(gm.name().unwrap_or("")),
                 prim.index()
             );
             use gltf::mesh::Mode;
+            use gltf::Semantic;
             let mode = prim.mode();
             if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
                 eprintln!(
@@ -341,11 +544,12 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
                 );
                 continue;
             }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let positions: Vec<[f32; 3]> = reader
-                .read_positions()
-                .ok_or_else(|| SceneError::file(path, format!("{what}: no readable POSITION attribute")))?
-                .collect();
+            let pos_acc = prim
+                .get(&Semantic::Positions)
+                .ok_or_else(|| fail(format!("{what}: no POSITION attribute")))?;
+            let positions =
+                gltf_data::read_vectors::<3>(&pos_acc, &buffers).map_err(|e| fail(format!("{what}: POSITION: {e}")))?;
+            let n = positions.len();
             let material = match prim.material().index() {
                 Some(i) if i < default_material => i,
                 _ => {
@@ -354,28 +558,38 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
                 }
             };
             let uv_set = material_uv_set.get(material).copied().unwrap_or(0);
-            let normals: Vec<[f32; 3]> = reader.read_normals().map(|n| n.collect()).unwrap_or_default();
-            let uvs: Vec<[f32; 2]> = reader
-                .read_tex_coords(uv_set)
-                .or_else(|| reader.read_tex_coords(0))
-                .map(|t| t.into_f32().collect())
-                .unwrap_or_default();
-            let raw: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None if prim.indices().is_some() => {
-                    return Err(SceneError::file(
-                        path,
-                        format!("{what}: indices are not readable (truncated buffer?)"),
-                    ));
+            let normals = match prim.get(&Semantic::Normals) {
+                Some(a) => {
+                    gltf_data::read_vectors::<3>(&a, &buffers).map_err(|e| fail(format!("{what}: NORMAL: {e}")))?
                 }
-                None => (0..positions.len() as u32).collect(),
+                None => Vec::new(),
+            };
+            let uv_acc = prim
+                .get(&Semantic::TexCoords(uv_set))
+                .or_else(|| prim.get(&Semantic::TexCoords(0)));
+            let uvs = match uv_acc {
+                Some(a) => {
+                    gltf_data::read_vectors::<2>(&a, &buffers).map_err(|e| fail(format!("{what}: TEXCOORD: {e}")))?
+                }
+                None => Vec::new(),
+            };
+            for (label, len) in [("NORMAL", normals.len()), ("TEXCOORD", uvs.len())] {
+                if len != 0 && len != n {
+                    return Err(fail(format!(
+                        "{what}: {label} has {len} elements but POSITION has {n} (they must match)"
+                    )));
+                }
+            }
+            let raw: Vec<u32> = match prim.indices() {
+                Some(a) => gltf_data::read_indices(&a, &buffers).map_err(|e| fail(format!("{what}: indices: {e}")))?,
+                None => (0..n as u32).collect(),
             };
             let indices = match mode {
                 Mode::TriangleStrip => strip_to_list(&raw),
                 Mode::TriangleFan => fan_to_list(&raw),
                 _ => raw,
             };
-            check_indices(path, &what, &indices, positions.len())?;
+            check_indices(path, &what, &indices, n)?;
             let name = gm
                 .name()
                 .map(str::to_owned)
@@ -393,6 +607,7 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
                 indices,
                 material,
             };
+            check_vertices(path, &what, &mesh)?;
             // Before any mirrored copy is made (normals follow the original winding).
             ensure_normals(&mut mesh);
             scene.meshes.push(mesh);
@@ -405,8 +620,8 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
     }
 
     // Nodes of the default scene (or all root nodes when there is no scene).
-    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
-        Some(s) => s.nodes().collect(),
+    let mut roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().map(|n| n.index()).collect(),
         None => {
             let mut is_child = vec![false; doc.nodes().len()];
             for n in doc.nodes() {
@@ -414,17 +629,36 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
                     is_child[c.index()] = true;
                 }
             }
-            doc.nodes().filter(|n| !is_child[n.index()]).collect()
+            doc.nodes()
+                .filter(|n| !is_child[n.index()])
+                .map(|n| n.index())
+                .collect()
         }
     };
+    {
+        let mut seen = vec![false; doc.nodes().len()];
+        roots.retain(|&r| !std::mem::replace(&mut seen[r], true));
+    }
+    let nodes: Vec<gltf::Node> = doc.nodes().collect();
+    let mut visited = vec![false; nodes.len()];
     let mut camera = None;
     let mut flipped: HashMap<usize, usize> = HashMap::new();
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY, 0)).collect();
-    while let Some((node, parent, depth)) = stack.pop() {
-        if depth > 256 {
-            return Err(SceneError::file(path, "node hierarchy is too deep (cyclic?)"));
+    let mut stack: Vec<(usize, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
+    while let Some((ni, parent)) = stack.pop() {
+        let node = &nodes[ni];
+        if std::mem::replace(&mut visited[ni], true) {
+            return Err(fail(format!(
+                "node {ni} is reached twice: the node hierarchy must be a tree (a cycle or a node with two parents)"
+            )));
         }
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * local;
+        if !local.is_finite() || !world.is_finite() {
+            return Err(fail(format!(
+                "node {ni} ('{}'): transform is out of range: its matrix (and its product with the parents') must be finite",
+                gltf_data::short(node.name().unwrap_or(""))
+            )));
+        }
         if let Some(gm) = node.mesh() {
             let name = node
                 .name()
@@ -455,12 +689,18 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
             }
         }
         if camera.is_none() {
-            if let Some(cam) = node.camera() {
-                if let gltf::camera::Projection::Perspective(p) = cam.projection() {
+            // From the JSON: `gltf`'s `Camera::projection` panics when `type`
+            // names a projection whose object is missing.
+            let perspective = node
+                .camera()
+                .and_then(|cam| doc.as_json().cameras.get(cam.index()))
+                .and_then(|c| c.perspective.as_ref());
+            if let Some(p) = perspective {
+                {
                     let eye = world.transform_point3(Vec3::ZERO);
                     let fwd = world.transform_vector3(-Vec3::Z).normalize_or_zero();
                     let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-                    let c = Camera::new(eye, eye + fwd, up, p.yfov().to_degrees(), p.znear());
+                    let c = Camera::new(eye, eye + fwd, up, p.yfov.to_degrees(), p.znear);
                     if c.validate().is_ok() {
                         camera = Some(c);
                     }
@@ -468,7 +708,7 @@ fn gltf_file(path: &Path) -> Result<MeshFile, SceneError> {
             }
         }
         for c in node.children() {
-            stack.push((c, world, depth + 1));
+            stack.push((c.index(), world));
         }
     }
     let has_camera = camera.is_some();
@@ -502,63 +742,66 @@ fn fan_to_list(s: &[u32]) -> Vec<u32> {
     out
 }
 
-/// Converts decoded glTF image data to an RGBA8 [`Texture`].
-fn gltf_texture(path: &Path, name: String, d: &gltf::image::Data) -> Result<Texture, SceneError> {
-    use gltf::image::Format;
-    let n = d.width as usize * d.height as usize;
-    let (channels, bytes_per_channel) = match d.format {
-        Format::R8 => (1, 1),
-        Format::R8G8 => (2, 1),
-        Format::R8G8B8 => (3, 1),
-        Format::R8G8B8A8 => (4, 1),
-        Format::R16 => (1, 2),
-        Format::R16G16 => (2, 2),
-        Format::R16G16B16 => (3, 2),
-        Format::R16G16B16A16 => (4, 2),
-        Format::R32G32B32FLOAT => (3, 4),
-        Format::R32G32B32A32FLOAT => (4, 4),
-    };
-    if d.pixels.len() < n * channels * bytes_per_channel || n == 0 {
-        return Err(SceneError::file(path, format!("image '{name}' has inconsistent size")));
-    }
-    let value = |i: usize| -> u8 {
-        let b = &d.pixels[i * bytes_per_channel..(i + 1) * bytes_per_channel];
-        match bytes_per_channel {
-            1 => b[0],
-            2 => (u16::from_ne_bytes([b[0], b[1]]) >> 8) as u8,
-            _ => {
-                let f = f32::from_ne_bytes([b[0], b[1], b[2], b[3]]);
-                (f.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
-            }
-        }
-    };
-    let mut rgba8 = Vec::with_capacity(n * 4);
-    for p in 0..n {
-        let c = |k: usize| value(p * channels + k);
-        let px = match channels {
-            1 => [c(0), c(0), c(0), 255],
-            2 => [c(0), c(0), c(0), c(1)],
-            3 => [c(0), c(1), c(2), 255],
-            _ => [c(0), c(1), c(2), c(3)],
-        };
-        rgba8.extend_from_slice(&px);
-    }
-    Ok(Texture {
-        name,
-        width: d.width,
-        height: d.height,
-        rgba8,
-    })
-}
-
 // ---------------------------------------------------------------------------
 // OBJ / MTL
 
-fn obj_file(path: &Path) -> Result<MeshFile, SceneError> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot read OBJ file: {e}")))?;
+/// Checks the numbers of the `v`, `vn` and `vt` lines of OBJ text: a
+/// non-finite one is an error naming the line and the vertex.
+fn obj_check_numbers(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
+    let mut counts = [0usize; 3];
+    for (li, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let Ok(line) = std::str::from_utf8(line) else {
+            continue;
+        };
+        let mut words = line.split_whitespace();
+        let (k, what) = match words.next() {
+            Some("v") => (0, "position"),
+            Some("vn") => (1, "normal"),
+            Some("vt") => (2, "texture coordinate"),
+            _ => continue,
+        };
+        counts[k] += 1;
+        if words.any(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite())) {
+            return Err(SceneError::file(
+                path,
+                format!(
+                    "line {}: vertex {} has a non-finite {what} ('{}'): values must be finite f32",
+                    li + 1,
+                    counts[k],
+                    gltf_data::short(line.trim())
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks what `tobj` would panic on in an MTL file: a colour (`Ka`, `Kd`,
+/// `Ks`, `Ke`) with fewer than 3 numbers.
+fn check_mtl(bytes: &[u8]) -> Result<(), String> {
+    for (li, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let Ok(line) = std::str::from_utf8(line) else {
+            continue;
+        };
+        let mut words = line.split_whitespace();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
+            let n = words.count();
+            if n < 3 {
+                return Err(format!(
+                    "line {}: '{key}' has {n} values: it needs 3 numbers (r g b)",
+                    li + 1
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn obj_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Result<MeshFile, SceneError> {
+    obj_check_numbers(path, bytes)?;
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
     // MTL libraries in load order: (path, number of materials or the error).
-    let libraries: RefCell<Vec<(PathBuf, Result<usize, tobj::LoadError>)>> = RefCell::new(Vec::new());
+    let libraries: RefCell<Vec<(PathBuf, Result<usize, String>)>> = RefCell::new(Vec::new());
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -566,21 +809,24 @@ fn obj_file(path: &Path) -> Result<MeshFile, SceneError> {
     };
     let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(bytes), &options, |mtl| {
         let full = dir.join(mtl);
-        let result = tobj::load_mtl(&full);
-        libraries
-            .borrow_mut()
-            .push((full, result.as_ref().map(|(m, _)| m.len()).map_err(|e| *e)));
-        result
+        let result = match files.read(&full) {
+            Ok(text) => match check_mtl(&text) {
+                // tobj panics on a colour line with fewer than 3 numbers.
+                Err(why) => Err((tobj::LoadError::MaterialParseError, why)),
+                Ok(()) => tobj::load_mtl_buf(&mut std::io::Cursor::new(text)).map_err(|e| (e, e.to_string())),
+            },
+            Err(why) => Err((tobj::LoadError::OpenFileFailed, format!("cannot open it: {why}"))),
+        };
+        libraries.borrow_mut().push((
+            full,
+            result.as_ref().map(|(m, _)| m.len()).map_err(|(_, why)| why.clone()),
+        ));
+        result.map_err(|(e, _)| e)
     })
     .map_err(|e| SceneError::file(path, format!("invalid OBJ file: {e}")))?;
     let libraries = libraries.into_inner();
     for (lib, result) in &libraries {
-        if let Err(e) = result {
-            let why = if *e == tobj::LoadError::OpenFileFailed {
-                "cannot open it".to_string()
-            } else {
-                e.to_string()
-            };
+        if let Err(why) = result {
             return Err(SceneError::file(
                 path,
                 format!("material library {}: {why}", lib.display()),
@@ -620,6 +866,7 @@ fn obj_file(path: &Path) -> Result<MeshFile, SceneError> {
             mat.roughness = (2.0 / (ns.max(0.0) + 2.0)).sqrt();
         }
         mat.metallic = 0.0;
+        check_material(path, &mut mat)?;
         if let Some(tex) = &m.diffuse_texture {
             let rel = texture_file_name(tex);
             let base = material_dirs.get(i).cloned().unwrap_or_else(|| dir.clone());
@@ -631,7 +878,7 @@ fn obj_file(path: &Path) -> Result<MeshFile, SceneError> {
                         .get(i)
                         .map(|l| l.display().to_string())
                         .unwrap_or_default();
-                    let texture = load_texture(&full).map_err(|e| {
+                    let texture = read_texture(&full, files).map_err(|e| {
                         SceneError::file(
                             path,
                             format!(
@@ -658,7 +905,7 @@ fn obj_file(path: &Path) -> Result<MeshFile, SceneError> {
         if m.indices.is_empty() {
             continue;
         }
-        let what = format!("object '{}'", model.name);
+        let what = format!("object '{}'", gltf_data::short(&model.name));
         if m.positions.len() % 3 != 0 {
             return Err(SceneError::file(path, format!("{what}: malformed positions")));
         }
@@ -682,14 +929,16 @@ fn obj_file(path: &Path) -> Result<MeshFile, SceneError> {
                 default_material
             }
         };
-        scene.meshes.push(Mesh {
+        let mesh = Mesh {
             name: model.name.clone(),
             positions,
             normals,
             uvs,
             indices: m.indices,
             material,
-        });
+        };
+        check_vertices(path, &what, &mesh)?;
+        scene.meshes.push(mesh);
         scene.objects.push(Object {
             name: model.name,
             mesh: scene.meshes.len() - 1,
@@ -721,27 +970,18 @@ fn texture_file_name(value: &str) -> String {
 
 /// Loads an image file as an RGBA8 [`Texture`] (8-bit texels kept as stored,
 /// i.e. sRGB-encoded for colour maps).
+/// Within the limits of [`decode_texture`].
 pub fn load_texture(path: &Path) -> Result<Texture, String> {
-    if !path.is_file() {
-        return Err("file not found".into());
-    }
-    let img = image::open(path)
-        .map_err(|e| format!("cannot decode image: {e}"))?
-        .to_rgba8();
-    let (width, height) = img.dimensions();
-    if width == 0 || height == 0 {
-        return Err("image is empty".into());
-    }
+    read_texture(path, &DiskFiles)
+}
+
+fn read_texture(path: &Path, files: &dyn FileSource) -> Result<Texture, String> {
+    let bytes = files.read(path)?;
     let name = path
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    Ok(Texture {
-        name,
-        width,
-        height,
-        rgba8: img.into_raw(),
-    })
+    decode_texture(&bytes, &name)
 }
 
 // ---------------------------------------------------------------------------
@@ -929,7 +1169,7 @@ impl Check<'_> {
     }
 }
 
-fn build_toml_scene(doc: TomlScene, path: &Path) -> Result<Scene, SceneError> {
+fn build_toml_scene(doc: TomlScene, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     let ck = Check { path };
     let dir = path.parent().unwrap_or(Path::new(""));
 
@@ -959,7 +1199,8 @@ fn build_toml_scene(doc: TomlScene, path: &Path) -> Result<Scene, SceneError> {
             if !matches!(extension(&mesh_path).as_deref(), Some("obj" | "gltf" | "glb")) {
                 return Err(ck.err("mesh", format!("'{mesh}' must be a .obj, .gltf or .glb file")));
             }
-            let f = load_mesh_file(&mesh_path).map_err(|e| ck.err("mesh", format!("cannot load '{mesh}': {e}")))?;
+            let f =
+                load_mesh_file(&mesh_path, files).map_err(|e| ck.err("mesh", format!("cannot load '{mesh}': {e}")))?;
             let has_camera = f.has_camera;
             let mut s = f.scene;
             if !f.has_lights {

@@ -7,6 +7,11 @@ use serde::{Deserialize, Serialize};
 use crate::camera::Camera;
 use crate::path::CameraPath;
 
+/// Largest magnitude of a vertex coordinate (object and world space) a loaded
+/// scene may have: far beyond any real scene, small enough that bounds,
+/// diagonals and camera distances computed from them stay finite in f32.
+pub const MAX_COORDINATE: f32 = 1e18;
+
 /// Triangle mesh in object space. One material per mesh (loaders split by material).
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -307,6 +312,182 @@ impl Scene {
         out
     }
 
+    /// Checks the invariants every loaded scene satisfies; the error names the
+    /// element (mesh and vertex, material, texture, object, light, …):
+    ///
+    /// - meshes: finite positions within ±[`MAX_COORDINATE`]; as many unit
+    ///   normals and finite UVs as positions; a multiple of 3 indices, each in
+    ///   range; a material in range;
+    /// - objects: a mesh in range, a finite transform;
+    /// - materials: finite values with colours, opacity, roughness and metallic
+    ///   in [0, 1] (emission >= 0); a texture in range;
+    /// - textures: non-empty, `width × height × 4` bytes;
+    /// - the camera passes [`Camera::validate`]; camera path keyframes are finite;
+    /// - lights and settings finite (settings' lengths and exposure > 0);
+    /// - world-space bounds at frame 0 within ±[`MAX_COORDINATE`].
+    pub fn validate(&self) -> Result<(), String> {
+        let fin3 = |v: &[f32; 3]| v.iter().all(|c| c.is_finite());
+        for m in &self.meshes {
+            let what = format!("mesh '{}'", short(&m.name));
+            if let Some((i, p)) = m
+                .positions
+                .iter()
+                .enumerate()
+                .find(|(_, p)| !(fin3(p) && p.iter().all(|c| c.abs() <= MAX_COORDINATE)))
+            {
+                return Err(format!(
+                    "{what}: vertex {i} position {p:?} is out of range: must be finite and within ±{MAX_COORDINATE:e}"
+                ));
+            }
+            if m.normals.len() != m.positions.len() || m.uvs.len() != m.positions.len() {
+                return Err(format!(
+                    "{what}: {} normals and {} UVs for {} positions (they must match)",
+                    m.normals.len(),
+                    m.uvs.len(),
+                    m.positions.len()
+                ));
+            }
+            if let Some((i, n)) = m
+                .normals
+                .iter()
+                .enumerate()
+                .find(|(_, n)| !(fin3(n) && (Vec3::from(**n).length() - 1.0).abs() < 1e-3))
+            {
+                return Err(format!("{what}: vertex {i} normal {n:?} is not a finite unit vector"));
+            }
+            if let Some((i, t)) = m.uvs.iter().enumerate().find(|(_, t)| !t.iter().all(|c| c.is_finite())) {
+                return Err(format!("{what}: vertex {i} has a non-finite texture coordinate {t:?}"));
+            }
+            if m.indices.len() % 3 != 0 {
+                return Err(format!(
+                    "{what}: index count {} is not a multiple of 3",
+                    m.indices.len()
+                ));
+            }
+            if let Some(&i) = m.indices.iter().find(|&&i| i as usize >= m.positions.len()) {
+                return Err(format!(
+                    "{what}: vertex index {i} is out of range (the mesh has {} vertices)",
+                    m.positions.len()
+                ));
+            }
+            if m.material >= self.materials.len() {
+                return Err(format!("{what}: material {} is out of range", m.material));
+            }
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            if o.mesh >= self.meshes.len() {
+                return Err(format!(
+                    "object {i} ('{}'): mesh {} is out of range",
+                    short(&o.name),
+                    o.mesh
+                ));
+            }
+            if !o.transform.is_finite() {
+                return Err(format!("object {i} ('{}'): transform is not finite", short(&o.name)));
+            }
+        }
+        for m in &self.materials {
+            let unit = |x: f32| (0.0..=1.0).contains(&x);
+            if !(m.base_color.iter().all(|&c| unit(c))
+                && m.emission.iter().all(|&c| c.is_finite() && c >= 0.0)
+                && unit(m.opacity)
+                && unit(m.roughness)
+                && unit(m.metallic))
+            {
+                return Err(format!(
+                    "material '{}': a value is out of range (base colour, opacity, roughness, metallic in [0, 1]; emission finite and >= 0)",
+                    short(&m.name)
+                ));
+            }
+            if m.base_color_texture.is_some_and(|t| t >= self.textures.len()) {
+                return Err(format!("material '{}': texture index is out of range", short(&m.name)));
+            }
+        }
+        for t in &self.textures {
+            if t.width == 0 || t.height == 0 || t.rgba8.len() as u64 != t.width as u64 * t.height as u64 * 4 {
+                return Err(format!(
+                    "texture '{}': {}×{} with {} bytes (must be non-empty with width × height × 4 bytes)",
+                    short(&t.name),
+                    t.width,
+                    t.height,
+                    t.rgba8.len()
+                ));
+            }
+        }
+        self.camera.validate()?;
+        if let Some(p) = &self.camera_path {
+            if p.keyframes.is_empty()
+                || !p
+                    .keyframes
+                    .iter()
+                    .all(|k| k.frame.is_finite() && k.eye.is_finite() && k.target.is_finite())
+            {
+                return Err("camera path: keyframes must exist and be finite".into());
+            }
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            let ok = match l {
+                Light::Sun {
+                    direction,
+                    color,
+                    illuminance,
+                } => direction.is_finite() && fin3(color) && illuminance.is_finite(),
+                Light::Point {
+                    position,
+                    color,
+                    intensity,
+                } => position.is_finite() && fin3(color) && intensity.is_finite(),
+                Light::Spot {
+                    position,
+                    direction,
+                    color,
+                    intensity,
+                    inner_deg,
+                    outer_deg,
+                } => {
+                    position.is_finite()
+                        && direction.is_finite()
+                        && fin3(color)
+                        && intensity.is_finite()
+                        && inner_deg.is_finite()
+                        && outer_deg.is_finite()
+                }
+                Light::Rect {
+                    center,
+                    half_u,
+                    half_v,
+                    radiance,
+                } => center.is_finite() && half_u.is_finite() && half_v.is_finite() && fin3(radiance),
+            };
+            if !ok {
+                return Err(format!("light {i}: values must be finite"));
+            }
+        }
+        let st = &self.settings;
+        let pos = |x: f32| x.is_finite() && x > 0.0;
+        if !(pos(st.ao_radius)
+            && pos(st.min_separation)
+            && pos(st.radiosity_radius)
+            && pos(st.exposure)
+            && fin3(&st.sky)
+            && fin3(&st.ambient))
+        {
+            return Err(format!(
+                "settings {st:?} are out of range: lengths and exposure finite and > 0, colours finite"
+            ));
+        }
+        if !self.objects.is_empty() {
+            let (lo, hi) = self.bounds(0.0);
+            let extent = lo.abs().max(hi.abs()).max_element();
+            if (extent.is_nan() || extent > MAX_COORDINATE) && self.triangle_count() > 0 {
+                return Err(format!(
+                    "the world-space bounds {lo}..{hi} are out of range: coordinates must be within ±{MAX_COORDINATE:e}"
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// World-space axis-aligned bounds at `frame` (min, max).
     pub fn bounds(&self, frame: f32) -> (Vec3, Vec3) {
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -320,5 +501,15 @@ impl Scene {
             }
         }
         (lo, hi)
+    }
+}
+
+/// At most 80 characters of `s` (for messages).
+fn short(s: &str) -> String {
+    if s.chars().count() <= 80 {
+        s.to_string()
+    } else {
+        let t: String = s.chars().take(77).collect();
+        format!("{t}...")
     }
 }

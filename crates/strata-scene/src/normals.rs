@@ -71,16 +71,28 @@ pub fn smooth_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> 
 
 /// Makes `mesh.normals` usable: generates smooth normals when the mesh has
 /// none (or a count that does not match `positions`), otherwise re-normalises
-/// the given ones (non-finite or zero normals become +Y).
+/// the given ones; a given normal that is zero-length (or not finite) is
+/// replaced by the generated smooth normal of its vertex (+Y where that too is
+/// degenerate).
 ///
-/// Returns `true` when the normals were generated.
+/// Returns `true` when all the normals were generated.
 pub fn ensure_normals(mesh: &mut Mesh) -> bool {
     if mesh.normals.len() != mesh.positions.len() {
         mesh.normals = smooth_normals(&mesh.positions, &mesh.indices);
         return true;
     }
-    for n in &mut mesh.normals {
-        *n = normalize_or_fallback(Vec3::from(*n)).to_array();
+    let usable = |n: Vec3| {
+        let len = n.length();
+        len.is_finite() && len > 1e-30 && (n / len).is_finite()
+    };
+    let mut smooth: Option<Vec<[f32; 3]>> = None;
+    for (i, n) in mesh.normals.iter_mut().enumerate() {
+        let v = Vec3::from(*n);
+        *n = if usable(v) {
+            normalize_or_fallback(v).to_array()
+        } else {
+            smooth.get_or_insert_with(|| smooth_normals(&mesh.positions, &mesh.indices))[i]
+        };
     }
     false
 }
