@@ -23,6 +23,13 @@ fn main() {
         .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG").unwrap_or_else(|_| "warn".into()))
         .with_writer(std::io::stderr)
         .init();
+    // Ctrl-C: outputs and cache entries are written to temporaries and renamed, so an
+    // interrupt leaves the destinations untouched; remove the temporaries in flight.
+    let _ = ctrlc::set_handler(|| {
+        strata_scene::atomic::remove_in_flight();
+        eprintln!("strata: interrupted: no output was written");
+        std::process::exit(130);
+    });
     let cli = match args::Cli::try_parse() {
         Ok(c) => c,
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version

@@ -2,9 +2,11 @@
 //! is stored under a key derived from everything that determines it and reused while that is
 //! unchanged.
 //!
-//! Each entry is `<key>.bin` (magic `STRATAREF1`, then width, height, channels as little-endian
-//! `u32`, then the float data as little-endian `f32`, bit-exact) and `<key>.txt` holding the
-//! description the key was derived from, for humans.
+//! Each entry is `<key>.bin` (magic `STRATAREF2` naming the format version, then width, height,
+//! channels as little-endian `u32`, the 64-bit FNV-1a checksum of the data, then the float data as
+//! little-endian `f32`, bit-exact) and `<key>.txt` holding the description the key was derived
+//! from, for humans. Both are written atomically. An entry that is truncated, corrupt (checksum)
+//! or of an older format version is reported and recomputed.
 
 use std::ffi::OsString;
 use std::fs;
@@ -13,8 +15,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use strata_scene::ImageBuf;
 
-const MAGIC: &[u8; 10] = b"STRATAREF1";
-const HEADER_LEN: usize = MAGIC.len() + 12;
+const MAGIC: &[u8; 10] = b"STRATAREF2";
+/// Magic + width, height, channels + checksum.
+const HEADER_LEN: usize = MAGIC.len() + 12 + 8;
 
 /// A directory of cached reference images.
 #[derive(Clone, Debug)]
@@ -94,14 +97,10 @@ impl RefCache {
             .with_context(|| format!("{}: cannot create the reference cache directory", self.dir.display()))?;
 
         let path = self.bin_path(key);
-        let tmp = self.dir.join(format!("{key}.bin.tmp{}", std::process::id()));
-        fs::write(&tmp, encode(img)).with_context(|| format!("{}: cannot write cache entry", tmp.display()))?;
-        if let Err(e) = fs::rename(&tmp, &path) {
-            let _ = fs::remove_file(&tmp);
-            return Err(e).with_context(|| format!("{}: cannot move cache entry into place", path.display()));
-        }
+        strata_scene::atomic::write(&path, &encode(img)).map_err(|e| anyhow::anyhow!("reference cache: {e}"))?;
         let txt = self.dir.join(format!("{key}.txt"));
-        fs::write(&txt, description).with_context(|| format!("{}: cannot write description", txt.display()))?;
+        strata_scene::atomic::write(&txt, description.as_bytes())
+            .map_err(|e| anyhow::anyhow!("reference cache: {e}"))?;
         Ok(path)
     }
 
@@ -145,9 +144,9 @@ fn encode(img: &ImageBuf) -> Vec<u8> {
     for v in [img.width, img.height, img.channels] {
         out.extend_from_slice(&v.to_le_bytes());
     }
-    for v in &img.data {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
+    let payload: Vec<u8> = img.data.iter().flat_map(|v| v.to_le_bytes()).collect();
+    out.extend_from_slice(&fnv1a64(&payload).to_le_bytes());
+    out.extend_from_slice(&payload);
     out
 }
 
@@ -158,8 +157,15 @@ fn decode(bytes: &[u8]) -> std::result::Result<ImageBuf, String> {
             bytes.len()
         ));
     }
+    if &bytes[..MAGIC.len() - 1] == b"STRATAREF" && bytes[MAGIC.len() - 1] != MAGIC[MAGIC.len() - 1] {
+        return Err(format!(
+            "format version {} is not the current {}",
+            bytes[MAGIC.len() - 1] as char,
+            MAGIC[MAGIC.len() - 1] as char
+        ));
+    }
     if &bytes[..MAGIC.len()] != MAGIC {
-        return Err("wrong magic: not a STRATAREF1 file".into());
+        return Err("wrong magic: not a STRATAREF file".into());
     }
     let u32_at = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
     let (width, height, channels) = (u32_at(10), u32_at(14), u32_at(18));
@@ -167,6 +173,7 @@ fn decode(bytes: &[u8]) -> std::result::Result<ImageBuf, String> {
         return Err(format!("{channels} channels: expected 1 to 4"));
     }
     let payload = &bytes[HEADER_LEN..];
+    let stored = u64::from_le_bytes(bytes[22..30].try_into().expect("8 bytes"));
     let count = (width as usize)
         .checked_mul(height as usize)
         .and_then(|n| n.checked_mul(channels as usize))
@@ -177,6 +184,9 @@ fn decode(bytes: &[u8]) -> std::result::Result<ImageBuf, String> {
                 payload.len()
             )
         })?;
+    if fnv1a64(payload) != stored {
+        return Err("checksum mismatch: the data is corrupt".into());
+    }
     let data = payload
         .chunks_exact(4)
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -273,6 +283,27 @@ mod tests {
         fs::write(&path, &huge).unwrap();
         assert!(cache.load(&key).is_none());
         fs::write(&path, &bytes).unwrap();
+        assert!(cache.load(&key).is_some());
+    }
+
+    #[test]
+    fn flipped_bits_and_old_format_versions_are_detected() {
+        let tmp = TempDir::new("checksum");
+        let cache = RefCache::new(&tmp.0);
+        let key = RefCache::key("y");
+        let path = cache.store(&key, &sample(), "y").unwrap();
+        let bytes = fs::read(&path).unwrap();
+        // same length, one bit of one float changed: only the checksum can tell
+        let mut flipped = bytes.clone();
+        *flipped.last_mut().unwrap() ^= 0x01;
+        assert!(decode(&flipped).unwrap_err().contains("checksum"));
+        fs::write(&path, &flipped).unwrap();
+        assert!(cache.load(&key).is_none());
+        let mut v1 = bytes.clone();
+        v1[9] = b'1';
+        assert!(decode(&v1).unwrap_err().contains("format version 1"));
+        // storing again repairs the entry
+        cache.store(&key, &sample(), "y").unwrap();
         assert!(cache.load(&key).is_some());
     }
 

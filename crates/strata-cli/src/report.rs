@@ -43,8 +43,8 @@ figcaption{font-size:90%;padding:2px 0}";
 pub fn write_report(dir: &Path, title: &str, sections: &[ReportSection], numbers: &Value) -> Result<PathBuf> {
     fs::create_dir_all(dir).with_context(|| format!("{}: cannot create the report directory", dir.display()))?;
     let path = dir.join("index.html");
-    fs::write(&path, render(title, sections, numbers))
-        .with_context(|| format!("{}: cannot write the report", path.display()))?;
+    strata_scene::atomic::write(&path, render(title, sections, numbers).as_bytes())
+        .map_err(|e| anyhow::anyhow!("cannot write the report: {e}"))?;
     Ok(path)
 }
 

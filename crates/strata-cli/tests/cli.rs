@@ -652,3 +652,108 @@ fn negative_vector_arguments_work_in_the_plain_form() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(out.exists());
 }
+
+/// Issue 16: a truncated cache entry is detected, reported, recomputed and
+/// rewritten; the run still succeeds with the same numbers.
+#[test]
+fn truncated_cache_entry_is_reported_and_recomputed() {
+    let cache = scratch("truncated-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let args = [
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        "ao",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--ref-spp",
+        "8",
+        "--json",
+        "--quiet",
+        "--cache",
+        cache.to_str().unwrap(),
+    ];
+    let v = json_of(&strata(&args));
+    let bins: Vec<PathBuf> = std::fs::read_dir(&cache)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "bin"))
+        .collect();
+    assert!(!bins.is_empty(), "nothing cached");
+    let sizes: Vec<u64> = bins.iter().map(|p| std::fs::metadata(p).unwrap().len()).collect();
+    for p in &bins {
+        let bytes = std::fs::read(p).unwrap();
+        std::fs::write(p, &bytes[..bytes.len() / 2]).unwrap();
+    }
+    let o = strata(&args);
+    let v2 = json_of(&o);
+    assert!(
+        stderr(&o).contains("corrupt"),
+        "the truncated entry is reported: {}",
+        stderr(&o)
+    );
+    assert_eq!(v["flip"], v2["flip"], "recomputed reference gives the same numbers");
+    for (p, size) in bins.iter().zip(sizes) {
+        assert_eq!(
+            std::fs::metadata(p).unwrap().len(),
+            size,
+            "{} rewritten whole",
+            p.display()
+        );
+    }
+}
+
+/// Issue 16: Ctrl-C (SIGINT) during `strata reference` leaves neither the output
+/// nor a temporary file, and exits non-zero; the same command then completes.
+#[test]
+fn interrupted_reference_leaves_no_partial_file() {
+    let dir = scratch("interrupted");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("gi.exr");
+    let run = |spp: &str| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
+        cmd.args([
+            "reference",
+            "--scene",
+            "cornell",
+            "--kind",
+            "gi",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--spp",
+            spp,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        cmd.stderr(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped());
+        cmd.spawn().unwrap()
+    };
+    let child = run("65536");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert!(!o.status.success(), "an interrupted run must not report success");
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(left.is_empty(), "interrupted run left {left:?}");
+    let o = run("1").wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, vec![std::ffi::OsString::from("gi.exr")]);
+}

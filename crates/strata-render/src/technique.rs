@@ -146,7 +146,7 @@ mod tests {
             assert!(registry()[..i].iter().all(|u| u.name != t.name), "duplicate {}", t.name);
             assert_eq!(find(t.name).unwrap().name, t.name);
         }
-        let e = find("nope").unwrap_err().to_string();
+        let e = find("nope").err().expect("unknown name").to_string();
         assert!(e.contains("direct") && e.contains("full"), "{e}");
     }
 

@@ -61,7 +61,8 @@ impl ImageBuf {
     }
 
     /// Writes by extension: `.png` (values clamped to [0, 1], sRGB-encoded unless
-    /// `srgb` is false) or `.exr` (linear float RGBA).
+    /// `srgb` is false) or `.exr` (linear float RGBA). Atomic: the file is encoded
+    /// beside `path` and renamed into place ([`crate::atomic`]).
     pub fn save(&self, path: &Path, srgb: bool) -> Result<(), String> {
         let ext = path
             .extension()
@@ -80,15 +81,19 @@ impl ImageBuf {
                     bytes.push((p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
                 }
                 let img = image::RgbaImage::from_raw(self.width, self.height, bytes).expect("size matches");
-                img.save(path)
-                    .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
+                crate::atomic::write_with(path, |tmp| {
+                    img.save(tmp)
+                        .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
+                })
             }
             Some("exr") => {
                 let px: Vec<f32> = self.to_rgba32().into_iter().flatten().collect();
                 let img = image::Rgba32FImage::from_raw(self.width, self.height, px).expect("size matches");
-                image::DynamicImage::ImageRgba32F(img)
-                    .save(path)
-                    .map_err(|e| format!("{}: cannot write EXR: {e}", path.display()))
+                let img = image::DynamicImage::ImageRgba32F(img);
+                crate::atomic::write_with(path, |tmp| {
+                    img.save(tmp)
+                        .map_err(|e| format!("{}: cannot write EXR: {e}", path.display()))
+                })
             }
             _ => Err(format!(
                 "{}: unsupported output format: use .png or .exr",

@@ -9,6 +9,7 @@
 //! - [`shapes`]: mesh builders (boxes, quads, cylinders, arches) for procedural scenes;
 //! - [`normals`]: smooth/flat normal generation.
 
+pub mod atomic;
 pub mod camera;
 pub mod error;
 pub mod files;
