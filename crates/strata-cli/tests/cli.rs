@@ -757,3 +757,27 @@ fn interrupted_reference_leaves_no_partial_file() {
         .collect();
     assert_eq!(left, vec![std::ffi::OsString::from("gi.exr")]);
 }
+
+/// Issue 16: a frame over the memory budget is a one-line error before anything
+/// is allocated, and no output is written.
+#[test]
+fn frame_over_the_memory_budget_is_refused() {
+    let out = scratch("huge.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "atrium",
+        "--technique",
+        "ao",
+        "--layers",
+        "4",
+        "--width",
+        "8192",
+        "--height",
+        "8192",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["width 8192", "layers 4", "STRATA_MEMORY_BUDGET_MB"]);
+    assert!(!out.exists());
+}

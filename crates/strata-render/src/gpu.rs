@@ -156,6 +156,13 @@ impl GpuContext {
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             sink.lock().unwrap_or_else(|p| p.into_inner()).push(e.to_string());
         }));
+        // A lost device (driver reset, destroyed) becomes an error of the next check, not a hang.
+        let lost = errors.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            lost.lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(format!("the GPU device was lost ({reason:?}): {message}"));
+        });
         Ok(Self {
             instance,
             adapter,

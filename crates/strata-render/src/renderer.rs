@@ -19,6 +19,39 @@ use crate::profiler::{PassTimings, Profiler};
 use crate::scene_gpu::GpuScene;
 use crate::RenderError;
 
+/// GPU memory strata may allocate for one renderer unless `STRATA_MEMORY_BUDGET_MB`
+/// says otherwise: 8 GiB (the estimate is checked before anything is allocated).
+pub const DEFAULT_MEMORY_BUDGET: u64 = 8 << 30;
+
+/// The memory budget in bytes: `STRATA_MEMORY_BUDGET_MB` (MiB, ≥ 1) or [`DEFAULT_MEMORY_BUDGET`].
+pub fn memory_budget() -> Result<u64, RenderError> {
+    match std::env::var("STRATA_MEMORY_BUDGET_MB") {
+        Err(_) => Ok(DEFAULT_MEMORY_BUDGET),
+        Ok(v) => match v.trim().parse::<u64>() {
+            Ok(mb) if mb >= 1 => Ok(mb << 20),
+            _ => Err(RenderError::Parameter(format!(
+                "STRATA_MEMORY_BUDGET_MB '{v}' is invalid: must be a whole number of MiB >= 1"
+            ))),
+        },
+    }
+}
+
+fn texel_bytes(f: wgpu::TextureFormat) -> u64 {
+    f.block_copy_size(None)
+        .or_else(|| f.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)))
+        .unwrap_or(16) as u64
+}
+
+fn desc_bytes(d: &crate::frame::TargetDesc, w: u32, h: u32) -> u64 {
+    let base = w as u64 * h as u64 * d.layers as u64 * texel_bytes(d.format);
+    // a full MIP chain adds at most a third
+    if d.mips > 1 {
+        base * 4 / 3
+    } else {
+        base
+    }
+}
+
 /// Smallest and largest accepted image sizes.
 pub const MIN_SIZE: u32 = 8;
 pub const MAX_SIZE: u32 = 8192;
@@ -171,6 +204,107 @@ impl RenderSettings {
         self.deep.validate()
     }
 
+    /// Upper bound of the GPU memory a renderer with these settings allocates for
+    /// `scene`, in bytes: every screen target (exactly where the pass declares its
+    /// list, a documented bound for targets a stage creates internally: AO ≤ 24,
+    /// radiosity ≤ 48 bytes per pixel), the shadow maps, and the scene's vertex,
+    /// index and texture data.
+    pub fn estimated_bytes(&self, scene: &Scene) -> u64 {
+        use crate::frame::TargetDesc;
+        let (w, h) = self.internal_size();
+        let px = w as u64 * h as u64;
+        let sum = |ds: &[TargetDesc]| ds.iter().map(|d| desc_bytes(d, w, h)).sum::<u64>();
+        let mut bytes = sum(&self.deep.outputs());
+        if !self.deep.uses_history() {
+            // csz-history, when only a temporal filter keeps it
+            bytes += px * self.deep.array_layers() as u64 * 4;
+        }
+        if self.shade {
+            bytes += sum(crate::passes::lighting::OUTPUTS) + sum(crate::passes::tonemap::OUTPUTS);
+            let lights = gpu_lights(scene, 0.0, self.shadow.resolution);
+            let maps = crate::lights::shadow_layer_count(&lights).max(1) as u64;
+            bytes += maps * (self.shadow.resolution as u64).pow(2) * 4;
+        }
+        let levels = [
+            self.ao.as_ref().map(|a| a.mips.levels),
+            self.radiosity.as_ref().map(|r| r.mips.levels),
+        ]
+        .into_iter()
+        .flatten()
+        .max();
+        if let Some(levels) = levels {
+            bytes += desc_bytes(&DepthMipSettings { levels }.output(self.deep.layers, w, h), w, h);
+        }
+        if self.ao.is_some() {
+            bytes += px * 24;
+        }
+        if self.radiosity.is_some() {
+            bytes += sum(&crate::passes::radiosity::OUTPUTS)
+                + sum(&crate::passes::radiosity::BOUNCE_OUTPUTS)
+                + sum(&crate::passes::compose::OUTPUTS)
+                + px * 48;
+        }
+        if self.reflections.is_some() {
+            bytes += sum(&crate::passes::reflections::OUTPUTS);
+        }
+        let geometry: u64 = scene
+            .meshes
+            .iter()
+            .map(|m| m.positions.len() as u64 * 32 + m.indices.len() as u64 * 4)
+            .sum();
+        let textures: u64 = scene
+            .textures
+            .iter()
+            .map(|t| t.width as u64 * t.height as u64 * 4 * 4 / 3)
+            .sum();
+        bytes + geometry + textures
+    }
+
+    /// Checks the settings against the adapter's limits and the memory budget,
+    /// before anything is allocated; errors name the parameters and the limit.
+    pub fn check_resources(&self, gpu: &GpuContext, scene: &Scene) -> Result<(), RenderError> {
+        let limits = gpu.device.limits();
+        let (w, h) = self.internal_size();
+        let max = limits.max_texture_dimension_2d;
+        if w > max || h > max {
+            return Err(RenderError::Parameter(format!(
+                "rendered size {w}x{h} (width, height and guard band) exceeds the adapter's largest texture, {max}x{max}"
+            )));
+        }
+        if self.deep.array_layers() > limits.max_texture_array_layers {
+            return Err(RenderError::Parameter(format!(
+                "layers {} exceed the adapter's {} texture array layers",
+                self.deep.array_layers(),
+                limits.max_texture_array_layers
+            )));
+        }
+        if self.shade {
+            let lights = gpu_lights(scene, 0.0, self.shadow.resolution);
+            let maps = crate::lights::shadow_layer_count(&lights) as u32;
+            if maps > limits.max_texture_array_layers {
+                return Err(RenderError::Parameter(format!(
+                    "scene '{}' needs {maps} shadow maps: more than the adapter's {} texture array layers",
+                    scene.name, limits.max_texture_array_layers
+                )));
+            }
+        }
+        let budget = memory_budget()?;
+        let need = self.estimated_bytes(scene);
+        if need > budget {
+            return Err(RenderError::Parameter(format!(
+                "width {} x height {} x layers {} needs about {} MiB of GPU memory for scene '{}', over the budget of {} MiB \
+                 (lower the size or layers, or raise STRATA_MEMORY_BUDGET_MB)",
+                self.width,
+                self.height,
+                self.deep.layers,
+                need >> 20,
+                scene.name,
+                budget >> 20
+            )));
+        }
+        Ok(())
+    }
+
     /// Guard-band pixels per side.
     pub fn guard_pixels(&self) -> u32 {
         self.guard_band.pixels(self.height)
@@ -220,6 +354,7 @@ impl Renderer {
                 scene.name
             )));
         }
+        settings.check_resources(gpu, scene)?;
         let scene_gpu = GpuScene::new(gpu, scene);
         let (w, h) = settings.internal_size();
         let mut targets = Targets::new(w, h);
