@@ -7,8 +7,8 @@ source scripts/setup.sh
 OUT="${OUT:-out/demo}"
 W="${W:-640}"; H="${H:-360}"
 mkdir -p "$OUT"
-echo "[strata demo] building the strata CLI (release)" >&2
-cargo build --release -q -p strata-cli
+echo "[strata demo] building strata (release; the first build takes about 3 min on 2 idle cores, up to 10 min when busy)" >&2
+cargo build --release -p strata-cli
 S=target/release/strata
 echo "[strata demo] device:" >&2
 $S info | tee "$OUT/info.txt"
