@@ -35,6 +35,8 @@ pub enum Command {
     Reference(ReferenceArgs),
     /// GPU timestamp benchmarks (per-pass milliseconds).
     Bench(BenchArgs),
+    /// The registered techniques with their outputs, presets and settings (defaults, ranges).
+    Techniques(TechniquesArgs),
     /// Render many frames along the camera path and sample resident memory and wgpu's allocations (JSON).
     Soak(SoakArgs),
     /// Compare a GPU technique with the CPU ground truth for the same camera (FLIP, RMSE, MAE; JSON; HTML report).
@@ -115,22 +117,16 @@ impl DeepArgs {
     }
 }
 
+fn parse_technique(s: &str) -> Result<&'static strata_render::technique::Technique, String> {
+    strata_render::technique::find(s).map_err(|e| e.to_string())
+}
+
 fn parse_variant(s: &str) -> Result<Variant, String> {
     s.parse()
 }
 
 fn parse_guard_band(s: &str) -> Result<GuardBand, String> {
     s.parse()
-}
-
-#[derive(Copy, Clone, PartialEq, Eq, ValueEnum, Debug)]
-pub enum Technique {
-    /// Direct light (sun/point/spot/area, shadows) + emission + ambient.
-    Direct,
-    /// Deep-G-buffer ambient visibility AV in [0, 1] (DGB §3.1; 1 = unoccluded): PNG grey (byte = 255·AV), EXR linear.
-    Ao,
-    /// Direct light + deep-G-buffer radiosity (DGB §3.2–3.3) + mirror reflections (§3.6): the composed image.
-    Full,
 }
 
 /// Deep-G-buffer radiosity settings (DGB §3.2–3.5): a Table 2 preset, then overrides.
@@ -376,9 +372,9 @@ pub struct FrameArgs {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub gpu: GpuArgs,
-    /// Shading technique.
-    #[arg(long, value_enum, default_value_t = Technique::Direct)]
-    pub technique: Technique,
+    /// Shading technique (`strata techniques` lists them with their settings).
+    #[arg(long, default_value = "direct", value_parser = parse_technique)]
+    pub technique: &'static strata_render::technique::Technique,
     #[command(flatten)]
     pub deep: DeepArgs,
     #[command(flatten)]
@@ -395,6 +391,17 @@ pub struct FrameArgs {
     /// path tracer and cached in $STRATA_CACHE).
     #[arg(long)]
     pub no_probes: bool,
+    /// Any registered setting of the technique, NAME=VALUE, applied last (repeatable;
+    /// `strata techniques` lists the names and ranges).
+    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    pub set: Vec<String>,
+}
+
+#[derive(Args)]
+pub struct TechniquesArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `strata soak`: a long run along the camera path that samples memory.

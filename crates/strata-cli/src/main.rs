@@ -15,10 +15,18 @@ mod reference;
 mod render;
 mod report;
 mod soak;
+mod techniques;
 
 use clap::Parser;
 
 fn main() {
+    // Output piped into `head` and closed early: end quietly like other command-line
+    // tools instead of panicking on the broken pipe.
+    #[cfg(unix)]
+    // SAFETY: restores the default action of one signal before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     tracing_subscriber::fmt()
         .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG").unwrap_or_else(|_| "warn".into()))
         .with_writer(std::io::stderr)
@@ -50,6 +58,7 @@ fn main() {
         args::Command::Reference(a) => reference::run(&a),
         args::Command::Bench(a) => bench::run(&a),
         args::Command::Soak(a) => soak::run(&a),
+        args::Command::Techniques(a) => techniques::run(&a),
         args::Command::Eval(a) => eval::run(&a),
     };
     if let Err(e) = result {

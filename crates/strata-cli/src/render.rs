@@ -6,26 +6,14 @@ use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_render::frame::FrameCameras;
 use strata_scene::Scene;
 
-use crate::args::{FrameArgs, RenderArgs, Technique};
+use crate::args::{FrameArgs, RenderArgs};
 use crate::output::{cameras_at, check_output, save, scene_and_camera};
 
 /// The scene, its cameras and the render settings that `f` asks for (validated).
 pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
     let (scene, cams) = scene_and_camera(&f.scene)?;
-    let radiosity = match f.technique {
-        Technique::Full => Some(f.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?),
-        _ => None,
-    };
-    // the full image: radiosity blended with baked light probes (modulated by AO), reflections
-    let probes = match f.technique {
-        Technique::Full if !f.no_probes => Some(crate::probes::scene_probes(
-            &scene,
-            &crate::ref_cache::RefCache::new(crate::ref_cache::RefCache::default_dir()),
-            false,
-        )?),
-        _ => None,
-    };
-    let settings = RenderSettings {
+    let t = f.technique;
+    let base = RenderSettings {
         width: f.scene.width,
         height: f.scene.height,
         deep: f.deep.settings(),
@@ -34,14 +22,37 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
             resolution: f.shadow_resolution,
         },
         exposure: f.exposure,
-        // AO alone needs no lighting passes
-        shade: f.technique != Technique::Ao,
-        ao: (f.technique != Technique::Direct).then(|| f.ao.settings()),
-        probes,
-        reflections: (f.technique == Technique::Full).then(Default::default),
-        radiosity,
+        ao: Some(f.ao.settings()),
         ..Default::default()
     };
+    let preset = (!t.presets.is_empty()).then_some(f.radiosity.preset.as_str());
+    // configure fails only on an unknown preset
+    let mut settings = t
+        .settings(&base, preset)
+        .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
+    if settings.radiosity.is_some() {
+        // the preset, then the radiosity flags
+        settings.radiosity = Some(f.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?);
+        // blended with baked light probes (modulated by AO)
+        if !f.no_probes {
+            settings.probes = Some(crate::probes::scene_probes(
+                &scene,
+                &crate::ref_cache::RefCache::new(crate::ref_cache::RefCache::default_dir()),
+                false,
+            )?);
+        }
+    }
+    for kv in &f.set {
+        let (name, value) = kv
+            .split_once('=')
+            .ok_or_else(|| anyhow::anyhow!("--set {kv}: expected NAME=VALUE (e.g. --set samples=32)"))?;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--set {kv}: '{value}' is not a number"))?;
+        t.set(&mut settings, name.trim(), v)
+            .map_err(|e| anyhow::anyhow!("--set {kv}: {e}"))?;
+    }
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok((scene, cams, settings))
 }
@@ -57,7 +68,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     })?;
     let mut r = Renderer::new(&gpu, &scene, settings)?;
     if a.list_passes {
-        println!("frame of '{}' ({:?}):", scene.name, f.technique);
+        println!("frame of '{}' ({}):", scene.name, f.technique.name);
         for p in r.pass_infos() {
             println!(
                 "  {:<12} reads [{}] writes [{}]",
@@ -87,14 +98,14 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         r.render(&gpu, &scene, &cameras_at(&scene, &f.scene, t), t)?;
     }
     let t = r.render(&gpu, &scene, &cams, f.scene.frame)?;
-    let (img, srgb) = match (&a.debug_view, f.technique, exr) {
-        (Some(v), _, _) => (r.debug_view(&gpu, v, exr)?, true),
-        // AV itself: PNG byte = 255·AV (no transfer function), EXR linear
-        (None, Technique::Ao, _) => (r.read_target(&gpu, "ao")?, false),
-        (None, Technique::Direct, true) => (r.read_target(&gpu, "hdr")?, true),
-        (None, Technique::Full, true) => (r.read_target(&gpu, "hdr-reflected")?, true),
-        (None, _, false) => (r.read_target(&gpu, "ldr")?, true),
+    let (img, srgb) = match (&a.debug_view, exr) {
+        (Some(v), _) => (r.debug_view(&gpu, v, exr)?, true),
+        // EXR: the linear result
+        (None, true) => (r.read_target(&gpu, f.technique.output)?, true),
+        // PNG: tonemapped sRGB, or raw values (AO: byte = 255·AV)
+        (None, false) => (r.read_target(&gpu, f.technique.display.0)?, f.technique.display.1),
     };
+
     // ldr/albedo are already linear after read-back decode; PNG re-encodes sRGB.
     save(&img, out, srgb)?;
     if a.timings {

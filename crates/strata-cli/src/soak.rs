@@ -82,7 +82,7 @@ pub fn run(a: &SoakArgs) -> Result<()> {
     if a.json {
         let v = serde_json::json!({
             "scene": scene.name,
-            "technique": format!("{:?}", f.technique).to_lowercase(),
+            "technique": f.technique.name,
             "layers": r.settings.deep.layers,
             "variant": r.settings.deep.variant.name(),
             "width": f.scene.width,

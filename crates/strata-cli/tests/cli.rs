@@ -781,3 +781,77 @@ fn frame_over_the_memory_budget_is_refused() {
     assert_one_line_error(&o, &["width 8192", "layers 4", "STRATA_MEMORY_BUDGET_MB"]);
     assert!(!out.exists());
 }
+
+/// Issue 9: `strata techniques --json` lists every registered technique with its
+/// settings, defaults and ranges; every listed setting is settable with `--set`
+/// and its range is enforced there with a one-line error.
+#[test]
+fn techniques_json_lists_settings_defaults_and_ranges() {
+    let v = json_of(&strata(&["techniques", "--json"]));
+    let ts = v["techniques"].as_array().expect("techniques");
+    let names: Vec<&str> = ts.iter().map(|t| t["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["direct", "ao", "full"]);
+    let full = &ts[2];
+    assert_eq!(
+        full["presets"],
+        serde_json::json!(["balanced", "high-performance", "high-quality"])
+    );
+    for t in ts {
+        let settings = t["settings"].as_array().unwrap();
+        assert!(!settings.is_empty(), "{} lists no settings", t["name"]);
+        for s in settings {
+            assert!(s["doc"].as_str().is_some_and(|d| !d.is_empty()), "{s}");
+            assert!(s["range"]["text"].as_str().is_some(), "{s}");
+            assert!(s["default"].is_number() || s["default"].is_null(), "{s}");
+            if let (Some(d), Some(min)) = (s["default"].as_f64(), s["range"]["min"].as_f64()) {
+                assert!(d >= min, "default below range: {s}");
+            }
+        }
+    }
+    let ao = &ts[1]["settings"];
+    let samples = ao.as_array().unwrap().iter().find(|s| s["name"] == "samples").unwrap();
+    assert_eq!(samples["default"], 19.0);
+    assert_eq!(samples["range"]["text"], "1..=256");
+    // --set applies a registered setting, and enforces its range in one line
+    let out = scratch("set-samples.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--technique",
+        "ao",
+        "--set",
+        "samples=8",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = strata(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--technique",
+        "full",
+        "--set",
+        "reflection-steps=0",
+        "--out",
+        "x.png",
+    ]);
+    assert_one_line_error(&o, &["reflection-steps", "1..=1024"]);
+    let o = strata(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--technique",
+        "direct",
+        "--set",
+        "samples=8",
+        "--out",
+        "x.png",
+    ]);
+    assert_one_line_error(&o, &["samples", "valid settings are"]);
+}

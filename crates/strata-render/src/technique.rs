@@ -27,16 +27,287 @@ impl EvalKind {
     }
 }
 
+/// The valid values of a numeric setting.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Range {
+    /// a..=b
+    Closed(f64, f64),
+    /// [a, b)
+    HalfOpen(f64, f64),
+    /// ≥ a
+    AtLeast(f64),
+    /// > a
+    Above(f64),
+}
+
+impl Range {
+    pub fn contains(self, v: f64) -> bool {
+        match self {
+            Range::Closed(a, b) => (a..=b).contains(&v),
+            Range::HalfOpen(a, b) => (a..b).contains(&v),
+            Range::AtLeast(a) => v >= a && v.is_finite(),
+            Range::Above(a) => v > a && v.is_finite(),
+        }
+    }
+}
+
+impl std::fmt::Display for Range {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Range::Closed(a, b) => write!(f, "{a}..={b}"),
+            Range::HalfOpen(a, b) => write!(f, "[{a}, {b})"),
+            Range::AtLeast(a) => write!(f, ">= {a}"),
+            Range::Above(a) => write!(f, "> {a}"),
+        }
+    }
+}
+
+/// One numeric setting of a technique, as `strata techniques` lists it and a
+/// viewer edits it. `name` is the CLI flag without `--`; `get` returns `None`
+/// where the value comes from the scene (e.g. the AO radius). The declared
+/// range is the one `RenderSettings::validate` enforces (a test checks both ends).
+pub struct SettingInfo {
+    pub name: &'static str,
+    pub doc: &'static str,
+    pub range: Range,
+    /// Whole numbers only.
+    pub integer: bool,
+    pub get: fn(&RenderSettings) -> Option<f64>,
+    pub set: fn(&mut RenderSettings, f64),
+}
+
+macro_rules! setting {
+    ($name:literal, $doc:literal, $range:expr, $int:literal, |$s:ident| $get:expr, |$t:ident, $v:ident| $set:expr) => {
+        SettingInfo {
+            name: $name,
+            doc: $doc,
+            range: $range,
+            integer: $int,
+            get: |$s: &RenderSettings| $get,
+            set: |$t: &mut RenderSettings, $v: f64| $set,
+        }
+    };
+}
+
+fn ao_mut(s: &mut RenderSettings) -> &mut AoSettings {
+    s.ao.get_or_insert_with(AoSettings::default)
+}
+
+fn ao_of(s: &RenderSettings) -> AoSettings {
+    s.ao.clone().unwrap_or_default()
+}
+
+fn radiosity_mut(s: &mut RenderSettings) -> &mut radiosity::RadiositySettings {
+    s.radiosity.get_or_insert_with(Default::default)
+}
+
+fn radiosity_of(s: &RenderSettings) -> radiosity::RadiositySettings {
+    s.radiosity.clone().unwrap_or_default()
+}
+
+static DIRECT_SETTINGS: [SettingInfo; 2] = [
+    setting!(
+        "shadow-resolution",
+        "shadow map resolution per light",
+        Range::Closed(64.0, 8192.0),
+        true,
+        |s| Some(s.shadow.resolution as f64),
+        |s, v| s.shadow.resolution = v as u32
+    ),
+    setting!(
+        "exposure",
+        "exposure multiplier before tonemapping (default: the scene's)",
+        Range::Above(0.0),
+        false,
+        |s| s.exposure.map(f64::from),
+        |s, v| s.exposure = Some(v as f32)
+    ),
+];
+
+static AO_SETTINGS: [SettingInfo; 10] = [
+    setting!(
+        "ao-radius",
+        "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
+        Range::Above(0.0),
+        false,
+        |s| ao_of(s).radius.map(f64::from),
+        |s, v| ao_mut(s).radius = Some(v as f32)
+    ),
+    setting!(
+        "ao-bias",
+        "bias β in scene units (default 0.01·r)",
+        Range::AtLeast(0.0),
+        false,
+        |s| ao_of(s).bias.map(f64::from),
+        |s, v| ao_mut(s).bias = Some(v as f32)
+    ),
+    setting!(
+        "ao-intensity",
+        "multiplies the sum in DGB Eq. 1",
+        Range::AtLeast(0.0),
+        false,
+        |s| Some(ao_of(s).intensity as f64),
+        |s, v| ao_mut(s).intensity = v as f32
+    ),
+    setting!(
+        "samples",
+        "AO taps N per pixel (τ from DGB Listing 3 for N <= 98)",
+        Range::Closed(1.0, 256.0),
+        true,
+        |s| Some(ao_of(s).samples as f64),
+        |s, v| ao_mut(s).samples = v as u32
+    ),
+    setting!(
+        "alpha",
+        "temporal filter weight α of the history (DGB §3.3; 0 = off)",
+        Range::HalfOpen(0.0, 1.0),
+        false,
+        |s| Some(ao_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
+        |s, v| {
+            let a = ao_mut(s);
+            a.temporal = if v == 0.0 {
+                None
+            } else {
+                Some(crate::passes::temporal::TemporalSettings {
+                    alpha: v as f32,
+                    ..a.temporal.unwrap_or_default()
+                })
+            }
+        }
+    ),
+    setting!(
+        "temporal-distance",
+        "reprojection accepted within this distance of either layer (scene units)",
+        Range::Above(0.0),
+        false,
+        |s| Some(ao_of(s).temporal.unwrap_or_default().max_distance as f64),
+        |s, v| {
+            let a = ao_mut(s);
+            let mut t = a.temporal.unwrap_or_default();
+            t.max_distance = v as f32;
+            a.temporal = Some(t)
+        }
+    ),
+    setting!(
+        "blur-radius",
+        "bilateral taps on each side (0 = none)",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(ao_of(s).blur.radius as f64),
+        |s, v| ao_mut(s).blur.radius = v as u32
+    ),
+    setting!(
+        "blur-step",
+        "pixels between bilateral taps",
+        Range::Closed(1.0, 8.0),
+        true,
+        |s| Some(ao_of(s).blur.step as f64),
+        |s, v| ao_mut(s).blur.step = v as u32
+    ),
+    setting!(
+        "mip-levels",
+        "depth MIP levels",
+        Range::Closed(1.0, crate::passes::depth_mip::MAX_LEVELS as f64),
+        true,
+        |s| Some(ao_of(s).mips.levels as f64),
+        |s, v| ao_mut(s).mips.levels = v as u32
+    ),
+    setting!(
+        "mip-q",
+        "tap radius q in pixels at which the MIP level first increments (DGB §3.4)",
+        Range::AtLeast(1.0),
+        false,
+        |s| Some(ao_of(s).q as f64),
+        |s, v| ao_mut(s).q = v as f32
+    ),
+];
+
+static RADIOSITY_SETTINGS: [SettingInfo; 7] = [
+    setting!(
+        "indirect-samples",
+        "radiosity taps N per pixel (DGB Eq. 4-5; default: the preset's)",
+        Range::Closed(1.0, 256.0),
+        true,
+        |s| Some(radiosity_of(s).samples as f64),
+        |s, v| radiosity_mut(s).samples = v as u32
+    ),
+    setting!(
+        "radiosity-radius",
+        "world-space gather radius (default: the scene's radiosity_radius)",
+        Range::Above(0.0),
+        false,
+        |s| radiosity_of(s).radius.map(f64::from),
+        |s, v| radiosity_mut(s).radius = Some(v as f32)
+    ),
+    setting!(
+        "indirect-blur-radius",
+        "bilateral taps on each side for the indirect light",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(radiosity_of(s).blur.radius as f64),
+        |s, v| radiosity_mut(s).blur.radius = v as u32
+    ),
+    setting!(
+        "indirect-alpha",
+        "temporal filter weight α of the indirect light (0 = off)",
+        Range::HalfOpen(0.0, 1.0),
+        false,
+        |s| Some(radiosity_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
+        |s, v| {
+            let r = radiosity_mut(s);
+            r.temporal = if v == 0.0 {
+                None
+            } else {
+                Some(crate::passes::temporal::TemporalSettings {
+                    alpha: v as f32,
+                    ..r.temporal.unwrap_or_default()
+                })
+            }
+        }
+    ),
+    setting!(
+        "delta",
+        "progressive multi-bounce damping δ (DGB §3.3; 0 = single bounce)",
+        Range::Closed(0.0, 1.0),
+        false,
+        |s| Some(radiosity_of(s).delta as f64),
+        |s, v| radiosity_mut(s).delta = v as f32
+    ),
+    setting!(
+        "reflection-distance",
+        "mirror ray-march length in scene units (DGB §3.6)",
+        Range::Above(0.0),
+        false,
+        |s| Some(s.reflections.unwrap_or_default().max_distance as f64),
+        |s, v| s
+            .reflections
+            .get_or_insert_with(ReflectionSettings::default)
+            .max_distance = v as f32
+    ),
+    setting!(
+        "reflection-steps",
+        "mirror ray-march steps",
+        Range::Closed(1.0, 1024.0),
+        true,
+        |s| Some(s.reflections.unwrap_or_default().steps as f64),
+        |s, v| s.reflections.get_or_insert_with(ReflectionSettings::default).steps = v as u32
+    ),
+];
+
 /// One registered technique.
 pub struct Technique {
     pub name: &'static str,
     /// One line: what it renders and from which paper section.
     pub doc: &'static str,
-    /// The target holding the technique's image.
+    /// The target holding the technique's linear result (EXR output, `eval`).
     pub output: &'static str,
+    /// The target a PNG shows, and whether it is sRGB-encoded (false: raw values, e.g. AV).
+    pub display: (&'static str, bool),
     pub eval: EvalKind,
     /// Named parameter sets (the first is the default); empty when it has none.
     pub presets: &'static [&'static str],
+    /// Its numeric settings, in groups (e.g. `full` = direct's + AO's + its own).
+    pub settings: &'static [&'static [SettingInfo]],
     /// Turns `s` into this technique's settings with `preset` (`None`: the default
     /// preset). The caller keeps size, layers, variant and guard band; light probes
     /// (baked on the CPU) stay the caller's to add.
@@ -44,6 +315,33 @@ pub struct Technique {
 }
 
 impl Technique {
+    /// Every setting of this technique.
+    pub fn setting_list(&self) -> impl Iterator<Item = &'static SettingInfo> {
+        self.settings.iter().flat_map(|g| g.iter())
+    }
+
+    /// Sets setting `name` to `value` after checking its range; the error names
+    /// the setting and its valid range.
+    pub fn set(&self, s: &mut RenderSettings, name: &str, value: f64) -> Result<(), RenderError> {
+        let info = self.setting_list().find(|i| i.name == name).ok_or_else(|| {
+            let names: Vec<_> = self.setting_list().map(|i| i.name).collect();
+            RenderError::Parameter(format!(
+                "technique '{}' has no setting '{name}': valid settings are {}",
+                self.name,
+                names.join(", ")
+            ))
+        })?;
+        if !info.range.contains(value) || (info.integer && value.fract() != 0.0) {
+            return Err(RenderError::Parameter(format!(
+                "{name} {value} is out of range: must be {}{}",
+                if info.integer { "a whole number in " } else { "" },
+                info.range
+            )));
+        }
+        (info.set)(s, value);
+        Ok(())
+    }
+
     /// Settings for this technique on top of `base`.
     pub fn settings(&self, base: &RenderSettings, preset: Option<&str>) -> Result<RenderSettings, RenderError> {
         let mut s = base.clone();
@@ -97,25 +395,31 @@ static REGISTRY: [Technique; 3] = [
     Technique {
         name: "direct",
         doc: "direct light (shadowed sun, point, spot, rect) and emission from G-buffer layer 0, tonemapped",
-        output: "ldr",
+        output: "hdr",
+        display: ("ldr", true),
         eval: EvalKind::None,
         presets: &[],
+        settings: &[&DIRECT_SETTINGS],
         configure: configure_direct,
     },
     Technique {
         name: "ao",
         doc: "deep-G-buffer ambient obscurance over every layer (DGB §3.1, Eq. 1-2), temporal + bilateral filtered",
         output: "ao",
+        display: ("ao", false),
         eval: EvalKind::AmbientVisibility,
         presets: &[],
+        settings: &[&AO_SETTINGS],
         configure: configure_ao,
     },
     Technique {
         name: "full",
         doc: "direct + deep-G-buffer radiosity (DGB §3.2-3.3) + light probes + AO + mirror reflections (§3.6)",
         output: "hdr-reflected",
+        display: ("ldr", true),
         eval: EvalKind::Radiance,
         presets: FULL_PRESETS,
+        settings: &[&DIRECT_SETTINGS, &AO_SETTINGS, &RADIOSITY_SETTINGS],
         configure: configure_full,
     },
 ];
@@ -169,6 +473,80 @@ mod tests {
                 t.name
             );
         }
+    }
+
+    /// The declared ranges are the validated ones: each end inside validates,
+    /// each end outside fails `RenderSettings::validate` (where the type can hold it).
+    #[test]
+    fn declared_ranges_match_validation() {
+        let base = RenderSettings::default();
+        for t in registry() {
+            let defaults = t.settings(&base, None).unwrap();
+            for info in t.setting_list() {
+                let check = |v: f64, valid: bool| {
+                    let mut s = defaults.clone();
+                    (info.set)(&mut s, v);
+                    let r = s.validate();
+                    assert_eq!(
+                        r.is_ok(),
+                        valid,
+                        "{} {}: {v} ({}): {r:?}",
+                        t.name,
+                        info.name,
+                        info.range
+                    );
+                    if valid {
+                        assert_eq!(
+                            (info.get)(&s),
+                            Some(v as f32 as f64),
+                            "{} {} reads back",
+                            t.name,
+                            info.name
+                        );
+                    }
+                };
+                let step = if info.integer { 1.0 } else { 1e-3 };
+                match info.range {
+                    Range::Closed(a, b) => {
+                        check(a, true);
+                        check(b, true);
+                        check(b + step, false);
+                        if a - step >= 0.0 || !info.integer {
+                            check(a - step, false);
+                        }
+                    }
+                    Range::HalfOpen(a, b) => {
+                        check(a, true);
+                        check(b - step, true);
+                        check(b, false);
+                        check(a - step, false);
+                    }
+                    Range::AtLeast(a) => {
+                        check(a, true);
+                        check(a - step, false);
+                    }
+                    Range::Above(a) => {
+                        check(a + step, true);
+                        check(a, false);
+                    }
+                }
+                assert!(!info.doc.is_empty());
+            }
+        }
+    }
+
+    #[test]
+    fn set_checks_the_range_and_names_it() {
+        let t = find("ao").unwrap();
+        let mut s = t.settings(&RenderSettings::default(), None).unwrap();
+        t.set(&mut s, "samples", 32.0).unwrap();
+        assert_eq!(s.ao.as_ref().unwrap().samples, 32);
+        let e = t.set(&mut s, "samples", 300.0).unwrap_err().to_string();
+        assert!(e.contains("samples") && e.contains("1..=256"), "{e}");
+        let e = t.set(&mut s, "samples", 2.5).unwrap_err().to_string();
+        assert!(e.contains("whole number"), "{e}");
+        let e = t.set(&mut s, "nope", 1.0).unwrap_err().to_string();
+        assert!(e.contains("valid settings are") && e.contains("ao-radius"), "{e}");
     }
 
     #[test]
