@@ -2,6 +2,7 @@
 
 pub mod ao;
 pub mod bilateral;
+pub(crate) mod builder;
 pub mod compose;
 pub mod deep_gbuffer;
 pub mod depth_mip;

@@ -4,6 +4,7 @@
 
 pub(crate) mod stage;
 
+use crate::passes::builder::{FullscreenPass, PassBuilder};
 use glam::Vec3;
 use strata_scene::{ImageBuf, Scene};
 
@@ -169,57 +170,30 @@ pub const OUTPUT: TargetDesc = TargetDesc::new(
 );
 
 pub struct AoPass {
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    uniforms: wgpu::Buffer,
+    pass: FullscreenPass,
     last: std::cell::Cell<AoUniforms>,
 }
 
 impl AoPass {
     pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32) -> Self {
-        use crate::passes::{texture_entry, uniform_entry};
-        let device = &gpu.device;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ao"),
-            entries: &[
-                uniform_entry(0),
-                texture_entry(1, wgpu::TextureViewDimension::D2, false),
-                texture_entry(2, wgpu::TextureViewDimension::D2, false),
-            ],
-        });
         let zeroed = AoUniforms::zeroed();
-        let uniforms = crate::passes::uniform_buffer(device, "ao", &zeroed);
-        let group = crate::passes::bind_group(
-            device,
-            "ao",
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&targets.get("zmip").view),
-                wgpu::BindingResource::TextureView(&targets.get("npack").view),
-            ],
-        );
-        let pl = crate::passes::frame_pipeline_layout(device, "ao", scene, &[&layout]);
-        let module = crate::shader::module(device, "ao", include_str!("ao.wgsl"));
-        let pipeline = crate::passes::fullscreen_pipeline_with(
-            device,
-            "ao",
-            &pl,
-            &module,
-            "fs_main",
-            &[("LAYERS", layers as f64)],
-            &[Some(wgpu::ColorTargetState::from(OUTPUT.format))],
-        );
+        let pass = PassBuilder::new(gpu, targets, "ao")
+            .shader("ao", include_str!("ao.wgsl"))
+            .constant("LAYERS", layers as f64)
+            .frame(scene)
+            .uniforms(&zeroed)
+            .read("zmip")
+            .read("npack")
+            .write(OUTPUT.name)
+            .build();
         Self {
-            pipeline,
-            group,
-            uniforms,
+            pass,
             last: std::cell::Cell::new(zeroed),
         }
     }
 
     pub fn set_frame(&self, gpu: &GpuContext, u: AoUniforms) {
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.pass.set_uniforms(gpu, &u);
         self.last.set(u);
     }
 
@@ -233,21 +207,11 @@ use bytemuck::Zeroable;
 
 impl Pass for AoPass {
     fn info(&self) -> PassInfo {
-        PassInfo {
-            name: "ao",
-            inputs: vec!["zmip", "npack"],
-            outputs: vec![OUTPUT.name],
-        }
+        self.pass.info()
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        crate::passes::fullscreen_pass(
-            encoder,
-            "ao",
-            &self.pipeline,
-            &[&targets.get(OUTPUT.name).view],
-            &[&scene.frame_bind_group, &self.group],
-        );
+        self.pass.encode(scene, targets, encoder);
     }
 }
 

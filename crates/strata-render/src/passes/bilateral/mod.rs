@@ -4,6 +4,7 @@
 
 use crate::frame::{Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
+use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
 
 /// Defaults: radius 4 taps with step 2 pixels (SAO's AO blur: 9 taps spanning
@@ -92,11 +93,7 @@ impl BilateralUniforms {
 
 /// One direction of the separable filter, from target `input` into `output`.
 pub struct BilateralPass {
-    name: &'static str,
-    input: &'static str,
-    output: &'static str,
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
+    pass: FullscreenPass,
 }
 
 impl BilateralPass {
@@ -112,67 +109,26 @@ impl BilateralPass {
         output: &'static str,
         vertical: bool,
     ) -> Self {
-        use crate::passes::{texture_entry, uniform_entry};
-        let device = &gpu.device;
-        let d2 = wgpu::TextureViewDimension::D2;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(name),
-            entries: &[
-                uniform_entry(0),
-                texture_entry(1, d2, false),
-                texture_entry(2, d2, false),
-                texture_entry(3, d2, false),
-            ],
-        });
-        let uniforms = crate::passes::uniform_buffer(device, name, &BilateralUniforms::new(settings));
-        let group = crate::passes::bind_group(
-            device,
-            name,
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&targets.get(input).view),
-                wgpu::BindingResource::TextureView(&targets.get("zpack").view),
-                wgpu::BindingResource::TextureView(&targets.get("npack").view),
-            ],
-        );
-        let pl = crate::passes::frame_pipeline_layout(device, name, scene, &[&layout]);
-        let module = crate::shader::module(device, "bilateral", include_str!("bilateral.wgsl"));
-        let pipeline = crate::passes::fullscreen_pipeline_with(
-            device,
-            name,
-            &pl,
-            &module,
-            "fs_main",
-            &[("DIRECTION", vertical as u32 as f64)],
-            &[Some(wgpu::ColorTargetState::from(targets.get(output).desc.format))],
-        );
-        Self {
-            name,
-            input,
-            output,
-            pipeline,
-            group,
-        }
+        let pass = PassBuilder::new(gpu, targets, name)
+            .shader("bilateral", include_str!("bilateral.wgsl"))
+            .constant("DIRECTION", vertical as u32 as f64)
+            .frame(scene)
+            .uniforms(&BilateralUniforms::new(settings))
+            .read(input)
+            .read("zpack")
+            .read("npack")
+            .write(output)
+            .build();
+        Self { pass }
     }
 }
 
 impl Pass for BilateralPass {
     fn info(&self) -> PassInfo {
-        PassInfo {
-            name: self.name,
-            inputs: vec![self.input, "zpack", "npack"],
-            outputs: vec![self.output],
-        }
+        self.pass.info()
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        crate::passes::fullscreen_pass(
-            encoder,
-            self.name,
-            &self.pipeline,
-            &[&targets.get(self.output).view],
-            &[&scene.frame_bind_group, &self.group],
-        );
+        self.pass.encode(scene, targets, encoder);
     }
 }

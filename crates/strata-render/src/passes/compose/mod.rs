@@ -5,6 +5,7 @@
 //! E = c · E_dgb + (1 − c) · AV · E_probe. Outputs `hdr-full`,
 //! `indirect-blended` (E, c) and `probe-irradiance` (AV · E_probe, AV).
 
+use crate::passes::builder::{FullscreenPass, PassBuilder};
 use strata_scene::probes::IrradianceProbes;
 
 use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
@@ -45,9 +46,7 @@ struct ComposeUniforms {
 }
 
 pub struct ComposePass {
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    inputs: Vec<&'static str>,
+    pass: FullscreenPass,
 }
 
 impl ComposePass {
@@ -59,31 +58,6 @@ impl ComposePass {
         boost: bool,
         probes: Option<&IrradianceProbes>,
     ) -> Self {
-        use crate::passes::{texture_entry, uniform_entry};
-        let device = &gpu.device;
-        let d2 = wgpu::TextureViewDimension::D2;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("compose"),
-            entries: &[
-                uniform_entry(0),
-                texture_entry(1, d2, false),
-                texture_entry(2, d2, false),
-                texture_entry(3, d2, false),
-                texture_entry(4, d2, false),
-                texture_entry(5, d2, false),
-                texture_entry(6, d2, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 7,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
         let use_ao = probes.is_some() && targets.try_get("ao").is_some();
         let u = ComposeUniforms {
             boost: boost as u32,
@@ -94,7 +68,6 @@ impl ComposePass {
             spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(0.0).to_array()),
             dims: probes.map_or([1, 1, 1, 0], |p| [p.dims[0], p.dims[1], p.dims[2], 0]),
         };
-        let buffer = crate::passes::uniform_buffer(device, "compose", &u);
         let data: Vec<[f32; 4]> = match probes {
             Some(p) => p
                 .coeffs
@@ -109,63 +82,38 @@ impl ComposePass {
             None => vec![[0.0; 4]; 9],
         };
         let probe_buf = wgpu::util::DeviceExt::create_buffer_init(
-            device,
+            &gpu.device,
             &wgpu::util::BufferInitDescriptor {
                 label: Some("light probes"),
                 contents: bytemuck::cast_slice(&data),
                 usage: wgpu::BufferUsages::STORAGE,
             },
         );
-        let layer0 = |n: &str| wgpu::BindingResource::TextureView(targets.get(n).layer(0));
-        let ao = if use_ao { "ao" } else { "indirect" };
-        let group = crate::passes::bind_group(
-            device,
-            "compose",
-            &layout,
-            &[
-                buffer.as_entire_binding(),
-                layer0("hdr"),
-                layer0("albedo"),
-                layer0("normal"),
-                layer0("indirect"),
-                layer0("csz"),
-                layer0(ao),
-                probe_buf.as_entire_binding(),
-            ],
-        );
-        let pl = crate::passes::frame_pipeline_layout(device, "compose", scene, &[&layout]);
-        let module = crate::shader::module(device, "compose", include_str!("compose.wgsl"));
-        let formats = crate::passes::color_targets(&OUTPUTS);
-        let pipeline = crate::passes::fullscreen_pipeline(device, "compose", &pl, &module, &formats);
-        let mut inputs = vec!["hdr", "albedo", "normal", "indirect", "csz"];
-        if use_ao {
-            inputs.push("ao");
+        let mut b = PassBuilder::new(gpu, targets, "compose")
+            .shader("compose", include_str!("compose.wgsl"))
+            .frame(scene)
+            .uniforms(&u)
+            .read_layer("hdr", 0)
+            .read_layer("albedo", 0)
+            .read_layer("normal", 0)
+            .read_layer("indirect", 0)
+            .read_layer("csz", 0)
+            // without AO the binding is filled by a target that is read anyway
+            .read_layer(if use_ao { "ao" } else { "indirect" }, 0)
+            .storage(&probe_buf);
+        for t in &OUTPUTS {
+            b = b.write(t.name);
         }
-        Self {
-            pipeline,
-            group,
-            inputs,
-        }
+        Self { pass: b.build() }
     }
 }
 
 impl Pass for ComposePass {
     fn info(&self) -> PassInfo {
-        PassInfo {
-            name: "compose",
-            inputs: self.inputs.clone(),
-            outputs: OUTPUTS.iter().map(|t| t.name).collect(),
-        }
+        self.pass.info()
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs = crate::passes::output_views(targets, &OUTPUTS);
-        crate::passes::fullscreen_pass(
-            encoder,
-            "compose",
-            &self.pipeline,
-            &outputs,
-            &[&scene.frame_bind_group, &self.group],
-        );
+        self.pass.encode(scene, targets, encoder);
     }
 }

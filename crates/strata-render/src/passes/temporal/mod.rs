@@ -5,6 +5,7 @@
 
 use crate::frame::{Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
+use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
 
 /// Defaults: α = 0.85 (the paper's recommendation); reprojection accepted when
@@ -58,15 +59,9 @@ pub struct TemporalUniforms {
 
 /// Filters target `input` with `history` (last frame's `output`) into `output`.
 pub struct TemporalPass {
-    name: &'static str,
-    input: &'static str,
-    history: &'static str,
-    output: &'static str,
     settings: TemporalSettings,
     layers: u32,
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    uniforms: wgpu::Buffer,
+    pass: FullscreenPass,
 }
 
 impl TemporalPass {
@@ -82,57 +77,26 @@ impl TemporalPass {
         output: &'static str,
         layers: u32,
     ) -> Self {
-        use crate::passes::{texture_entry, uniform_entry};
-        let device = &gpu.device;
-        let d2 = wgpu::TextureViewDimension::D2;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(name),
-            entries: &[
-                uniform_entry(0),
-                texture_entry(1, d2, false),
-                texture_entry(2, d2, false),
-                texture_entry(3, d2, false),
-                texture_entry(4, wgpu::TextureViewDimension::D2Array, false),
-            ],
-        });
         let u = TemporalUniforms {
             alpha: settings.alpha,
             max_distance: settings.max_distance,
             has_history: 0,
             layers,
         };
-        let uniforms = crate::passes::uniform_buffer(device, name, &u);
-        let group = crate::passes::bind_group(
-            device,
-            name,
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&targets.get(input).view),
-                wgpu::BindingResource::TextureView(&targets.get(history).view),
-                wgpu::BindingResource::TextureView(&targets.get("zpack").view),
-                wgpu::BindingResource::TextureView(&targets.get("csz-history").array_view),
-            ],
-        );
-        let pl = crate::passes::frame_pipeline_layout(device, name, scene, &[&layout]);
-        let module = crate::shader::module(device, "temporal", include_str!("temporal.wgsl"));
-        let pipeline = crate::passes::fullscreen_pipeline(
-            device,
-            name,
-            &pl,
-            &module,
-            &[Some(wgpu::ColorTargetState::from(targets.get(output).desc.format))],
-        );
+        let pass = PassBuilder::new(gpu, targets, name)
+            .shader("temporal", include_str!("temporal.wgsl"))
+            .frame(scene)
+            .uniforms(&u)
+            .read(input)
+            .read(history)
+            .read("zpack")
+            .read_array("csz-history")
+            .write(output)
+            .build();
         Self {
-            name,
-            input,
-            history,
-            output,
             settings: *settings,
             layers,
-            pipeline,
-            group,
-            uniforms,
+            pass,
         }
     }
 
@@ -144,26 +108,16 @@ impl TemporalPass {
             has_history: has_history as u32,
             layers: self.layers,
         };
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.pass.set_uniforms(gpu, &u);
     }
 }
 
 impl Pass for TemporalPass {
     fn info(&self) -> PassInfo {
-        PassInfo {
-            name: self.name,
-            inputs: vec![self.input, self.history, "zpack", "csz-history"],
-            outputs: vec![self.output],
-        }
+        self.pass.info()
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        crate::passes::fullscreen_pass(
-            encoder,
-            self.name,
-            &self.pipeline,
-            &[&targets.get(self.output).view],
-            &[&scene.frame_bind_group, &self.group],
-        );
+        self.pass.encode(scene, targets, encoder);
     }
 }

@@ -1,0 +1,327 @@
+//! Declarative full-screen passes: a pass is its WGSL plus what it reads, writes
+//! and which uniforms it takes; the builder makes the bind-group layout, the bind
+//! group, the uniform buffer, the pipeline layout and the pipeline, and the built
+//! pass reports its inputs/outputs and records itself.
+//!
+//! ```ignore
+//! let pass = PassBuilder::new(gpu, targets, "temporal")
+//!     .shader("temporal", include_str!("temporal.wgsl"))
+//!     .frame(scene)                     // group 0: frame uniforms
+//!     .uniforms(&u)                     // group 1 binding 0
+//!     .read(input).read(history)        // bindings 1, 2, …
+//!     .write(output)
+//!     .build();
+//! ```
+
+use crate::frame::{PassInfo, Targets};
+use crate::gpu::GpuContext;
+use crate::scene_gpu::GpuScene;
+
+/// Which view of a written target a pass renders into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Attachment {
+    /// The whole target (its `view`).
+    Whole,
+    /// One array layer.
+    Layer(u32),
+    /// One MIP level of layer 0.
+    Mip(u32),
+}
+
+/// A full-screen pass made by [`PassBuilder`].
+pub(crate) struct FullscreenPass {
+    pub name: &'static str,
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    uniforms: Option<wgpu::Buffer>,
+    frame: bool,
+    inputs: Vec<&'static str>,
+    outputs: Vec<(&'static str, Attachment)>,
+}
+
+impl FullscreenPass {
+    /// Replaces the pass's uniforms (declared with [`PassBuilder::uniforms`]).
+    pub fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
+        let buf = self.uniforms.as_ref().expect("the pass declared uniforms");
+        gpu.queue.write_buffer(buf, 0, bytemuck::bytes_of(value));
+    }
+
+    pub fn info(&self) -> PassInfo {
+        PassInfo {
+            name: self.name,
+            inputs: self.inputs.clone(),
+            outputs: self.outputs.iter().map(|o| o.0).collect(),
+        }
+    }
+
+    /// Records the pass (clearing its outputs), shading only inside `scissor` when given.
+    pub fn encode_in(
+        &self,
+        scene: &GpuScene,
+        targets: &Targets,
+        encoder: &mut wgpu::CommandEncoder,
+        scissor: Option<[u32; 4]>,
+    ) {
+        let views: Vec<&wgpu::TextureView> = self
+            .outputs
+            .iter()
+            .map(|&(name, a)| {
+                let t = targets.get(name);
+                match a {
+                    Attachment::Whole => &t.view,
+                    Attachment::Layer(j) => t.layer(j),
+                    Attachment::Mip(m) => &t.mip_views[m as usize],
+                }
+            })
+            .collect();
+        let groups: Vec<&wgpu::BindGroup> = if self.frame {
+            vec![&scene.frame_bind_group, &self.group]
+        } else {
+            vec![&self.group]
+        };
+        super::fullscreen_pass_in(encoder, self.name, &self.pipeline, &views, &groups, scissor);
+    }
+
+    pub fn encode(&self, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        self.encode_in(scene, targets, encoder, None)
+    }
+}
+
+impl crate::frame::Pass for FullscreenPass {
+    fn info(&self) -> PassInfo {
+        FullscreenPass::info(self)
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        FullscreenPass::encode(self, scene, targets, encoder)
+    }
+}
+
+/// Declares a [`FullscreenPass`]; bindings are numbered in declaration order.
+pub(crate) struct PassBuilder<'a> {
+    gpu: &'a GpuContext,
+    targets: &'a Targets,
+    name: &'static str,
+    shader: Option<(&'static str, &'static str)>,
+    entry: &'static str,
+    constants: Vec<(&'static str, f64)>,
+    frame_layout: Option<&'a wgpu::BindGroupLayout>,
+    /// Initial contents of the uniform buffer, created by `build`.
+    uniforms: Option<Vec<u8>>,
+    layout_entries: Vec<wgpu::BindGroupLayoutEntry>,
+    /// `None` marks the uniform buffer's binding.
+    resources: Vec<Option<wgpu::BindingResource<'a>>>,
+    inputs: Vec<&'static str>,
+    outputs: Vec<(&'static str, Attachment)>,
+}
+
+impl<'a> PassBuilder<'a> {
+    pub fn new(gpu: &'a GpuContext, targets: &'a Targets, name: &'static str) -> Self {
+        Self {
+            gpu,
+            targets,
+            name,
+            shader: None,
+            entry: "fs_main",
+            constants: Vec::new(),
+            frame_layout: None,
+            uniforms: None,
+            layout_entries: Vec::new(),
+            resources: Vec::new(),
+            inputs: Vec::new(),
+            outputs: Vec::new(),
+        }
+    }
+
+    /// The WGSL (with `#import`s) and its label.
+    pub fn shader(mut self, label: &'static str, source: &'static str) -> Self {
+        self.shader = Some((label, source));
+        self
+    }
+
+    /// The fragment entry point (default `fs_main`).
+    pub fn entry(mut self, entry: &'static str) -> Self {
+        self.entry = entry;
+        self
+    }
+
+    /// A pipeline-overridable constant.
+    pub fn constant(mut self, name: &'static str, value: f64) -> Self {
+        self.constants.push((name, value));
+        self
+    }
+
+    /// Binds the frame uniforms as group 0 (the pass's own group becomes 1).
+    pub fn frame(mut self, scene: &'a GpuScene) -> Self {
+        self.frame_layout = Some(&scene.frame_layout);
+        self
+    }
+
+    fn push(mut self, ty: wgpu::BindingType, resource: Option<wgpu::BindingResource<'a>>) -> Self {
+        self.layout_entries.push(wgpu::BindGroupLayoutEntry {
+            binding: self.layout_entries.len() as u32,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty,
+            count: None,
+        });
+        self.resources.push(resource);
+        self
+    }
+
+    /// A uniform buffer holding `value` (update it with [`FullscreenPass::set_uniforms`]).
+    pub fn uniforms<T: bytemuck::Pod>(mut self, value: &T) -> Self {
+        assert!(self.uniforms.is_none(), "one uniform buffer per pass");
+        self.uniforms = Some(bytemuck::bytes_of(value).to_vec());
+        self.push(
+            wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            None,
+        )
+    }
+
+    /// Any texture view (`input` names it in the pass's declared inputs; "" for none).
+    pub fn view(
+        mut self,
+        input: &'static str,
+        view: &'a wgpu::TextureView,
+        dimension: wgpu::TextureViewDimension,
+        filterable: bool,
+    ) -> Self {
+        if !input.is_empty() && !self.inputs.contains(&input) {
+            self.inputs.push(input);
+        }
+        self.push(
+            wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable },
+                view_dimension: dimension,
+                multisampled: false,
+            },
+            Some(wgpu::BindingResource::TextureView(view)),
+        )
+    }
+
+    /// Target `name` as a whole (`D2Array` when it has several layers).
+    pub fn read(self, name: &'static str) -> Self {
+        let t = self.targets.get(name);
+        let dim = if t.desc.layers > 1 {
+            wgpu::TextureViewDimension::D2Array
+        } else {
+            wgpu::TextureViewDimension::D2
+        };
+        self.view(name, &t.view, dim, false)
+    }
+
+    /// Target `name` as a `D2Array` (also when it has one layer).
+    pub fn read_array(self, name: &'static str) -> Self {
+        let t = self.targets.get(name);
+        self.view(name, &t.array_view, wgpu::TextureViewDimension::D2Array, false)
+    }
+
+    /// Array layer `j` of target `name`.
+    pub fn read_layer(self, name: &'static str, j: u32) -> Self {
+        let t = self.targets.get(name);
+        self.view(name, t.layer(j), wgpu::TextureViewDimension::D2, false)
+    }
+
+    /// A read-only storage buffer.
+    pub fn storage(self, buffer: &'a wgpu::Buffer) -> Self {
+        self.push(
+            wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Some(buffer.as_entire_binding()),
+        )
+    }
+
+    /// A sampler of binding type `ty`.
+    pub fn sampler(self, sampler: &'a wgpu::Sampler, ty: wgpu::SamplerBindingType) -> Self {
+        self.push(
+            wgpu::BindingType::Sampler(ty),
+            Some(wgpu::BindingResource::Sampler(sampler)),
+        )
+    }
+
+    /// Renders into target `name` (whole); colour targets follow declaration order.
+    pub fn write(self, name: &'static str) -> Self {
+        self.write_to(name, Attachment::Whole)
+    }
+
+    /// Renders into one view of target `name`.
+    pub fn write_to(mut self, name: &'static str, attachment: Attachment) -> Self {
+        self.outputs.push((name, attachment));
+        self
+    }
+
+    pub fn build(self) -> FullscreenPass {
+        let device = &self.gpu.device;
+        let (label, source) = self.shader.expect("a pass needs its WGSL");
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(self.name),
+            entries: &self.layout_entries,
+        });
+        let uniforms = self.uniforms.as_ref().map(|bytes| {
+            use wgpu::util::DeviceExt;
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(self.name),
+                contents: bytes,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            })
+        });
+        let entries: Vec<wgpu::BindGroupEntry> = self
+            .resources
+            .iter()
+            .enumerate()
+            .map(|(i, r)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: match r {
+                    Some(r) => r.clone(),
+                    None => uniforms.as_ref().expect("declared uniforms").as_entire_binding(),
+                },
+            })
+            .collect();
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.name),
+            layout: &group_layout,
+            entries: &entries,
+        });
+        let mut layouts = Vec::new();
+        if let Some(f) = self.frame_layout {
+            layouts.push(Some(f));
+        }
+        layouts.push(Some(&group_layout));
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(self.name),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(device, label, source);
+        let formats: Vec<Option<wgpu::ColorTargetState>> = self
+            .outputs
+            .iter()
+            .map(|(n, _)| Some(wgpu::ColorTargetState::from(self.targets.get(n).desc.format)))
+            .collect();
+        let pipeline = super::fullscreen_pipeline_with(
+            device,
+            self.name,
+            &pipeline_layout,
+            &module,
+            self.entry,
+            &self.constants,
+            &formats,
+        );
+        FullscreenPass {
+            name: self.name,
+            pipeline,
+            group,
+            uniforms,
+            frame: self.frame_layout.is_some(),
+            inputs: self.inputs,
+            outputs: self.outputs,
+        }
+    }
+}
