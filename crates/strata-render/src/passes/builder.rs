@@ -17,17 +17,6 @@ use crate::frame::{PassInfo, Targets};
 use crate::gpu::GpuContext;
 use crate::scene_gpu::GpuScene;
 
-/// Which view of a written target a pass renders into.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Attachment {
-    /// The whole target (its `view`).
-    Whole,
-    /// One array layer.
-    Layer(u32),
-    /// One MIP level of layer 0.
-    Mip(u32),
-}
-
 /// A full-screen pass made by [`PassBuilder`].
 pub(crate) struct FullscreenPass {
     pub name: &'static str,
@@ -36,7 +25,7 @@ pub(crate) struct FullscreenPass {
     uniforms: Option<wgpu::Buffer>,
     frame: bool,
     inputs: Vec<&'static str>,
-    outputs: Vec<(&'static str, Attachment)>,
+    outputs: Vec<&'static str>,
 }
 
 impl FullscreenPass {
@@ -50,7 +39,7 @@ impl FullscreenPass {
         PassInfo {
             name: self.name,
             inputs: self.inputs.clone(),
-            outputs: self.outputs.iter().map(|o| o.0).collect(),
+            outputs: self.outputs.clone(),
         }
     }
 
@@ -62,18 +51,7 @@ impl FullscreenPass {
         encoder: &mut wgpu::CommandEncoder,
         scissor: Option<[u32; 4]>,
     ) {
-        let views: Vec<&wgpu::TextureView> = self
-            .outputs
-            .iter()
-            .map(|&(name, a)| {
-                let t = targets.get(name);
-                match a {
-                    Attachment::Whole => &t.view,
-                    Attachment::Layer(j) => t.layer(j),
-                    Attachment::Mip(m) => &t.mip_views[m as usize],
-                }
-            })
-            .collect();
+        let views: Vec<&wgpu::TextureView> = self.outputs.iter().map(|n| &targets.get(n).view).collect();
         let groups: Vec<&wgpu::BindGroup> = if self.frame {
             vec![&scene.frame_bind_group, &self.group]
         } else {
@@ -97,6 +75,28 @@ impl crate::frame::Pass for FullscreenPass {
     }
 }
 
+/// `impl Pass` for a struct whose field `pass` is its [`FullscreenPass`].
+macro_rules! delegate_pass {
+    ($t:ty) => {
+        impl crate::frame::Pass for $t {
+            fn info(&self) -> crate::frame::PassInfo {
+                self.pass.info()
+            }
+
+            fn encode(
+                &self,
+                _gpu: &crate::gpu::GpuContext,
+                scene: &crate::scene_gpu::GpuScene,
+                targets: &crate::frame::Targets,
+                encoder: &mut wgpu::CommandEncoder,
+            ) {
+                self.pass.encode(scene, targets, encoder);
+            }
+        }
+    };
+}
+pub(crate) use delegate_pass;
+
 /// Declares a [`FullscreenPass`]; bindings are numbered in declaration order.
 pub(crate) struct PassBuilder<'a> {
     gpu: &'a GpuContext,
@@ -112,7 +112,7 @@ pub(crate) struct PassBuilder<'a> {
     /// `None` marks the uniform buffer's binding.
     resources: Vec<Option<wgpu::BindingResource<'a>>>,
     inputs: Vec<&'static str>,
-    outputs: Vec<(&'static str, Attachment)>,
+    outputs: Vec<&'static str>,
 }
 
 impl<'a> PassBuilder<'a> {
@@ -238,7 +238,8 @@ impl<'a> PassBuilder<'a> {
         )
     }
 
-    /// A sampler of binding type `ty`.
+    /// A sampler of binding type `ty` (for the passes to come: ILS, A-buffer, BZB).
+    #[allow(dead_code)]
     pub fn sampler(self, sampler: &'a wgpu::Sampler, ty: wgpu::SamplerBindingType) -> Self {
         self.push(
             wgpu::BindingType::Sampler(ty),
@@ -246,14 +247,9 @@ impl<'a> PassBuilder<'a> {
         )
     }
 
-    /// Renders into target `name` (whole); colour targets follow declaration order.
-    pub fn write(self, name: &'static str) -> Self {
-        self.write_to(name, Attachment::Whole)
-    }
-
-    /// Renders into one view of target `name`.
-    pub fn write_to(mut self, name: &'static str, attachment: Attachment) -> Self {
-        self.outputs.push((name, attachment));
+    /// Renders into target `name` (whole, cleared); colour targets follow declaration order.
+    pub fn write(mut self, name: &'static str) -> Self {
+        self.outputs.push(name);
         self
     }
 
@@ -303,7 +299,7 @@ impl<'a> PassBuilder<'a> {
         let formats: Vec<Option<wgpu::ColorTargetState>> = self
             .outputs
             .iter()
-            .map(|(n, _)| Some(wgpu::ColorTargetState::from(self.targets.get(n).desc.format)))
+            .map(|n| Some(wgpu::ColorTargetState::from(self.targets.get(n).desc.format)))
             .collect();
         let pipeline = super::fullscreen_pipeline_with(
             device,

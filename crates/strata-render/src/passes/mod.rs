@@ -168,32 +168,6 @@ pub(crate) fn bind_group(
     })
 }
 
-/// A pipeline layout of the frame uniforms (group 0) and `groups` after it.
-pub(crate) fn frame_pipeline_layout(
-    device: &wgpu::Device,
-    label: &str,
-    scene: &crate::scene_gpu::GpuScene,
-    groups: &[&wgpu::BindGroupLayout],
-) -> wgpu::PipelineLayout {
-    let mut layouts = vec![Some(&scene.frame_layout)];
-    layouts.extend(groups.iter().map(|g| Some(*g)));
-    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &layouts,
-        immediate_size: 0,
-    })
-}
-
-/// A uniform buffer initialised with `value`.
-pub(crate) fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, value: &T) -> wgpu::Buffer {
-    use wgpu::util::DeviceExt;
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytemuck::bytes_of(value),
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-    })
-}
-
 /// Keeps targets for the next frame at the end of this one: `csz` →
 /// `csz-history` (the single-pass deep G-buffer's oracle and the temporal
 /// filter's reprojection test) and each temporal filter's output →

@@ -8,7 +8,7 @@ use crate::passes::builder::{FullscreenPass, PassBuilder};
 use glam::Vec3;
 use strata_scene::{ImageBuf, Scene};
 
-use crate::frame::{FrameUniforms, Pass, PassInfo, TargetDesc, Targets};
+use crate::frame::{FrameUniforms, TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::passes::bilateral::BilateralSettings;
 use crate::passes::depth_mip::DepthMipSettings;
@@ -205,15 +205,7 @@ impl AoPass {
 
 use bytemuck::Zeroable;
 
-impl Pass for AoPass {
-    fn info(&self) -> PassInfo {
-        self.pass.info()
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode(scene, targets, encoder);
-    }
-}
+crate::passes::builder::delegate_pass!(AoPass);
 
 /// CPU evaluation of exactly what `ao.wgsl` computes at pixel (x, y), from
 /// read-back buffers: `zmip[m]` is MIP level m (channel j = layer j), `normals`

@@ -2,7 +2,7 @@
 //! [SGNS07]), reusable by every noisy screen-space estimate: a horizontal and a
 //! vertical [`BilateralPass`].
 
-use crate::frame::{Pass, PassInfo, Targets};
+use crate::frame::Targets;
 use crate::gpu::GpuContext;
 use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
@@ -123,12 +123,4 @@ impl BilateralPass {
     }
 }
 
-impl Pass for BilateralPass {
-    fn info(&self) -> PassInfo {
-        self.pass.info()
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode(scene, targets, encoder);
-    }
-}
+crate::passes::builder::delegate_pass!(BilateralPass);

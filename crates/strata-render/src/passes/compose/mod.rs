@@ -8,7 +8,7 @@
 use crate::passes::builder::{FullscreenPass, PassBuilder};
 use strata_scene::probes::IrradianceProbes;
 
-use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::frame::{TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::scene_gpu::GpuScene;
 
@@ -108,12 +108,4 @@ impl ComposePass {
     }
 }
 
-impl Pass for ComposePass {
-    fn info(&self) -> PassInfo {
-        self.pass.info()
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode(scene, targets, encoder);
-    }
-}
+crate::passes::builder::delegate_pass!(ComposePass);

@@ -620,80 +620,28 @@ impl Pass for GeometryPass {
 /// Packs the per-layer arrays into DGB Table 1's layout (`zpack`, `npack`, and
 /// `zpack23`, `npack23` for k > 2).
 pub struct PackPass {
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    outputs: Vec<&'static str>,
+    pass: crate::passes::builder::FullscreenPass,
 }
 
 impl PackPass {
     pub fn new(gpu: &GpuContext, targets: &Targets, settings: &DeepGBufferSettings) -> Self {
-        let device = &gpu.device;
-        let entry = |binding| crate::passes::texture_entry(binding, wgpu::TextureViewDimension::D2Array, false);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pack"),
-            entries: &[entry(0), entry(1)],
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("pack"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&targets.get("csz").array_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&targets.get("normal").array_view),
-                },
-            ],
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pack"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let module = crate::shader::module(device, "pack", include_str!("pack.wgsl"));
-        let outputs: Vec<&'static str> = if settings.layers > 2 {
-            vec!["zpack", "npack", "zpack23", "npack23"]
-        } else {
-            vec!["zpack", "npack"]
-        };
-        let formats: Vec<Option<wgpu::ColorTargetState>> = outputs
-            .iter()
-            .map(|n| Some(wgpu::ColorTargetState::from(targets.get(n).desc.format)))
-            .collect();
-        let entry_point = if settings.layers > 2 { "fs_pack4" } else { "fs_pack2" };
-        let pipeline = crate::passes::fullscreen_pipeline_with(
-            device,
-            "pack",
-            &pl,
-            &module,
-            entry_point,
-            &[("LAYERS", settings.layers as f64)],
-            &formats,
-        );
-        Self {
-            pipeline,
-            group,
-            outputs,
+        let four = settings.layers > 2;
+        let mut b = crate::passes::builder::PassBuilder::new(gpu, targets, "pack")
+            .shader("pack", include_str!("pack.wgsl"))
+            .entry(if four { "fs_pack4" } else { "fs_pack2" })
+            .constant("LAYERS", settings.layers as f64)
+            .read_array("csz")
+            .read_array("normal")
+            .write("zpack")
+            .write("npack");
+        if four {
+            b = b.write("zpack23").write("npack23");
         }
+        Self { pass: b.build() }
     }
 }
 
-impl Pass for PackPass {
-    fn info(&self) -> PassInfo {
-        PassInfo {
-            name: "pack",
-            inputs: vec!["csz", "normal"],
-            outputs: self.outputs.clone(),
-        }
-    }
-
-    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs: Vec<_> = self.outputs.iter().map(|n| &targets.get(n).view).collect();
-        crate::passes::fullscreen_pass(encoder, "pack", &self.pipeline, &outputs, &[&self.group]);
-    }
-}
+crate::passes::builder::delegate_pass!(PackPass);
 
 /// Relative depth difference above which two layers hold different surfaces.
 pub const SURFACE_TOLERANCE: f32 = 1e-4;

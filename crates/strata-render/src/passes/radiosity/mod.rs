@@ -11,6 +11,7 @@
 
 pub(crate) mod stage;
 
+use crate::passes::builder::{FullscreenPass, PassBuilder};
 use glam::Vec3;
 use strata_scene::ImageBuf;
 
@@ -261,12 +262,9 @@ pub const OUTPUTS: [TargetDesc; 2] = [
 ];
 
 pub struct RadiosityPass {
-    inputs: Vec<&'static str>,
+    pass: FullscreenPass,
     /// Shaded region (the image plus the shaded part of the guard band).
     scissor: Option<[u32; 4]>,
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    uniforms: wgpu::Buffer,
     last: std::cell::Cell<RadiosityUniforms>,
 }
 
@@ -283,63 +281,30 @@ impl RadiosityPass {
         scissor: Option<[u32; 4]>,
         receiver1: bool,
     ) -> Self {
-        use crate::passes::{texture_entry, uniform_entry};
-        let device = &gpu.device;
-        let d2 = wgpu::TextureViewDimension::D2;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("radiosity"),
-            entries: &[
-                uniform_entry(0),
-                texture_entry(1, d2, false),
-                texture_entry(2, d2, false),
-                texture_entry(3, d2, false),
-                texture_entry(4, d2, false),
-            ],
-        });
         let zeroed: RadiosityUniforms = bytemuck::Zeroable::zeroed();
-        let uniforms = crate::passes::uniform_buffer(device, "radiosity", &zeroed);
-        let b1 = if layers > 1 { b[1] } else { b[0] };
-        let view = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).view);
-        let group = crate::passes::bind_group(
-            device,
-            "radiosity",
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                view("zmip"),
-                view("npack"),
-                view(b[0]),
-                view(b1),
-            ],
-        );
-        let pl = crate::passes::frame_pipeline_layout(device, "radiosity", scene, &[&layout]);
-        let module = crate::shader::module(device, "radiosity", include_str!("radiosity.wgsl"));
-        let formats = crate::passes::color_targets(&OUTPUTS);
-        let pipeline = crate::passes::fullscreen_pipeline_with(
-            device,
-            "radiosity",
-            &pl,
-            &module,
-            "fs_main",
-            &[("LAYERS", layers as f64), ("RECEIVER1", receiver1 as u32 as f64)],
-            &formats,
-        );
-        let mut inputs = vec!["zmip", "npack", b[0]];
-        if layers > 1 {
-            inputs.push(b[1]);
+        let mut builder = PassBuilder::new(gpu, targets, "radiosity")
+            .shader("radiosity", include_str!("radiosity.wgsl"))
+            .constant("LAYERS", layers as f64)
+            .constant("RECEIVER1", receiver1 as u32 as f64)
+            .frame(scene)
+            .uniforms(&zeroed)
+            .read("zmip")
+            .read("npack")
+            .read(b[0])
+            // one layer: layer 0's buffer fills the binding
+            .read(if layers > 1 { b[1] } else { b[0] });
+        for t in &OUTPUTS {
+            builder = builder.write(t.name);
         }
         Self {
-            inputs,
+            pass: builder.build(),
             scissor,
-            pipeline,
-            group,
-            uniforms,
             last: std::cell::Cell::new(zeroed),
         }
     }
 
     pub fn set_frame(&self, gpu: &GpuContext, u: RadiosityUniforms) {
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.pass.set_uniforms(gpu, &u);
         self.last.set(u);
     }
 
@@ -350,23 +315,11 @@ impl RadiosityPass {
 
 impl Pass for RadiosityPass {
     fn info(&self) -> PassInfo {
-        PassInfo {
-            name: "radiosity",
-            inputs: self.inputs.clone(),
-            outputs: OUTPUTS.iter().map(|t| t.name).collect(),
-        }
+        self.pass.info()
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs = crate::passes::output_views(targets, &OUTPUTS);
-        crate::passes::fullscreen_pass_in(
-            encoder,
-            "radiosity",
-            &self.pipeline,
-            &outputs,
-            &[&scene.frame_bind_group, &self.group],
-            self.scissor,
-        );
+        self.pass.encode_in(scene, targets, encoder, self.scissor);
     }
 }
 
@@ -398,11 +351,8 @@ pub const BOUNCE_OUTPUTS: [TargetDesc; 2] = [
 ];
 
 pub struct PropagatePass {
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    uniforms: wgpu::Buffer,
+    pass: FullscreenPass,
     settings: PropagateUniforms,
-    inputs: Vec<&'static str>,
 }
 
 impl PropagatePass {
@@ -414,83 +364,37 @@ impl PropagatePass {
         s: &RadiositySettings,
         max_distance: f32,
     ) -> Self {
-        use crate::passes::{texture_entry, uniform_entry};
-        let device = &gpu.device;
-        let (d2, arr) = (wgpu::TextureViewDimension::D2, wgpu::TextureViewDimension::D2Array);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("propagate"),
-            entries: &[
-                uniform_entry(0),
-                texture_entry(1, arr, false),
-                texture_entry(2, arr, false),
-                texture_entry(3, arr, false),
-                texture_entry(4, d2, false),
-                texture_entry(5, d2, false),
-                texture_entry(6, arr, false),
-                texture_entry(7, d2, false),
-                texture_entry(8, d2, false),
-            ],
-        });
         let settings = PropagateUniforms {
             delta: s.delta,
             max_distance,
             has_history: 0,
             boost: s.boost as u32,
         };
-        let uniforms = crate::passes::uniform_buffer(device, "propagate", &settings);
-        let direct1 = if layers > 1 { "radiosity1" } else { "radiosity0" };
-        let e1 = if layers > 1 {
-            "indirect1-history"
+        // one layer: layer 0's buffers fill layer 1's bindings
+        let (direct1, e1) = if layers > 1 {
+            ("radiosity1", "indirect1-history")
         } else {
-            "indirect-history"
+            ("radiosity0", "indirect-history")
         };
-        let view = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).view);
-        let array = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).array_view);
-        let group = crate::passes::bind_group(
-            device,
-            "propagate",
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                array("csz"),
-                array("albedo"),
-                array("normal"),
-                view("radiosity0"),
-                view(direct1),
-                array("csz-history"),
-                view("indirect-history"),
-                view(e1),
-            ],
-        );
-        let pl = crate::passes::frame_pipeline_layout(device, "propagate", scene, &[&layout]);
-        let module = crate::shader::module(device, "propagate", include_str!("propagate.wgsl"));
-        let formats = crate::passes::color_targets(&BOUNCE_OUTPUTS);
-        let pipeline = crate::passes::fullscreen_pipeline_with(
-            device,
-            "propagate",
-            &pl,
-            &module,
-            "fs_main",
-            &[("LAYERS", layers as f64)],
-            &formats,
-        );
-        let mut inputs = vec![
-            "csz",
-            "albedo",
-            "normal",
-            "radiosity0",
-            "csz-history",
-            "indirect-history",
-        ];
-        if layers > 1 {
-            inputs.extend(["radiosity1", "indirect1-history"]);
+        let mut b = PassBuilder::new(gpu, targets, "propagate")
+            .shader("propagate", include_str!("propagate.wgsl"))
+            .constant("LAYERS", layers as f64)
+            .frame(scene)
+            .uniforms(&settings)
+            .read_array("csz")
+            .read_array("albedo")
+            .read_array("normal")
+            .read("radiosity0")
+            .read(direct1)
+            .read_array("csz-history")
+            .read("indirect-history")
+            .read(e1);
+        for t in &BOUNCE_OUTPUTS {
+            b = b.write(t.name);
         }
         Self {
-            pipeline,
-            group,
-            uniforms,
+            pass: b.build(),
             settings,
-            inputs,
         }
     }
 
@@ -500,30 +404,11 @@ impl PropagatePass {
             has_history: has_history as u32,
             ..self.settings
         };
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.pass.set_uniforms(gpu, &u);
     }
 }
 
-impl Pass for PropagatePass {
-    fn info(&self) -> PassInfo {
-        PassInfo {
-            name: "propagate",
-            inputs: self.inputs.clone(),
-            outputs: BOUNCE_OUTPUTS.iter().map(|t| t.name).collect(),
-        }
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs = crate::passes::output_views(targets, &BOUNCE_OUTPUTS);
-        crate::passes::fullscreen_pass(
-            encoder,
-            "propagate",
-            &self.pipeline,
-            &outputs,
-            &[&scene.frame_bind_group, &self.group],
-        );
-    }
-}
+crate::passes::builder::delegate_pass!(PropagatePass);
 
 /// Read-back inputs of the gather, for [`irradiance_cpu`].
 pub struct GatherInputs<'a> {

@@ -7,8 +7,9 @@
 //! 1 environment, 2 layer-0 hit, 3 layer-1 hit) and `hdr-reflected` (the input
 //! image plus F0 · reflected radiance on mirrors).
 
-use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::frame::{TargetDesc, Targets};
 use crate::gpu::GpuContext;
+use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
 
 /// Defaults: 64 steps over 16 scene units, surface thickness Δz = the deep
@@ -83,10 +84,7 @@ pub const OUTPUTS: [TargetDesc; 2] = [
 ];
 
 pub struct ReflectionPass {
-    inputs: Vec<&'static str>,
-    pipeline: wgpu::RenderPipeline,
-    group: wgpu::BindGroup,
-    uniforms: wgpu::Buffer,
+    pass: FullscreenPass,
     settings: ReflectionSettings,
 }
 
@@ -100,62 +98,32 @@ impl ReflectionPass {
         input: &'static str,
         settings: &ReflectionSettings,
     ) -> Self {
-        use crate::passes::{texture_entry, uniform_entry};
-        let device = &gpu.device;
-        let (d2, arr) = (wgpu::TextureViewDimension::D2, wgpu::TextureViewDimension::D2Array);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("reflections"),
-            entries: &[
-                uniform_entry(0),
-                texture_entry(1, arr, false),
-                texture_entry(2, arr, false),
-                texture_entry(3, arr, false),
-                texture_entry(4, d2, false),
-                texture_entry(5, d2, false),
-            ],
-        });
-        let uniforms = crate::passes::uniform_buffer(
-            device,
-            "reflections",
-            &<ReflectionUniforms as bytemuck::Zeroable>::zeroed(),
-        );
-        let layer1 = if layers > 1 { "radiosity1" } else { "radiosity0" };
-        let view = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).view);
-        let array = |n: &str| wgpu::BindingResource::TextureView(&targets.get(n).array_view);
-        let group = crate::passes::bind_group(
-            device,
-            "reflections",
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                array("csz"),
-                array("normal"),
-                array("albedo"),
-                view(input),
-                view(layer1),
-            ],
-        );
-        let pl = crate::passes::frame_pipeline_layout(device, "reflections", scene, &[&layout]);
-        let module = crate::shader::module(device, "reflections", include_str!("reflections.wgsl"));
-        let formats = crate::passes::color_targets(&OUTPUTS);
-        let pipeline = crate::passes::fullscreen_pipeline_with(
-            device,
-            "reflections",
-            &pl,
-            &module,
-            "fs_main",
-            &[("LAYERS", layers as f64)],
-            &formats,
-        );
-        let mut inputs = vec!["csz", "normal", "albedo", input];
-        if layers > 1 {
-            inputs.push("radiosity1");
+        // one layer: the binding holds layer 0's radiosity, never read
+        let (layer1, declared) = if layers > 1 {
+            ("radiosity1", "radiosity1")
+        } else {
+            ("radiosity0", "")
+        };
+        let mut b = PassBuilder::new(gpu, targets, "reflections")
+            .shader("reflections", include_str!("reflections.wgsl"))
+            .constant("LAYERS", layers as f64)
+            .frame(scene)
+            .uniforms(&<ReflectionUniforms as bytemuck::Zeroable>::zeroed())
+            .read_array("csz")
+            .read_array("normal")
+            .read_array("albedo")
+            .read(input)
+            .view(
+                declared,
+                &targets.get(layer1).view,
+                wgpu::TextureViewDimension::D2,
+                false,
+            );
+        for t in &OUTPUTS {
+            b = b.write(t.name);
         }
         Self {
-            inputs,
-            pipeline,
-            group,
-            uniforms,
+            pass: b.build(),
             settings: *settings,
         }
     }
@@ -168,27 +136,8 @@ impl ReflectionPass {
             thickness: s.thickness.unwrap_or(min_separation),
             max_roughness: s.max_roughness,
         };
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.pass.set_uniforms(gpu, &u);
     }
 }
 
-impl Pass for ReflectionPass {
-    fn info(&self) -> PassInfo {
-        PassInfo {
-            name: "reflections",
-            inputs: self.inputs.clone(),
-            outputs: OUTPUTS.iter().map(|t| t.name).collect(),
-        }
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let outputs = crate::passes::output_views(targets, &OUTPUTS);
-        crate::passes::fullscreen_pass(
-            encoder,
-            "reflections",
-            &self.pipeline,
-            &outputs,
-            &[&scene.frame_bind_group, &self.group],
-        );
-    }
-}
+crate::passes::builder::delegate_pass!(ReflectionPass);

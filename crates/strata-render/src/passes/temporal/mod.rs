@@ -3,7 +3,7 @@
 //! rejection of failed reprojections. The pass's output is kept as
 //! `<output>-history` by a [`HistoryPass`](crate::passes::HistoryPass).
 
-use crate::frame::{Pass, PassInfo, Targets};
+use crate::frame::Targets;
 use crate::gpu::GpuContext;
 use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
@@ -112,12 +112,4 @@ impl TemporalPass {
     }
 }
 
-impl Pass for TemporalPass {
-    fn info(&self) -> PassInfo {
-        self.pass.info()
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode(scene, targets, encoder);
-    }
-}
+crate::passes::builder::delegate_pass!(TemporalPass);

@@ -1,6 +1,6 @@
 //! Exposure and ACES filmic tonemapping of `hdr` into the sRGB `ldr` target.
 
-use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::frame::{TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
@@ -29,12 +29,4 @@ impl TonemapPass {
     }
 }
 
-impl Pass for TonemapPass {
-    fn info(&self) -> PassInfo {
-        self.pass.info()
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode(scene, targets, encoder);
-    }
-}
+crate::passes::builder::delegate_pass!(TonemapPass);
