@@ -22,6 +22,7 @@ pub mod path;
 pub mod probes;
 pub mod procedural;
 pub mod shapes;
+pub mod skip;
 
 pub use camera::Camera;
 pub use error::SceneError;

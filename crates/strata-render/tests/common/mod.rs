@@ -35,7 +35,8 @@ pub fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
     if p.exists() {
         Some(p)
     } else {
-        eprintln!("skipping: shared scene not found at {}", p.display());
+        let test = std::thread::current().name().unwrap_or("?").to_string();
+        strata_scene::skip::note_skip(&test, &format!("shared scene not found at {}", p.display()));
         None
     }
 }
