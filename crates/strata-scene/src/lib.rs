@@ -13,7 +13,6 @@ pub mod atomic;
 pub mod camera;
 pub mod error;
 pub mod files;
-mod gltf_data;
 pub mod image_buf;
 pub mod load;
 pub mod model;
