@@ -16,7 +16,7 @@ use serde::Deserialize;
 use crate::camera::Camera;
 use crate::error::SceneError;
 use crate::files::FileSource;
-use crate::model::{Animation, Light, Material, Object, Scene};
+use crate::model::{Animation, Light, Material, Object, Scene, SceneSettings};
 use crate::path::{CameraPath, Keyframe};
 use crate::shapes::MeshBuilder;
 
@@ -224,12 +224,65 @@ impl Check<'_> {
     }
 }
 
+/// Builds the scene of a parsed TOML file, section by section (the order
+/// matters: placement before the defaults that depend on the placed bounds,
+/// the ground after them so that the default camera frames the mesh only).
 fn build_scene(doc: TomlScene, path: &Path, files: &dyn FileSource) -> Result<Scene, SceneError> {
     let ck = Check { path };
     let dir = path.parent().unwrap_or(Path::new(""));
+    let (mut scene, has_camera, from_file) = base_scene(&doc, &ck, dir, files)?;
+    place(&doc, &ck, &mut scene)?;
 
-    // Base scene.
-    let (mut scene, has_camera, from_file) = match (&doc.mesh, &doc.builtin) {
+    // Defaults that depend on the placed geometry (before the ground is added,
+    // so that the default camera frames the mesh, not the ground).
+    let (lo, hi) = scene.bounds(0.0);
+    if from_file {
+        scene.settings = default_settings(lo, hi);
+        if !has_camera {
+            scene.camera = default_camera(lo, hi);
+        }
+    }
+
+    if let Some(g) = &doc.ground {
+        add_ground(g, &ck, &mut scene, lo, hi)?;
+    }
+    if let Some(c) = &doc.camera {
+        set_camera(c, &ck, &mut scene)?;
+    }
+    if let Some(p) = &doc.camera_path {
+        scene.camera_path = Some(camera_path(p, &ck, &scene.camera)?);
+    }
+    if !doc.light.is_empty() {
+        let mut lights = Vec::with_capacity(doc.light.len());
+        for (i, l) in doc.light.iter().enumerate() {
+            lights.push(light(i, l, &ck, &mut scene)?);
+        }
+        scene.lights = lights;
+    }
+    if let Some(s) = &doc.settings {
+        apply_settings(s, &ck, &mut scene.settings)?;
+    }
+    for (i, a) in doc.animate.iter().enumerate() {
+        animate(i, a, &ck, &mut scene)?;
+    }
+
+    if let Some(n) = doc.name {
+        scene.name = n;
+    } else if let Some(stem) = path.file_stem() {
+        scene.name = stem.to_string_lossy().into_owned();
+    }
+    Ok(scene)
+}
+
+/// The base scene (`mesh` or `builtin`), whether it has its own camera, and
+/// whether it came from a mesh file (which then gets default settings).
+fn base_scene(
+    doc: &TomlScene,
+    ck: &Check,
+    dir: &Path,
+    files: &dyn FileSource,
+) -> Result<(Scene, bool, bool), SceneError> {
+    Ok(match (&doc.mesh, &doc.builtin) {
         (Some(_), Some(_)) => return Err(ck.err("mesh", "give either `mesh` or `builtin`, not both")),
         (None, None) => {
             return Err(ck.err(
@@ -263,9 +316,11 @@ fn build_scene(doc: TomlScene, path: &Path, files: &dyn FileSource) -> Result<Sc
             }
             (s, has_camera, true)
         }
-    };
+    })
+}
 
-    // Placement of the base scene.
+/// Places the base scene: `scale`, then `translate`.
+fn place(doc: &TomlScene, ck: &Check, scene: &mut Scene) -> Result<(), SceneError> {
     let scale = match doc.scale {
         Some(s) => ck.positive("scale", s)?,
         None => 1.0,
@@ -276,254 +331,235 @@ fn build_scene(doc: TomlScene, path: &Path, files: &dyn FileSource) -> Result<Sc
     };
     let place = Mat4::from_translation(translate) * Mat4::from_scale(Vec3::splat(scale));
     if place != Mat4::IDENTITY {
-        transform_scene(&mut scene, place, scale);
+        transform_scene(scene, place, scale);
     }
+    Ok(())
+}
 
-    // Defaults that depend on the placed geometry (before the ground is added,
-    // so that the default camera frames the mesh, not the ground).
-    let (lo, hi) = scene.bounds(0.0);
-    if from_file {
-        scene.settings = default_settings(lo, hi);
-        if !has_camera {
-            scene.camera = default_camera(lo, hi);
-        }
+/// `[ground]`: a horizontal quad under the bounds `lo..hi` of the placed scene.
+fn add_ground(g: &TomlGround, ck: &Check, scene: &mut Scene, lo: Vec3, hi: Vec3) -> Result<(), SceneError> {
+    let y = match g.y {
+        Some(y) => ck.finite("ground.y", y)?,
+        None => lo.y,
+    };
+    let size = match g.size {
+        Some(s) => ck.positive("ground.size", s)?,
+        None => 3.0 * (hi - lo).length().max(1e-3),
+    };
+    let color = ck.color("ground.color", g.color.unwrap_or([0.5; 3]))?;
+    let c = 0.5 * (lo + hi);
+    let mut b = MeshBuilder::new();
+    b.rect(Vec3::new(c.x, y, c.z), Vec3::Z * (0.5 * size), Vec3::X * (0.5 * size)); // z × x = +y
+    add_object(scene, "ground", b, Material::diffuse("ground", color));
+    Ok(())
+}
+
+/// `[camera]`: replaces the camera (missing `near` keeps the base scene's) and
+/// drops the base scene's camera path.
+fn set_camera(c: &TomlCamera, ck: &Check, scene: &mut Scene) -> Result<(), SceneError> {
+    let cam = Camera::new(
+        ck.vec("camera.eye", c.eye)?,
+        ck.vec("camera.target", c.target)?,
+        ck.vec("camera.up", c.up.unwrap_or([0.0, 1.0, 0.0]))?,
+        c.fov.unwrap_or(60.0),
+        c.near.unwrap_or(scene.camera.near),
+    );
+    if !(cam.fov_y_deg > 0.0 && cam.fov_y_deg < 180.0) {
+        return Err(ck.err(
+            "camera.fov",
+            format!("{} is out of range: must be in (0, 180) degrees", cam.fov_y_deg),
+        ));
     }
-
-    // Ground quad.
-    if let Some(g) = &doc.ground {
-        let y = match g.y {
-            Some(y) => ck.finite("ground.y", y)?,
-            None => lo.y,
-        };
-        let size = match g.size {
-            Some(s) => ck.positive("ground.size", s)?,
-            None => 3.0 * (hi - lo).length().max(1e-3),
-        };
-        let color = ck.color("ground.color", g.color.unwrap_or([0.5; 3]))?;
-        let c = 0.5 * (lo + hi);
-        let mut b = MeshBuilder::new();
-        b.rect(Vec3::new(c.x, y, c.z), Vec3::Z * (0.5 * size), Vec3::X * (0.5 * size)); // z × x = +y
-        add_object(&mut scene, "ground", b, Material::diffuse("ground", color));
+    if !(cam.near.is_finite() && cam.near > 0.0) {
+        return Err(ck.err("camera.near", format!("{} is out of range: must be > 0", cam.near)));
     }
+    cam.validate().map_err(|e| ck.err("camera", e))?;
+    scene.camera = cam;
+    scene.camera_path = None;
+    Ok(())
+}
 
-    // Camera.
-    if let Some(c) = &doc.camera {
-        let cam = Camera::new(
-            ck.vec("camera.eye", c.eye)?,
-            ck.vec("camera.target", c.target)?,
-            ck.vec("camera.up", c.up.unwrap_or([0.0, 1.0, 0.0]))?,
-            c.fov.unwrap_or(60.0),
-            c.near.unwrap_or(scene.camera.near),
-        );
-        if !(cam.fov_y_deg > 0.0 && cam.fov_y_deg < 180.0) {
-            return Err(ck.err(
-                "camera.fov",
-                format!("{} is out of range: must be in (0, 180) degrees", cam.fov_y_deg),
-            ));
-        }
-        if !(cam.near.is_finite() && cam.near > 0.0) {
-            return Err(ck.err("camera.near", format!("{} is out of range: must be > 0", cam.near)));
-        }
-        cam.validate().map_err(|e| ck.err("camera", e))?;
-        scene.camera = cam;
-        scene.camera_path = None;
-    }
-
-    // Camera path.
-    if let Some(p) = &doc.camera_path {
-        let mut keys = Vec::with_capacity(p.keyframes.len());
-        for (i, k) in p.keyframes.iter().enumerate() {
-            let key = format!("camera_path.keyframes[{i}]");
-            let frame = ck.finite(&format!("{key}.frame"), k.frame)?;
-            let eye = ck.vec(&format!("{key}.eye"), k.eye)?;
-            let target = ck.vec(&format!("{key}.target"), k.target)?;
-            Camera {
-                eye,
-                target,
-                ..scene.camera
-            }
+/// `[camera_path]`: each keyframe checked as a variation of `camera`.
+fn camera_path(p: &TomlPath, ck: &Check, camera: &Camera) -> Result<CameraPath, SceneError> {
+    let mut keys = Vec::with_capacity(p.keyframes.len());
+    for (i, k) in p.keyframes.iter().enumerate() {
+        let key = format!("camera_path.keyframes[{i}]");
+        let frame = ck.finite(&format!("{key}.frame"), k.frame)?;
+        let eye = ck.vec(&format!("{key}.eye"), k.eye)?;
+        let target = ck.vec(&format!("{key}.target"), k.target)?;
+        Camera { eye, target, ..*camera }
             .validate()
             .map_err(|e| ck.err(&key, e))?;
-            keys.push(Keyframe { frame, eye, target });
-        }
-        scene.camera_path = Some(CameraPath::new(keys).map_err(|e| ck.err("camera_path.keyframes", e))?);
+        keys.push(Keyframe { frame, eye, target });
     }
+    CameraPath::new(keys).map_err(|e| ck.err("camera_path.keyframes", e))
+}
 
-    // Lights.
-    if !doc.light.is_empty() {
-        let mut lights = Vec::with_capacity(doc.light.len());
-        for (i, l) in doc.light.iter().enumerate() {
-            let k = |f: &str| format!("light[{i}].{f}");
-            let light = match l {
-                TomlLight::Sun {
-                    direction,
-                    color,
-                    illuminance,
-                } => Light::Sun {
-                    direction: ck.direction(&k("direction"), *direction)?,
-                    color: ck.color(&k("color"), *color)?,
-                    illuminance: ck.positive(&k("illuminance"), *illuminance)?,
-                },
-                TomlLight::Point {
-                    position,
-                    color,
-                    intensity,
-                } => Light::Point {
-                    position: ck.vec(&k("position"), *position)?,
-                    color: ck.color(&k("color"), *color)?,
-                    intensity: ck.positive(&k("intensity"), *intensity)?,
-                },
-                TomlLight::Spot {
-                    position,
-                    direction,
-                    color,
-                    intensity,
-                    inner_deg,
-                    outer_deg,
-                } => {
-                    if !(*outer_deg > 0.0 && *outer_deg < 90.0) {
-                        return Err(ck.err(
-                            &k("outer_deg"),
-                            format!("{outer_deg} is out of range: must be in (0, 90) degrees"),
-                        ));
-                    }
-                    if !(*inner_deg > 0.0 && inner_deg <= outer_deg) {
-                        return Err(ck.err(
-                            &k("inner_deg"),
-                            format!("{inner_deg} is out of range: must be in (0, outer_deg = {outer_deg}] degrees"),
-                        ));
-                    }
-                    Light::Spot {
-                        position: ck.vec(&k("position"), *position)?,
-                        direction: ck.direction(&k("direction"), *direction)?,
-                        color: ck.color(&k("color"), *color)?,
-                        intensity: ck.positive(&k("intensity"), *intensity)?,
-                        inner_deg: *inner_deg,
-                        outer_deg: *outer_deg,
-                    }
-                }
-                TomlLight::Rect {
-                    center,
-                    half_u,
-                    half_v,
-                    radiance,
-                    emitter,
-                } => {
-                    let center = ck.vec(&k("center"), *center)?;
-                    let half_u = ck.vec(&k("half_u"), *half_u)?;
-                    let half_v = ck.vec(&k("half_v"), *half_v)?;
-                    if half_u.cross(half_v).length() <= 1e-12 {
-                        return Err(ck.err(&k("half_u"), "half_u and half_v must be non-zero and not parallel"));
-                    }
-                    let radiance = ck.color(&k("radiance"), *radiance)?;
-                    if radiance.iter().all(|&r| r == 0.0) {
-                        return Err(ck.err(&k("radiance"), "is out of range: must have a component > 0"));
-                    }
-                    if *emitter {
-                        let mut b = MeshBuilder::new();
-                        b.rect(center, half_u, half_v);
-                        add_object(
-                            &mut scene,
-                            &format!("light{i}"),
-                            b,
-                            Material::emissive(&format!("light{i}"), radiance),
-                        );
-                    }
-                    Light::Rect {
-                        center,
-                        half_u,
-                        half_v,
-                        radiance,
-                    }
-                }
-            };
-            lights.push(light);
+/// `[[light]]` number `i`; a rect light with `emitter = true` also adds its
+/// emissive quad to `scene`.
+fn light(i: usize, l: &TomlLight, ck: &Check, scene: &mut Scene) -> Result<Light, SceneError> {
+    let k = |f: &str| format!("light[{i}].{f}");
+    Ok(match l {
+        TomlLight::Sun {
+            direction,
+            color,
+            illuminance,
+        } => Light::Sun {
+            direction: ck.direction(&k("direction"), *direction)?,
+            color: ck.color(&k("color"), *color)?,
+            illuminance: ck.positive(&k("illuminance"), *illuminance)?,
+        },
+        TomlLight::Point {
+            position,
+            color,
+            intensity,
+        } => Light::Point {
+            position: ck.vec(&k("position"), *position)?,
+            color: ck.color(&k("color"), *color)?,
+            intensity: ck.positive(&k("intensity"), *intensity)?,
+        },
+        TomlLight::Spot {
+            position,
+            direction,
+            color,
+            intensity,
+            inner_deg,
+            outer_deg,
+        } => {
+            if !(*outer_deg > 0.0 && *outer_deg < 90.0) {
+                return Err(ck.err(
+                    &k("outer_deg"),
+                    format!("{outer_deg} is out of range: must be in (0, 90) degrees"),
+                ));
+            }
+            if !(*inner_deg > 0.0 && inner_deg <= outer_deg) {
+                return Err(ck.err(
+                    &k("inner_deg"),
+                    format!("{inner_deg} is out of range: must be in (0, outer_deg = {outer_deg}] degrees"),
+                ));
+            }
+            Light::Spot {
+                position: ck.vec(&k("position"), *position)?,
+                direction: ck.direction(&k("direction"), *direction)?,
+                color: ck.color(&k("color"), *color)?,
+                intensity: ck.positive(&k("intensity"), *intensity)?,
+                inner_deg: *inner_deg,
+                outer_deg: *outer_deg,
+            }
         }
-        scene.lights = lights;
+        TomlLight::Rect {
+            center,
+            half_u,
+            half_v,
+            radiance,
+            emitter,
+        } => {
+            let center = ck.vec(&k("center"), *center)?;
+            let half_u = ck.vec(&k("half_u"), *half_u)?;
+            let half_v = ck.vec(&k("half_v"), *half_v)?;
+            if half_u.cross(half_v).length() <= 1e-12 {
+                return Err(ck.err(&k("half_u"), "half_u and half_v must be non-zero and not parallel"));
+            }
+            let radiance = ck.color(&k("radiance"), *radiance)?;
+            if radiance.iter().all(|&r| r == 0.0) {
+                return Err(ck.err(&k("radiance"), "is out of range: must have a component > 0"));
+            }
+            if *emitter {
+                let mut b = MeshBuilder::new();
+                b.rect(center, half_u, half_v);
+                add_object(
+                    scene,
+                    &format!("light{i}"),
+                    b,
+                    Material::emissive(&format!("light{i}"), radiance),
+                );
+            }
+            Light::Rect {
+                center,
+                half_u,
+                half_v,
+                radiance,
+            }
+        }
+    })
+}
+
+/// `[settings]`: overrides the given values of `st`.
+fn apply_settings(s: &TomlSettings, ck: &Check, st: &mut SceneSettings) -> Result<(), SceneError> {
+    if let Some(x) = s.ao_radius {
+        st.ao_radius = ck.positive("settings.ao_radius", x)?;
     }
-
-    // Settings.
-    if let Some(s) = &doc.settings {
-        let st = &mut scene.settings;
-        if let Some(x) = s.ao_radius {
-            st.ao_radius = ck.positive("settings.ao_radius", x)?;
-        }
-        if let Some(x) = s.min_separation {
-            st.min_separation = ck.positive("settings.min_separation", x)?;
-        }
-        if let Some(x) = s.radiosity_radius {
-            st.radiosity_radius = ck.positive("settings.radiosity_radius", x)?;
-        }
-        if let Some(x) = s.exposure {
-            st.exposure = ck.positive("settings.exposure", x)?;
-        }
-        if let Some(c) = s.sky {
-            st.sky = ck.color("settings.sky", c)?;
-        }
-        if let Some(c) = s.ambient {
-            st.ambient = ck.color("settings.ambient", c)?;
-        }
+    if let Some(x) = s.min_separation {
+        st.min_separation = ck.positive("settings.min_separation", x)?;
     }
+    if let Some(x) = s.radiosity_radius {
+        st.radiosity_radius = ck.positive("settings.radiosity_radius", x)?;
+    }
+    if let Some(x) = s.exposure {
+        st.exposure = ck.positive("settings.exposure", x)?;
+    }
+    if let Some(c) = s.sky {
+        st.sky = ck.color("settings.sky", c)?;
+    }
+    if let Some(c) = s.ambient {
+        st.ambient = ck.color("settings.ambient", c)?;
+    }
+    Ok(())
+}
 
-    // Animations.
-    for (i, a) in doc.animate.iter().enumerate() {
-        let k = |f: &str| format!("animate[{i}].{f}");
-        let (object, animation) = match a {
-            TomlAnimate::Swing {
-                object,
-                pivot,
-                axis,
-                amplitude_deg,
-                period_frames,
-            } => (
-                object,
-                Animation::Swing {
-                    pivot: ck.vec(&k("pivot"), *pivot)?,
-                    axis: ck.direction(&k("axis"), *axis)?,
-                    amplitude_deg: ck.finite(&k("amplitude_deg"), *amplitude_deg)?,
-                    period_frames: ck.positive(&k("period_frames"), *period_frames)?,
-                },
-            ),
-            TomlAnimate::Slide {
-                object,
-                amplitude,
-                period_frames,
-            } => (
-                object,
-                Animation::Slide {
-                    amplitude: ck.vec(&k("amplitude"), *amplitude)?,
-                    period_frames: ck.positive(&k("period_frames"), *period_frames)?,
-                },
-            ),
+/// `[[animate]]` number `i`: sets the animation of every object of `scene`
+/// with its `object` name (an error naming the objects when there is none).
+fn animate(i: usize, a: &TomlAnimate, ck: &Check, scene: &mut Scene) -> Result<(), SceneError> {
+    let k = |f: &str| format!("animate[{i}].{f}");
+    let (object, animation) = match a {
+        TomlAnimate::Swing {
+            object,
+            pivot,
+            axis,
+            amplitude_deg,
+            period_frames,
+        } => (
+            object,
+            Animation::Swing {
+                pivot: ck.vec(&k("pivot"), *pivot)?,
+                axis: ck.direction(&k("axis"), *axis)?,
+                amplitude_deg: ck.finite(&k("amplitude_deg"), *amplitude_deg)?,
+                period_frames: ck.positive(&k("period_frames"), *period_frames)?,
+            },
+        ),
+        TomlAnimate::Slide {
+            object,
+            amplitude,
+            period_frames,
+        } => (
+            object,
+            Animation::Slide {
+                amplitude: ck.vec(&k("amplitude"), *amplitude)?,
+                period_frames: ck.positive(&k("period_frames"), *period_frames)?,
+            },
+        ),
+    };
+    let mut found = false;
+    for o in scene.objects.iter_mut().filter(|o| &o.name == object) {
+        o.animation = Some(animation.clone());
+        found = true;
+    }
+    if !found {
+        let mut names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+        names.sort_unstable();
+        names.dedup();
+        let more = if names.len() > 20 {
+            format!(", … ({} in all)", names.len())
+        } else {
+            String::new()
         };
-        let mut found = false;
-        for o in scene.objects.iter_mut().filter(|o| &o.name == object) {
-            o.animation = Some(animation.clone());
-            found = true;
-        }
-        if !found {
-            let mut names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
-            names.sort_unstable();
-            names.dedup();
-            let more = if names.len() > 20 {
-                format!(", … ({} in all)", names.len())
-            } else {
-                String::new()
-            };
-            names.truncate(20);
-            return Err(ck.err(
-                &k("object"),
-                format!("no object named '{object}' (objects: {}{more})", names.join(", ")),
-            ));
-        }
+        names.truncate(20);
+        return Err(ck.err(
+            &k("object"),
+            format!("no object named '{object}' (objects: {}{more})", names.join(", ")),
+        ));
     }
-
-    if let Some(n) = doc.name {
-        scene.name = n;
-    } else if let Some(stem) = path.file_stem() {
-        scene.name = stem.to_string_lossy().into_owned();
-    }
-    Ok(scene)
+    Ok(())
 }
 
 /// Adds a static object with its own mesh and material.
