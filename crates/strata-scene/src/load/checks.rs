@@ -1,15 +1,14 @@
 //! Checks shared by the mesh loaders ([`super::gltf`], [`super::obj`]):
 //! vertex data (finite positions within ±[`MAX_COORDINATE`], finite normals
 //! and texture coordinates), material values (finite, then clamped to their
-//! ranges), triangle indices against the vertex count. Errors name the file
-//! and the mesh or material.
+//! ranges), triangle indices against the vertex count, material indices
+//! against the file's materials ([`MaterialSlots`]). Errors name the file and
+//! the mesh or material.
 
 use std::path::Path;
 
-use crate::error::SceneError;
+use crate::error::{short, SceneError};
 use crate::model::{Material, Mesh, MAX_COORDINATE};
-
-use super::gltf_data;
 
 /// Checks a mesh's vertex data: positions finite and within ±[`MAX_COORDINATE`],
 /// normals and UVs finite. `what` names the mesh.
@@ -59,7 +58,7 @@ pub(super) fn check_material(path: &Path, m: &mut Material) -> Result<(), SceneE
             path,
             format!(
                 "material '{}': {field} {v:?} is out of range: must be finite",
-                gltf_data::short(&m.name)
+                short(&m.name)
             ),
         )
     };
@@ -101,4 +100,40 @@ pub(super) fn check_indices(path: &Path, what: &str, indices: &[u32], vertex_cou
         ));
     }
     Ok(())
+}
+
+/// Material indices of a mesh file's meshes: one of the file's `count`
+/// materials, or a default material appended after them when a mesh has no
+/// material or an out-of-range one.
+pub(super) struct MaterialSlots {
+    count: usize,
+    default_used: bool,
+}
+
+impl MaterialSlots {
+    /// Slots for a scene whose first `count` materials are the file's.
+    pub(super) fn new(count: usize) -> Self {
+        MaterialSlots {
+            count,
+            default_used: false,
+        }
+    }
+
+    /// The material of a mesh that names material `index`.
+    pub(super) fn resolve(&mut self, index: Option<usize>) -> usize {
+        match index {
+            Some(i) if i < self.count => i,
+            _ => {
+                self.default_used = true;
+                self.count
+            }
+        }
+    }
+
+    /// Appends the default material to `materials` when a mesh uses it.
+    pub(super) fn finish(self, materials: &mut Vec<Material>) {
+        if self.default_used {
+            materials.push(Material::default());
+        }
+    }
 }

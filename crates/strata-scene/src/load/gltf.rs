@@ -15,13 +15,13 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use crate::camera::Camera;
-use crate::error::SceneError;
+use crate::error::{short, SceneError};
 use crate::files::FileSource;
 use crate::model::{Material, Mesh, Object, Scene};
 use crate::normals::ensure_normals;
 
-use super::checks::{check_indices, check_material, check_vertices};
-use super::texture::decode_texture;
+use super::checks::{check_indices, check_material, check_vertices, MaterialSlots};
+use super::texture::{decode_texture, TextureCache};
 use super::{gltf_data, MeshFile};
 
 /// Loads glTF or GLB contents `bytes` (external buffers and images relative to
@@ -43,7 +43,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
     let mut scene = Scene::default();
 
     // Materials (+ base colour textures, one per referenced image).
-    let mut image_to_texture: HashMap<usize, usize> = HashMap::new();
+    let mut textures = TextureCache::new();
     let mut material_uv_set: Vec<u32> = Vec::new();
     for (mi, m) in doc.materials().enumerate() {
         let pbr = m.pbr_metallic_roughness();
@@ -68,33 +68,21 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
             let source = info.texture().source();
             let image = source.index();
             uv_set = info.tex_coord();
-            let ti = match image_to_texture.get(&image) {
-                Some(&ti) => ti,
-                None => {
-                    let name = source
-                        .name()
-                        .map(str::to_owned)
-                        .unwrap_or_else(|| format!("image{image}"));
-                    let texture = gltf_data::image_bytes(doc, image, &buffers, base, files)
-                        .and_then(|data| decode_texture(&data, &name))
-                        .map_err(|e| {
-                            fail(format!(
-                                "material {mi}: image {image} ('{}'): {e}",
-                                gltf_data::short(&name)
-                            ))
-                        })?;
-                    scene.textures.push(texture);
-                    image_to_texture.insert(image, scene.textures.len() - 1);
-                    scene.textures.len() - 1
-                }
-            };
+            let ti = textures.get_or_load(&mut scene.textures, image, |&image| {
+                let name = source
+                    .name()
+                    .map(str::to_owned)
+                    .unwrap_or_else(|| format!("image{image}"));
+                gltf_data::image_bytes(doc, image, &buffers, base, files)
+                    .and_then(|data| decode_texture(&data, &name))
+                    .map_err(|e| fail(format!("material {mi}: image {image} ('{}'): {e}", short(&name))))
+            })?;
             mat.base_color_texture = Some(ti);
         }
         scene.materials.push(mat);
         material_uv_set.push(uv_set);
     }
-    let default_material = scene.materials.len();
-    let mut default_used = false;
+    let mut slots = MaterialSlots::new(scene.materials.len());
 
     // Meshes: one of ours per triangle primitive.
     let mut mesh_map: Vec<Vec<usize>> = Vec::new();
@@ -104,7 +92,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
             let what = format!(
                 "mesh {} ('{}') primitive {}",
                 gm.index(),
-                gltf_data::short(gm.name().unwrap_or("")),
+                short(gm.name().unwrap_or("")),
                 prim.index()
             );
             use gltf::mesh::Mode;
@@ -123,13 +111,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
             let positions =
                 gltf_data::read_vectors::<3>(&pos_acc, &buffers).map_err(|e| fail(format!("{what}: POSITION: {e}")))?;
             let n = positions.len();
-            let material = match prim.material().index() {
-                Some(i) if i < default_material => i,
-                _ => {
-                    default_used = true;
-                    default_material
-                }
-            };
+            let material = slots.resolve(prim.material().index());
             let uv_set = material_uv_set.get(material).copied().unwrap_or(0);
             let normals = match prim.get(&Semantic::Normals) {
                 Some(a) => {
@@ -188,9 +170,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
         }
         mesh_map.push(ours);
     }
-    if default_used {
-        scene.materials.push(Material::default());
-    }
+    slots.finish(&mut scene.materials);
 
     // Nodes of the default scene (or all root nodes when there is no scene).
     let mut roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
@@ -229,7 +209,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
         if !local.is_finite() || !world.is_finite() {
             return Err(fail(format!(
                 "node {ni} ('{}'): transform is out of range: its matrix (and its product with the parents') must be finite",
-                gltf_data::short(node.name().unwrap_or(""))
+                short(node.name().unwrap_or(""))
             )));
         }
         if let Some(gm) = node.mesh() {

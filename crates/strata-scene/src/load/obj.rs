@@ -9,27 +9,31 @@
 //! indices and vertices through [`super::checks`].
 
 use std::cell::RefCell;
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::Mat4;
 
-use crate::error::SceneError;
+use crate::error::{short, SceneError};
 use crate::files::FileSource;
 use crate::model::{Material, Mesh, Object, Scene};
 
-use super::checks::{check_indices, check_material, check_vertices};
-use super::texture::read_texture;
-use super::{gltf_data, MeshFile};
+use super::checks::{check_indices, check_material, check_vertices, MaterialSlots};
+use super::texture::{read_texture, TextureCache};
+use super::MeshFile;
+
+/// The lines of `bytes` that are valid UTF-8, with their 0-based numbers.
+fn utf8_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &str)> {
+    bytes
+        .split(|&b| b == b'\n')
+        .enumerate()
+        .filter_map(|(i, line)| Some((i, std::str::from_utf8(line).ok()?)))
+}
 
 /// Checks the numbers of the `v`, `vn` and `vt` lines of OBJ text: a
 /// non-finite one is an error naming the line and the vertex.
 fn obj_check_numbers(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
     let mut counts = [0usize; 3];
-    for (li, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let Ok(line) = std::str::from_utf8(line) else {
-            continue;
-        };
+    for (li, line) in utf8_lines(bytes) {
         let mut words = line.split_whitespace();
         let (k, what) = match words.next() {
             Some("v") => (0, "position"),
@@ -45,7 +49,7 @@ fn obj_check_numbers(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
                     "line {}: vertex {} has a non-finite {what} ('{}'): values must be finite f32",
                     li + 1,
                     counts[k],
-                    gltf_data::short(line.trim())
+                    short(line.trim())
                 ),
             ));
         }
@@ -56,10 +60,7 @@ fn obj_check_numbers(path: &Path, bytes: &[u8]) -> Result<(), SceneError> {
 /// Checks what `tobj` would panic on in an MTL file: a colour (`Ka`, `Kd`,
 /// `Ks`, `Ke`) with fewer than 3 numbers.
 fn check_mtl(bytes: &[u8]) -> Result<(), String> {
-    for (li, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let Ok(line) = std::str::from_utf8(line) else {
-            continue;
-        };
+    for (li, line) in utf8_lines(bytes) {
         let mut words = line.split_whitespace();
         if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
             let n = words.count();
@@ -124,7 +125,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
     }
 
     let mut scene = Scene::default();
-    let mut textures: HashMap<PathBuf, usize> = HashMap::new();
+    let mut textures = TextureCache::new();
     for (i, m) in materials.iter().enumerate() {
         let mut mat = Material {
             name: m.name.clone(),
@@ -149,42 +150,34 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
         if let Some(tex) = &m.diffuse_texture {
             let rel = texture_file_name(tex);
             let base = material_dirs.get(i).cloned().unwrap_or_else(|| dir.clone());
-            let full = base.join(&rel);
-            let ti = match textures.get(&full) {
-                Some(&ti) => ti,
-                None => {
-                    let lib = material_libs
-                        .get(i)
-                        .map(|l| l.display().to_string())
-                        .unwrap_or_default();
-                    let texture = read_texture(&full, files).map_err(|e| {
-                        SceneError::file(
-                            path,
-                            format!(
-                                "material '{}' in {lib}: texture {} (map_Kd {rel}): {e}",
-                                m.name,
-                                full.display()
-                            ),
-                        )
-                    })?;
-                    scene.textures.push(texture);
-                    textures.insert(full, scene.textures.len() - 1);
-                    scene.textures.len() - 1
-                }
-            };
+            let ti = textures.get_or_load(&mut scene.textures, base.join(&rel), |full| {
+                let lib = material_libs
+                    .get(i)
+                    .map(|l| l.display().to_string())
+                    .unwrap_or_default();
+                read_texture(full, files).map_err(|e| {
+                    SceneError::file(
+                        path,
+                        format!(
+                            "material '{}' in {lib}: texture {} (map_Kd {rel}): {e}",
+                            m.name,
+                            full.display()
+                        ),
+                    )
+                })
+            })?;
             mat.base_color_texture = Some(ti);
         }
         scene.materials.push(mat);
     }
-    let default_material = scene.materials.len();
-    let mut default_used = false;
+    let mut slots = MaterialSlots::new(scene.materials.len());
 
     for model in models {
         let m = model.mesh;
         if m.indices.is_empty() {
             continue;
         }
-        let what = format!("object '{}'", gltf_data::short(&model.name));
+        let what = format!("object '{}'", short(&model.name));
         if m.positions.len() % 3 != 0 {
             return Err(SceneError::file(path, format!("{what}: malformed positions")));
         }
@@ -201,13 +194,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
         } else {
             Vec::new()
         };
-        let material = match m.material_id {
-            Some(i) if i < default_material => i,
-            _ => {
-                default_used = true;
-                default_material
-            }
-        };
+        let material = slots.resolve(m.material_id);
         let mesh = Mesh {
             name: model.name.clone(),
             positions,
@@ -225,9 +212,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
             animation: None,
         });
     }
-    if default_used {
-        scene.materials.push(Material::default());
-    }
+    slots.finish(&mut scene.materials);
     Ok(MeshFile {
         scene,
         has_camera: false,

@@ -11,6 +11,8 @@
 //! EXR headers are checked first ([`check_exr_header`]): the `exr` decoder
 //! allocates a whole tile outside the `image` crate's limits.
 
+use std::collections::HashMap;
+use std::hash::Hash;
 use std::path::Path;
 
 use crate::files::FileSource;
@@ -160,4 +162,32 @@ pub(super) fn read_texture(path: &Path, files: &dyn FileSource) -> Result<Textur
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     decode_texture(&bytes, &name)
+}
+
+/// The textures of a file's materials, each loaded once: materials that refer
+/// to the same key (glTF image index, OBJ texture path) share one texture.
+pub(super) struct TextureCache<K> {
+    index: HashMap<K, usize>,
+}
+
+impl<K: Hash + Eq> TextureCache<K> {
+    pub(super) fn new() -> Self {
+        TextureCache { index: HashMap::new() }
+    }
+
+    /// The index in `textures` of the texture for `key`: loaded by `load` and
+    /// appended the first time `key` is seen.
+    pub(super) fn get_or_load<E>(
+        &mut self,
+        textures: &mut Vec<Texture>,
+        key: K,
+        load: impl FnOnce(&K) -> Result<Texture, E>,
+    ) -> Result<usize, E> {
+        if let Some(&ti) = self.index.get(&key) {
+            return Ok(ti);
+        }
+        textures.push(load(&key)?);
+        self.index.insert(key, textures.len() - 1);
+        Ok(textures.len() - 1)
+    }
 }
