@@ -4,7 +4,7 @@
 //! - [`camera`]: the one camera model (pixel centres, camera-space depth);
 //! - [`path`]: camera paths;
 //! - [`load`]: glTF 2.0, OBJ/MTL and TOML scene files;
-//! - [`files`]: where loaders read referenced files; bounded texture decoding;
+//! - [`files`]: where loaders read referenced files (and, re-exported, bounded texture decoding);
 //! - [`procedural`]: built-in scenes (`cornell`, `atrium`, `warehouse`, …);
 //! - [`shapes`]: mesh builders (boxes, quads, cylinders, arches) for procedural scenes;
 //! - [`normals`]: smooth/flat normal generation.

@@ -6,15 +6,17 @@
 //! - **glTF 2.0** (`gltf::import`: embedded or external buffers and images,
 //!   `.glb`): each triangle primitive (mode TRIANGLES, TRIANGLE_STRIP or
 //!   TRIANGLE_FAN; points and lines are skipped with a warning) becomes a
-//!   [`Mesh`]; every node of the default scene that has a mesh becomes one
-//!   [`Object`] per primitive, with the node hierarchy's world transform.
+//!   [`Mesh`](crate::model::Mesh); every node of the default scene that has
+//!   a mesh becomes one [`Object`](crate::model::Object) per primitive, with
+//!   the node hierarchy's world transform.
 //!   Materials: `baseColorFactor` (linear RGB; its alpha is the opacity unless
 //!   `alphaMode` is OPAQUE), `baseColorTexture` (converted to RGBA8),
 //!   `emissiveFactor` × `KHR_materials_emissive_strength`, roughness, metallic.
 //!   The first perspective camera node becomes the camera. `KHR_lights_punctual`
 //!   is not read.
-//! - **OBJ/MTL** (`tobj`, triangulated, single index): one [`Mesh`] per
-//!   object/group and material. `Kd` → base colour, `map_Kd` → texture
+//! - **OBJ/MTL** (`tobj`, triangulated, single index): one
+//!   [`Mesh`](crate::model::Mesh) per object/group and material.
+//!   `Kd` → base colour, `map_Kd` → texture
 //!   (relative to the MTL file's folder; a missing file is an error naming it),
 //!   `Ke` → emission, `d` (or `1 − Tr`) → opacity, `Ns` → roughness
 //!   `sqrt(2 / (Ns + 2))`, metallic 0. OBJ texture coordinates are flipped
@@ -120,12 +122,14 @@
 //! the base scene's own camera and lights, but not the TOML's (those are in
 //! final world units).
 
-mod checks;
-mod gltf;
-mod gltf_data;
-mod obj;
-pub(crate) mod texture;
-mod toml;
+// This file: the public entry points, dispatch by extension, defaults and
+// what glTF and OBJ share after parsing (`MeshFile`, `load_mesh_slice`).
+mod checks; // checks shared by the glTF and OBJ loaders
+mod gltf; // glTF / GLB scenes
+mod gltf_data; // bounds-checked glTF buffers, accessors and images
+mod obj; // OBJ + MTL
+pub(crate) mod texture; // bounded image decoding (re-exported by `files`)
+mod toml; // TOML scene descriptions
 
 use std::path::Path;
 
