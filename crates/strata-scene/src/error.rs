@@ -34,3 +34,13 @@ pub fn one_line(s: &str) -> String {
         .map(|c| if c.is_control() { ' ' } else { c })
         .collect()
 }
+
+/// At most 80 characters of `s` (for messages).
+pub(crate) fn short(s: &str) -> String {
+    if s.chars().count() <= 80 {
+        s.to_string()
+    } else {
+        let t: String = s.chars().take(77).collect();
+        format!("{t}...")
+    }
+}

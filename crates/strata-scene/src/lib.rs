@@ -4,7 +4,7 @@
 //! - [`camera`]: the one camera model (pixel centres, camera-space depth);
 //! - [`path`]: camera paths;
 //! - [`load`]: glTF 2.0, OBJ/MTL and TOML scene files;
-//! - [`files`]: where loaders read referenced files; bounded texture decoding;
+//! - [`files`]: where loaders read referenced files (and, re-exported, bounded texture decoding);
 //! - [`procedural`]: built-in scenes (`cornell`, `atrium`, `warehouse`, …);
 //! - [`shapes`]: mesh builders (boxes, quads, cylinders, arches) for procedural scenes;
 //! - [`normals`]: smooth/flat normal generation.
@@ -13,7 +13,6 @@ pub mod atomic;
 pub mod camera;
 pub mod error;
 pub mod files;
-mod gltf_data;
 pub mod image_buf;
 pub mod load;
 pub mod model;

@@ -5,6 +5,7 @@ use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
+use crate::error::short;
 use crate::path::CameraPath;
 
 /// Largest magnitude of a vertex coordinate (object and world space) a loaded
@@ -501,15 +502,5 @@ impl Scene {
             }
         }
         (lo, hi)
-    }
-}
-
-/// At most 80 characters of `s` (for messages).
-fn short(s: &str) -> String {
-    if s.chars().count() <= 80 {
-        s.to_string()
-    } else {
-        let t: String = s.chars().take(77).collect();
-        format!("{t}...")
     }
 }

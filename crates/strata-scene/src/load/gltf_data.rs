@@ -8,6 +8,7 @@ use std::path::Path;
 
 use gltf::accessor::{DataType, Dimensions};
 
+use crate::error::short;
 use crate::files::FileSource;
 
 /// Most elements an accessor without a buffer view (all zeros, optionally
@@ -135,16 +136,6 @@ pub fn uri_bytes(uri: &str, base: &Path, files: &dyn FileSource) -> Result<Vec<u
         base.join(percent_decode(uri)?)
     };
     files.read(&file).map_err(|e| format!("{}: {e}", file.display()))
-}
-
-/// At most 80 characters of `s` (for messages).
-pub fn short(s: &str) -> String {
-    if s.chars().count() <= 80 {
-        s.to_string()
-    } else {
-        let t: String = s.chars().take(77).collect();
-        format!("{t}...")
-    }
 }
 
 /// Loads every buffer, each cut to its declared `byteLength` (an error when
