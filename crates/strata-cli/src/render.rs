@@ -18,9 +18,9 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
     };
     // the full image: radiosity blended with baked light probes (modulated by AO), reflections
     let probes = match f.technique {
-        Technique::Full if !f.no_probes => Some(crate::probes::scene_probes(
+        Technique::Full if !f.no_probes => Some(strata_eval::cache::probes::scene_probes(
             &scene,
-            &crate::ref_cache::RefCache::new(crate::ref_cache::RefCache::default_dir()),
+            &strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir()),
             false,
         )?),
         _ => None,
