@@ -290,20 +290,13 @@ mod tests {
 
     #[test]
     fn linear_errors_and_display() {
-        let a = ImageBuf {
-            width: 2,
-            height: 1,
-            channels: 1,
-            data: vec![1.0, 0.0],
-        };
-        let b = ImageBuf {
-            data: vec![3.0, 0.0],
-            ..a.clone()
-        };
+        let a = pattern(2, 2).channel(0);
+        let b = offset(&a, 2.0);
         let (rmse, mae) = linear_errors(&a, &b);
-        assert!((mae - 1.0).abs() < 1e-6 && (rmse - 2.0f32.sqrt()).abs() < 1e-6);
+        assert!((mae - 2.0).abs() < 1e-6 && (rmse - 2.0).abs() < 1e-6);
         let d = display(&b, 1.0);
-        assert!(d.data[0] > 0.9 && d.data[0] <= 1.0 && d.data[1] == 0.0, "{:?}", d.data);
+        assert!(d.data.iter().all(|v| *v > 0.9 && *v <= 1.0), "{:?}", d.data);
+        assert_eq!(display(&ImageBuf::new(2, 2, 1), 1.0).data, vec![0.0; 4]);
         let json = serde_json::to_value(compare(&a, &b).unwrap().0).unwrap();
         let keys: Vec<_> = json.as_object().unwrap().keys().cloned().collect();
         assert_eq!(keys, ["flip", "mae", "rmse"]);

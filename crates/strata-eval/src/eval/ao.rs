@@ -14,7 +14,7 @@ use super::{figure, flicker, write_report, EvalSettings};
 use crate::cache::{scene_fingerprint, RefCache};
 use crate::metrics::compare;
 use crate::report::Section;
-use crate::results::{AoErrors, AoEval, ByLayers, EvalResult, EvalRun};
+use crate::results::{AoErrors, AoEval, EvalResult};
 
 /// One GPU AO evaluation: the image and its errors against both references.
 struct AoResult {
@@ -100,35 +100,19 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         None => None,
     };
     let out = AoEval {
-        run: EvalRun {
-            scene: s.scene.scene.clone(),
-            layers: k,
-            variant: s.deep.variant.to_string(),
-            width: w,
-            height: h,
-            frame: s.scene.frame,
+        run: s.run_info(
             ref_spp,
-            reference: "obscurance (DGB Eq. 2 over all surfaces, spiral radial density)".into(),
-            device: gpu.describe(),
+            "obscurance (DGB Eq. 2 over all surfaces, spiral radial density)",
+            gpu.describe(),
             flicker,
-        },
+        ),
         samples: settings.samples,
         radius,
         bias: beta,
         epsilon,
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
-        by_layers: match s.report {
-            Some(_) => results
-                .iter()
-                .chain([&main])
-                .map(|r| ByLayers {
-                    layers: r.layers,
-                    errors: r.errors,
-                })
-                .collect(),
-            None => Vec::new(),
-        },
+        by_layers: s.by_layers(results.iter().chain([&main]).map(|r| (r.layers, r.errors))),
     };
     if let Some(dir) = &s.report {
         write_ao_report(dir, s, &out, &main, results.first(), &ref_obscurance, &ref_binary)?;

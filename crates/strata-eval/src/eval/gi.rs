@@ -17,7 +17,7 @@ use super::{figure, flicker, write_report, EvalSettings};
 use crate::cache::{scene_fingerprint, RefCache};
 use crate::metrics::{compare_radiance, display};
 use crate::report::Section;
-use crate::results::{ByLayers, EvalResult, EvalRun, Fig10, Fig10Row, GiErrors, GiEval};
+use crate::results::{EvalResult, Fig10, Fig10Row, GiErrors, GiEval};
 
 /// What only the GI evaluation takes.
 #[derive(Clone, Copy, Debug)]
@@ -128,18 +128,12 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         None => None,
     };
     let out = GiEval {
-        run: EvalRun {
-            scene: s.scene.scene.clone(),
-            layers: k,
-            variant: s.deep.variant.to_string(),
-            width: w,
-            height: h,
-            frame: s.scene.frame,
-            ref_spp: spp,
-            reference: "path-traced diffuse GI, sky and ambient off (indirect = light reflected at least twice)".into(),
-            device: gpu.describe(),
+        run: s.run_info(
+            spp,
+            "path-traced diffuse GI, sky and ambient off (indirect = light reflected at least twice)",
+            gpu.describe(),
             flicker,
-        },
+        ),
         samples: rs.samples,
         radius: rs.radius.unwrap_or(scene.settings.radiosity_radius),
         normal_test: rs.normal_test,
@@ -151,17 +145,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
         fig10,
-        by_layers: match s.report {
-            Some(_) => results
-                .iter()
-                .chain([&main])
-                .map(|r| ByLayers {
-                    layers: r.layers,
-                    errors: r.errors,
-                })
-                .collect(),
-            None => Vec::new(),
-        },
+        by_layers: s.by_layers(results.iter().chain([&main]).map(|r| (r.layers, r.errors))),
     };
     if let Some(dir) = &s.report {
         let refs = (&ref_total, &ref_indirect);

@@ -12,7 +12,7 @@ use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{Camera, ImageBuf, Scene};
 
 use crate::report::{sections, Page, ReportImage, Section};
-use crate::results::{EvalResult, Flicker};
+use crate::results::{ByLayers, EvalResult, EvalRun, Flicker};
 use crate::scene::SceneSpec;
 
 pub mod ao;
@@ -78,6 +78,30 @@ impl EvalSettings {
             deep: DeepGBufferSettings { layers, ..self.deep },
             guard_band: self.guard_band,
             ..Default::default()
+        }
+    }
+
+    /// What the result says about this run besides its errors.
+    pub(crate) fn run_info(&self, ref_spp: u32, reference: &str, device: String, flicker: Option<Flicker>) -> EvalRun {
+        EvalRun {
+            scene: self.scene.scene.clone(),
+            layers: self.deep.layers,
+            variant: self.deep.variant.to_string(),
+            width: self.scene.width,
+            height: self.scene.height,
+            frame: self.scene.frame,
+            ref_spp,
+            reference: reference.into(),
+            device,
+            flicker,
+        }
+    }
+
+    /// With a report, the errors of every evaluated layer count (`(layers, errors)` pairs).
+    pub(crate) fn by_layers<E: Copy>(&self, evaluated: impl Iterator<Item = (u32, E)>) -> Vec<ByLayers<E>> {
+        match self.report {
+            Some(_) => evaluated.map(|(layers, errors)| ByLayers { layers, errors }).collect(),
+            None => Vec::new(),
         }
     }
 
