@@ -46,20 +46,10 @@ $S bench ao --scene atrium --width "$W" --height "$H" --layers 2 --frames 5 --js
 cat "$OUT/bench-ao.json"
 $S bench radiosity --scene atrium --width "$W" --height "$H" --layers 2 --frames 5 --preset balanced --json > "$OUT/bench-radiosity.json"
 cat "$OUT/bench-radiosity.json"
-{
-  echo "<!doctype html><meta charset=utf-8><title>strata demo</title>"
-  echo "<style>body{font-family:sans-serif;max-width:1400px;margin:auto}img{max-width:45%;margin:4px;image-rendering:pixelated}figure{display:inline-block;margin:4px}</style>"
-  echo "<h1>strata demo report</h1><p>$(date -u +%Y-%m-%dT%H:%MZ)</p><pre>$(cat "$OUT/info.txt")</pre>"
-  echo "<h2>Renders</h2>"
-  for f in atrium-full mirror-full atrium atrium-ao cornell warehouse; do echo "<figure><img src=$f.png><figcaption>$f</figcaption></figure>"; done
-  echo "<h2>Fig. 9 views (atrium, full)</h2>"
-  for v in confidence gbuffer-only probe-only blended; do echo "<figure><img src=atrium-$v.png><figcaption>$v</figcaption></figure>"; done
-  echo "<h2>Deep-G-buffer radiosity vs path tracer</h2><p><a href=gi-eval/index.html>evaluation report</a></p><pre>$(cat "$OUT/eval-gi.json")</pre>"
-  echo "<h2>Deep-G-buffer AO vs ray-traced obscurance</h2><p><a href=ao-eval/index.html>evaluation report</a></p><pre>$(cat "$OUT/eval-ao.json")</pre>"
-  echo "<h2>atrium G-buffer and lighting targets</h2>"
-  for v in csz normal albedo emission direct-diffuse shadow; do echo "<figure><img src=atrium-$v.png><figcaption>$v</figcaption></figure>"; done
-  echo "<h2>CPU reference</h2><figure><img src=atrium-ref-ao.png><figcaption>atrium AO (binary visibility)</figcaption></figure>"
-  echo "<figure><img src=cornell-ref-gi.png><figcaption>cornell path-traced GI</figcaption></figure>"
-  echo "<h2>GPU timings (strata bench gbuffer, strata bench ao)</h2><pre>$(cat "$OUT/bench-gbuffer.json")</pre><pre>$(cat "$OUT/bench-ao.json")</pre><pre>$(cat "$OUT/bench-radiosity.json")</pre>"
-} > "$OUT/report.html"
+echo "[strata demo] report: tables and plots of the JSON above, the images, links to the evaluation reports" >&2
+$S report --from "$OUT" --out "$OUT/report.html" --title "strata demo report" --force \
+  --figures "Renders=atrium-full.png,mirror-full.png,atrium.png,atrium-ao.png,cornell.png,warehouse.png" \
+  --figures "Fig. 9 views (atrium, full)=atrium-confidence.png,atrium-gbuffer-only.png,atrium-probe-only.png,atrium-blended.png" \
+  --figures "atrium G-buffer and lighting targets=atrium-csz.png,atrium-normal.png,atrium-albedo.png,atrium-emission.png,atrium-direct-diffuse.png,atrium-shadow.png" \
+  --figures "CPU reference (atrium AO with binary visibility; cornell path-traced GI)=atrium-ref-ao.png,cornell-ref-gi.png"
 echo "[strata demo] wrote $OUT/report.html and images in $OUT/" >&2

@@ -41,6 +41,8 @@ pub enum Command {
     Soak(SoakArgs),
     /// Compare a GPU technique with the CPU ground truth for the same camera (FLIP, RMSE, MAE; JSON; HTML report).
     Eval(EvalArgs),
+    /// Stitch the result JSON files, images and reports in a folder into one HTML page (tables, SVG plots).
+    Report(crate::report_cmd::ReportArgs),
 }
 
 #[derive(Args, Clone)]

@@ -1,106 +1,123 @@
-//! `strata bench`: GPU timestamp benchmarks and reference throughput.
+//! `strata bench`: runs a benchmark of `strata_eval::bench` and prints its result as one JSON
+//! object or a table.
 
 use anyhow::Result;
-use serde_json::json;
-use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+use strata_eval::bench::{ao, deep, gbuffer, radiosity, reference, reflections};
+use strata_eval::results::{to_json_string, BenchResult, DeepBench, GbufferBench, ReferenceBench, StageBench};
+use strata_render::passes::reflections::ReflectionSettings;
 
-use crate::args::{BenchArgs, BenchGbufferArgs, BenchWhat};
-use crate::output::{cameras_at, scene_and_camera};
+use crate::args::{BenchArgs, BenchWhat};
 
 pub fn run(a: &BenchArgs) -> Result<()> {
-    match &a.what {
-        BenchWhat::Gbuffer(b) => gbuffer(b),
-        BenchWhat::DeepGbuffer(b) => crate::bench_deep::run(b),
-        BenchWhat::Reference(b) => crate::reference::bench(b),
-        BenchWhat::Ao(b) => crate::bench_gi::ao(b),
-        BenchWhat::Radiosity(b) => crate::bench_gi::radiosity(b),
-        BenchWhat::Reflections(b) => crate::bench_gi::reflections(b),
-    }
-}
-
-/// Median and minimum of a sample.
-pub fn median_min(v: &mut [f64]) -> (f64, f64) {
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    let med = if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    };
-    (med, v[0])
-}
-
-fn gbuffer(a: &BenchGbufferArgs) -> Result<()> {
-    if !(1..=10000).contains(&a.frames) {
-        anyhow::bail!("--frames {} is out of range: must be in 1..=10000", a.frames);
-    }
-    let (scene, _) = scene_and_camera(&a.scene)?;
-    let gpu = GpuContext::new(&GpuOptions {
-        adapter: a.gpu.adapter.clone(),
-    })?;
-    if !gpu.has(wgpu_ts()) {
-        anyhow::bail!(
-            "the adapter lacks TIMESTAMP_QUERY / TIMESTAMP_QUERY_INSIDE_ENCODERS, which `strata bench` needs"
-        );
-    }
-    let settings = RenderSettings {
-        width: a.scene.width,
-        height: a.scene.height,
-        ..Default::default()
-    };
-    let mut r = Renderer::new(&gpu, &scene, settings)?;
-    // Warm-up frame (pipeline creation, first-use allocations).
-    let f0 = a.scene.frame;
-    r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f0), f0)?;
-    let names: Vec<&str> = r.pass_infos().iter().map(|p| p.name).collect();
-    let mut samples: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
-    let mut totals = Vec::new();
-    for i in 0..a.frames {
-        let f = a.scene.frame + i as f32;
-        let t = r.render(&gpu, &scene, &cameras_at(&scene, &a.scene, f), f)?;
-        for (k, n) in names.iter().enumerate() {
-            samples[k].push(t.get(n).unwrap_or(f64::NAN));
+    let (result, json) = match &a.what {
+        BenchWhat::Gbuffer(b) => (BenchResult::Gbuffer(gbuffer::run(&b.into())?), b.json),
+        BenchWhat::DeepGbuffer(b) => (BenchResult::DeepGbuffer(deep::run(&b.into())?), b.json),
+        BenchWhat::Reference(b) => (
+            BenchResult::Reference(reference::run(&(&b.scene).into(), b.mrays)?),
+            b.json,
+        ),
+        BenchWhat::Ao(b) => (
+            BenchResult::Ao(ao::run(&(&b.stage).into(), &b.ao.settings())?),
+            b.stage.json,
+        ),
+        BenchWhat::Radiosity(b) => {
+            let rs = b.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
+            let r = radiosity::run(&(&b.stage).into(), &b.radiosity.preset, &rs)?;
+            (BenchResult::Radiosity(r), b.stage.json)
         }
-        totals.push(t.total());
-    }
-    let rows: Vec<_> = names
-        .iter()
-        .zip(samples.iter_mut())
-        .map(|(n, s)| {
-            let (med, min) = median_min(s);
-            (n.to_string(), med, min)
-        })
-        .collect();
-    let (tmed, tmin) = median_min(&mut totals);
-    if a.json {
-        let v = json!({
-            "bench": "gbuffer",
-            "scene": a.scene.scene, "width": a.scene.width, "height": a.scene.height, "frames": a.frames,
-            "triangles": scene.triangle_count(),
-            "device": gpu.describe(),
-            "passes": rows.iter().map(|(n, med, min)| json!({"name": n, "median_ms": med, "min_ms": min})).collect::<Vec<_>>(),
-            "total_median_ms": tmed, "total_min_ms": tmin,
-        });
-        println!("{}", serde_json::to_string(&v)?);
-    } else {
-        println!(
-            "{} at {}x{}, {} triangles, {} frames on {}",
-            a.scene.scene,
-            a.scene.width,
-            a.scene.height,
-            scene.triangle_count(),
-            a.frames,
-            gpu.describe()
-        );
-        println!("{:<10} {:>10} {:>10}", "pass", "median ms", "min ms");
-        for (n, med, min) in &rows {
-            println!("{n:<10} {med:>10.3} {min:>10.3}");
+        BenchWhat::Reflections(b) => {
+            let rs = ReflectionSettings {
+                steps: b.steps,
+                max_distance: b.max_distance,
+                ..Default::default()
+            };
+            let r = reflections::run(&(&b.stage).into(), &rs)?;
+            (BenchResult::Reflections(r), b.stage.json)
         }
-        println!("{:<10} {:>10.3} {:>10.3}", "total", tmed, tmin);
+    };
+    if json {
+        println!("{}", to_json_string(&result)?);
+        return Ok(());
+    }
+    match &result {
+        BenchResult::Gbuffer(g) => print_gbuffer(g),
+        BenchResult::DeepGbuffer(d) => print_deep(d, frame_of(a)),
+        BenchResult::Reference(r) => print_reference(r),
+        BenchResult::Ao(s) | BenchResult::Radiosity(s) | BenchResult::Reflections(s) => print_stage(result.name(), s),
     }
     Ok(())
 }
 
-pub fn wgpu_ts() -> strata_render::gpu::Features {
-    strata_render::gpu::Features::TIMESTAMP_QUERY | strata_render::gpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+fn frame_of(a: &BenchArgs) -> f32 {
+    match &a.what {
+        BenchWhat::DeepGbuffer(b) => b.scene.frame,
+        _ => 0.0,
+    }
+}
+
+fn print_gbuffer(g: &GbufferBench) {
+    let r = &g.run;
+    println!(
+        "{} at {}x{}, {} triangles, {} frames on {}",
+        r.scene, r.width, r.height, r.triangles, r.frames, r.device
+    );
+    println!("{:<10} {:>10} {:>10}", "pass", "median ms", "min ms");
+    for p in &g.passes {
+        println!("{:<10} {:>10.3} {:>10.3}", p.name, p.median_ms, p.min_ms);
+    }
+    println!("{:<10} {:>10.3} {:>10.3}", "total", g.total_median_ms, g.total_min_ms);
+}
+
+fn print_stage(name: &str, s: &StageBench) {
+    let r = &s.run;
+    println!(
+        "{} {name} at {}x{}, k = {}, {} frames on {}",
+        r.scene, r.width, r.height, s.layers, r.frames, r.device
+    );
+    println!("{:<18} {:>10} {:>10}", "pass", "median ms", "min ms");
+    for p in &s.passes {
+        println!("{:<18} {:>10.3} {:>10.3}", p.name, p.median_ms, p.min_ms);
+    }
+    println!("{}", s.split_line(name));
+}
+
+fn print_deep(d: &DeepBench, f0: f32) {
+    let r = &d.run;
+    println!(
+        "{} at {}x{}, {} layers, {} triangles, {} frames from frame {} on {}",
+        r.scene, r.width, r.height, d.layers, r.triangles, r.frames, f0, r.device
+    );
+    println!(
+        "{:<13} {:>10} {:>10} {:>10} {:>8} {:>10} {:>14}",
+        "method", "layer1 ms", "layer2 ms", "total ms", "l2/l1", "mismatch %", "multiview ms"
+    );
+    for row in &d.rows {
+        let mv = row
+            .multiview_total_ms
+            .map(|v| format!("{v:.3}"))
+            .unwrap_or_else(|| "-".into());
+        println!(
+            "{:<13} {:>10.3} {:>10.3} {:>10.3} {:>8.2} {:>10.3} {mv:>14}",
+            row.method,
+            row.layer1_ms,
+            row.layer2_ms,
+            row.total_ms,
+            row.layer2_ms / row.layer1_ms,
+            row.mismatch_pct
+        );
+    }
+    println!("(peel, and single-pass methods with a multiview column, ran one submission per layer)");
+}
+
+fn print_reference(r: &ReferenceBench) {
+    println!(
+        "{}: {} triangles, BVH {:.2} s; {:.1} M rays (primary + 1 diffuse bounce) in {:.2} s on {} threads = {:.2} M rays/s",
+        r.scene,
+        r.triangles,
+        r.bvh_build_s,
+        r.rays as f64 * 1e-6,
+        r.seconds,
+        r.threads,
+        r.mrays_per_s
+    );
 }

@@ -2,18 +2,13 @@
 
 mod args;
 mod bench;
-mod bench_deep;
-mod bench_gi;
+mod convert;
 mod eval;
-mod eval_gi;
 mod info;
-mod metrics;
 mod output;
-mod probes;
-mod ref_cache;
 mod reference;
 mod render;
-mod report;
+mod report_cmd;
 mod soak;
 mod techniques;
 
@@ -60,6 +55,7 @@ fn main() {
         args::Command::Soak(a) => soak::run(&a),
         args::Command::Techniques(a) => techniques::run(&a),
         args::Command::Eval(a) => eval::run(&a),
+        args::Command::Report(a) => report_cmd::run(&a),
     };
     if let Err(e) = result {
         // One line: what is wrong and what is valid.

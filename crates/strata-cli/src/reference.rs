@@ -1,18 +1,16 @@
-//! `strata reference` (CPU ground truth images) and `strata bench reference`
-//! (ray throughput).
+//! `strata reference`: CPU ground truth images (its throughput benchmark is
+//! `strata_eval::bench::reference`).
 
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 use anyhow::{bail, Result};
-use serde_json::json;
 use strata_reference::ao::{AoBinarySettings, ObscuranceSettings};
 use strata_reference::gi::GiSettings;
 use strata_reference::layers::LayerSettings;
 use strata_reference::Reference;
 use strata_scene::ImageBuf;
 
-use crate::args::{BenchReferenceArgs, ReferenceArgs, ReferenceKind};
+use crate::args::{ReferenceArgs, ReferenceKind};
 use crate::output::{check_output, save, scene_and_camera};
 
 pub fn run(a: &ReferenceArgs) -> Result<()> {
@@ -136,48 +134,9 @@ fn sibling(p: &Path, suffix: &str) -> PathBuf {
 
 /// Exposure + the GPU's ACES curve, for PNG output of radiance images.
 fn tonemap(img: &ImageBuf, exposure: f32) -> ImageBuf {
-    let aces = |x: f32| ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
     let mut o = img.clone();
-    o.data.iter_mut().for_each(|v| *v = aces(*v * exposure));
+    o.data
+        .iter_mut()
+        .for_each(|v| *v = strata_eval::metrics::aces(*v * exposure));
     o
-}
-
-pub fn bench(a: &BenchReferenceArgs) -> Result<()> {
-    let (scene, cams) = scene_and_camera(&a.scene)?;
-    let camera = cams.current;
-    if !(a.mrays > 0.0 && a.mrays <= 10_000.0) {
-        bail!("--mrays {} is out of range: must be in (0, 10000]", a.mrays);
-    }
-    let reference = Reference::new(&scene, a.scene.frame).with_progress(false);
-    let t = reference.measure_throughput(
-        &camera,
-        a.scene.width,
-        a.scene.height,
-        (a.mrays * 1e6) as u64,
-        Duration::from_secs(600),
-    );
-    let threads = t.threads;
-    if a.json {
-        println!(
-            "{}",
-            serde_json::to_string(&json!({
-                "bench": "reference", "scene": a.scene.scene, "triangles": scene.triangle_count(),
-                "width": a.scene.width, "height": a.scene.height, "threads": threads,
-                "bvh_build_s": reference.build_seconds(), "rays": t.rays, "seconds": t.seconds,
-                "mrays_per_s": t.mrays_per_second(),
-            }))?
-        );
-    } else {
-        println!(
-            "{}: {} triangles, BVH {:.2} s; {:.1} M rays (primary + 1 diffuse bounce) in {:.2} s on {} threads = {:.2} M rays/s",
-            a.scene.scene,
-            scene.triangle_count(),
-            reference.build_seconds(),
-            t.rays as f64 * 1e-6,
-            t.seconds,
-            threads,
-            t.mrays_per_second()
-        );
-    }
-    Ok(())
 }

@@ -35,9 +35,9 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
         settings.radiosity = Some(f.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?);
         // blended with baked light probes (modulated by AO)
         if !f.no_probes {
-            settings.probes = Some(crate::probes::scene_probes(
+            settings.probes = Some(strata_eval::cache::probes::scene_probes(
                 &scene,
-                &crate::ref_cache::RefCache::new(crate::ref_cache::RefCache::default_dir()),
+                &strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir()),
                 false,
             )?);
         }

@@ -9,18 +9,19 @@ use strata_reference::Reference;
 use strata_scene::probes::IrradianceProbes;
 use strata_scene::{ImageBuf, Scene};
 
-use crate::ref_cache::RefCache;
+use super::{scene_fingerprint, RefCache};
 
 /// Probes per axis, rays per probe, path bounces.
 pub const GRID: [u32; 3] = [8, 4, 8];
 pub const RAYS: u32 = 512;
 pub const BOUNCES: u32 = 3;
 
-/// The scene's probes at animation frame 0 (static lighting), from the cache or baked.
+/// The scene's probes at animation frame 0 (static lighting), from the cache or baked (with a
+/// notice on stderr unless `quiet`).
 pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
         "v2 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
-        crate::eval::scene_fingerprint(scene, 0.0)
+        scene_fingerprint(scene, 0.0)
     );
     let key = RefCache::key(&description);
     if let Some(img) = cache.load(&key) {

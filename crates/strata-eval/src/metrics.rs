@@ -1,15 +1,18 @@
-//! Image error metrics for `strata eval`: NVIDIA's LDR ꟻLIP (via the `nv-flip` crate), RMSE and MAE
-//! between a reference image and a test image, plus the ꟻLIP error map for the report.
+//! Image error metrics: NVIDIA's LDR ꟻLIP (via the `nv-flip` crate), RMSE and MAE between a
+//! reference image and a test image, plus the ꟻLIP error map for the report; RMSE and MAE of
+//! linear values ([`linear_errors`]) and the tonemapper's display values ([`display`]).
 //!
 //! Both images are *display values* in [0, 1]: the caller decides the encoding (exposure, tonemap,
 //! sRGB or not) before calling [`compare`]; nothing here applies a transfer function.
 
 use anyhow::{bail, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use strata_scene::ImageBuf;
 
 /// Errors of a test image against a reference image.
-#[derive(Clone, Copy, Debug, Serialize)]
+///
+/// Serialised as `{"flip", "rmse", "mae"}` (the pixel count is left out).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ErrorStats {
     /// Mean ꟻLIP error over all pixels (0 = identical, 1 = maximal), LDR ꟻLIP at
     /// [`nv_flip::DEFAULT_PIXELS_PER_DEGREE`] on the 8-bit quantised images.
@@ -19,14 +22,8 @@ pub struct ErrorStats {
     /// Mean absolute difference over every channel of every pixel of the float data (unclamped).
     pub mae: f32,
     /// Number of pixels compared.
+    #[serde(skip)]
     pub pixels: usize,
-}
-
-impl ErrorStats {
-    /// `{"flip", "rmse", "mae"}` for reports.
-    pub fn json(&self) -> serde_json::Value {
-        serde_json::json!({"flip": self.flip, "rmse": self.rmse, "mae": self.mae})
-    }
 }
 
 /// Compares `test` against `reference`; returns the error statistics and the ꟻLIP error map.
@@ -86,6 +83,40 @@ pub fn compare(reference: &ImageBuf, test: &ImageBuf) -> Result<(ErrorStats, Ima
         pixels: w as usize * h as usize,
     };
     Ok((stats, map))
+}
+
+/// RMSE and MAE of linear values (every channel of every pixel; images of the same shape).
+pub fn linear_errors(reference: &ImageBuf, test: &ImageBuf) -> (f32, f32) {
+    let n = reference.data.len().max(1) as f64;
+    let (mut se, mut ae) = (0.0f64, 0.0f64);
+    for (r, t) in reference.data.iter().zip(&test.data) {
+        let d = (*t - *r) as f64;
+        se += d * d;
+        ae += d.abs();
+    }
+    ((se / n).sqrt() as f32, (ae / n) as f32)
+}
+
+/// [`compare`] on display values (`display(·, exposure)`: FLIP and the map) with RMSE and MAE
+/// replaced by those of the linear radiance.
+pub fn compare_radiance(reference: &ImageBuf, test: &ImageBuf, exposure: f32) -> Result<(ErrorStats, ImageBuf)> {
+    let (mut stats, map) = compare(&display(reference, exposure), &display(test, exposure))?;
+    (stats.rmse, stats.mae) = linear_errors(reference, test);
+    Ok((stats, map))
+}
+
+/// ACES filmic fit (as `color.wgsl`), clamped to [0, 1].
+pub fn aces(x: f32) -> f32 {
+    ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+}
+
+/// The tonemapper's display values: exposure, ACES fit (as `color.wgsl`), sRGB.
+pub fn display(img: &ImageBuf, exposure: f32) -> ImageBuf {
+    let mut out = img.clone();
+    for v in &mut out.data {
+        *v = strata_scene::image_buf::linear_to_srgb(aces(*v * exposure));
+    }
+    out
 }
 
 /// Validates what `compare` (and `nv-flip`, which panics on short data) relies on.
@@ -255,6 +286,20 @@ mod tests {
             data: vec![1.0 / 255.0, 0.499 / 255.0, 0.2],
         };
         assert_eq!(ldr_bytes(&c), vec![1, 0, 51]);
+    }
+
+    #[test]
+    fn linear_errors_and_display() {
+        let a = pattern(2, 2).channel(0);
+        let b = offset(&a, 2.0);
+        let (rmse, mae) = linear_errors(&a, &b);
+        assert!((mae - 2.0).abs() < 1e-6 && (rmse - 2.0).abs() < 1e-6);
+        let d = display(&b, 1.0);
+        assert!(d.data.iter().all(|v| *v > 0.9 && *v <= 1.0), "{:?}", d.data);
+        assert_eq!(display(&ImageBuf::new(2, 2, 1), 1.0).data, vec![0.0; 4]);
+        let json = serde_json::to_value(compare(&a, &b).unwrap().0).unwrap();
+        let keys: Vec<_> = json.as_object().unwrap().keys().cloned().collect();
+        assert_eq!(keys, ["flip", "mae", "rmse"]);
     }
 
     #[test]

@@ -1,6 +1,6 @@
-//! On-disk cache of CPU reference images for `strata eval`: a reference render takes minutes, so it
-//! is stored under a key derived from everything that determines it and reused while that is
-//! unchanged.
+//! On-disk cache of CPU reference images (and, in [`probes`], baked light probes): a reference
+//! render takes minutes, so it is stored under a key derived from everything that determines it
+//! ([`scene_fingerprint`], camera, settings) and reused while that is unchanged.
 //!
 //! Each entry is `<key>.bin` (magic `STRATAREF2` naming the format version, then width, height,
 //! channels as little-endian `u32`, the 64-bit FNV-1a checksum of the data, then the float data as
@@ -13,7 +13,9 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use strata_scene::ImageBuf;
+use strata_scene::{ImageBuf, Scene};
+
+pub mod probes;
 
 const MAGIC: &[u8; 10] = b"STRATAREF2";
 /// Magic + width, height, channels + checksum.
@@ -107,6 +109,51 @@ impl RefCache {
     fn bin_path(&self, key: &str) -> PathBuf {
         self.dir.join(format!("{key}.bin"))
     }
+
+    /// The image for `description`, from the cache (unless `refresh`) or computed and stored
+    /// (a failure to store is logged, not fatal).
+    pub fn get_or_compute(&self, refresh: bool, description: &str, compute: impl FnOnce() -> ImageBuf) -> ImageBuf {
+        let key = RefCache::key(description);
+        if !refresh {
+            if let Some(img) = self.load(&key) {
+                tracing::info!("reference {key} from {}", self.dir.display());
+                return img;
+            }
+        }
+        let img = compute();
+        self.store_or_warn(&key, &img, description);
+        img
+    }
+
+    /// [`RefCache::store`], logging a failure instead of returning it.
+    pub fn store_or_warn(&self, key: &str, img: &ImageBuf, description: &str) {
+        if let Err(e) = self.store(key, img, description) {
+            tracing::warn!("could not cache the reference: {e:#}");
+        }
+    }
+}
+
+/// Identifies a scene's content at one frame for cache keys: name, triangle count, an FNV-1a hash
+/// of every vertex position and index, the materials, the object transforms at `frame`, and the
+/// scene settings.
+pub fn scene_fingerprint(scene: &Scene, frame: f32) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for m in &scene.meshes {
+        eat(bytemuck::cast_slice(&m.positions));
+        eat(bytemuck::cast_slice(&m.indices));
+        eat(&(m.material as u64).to_le_bytes());
+    }
+    for o in &scene.objects {
+        eat(bytemuck::cast_slice(&o.transform_at(frame).to_cols_array()));
+        eat(&(o.mesh as u64).to_le_bytes());
+    }
+    eat(format!("{:?}{:?}", scene.materials, scene.settings).as_bytes());
+    format!("scene={} tris={} geometry={h:016x}", scene.name, scene.triangle_count(),)
 }
 
 /// [`RefCache::default_dir`] with the environment given as a function (testable without touching

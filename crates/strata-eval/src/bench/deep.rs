@@ -4,15 +4,35 @@
 
 use std::path::Path;
 
+use std::path::PathBuf;
+
 use anyhow::{bail, Result};
-use serde_json::json;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, LayerComparison, Submission, Variant};
-use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::ImageBuf;
 
-use crate::args::BenchDeepArgs;
-use crate::bench::{median_min, wgpu_ts};
-use crate::output::{cameras_at, check_output, save, scene_and_camera};
+use super::{bench_run, check_frames, timing_gpu};
+use crate::files::{check_output, save};
+use crate::results::{DeepBench, DeepRow};
+use crate::scene::SceneSpec;
+use crate::stats::median_min;
+
+/// What to compare.
+#[derive(Clone, Debug)]
+pub struct DeepSettings {
+    pub scene: SceneSpec,
+    pub adapter: Option<String>,
+    /// Frames along the camera path to time and compare (after one warm-up frame), 1..=10000.
+    pub frames: u32,
+    /// Deep G-buffer layers k, 2..=4 (delay and predict run only for k = 2).
+    pub layers: u32,
+    /// Minimum separation Δz in scene units (default: the scene's).
+    pub min_separation: Option<f32>,
+    /// Write Fig. 3-style images into this folder.
+    pub images: Option<PathBuf>,
+    /// Overwrite existing images.
+    pub force: bool,
+}
 
 /// One construction method being measured.
 struct Method {
@@ -28,14 +48,12 @@ struct Method {
     counted: u64,
 }
 
-pub fn run(a: &BenchDeepArgs) -> Result<()> {
-    if !(1..=10000).contains(&a.frames) {
-        bail!("--frames {} is out of range: must be in 1..=10000", a.frames);
-    }
+pub fn run(a: &DeepSettings) -> Result<DeepBench> {
+    check_frames(a.frames)?;
     if !(2..=strata_render::passes::deep_gbuffer::MAX_LAYERS).contains(&a.layers) {
         bail!("--layers {} is out of range: must be in 2..=4", a.layers);
     }
-    let (scene, _) = scene_and_camera(&a.scene)?;
+    let (scene, _) = a.scene.load()?;
     if let Some(dir) = &a.images {
         for m in Variant::ALL {
             check_output(&dir.join(format!("{m}-layer1.png")), a.force)?;
@@ -44,12 +62,7 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
             }
         }
     }
-    let gpu = GpuContext::new(&GpuOptions {
-        adapter: a.gpu.adapter.clone(),
-    })?;
-    if !gpu.has(wgpu_ts()) {
-        bail!("the adapter lacks TIMESTAMP_QUERY / TIMESTAMP_QUERY_INSIDE_ENCODERS, which `strata bench` needs");
-    }
+    let gpu = timing_gpu(&a.adapter)?;
     let settings = |layers: u32, variant: Variant, submission: Submission| RenderSettings {
         width: a.scene.width,
         height: a.scene.height,
@@ -95,7 +108,7 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
     // Frame f0 − 1 is the warm-up (and gives the single-pass variants their first oracle).
     for i in -1..a.frames as i32 {
         let f = f0 + i as f32;
-        let cams = cameras_at(&scene, &a.scene, f);
+        let cams = a.scene.cameras_at(&scene, f);
         let mut peel_layer1: Option<ImageBuf> = None;
         for m in methods.iter_mut() {
             let t = m.renderer.render(&gpu, &scene, &cams, f)?;
@@ -169,50 +182,23 @@ pub fn run(a: &BenchDeepArgs) -> Result<()> {
         },
     };
 
-    if a.json {
-        let v = json!({
-            "scene": a.scene.scene, "width": a.scene.width, "height": a.scene.height,
-            "layers": a.layers, "frames": a.frames, "triangles": scene.triangle_count(),
-            "device": gpu.describe(),
-            "rows": rows.iter().map(|(m, l1, l2, t, mm, mv)| {
-                let mut row = json!({
-                    "method": m, "layer1_ms": l1, "layer2_ms": l2, "total_ms": t, "mismatch_pct": mm,
-                    "submission": submission(m),
-                });
-                if let Some(mv) = mv {
-                    row["multiview_total_ms"] = json!(mv);
-                    row["multiview_layer2_ms"] = json!(mv - l1);
-                }
-                row
-            }).collect::<Vec<_>>(),
-        });
-        println!("{}", serde_json::to_string(&v)?);
-    } else {
-        println!(
-            "{} at {}x{}, {} layers, {} triangles, {} frames from frame {} on {}",
-            a.scene.scene,
-            a.scene.width,
-            a.scene.height,
-            a.layers,
-            scene.triangle_count(),
-            a.frames,
-            f0,
-            gpu.describe()
-        );
-        println!(
-            "{:<13} {:>10} {:>10} {:>10} {:>8} {:>10} {:>14}",
-            "method", "layer1 ms", "layer2 ms", "total ms", "l2/l1", "mismatch %", "multiview ms"
-        );
-        for (m, l1, l2, t, mm, mv) in &rows {
-            let mv = mv.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
-            println!(
-                "{m:<13} {l1:>10.3} {l2:>10.3} {t:>10.3} {:>8.2} {mm:>10.3} {mv:>14}",
-                l2 / l1
-            );
-        }
-        println!("(peel, and single-pass methods with a multiview column, ran one submission per layer)");
-    }
-    Ok(())
+    Ok(DeepBench {
+        run: bench_run(&a.scene, a.frames, &scene, &gpu),
+        layers: a.layers,
+        rows: rows
+            .iter()
+            .map(|&(m, l1, l2, t, mm, mv)| DeepRow {
+                method: m.into(),
+                layer1_ms: l1,
+                layer2_ms: l2,
+                total_ms: t,
+                mismatch_pct: mm,
+                submission: submission(m).into(),
+                multiview_total_ms: mv,
+                multiview_layer2_ms: mv.map(|mv| mv - l1),
+            })
+            .collect(),
+    })
 }
 
 /// GPU time of a frame's G-buffer construction: every geometry pass (layer 0,

@@ -1,0 +1,27 @@
+//! `strata bench ao`: the deep-G-buffer AO passes (DGB Table 4, AO column).
+
+use anyhow::Result;
+use serde_json::json;
+use strata_render::passes::ao::AoSettings;
+use strata_render::RenderSettings;
+
+use super::stage::{self, Stage, StageSettings};
+use crate::results::StageBench;
+
+/// The AO stage's passes, in frame order.
+pub const AO_PASSES: [&str; 5] = ["depth-mip", "ao", "ao-temporal", "ao-blur-h", "ao-blur-v"];
+
+pub fn run(stage: &StageSettings, ao: &AoSettings) -> Result<StageBench> {
+    let extra = json!({"samples": ao.samples, "blur_taps": ao.blur.taps(),
+        "temporal_alpha": ao.temporal.map_or(0.0, |t| t.alpha), "variant": stage.variant.to_string()});
+    stage::run(Stage {
+        stage,
+        passes: &AO_PASSES,
+        settings: Box::new(move |layers| RenderSettings {
+            shade: false,
+            ao: Some(ao.clone()),
+            ..stage.render_settings(layers)
+        }),
+        extra,
+    })
+}

@@ -1,0 +1,248 @@
+//! Evaluations: a GPU technique against the CPU ground truth for the same camera and pixel
+//! centres ([`ao`]: deep-G-buffer AO against the ray-traced obscurance; [`gi`]: deep-G-buffer
+//! radiosity against the path tracer), with temporal flicker along the camera path
+//! ([`flicker`]) and an HTML report. What both share is here.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use strata_render::passes::deep_gbuffer::DeepGBufferSettings;
+use strata_render::renderer::GuardBand;
+use strata_render::{GpuContext, RenderSettings, Renderer};
+use strata_scene::{Camera, ImageBuf, Scene};
+
+use crate::report::{sections, Page, ReportImage, Section};
+use crate::results::{ByLayers, EvalResult, EvalRun, Flicker};
+use crate::scene::SceneSpec;
+
+pub mod ao;
+pub mod gi;
+
+/// What every evaluation takes.
+#[derive(Clone, Debug)]
+pub struct EvalSettings {
+    pub scene: SceneSpec,
+    /// Adapter name substring (default: the first real GPU).
+    pub adapter: Option<String>,
+    /// Deep G-buffer construction; `deep.layers` is the k evaluated.
+    pub deep: DeepGBufferSettings,
+    pub guard_band: GuardBand,
+    /// Samples per pixel of the CPU reference, 1..=65536 (default: the technique's).
+    pub ref_spp: Option<u32>,
+    /// Static frames rendered before the evaluated one (gi), 0..=1000.
+    pub warmup: u32,
+    /// Folder of cached reference images.
+    pub cache: PathBuf,
+    /// Recompute the reference even when cached.
+    pub no_cache: bool,
+    /// Also measure flicker over this many frames, 2..=1000.
+    pub frames: Option<u32>,
+    /// Write an HTML report into this folder (with every k from 1 to `deep.layers`).
+    pub report: Option<PathBuf>,
+    /// Overwrite an existing report.
+    pub force: bool,
+    /// Progress bars of the CPU reference on stderr.
+    pub progress: bool,
+}
+
+impl EvalSettings {
+    /// Checks what every technique shares and returns the reference's samples per pixel
+    /// (`default_spp` unless `ref_spp`).
+    pub(crate) fn check(&self, default_spp: u32) -> Result<u32> {
+        let spp = self.ref_spp.unwrap_or(default_spp);
+        if !(1..=65536).contains(&spp) {
+            bail!("--ref-spp {spp} is out of range: must be in 1..=65536");
+        }
+        if let Some(n) = self.frames {
+            if !(2..=1000).contains(&n) {
+                bail!("--frames {n} is out of range: must be in 2..=1000");
+            }
+        }
+        if let Some(dir) = &self.report {
+            if dir.join("index.html").exists() && !self.force {
+                bail!(
+                    "--report {}: a report exists there; pass --force to overwrite it",
+                    dir.display()
+                );
+            }
+        }
+        Ok(spp)
+    }
+
+    /// Render settings of this size and construction with `layers` layers (the technique's
+    /// stages still to set).
+    pub(crate) fn render_settings(&self, layers: u32) -> RenderSettings {
+        RenderSettings {
+            width: self.scene.width,
+            height: self.scene.height,
+            deep: DeepGBufferSettings { layers, ..self.deep },
+            guard_band: self.guard_band,
+            ..Default::default()
+        }
+    }
+
+    /// What the result says about this run besides its errors.
+    pub(crate) fn run_info(&self, ref_spp: u32, reference: &str, device: String, flicker: Option<Flicker>) -> EvalRun {
+        EvalRun {
+            scene: self.scene.scene.clone(),
+            layers: self.deep.layers,
+            variant: self.deep.variant.to_string(),
+            width: self.scene.width,
+            height: self.scene.height,
+            frame: self.scene.frame,
+            ref_spp,
+            reference: reference.into(),
+            device,
+            flicker,
+        }
+    }
+
+    /// With a report, the errors of every evaluated layer count (`(layers, errors)` pairs).
+    pub(crate) fn by_layers<E: Copy>(&self, evaluated: impl Iterator<Item = (u32, E)>) -> Vec<ByLayers<E>> {
+        match self.report {
+            Some(_) => evaluated.map(|(layers, errors)| ByLayers { layers, errors }).collect(),
+            None => Vec::new(),
+        }
+    }
+
+    /// The layer counts to evaluate: k, and with a report every count from 1 to k.
+    pub(crate) fn layer_counts(&self) -> Vec<u32> {
+        let k = self.deep.layers;
+        match self.report {
+            Some(_) => (1..=k).collect(),
+            None => vec![k],
+        }
+    }
+}
+
+/// Writes `dir/index.html`: the result's tables and plots, then `images` (sections of figures
+/// already saved in `dir`).
+pub(crate) fn write_report(
+    dir: &std::path::Path,
+    title: String,
+    result: &EvalResult,
+    images: Vec<Section>,
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
+    let mut page = Page::new(title);
+    page.sections = sections::eval_sections(result, dir, "plot-")?;
+    page.sections.extend(images);
+    page.write(&dir.join("index.html"))?;
+    Ok(())
+}
+
+/// Saves `img` as `dir/name` (display values: bytes written as is) and returns its figure.
+pub(crate) fn figure(dir: &std::path::Path, img: &ImageBuf, name: &str, caption: String) -> Result<ReportImage> {
+    img.save(&dir.join(name), false).map_err(|e| anyhow::anyhow!(e))?;
+    Ok(ReportImage {
+        caption,
+        file: name.into(),
+    })
+}
+
+/// Last frame's depth and AV at sub-pixel position (px, py): 1/z and AV
+/// interpolated bilinearly between the four nearest texel centres (1/z is
+/// exact on planes); `None` where any of the four has no surface.
+fn reproject(csz: &ImageBuf, av: &ImageBuf, px: f32, py: f32) -> Option<(f32, f32)> {
+    let (fx, fy) = (px - 0.5, py - 0.5);
+    let (x0, y0) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - x0, fy - y0);
+    let clampx = |x: f32| (x.max(0.0) as u32).min(csz.width - 1);
+    let clampy = |y: f32| (y.max(0.0) as u32).min(csz.height - 1);
+    let (mut inv, mut value) = (0.0f32, 0.0f32);
+    for (dx, dy, w) in [
+        (0.0, 0.0, (1.0 - tx) * (1.0 - ty)),
+        (1.0, 0.0, tx * (1.0 - ty)),
+        (0.0, 1.0, (1.0 - tx) * ty),
+        (1.0, 1.0, tx * ty),
+    ] {
+        let (x, y) = (clampx(x0 + dx), clampy(y0 + dy));
+        let z = csz.pixel(x, y)[0];
+        if z <= 0.0 {
+            return None;
+        }
+        inv += w / z;
+        value += w * av.pixel(x, y)[0];
+    }
+    Some((1.0 / inv, value))
+}
+
+/// Temporal instability of channel 0 of target `target` rendered with `settings` along the
+/// camera path from `spec.frame` over `frames` frames: mean |v_t(p) − v_{t−1}(p′)| over pixels
+/// whose surface reprojects (p′ in frame t − 1, interpolated) onto the same surface within
+/// `threshold`, averaged over consecutive frame pairs.
+pub fn flicker(
+    gpu: &GpuContext,
+    scene: &Scene,
+    spec: &SceneSpec,
+    settings: RenderSettings,
+    target: &str,
+    threshold: f32,
+    frames: u32,
+) -> Result<Flicker> {
+    let mut r = Renderer::new(gpu, scene, settings)?;
+    let (w, h) = (spec.width, spec.height);
+    let mut prev: Option<(Camera, ImageBuf, ImageBuf)> = None;
+    let (mut sum, mut pairs, mut valid, mut counted) = (0.0f64, 0u32, 0u64, 0u64);
+    // one warm-up frame so the first measured pair already has history
+    let f0 = spec.frame;
+    r.render(gpu, scene, &spec.cameras_at(scene, f0 - 1.0), f0 - 1.0)?;
+    let mut per_frame = Vec::new();
+    for i in 0..frames {
+        let f = f0 + i as f32;
+        let cams = spec.cameras_at(scene, f);
+        r.render(gpu, scene, &cams, f)?;
+        let av = r.read_target(gpu, target)?.channel(0);
+        let csz = r.read_target(gpu, "csz")?;
+        if let Some((pcam, pav, pcsz)) = &prev {
+            let vp = pcam.view_projection(w as f32 / h as f32);
+            let (mut d, mut n) = (0.0f64, 0u64);
+            for y in 0..h {
+                for x in 0..w {
+                    let z = csz.pixel(x, y)[0];
+                    if z <= 0.0 {
+                        continue;
+                    }
+                    counted += 1;
+                    let p = cams.current.eye + cams.current.pixel_dir(x, y, w, h) * z;
+                    let clip = vp * p.extend(1.0);
+                    if clip.w <= 0.0 {
+                        continue;
+                    }
+                    let (px, py) = (
+                        (clip.x / clip.w * 0.5 + 0.5) * w as f32,
+                        (0.5 - 0.5 * clip.y / clip.w) * h as f32,
+                    );
+                    if !(px >= 0.0 && py >= 0.0 && px < w as f32 && py < h as f32) {
+                        continue;
+                    }
+                    let Some((zq, prev_av)) = reproject(pcsz, pav, px, py) else {
+                        continue;
+                    };
+                    if (zq - clip.w).abs() >= threshold {
+                        continue;
+                    }
+                    d += (av.pixel(x, y)[0] - prev_av).abs() as f64;
+                    n += 1;
+                }
+            }
+            if n > 0 {
+                sum += d / n as f64;
+                pairs += 1;
+                per_frame.push([f as f64, d / n as f64]);
+            }
+            valid += n;
+        }
+        prev = Some((cams.current, av, csz));
+    }
+    Ok(Flicker {
+        mean: if pairs > 0 { sum / pairs as f64 } else { 0.0 },
+        frames,
+        valid_fraction: if counted > 0 {
+            valid as f64 / counted as f64
+        } else {
+            0.0
+        },
+        per_frame,
+    })
+}

@@ -1,0 +1,364 @@
+//! Tables and plots of benchmark and evaluation results: errors by layer count (rows k, columns
+//! FLIP / RMSE / MAE / flicker) with an error-vs-layers plot and a flicker-over-frames plot;
+//! per-pass GPU times (rows passes, columns median / min ms) with a bar plot. Plots are written
+//! as SVG files into the page's folder, named `{prefix}{what}.svg`.
+
+use std::path::Path;
+
+use anyhow::Result;
+use serde::Serialize;
+
+use super::{plot, write_file, Cell, ReportImage, Section, Table};
+use crate::metrics::ErrorStats;
+use crate::results::{BenchResult, DeepBench, EvalResult, EvalRun, Fig10, PassTime, StageBench};
+
+/// Writes `svg` as `dir/file` and returns the figure that shows it.
+fn plot_file(dir: &Path, file: String, svg: String, caption: String) -> Result<ReportImage> {
+    write_file(&dir.join(&file), svg.as_bytes())?;
+    Ok(ReportImage { caption, file })
+}
+
+/// A `name | value` table of `v`'s fields other than `skip` (the settings of a run).
+fn settings_table<T: Serialize>(caption: &str, v: &T, skip: &[&str]) -> Result<Table> {
+    let mut v = serde_json::to_value(v)?;
+    if let Some(m) = v.as_object_mut() {
+        m.retain(|k, _| !skip.contains(&k.as_str()));
+    }
+    Ok(Table::key_values(caption, &v))
+}
+
+const AO_HEADER: [&str; 7] = [
+    "layers k",
+    "FLIP",
+    "RMSE",
+    "MAE",
+    "FLIP vs binary",
+    "MAE vs binary",
+    "flicker",
+];
+
+const GI_HEADER: [&str; 8] = [
+    "layers k",
+    "indirect FLIP",
+    "indirect RMSE",
+    "indirect MAE",
+    "full FLIP",
+    "full RMSE",
+    "full MAE",
+    "flicker",
+];
+
+/// One row of an error table: the label, then the cells.
+struct ErrorRow {
+    layers: u32,
+    cells: Vec<Cell>,
+    /// (FLIP, MAE) for the plot.
+    flip_mae: (f32, f32),
+}
+
+fn stats_cells(s: &ErrorStats) -> Vec<Cell> {
+    vec![s.flip.into(), s.rmse.into(), s.mae.into()]
+}
+
+/// Sections of an evaluation: its settings, the errors by layer count, DGB Fig. 10 when
+/// present, and the plots.
+pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Section>> {
+    let run = r.run();
+    let (what, header, rows, fig10): (_, &[&str], Vec<ErrorRow>, Option<&Fig10>) = match r {
+        EvalResult::Ao(e) => {
+            let row = |layers: u32, x: &crate::results::AoErrors| ErrorRow {
+                layers,
+                cells: [
+                    stats_cells(&x.obscurance),
+                    vec![x.binary.flip.into(), x.binary.mae.into()],
+                ]
+                .concat(),
+                flip_mae: (x.obscurance.flip, x.obscurance.mae),
+            };
+            let mut rows: Vec<ErrorRow> = e.by_layers.iter().map(|b| row(b.layers, &b.errors)).collect();
+            if rows.is_empty() {
+                rows.extend(e.layers_1.as_ref().map(|x| row(1, x)));
+                rows.push(row(run.layers, &e.errors));
+            }
+            ("AO against the ray-traced obscurance", &AO_HEADER[..], rows, None)
+        }
+        EvalResult::Gi(e) => {
+            let row = |layers: u32, x: &crate::results::GiErrors| ErrorRow {
+                layers,
+                cells: [stats_cells(&x.indirect), stats_cells(&x.full)].concat(),
+                flip_mae: (x.indirect.flip, x.indirect.mae),
+            };
+            let mut rows: Vec<ErrorRow> = e.by_layers.iter().map(|b| row(b.layers, &b.errors)).collect();
+            if rows.is_empty() {
+                rows.extend(e.layers_1.as_ref().map(|x| row(1, x)));
+                rows.push(row(run.layers, &e.errors));
+            }
+            (
+                "radiosity against the path tracer",
+                &GI_HEADER[..],
+                rows,
+                e.fig10.as_ref(),
+            )
+        }
+    };
+    let mut errors = Table::new(format!("Errors by layer count ({what})"), header);
+    for r in &rows {
+        let flicker = run.flicker.as_ref().filter(|_| r.layers == run.layers).map(|f| f.mean);
+        let mut cells = vec![Cell::Text(r.layers.to_string())];
+        cells.extend(r.cells.iter().cloned());
+        cells.push(flicker.into());
+        errors.row(cells);
+    }
+    let skip = [
+        "flip",
+        "rmse",
+        "mae",
+        "binary",
+        "full",
+        "layers_1",
+        "by_layers",
+        "fig10",
+        "flicker_per_frame",
+    ];
+    let mut section = Section::new(format!("{} on {}: numbers", technique(r), run.scene))
+        .table(settings_table("Settings", r, &skip)?)
+        .table(errors);
+    if let Some(f) = fig10 {
+        let mut t = Table::new(
+            "DGB Fig. 10: single-bounce radiosity against single-bounce references",
+            &[
+                "GPU",
+                "FLIP vs visibility",
+                "MAE vs visibility",
+                "FLIP vs mutual visibility",
+                "MAE vs mutual visibility",
+            ],
+        );
+        for (name, row) in [("with the n_Y test", &f.normal_test), ("without", &f.no_normal_test)] {
+            t.row(vec![
+                name.into(),
+                row.vs_visibility.flip.into(),
+                row.vs_visibility.mae.into(),
+                row.vs_mutual_visibility.flip.into(),
+                row.vs_mutual_visibility.mae.into(),
+            ]);
+        }
+        section = section.table(t);
+    }
+    section = section.figures(eval_plots(run, &rows, dir, prefix)?);
+    Ok(vec![section])
+}
+
+fn technique(r: &EvalResult) -> &'static str {
+    match r {
+        EvalResult::Ao(_) => "eval ao",
+        EvalResult::Gi(_) => "eval gi",
+    }
+}
+
+fn eval_plots(run: &EvalRun, rows: &[ErrorRow], dir: &Path, prefix: &str) -> Result<Vec<ReportImage>> {
+    let mut figs = Vec::new();
+    let points = |f: fn(&ErrorRow) -> f32| rows.iter().map(|r| (r.layers as f64, f(r) as f64)).collect();
+    let svg = plot::lines(
+        &format!("Error against layers ({})", run.scene),
+        "layers k",
+        "error",
+        &[
+            ("FLIP".into(), points(|r| r.flip_mae.0)),
+            ("MAE".into(), points(|r| r.flip_mae.1)),
+        ],
+    )?;
+    figs.push(plot_file(
+        dir,
+        format!("{prefix}errors.svg"),
+        svg,
+        "FLIP and MAE against the layer count k".into(),
+    )?);
+    if let Some(f) = run.flicker.as_ref().filter(|f| !f.per_frame.is_empty()) {
+        let pts = f.per_frame.iter().map(|p| (p[0], p[1])).collect();
+        let svg = plot::lines(
+            &format!("Flicker along the camera path ({}, k = {})", run.scene, run.layers),
+            "frame",
+            "mean |Δ| after reprojection",
+            &[("flicker".into(), pts)],
+        )?;
+        figs.push(plot_file(
+            dir,
+            format!("{prefix}flicker.svg"),
+            svg,
+            format!("flicker per frame (mean {:.5})", f.mean),
+        )?);
+    }
+    Ok(figs)
+}
+
+/// A pass table (rows passes, columns median / min ms per configuration) and the total row.
+fn pass_table(caption: String, configs: &[(&str, &[PassTime], (f64, f64))]) -> Table {
+    let mut header = vec!["pass".to_string()];
+    for (name, _, _) in configs {
+        header.push(format!("median ms{name}"));
+        header.push(format!("min ms{name}"));
+    }
+    let mut t = Table {
+        caption,
+        header,
+        rows: Vec::new(),
+    };
+    let Some((_, first, _)) = configs.first() else {
+        return t;
+    };
+    for p in first.iter() {
+        let mut row = vec![Cell::Text(p.name.clone())];
+        for (_, passes, _) in configs {
+            let q = passes.iter().find(|q| q.name == p.name);
+            row.push(q.map(|q| q.median_ms).into());
+            row.push(q.map(|q| q.min_ms).into());
+        }
+        t.row(row);
+    }
+    let mut total = vec![Cell::Text("total".into())];
+    for (_, _, (med, min)) in configs {
+        total.push((*med).into());
+        total.push((*min).into());
+    }
+    t.row(total);
+    t
+}
+
+/// Sections of a benchmark: settings, the time table, and a bar plot.
+pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<Section>> {
+    let name = b.name();
+    let skip = ["bench", "passes", "passes_layers_1", "rows", "increment_spread"];
+    let mut section = Section::new(format!("bench {name}")).table(settings_table("Settings", b, &skip)?);
+    match b {
+        BenchResult::Gbuffer(g) => {
+            section = section.table(pass_table(
+                "GPU time per pass".into(),
+                &[("", &g.passes, (g.total_median_ms, g.total_min_ms))],
+            ));
+            let svg = pass_bars(&format!("bench {name}: {}", g.run.scene), &g.passes, None)?;
+            section = section.figures(vec![plot_file(
+                dir,
+                format!("{prefix}passes.svg"),
+                svg,
+                "median GPU ms per pass".into(),
+            )?]);
+        }
+        BenchResult::Ao(s) | BenchResult::Radiosity(s) | BenchResult::Reflections(s) => {
+            section = stage_section(section, name, s, dir, prefix)?;
+        }
+        BenchResult::DeepGbuffer(d) => {
+            section = deep_section(section, d, dir, prefix)?;
+        }
+        BenchResult::Reference(_) => {}
+    }
+    Ok(vec![section])
+}
+
+fn pass_bars(title: &str, passes: &[PassTime], layers_1: Option<(&[PassTime], u32)>) -> Result<String> {
+    let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
+    let medians = |ps: &[PassTime]| {
+        names
+            .iter()
+            .map(|n| ps.iter().find(|p| &p.name == n).map_or(f64::NAN, |p| p.median_ms))
+            .collect::<Vec<_>>()
+    };
+    let mut series = Vec::new();
+    match layers_1 {
+        Some((one, k)) => {
+            series.push((format!("k = {k}"), medians(passes)));
+            series.push(("k = 1".to_string(), medians(one)));
+        }
+        None => series.push(("median".to_string(), medians(passes))),
+    }
+    plot::bars(title, "median GPU ms", &names, &series)
+}
+
+fn stage_section(section: Section, name: &str, s: &StageBench, dir: &Path, prefix: &str) -> Result<Section> {
+    let k = s.layers;
+    let kname = format!(" (k = {k})");
+    let mut configs: Vec<(&str, &[PassTime], (f64, f64))> =
+        vec![(&kname, &s.passes, (s.total_median_ms, s.total_min_ms))];
+    if let Some(one) = &s.passes_layers_1 {
+        configs.push((" (k = 1)", one, (s.layer1_ms, f64::NAN)));
+    }
+    let mut section = section
+        .table(pass_table("GPU time per pass".into(), &configs))
+        .text(s.split_line(name));
+    if let Some(sp) = &s.increment_spread {
+        let mut t = Table::new(
+            format!("Per-frame increment of layers 2..{k} (k = {k} − k = 1, same frame)"),
+            &[
+                "median ms",
+                "Q1 ms",
+                "Q3 ms",
+                "min ms",
+                "max ms",
+                "frames",
+                "within noise",
+            ],
+        );
+        t.row(vec![
+            sp.median_ms.into(),
+            sp.q1_ms.into(),
+            sp.q3_ms.into(),
+            sp.min_ms.into(),
+            sp.max_ms.into(),
+            Cell::Text(sp.frames.to_string()),
+            Cell::Text(if sp.includes_zero() { "yes" } else { "no" }.into()),
+        ]);
+        section = section.table(t);
+    }
+    let one = s.passes_layers_1.as_deref().map(|p| (p, k));
+    let svg = pass_bars(&format!("bench {name}: {}", s.run.scene), &s.passes, one)?;
+    Ok(section.figures(vec![plot_file(
+        dir,
+        format!("{prefix}passes.svg"),
+        svg,
+        "median GPU ms per pass".into(),
+    )?]))
+}
+
+fn deep_section(section: Section, d: &DeepBench, dir: &Path, prefix: &str) -> Result<Section> {
+    let mut t = Table::new(
+        format!("Deep G-buffer construction, k = {} (DGB Table 5)", d.layers),
+        &[
+            "method",
+            "layer1 ms",
+            "layer2 ms",
+            "total ms",
+            "l2/l1",
+            "mismatch %",
+            "submission",
+            "multiview ms",
+        ],
+    );
+    for r in &d.rows {
+        t.row(vec![
+            r.method.clone().into(),
+            r.layer1_ms.into(),
+            r.layer2_ms.into(),
+            r.total_ms.into(),
+            (r.layer2_ms / r.layer1_ms).into(),
+            r.mismatch_pct.into(),
+            r.submission.clone().into(),
+            r.multiview_total_ms.into(),
+        ]);
+    }
+    let methods: Vec<String> = d.rows.iter().map(|r| r.method.clone()).collect();
+    let svg = plot::bars(
+        &format!("Deep G-buffer construction ({})", d.run.scene),
+        "median GPU ms",
+        &methods,
+        &[
+            ("layer 1".into(), d.rows.iter().map(|r| r.layer1_ms).collect()),
+            ("layers 2..k".into(), d.rows.iter().map(|r| r.layer2_ms).collect()),
+        ],
+    )?;
+    Ok(section.table(t).figures(vec![plot_file(
+        dir,
+        format!("{prefix}methods.svg"),
+        svg,
+        "median GPU ms per construction method".into(),
+    )?]))
+}

@@ -1,0 +1,417 @@
+//! What the benchmarks and evaluations return: plain data, serialised as the JSON objects
+//! `strata bench … --json` and `strata eval … --json` print, and read back by
+//! [`crate::report::stitch`]. Keys are the ones those commands have always printed; fields added
+//! since (`increment_spread`, `increment_within_noise`, `flicker_per_frame`, `by_layers`,
+//! `bench: "deep-gbuffer"`) are extra keys.
+
+use serde::{Deserialize, Serialize};
+
+use crate::metrics::ErrorStats;
+use crate::stats::Spread;
+
+/// The JSON text of a result as the CLI prints it: through `serde_json::Value`, so keys are
+/// sorted and floats print as before the move into this crate.
+pub fn to_json_string<T: Serialize>(v: &T) -> serde_json::Result<String> {
+    serde_json::to_string(&serde_json::to_value(v)?)
+}
+
+/// Median and minimum GPU time of one pass over the timed frames.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PassTime {
+    pub name: String,
+    pub median_ms: f64,
+    pub min_ms: f64,
+}
+
+/// What every GPU benchmark ran on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BenchRun {
+    pub scene: String,
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub triangles: usize,
+    pub device: String,
+}
+
+/// `strata bench gbuffer`: per-pass times of the single-layer frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GbufferBench {
+    #[serde(flatten)]
+    pub run: BenchRun,
+    pub passes: Vec<PassTime>,
+    pub total_median_ms: f64,
+    pub total_min_ms: f64,
+}
+
+/// `strata bench ao | radiosity | reflections`: the technique's passes with k layers, and the
+/// "1st layer + increment" split against k = 1.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageBench {
+    #[serde(flatten)]
+    pub run: BenchRun,
+    pub layers: u32,
+    pub passes: Vec<PassTime>,
+    /// Median over frames of the per-frame sum of the technique's passes (k layers).
+    pub total_median_ms: f64,
+    pub total_min_ms: f64,
+    /// `total_median_ms` of the k = 1 run (of this run when k = 1).
+    pub layer1_ms: f64,
+    /// `total_median_ms − layer1_ms` (a difference of medians: they add up).
+    pub increment_ms: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub passes_layers_1: Option<Vec<PassTime>>,
+    /// The per-frame differences (k layers − 1 layer, same frame); k > 1 only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub increment_spread: Option<Spread>,
+    /// Whether `increment_spread`'s interquartile range includes zero; k > 1 only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub increment_within_noise: Option<bool>,
+    /// The technique's settings (preset, samples, variant, ...).
+    #[serde(flatten)]
+    pub settings: serde_json::Map<String, serde_json::Value>,
+}
+
+impl StageBench {
+    /// "total T ms = F (1st layer) + I (layers 2..k)", and with k > 1 the per-frame increments'
+    /// median, interquartile range and range, and whether the increment is within the
+    /// frame-to-frame noise (its interquartile range includes zero).
+    pub fn split_line(&self, name: &str) -> String {
+        let mut line = format!(
+            "{name} total {:.3} ms = {:.3} (1st layer) + {:.3} (layers 2..{})",
+            self.total_median_ms, self.layer1_ms, self.increment_ms, self.layers
+        );
+        if let Some(s) = &self.increment_spread {
+            line.push_str(&format!(
+                "; per-frame increment median {:.3} ms, IQR [{:.3}, {:.3}], range [{:.3}, {:.3}] over {} frames",
+                s.median_ms, s.q1_ms, s.q3_ms, s.min_ms, s.max_ms, s.frames
+            ));
+            if s.includes_zero() {
+                line.push_str(": within the frame-to-frame noise (the IQR includes 0)");
+            }
+        }
+        line
+    }
+}
+
+/// One construction method of `strata bench deep-gbuffer` (DGB Table 5, Fig. 3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DeepRow {
+    pub method: String,
+    pub layer1_ms: f64,
+    pub layer2_ms: f64,
+    pub total_ms: f64,
+    /// Second-layer pixels that differ from the exact peel, percent.
+    pub mismatch_pct: f64,
+    /// "per-layer" or "multiview".
+    pub submission: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub multiview_total_ms: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub multiview_layer2_ms: Option<f64>,
+}
+
+/// `strata bench deep-gbuffer`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DeepBench {
+    #[serde(flatten)]
+    pub run: BenchRun,
+    pub layers: u32,
+    pub rows: Vec<DeepRow>,
+}
+
+/// `strata bench reference`: CPU ray throughput.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceBench {
+    pub scene: String,
+    pub triangles: usize,
+    pub width: u32,
+    pub height: u32,
+    pub threads: usize,
+    pub bvh_build_s: f64,
+    pub rays: u64,
+    pub seconds: f64,
+    pub mrays_per_s: f64,
+}
+
+/// Any benchmark's result, tagged by `"bench"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "bench", rename_all = "kebab-case")]
+pub enum BenchResult {
+    Gbuffer(GbufferBench),
+    DeepGbuffer(DeepBench),
+    Ao(StageBench),
+    Radiosity(StageBench),
+    Reflections(StageBench),
+    Reference(ReferenceBench),
+}
+
+impl BenchResult {
+    /// The `"bench"` tag.
+    pub fn name(&self) -> &'static str {
+        match self {
+            BenchResult::Gbuffer(_) => "gbuffer",
+            BenchResult::DeepGbuffer(_) => "deep-gbuffer",
+            BenchResult::Ao(_) => "ao",
+            BenchResult::Radiosity(_) => "radiosity",
+            BenchResult::Reflections(_) => "reflections",
+            BenchResult::Reference(_) => "reference",
+        }
+    }
+}
+
+/// Temporal instability along the camera path: mean |v_t(p) − v_{t−1}(p′)| over pixels whose
+/// surface reprojects onto the same surface, averaged over consecutive frame pairs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Flicker {
+    #[serde(rename = "flicker")]
+    pub mean: f64,
+    #[serde(rename = "flicker_frames")]
+    pub frames: u32,
+    #[serde(rename = "flicker_valid_fraction")]
+    pub valid_fraction: f64,
+    /// `[frame t, mean |Δ| between t − 1 and t]` for each pair with valid pixels.
+    #[serde(rename = "flicker_per_frame", default)]
+    pub per_frame: Vec<[f64; 2]>,
+}
+
+/// What every evaluation reports besides its errors.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvalRun {
+    pub scene: String,
+    pub layers: u32,
+    pub variant: String,
+    pub width: u32,
+    pub height: u32,
+    pub frame: f32,
+    pub ref_spp: u32,
+    /// What the reference computes, in words.
+    pub reference: String,
+    pub device: String,
+    #[serde(flatten)]
+    pub flicker: Option<Flicker>,
+}
+
+/// Errors of one configuration of `k` layers (the report's error-vs-layers rows).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ByLayers<E> {
+    pub layers: u32,
+    #[serde(flatten)]
+    pub errors: E,
+}
+
+/// Deep-G-buffer AO errors: against the obscurance reference (top level) and binary AO.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AoErrors {
+    #[serde(flatten)]
+    pub obscurance: ErrorStats,
+    pub binary: ErrorStats,
+}
+
+/// `strata eval --technique ao`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AoEval {
+    #[serde(flatten)]
+    pub run: EvalRun,
+    pub samples: u32,
+    pub radius: f32,
+    pub bias: f32,
+    pub epsilon: f32,
+    #[serde(flatten)]
+    pub errors: AoErrors,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layers_1: Option<AoErrors>,
+    /// With a report: every k from 1 to `layers`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub by_layers: Vec<ByLayers<AoErrors>>,
+}
+
+/// Deep-G-buffer radiosity errors: the indirect light (top level) and direct + indirect.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GiErrors {
+    #[serde(flatten)]
+    pub indirect: ErrorStats,
+    pub full: ErrorStats,
+}
+
+/// One GPU configuration of DGB Fig. 10 against both single-bounce references.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fig10Row {
+    pub vs_visibility: ErrorStats,
+    pub vs_mutual_visibility: ErrorStats,
+}
+
+/// DGB Fig. 10's error sources (single-bounce GPU radiosity with and without the n_Y test).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fig10 {
+    pub normal_test: Fig10Row,
+    pub no_normal_test: Fig10Row,
+}
+
+/// `strata eval --technique gi`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GiEval {
+    #[serde(flatten)]
+    pub run: EvalRun,
+    pub samples: u32,
+    pub radius: f32,
+    pub normal_test: bool,
+    pub min_mip: u32,
+    pub delta: f32,
+    pub boost: bool,
+    pub warmup: u32,
+    pub ref_bounces: u32,
+    #[serde(flatten)]
+    pub errors: GiErrors,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layers_1: Option<GiErrors>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fig10: Option<Fig10>,
+    /// With a report: every k from 1 to `layers`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub by_layers: Vec<ByLayers<GiErrors>>,
+}
+
+/// Any evaluation's result, tagged by `"technique"`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "technique", rename_all = "lowercase")]
+pub enum EvalResult {
+    Ao(AoEval),
+    Gi(GiEval),
+}
+
+impl EvalResult {
+    pub fn run(&self) -> &EvalRun {
+        match self {
+            EvalResult::Ao(e) => &e.run,
+            EvalResult::Gi(e) => &e.run,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stats(x: f32) -> ErrorStats {
+        ErrorStats {
+            flip: x,
+            rmse: 2.0 * x,
+            mae: x,
+            pixels: 0,
+        }
+    }
+
+    fn run() -> EvalRun {
+        EvalRun {
+            scene: "atrium".into(),
+            layers: 2,
+            variant: "reproject".into(),
+            width: 32,
+            height: 16,
+            frame: 0.0,
+            ref_spp: 16,
+            reference: "obscurance".into(),
+            device: "lavapipe".into(),
+            flicker: None,
+        }
+    }
+
+    #[test]
+    fn ao_eval_keeps_the_cli_keys_and_round_trips() {
+        let errors = AoErrors {
+            obscurance: stats(0.25),
+            binary: stats(0.5),
+        };
+        let mut e = AoEval {
+            run: run(),
+            samples: 19,
+            radius: 1.0,
+            bias: 0.01,
+            epsilon: 0.001,
+            errors,
+            layers_1: Some(errors),
+            by_layers: vec![],
+        };
+        let v = serde_json::to_value(EvalResult::Ao(e.clone())).unwrap();
+        for key in [
+            "technique",
+            "scene",
+            "layers",
+            "flip",
+            "rmse",
+            "mae",
+            "binary",
+            "ref_spp",
+            "device",
+        ] {
+            assert!(v.get(key).is_some(), "{key}: {v}");
+        }
+        assert_eq!(v["technique"], "ao");
+        assert_eq!(v["binary"]["flip"], 0.5);
+        assert_eq!(v["layers_1"]["binary"]["mae"], 0.5);
+        assert!(v.get("flicker").is_none() && v.get("by_layers").is_none());
+        e.run.flicker = Some(Flicker {
+            mean: 0.01,
+            frames: 3,
+            valid_fraction: 0.9,
+            per_frame: vec![[1.0, 0.01], [2.0, 0.02]],
+        });
+        let r = EvalResult::Ao(e);
+        let v = serde_json::to_value(&r).unwrap();
+        assert_eq!(v["flicker"], 0.01);
+        assert_eq!(v["flicker_frames"], 3);
+        let back: EvalResult = serde_json::from_value(v).unwrap();
+        assert_eq!(back, r);
+    }
+
+    #[test]
+    fn stage_bench_flattens_its_settings_and_round_trips() {
+        let mut settings = serde_json::Map::new();
+        settings.insert("preset".into(), "balanced".into());
+        settings.insert("samples".into(), 13.into());
+        let b = BenchResult::Radiosity(StageBench {
+            run: BenchRun {
+                scene: "cornell".into(),
+                width: 48,
+                height: 48,
+                frames: 2,
+                triangles: 30,
+                device: "lavapipe".into(),
+            },
+            layers: 2,
+            passes: vec![PassTime {
+                name: "radiosity".into(),
+                median_ms: 1.0,
+                min_ms: 0.5,
+            }],
+            total_median_ms: 1.0,
+            total_min_ms: 0.5,
+            layer1_ms: 0.75,
+            increment_ms: 0.25,
+            passes_layers_1: None,
+            increment_spread: Spread::of_differences(&[1.0, 1.1], &[0.8, 0.7]),
+            increment_within_noise: Some(false),
+            settings,
+        });
+        let v = serde_json::to_value(&b).unwrap();
+        assert_eq!(v["bench"], "radiosity");
+        assert_eq!(v["samples"], 13);
+        assert_eq!(v["increment_within_noise"], false);
+        assert!(v["increment_spread"]["q1_ms"].as_f64().is_some());
+        let BenchResult::Radiosity(sb) = &b else { unreachable!() };
+        let line = sb.split_line("radiosity");
+        assert!(
+            line.starts_with("radiosity total 1.000 ms = 0.750 (1st layer) + 0.250 (layers 2..2)"),
+            "{line}"
+        );
+        assert!(line.contains("IQR [0.250, 0.350]") && !line.contains("noise"), "{line}");
+        let mut noisy = sb.clone();
+        noisy.increment_spread = Spread::of_differences(&[1.0, 0.5], &[0.8, 0.7]);
+        assert!(noisy
+            .split_line("radiosity")
+            .contains("within the frame-to-frame noise"));
+        let back: BenchResult = serde_json::from_value(v).unwrap();
+        assert_eq!(back, b);
+    }
+}
