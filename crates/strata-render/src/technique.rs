@@ -97,6 +97,14 @@ fn ao_of(s: &RenderSettings) -> AoSettings {
     s.ao.clone().unwrap_or_default()
 }
 
+/// α of an optional temporal filter: 0 turns it off, any other value keeps its distance threshold.
+fn set_alpha(t: &mut Option<crate::passes::temporal::TemporalSettings>, v: f64) {
+    *t = (v != 0.0).then(|| crate::passes::temporal::TemporalSettings {
+        alpha: v as f32,
+        ..t.unwrap_or_default()
+    });
+}
+
 fn radiosity_mut(s: &mut RenderSettings) -> &mut radiosity::RadiositySettings {
     s.radiosity.get_or_insert_with(Default::default)
 }
@@ -163,17 +171,7 @@ static AO_SETTINGS: [SettingInfo; 10] = [
         Range::HalfOpen(0.0, 1.0),
         false,
         |s| Some(ao_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
-        |s, v| {
-            let a = ao_mut(s);
-            a.temporal = if v == 0.0 {
-                None
-            } else {
-                Some(crate::passes::temporal::TemporalSettings {
-                    alpha: v as f32,
-                    ..a.temporal.unwrap_or_default()
-                })
-            }
-        }
+        |s, v| set_alpha(&mut ao_mut(s).temporal, v)
     ),
     setting!(
         "temporal-distance",
@@ -253,17 +251,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 7] = [
         Range::HalfOpen(0.0, 1.0),
         false,
         |s| Some(radiosity_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
-        |s, v| {
-            let r = radiosity_mut(s);
-            r.temporal = if v == 0.0 {
-                None
-            } else {
-                Some(crate::passes::temporal::TemporalSettings {
-                    alpha: v as f32,
-                    ..r.temporal.unwrap_or_default()
-                })
-            }
-        }
+        |s, v| set_alpha(&mut radiosity_mut(s).temporal, v)
     ),
     setting!(
         "delta",
