@@ -119,6 +119,23 @@ impl DeepArgs {
     }
 }
 
+/// A technique `eval` can compare: one whose eval kind is not `none` (`gi` = `full`).
+fn parse_eval_technique(s: &str) -> Result<&'static strata_render::technique::Technique, String> {
+    let t = parse_technique(if s == "gi" { "full" } else { s })?;
+    if t.eval == strata_render::technique::EvalKind::None {
+        let names: Vec<_> = strata_render::technique::registry()
+            .iter()
+            .filter(|t| t.eval != strata_render::technique::EvalKind::None)
+            .map(|t| t.name)
+            .collect();
+        return Err(format!(
+            "technique '{s}' has no ground-truth comparison: eval takes {} (gi = full)",
+            names.join(", ")
+        ));
+    }
+    Ok(t)
+}
+
 fn parse_technique(s: &str) -> Result<&'static strata_render::technique::Technique, String> {
     strata_render::technique::find(s).map_err(|e| e.to_string())
 }
@@ -281,13 +298,6 @@ fn parse_turns(s: &str) -> Result<SpiralTurns, String> {
 }
 
 /// What `strata eval` compares.
-#[derive(Copy, Clone, PartialEq, Eq, ValueEnum, Debug)]
-pub enum EvalTechnique {
-    /// Deep-G-buffer AO against the ray-traced obscurance (same Eq. 2, same r, β, ε; all layers) and binary AO.
-    Ao,
-    /// Deep-G-buffer radiosity (indirect diffuse, and direct + indirect) against the CPU path tracer.
-    Gi,
-}
 
 #[derive(Args)]
 pub struct EvalArgs {
@@ -296,8 +306,10 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub gpu: GpuArgs,
     /// What to evaluate.
-    #[arg(long, value_enum, default_value_t = EvalTechnique::Ao)]
-    pub technique: EvalTechnique,
+    /// Registered technique to compare (`strata techniques`): its eval kind picks the reference —
+    /// `ao` against ray-traced obscurance and binary AO, `full` (alias `gi`) against the path tracer.
+    #[arg(long, default_value = "ao", value_parser = parse_eval_technique)]
+    pub technique: &'static strata_render::technique::Technique,
     #[command(flatten)]
     pub deep: DeepArgs,
     #[command(flatten)]

@@ -5,13 +5,17 @@ use anyhow::Result;
 use strata_eval::eval::{ao, gi, EvalSettings};
 use strata_eval::results::{to_json_string, EvalResult};
 
-use crate::args::{EvalArgs, EvalTechnique};
+use strata_render::technique::EvalKind;
+
+use crate::args::EvalArgs;
 
 pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
-    let result = match a.technique {
-        EvalTechnique::Ao => EvalResult::Ao(ao::run(&s, &a.ao.settings())?),
-        EvalTechnique::Gi => {
+    // the registry's eval kind picks the comparison
+    let result = match a.technique.eval {
+        EvalKind::AmbientVisibility => EvalResult::Ao(ao::run(&s, &a.ao.settings())?),
+        EvalKind::None => unreachable!("the argument parser admits only comparable techniques"),
+        EvalKind::Radiance => {
             let rs = a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
             let g = gi::GiEvalSettings {
                 bounces: a.bounces,
