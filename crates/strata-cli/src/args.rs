@@ -136,6 +136,18 @@ fn parse_eval_technique(s: &str) -> Result<&'static strata_render::technique::Te
     Ok(t)
 }
 
+/// `NAME=VALUE` of `--set`.
+pub fn parse_set(kv: &str) -> Result<(String, f64), String> {
+    let (name, value) = kv
+        .split_once('=')
+        .ok_or_else(|| format!("--set {kv}: expected NAME=VALUE (e.g. --set samples=32)"))?;
+    let v: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("--set {kv}: '{value}' is not a number"))?;
+    Ok((name.trim().to_string(), v))
+}
+
 fn parse_technique(s: &str) -> Result<&'static strata_render::technique::Technique, String> {
     strata_render::technique::find(s).map_err(|e| e.to_string())
 }
@@ -407,8 +419,8 @@ pub struct FrameArgs {
     pub no_probes: bool,
     /// Any registered setting of the technique, NAME=VALUE, applied last (repeatable;
     /// `strata techniques` lists the names and ranges).
-    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true)]
-    pub set: Vec<String>,
+    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = parse_set)]
+    pub set: Vec<(String, f64)>,
 }
 
 #[derive(Args)]
@@ -509,6 +521,8 @@ pub enum BenchWhat {
     /// Deep-G-buffer mirror reflections (DGB §3.6; Table 4's ray-tracing footnote): GPU ms of
     /// the ray march, 1st layer + 2nd layer.
     Reflections(BenchReflectionsArgs),
+    /// GPU time of any registered technique's passes (`strata techniques`), k = 1 and k layers.
+    Technique(BenchTechniqueArgs),
 }
 
 #[derive(Args)]
@@ -550,6 +564,21 @@ pub struct BenchStageArgs {
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Args)]
+pub struct BenchTechniqueArgs {
+    #[command(flatten)]
+    pub stage: BenchStageArgs,
+    /// Registered technique (`strata techniques` lists them).
+    #[arg(long, value_parser = parse_technique)]
+    pub technique: &'static strata_render::technique::Technique,
+    /// One of the technique's presets (default: its first).
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// Any registered setting of the technique, NAME=VALUE, range-checked (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = parse_set)]
+    pub set: Vec<(String, f64)>,
 }
 
 #[derive(Args)]

@@ -2,7 +2,7 @@
 //! object or a table.
 
 use anyhow::Result;
-use strata_eval::bench::{ao, deep, gbuffer, radiosity, reference, reflections};
+use strata_eval::bench::{ao, deep, gbuffer, radiosity, reference, reflections, technique};
 use strata_eval::results::{to_json_string, BenchResult, DeepBench, GbufferBench, ReferenceBench, StageBench};
 use strata_render::passes::reflections::ReflectionSettings;
 
@@ -25,6 +25,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             let r = radiosity::run(&(&b.stage).into(), &b.radiosity.preset, &rs)?;
             (BenchResult::Radiosity(r), b.stage.json)
         }
+        BenchWhat::Technique(b) => {
+            let r = technique::run(&(&b.stage).into(), b.technique, b.preset.as_deref(), &b.set)?;
+            (BenchResult::Technique(r), b.stage.json)
+        }
         BenchWhat::Reflections(b) => {
             let rs = ReflectionSettings {
                 steps: b.steps,
@@ -44,6 +48,14 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         BenchResult::DeepGbuffer(d) => print_deep(d, frame_of(a)),
         BenchResult::Reference(r) => print_reference(r),
         BenchResult::Ao(s) | BenchResult::Radiosity(s) | BenchResult::Reflections(s) => print_stage(result.name(), s),
+        BenchResult::Technique(s) => {
+            let name = s
+                .settings
+                .get("technique")
+                .and_then(|v| v.as_str())
+                .unwrap_or("technique");
+            print_stage(name, s)
+        }
     }
     Ok(())
 }

@@ -42,16 +42,9 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
             )?);
         }
     }
-    for kv in &f.set {
-        let (name, value) = kv
-            .split_once('=')
-            .ok_or_else(|| anyhow::anyhow!("--set {kv}: expected NAME=VALUE (e.g. --set samples=32)"))?;
-        let v: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| anyhow::anyhow!("--set {kv}: '{value}' is not a number"))?;
-        t.set(&mut settings, name.trim(), v)
-            .map_err(|e| anyhow::anyhow!("--set {kv}: {e}"))?;
+    for (name, value) in &f.set {
+        t.set(&mut settings, name, *value)
+            .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
     }
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok((scene, cams, settings))

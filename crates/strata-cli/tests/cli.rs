@@ -855,3 +855,57 @@ fn techniques_json_lists_settings_defaults_and_ranges() {
     ]);
     assert_one_line_error(&o, &["samples", "valid settings are"]);
 }
+
+/// Issue 9: `bench technique` times any registered technique's declared passes
+/// (k = 1 and k = 2, increment with its spread); bad presets and settings are
+/// one-line errors before any GPU work.
+#[test]
+fn bench_technique_times_the_registered_passes() {
+    let v = json_of(&strata(&[
+        "bench",
+        "technique",
+        "--technique",
+        "ao",
+        "--scene",
+        "cornell",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+        "--set",
+        "samples=12",
+        "--json",
+    ]));
+    assert_eq!(v["bench"], "technique");
+    assert_eq!(v["technique"], "ao");
+    assert_eq!(v["set"]["samples"], 12.0);
+    assert_eq!(
+        pass_names(&v),
+        ["depth-mip", "ao", "ao-temporal", "ao-blur-h", "ao-blur-v"]
+    );
+    assert!(v["increment_spread"]["frames"].as_u64() == Some(2), "{v}");
+    let o = strata(&[
+        "bench",
+        "technique",
+        "--technique",
+        "ao",
+        "--set",
+        "samples=999",
+        "--frames",
+        "1",
+    ]);
+    assert_one_line_error(&o, &["--set samples=999", "1..=256"]);
+    let o = strata(&[
+        "bench",
+        "technique",
+        "--technique",
+        "full",
+        "--preset",
+        "ultra",
+        "--frames",
+        "1",
+    ]);
+    assert_one_line_error(&o, &["--preset", "valid presets are"]);
+}

@@ -144,6 +144,8 @@ pub enum BenchResult {
     Radiosity(StageBench),
     Reflections(StageBench),
     Reference(ReferenceBench),
+    /// Any registered technique (`strata bench technique`).
+    Technique(StageBench),
 }
 
 impl BenchResult {
@@ -156,6 +158,7 @@ impl BenchResult {
             BenchResult::Radiosity(_) => "radiosity",
             BenchResult::Reflections(_) => "reflections",
             BenchResult::Reference(_) => "reference",
+            BenchResult::Technique(_) => "technique",
         }
     }
 }

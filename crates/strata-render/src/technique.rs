@@ -294,6 +294,9 @@ pub struct Technique {
     pub eval: EvalKind,
     /// Named parameter sets (the first is the default); empty when it has none.
     pub presets: &'static [&'static str],
+    /// The passes it adds to the frame, in frame order (what `strata bench technique`
+    /// times; a test checks each runs in its frame).
+    pub passes: &'static [&'static str],
     /// Its numeric settings, in groups (e.g. `full` = direct's + AO's + its own).
     pub settings: &'static [&'static [SettingInfo]],
     /// Turns `s` into this technique's settings with `preset` (`None`: the default
@@ -376,6 +379,40 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
     Ok(())
 }
 
+/// The AO stage's passes (DGB Table 4's AO column).
+pub const AO_PASSES: &[&str] = &["depth-mip", "ao", "ao-temporal", "ao-blur-h", "ao-blur-v"];
+
+/// The radiosity stage's passes (Table 4's indirect columns: gather, reconstruction, compose).
+pub const RADIOSITY_PASSES: &[&str] = &[
+    "depth-mip",
+    "propagate",
+    "radiosity",
+    "indirect-temporal",
+    "indirect-blur-h",
+    "indirect-blur-v",
+    "compose",
+];
+
+const DIRECT_PASSES: &[&str] = &["shadow", "lighting", "tonemap"];
+
+const FULL_PASSES: &[&str] = &[
+    "shadow",
+    "lighting",
+    "depth-mip",
+    "ao",
+    "ao-temporal",
+    "ao-blur-h",
+    "ao-blur-v",
+    "propagate",
+    "radiosity",
+    "indirect-temporal",
+    "indirect-blur-h",
+    "indirect-blur-v",
+    "compose",
+    "reflections",
+    "tonemap",
+];
+
 /// Preset names of the DGB radiosity (Table 2), default first.
 const FULL_PRESETS: &[&str] = &["balanced", "high-performance", "high-quality"];
 
@@ -387,6 +424,7 @@ static REGISTRY: [Technique; 3] = [
         display: ("ldr", true),
         eval: EvalKind::None,
         presets: &[],
+        passes: DIRECT_PASSES,
         settings: &[&DIRECT_SETTINGS],
         configure: configure_direct,
     },
@@ -397,6 +435,7 @@ static REGISTRY: [Technique; 3] = [
         display: ("ao", false),
         eval: EvalKind::AmbientVisibility,
         presets: &[],
+        passes: AO_PASSES,
         settings: &[&AO_SETTINGS],
         configure: configure_ao,
     },
@@ -407,6 +446,7 @@ static REGISTRY: [Technique; 3] = [
         display: ("ldr", true),
         eval: EvalKind::Radiance,
         presets: FULL_PRESETS,
+        passes: FULL_PASSES,
         settings: &[&DIRECT_SETTINGS, &AO_SETTINGS, &RADIOSITY_SETTINGS],
         configure: configure_full,
     },

@@ -50,8 +50,15 @@ fn non_finite(img: &ImageBuf) -> usize {
 
 /// Renders three frames and checks every target and debug view; returns the
 /// number of images checked.
-fn check(gpu: &GpuContext, scene: &Scene, settings: RenderSettings, what: &str) -> usize {
+fn check(gpu: &GpuContext, scene: &Scene, settings: RenderSettings, declared: &[&str], what: &str) -> usize {
     let mut r = Renderer::new(gpu, scene, settings).unwrap_or_else(|e| panic!("{what}: renderer: {e}"));
+    let frame: Vec<&str> = r.pass_infos().iter().map(|p| p.name).collect();
+    for p in declared {
+        assert!(
+            frame.contains(p),
+            "{what}: declared pass '{p}' is not in the frame {frame:?}"
+        );
+    }
     for f in 0..3 {
         let t = f as f32;
         r.render(gpu, scene, &FrameCameras::along_path(scene, t), t)
@@ -126,7 +133,7 @@ fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
                         s.probes = Some(probes(&scene));
                     }
                     let what = format!("{scene_name} {} {} k={layers} {variant}", t.name, preset.unwrap_or("-"));
-                    images += check(&gpu, &scene, s, &what);
+                    images += check(&gpu, &scene, s, t.passes, &what);
                     runs += 1;
                 }
             }

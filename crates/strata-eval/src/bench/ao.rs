@@ -8,15 +8,15 @@ use strata_render::RenderSettings;
 use super::stage::{self, Stage, StageSettings};
 use crate::results::StageBench;
 
-/// The AO stage's passes, in frame order.
-pub const AO_PASSES: [&str; 5] = ["depth-mip", "ao", "ao-temporal", "ao-blur-h", "ao-blur-v"];
+/// The AO stage's passes, in frame order (declared by the technique registry).
+pub use strata_render::technique::AO_PASSES;
 
 pub fn run(stage: &StageSettings, ao: &AoSettings) -> Result<StageBench> {
     let extra = json!({"samples": ao.samples, "blur_taps": ao.blur.taps(),
         "temporal_alpha": ao.temporal.map_or(0.0, |t| t.alpha), "variant": stage.variant.to_string()});
     stage::run(Stage {
         stage,
-        passes: &AO_PASSES,
+        passes: AO_PASSES,
         settings: Box::new(move |layers| RenderSettings {
             shade: false,
             ao: Some(ao.clone()),

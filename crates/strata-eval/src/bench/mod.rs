@@ -17,6 +17,7 @@ pub mod radiosity;
 pub mod reference;
 pub mod reflections;
 pub mod stage;
+pub mod technique;
 
 /// The wgpu features `strata bench` needs.
 pub fn timestamp_features() -> strata_render::gpu::Features {

@@ -9,17 +9,8 @@ use strata_render::RenderSettings;
 use super::stage::{self, Stage, StageSettings};
 use crate::results::StageBench;
 
-/// The radiosity stage's passes, in frame order (Table 4 includes the spatial and temporal
-/// reconstruction).
-pub const RADIOSITY_PASSES: [&str; 7] = [
-    "depth-mip",
-    "propagate",
-    "radiosity",
-    "indirect-temporal",
-    "indirect-blur-h",
-    "indirect-blur-v",
-    "compose",
-];
+/// The radiosity stage's passes, in frame order (declared by the technique registry).
+pub use strata_render::technique::RADIOSITY_PASSES;
 
 /// `preset` is the Table 2 preset's name the settings came from (reported, not applied).
 pub fn run(stage: &StageSettings, preset: &str, rs: &RadiositySettings) -> Result<StageBench> {
@@ -27,7 +18,7 @@ pub fn run(stage: &StageSettings, preset: &str, rs: &RadiositySettings) -> Resul
         "normal_test": rs.normal_test, "min_mip": rs.min_mip, "variant": stage.variant.to_string()});
     stage::run(Stage {
         stage,
-        passes: &RADIOSITY_PASSES,
+        passes: RADIOSITY_PASSES,
         settings: Box::new(move |layers| RenderSettings {
             radiosity: Some(rs.clone()),
             ..stage.render_settings(layers)

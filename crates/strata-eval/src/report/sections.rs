@@ -244,7 +244,7 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
                 "median GPU ms per pass".into(),
             )?]);
         }
-        BenchResult::Ao(s) | BenchResult::Radiosity(s) | BenchResult::Reflections(s) => {
+        BenchResult::Ao(s) | BenchResult::Radiosity(s) | BenchResult::Reflections(s) | BenchResult::Technique(s) => {
             section = stage_section(section, name, s, dir, prefix)?;
         }
         BenchResult::DeepGbuffer(d) => {

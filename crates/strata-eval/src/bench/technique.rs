@@ -1,0 +1,48 @@
+//! `strata bench technique`: the GPU time of any registered technique's passes
+//! (`Technique::passes`) with k = 1 and k layers, through the shared [`stage`](super::stage)
+//! driver, so a new technique is benchmarked by registering.
+
+use anyhow::Result;
+use serde_json::json;
+use strata_render::technique::Technique;
+use strata_render::RenderSettings;
+
+use super::stage::{self, Stage, StageSettings};
+use crate::results::StageBench;
+
+/// `preset`: one of the technique's presets (`None`: its default); `set`: registered settings
+/// applied last, each checked against its declared range. Light probes are not baked here.
+pub fn run(
+    stage: &StageSettings,
+    technique: &'static Technique,
+    preset: Option<&str>,
+    set: &[(String, f64)],
+) -> Result<StageBench> {
+    let configure = move |layers: u32| -> Result<RenderSettings> {
+        // (the messages name the command's flags, like the other drivers')
+        let mut s = technique
+            .settings(&stage.render_settings(layers), preset)
+            .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
+        for (name, value) in set {
+            technique
+                .set(&mut s, name, *value)
+                .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+        }
+        s.validate()?;
+        Ok(s)
+    };
+    // every error (preset, setting, range) before any GPU work
+    configure(stage.layers)?;
+    let extra = json!({
+        "technique": technique.name,
+        "preset": preset.or(technique.presets.first().copied()),
+        "variant": stage.variant.to_string(),
+        "set": set.iter().map(|(n, v)| (n.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+    });
+    stage::run(Stage {
+        stage,
+        passes: technique.passes,
+        settings: Box::new(move |layers| configure(layers).expect("checked before the GPU work")),
+        extra,
+    })
+}
