@@ -280,7 +280,7 @@ impl RenderSettings {
         }
         if self.shade {
             let lights = gpu_lights(scene, 0.0, self.shadow.resolution);
-            let maps = crate::lights::shadow_layer_count(&lights) as u32;
+            let maps = crate::lights::shadow_layer_count(&lights);
             if maps > limits.max_texture_array_layers {
                 return Err(RenderError::Parameter(format!(
                     "scene '{}' needs {maps} shadow maps: more than the adapter's {} texture array layers",

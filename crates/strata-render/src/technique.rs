@@ -373,9 +373,9 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
     let name = preset.unwrap_or(radiosity::PRESETS[1].0);
     let p = radiosity::Preset::named(name).map_err(RenderError::Parameter)?;
     s.shade = true;
-    s.ao = Some(s.ao.clone().unwrap_or_else(AoSettings::default));
+    s.ao = Some(s.ao.clone().unwrap_or_default());
     s.radiosity = Some(p.apply(radiosity::RadiositySettings::default()));
-    s.reflections = Some(s.reflections.unwrap_or_else(ReflectionSettings::default));
+    s.reflections = Some(s.reflections.unwrap_or_default());
     Ok(())
 }
 
