@@ -10,11 +10,21 @@ use strata_fuzz::{alloc, Campaign, Format};
 #[global_allocator]
 static ALLOC: alloc::Counting = alloc::Counting;
 
+/// The counting allocator sees every thread of the process: the tests of this
+/// binary run one at a time, so one test's allocations never count against the
+/// other's limits (they ran in parallel before and could fail at random).
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    SERIAL.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 const INPUTS_PER_FORMAT: u64 = 4_000;
 const SEED: u64 = 20261123;
 
 #[test]
 fn fixed_seed_slice_has_no_findings() {
+    let _serial = serial();
     let t0 = Instant::now();
     let mut report = Vec::new();
     let mut findings = Vec::new();
@@ -61,6 +71,7 @@ fn fixed_seed_slice_has_no_findings() {
 
 #[test]
 fn the_oracle_catches_a_panic_and_an_over_allocation() {
+    let _serial = serial();
     // The runner itself must turn a panic into a finding and see a big allocation.
     let target = strata_fuzz::Target::new();
     let limits = strata_fuzz::Limits {
