@@ -10,7 +10,8 @@ pub fn note_skip(test: &str, reason: &str) {
     eprintln!("skipping {test}: {reason}");
     if let Some(path) = std::env::var_os("STRATA_SKIP_LOG") {
         if let Ok(mut f) = std::fs::OpenOptions::new().create(true).append(true).open(path) {
-            let _ = writeln!(f, "{test}: {reason}");
+            // one write per line: tests run in parallel, and a single append is atomic
+            let _ = f.write_all(format!("{test}: {reason}\n").as_bytes());
         }
     }
 }
