@@ -136,6 +136,15 @@ fn parse_eval_technique(s: &str) -> Result<&'static strata_render::technique::Te
     Ok(t)
 }
 
+/// `--set NAME=VALUE` (`render`, `soak`, `bench technique`).
+#[derive(Args)]
+pub struct SetArgs {
+    /// Any registered setting of the technique, NAME=VALUE, range-checked and applied last
+    /// (repeatable; `strata techniques` lists the names and ranges).
+    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = parse_set)]
+    pub values: Vec<(String, f64)>,
+}
+
 /// `NAME=VALUE` of `--set`.
 pub fn parse_set(kv: &str) -> Result<(String, f64), String> {
     let (name, value) = kv
@@ -317,7 +326,6 @@ pub struct EvalArgs {
     pub scene: SceneArgs,
     #[command(flatten)]
     pub gpu: GpuArgs,
-    /// What to evaluate.
     /// Registered technique to compare (`strata techniques`): its eval kind picks the reference —
     /// `ao` against ray-traced obscurance and binary AO, `full` (alias `gi`) against the path tracer.
     #[arg(long, default_value = "ao", value_parser = parse_eval_technique)]
@@ -417,10 +425,8 @@ pub struct FrameArgs {
     /// path tracer and cached in $STRATA_CACHE).
     #[arg(long)]
     pub no_probes: bool,
-    /// Any registered setting of the technique, NAME=VALUE, applied last (repeatable;
-    /// `strata techniques` lists the names and ranges).
-    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = parse_set)]
-    pub set: Vec<(String, f64)>,
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 #[derive(Args)]
@@ -576,9 +582,8 @@ pub struct BenchTechniqueArgs {
     /// One of the technique's presets (default: its first).
     #[arg(long)]
     pub preset: Option<String>,
-    /// Any registered setting of the technique, NAME=VALUE, range-checked (repeatable).
-    #[arg(long = "set", value_name = "NAME=VALUE", allow_hyphen_values = true, value_parser = parse_set)]
-    pub set: Vec<(String, f64)>,
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 #[derive(Args)]

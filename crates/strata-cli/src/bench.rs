@@ -26,7 +26,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             (BenchResult::Radiosity(r), b.stage.json)
         }
         BenchWhat::Technique(b) => {
-            let r = technique::run(&(&b.stage).into(), b.technique, b.preset.as_deref(), &b.set)?;
+            let r = technique::run(&(&b.stage).into(), b.technique, b.preset.as_deref(), &b.set.values)?;
             (BenchResult::Technique(r), b.stage.json)
         }
         BenchWhat::Reflections(b) => {

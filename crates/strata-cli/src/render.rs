@@ -42,7 +42,7 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
             )?);
         }
     }
-    for (name, value) in &f.set {
+    for (name, value) in &f.set.values {
         t.set(&mut settings, name, *value)
             .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
     }
