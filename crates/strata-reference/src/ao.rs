@@ -151,16 +151,32 @@ impl Reference<'_> {
         if settings.spp == 0 {
             return 1.0;
         }
+        let unoccluded = self.ao_binary_unoccluded(p, n, ng, settings.radius, key, 0..settings.spp);
+        1.0 - (settings.spp - unoccluded) as f32 / settings.spp as f32
+    }
+
+    /// How many of the hemisphere rays with sample indices in `samples` (R2
+    /// sequence rotated by `key`) leave `p` without a hit within `radius`: the
+    /// partial sums [`crate::converge`] accumulates sample range by range.
+    pub(crate) fn ao_binary_unoccluded(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        ng: Vec3,
+        radius: f32,
+        key: u64,
+        samples: std::ops::Range<u32>,
+    ) -> u32 {
         let origin = p + ng * self.epsilon;
         let offset = pixel_offset(key);
-        let mut hits = 0u32;
-        for i in 0..settings.spp {
+        let mut free = 0u32;
+        for i in samples {
             let d = cosine_hemisphere(n, r2(i, offset));
-            if self.bvh.occluded(origin, d, 0.0, settings.radius) {
-                hits += 1;
+            if !self.bvh.occluded(origin, d, 0.0, radius) {
+                free += 1;
             }
         }
-        1.0 - hits as f32 / settings.spp as f32
+        free
     }
 
     /// DGB obscurance ambient visibility (Eq. 1–2 over all layers) per pixel
@@ -200,13 +216,29 @@ impl Reference<'_> {
         if settings.spp == 0 {
             return (1.0, 0.0);
         }
+        let sum = self.obscurance_sum(camera, x, n, settings, key, 0..settings.spp);
+        let mean = (sum / settings.spp as f64) as f32;
+        (obscurance_visibility(mean), mean)
+    }
+
+    /// Σ A_i over the samples with indices in `samples` (R2 sequence rotated by
+    /// `key`): the partial sums behind [`Reference::ao_obscurance_at`].
+    pub(crate) fn obscurance_sum(
+        &self,
+        camera: &Camera,
+        x: Vec3,
+        n: Vec3,
+        settings: &ObscuranceSettings,
+        key: u64,
+        samples: std::ops::Range<u32>,
+    ) -> f64 {
         let (right, up, _) = camera.basis();
         let z = camera.depth_of(x);
         let r = settings.radius;
         let offset = pixel_offset(key);
         let mut hits = Vec::new();
         let mut sum = 0.0f64;
-        for i in 0..settings.spp {
+        for i in samples {
             let [u, w] = r2(i, offset);
             let rho = match settings.disk {
                 DiskSampling::UniformArea => r * u.sqrt(),
@@ -226,10 +258,14 @@ impl Reference<'_> {
             }
             sum += a as f64;
         }
-        let mean = (sum / settings.spp as f64) as f32;
-        let av = (1.0 - (std::f32::consts::PI * mean).sqrt()).max(0.0);
-        (av, mean)
+        sum
     }
+}
+
+/// DGB Eq. 1: ambient visibility `max(0, 1 − √(π · mean A_i))` from the mean of
+/// the per-sample obscurance terms.
+pub fn obscurance_visibility(mean: f32) -> f32 {
+    (1.0 - (std::f32::consts::PI * mean).sqrt()).max(0.0)
 }
 
 /// Per-pixel key for sample rotations.

@@ -137,14 +137,7 @@ impl Reference<'_> {
     /// Path-traced diffuse GI (linear RGB radiance): total, direct and indirect.
     pub fn gi(&self, camera: &Camera, width: u32, height: u32, settings: &GiSettings) -> GiImages {
         let px = self.for_each_pixel("GI", width, height, |x, y, rays| {
-            let dir = camera.pixel_dir(x, y, width, height);
-            let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
-            for s in 0..settings.spp {
-                let mut rng = Rng::new(hash(&[settings.seed, y as u64 * width as u64 + x as u64, s as u64]));
-                let (d, i) = self.trace_path(camera.eye, camera.near, dir, settings, &mut rng, rays);
-                direct += d;
-                indirect += i;
-            }
+            let [direct, indirect] = self.gi_pixel_sum(camera, x, y, width, height, settings, 0..settings.spp, rays);
             let k = 1.0 / settings.spp.max(1) as f32;
             [direct * k, indirect * k]
         });
@@ -160,6 +153,33 @@ impl Reference<'_> {
             out.total.data[3 * i..3 * i + 3].copy_from_slice(&t.to_array());
         }
         out
+    }
+
+    /// (direct, indirect) radiance summed over the paths with sample indices in
+    /// `samples` through the centre of pixel (x, y): the partial sums
+    /// [`crate::converge`] accumulates. Path `s` of a pixel is the same whatever
+    /// range it is traced in.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn gi_pixel_sum(
+        &self,
+        camera: &Camera,
+        x: u32,
+        y: u32,
+        width: u32,
+        height: u32,
+        settings: &GiSettings,
+        samples: std::ops::Range<u32>,
+        rays: &mut u64,
+    ) -> [Vec3; 2] {
+        let dir = camera.pixel_dir(x, y, width, height);
+        let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
+        for s in samples {
+            let mut rng = Rng::new(hash(&[settings.seed, y as u64 * width as u64 + x as u64, s as u64]));
+            let (d, i) = self.trace_path(camera.eye, camera.near, dir, settings, &mut rng, rays);
+            direct += d;
+            indirect += i;
+        }
+        [direct, indirect]
     }
 
     /// Radiance arriving at `origin` from direction −`dir` (one path sample):

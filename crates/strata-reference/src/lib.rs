@@ -38,6 +38,7 @@
 
 pub mod ao;
 pub mod bvh;
+pub mod converge;
 pub mod gi;
 pub mod layers;
 pub mod probes;
@@ -54,6 +55,7 @@ use strata_scene::{Camera, Material, Scene};
 
 pub use ao::{AoBinarySettings, DiskSampling, ObscuranceSettings};
 pub use bvh::{Bvh, Hit, SurfaceHit};
+pub use converge::{ConvergeRule, Converged, Estimator};
 pub use gi::{GiImages, GiSettings};
 pub use layers::{DeepLayers, Layer, LayerSettings, NO_ID};
 

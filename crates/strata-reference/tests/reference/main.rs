@@ -3,6 +3,7 @@
 
 mod ao;
 mod bvh;
+mod converge;
 mod gi;
 mod layers;
 mod scenes;
