@@ -336,9 +336,14 @@ pub struct EvalArgs {
     pub ao: AoArgs,
     #[command(flatten)]
     pub radiosity: RadiosityArgs,
-    /// Samples per pixel of the CPU reference, 1..=65536 (default: 256 for ao, 64 for gi).
+    /// Cap on the CPU reference's samples per pixel, 2..=65536 (default 16384). The reference
+    /// integrates until --ref-noise is met or this cap is reached.
     #[arg(long)]
     pub ref_spp: Option<u32>,
+    /// Noise target of the CPU reference, in [0, 1): ꟻLIP between its two independent halves
+    /// (0: integrate to the --ref-spp cap). Converged references are cached.
+    #[arg(long, default_value_t = 0.02)]
+    pub ref_noise: f64,
     /// Indirect bounces of the path-traced reference (gi), 1..=64.
     #[arg(long, default_value_t = 4)]
     pub bounces: u32,

@@ -32,6 +32,7 @@ impl From<&EvalArgs> for EvalSettings {
             deep: a.deep.settings(),
             guard_band: a.deep.guard_band,
             ref_spp: a.ref_spp,
+            ref_noise: a.ref_noise,
             warmup: a.warmup,
             cache: a.cache.clone().unwrap_or_else(RefCache::default_dir),
             no_cache: a.no_cache,

@@ -36,8 +36,8 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         EvalResult::Ao(e) => {
             let (o, b) = (&e.errors.obscurance, &e.errors.binary);
             println!(
-                "{} ao k={k} {w}x{h}: FLIP {:.4}  RMSE {:.4}  MAE {:.4} (vs obscurance, {} spp); vs binary AO: FLIP {:.4}  MAE {:.4}",
-                run.scene, o.flip, o.rmse, o.mae, run.ref_spp, b.flip, b.mae
+                "{} ao k={k} {w}x{h}: FLIP {:.4}  RMSE {:.4}  MAE {:.4} (vs obscurance, {} spp, reference noise FLIP {:.4}); vs binary AO: FLIP {:.4}  MAE {:.4}",
+                run.scene, o.flip, o.rmse, o.mae, run.ref_spp, noise(o), b.flip, b.mae
             );
             if let Some(f) = &run.flicker {
                 println!(
@@ -51,10 +51,15 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         EvalResult::Gi(e) => {
             let (i, f) = (&e.errors.indirect, &e.errors.full);
             println!(
-                "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces)",
-                run.scene, i.flip, i.rmse, i.mae, f.flip, f.rmse, run.ref_spp, e.ref_bounces
+                "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces, noise FLIP {:.4} indirect / {:.4} full)",
+                run.scene, i.flip, i.rmse, i.mae, f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
             );
         }
     }
     Ok(())
+}
+
+/// The reference noise (ꟻLIP between its halves) beside an error.
+fn noise(e: &strata_eval::metrics::ErrorStats) -> f32 {
+    e.ref_noise.map_or(f32::NAN, |n| n.flip)
 }

@@ -327,6 +327,14 @@ fn eval_ao_prints_errors_and_caches_the_reference() {
     assert_eq!(v["technique"], "ao");
     assert_eq!(v["layers"], 2);
     assert_eq!(v["ref_spp"], 16);
+    // issue 10: the reference's own noise and the speckles of both images beside the errors
+    assert_eq!(v["ref_noise"]["spp"], 16);
+    assert!(v["ref_noise"]["flip"].as_f64().is_some_and(|f| f > 0.0), "{v}");
+    assert!(v["outliers"].as_u64().is_some() && v["binary"]["ref_outliers"].as_u64().is_some());
+    // 16 spp cannot reach the default ꟻLIP 0.02 between the halves: the run says so
+    assert_eq!(v["ref_noise"]["converged"], false);
+    let warnings = v["warnings"].as_array().expect("warnings");
+    assert!(warnings.iter().any(|w| w.as_str().unwrap().contains("--ref-spp cap")), "{warnings:?}");
     for key in ["flip", "rmse", "mae", "flicker"] {
         let x = v[key].as_f64().unwrap_or_else(|| panic!("{key} missing: {v}"));
         assert!((0.0..1.0).contains(&x), "{key} = {x}");
@@ -372,6 +380,12 @@ fn eval_rejects_out_of_range_parameters() {
         "eval", "--scene", "plane", "--alpha", "1.5", "--width", "16", "--height", "16",
     ]);
     assert_one_line_error(&o, &["alpha", "[0, 1)"]);
+    let o = strata(&[
+        "eval", "--scene", "plane", "--ref-noise", "1.5", "--width", "16", "--height", "16",
+    ]);
+    assert_one_line_error(&o, &["--ref-noise", "[0, 1)"]);
+    let o = strata(&["eval", "--scene", "plane", "--ref-spp", "1", "--width", "16", "--height", "16"]);
+    assert_one_line_error(&o, &["--ref-spp", "2..=65536"]);
 }
 
 #[test]

@@ -9,10 +9,27 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use strata_scene::ImageBuf;
 
+/// A reference's own noise: its two independent halves (see
+/// `strata_reference::converge`) compared with each other, on the same values
+/// as the errors it stands beside.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RefNoise {
+    /// ꟻLIP between the halves (display values, as [`ErrorStats::flip`]).
+    pub flip: f32,
+    /// RMSE between the halves (as [`ErrorStats::rmse`]).
+    pub rmse: f32,
+    /// Samples per pixel of the whole reference (both halves).
+    pub spp: u32,
+    /// Whether the noise target was met (false: the sample cap stopped it).
+    pub converged: bool,
+}
+
 /// Errors of a test image against a reference image.
 ///
-/// Serialised as `{"flip", "rmse", "mae"}` (the pixel count is left out).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// Serialised as `{"flip", "rmse", "mae"}` (the pixel count is left out), plus, where an
+/// evaluation fills them, `ref_noise` (the reference's own noise), `outliers` and
+/// `ref_outliers` (speckles of the test image and of the reference, [`outliers`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ErrorStats {
     /// Mean ꟻLIP error over all pixels (0 = identical, 1 = maximal), LDR ꟻLIP at
     /// [`nv_flip::DEFAULT_PIXELS_PER_DEGREE`] on the 8-bit quantised images.
@@ -24,6 +41,59 @@ pub struct ErrorStats {
     /// Number of pixels compared.
     #[serde(skip)]
     pub pixels: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ref_noise: Option<RefNoise>,
+    /// Pixels of the test image that are [`outliers`] (display values).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outliers: Option<u32>,
+    /// Pixels of the reference that are [`outliers`] (display values).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ref_outliers: Option<u32>,
+}
+
+impl ErrorStats {
+    /// Whether the error is within 2× of the reference's own noise (ꟻLIP or RMSE): then the
+    /// reference cannot tell this error apart from its noise.
+    pub fn within_ref_noise(&self) -> bool {
+        self.ref_noise
+            .is_some_and(|n| self.flip <= 2.0 * n.flip || self.rmse <= 2.0 * n.rmse)
+    }
+}
+
+/// Display-value difference from the 3×3 median above which a pixel counts as an outlier.
+pub const OUTLIER_THRESHOLD: f32 = 0.25;
+
+/// Pixels whose value differs from the median of their 3×3 neighbourhood (clamped at the image
+/// border) by more than `threshold` in any channel: isolated speckles ("fireflies", black dots)
+/// rather than edges, which a median follows.
+pub fn outliers(img: &ImageBuf, threshold: f32) -> u32 {
+    let (w, h, c) = (img.width as i64, img.height as i64, img.channels as usize);
+    if w == 0 || h == 0 || c == 0 || img.data.len() < (w * h) as usize * c {
+        return 0;
+    }
+    let mut count = 0u32;
+    let mut window = [0.0f32; 9];
+    for y in 0..h {
+        for x in 0..w {
+            let at = |xx: i64, yy: i64, ch: usize| {
+                let (xx, yy) = (xx.clamp(0, w - 1), yy.clamp(0, h - 1));
+                img.data[(yy * w + xx) as usize * c + ch]
+            };
+            let outlier = (0..c).any(|ch| {
+                let mut k = 0;
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        window[k] = at(x + dx, y + dy, ch);
+                        k += 1;
+                    }
+                }
+                window.sort_unstable_by(f32::total_cmp);
+                (at(x, y, ch) - window[4]).abs() > threshold
+            });
+            count += outlier as u32;
+        }
+    }
+    count
 }
 
 /// Compares `test` against `reference`; returns the error statistics and the ꟻLIP error map.
@@ -81,6 +151,7 @@ pub fn compare(reference: &ImageBuf, test: &ImageBuf) -> Result<(ErrorStats, Ima
         rmse: (sum_sq / n).sqrt() as f32,
         mae: (sum_abs / n) as f32,
         pixels: w as usize * h as usize,
+        ..Default::default()
     };
     Ok((stats, map))
 }
@@ -300,6 +371,63 @@ mod tests {
         let json = serde_json::to_value(compare(&a, &b).unwrap().0).unwrap();
         let keys: Vec<_> = json.as_object().unwrap().keys().cloned().collect();
         assert_eq!(keys, ["flip", "mae", "rmse"]);
+    }
+
+    #[test]
+    fn outliers_are_isolated_speckles_not_edges() {
+        let mut img = pattern(24, 16).channel(0);
+        assert_eq!(outliers(&img, OUTLIER_THRESHOLD), 0, "a smooth ramp has none");
+        // a hard vertical edge: the median follows it
+        for y in 0..16 {
+            for x in 12..24 {
+                img.pixel_mut(x, y)[0] = 1.0;
+            }
+        }
+        assert_eq!(outliers(&img, OUTLIER_THRESHOLD), 0, "an edge is not an outlier");
+        // two isolated black dots, one in a corner (clamped border), and a 2-pixel vertical run
+        img.pixel_mut(18, 8)[0] = 0.0;
+        img.pixel_mut(23, 0)[0] = 0.0;
+        img.pixel_mut(16, 3)[0] = 0.0;
+        img.pixel_mut(16, 4)[0] = 0.0;
+        assert_eq!(outliers(&img, OUTLIER_THRESHOLD), 4);
+        // a stripe two pixels thick is a feature (the median follows it); one pixel thick, every
+        // pixel of it is an outlier (what a 3×3 median calls a speckle)
+        let mut blob = ImageBuf::new(9, 9, 3);
+        blob.data.iter_mut().for_each(|v| *v = 1.0);
+        for y in 3..5 {
+            for x in 0..9 {
+                blob.pixel_mut(x, y).copy_from_slice(&[0.0; 3]);
+            }
+        }
+        assert_eq!(outliers(&blob, OUTLIER_THRESHOLD), 0);
+        let mut line = blob.clone();
+        for x in 0..9 {
+            line.pixel_mut(x, 4).copy_from_slice(&[1.0; 3]);
+        }
+        assert_eq!(outliers(&line, OUTLIER_THRESHOLD), 9);
+        blob.pixel_mut(0, 8)[1] = 0.5; // one channel off by 0.5
+        assert_eq!(outliers(&blob, OUTLIER_THRESHOLD), 1);
+        assert_eq!(outliers(&ImageBuf::new(0, 0, 1), 0.1), 0);
+    }
+
+    #[test]
+    fn errors_within_twice_the_reference_noise_are_flagged() {
+        let noise = RefNoise {
+            flip: 0.02,
+            rmse: 0.01,
+            spp: 64,
+            converged: true,
+        };
+        let e = |flip, rmse| ErrorStats {
+            flip,
+            rmse,
+            ref_noise: Some(noise),
+            ..Default::default()
+        };
+        assert!(e(0.039, 0.5).within_ref_noise());
+        assert!(e(0.5, 0.02).within_ref_noise());
+        assert!(!e(0.041, 0.021).within_ref_noise());
+        assert!(!ErrorStats::default().within_ref_noise(), "no noise measured, no flag");
     }
 
     #[test]

@@ -193,6 +193,10 @@ pub struct EvalRun {
     pub device: String,
     #[serde(flatten)]
     pub flicker: Option<Flicker>,
+    /// Things the reader of the numbers must know (a reference that did not converge, an error
+    /// within 2× of the reference's noise); also printed on stderr.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Errors of one configuration of `k` layers (the report's error-vs-layers rows).
@@ -301,7 +305,7 @@ mod tests {
             flip: x,
             rmse: 2.0 * x,
             mae: x,
-            pixels: 0,
+            ..Default::default()
         }
     }
 
@@ -317,6 +321,7 @@ mod tests {
             reference: "obscurance".into(),
             device: "lavapipe".into(),
             flicker: None,
+            warnings: vec![],
         }
     }
 

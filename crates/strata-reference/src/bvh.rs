@@ -68,11 +68,22 @@ pub struct SurfaceHit {
 }
 
 impl SurfaceHit {
-    /// (shading, geometric) normals, each flipped independently to the side the
-    /// ray `dir` came from (so both have a non-positive dot product with `dir`).
+    /// (shading, geometric) normals on the side the ray `dir` came from: both
+    /// are flipped when the ray arrives at the back of the *geometric* surface
+    /// (`geometric · dir > 0`), as the GPU flips back faces' normals by
+    /// `front_facing`. The geometric normal then faces the ray; the shading
+    /// normal stays on the geometric normal's side of the surface even where it
+    /// points slightly away from the viewer (silhouettes of smooth meshes).
+    /// Flipping the shading normal by its own dot product with `dir` instead
+    /// would turn it into the surface there, and every hemisphere ray would hit
+    /// the surface itself: the isolated black pixels `docs/reference.md`
+    /// traces back to this.
     pub fn facing_normals(&self, dir: Vec3) -> (Vec3, Vec3) {
-        let flip = |n: Vec3| if n.dot(dir) > 0.0 { -n } else { n };
-        (flip(self.shading_normal), flip(self.geometric_normal))
+        if self.geometric_normal.dot(dir) > 0.0 {
+            (-self.shading_normal, -self.geometric_normal)
+        } else {
+            (self.shading_normal, self.geometric_normal)
+        }
     }
 }
 

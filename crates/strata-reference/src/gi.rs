@@ -35,7 +35,7 @@ use glam::Vec3;
 use strata_scene::{Camera, ImageBuf, Light, Material};
 
 use crate::bvh::Bvh;
-use crate::sampling::{cosine_hemisphere, hash, triangle_barycentrics, Rng};
+use crate::sampling::{cosine_hemisphere, hash, pixel_offset, r2, triangle_barycentrics, Rng};
 use crate::Reference;
 
 /// Settings of the path tracer.
@@ -173,9 +173,15 @@ impl Reference<'_> {
     ) -> [Vec3; 2] {
         let dir = camera.pixel_dir(x, y, width, height);
         let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
+        let pixel = y as u64 * width as u64 + x as u64;
+        // The first bounce direction (the dimension the indirect light depends
+        // on most) follows the R2 sequence with a per-pixel rotation; the
+        // rest of the path is random.
+        let offset = pixel_offset(hash(&[settings.seed, pixel, 0x0b0c]));
         for s in samples {
-            let mut rng = Rng::new(hash(&[settings.seed, y as u64 * width as u64 + x as u64, s as u64]));
-            let (d, i) = self.trace_path(camera.eye, camera.near, dir, settings, &mut rng, rays);
+            let mut rng = Rng::new(hash(&[settings.seed, pixel, s as u64]));
+            let first = Some(r2(s, offset));
+            let (d, i) = self.trace_path(camera.eye, camera.near, dir, settings, first, &mut rng, rays);
             direct += d;
             indirect += i;
         }
@@ -186,17 +192,20 @@ impl Reference<'_> {
     /// emission and direct light of the first surface along `dir`, plus what it
     /// reflects of further bounces, or the sky. Used to bake light probes.
     pub fn radiance(&self, origin: Vec3, dir: Vec3, settings: &GiSettings, rng: &mut Rng, rays: &mut u64) -> Vec3 {
-        let (d, i) = self.trace_path(origin, 0.0, dir, settings, rng, rays);
+        let (d, i) = self.trace_path(origin, 0.0, dir, settings, None, rng, rays);
         d + i
     }
 
     /// One path from `origin` (hits beyond `t_min`) along `dir`: (direct, indirect).
+    /// `first_bounce`: the uniform sample of the first bounce direction (random when `None`).
+    #[allow(clippy::too_many_arguments)]
     fn trace_path(
         &self,
         origin: Vec3,
         t_min: f32,
         dir: Vec3,
         settings: &GiSettings,
+        first_bounce: Option<[f32; 2]>,
         rng: &mut Rng,
         rays: &mut u64,
     ) -> (Vec3, Vec3) {
@@ -230,7 +239,11 @@ impl Reference<'_> {
             if last && sky == Vec3::ZERO {
                 break;
             }
-            let wi = cosine_hemisphere(n, rng.next_2d());
+            let u = match (depth, first_bounce) {
+                (0, Some(u)) => u,
+                _ => rng.next_2d(),
+            };
+            let wi = cosine_hemisphere(n, u);
             if wi.dot(ng) <= 0.0 {
                 break;
             }

@@ -15,7 +15,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use strata_scene::{ImageBuf, Scene};
 
+pub mod converged;
 pub mod probes;
+
+/// Most channels an entry may have (converged GI halves hold 6: direct and indirect RGB).
+const MAX_CHANNELS: u32 = 8;
 
 const MAGIC: &[u8; 10] = b"STRATAREF2";
 /// Magic + width, height, channels + checksum.
@@ -104,6 +108,36 @@ impl RefCache {
         strata_scene::atomic::write(&txt, description.as_bytes())
             .map_err(|e| anyhow::anyhow!("reference cache: {e}"))?;
         Ok(path)
+    }
+
+    /// Stores `value` as JSON in `<key>.json` (atomically): metadata beside an image entry.
+    pub fn store_json<T: serde::Serialize>(&self, key: &str, value: &T) -> Result<PathBuf> {
+        if !valid_key(key) {
+            bail!("reference cache: invalid key {key:?}: use ASCII letters, digits, '-' or '_'");
+        }
+        fs::create_dir_all(&self.dir)
+            .with_context(|| format!("{}: cannot create the reference cache directory", self.dir.display()))?;
+        let path = self.dir.join(format!("{key}.json"));
+        let text = serde_json::to_vec(value)?;
+        strata_scene::atomic::write(&path, &text).map_err(|e| anyhow::anyhow!("reference cache: {e}"))?;
+        Ok(path)
+    }
+
+    /// The JSON stored by [`RefCache::store_json`] under `key`, or `None` when there is none or it
+    /// does not parse as `T` (logged).
+    pub fn load_json<T: serde::de::DeserializeOwned>(&self, key: &str) -> Option<T> {
+        if !valid_key(key) {
+            return None;
+        }
+        let path = self.dir.join(format!("{key}.json"));
+        let bytes = fs::read(&path).ok()?;
+        match serde_json::from_slice(&bytes) {
+            Ok(v) => Some(v),
+            Err(e) => {
+                tracing::warn!("reference cache: ignoring unreadable {}: {e}", path.display());
+                None
+            }
+        }
     }
 
     fn bin_path(&self, key: &str) -> PathBuf {
@@ -216,8 +250,8 @@ fn decode(bytes: &[u8]) -> std::result::Result<ImageBuf, String> {
     }
     let u32_at = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
     let (width, height, channels) = (u32_at(10), u32_at(14), u32_at(18));
-    if !(1..=4).contains(&channels) {
-        return Err(format!("{channels} channels: expected 1 to 4"));
+    if !(1..=MAX_CHANNELS).contains(&channels) {
+        return Err(format!("{channels} channels: expected 1 to {MAX_CHANNELS}"));
     }
     let payload = &bytes[HEADER_LEN..];
     let stored = u64::from_le_bytes(bytes[22..30].try_into().expect("8 bytes"));

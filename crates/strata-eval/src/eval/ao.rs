@@ -5,16 +5,19 @@ use std::path::Path;
 
 use anyhow::Result;
 use strata_reference::ao::{AoBinarySettings, DiskSampling, ObscuranceSettings};
-use strata_reference::Reference;
+use strata_reference::{Estimator, Reference};
 use strata_render::passes::ao::AoSettings;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{ImageBuf, Scene};
 
-use super::{figure, flicker, write_report, EvalSettings};
+use super::{figure, flicker, half_flip, noise_warnings, write_report, EvalSettings, RefImage};
 use crate::cache::{scene_fingerprint, RefCache};
 use crate::metrics::compare;
 use crate::report::Section;
 use crate::results::{AoErrors, AoEval, EvalResult};
+
+/// Default cap on the references' samples per pixel (`--ref-spp`).
+pub const DEFAULT_CAP: u32 = 16_384;
 
 /// One GPU AO evaluation: the image and its errors against both references.
 struct AoResult {
@@ -34,7 +37,7 @@ fn render_settings(s: &EvalSettings, layers: u32, ao: &AoSettings) -> RenderSett
 }
 
 pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
-    let ref_spp = s.check(256)?;
+    let rule = s.check(DEFAULT_CAP, 16)?;
     let (scene, cams) = s.scene.load()?;
     render_settings(s, s.deep.layers, settings)
         .validate()
@@ -43,34 +46,29 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
     let camera = cams.current;
     let (radius, beta, epsilon) = settings.resolve(&scene);
 
-    // Ground truth (cached): the obscurance of Eq. 2 over all surfaces with the
-    // spiral's radial density, and binary visibility within r.
+    // Ground truth, converged to the noise target and cached: the obscurance of Eq. 2 over all
+    // surfaces with the spiral's radial density, and binary visibility within r.
     let cache = RefCache::new(&s.cache);
     let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
-    let obscurance_settings = ObscuranceSettings {
+    let obscurance = Estimator::Obscurance(ObscuranceSettings {
         radius,
         beta,
         epsilon,
-        spp: ref_spp,
         disk: DiskSampling::SpiralRadius,
         ..ObscuranceSettings::new(radius)
-    };
-    let binary_settings = AoBinarySettings {
-        spp: ref_spp,
-        ..AoBinarySettings::new(radius)
-    };
+    });
+    let binary = Estimator::AoBinary(AoBinarySettings::new(radius));
     let scene_id = scene_fingerprint(&scene, s.scene.frame);
     let cam_id = format!("{camera:?} {w}x{h}");
-    let ref_obscurance = cache.get_or_compute(
-        s.no_cache,
-        &format!("v1 obscurance {scene_id} {cam_id} {obscurance_settings:?}"),
-        || reference.ao_obscurance(&camera, w, h, &obscurance_settings),
-    );
-    let ref_binary = cache.get_or_compute(
-        s.no_cache,
-        &format!("v1 binary-ao {scene_id} {cam_id} {binary_settings:?}"),
-        || reference.ao_binary(&camera, w, h, &binary_settings),
-    );
+    let converge = |name: &str, est: &Estimator| {
+        let description = format!("v2 converged {name} {scene_id} {cam_id} {est:?} {rule:?}");
+        let c = cache.converged(s.no_cache, &description, est, || {
+            reference.converge(&camera, w, h, est, &rule, |a, b| half_flip(a, b, |i| i.clone()))
+        });
+        RefImage::of(&c, |i| i.clone(), |i| i.clone())
+    };
+    let ref_obscurance = converge("obscurance", &obscurance)?;
+    let ref_binary = converge("binary-ao", &binary)?;
 
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
@@ -78,8 +76,9 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
     let evaluate = |layers: u32| -> Result<AoResult> {
         let mut r = Renderer::new(&gpu, &scene, render_settings(s, layers, settings))?;
         let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
-        let (obscurance, obscurance_map) = compare(&ref_obscurance, &av)?;
-        let (binary, binary_map) = compare(&ref_binary, &av)?;
+        let (obscurance, obscurance_map) = compare(&ref_obscurance.image, &av)?;
+        let (binary, binary_map) = compare(&ref_binary.image, &av)?;
+        let (obscurance, binary) = (ref_obscurance.annotate(obscurance, &av), ref_binary.annotate(binary, &av));
         Ok(AoResult {
             layers,
             av,
@@ -101,10 +100,14 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
     };
     let out = AoEval {
         run: s.run_info(
-            ref_spp,
+            ref_obscurance.noise.spp,
             "obscurance (DGB Eq. 2 over all surfaces, spiral radial density)",
             gpu.describe(),
             flicker,
+            noise_warnings(&[
+                ("ao vs obscurance", &main.errors.obscurance),
+                ("ao vs binary AO", &main.errors.binary),
+            ]),
         ),
         samples: settings.samples,
         radius,
@@ -115,7 +118,7 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         by_layers: s.by_layers(results.iter().chain([&main]).map(|r| (r.layers, r.errors))),
     };
     if let Some(dir) = &s.report {
-        write_ao_report(dir, s, &out, &main, results.first(), &ref_obscurance, &ref_binary)?;
+        write_ao_report(dir, s, &out, &main, results.first(), &ref_obscurance.image, &ref_binary.image)?;
     }
     Ok(out)
 }
@@ -147,8 +150,8 @@ fn write_ao_report(
         "{k}-layer deep-G-buffer AO against the ray-traced obscurance"
     ))
     .text(format!(
-        "AV = 1 − AO (white = unoccluded), {}×{} pixels, frame {}. The reference evaluates DGB Eq. 2 with the same r, β, ε over every surface along each sample ray ({} spp, spiral radial density). Values are shown as grey bytes 255·AV; FLIP maps use the magma scale.",
-        s.scene.width, s.scene.height, s.scene.frame, out.run.ref_spp
+        "AV = 1 − AO (white = unoccluded), {}×{} pixels, frame {}. The reference evaluates DGB Eq. 2 with the same r, β, ε over every surface along each sample ray ({} spp converged to ꟻLIP {:.4} between two independent halves, spiral radial density). Values are shown as grey bytes 255·AV; FLIP maps use the magma scale.",
+        s.scene.width, s.scene.height, s.scene.frame, out.run.ref_spp, out.errors.obscurance.ref_noise.map_or(0.0, |n| n.flip)
     ))
     .figures(vec![
         fig(&main.av, &format!("gpu-k{k}.png"), format!("GPU, k = {k}: FLIP {:.4}, MAE {:.4}", st.flip, st.mae))?,

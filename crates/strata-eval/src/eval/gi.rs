@@ -6,18 +6,23 @@ use std::path::Path;
 
 use anyhow::{bail, Result};
 use strata_reference::gi::{GiSettings, OneBounceSettings};
-use strata_reference::Reference;
+use strata_reference::{Estimator, Reference};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::lighting::LightingSettings;
 use strata_render::passes::radiosity::RadiositySettings;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, ImageBuf, Scene};
 
-use super::{figure, flicker, write_report, EvalSettings};
+use super::{figure, flicker, half_flip, noise_warnings, write_report, EvalSettings, RefImage};
 use crate::cache::{scene_fingerprint, RefCache};
 use crate::metrics::{compare_radiance, display};
 use crate::report::Section;
 use crate::results::{EvalResult, Fig10, Fig10Row, GiErrors, GiEval};
+
+/// Default cap on the path tracer's samples per pixel (`--ref-spp`).
+pub const DEFAULT_CAP: u32 = 16_384;
+/// Samples per pixel of Fig. 10's single-bounce references.
+const FIG10_SPP: u32 = 256;
 
 /// What only the GI evaluation takes.
 #[derive(Clone, Copy, Debug)]
@@ -39,7 +44,7 @@ struct GiResult {
 }
 
 pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Result<GiEval> {
-    let spp = s.check(64)?;
+    let rule = s.check(DEFAULT_CAP, 8)?;
     if !(1..=64).contains(&g.bounces) {
         bail!("--bounces {} is out of range: must be in 1..=64", g.bounces);
     }
@@ -55,43 +60,41 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         .validate()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
 
+    // The path tracer converged until both the full image and the indirect light of its two
+    // halves are within the noise target (ꟻLIP on the tonemapped images); cached.
     let cache = RefCache::new(&s.cache);
-    let gi_settings = GiSettings {
-        spp,
+    let exposure = scene.settings.exposure;
+    let estimator = Estimator::Gi(GiSettings {
         bounces: g.bounces,
         ..Default::default()
-    };
+    });
     let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
-    let key = format!(
-        "v1 gi {} {camera:?} {w}x{h} {gi_settings:?}",
+    let description = format!(
+        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
         scene_fingerprint(&scene, s.scene.frame)
     );
-    // one path-traced run gives both images; both are cached
-    let descriptions = [format!("{key} total"), format!("{key} indirect")];
-    let keys = descriptions.each_ref().map(|d| RefCache::key(d));
-    let loaded = (!s.no_cache).then(|| (cache.load(&keys[0]), cache.load(&keys[1])));
-    let (ref_total, ref_indirect) = match loaded {
-        Some((Some(t), Some(i))) => (t, i),
-        _ => {
-            let g = reference.gi(&camera, w, h, &gi_settings);
-            cache.store_or_warn(&keys[0], &g.total, &descriptions[0]);
-            cache.store_or_warn(&keys[1], &g.indirect, &descriptions[1]);
-            (g.total, g.indirect)
-        }
-    };
+    let shown = |img: &ImageBuf| display(img, exposure);
+    let converged = cache.converged(s.no_cache, &description, &estimator, || {
+        reference.converge(&camera, w, h, &estimator, &rule, |a, b| {
+            half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown))
+        })
+    });
+    let ref_total = RefImage::of(&converged, total, shown)?;
+    let ref_indirect = RefImage::of(&converged, indirect, shown)?;
 
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
     })?;
-    let exposure = scene.settings.exposure;
     let evaluate = |layers: u32| -> Result<GiResult> {
         let mut r = Renderer::new(&gpu, &scene, render_settings(s, layers, rs))?;
         // static warm-up at the evaluated camera: bounces and temporal history
         let renders = s.warmup.max(1) + 1;
         let (full, indirect) = render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, renders)?;
         // RMSE / MAE on linear radiance, FLIP on the tonemapped images
-        let (full_stats, full_map) = compare_radiance(&ref_total, &full, exposure)?;
-        let (indirect_stats, indirect_map) = compare_radiance(&ref_indirect, &indirect, exposure)?;
+        let (full_stats, full_map) = compare_radiance(&ref_total.image, &full, exposure)?;
+        let (indirect_stats, indirect_map) = compare_radiance(&ref_indirect.image, &indirect, exposure)?;
+        let full_stats = ref_total.annotate(full_stats, &display(&full, exposure));
+        let indirect_stats = ref_indirect.annotate(indirect_stats, &display(&indirect, exposure));
         Ok(GiResult {
             layers,
             full,
@@ -108,7 +111,8 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     let mut results = s.layer_counts().into_iter().map(evaluate).collect::<Result<Vec<_>>>()?;
     let main = results.pop().expect("k is evaluated");
     let fig10 = match g.fig10 {
-        true => Some(fig10(s, &gpu, &scene, rs, &cache, spp)?),
+        // single-bounce references at a fixed sample count (not converged)
+        true => Some(fig10(s, &gpu, &scene, rs, &cache, rule.max_spp.min(FIG10_SPP))?),
         false => None,
     };
     let flicker = match s.frames {
@@ -129,10 +133,11 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     };
     let out = GiEval {
         run: s.run_info(
-            spp,
+            converged.spp(),
             "path-traced diffuse GI, sky and ambient off (indirect = light reflected at least twice)",
             gpu.describe(),
             flicker,
+            noise_warnings(&[("gi indirect", &main.errors.indirect), ("gi full", &main.errors.full)]),
         ),
         samples: rs.samples,
         radius: rs.radius.unwrap_or(scene.settings.radiosity_radius),
@@ -148,7 +153,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         by_layers: s.by_layers(results.iter().chain([&main]).map(|r| (r.layers, r.errors))),
     };
     if let Some(dir) = &s.report {
-        let refs = (&ref_total, &ref_indirect);
+        let refs = (&ref_total.image, &ref_indirect.image);
         write_gi_report(dir, s, &out, &main, results.first(), refs, exposure)?;
     }
     Ok(out)
@@ -189,6 +194,33 @@ fn render_indirect(
     Ok((full, indirect))
 }
 
+/// Channels `first..first + 3` of `img` as an RGB image.
+fn channels3(img: &ImageBuf, first: usize) -> ImageBuf {
+    let mut out = ImageBuf::new(img.width, img.height, 3);
+    for (o, p) in out
+        .data
+        .chunks_exact_mut(3)
+        .zip(img.data.chunks_exact(img.channels as usize))
+    {
+        o.copy_from_slice(&p[first..first + 3]);
+    }
+    out
+}
+
+/// Direct + indirect of a 6-channel GI estimate (`Estimator::Gi`).
+fn total(img: &ImageBuf) -> ImageBuf {
+    let mut out = channels3(img, 0);
+    for (o, i) in out.data.iter_mut().zip(channels3(img, 3).data) {
+        *o += i;
+    }
+    out
+}
+
+/// The indirect part of a 6-channel GI estimate.
+fn indirect(img: &ImageBuf) -> ImageBuf {
+    channels3(img, 3)
+}
+
 fn rgb(img: &ImageBuf) -> ImageBuf {
     let mut out = ImageBuf::new(img.width, img.height, 3);
     for (o, p) in out
@@ -218,8 +250,8 @@ fn write_gi_report(
     let mut sections = vec![
         Section::new(format!("Indirect diffuse light, {k} layers, against the path tracer"))
             .text(format!(
-                "Tonemapped with the scene exposure ({exposure}); GPU indirect = composed image − direct. Reference: {} spp, {} bounces.",
-                out.run.ref_spp, out.ref_bounces
+                "Tonemapped with the scene exposure ({exposure}); GPU indirect = composed image − direct. Reference: {} spp (converged to ꟻLIP {:.4} between two independent halves), {} bounces.",
+                out.run.ref_spp, out.errors.indirect.ref_noise.map_or(0.0, |n| n.flip), out.ref_bounces
             ))
             .figures(vec![
                 fig(&main.indirect, &format!("indirect-k{k}.png"), format!("GPU, k = {k}: FLIP {:.4}", st.flip))?,

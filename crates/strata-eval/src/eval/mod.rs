@@ -11,6 +11,9 @@ use strata_render::renderer::GuardBand;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{Camera, ImageBuf, Scene};
 
+use strata_reference::{ConvergeRule, Converged};
+
+use crate::metrics::{compare, linear_errors, outliers, ErrorStats, RefNoise, OUTLIER_THRESHOLD};
 use crate::report::{sections, Page, ReportImage, Section};
 use crate::results::{ByLayers, EvalResult, EvalRun, Flicker};
 use crate::scene::SceneSpec;
@@ -27,8 +30,11 @@ pub struct EvalSettings {
     /// Deep G-buffer construction; `deep.layers` is the k evaluated.
     pub deep: DeepGBufferSettings,
     pub guard_band: GuardBand,
-    /// Samples per pixel of the CPU reference, 1..=65536 (default: the technique's).
+    /// Cap on the CPU reference's samples per pixel, 2..=65536 (default: the technique's).
     pub ref_spp: Option<u32>,
+    /// Noise target of the CPU reference: ꟻLIP between its two independent halves, in
+    /// [0, 1) (0: always integrate to the `ref_spp` cap). See `strata_reference::converge`.
+    pub ref_noise: f64,
     /// Static frames rendered before the evaluated one (gi), 0..=1000.
     pub warmup: u32,
     /// Folder of cached reference images.
@@ -46,12 +52,16 @@ pub struct EvalSettings {
 }
 
 impl EvalSettings {
-    /// Checks what every technique shares and returns the reference's samples per pixel
-    /// (`default_spp` unless `ref_spp`).
-    pub(crate) fn check(&self, default_spp: u32) -> Result<u32> {
-        let spp = self.ref_spp.unwrap_or(default_spp);
-        if !(1..=65536).contains(&spp) {
-            bail!("--ref-spp {spp} is out of range: must be in 1..=65536");
+    /// Checks what every technique shares and returns the reference's convergence rule: the
+    /// `ref_noise` target, the cap `ref_spp` (`default_cap` unless given), first rounds of
+    /// `first_spp` samples per half.
+    pub(crate) fn check(&self, default_cap: u32, first_spp: u32) -> Result<ConvergeRule> {
+        let spp = self.ref_spp.unwrap_or(default_cap);
+        if !(2..=65536).contains(&spp) {
+            bail!("--ref-spp {spp} is out of range: must be in 2..=65536");
+        }
+        if !(0.0..1.0).contains(&self.ref_noise) {
+            bail!("--ref-noise {} is out of range: must be in [0, 1)", self.ref_noise);
         }
         if let Some(n) = self.frames {
             if !(2..=1000).contains(&n) {
@@ -66,7 +76,11 @@ impl EvalSettings {
                 );
             }
         }
-        Ok(spp)
+        Ok(ConvergeRule {
+            target: self.ref_noise,
+            first_spp: first_spp.min(spp / 2),
+            max_spp: spp,
+        })
     }
 
     /// Render settings of this size and construction with `layers` layers (the technique's
@@ -82,7 +96,14 @@ impl EvalSettings {
     }
 
     /// What the result says about this run besides its errors.
-    pub(crate) fn run_info(&self, ref_spp: u32, reference: &str, device: String, flicker: Option<Flicker>) -> EvalRun {
+    pub(crate) fn run_info(
+        &self,
+        ref_spp: u32,
+        reference: &str,
+        device: String,
+        flicker: Option<Flicker>,
+        warnings: Vec<String>,
+    ) -> EvalRun {
         EvalRun {
             scene: self.scene.scene.clone(),
             layers: self.deep.layers,
@@ -94,6 +115,7 @@ impl EvalSettings {
             reference: reference.into(),
             device,
             flicker,
+            warnings,
         }
     }
 
@@ -113,6 +135,82 @@ impl EvalSettings {
             None => vec![k],
         }
     }
+}
+
+/// A converged reference image with its measured noise and speckles.
+pub(crate) struct RefImage {
+    /// Values as compared (AV, or linear radiance).
+    pub image: ImageBuf,
+    pub noise: RefNoise,
+    /// [`outliers`] of the reference's display values.
+    pub outliers: u32,
+}
+
+impl RefImage {
+    /// Channels `pick` selects from `c`'s image and halves, with noise measured on `display`
+    /// values (ꟻLIP) and the picked values (RMSE).
+    pub fn of(
+        c: &Converged,
+        pick: impl Fn(&ImageBuf) -> ImageBuf,
+        display: impl Fn(&ImageBuf) -> ImageBuf,
+    ) -> Result<Self> {
+        let [a, b] = c.half_images().map(|h| pick(&h));
+        let (stats, _) = compare(&display(&a), &display(&b))?;
+        let image = pick(&c.image());
+        Ok(Self {
+            outliers: outliers(&display(&image), OUTLIER_THRESHOLD),
+            noise: RefNoise {
+                flip: stats.flip,
+                rmse: linear_errors(&a, &b).0,
+                spp: c.spp(),
+                converged: c.converged,
+            },
+            image,
+        })
+    }
+
+    /// `stats` (of a test image against this reference) with the reference's noise and the
+    /// outliers of both (the test image's on its `display` values).
+    pub fn annotate(&self, mut stats: ErrorStats, test_display: &ImageBuf) -> ErrorStats {
+        stats.ref_noise = Some(self.noise);
+        stats.outliers = Some(outliers(test_display, OUTLIER_THRESHOLD));
+        stats.ref_outliers = Some(self.outliers);
+        stats
+    }
+}
+
+/// ꟻLIP between two half images on `display` values: the noise measure the convergence rule
+/// drives to its target (1 when they cannot be compared, so the rule keeps integrating).
+pub(crate) fn half_flip(a: &ImageBuf, b: &ImageBuf, display: impl Fn(&ImageBuf) -> ImageBuf) -> f64 {
+    compare(&display(a), &display(b)).map_or(1.0, |(s, _)| s.flip as f64)
+}
+
+/// The warnings an evaluation's reader must see: references stopped by the cap, and errors
+/// within 2× of their reference's noise. Also printed on stderr.
+pub(crate) fn noise_warnings(errors: &[(&str, &ErrorStats)]) -> Vec<String> {
+    let mut out = Vec::new();
+    for (name, e) in errors {
+        let Some(n) = e.ref_noise else { continue };
+        if !n.converged {
+            out.push(format!(
+                "{name}: the reference stopped at the --ref-spp cap of {} spp with noise ꟻLIP {:.4} above the \
+                 --ref-noise target",
+                n.spp, n.flip
+            ));
+        }
+        if e.within_ref_noise() {
+            out.push(format!(
+                "{name}: the error (ꟻLIP {:.4}, RMSE {:.4}) is within 2× of the reference's own noise (ꟻLIP {:.4}, \
+                 RMSE {:.4}): converge the reference further (--ref-noise, --ref-spp) to tell them apart",
+                e.flip, e.rmse, n.flip, n.rmse
+            ));
+        }
+    }
+    out.dedup();
+    for w in &out {
+        eprintln!("warning: {w}");
+    }
+    out
 }
 
 /// Writes `dir/index.html`: the result's tables and plots, then `images` (sections of figures

@@ -262,3 +262,57 @@ fn obscurance_under_a_ceiling_matches_quadrature() {
         assert!((av as f64 - want_av).abs() < 0.005, "{disk:?}: AV {av} vs {want_av}");
     }
 }
+
+/// A lone smooth-shaded cylinder (12 facets) seen from the side: every visible
+/// point of a convex object sees open sky, so binary AV stays high — also at
+/// the silhouettes, where the interpolated normal points slightly away from the
+/// viewer while the facet faces it. Flipping that normal "towards the ray" (the
+/// reference's old rule) turned it into the cylinder and gave AV = 0 there: the
+/// isolated black pixels of `docs/reference.md`.
+#[test]
+fn smooth_silhouettes_are_not_self_occluded() {
+    let mut b = strata_scene::shapes::MeshBuilder::new();
+    b.cylinder(Vec3::ZERO, 1.0, 4.0, 12, false);
+    let mut s = scene_with(
+        vec![Material::diffuse("white", [0.8; 3])],
+        Camera::new(Vec3::new(0.0, 2.0, 6.0), Vec3::new(0.0, 2.0, 0.0), Vec3::Y, 40.0, 0.05),
+    );
+    s.meshes.push(b.build("cylinder", 0));
+    s.objects.push(strata_scene::Object {
+        name: "cylinder".into(),
+        mesh: 0,
+        transform: glam::Mat4::IDENTITY,
+        animation: None,
+    });
+    let r = Reference::new(&s, 0.0);
+    let cam = r.camera();
+    let (w, h) = (96, 64);
+    let av = r.ao_binary(
+        &cam,
+        w,
+        h,
+        &AoBinarySettings {
+            radius: 0.5,
+            spp: 64,
+            seed: 0,
+        },
+    );
+    let mut silhouette = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let Some(hit) = r.primary_hit(&cam, x, y, w, h) else {
+                continue;
+            };
+            let dir = cam.pixel_dir(x, y, w, h);
+            let v = av.data[(y * w + x) as usize];
+            if hit.shading_normal.dot(dir) > 0.0 {
+                silhouette += 1; // the interpolated normal points away from the viewer here
+                let (n, ng) = hit.facing_normals(dir);
+                assert!(n.dot(ng) > 0.0 && ng.dot(dir) < 0.0, "({x},{y}): n {n} ng {ng}");
+            }
+            // rays below the facet hit the facet itself: at most half of them
+            assert!(v >= 0.5, "({x},{y}) AV {v} on a lone convex cylinder");
+        }
+    }
+    assert!(silhouette > 0, "the view must contain silhouette pixels");
+}

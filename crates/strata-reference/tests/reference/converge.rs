@@ -1,7 +1,7 @@
 //! Convergence by a noise target: sample ranges add up, halves are independent,
 //! the rule stops where it should, and the result is the estimator's image.
 
-use strata_reference::converge::next_round_spp;
+use strata_reference::converge::{decay_exponent, next_round_spp, Round};
 use strata_reference::{AoBinarySettings, ConvergeRule, Estimator, GiSettings, ObscuranceSettings, Reference};
 use strata_scene::ImageBuf;
 
@@ -144,12 +144,24 @@ fn the_cap_stops_an_unreachable_target() {
 }
 
 #[test]
-fn next_round_follows_the_inverse_square_root_law_within_bounds() {
-    // target 0 (run to the cap): 8× per round
-    // noise twice the target: 4× the samples, +20 %
-    assert_eq!(next_round_spp(100, 0.04, 0.02), 480);
-    assert_eq!(next_round_spp(100, 0.021, 0.02), 200); // at least 2×
-    assert_eq!(next_round_spp(100, 1.0, 0.02), 800); // at most 8×
-    assert_eq!(next_round_spp(10, f64::NAN, 0.02), 80);
-    assert_eq!(next_round_spp(0, 1.0, 0.0), 8);
+fn next_round_follows_the_measured_decay_within_bounds() {
+    // noise twice the target at b = 0.5: 4× the samples, +20 %
+    assert_eq!(next_round_spp(100, 0.04, 0.02, 0.5), 480);
+    assert_eq!(next_round_spp(100, 0.021, 0.02, 0.5), 200); // at least 2×
+    assert_eq!(next_round_spp(100, 1.0, 0.02, 0.5), 800); // at most 8×
+    // ꟻLIP-like decay (b = 0.35) asks for more than b = 0.5 would
+    assert!(next_round_spp(100, 0.024, 0.02, 0.35) > next_round_spp(100, 0.024, 0.02, 0.5));
+    // target 0 (run to the cap), unusable noise: 8× per round
+    assert_eq!(next_round_spp(10, f64::NAN, 0.02, 0.5), 80);
+    assert_eq!(next_round_spp(0, 1.0, 0.0, 0.5), 8);
+    let round = |spp, noise| Round {
+        spp,
+        noise,
+        seconds: 0.0,
+    };
+    assert_eq!(decay_exponent(&[round(16, 0.2)]), 0.5);
+    let b = decay_exponent(&[round(16, 0.2), round(64, 0.1)]);
+    assert!((b - 0.5).abs() < 1e-12, "{b}");
+    assert_eq!(decay_exponent(&[round(16, 0.2), round(64, 0.2)]), 0.2); // clamped
+    assert_eq!(decay_exponent(&[round(16, 0.0), round(64, 0.0)]), 0.5);
 }
