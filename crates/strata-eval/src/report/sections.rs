@@ -119,10 +119,16 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         "by_layers",
         "fig10",
         "flicker_per_frame",
+        "ref_noise",
+        "outliers",
+        "ref_outliers",
+        "warnings",
     ];
     let mut section = Section::new(format!("{} on {}: numbers", technique(r), run.scene))
+        .text(run.warnings.iter().map(|w| format!("Warning: {w}")).collect::<Vec<_>>().join(" "))
         .table(settings_table("Settings", r, &skip)?)
-        .table(errors);
+        .table(errors)
+        .table(reference_table(r));
     if let Some(f) = fig10 {
         let mut t = Table::new(
             "DGB Fig. 10: single-bounce radiosity against single-bounce references",
@@ -147,6 +153,41 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
     }
     section = section.figures(eval_plots(run, &rows, dir, prefix)?);
     Ok(vec![section])
+}
+
+/// The references' own quality: samples, whether the noise target was met, the noise between
+/// the two independent halves, and the speckles of the reference and of the evaluated image.
+fn reference_table(r: &EvalResult) -> Table {
+    let mut t = Table::new(
+        "Reference quality (noise = the two independent halves of the reference compared; outliers = pixels off their 3×3 median by more than 0.25)",
+        &[
+            "reference",
+            "spp",
+            "converged",
+            "noise FLIP",
+            "noise RMSE",
+            "reference outliers",
+            "GPU outliers",
+        ],
+    );
+    let named: Vec<(&str, &ErrorStats)> = match r {
+        EvalResult::Ao(e) => vec![("obscurance", &e.errors.obscurance), ("binary AO", &e.errors.binary)],
+        EvalResult::Gi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
+    };
+    for (name, e) in named {
+        let Some(n) = e.ref_noise else { continue };
+        let count = |c: Option<u32>| c.map_or(Cell::Text("–".into()), |c| Cell::Text(c.to_string()));
+        t.row(vec![
+            name.into(),
+            Cell::Text(n.spp.to_string()),
+            (if n.converged { "yes" } else { "no (cap)" }).into(),
+            n.flip.into(),
+            n.rmse.into(),
+            count(e.ref_outliers),
+            count(e.outliers),
+        ]);
+    }
+    t
 }
 
 fn technique(r: &EvalResult) -> &'static str {
