@@ -32,11 +32,15 @@ $S reference --scene atrium --kind ao --spp 16 --width 160 --height 90 --out "$O
 $S reference --scene cornell --kind gi --spp 64 --bounces 3 --width 96 --height 96 --out "$OUT/cornell-ref-gi.png" --force --quiet
 echo "[strata demo] deep-G-buffer AO (2 layers) and its evaluation against the ray-traced obscurance" >&2
 $S render --scene atrium --technique ao --layers 2 --width "$W" --height "$H" --out "$OUT/atrium-ao.png" --force
-$S eval --scene atrium --technique ao --layers 2 --width 320 --height 180 --ref-spp 128 --frames 4 \
+# the references converge to the default noise target (ꟻLIP 0.02 between their two halves)
+$S eval --scene atrium --technique ao --layers 2 --width 320 --height 180 --frames 4 \
   --report "$OUT/ao-eval" --force --json --quiet > "$OUT/eval-ao.json"
 cat "$OUT/eval-ao.json"
 echo "[strata demo] deep-G-buffer radiosity against the path tracer" >&2
-$S eval --scene warehouse --technique gi --layers 2 --width 320 --height 180 \
+# the path tracer converges slowly (ꟻLIP ∝ spp^-0.35): the demo stops at ꟻLIP 0.05 between the
+# reference's halves (≈ 1,000 spp, minutes) instead of the default 0.02 (≈ 16,000 spp, most of an hour
+# on 2 cores); the JSON's ref_noise says which it reached
+$S eval --scene warehouse --technique gi --layers 2 --width 320 --height 180 --ref-noise 0.05 \
   --report "$OUT/gi-eval" --force --json --quiet > "$OUT/eval-gi.json"
 cat "$OUT/eval-gi.json"
 echo "[strata demo] GPU timings" >&2

@@ -336,7 +336,7 @@ pub struct EvalArgs {
     pub ao: AoArgs,
     #[command(flatten)]
     pub radiosity: RadiosityArgs,
-    /// Cap on the CPU reference's samples per pixel, 2..=65536 (default 16384). The reference
+    /// Cap on the CPU reference's samples per pixel, 2..=65536 (default 32768). The reference
     /// integrates until --ref-noise is met or this cap is reached.
     #[arg(long)]
     pub ref_spp: Option<u32>,

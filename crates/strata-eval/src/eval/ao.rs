@@ -17,7 +17,7 @@ use crate::report::Section;
 use crate::results::{AoErrors, AoEval, EvalResult};
 
 /// Default cap on the references' samples per pixel (`--ref-spp`).
-pub const DEFAULT_CAP: u32 = 16_384;
+pub const DEFAULT_CAP: u32 = 32_768;
 
 /// One GPU AO evaluation: the image and its errors against both references.
 struct AoResult {

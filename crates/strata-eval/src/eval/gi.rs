@@ -20,7 +20,7 @@ use crate::report::Section;
 use crate::results::{EvalResult, Fig10, Fig10Row, GiErrors, GiEval};
 
 /// Default cap on the path tracer's samples per pixel (`--ref-spp`).
-pub const DEFAULT_CAP: u32 = 16_384;
+pub const DEFAULT_CAP: u32 = 32_768;
 /// Samples per pixel of Fig. 10's single-bounce references.
 const FIG10_SPP: u32 = 256;
 
