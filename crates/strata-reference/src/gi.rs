@@ -74,7 +74,7 @@ pub struct GiImages {
 /// Emissive triangles with a CDF ∝ area × luminance(emission).
 pub(crate) struct EmissiveLights {
     /// (triangle index, area, emitted radiance)
-    tris: Vec<(u32, f32, Vec3)>,
+    pub(crate) tris: Vec<(u32, f32, Vec3)>,
     /// Inclusive prefix sums of the weights, normalised to end at 1.
     cdf: Vec<f32>,
     /// Σ weights.
@@ -114,7 +114,7 @@ impl EmissiveLights {
     }
 
     /// Picks a light triangle for uniform `u`: (index into `tris`, probability).
-    fn pick(&self, u: f32) -> (usize, f32) {
+    pub(crate) fn pick(&self, u: f32) -> (usize, f32) {
         let i = self.cdf.partition_point(|&c| c <= u).min(self.tris.len() - 1);
         let w = self.tris[i].1 as f64 * luminance(self.tris[i].2) as f64;
         (i, (w / self.total) as f32)
@@ -125,7 +125,7 @@ impl EmissiveLights {
     }
 }
 
-fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+pub(crate) fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     if e1 <= e0 {
         return if x >= e1 { 1.0 } else { 0.0 };
     }

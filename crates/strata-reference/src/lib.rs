@@ -43,6 +43,7 @@ pub mod gi;
 pub mod layers;
 pub mod probes;
 pub mod sampling;
+pub mod vpl;
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -58,6 +59,7 @@ pub use bvh::{Bvh, Hit, SurfaceHit};
 pub use converge::{ConvergeRule, Converged, Estimator};
 pub use gi::{GiImages, GiSettings};
 pub use layers::{DeepLayers, Layer, LayerSettings, NO_ID};
+pub use vpl::{Vpl, VplSettings};
 
 /// Counters accumulated over every computation run on a [`Reference`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -7,3 +7,4 @@ mod converge;
 mod gi;
 mod layers;
 mod scenes;
+mod vpl;
