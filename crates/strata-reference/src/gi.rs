@@ -35,7 +35,7 @@ use glam::Vec3;
 use strata_scene::{Camera, ImageBuf, Light, Material};
 
 use crate::bvh::Bvh;
-use crate::sampling::{cosine_hemisphere, hash, pixel_offset, r2, triangle_barycentrics, Rng};
+use crate::sampling::{cosine_hemisphere, hash, triangle_barycentrics, Rng};
 use crate::Reference;
 
 /// Settings of the path tracer.
@@ -177,10 +177,13 @@ impl Reference<'_> {
         // The first bounce direction (the dimension the indirect light depends
         // on most) follows the R2 sequence with a per-pixel rotation; the
         // rest of the path is random.
-        let offset = pixel_offset(hash(&[settings.seed, pixel, 0x0b0c]));
+        let offset = {
+            let mut r = Rng::new(hash(&[settings.seed, pixel, 0x0b0c]));
+            [0; 4].map(|_: u8| r.next_f32() as f64)
+        };
         for s in samples {
             let mut rng = Rng::new(hash(&[settings.seed, pixel, s as u64]));
-            let first = Some(r2(s, offset));
+            let first = Some(crate::sampling::kronecker4(s, &offset));
             let (d, i) = self.trace_path(camera.eye, camera.near, dir, settings, first, &mut rng, rays);
             direct += d;
             indirect += i;
@@ -197,7 +200,7 @@ impl Reference<'_> {
     }
 
     /// One path from `origin` (hits beyond `t_min`) along `dir`: (direct, indirect).
-    /// `first_bounce`: the uniform sample of the first bounce direction (random when `None`).
+    /// `first_bounces`: uniform samples of the first two bounce directions (random when `None`).
     #[allow(clippy::too_many_arguments)]
     fn trace_path(
         &self,
@@ -205,7 +208,7 @@ impl Reference<'_> {
         t_min: f32,
         dir: Vec3,
         settings: &GiSettings,
-        first_bounce: Option<[f32; 2]>,
+        first_bounces: Option<[f32; 4]>,
         rng: &mut Rng,
         rays: &mut u64,
     ) -> (Vec3, Vec3) {
@@ -239,8 +242,9 @@ impl Reference<'_> {
             if last && sky == Vec3::ZERO {
                 break;
             }
-            let u = match (depth, first_bounce) {
-                (0, Some(u)) => u,
+            let u = match (depth, first_bounces) {
+                (0, Some(u)) => [u[0], u[1]],
+                (1, Some(u)) => [u[2], u[3]],
                 _ => rng.next_2d(),
             };
             let wi = cosine_hemisphere(n, u);

@@ -72,6 +72,21 @@ pub fn r2(i: u32, offset: [f32; 2]) -> [f32; 2] {
     [u as f32, v as f32]
 }
 
+/// Point `k` of the 4-D Kronecker low-discrepancy sequence α_j = φ₄^−(j+1)
+/// (φ₄ the positive root of x⁵ = x + 1; Roberts' generalised golden ratio),
+/// rotated by `offset` (Cranley–Patterson).
+#[inline]
+pub fn kronecker4(k: u32, offset: &[f64; 4]) -> [f32; 4] {
+    const PHI4: f64 = 1.167_303_978_261_418_7;
+    let mut out = [0.0f32; 4];
+    let mut a = 1.0;
+    for (j, o) in out.iter_mut().enumerate() {
+        a /= PHI4;
+        *o = (0.5 + a * k as f64 + offset[j]).fract() as f32;
+    }
+    out
+}
+
 /// Per-pixel Cranley–Patterson offset for [`r2`].
 #[inline]
 pub fn pixel_offset(key: u64) -> [f32; 2] {

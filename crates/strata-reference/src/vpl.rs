@@ -97,7 +97,7 @@ impl Default for VplSettings {
 /// Point `k` of the 5-D Kronecker sequence α_j = φ₅^−(j+1), φ₅ the unique
 /// positive root of x⁶ = x + 1, rotated by `offset`.
 fn kronecker5(k: u32, offset: &[f64; 5]) -> [f32; 5] {
-    const PHI5: f64 = 1.167_303_978_261_418_7;
+    const PHI5: f64 = 1.134_724_138_401_518_8;
     let mut out = [0.0f32; 5];
     let mut a = 1.0;
     for (j, o) in out.iter_mut().enumerate() {

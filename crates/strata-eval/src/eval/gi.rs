@@ -64,8 +64,11 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     // halves are within the noise target (ꟻLIP on the tonemapped images); cached.
     let cache = RefCache::new(&s.cache);
     let exposure = scene.settings.exposure;
+    // No Russian roulette: the path length is bounded by `bounces` anyway, and roulette's
+    // reweighted survivors were most of the noise of the deeper bounces.
     let estimator = Estimator::Gi(GiSettings {
         bounces: g.bounces,
+        russian_roulette: false,
         ..Default::default()
     });
     let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
