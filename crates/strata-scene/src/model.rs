@@ -259,6 +259,9 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     pub lights: Vec<Light>,
     pub camera: Camera,
+    /// The cameras the scene file defines (glTF camera nodes, in node order);
+    /// `camera` starts as the first of them. Empty for files without cameras.
+    pub cameras: Vec<Camera>,
     pub camera_path: Option<CameraPath>,
     pub settings: SceneSettings,
 }

@@ -48,6 +48,13 @@ fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
 /// translated by (1, 0, 0) and a child scale of 2, plus a camera node at
 /// (0, 0, 5) and a second instance mirrored in x. `max_index` is the last index value.
 fn tiny_glb(last_index: u16) -> Vec<u8> {
+    tiny_glb_with(last_index, "", "", "")
+}
+
+/// [`tiny_glb`] with `root` inserted at the top level of the JSON, `nodes`
+/// appended to the node list (indices 4, 5, …) and `scene_nodes` appended to
+/// the scene's root nodes.
+fn tiny_glb_with(last_index: u16, root: &str, nodes: &str, scene_nodes: &str) -> Vec<u8> {
     let positions = f32_bytes(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0]);
     let uvs = f32_bytes(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]);
     let indices: Vec<u8> = [0u16, 1, 2, 0, 2, last_index]
@@ -65,12 +72,13 @@ fn tiny_glb(last_index: u16) -> Vec<u8> {
   "asset": {{"version": "2.0"}},
   "extensionsUsed": ["KHR_materials_emissive_strength"],
   "scene": 0,
-  "scenes": [{{"nodes": [0, 2, 3]}}],
+  {root}
+  "scenes": [{{"nodes": [0, 2, 3{scene_nodes}]}}],
   "nodes": [
     {{"name": "parent", "translation": [1, 0, 0], "children": [1]}},
     {{"name": "quad", "mesh": 0, "scale": [2, 2, 2]}},
     {{"name": "cam", "camera": 0, "translation": [0, 0, 5]}},
-    {{"name": "mirrored", "mesh": 0, "scale": [-1, 1, 1]}}
+    {{"name": "mirrored", "mesh": 0, "scale": [-1, 1, 1]}}{nodes}
   ],
   "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.8, "znear": 0.1}}}}],
   "meshes": [{{"name": "quadmesh", "primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "indices": 2, "material": 0}}]}}],
@@ -97,7 +105,7 @@ fn tiny_glb(last_index: u16) -> Vec<u8> {
   ]
 }}"#,
         len = bin.len(),
-        png_len = png.len()
+        png_len = png.len(),
     );
     glb(&json, &bin)
 }
@@ -144,6 +152,84 @@ fn tiny_glb_loads_everything() {
     assert!((s.camera.fov_y_deg - 0.8f32.to_degrees()).abs() < 1e-4 && s.camera.near == 0.1);
     // Default sun.
     assert_eq!(s.lights.len(), 1);
+}
+
+/// `KHR_lights_punctual`: one light of each type on nodes (one under a
+/// translated parent), a second camera; units converted as documented.
+fn lit_glb(spot: &str) -> Vec<u8> {
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let root = format!(
+        r#""extensions": {{"KHR_lights_punctual": {{"lights": [
+    {{"name": "sun", "type": "directional", "color": [1.0, 0.9, 0.8], "intensity": 683.0}},
+    {{"name": "bulb", "type": "point", "intensity": 1366.0, "range": 5.0}},
+    {{"name": "cone", "type": "spot", "color": [0.5, 1.0, 1.0], "intensity": 68.3{spot}}}
+  ]}}}},"#
+    );
+    // node 4: the sun pointing down (rotated −90° about X: −Z → −Y); node 5:
+    // parent at (0, 3, 0) of node 6, the bulb at +1 in x; node 7: the spot;
+    // node 8: a second camera.
+    let nodes = format!(
+        r#",
+    {{"name": "sun", "rotation": [{n}, 0, 0, {s}], "extensions": {{"KHR_lights_punctual": {{"light": 0}}}}}},
+    {{"name": "lamp", "translation": [0, 3, 0], "children": [6]}},
+    {{"name": "bulb", "translation": [1, 0, 0], "extensions": {{"KHR_lights_punctual": {{"light": 1}}}}}},
+    {{"name": "cone", "translation": [0, 2, 0], "extensions": {{"KHR_lights_punctual": {{"light": 2}}}}}},
+    {{"name": "cam2", "camera": 0, "translation": [0, 1, 7]}}"#,
+        n = -s
+    );
+    tiny_glb_with(3, &root, &nodes, ", 4, 5, 7, 8")
+}
+
+#[test]
+fn gltf_punctual_lights_and_cameras_load_with_the_extension_units() {
+    let p = write("lit.glb", &lit_glb(r#", "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}"#));
+    let s = load_path(&p).expect("lit glb");
+    assert_eq!(s.lights.len(), 3, "the file's lights replace the default sun: {:?}", s.lights);
+    let sun = s.lights.iter().find_map(|l| match l {
+        strata_scene::Light::Sun { direction, color, illuminance } => Some((*direction, *color, *illuminance)),
+        _ => None,
+    });
+    let (dir, color, lux) = sun.expect("a sun");
+    assert!(dir.abs_diff_eq(-Vec3::Y, 1e-5), "{dir}");
+    assert_eq!(color, [1.0, 0.9, 0.8]);
+    assert!((lux - 1.0).abs() < 1e-6, "683 lux = 1 W/m²: {lux}");
+    let point = s.lights.iter().find_map(|l| match l {
+        strata_scene::Light::Point { position, intensity, color } => Some((*position, *intensity, *color)),
+        _ => None,
+    });
+    let (pos, cd, white) = point.expect("a point light");
+    assert!(pos.abs_diff_eq(Vec3::new(1.0, 3.0, 0.0), 1e-6), "parent × child translation: {pos}");
+    assert!((cd - 2.0).abs() < 1e-6 && white == [1.0; 3]);
+    let spot = s.lights.iter().find_map(|l| match l {
+        strata_scene::Light::Spot { position, direction, intensity, inner_deg, outer_deg, .. } => {
+            Some((*position, *direction, *intensity, *inner_deg, *outer_deg))
+        }
+        _ => None,
+    });
+    let (pos, dir, i, inner, outer) = spot.expect("a spot");
+    assert!(pos.abs_diff_eq(Vec3::new(0.0, 2.0, 0.0), 1e-6) && dir.abs_diff_eq(-Vec3::Z, 1e-6));
+    assert!((i - 0.1).abs() < 1e-6 && (inner - 0.2f32.to_degrees()).abs() < 1e-4 && (outer - 0.5f32.to_degrees()).abs() < 1e-4);
+    // both cameras, in node order; the first is the camera
+    assert_eq!(s.cameras.len(), 2);
+    assert_eq!(s.camera, s.cameras[0]);
+    assert_eq!(s.cameras[1].eye, Vec3::new(0.0, 1.0, 7.0));
+    // a file without the extension keeps the default sun and has one camera
+    let plain = load_path(&write("plain.glb", &tiny_glb(3))).unwrap();
+    assert_eq!(plain.lights.len(), 1);
+    assert_eq!(plain.cameras.len(), 1);
+}
+
+#[test]
+fn bad_punctual_lights_are_one_line_errors() {
+    for (spot, words) in [
+        (r#", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.5}"#, &["cone", "inner < outer"][..]),
+        (r#", "spot": {"innerConeAngle": 0.1, "outerConeAngle": 2.0}"#, &["π/2"][..]),
+    ] {
+        let p = write("badspot.glb", &lit_glb(spot));
+        let e = load_path(&p).unwrap_err().to_string();
+        assert!(!e.contains('\n') && words.iter().all(|w| e.contains(w)), "{e}");
+        assert!(e.contains("badspot.glb"), "names the file: {e}");
+    }
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! glTF 2.0 (`.gltf`, `.glb`): materials with base colour textures, triangle
 //! primitives (lists, strips and fans, converted to lists), the default
-//! scene's node hierarchy and its first perspective camera (see the
-//! [`super`] docs for the mapping).
+//! scene's node hierarchy, its perspective cameras and its
+//! `KHR_lights_punctual` lights (see the [`super`] docs for the mapping).
 //!
 //! Checks: the GLB header, attribute indices, buffers, accessors and images
 //! through [`super::gltf_data`] (sizes against the bytes that are there);
@@ -17,7 +17,7 @@ use glam::{Mat4, Vec3};
 use crate::camera::Camera;
 use crate::error::{short, SceneError};
 use crate::files::FileSource;
-use crate::model::{Material, Mesh, Object, Scene};
+use crate::model::{Light, Material, Mesh, Object, Scene};
 use crate::normals::ensure_normals;
 
 use super::checks::{check_indices, check_material, check_vertices, MaterialSlots};
@@ -194,7 +194,8 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
     }
     let nodes: Vec<gltf::Node> = doc.nodes().collect();
     let mut visited = vec![false; nodes.len()];
-    let mut camera = None;
+    let mut cameras = Vec::new();
+    let mut lights = Vec::new();
     let mut flipped: HashMap<usize, usize> = HashMap::new();
     let mut stack: Vec<(usize, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
     while let Some((ni, parent)) = stack.pop() {
@@ -241,38 +242,139 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
                 });
             }
         }
-        if camera.is_none() {
-            // From the JSON: `gltf`'s `Camera::projection` panics when `type`
-            // names a projection whose object is missing.
-            let perspective = node
-                .camera()
-                .and_then(|cam| doc.as_json().cameras.get(cam.index()))
-                .and_then(|c| c.perspective.as_ref());
-            if let Some(p) = perspective {
-                {
-                    let eye = world.transform_point3(Vec3::ZERO);
-                    let fwd = world.transform_vector3(-Vec3::Z).normalize_or_zero();
-                    let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-                    let c = Camera::new(eye, eye + fwd, up, p.yfov.to_degrees(), p.znear);
-                    if c.validate().is_ok() {
-                        camera = Some(c);
-                    }
-                }
+        // From the JSON: `gltf`'s `Camera::projection` panics when `type`
+        // names a projection whose object is missing.
+        let perspective = node
+            .camera()
+            .and_then(|cam| doc.as_json().cameras.get(cam.index()))
+            .and_then(|c| c.perspective.as_ref());
+        if let Some(p) = perspective {
+            let eye = world.transform_point3(Vec3::ZERO);
+            let fwd = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+            let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+            let c = Camera::new(eye, eye + fwd, up, p.yfov.to_degrees(), p.znear);
+            if c.validate().is_ok() {
+                cameras.push((ni, c));
             }
+        }
+        if let Some(l) = punctual_light(doc, ni, world).map_err(|m| fail(m))? {
+            lights.push(l);
         }
         for c in node.children() {
             stack.push((c.index(), world));
         }
     }
-    let has_camera = camera.is_some();
-    if let Some(c) = camera {
-        scene.camera = c;
+    // file order (node index), not traversal order
+    cameras.sort_by_key(|(ni, _)| *ni);
+    let has_camera = !cameras.is_empty();
+    if let Some((_, c)) = cameras.first() {
+        scene.camera = *c;
     }
+    scene.cameras = cameras.into_iter().map(|(_, c)| c).collect();
+    let has_lights = !lights.is_empty();
+    scene.lights = lights;
     Ok(MeshFile {
         scene,
         has_camera,
-        has_lights: false,
+        has_lights,
     })
+}
+
+/// Photometric → strata's radiometric units: 683 lm per W (the luminous efficacy
+/// at 555 nm, the definition of the candela).
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+/// The `KHR_lights_punctual` light of node `ni` (world transform `world`), if it
+/// has one. Units as the extension defines them, converted to strata's:
+/// directional lux → sun irradiance lux / 683; point and spot candela → radiant
+/// intensity cd / 683; lights shine along the node's −Z; spot cone angles are
+/// radians from the axis (inner default 0, outer default π/4), inner < outer ≤
+/// π/2. `range` is not modelled (strata's lights fall off as 1/d² without a
+/// cutoff) and is ignored.
+fn punctual_light(doc: &gltf::Document, ni: usize, world: Mat4) -> Result<Option<Light>, String> {
+    use gltf::json::extensions::scene::khr_lights_punctual::Type;
+    use gltf::json::validation::Checked;
+    let json = doc.as_json();
+    let Some(index) = json.nodes[ni]
+        .extensions
+        .as_ref()
+        .and_then(|e| e.khr_lights_punctual.as_ref())
+        .map(|k| k.light.value())
+    else {
+        return Ok(None);
+    };
+    let all = json
+        .extensions
+        .as_ref()
+        .and_then(|e| e.khr_lights_punctual.as_ref())
+        .map_or(&[][..], |k| k.lights.as_slice());
+    let light = all.get(index).ok_or_else(|| {
+        format!(
+            "node {ni}: KHR_lights_punctual light {index} is out of range: the file defines {} light(s)",
+            all.len()
+        )
+    })?;
+    let name = light.name.clone().unwrap_or_else(|| format!("light {index}"));
+    if !light.color.iter().all(|c| c.is_finite() && *c >= 0.0) || !(light.intensity.is_finite() && light.intensity >= 0.0) {
+        return Err(format!(
+            "KHR_lights_punctual '{}': color and intensity must be finite and >= 0",
+            short(&name)
+        ));
+    }
+    let position = world.transform_point3(Vec3::ZERO);
+    let direction = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+    let color = light.color;
+    let radiometric = light.intensity / LUMENS_PER_WATT;
+    let needs_direction = || {
+        if direction == Vec3::ZERO || !direction.is_finite() {
+            Err(format!("KHR_lights_punctual '{}' on node {ni}: the node's transform collapses its −Z direction", short(&name)))
+        } else {
+            Ok(())
+        }
+    };
+    Ok(Some(match light.type_ {
+        Checked::Valid(Type::Directional) => {
+            needs_direction()?;
+            Light::Sun {
+                direction,
+                color,
+                illuminance: radiometric,
+            }
+        }
+        Checked::Valid(Type::Point) => Light::Point {
+            position,
+            color,
+            intensity: radiometric,
+        },
+        Checked::Valid(Type::Spot) => {
+            needs_direction()?;
+            let (inner, outer) = light
+                .spot
+                .as_ref()
+                .map_or((0.0, std::f32::consts::FRAC_PI_4), |s| (s.inner_cone_angle, s.outer_cone_angle));
+            if !(inner >= 0.0 && inner < outer && outer <= std::f32::consts::FRAC_PI_2) {
+                return Err(format!(
+                    "KHR_lights_punctual '{}': spot cone angles inner {inner} and outer {outer} are out of range: \
+                     must satisfy 0 <= inner < outer <= π/2",
+                    short(&name)
+                ));
+            }
+            Light::Spot {
+                position,
+                direction,
+                color,
+                intensity: radiometric,
+                inner_deg: inner.to_degrees(),
+                outer_deg: outer.to_degrees(),
+            }
+        }
+        Checked::Invalid => {
+            return Err(format!(
+                "KHR_lights_punctual '{}': unknown light type: must be directional, point or spot",
+                short(&name)
+            ))
+        }
+    }))
 }
 
 /// The triangle list of a triangle strip (every other triangle flipped to keep

@@ -12,8 +12,15 @@
 //!   Materials: `baseColorFactor` (linear RGB; its alpha is the opacity unless
 //!   `alphaMode` is OPAQUE), `baseColorTexture` (converted to RGBA8),
 //!   `emissiveFactor` × `KHR_materials_emissive_strength`, roughness, metallic.
-//!   The first perspective camera node becomes the camera. `KHR_lights_punctual`
-//!   is not read.
+//!   Every perspective camera node is kept in [`Scene::cameras`](crate::model::Scene)
+//!   (node order; the first becomes the camera, `--camera N` picks another).
+//!   `KHR_lights_punctual` lights on nodes become strata lights with the node's
+//!   world transform (shining along its −Z): directional → `Sun` with
+//!   illuminance lux / 683, point → `Point` and spot → `Spot` with radiant
+//!   intensity candela / 683 (683 lm/W, the candela's definition), spot cone
+//!   angles in radians from the axis; `range` is ignored (strata's lights have no
+//!   cutoff). A file with lights gets no default sun; a TOML wrapper's
+//!   `[[light]]` entries still replace them.
 //! - **OBJ/MTL** (`tobj`, triangulated, single index): one
 //!   [`Mesh`](crate::model::Mesh) per object/group and material.
 //!   `Kd` → base colour, `map_Kd` → texture
