@@ -88,6 +88,10 @@ pub struct SceneArgs {
     /// Vertical field of view in degrees, in (0, 180).
     #[arg(long, allow_negative_numbers = true)]
     pub fov: Option<f32>,
+    /// Which of the scene file's cameras to use (glTF camera nodes in file order, from 0;
+    /// default: the first). The --eye/--target/--up/--fov overrides apply on top.
+    #[arg(long)]
+    pub camera: Option<usize>,
 }
 
 /// Deep G-buffer construction (DGB §2).
@@ -386,7 +390,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub debug_view: Option<String>,
     /// Output file: .png (tonemapped, sRGB) or .exr (linear HDR).
-    #[arg(long, required_unless_present = "list_passes")]
+    #[arg(long, required_unless_present_any = ["list_passes", "list_lights"])]
     pub out: Option<PathBuf>,
     /// Overwrite the output file if it exists.
     #[arg(long)]
@@ -394,6 +398,10 @@ pub struct RenderArgs {
     /// Print the frame's passes with their inputs and outputs, and the debug views, then exit.
     #[arg(long)]
     pub list_passes: bool,
+    /// Print the scene's lights (type, position or direction, colour, intensity in strata's
+    /// units) and cameras, then exit.
+    #[arg(long)]
+    pub list_lights: bool,
     /// Print per-pass GPU times after rendering.
     #[arg(long)]
     pub timings: bool,

@@ -20,6 +20,7 @@ impl From<&SceneArgs> for SceneSpec {
             target: a.target,
             up: a.up,
             fov: a.fov,
+            camera: a.camera,
         }
     }
 }

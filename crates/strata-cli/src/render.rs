@@ -53,6 +53,10 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
 pub fn run(a: &RenderArgs) -> Result<()> {
     let f = &a.frame;
     let (scene, cams, settings) = prepare(f)?;
+    if a.list_lights {
+        print_lights(&scene);
+        return Ok(());
+    }
     if let Some(out) = &a.out {
         check_output(out, a.force)?;
     }
@@ -114,4 +118,37 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         scene.triangle_count()
     );
     Ok(())
+}
+
+/// `--list-lights`: one line per light and camera, in strata's units.
+fn print_lights(scene: &strata_scene::Scene) {
+    use strata_scene::Light;
+    let v = |v: glam::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
+    println!("lights of '{}': {}", scene.name, scene.lights.len());
+    for (i, l) in scene.lights.iter().enumerate() {
+        let line = match l {
+            Light::Sun { direction, color, illuminance } => {
+                format!("sun   direction {} color {color:?} illuminance {illuminance}", v(*direction))
+            }
+            Light::Point { position, color, intensity } => {
+                format!("point position {} color {color:?} intensity {intensity}", v(*position))
+            }
+            Light::Spot { position, direction, color, intensity, inner_deg, outer_deg } => format!(
+                "spot  position {} direction {} color {color:?} intensity {intensity} cone {inner_deg:.2}°..{outer_deg:.2}°",
+                v(*position),
+                v(*direction)
+            ),
+            Light::Rect { center, half_u, half_v, radiance } => format!(
+                "rect  center {} half_u {} half_v {} radiance {radiance:?}",
+                v(*center),
+                v(*half_u),
+                v(*half_v)
+            ),
+        };
+        println!("  {i}: {line}");
+    }
+    println!("cameras in the file: {}", scene.cameras.len());
+    for (i, c) in scene.cameras.iter().enumerate() {
+        println!("  {i}: eye {} target {} fov {:.2}°", v(c.eye), v(c.target), c.fov_y_deg);
+    }
 }

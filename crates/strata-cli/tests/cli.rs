@@ -923,3 +923,16 @@ fn bench_technique_times_the_registered_passes() {
     ]);
     assert_one_line_error(&o, &["--preset", "valid presets are"]);
 }
+
+/// Issue 17: `--list-lights` prints the scene's lights in strata's units; `--camera N` is
+/// range-checked against the file's cameras.
+#[test]
+fn render_lists_lights_and_checks_the_camera_index() {
+    let o = strata(&["render", "--scene", "warehouse", "--list-lights"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("lights of 'warehouse': 2"), "{out}");
+    assert!(out.contains("spot ") && out.contains("cone 15.00°..19.00°") && out.contains("point position (4.000, 3.200, 2.500)"), "{out}");
+    let o = strata(&["render", "--scene", "warehouse", "--camera", "0", "--list-lights"]);
+    assert_one_line_error(&o, &["--camera 0", "no cameras"]);
+}

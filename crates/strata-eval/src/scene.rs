@@ -25,6 +25,8 @@ pub struct SceneSpec {
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees.
     pub fov: Option<f32>,
+    /// Which of the scene file's cameras (`Scene::cameras`) to start from.
+    pub camera: Option<usize>,
 }
 
 impl SceneSpec {
@@ -39,13 +41,25 @@ impl SceneSpec {
             target: None,
             up: None,
             fov: None,
+            camera: None,
         }
     }
 
     /// Loads the scene and resolves the cameras of frames `frame − 1`, `frame` and `frame + 1`
     /// (the scene's path, then the overrides), checking the frame, camera and image size.
     pub fn load(&self) -> Result<(Scene, FrameCameras)> {
-        let scene = strata_scene::load_scene(&self.scene).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
+        let mut scene = strata_scene::load_scene(&self.scene).map_err(|e| anyhow::anyhow!("--scene: {e}"))?;
+        if let Some(n) = self.camera {
+            let k = scene.cameras.len();
+            match scene.cameras.get(n) {
+                Some(c) => {
+                    scene.camera = *c;
+                    scene.camera_path = None;
+                }
+                None if k == 0 => bail!("--camera {n} is out of range: the scene file defines no cameras"),
+                None => bail!("--camera {n} is out of range: the scene file defines {k} camera(s), 0..={}", k - 1),
+            }
+        }
         if !self.frame.is_finite() || self.frame < 0.0 {
             bail!("--frame {} is out of range: must be a finite number >= 0", self.frame);
         }
