@@ -36,37 +36,39 @@ fn texels(format: F, count: usize, seed: u64) -> Vec<Vec<u8>> {
         s
     };
     (0..count)
-        .map(|_| loop {
-            let t: Vec<u8> = match format {
-                F::Rgba8Unorm => next().to_le_bytes()[..4].to_vec(),
-                F::Rgba16Float => {
-                    let r = next();
-                    (0..4)
-                        .flat_map(|c| {
-                            let mut h = (r >> (16 * c)) as u16;
-                            if h & 0x7c00 == 0x7c00 && h & 0x03ff != 0 {
-                                h &= !0x4000; // a NaN: clear an exponent bit (finite)
-                            }
-                            h.to_le_bytes()
-                        })
-                        .collect()
+        .map(|_| {
+            loop {
+                let t: Vec<u8> = match format {
+                    F::Rgba8Unorm => next().to_le_bytes()[..4].to_vec(),
+                    F::Rgba16Float => {
+                        let r = next();
+                        (0..4)
+                            .flat_map(|c| {
+                                let mut h = (r >> (16 * c)) as u16;
+                                if h & 0x7c00 == 0x7c00 && h & 0x03ff != 0 {
+                                    h &= !0x4000; // a NaN: clear an exponent bit (finite)
+                                }
+                                h.to_le_bytes()
+                            })
+                            .collect()
+                    }
+                    F::Rgba32Float | F::R32Float => {
+                        let k = if format == F::R32Float { 1 } else { 4 };
+                        (0..k)
+                            .flat_map(|_| {
+                                let mut f = next() as u32;
+                                if f32::from_bits(f).is_nan() {
+                                    f &= !0x4000_0000; // a NaN: clear an exponent bit
+                                }
+                                f.to_le_bytes()
+                            })
+                            .collect()
+                    }
+                    _ => unreachable!("formats under test"),
+                };
+                if t.iter().any(|b| *b != 0) {
+                    break t;
                 }
-                F::Rgba32Float | F::R32Float => {
-                    let k = if format == F::R32Float { 1 } else { 4 };
-                    (0..k)
-                        .flat_map(|_| {
-                            let mut f = next() as u32;
-                            if f32::from_bits(f).is_nan() {
-                                f &= !0x4000_0000; // a NaN: clear an exponent bit
-                            }
-                            f.to_le_bytes()
-                        })
-                        .collect()
-                }
-                _ => unreachable!("formats under test"),
-            };
-            if t.iter().any(|b| *b != 0) {
-                break t;
             }
         })
         .collect()
@@ -88,7 +90,9 @@ fn upload(gpu: &GpuContext, texture: &wgpu::Texture, data: &[Vec<u8>]) {
 }
 
 fn read(gpu: &GpuContext, texture: &wgpu::Texture, bpp: usize) -> Vec<Vec<u8>> {
-    let bytes = gpu.read_texture(texture, 0).unwrap_or_else(|e| panic!("read-back: {e}"));
+    let bytes = gpu
+        .read_texture(texture, 0)
+        .unwrap_or_else(|e| panic!("read-back: {e}"));
     bytes.chunks_exact(bpp).map(<[u8]>::to_vec).collect()
 }
 
@@ -183,7 +187,10 @@ fn padding_holds_the_marker_and_never_gathers_back() {
     for format in [F::Rgba16Float, F::Rgba8Unorm, F::R32Float] {
         let bpp = format.block_copy_size(None).unwrap() as usize;
         let marker_bytes: Vec<u8> = match format {
-            F::Rgba16Float => [0x3c00u16, 0, 0x3c00, 0x3c00].iter().flat_map(|h| h.to_le_bytes()).collect(),
+            F::Rgba16Float => [0x3c00u16, 0, 0x3c00, 0x3c00]
+                .iter()
+                .flat_map(|h| h.to_le_bytes())
+                .collect(),
             F::Rgba8Unorm => vec![255, 0, 255, 255],
             F::R32Float => 1.0f32.to_le_bytes().to_vec(),
             _ => unreachable!(),
@@ -214,7 +221,10 @@ fn padding_holds_the_marker_and_never_gathers_back() {
                 }
             }
             assert_eq!(pads, tw * th - w * h);
-            assert!(back.iter().all(|t| t != &marker_bytes), "{format:?} {method:?}: marker gathered");
+            assert!(
+                back.iter().all(|t| t != &marker_bytes),
+                "{format:?} {method:?}: marker gathered"
+            );
             assert!(back == image, "{format:?} {method:?}: BS then BG is not the identity");
         }
     }
@@ -238,7 +248,11 @@ fn block_splitting_matches_fig2c() {
         for y in 0..h {
             for x in 0..w {
                 let [qx, qy] = g.block_split_index(x, y);
-                assert_eq!(inter[(qy * bw + qx) as usize], image[(y * w + x) as usize], "block {block} ({x}, {y})");
+                assert_eq!(
+                    inter[(qy * bw + qx) as usize],
+                    image[(y * w + x) as usize],
+                    "block {block} ({x}, {y})"
+                );
             }
         }
     }
@@ -272,7 +286,9 @@ fn invalid_parameters_are_errors_not_panics() {
         (F::R32Uint, SplitMethod::Naive),
         (F::Depth32Float, SplitMethod::Blocks { block: 4 }),
     ] {
-        let e = Interleave::new(&gpu, format, 16, 16, 2, 2, method).err().expect("format refused");
+        let e = Interleave::new(&gpu, format, 16, 16, 2, 2, method)
+            .err()
+            .expect("format refused");
         assert!(e.to_string().contains("format"), "{e}");
     }
     // wrong textures at record time: size, format, same texture for both
@@ -282,13 +298,25 @@ fn invalid_parameters_are_errors_not_panics() {
     let other = Interleave::new(&gpu, F::R32Float, 37, 23, 3, 2, SplitMethod::Compute).unwrap();
     let wrong_format = other.create_tiled_texture("r32").create_view(&Default::default());
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    assert!(ils.split(&mut enc, &tiled, &image).unwrap_err().to_string().contains("expected"));
-    assert!(ils.split(&mut enc, &image, &wrong_format).unwrap_err().to_string().contains("format"));
+    assert!(ils
+        .split(&mut enc, &tiled, &image)
+        .unwrap_err()
+        .to_string()
+        .contains("expected"));
+    assert!(ils
+        .split(&mut enc, &image, &wrong_format)
+        .unwrap_err()
+        .to_string()
+        .contains("format"));
     assert!(ils.gather(&mut enc, &tiled, &tiled).is_err());
     let naive = Interleave::new(&gpu, f, 37, 23, 3, 2, SplitMethod::Naive).unwrap();
     let no_render = ils.create_tiled_texture("storage only"); // STORAGE_BINDING, no RENDER_ATTACHMENT
     let no_render = no_render.create_view(&Default::default());
-    assert!(naive.split(&mut enc, &image, &no_render).unwrap_err().to_string().contains("usage"));
+    assert!(naive
+        .split(&mut enc, &image, &no_render)
+        .unwrap_err()
+        .to_string()
+        .contains("usage"));
     gpu.queue.submit([enc.finish()]);
     gpu.check_errors().expect("refused calls record nothing invalid");
 }

@@ -221,7 +221,10 @@ impl InterleaveGeometry {
 
     /// Compute workgroups of one BS or BG dispatch.
     pub fn workgroups(&self) -> [u32; 2] {
-        [self.tile[0].div_ceil(self.group[0]), self.tile[1].div_ceil(self.group[1])]
+        [
+            self.tile[0].div_ceil(self.group[0]),
+            self.tile[1].div_ceil(self.group[1]),
+        ]
     }
 
     /// Image texel (x, y) → its texel in the tiled buffer (§3.2).
@@ -451,7 +454,11 @@ impl Interleave {
                 "interleave format {format:?} is not supported by method {}: it must be a float-sampled, \
                  non-sRGB, non-snorm {} format (e.g. Rgba16Float, Rgba32Float, R32Float, Rgba8Unorm)",
                 method.name(),
-                if method == SplitMethod::Compute { "storage" } else { "render-target" },
+                if method == SplitMethod::Compute {
+                    "storage"
+                } else {
+                    "render-target"
+                },
             )));
         }
 
@@ -706,7 +713,12 @@ impl Interleave {
         dst: &wgpu::TextureView,
         profiler: Option<&Profiler>,
     ) -> Result<(), RenderError> {
-        self.check("split source", src, self.image_size(), wgpu::TextureUsages::TEXTURE_BINDING)?;
+        self.check(
+            "split source",
+            src,
+            self.image_size(),
+            wgpu::TextureUsages::TEXTURE_BINDING,
+        )?;
         self.check("split destination", dst, self.tiled_size(), self.write_usage())?;
         self.check_distinct(src, dst)?;
         let group = self.group(src, dst);
@@ -749,7 +761,12 @@ impl Interleave {
         dst: &wgpu::TextureView,
         profiler: Option<&Profiler>,
     ) -> Result<(), RenderError> {
-        self.check("gather source", src, self.tiled_size(), wgpu::TextureUsages::TEXTURE_BINDING)?;
+        self.check(
+            "gather source",
+            src,
+            self.tiled_size(),
+            wgpu::TextureUsages::TEXTURE_BINDING,
+        )?;
         self.check("gather destination", dst, self.image_size(), self.write_usage())?;
         self.check_distinct(src, dst)?;
         let group = self.group(src, dst);
@@ -901,7 +918,10 @@ mod tests {
                         assert_eq!(g.gather_index(tx, ty), Some([x, y]));
                         // §3.2: sub-buffer (x mod n, y mod m) holds it, at (x div n, y div m)
                         let [i, j] = g.sub_buffer(x, y);
-                        assert_eq!([tx, ty], [g.tile_origin(i, j)[0] + x / n, g.tile_origin(i, j)[1] + y / m]);
+                        assert_eq!(
+                            [tx, ty],
+                            [g.tile_origin(i, j)[0] + x / n, g.tile_origin(i, j)[1] + y / m]
+                        );
                     }
                 }
                 let padding = hit.iter().filter(|h| !**h).count() as u32;
