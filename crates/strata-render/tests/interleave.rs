@@ -320,3 +320,30 @@ fn invalid_parameters_are_errors_not_panics() {
     gpu.queue.submit([enc.finish()]);
     gpu.check_errors().expect("refused calls record nothing invalid");
 }
+
+/// The largest patterns (16×16 and a mixed 16×5): one compute workgroup covers
+/// a 2×2 rectangle of every sub-buffer; sub-buffers of 1–3 texels with padding.
+#[test]
+fn largest_patterns_round_trip() {
+    let gpu = common::gpu();
+    let format = F::Rgba16Float;
+    for (n, m) in [(16, 16), (16, 5)] {
+        for (w, h) in [(37, 23), (64, 48), (15, 1)] {
+            let image = texels(format, (w * h) as usize, (w + h + n + m) as u64);
+            let g = InterleaveGeometry::new(w, h, n, m, SplitMethod::Naive).unwrap();
+            let expected = g.split_cpu(&image, vec![0u8; 8]);
+            for method in methods(n, m) {
+                let ils = Interleave::new(&gpu, format, w, h, n, m, method).unwrap();
+                let (tiled, back) = round_trip(&gpu, &ils, &image);
+                assert!(
+                    back == image,
+                    "{n}x{m} {w}x{h} {method:?}: BS then BG is not the identity"
+                );
+                assert!(
+                    tiled == expected,
+                    "{n}x{m} {w}x{h} {method:?}: tiled buffer differs from the CPU twin"
+                );
+            }
+        }
+    }
+}
