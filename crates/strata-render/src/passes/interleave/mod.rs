@@ -17,9 +17,9 @@
 //!
 //! When n ∤ W or m ∤ H, the last local column (row) of some sub-buffers has no
 //! image texel. These *padding* texels hold the padding marker, by default
-//! [`PADDING_MARKER`] = (0, 0, 0, 0): all bits zero in every format (the strata
-//! G-buffers' "no surface" texel: zero depth, zero normal); a shading pass on
-//! the sub-buffers may skip them. [`Interleave::set_padding`] changes it. Every
+//! [`PADDING_MARKER`] = (0, 0, 0, 0): all bits zero in every format (strata's
+//! camera-space depth targets read 0 as "no surface"); a shading pass on the
+//! sub-buffers may skip them. [`Interleave::set_padding`] changes it. Every
 //! method writes the marker explicitly (never relies on a clear), and gathering
 //! reads only the texels of image texels, so padding never reaches a gathered
 //! image.
