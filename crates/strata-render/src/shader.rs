@@ -11,6 +11,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/scene.wgsl", include_str!("shaders/common/scene.wgsl")),
     ("common/spiral.wgsl", include_str!("shaders/common/spiral.wgsl")),
     ("common/reproject.wgsl", include_str!("shaders/common/reproject.wgsl")),
+    ("common/interleave.wgsl", include_str!("shaders/common/interleave.wgsl")),
 ];
 
 /// Expands `#import "…"` lines recursively; panics only on a missing module,
