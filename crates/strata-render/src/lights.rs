@@ -2,9 +2,11 @@
 //!
 //! Shadowed: the sun (orthographic map fitted to the scene bounds), spot lights and
 //! rectangular area lights (perspective maps). Point lights are unshadowed.
-//! A `Rect` light is shaded as a point light with a cosine emission lobe
-//! (intensity L·A·cosθ) at its centre — the analytic direct term; its true area
-//! is integrated by the CPU reference and later by radiosity.
+//! A `Rect` light is an area light: its Lambertian irradiance is the exact
+//! polygon integral (Lambert's formula over the rectangle clipped to the
+//! receiver's hemisphere), shadowed by one perspective map from its centre (hard
+//! shadows: the documented approximation); its GGX lobe uses the centre as a
+//! point light with the cosine emission lobe (intensity L·A·cos θ).
 
 use glam::camera::rh::proj::directx;
 use glam::{Mat4, Vec3};
@@ -29,6 +31,9 @@ pub struct GpuLight {
     pub color: [f32; 4],
     /// cos(outer), cos(inner), shadow texel size in world units at distance 1 (or absolute for sun), 0
     pub cone: [f32; 4],
+    /// Rect: the half-edge vectors (xyz); zero for other kinds.
+    pub half_u: [f32; 4],
+    pub half_v: [f32; 4],
     pub shadow_view_proj: [[f32; 4]; 4],
 }
 
@@ -72,6 +77,8 @@ pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuL
                         0.0,
                     ],
                     cone: [0.0, 0.0, 2.0 * radius / res, 0.0],
+                    half_u: [0.0; 4],
+                    half_v: [0.0; 4],
                     shadow_view_proj: (proj * view).to_cols_array_2d(),
                 }
             }
@@ -85,6 +92,8 @@ pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuL
                 direction: [0.0; 4],
                 color: [color[0] * intensity, color[1] * intensity, color[2] * intensity, 0.0],
                 cone: [-2.0, -1.0, 0.0, 0.0],
+                half_u: [0.0; 4],
+                half_v: [0.0; 4],
                 shadow_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
             },
             Light::Spot {
@@ -109,6 +118,8 @@ pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuL
                         2.0 * (fov * 0.5).tan() / res,
                         0.0,
                     ],
+                    half_u: [0.0; 4],
+                    half_v: [0.0; 4],
                     shadow_view_proj: (proj * view).to_cols_array_2d(),
                 }
             }
@@ -118,18 +129,18 @@ pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuL
                 half_v,
                 radiance,
             } => {
-                let n = half_u.cross(half_v);
-                let area = 4.0 * n.length();
-                let n = n.normalize();
+                let n = half_u.cross(half_v).normalize();
                 let fov = 150f32.to_radians();
                 let pos = c + n * 1e-4 * radius;
                 let (view, proj) = perspective_shadow(pos, n, fov, radius, center);
                 GpuLight {
                     kind: [KIND_RECT, next_layer(), 0, 0],
-                    position: pos.extend(1.0).to_array(),
+                    position: c.extend(1.0).to_array(),
                     direction: n.extend(0.0).to_array(),
-                    color: [radiance[0] * area, radiance[1] * area, radiance[2] * area, 0.0],
+                    color: [radiance[0], radiance[1], radiance[2], 0.0],
                     cone: [0.0, 0.0, 2.0 * (fov * 0.5).tan() / res, 0.0],
+                    half_u: half_u.extend(0.0).to_array(),
+                    half_v: half_v.extend(0.0).to_array(),
                     shadow_view_proj: (proj * view).to_cols_array_2d(),
                 }
             }
