@@ -1,7 +1,10 @@
 //! Lights as the GPU sees them, with shadow-map matrices.
 //!
 //! Shadowed: the sun (orthographic map fitted to the scene bounds), spot lights and
-//! rectangular area lights (perspective maps). Point lights are unshadowed.
+//! rectangular area lights (perspective maps), and the [`POINT_SHADOW_BUDGET`]
+//! most intense point lights (omnidirectional: six cube-face perspective maps,
+//! layers `base..base + 6`, picked per pixel by the major axis of the direction
+//! from the light). Other point lights are unshadowed.
 //! A `Rect` light is an area light: its Lambertian irradiance is the exact
 //! polygon integral (Lambert's formula over the rectangle clipped to the
 //! receiver's hemisphere), shadowed by one perspective map from its centre (hard
@@ -39,24 +42,63 @@ pub struct GpuLight {
 
 pub const NO_SHADOW: u32 = u32::MAX;
 
-/// Converts the scene's lights, assigning shadow-map layers in order.
+/// Point lights with omnidirectional shadows (6 cube-face layers each): the
+/// [`POINT_SHADOW_BUDGET`] most intense; the rest are unshadowed (reported by
+/// [`unshadowed_point_lights`]).
+pub const POINT_SHADOW_BUDGET: usize = 2;
+
+/// Field of view of a cube face's shadow map: a little over 90° so that the
+/// PCF kernel of a point near a face's border stays inside that face.
+pub const CUBE_FACE_FOV_DEG: f32 = 95.0;
+
+/// The cube faces' axes (+X, −X, +Y, −Y, +Z, −Z): face f of a point light's
+/// shadow map is layer `base + f`; `lighting.wgsl` picks f by the major axis of
+/// the direction from the light.
+pub const CUBE_FACES: [Vec3; 6] = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
+
+/// Indices (into `scene.lights`) of the point lights that get a shadow map.
+fn shadowed_point_lights(scene: &Scene) -> Vec<usize> {
+    let mut points: Vec<(usize, f32)> = scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| match l {
+            Light::Point { color, intensity, .. } => Some((i, intensity * (color[0] + color[1] + color[2]))),
+            _ => None,
+        })
+        .collect();
+    points.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    points.into_iter().take(POINT_SHADOW_BUDGET).map(|(i, _)| i).collect()
+}
+
+/// How many point lights go unshadowed because of [`POINT_SHADOW_BUDGET`].
+pub fn unshadowed_point_lights(scene: &Scene) -> usize {
+    let points = scene.lights.iter().filter(|l| matches!(l, Light::Point { .. })).count();
+    points - shadowed_point_lights(scene).len()
+}
+
+/// Converts the scene's lights, assigning shadow-map layers in order (a
+/// shadowed point light takes six: one per cube face).
 pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuLight> {
+    let shadowed_points = shadowed_point_lights(scene);
     let (lo, hi) = scene.bounds(frame);
     let (center, radius) = if lo.is_finite() && hi.is_finite() {
         ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3))
     } else {
         (Vec3::ZERO, 1.0)
     };
-    let mut layer = 0u32;
-    let mut next_layer = || {
-        layer += 1;
-        layer - 1
+    let layer = std::cell::Cell::new(0u32);
+    let next_layers = |n: u32| {
+        layer.set(layer.get() + n);
+        layer.get() - n
     };
+    let next_layer = || next_layers(1);
     let res = shadow_resolution as f32;
     scene
         .lights
         .iter()
-        .map(|l| match *l {
+        .enumerate()
+        .map(|(index, l)| match *l {
             Light::Sun {
                 direction,
                 color,
@@ -86,16 +128,21 @@ pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuL
                 position,
                 color,
                 intensity,
-            } => GpuLight {
-                kind: [KIND_POINT, NO_SHADOW, 0, 0],
-                position: position.extend(1.0).to_array(),
-                direction: [0.0; 4],
-                color: [color[0] * intensity, color[1] * intensity, color[2] * intensity, 0.0],
-                cone: [-2.0, -1.0, 0.0, 0.0],
-                half_u: [0.0; 4],
-                half_v: [0.0; 4],
-                shadow_view_proj: Mat4::IDENTITY.to_cols_array_2d(),
-            },
+            } => {
+                let shadowed = shadowed_points.contains(&index);
+                let fov = CUBE_FACE_FOV_DEG.to_radians();
+                GpuLight {
+                    kind: [KIND_POINT, if shadowed { next_layers(6) } else { NO_SHADOW }, 0, 0],
+                    position: position.extend(1.0).to_array(),
+                    direction: [0.0; 4],
+                    color: [color[0] * intensity, color[1] * intensity, color[2] * intensity, 0.0],
+                    cone: [-2.0, -1.0, 2.0 * (fov * 0.5).tan() / res, 0.0],
+                    half_u: [0.0; 4],
+                    half_v: [0.0; 4],
+                    // face 0; `shadow_matrices` gives all six
+                    shadow_view_proj: cube_face_matrix(position, 0, radius, center).to_cols_array_2d(),
+                }
+            }
             Light::Spot {
                 position,
                 direction,
@@ -159,7 +206,43 @@ fn perspective_shadow(pos: Vec3, dir: Vec3, fov: f32, scene_radius: f32, scene_c
     (look_at(pos, pos + dir, dir), directx::perspective(fov, 1.0, near, far))
 }
 
-/// Number of shadow-map layers the lights need.
+/// View-projection of face `face` (of [`CUBE_FACES`]) of a point light's
+/// shadow map: a [`CUBE_FACE_FOV_DEG`] perspective along the face's axis.
+fn cube_face_matrix(pos: Vec3, face: usize, scene_radius: f32, scene_center: Vec3) -> Mat4 {
+    let axis = CUBE_FACES[face];
+    let (view, proj) = perspective_shadow(pos, axis, CUBE_FACE_FOV_DEG.to_radians(), scene_radius, scene_center);
+    proj * view
+}
+
+/// Number of shadow-map layers the lights need (six per shadowed point light).
 pub fn shadow_layer_count(lights: &[GpuLight]) -> u32 {
-    lights.iter().filter(|l| l.kind[1] != NO_SHADOW).count() as u32
+    lights
+        .iter()
+        .filter(|l| l.kind[1] != NO_SHADOW)
+        .map(|l| if l.kind[0] == KIND_POINT { 6 } else { 1 })
+        .sum()
+}
+
+/// The view-projection of every shadow-map layer, indexed by layer: a light's
+/// own matrix, and for a shadowed point light its six cube faces.
+pub fn shadow_matrices(scene: &Scene, frame: f32, lights: &[GpuLight]) -> Vec<[[f32; 4]; 4]> {
+    let (lo, hi) = scene.bounds(frame);
+    let (center, radius) = if lo.is_finite() && hi.is_finite() {
+        ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3))
+    } else {
+        (Vec3::ZERO, 1.0)
+    };
+    let mut out = vec![Mat4::IDENTITY.to_cols_array_2d(); shadow_layer_count(lights) as usize];
+    for l in lights.iter().filter(|l| l.kind[1] != NO_SHADOW) {
+        let base = l.kind[1] as usize;
+        if l.kind[0] == KIND_POINT {
+            let pos = Vec3::from_slice(&l.position[..3]);
+            for face in 0..6 {
+                out[base + face] = cube_face_matrix(pos, face, radius, center).to_cols_array_2d();
+            }
+        } else {
+            out[base] = l.shadow_view_proj;
+        }
+    }
+    out
 }

@@ -370,7 +370,8 @@ impl Renderer {
         let geometry = deep_gbuffer::geometry_passes(gpu, &scene_gpu, &targets, &settings.deep)?;
         let pack = deep_gbuffer::PackPass::new(gpu, &targets, &settings.deep);
         let (shadow, lighting, tonemap) = if settings.shade {
-            let shadow = shadow::ShadowPass::new(gpu, &scene_gpu, &lights, &settings.shadow);
+            let matrices = crate::lights::shadow_matrices(scene, 0.0, &lights);
+            let shadow = shadow::ShadowPass::new(gpu, &scene_gpu, &matrices, &settings.shadow);
             let lighting = lighting::LightingPass::new(
                 gpu,
                 &scene_gpu,
@@ -589,7 +590,7 @@ impl Renderer {
         if self.animated {
             if let (Some(s), Some(l)) = (&self.shadow, &self.lighting) {
                 self.lights = gpu_lights(scene, frame, self.settings.shadow.resolution);
-                s.update(gpu, &self.lights);
+                s.update(gpu, &crate::lights::shadow_matrices(scene, frame, &self.lights));
                 l.update_lights(gpu, &self.lights);
             }
         }

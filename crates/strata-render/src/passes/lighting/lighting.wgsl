@@ -43,21 +43,44 @@ struct LightingParams {
 @group(1) @binding(5) var shadow_maps: texture_depth_2d_array;
 @group(1) @binding(6) var shadow_sampler: sampler_comparison;
 @group(1) @binding(7) var<uniform> params: LightingParams;
+// view-projection of every shadow-map layer (a point light's six cube faces included)
+@group(1) @binding(8) var<storage, read> shadow_mats: array<mat4x4f>;
 
 const PI: f32 = 3.14159265358979;
 const NO_SHADOW: u32 = 0xffffffffu;
+
+// The shadow-map layer of light `l` for a surface at p: its own, or for a point
+// light the cube face of the major axis of p − light (faces +X, −X, +Y, −Y, +Z, −Z).
+fn shadow_layer(l: GpuLight, p: vec3f) -> u32 {
+    if (l.kind.x != 1u) {
+        return l.kind.y;
+    }
+    let d = p - l.position.xyz;
+    let a = abs(d);
+    var face = 4u;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = 0u;
+    } else if (a.y >= a.z) {
+        face = 2u;
+    }
+    if ((face == 0u && d.x < 0.0) || (face == 2u && d.y < 0.0) || (face == 4u && d.z < 0.0)) {
+        face += 1u;
+    }
+    return l.kind.y + face;
+}
 
 fn shadow_visibility(l: GpuLight, p: vec3f, n: vec3f, dist: f32) -> f32 {
     if (l.kind.y == NO_SHADOW) {
         return 1.0;
     }
+    let layer = shadow_layer(l, p);
     // Normal offset of ~1.5 shadow texels (texel size grows with distance for perspective maps).
     var texel = l.cone.z;
     if (l.kind.x != 0u) {
         texel = texel * dist;
     }
     let q = p + n * texel * 1.5;
-    let c = l.shadow_view_proj * vec4f(q, 1.0);
+    let c = shadow_mats[layer] * vec4f(q, 1.0);
     let ndc = c.xyz / c.w;
     if (c.w <= 0.0 || any(abs(ndc.xy) > vec2f(1.0)) || ndc.z > 1.0) {
         return 1.0;
@@ -69,7 +92,7 @@ fn shadow_visibility(l: GpuLight, p: vec3f, n: vec3f, dist: f32) -> f32 {
     for (var y = -r; y <= r; y++) {
         for (var x = -r; x <= r; x++) {
             let o = vec2f(f32(x), f32(y)) / params.shadow_size;
-            sum += textureSampleCompareLevel(shadow_maps, shadow_sampler, uv + o, i32(l.kind.y), ndc.z);
+            sum += textureSampleCompareLevel(shadow_maps, shadow_sampler, uv + o, i32(layer), ndc.z);
             count += 1.0;
         }
     }

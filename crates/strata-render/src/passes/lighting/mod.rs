@@ -120,6 +120,16 @@ impl LightingPass {
                     count: None,
                 },
                 crate::passes::uniform_entry(7),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 8,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
             ],
         });
         let mut light_data = lights.to_vec();
@@ -175,6 +185,7 @@ impl LightingPass {
                     wgpu::BindingResource::TextureView(&shadow.array_view),
                     wgpu::BindingResource::Sampler(&sampler),
                     params_buf.as_entire_binding(),
+                    shadow.matrices.as_entire_binding(),
                 ],
             )
         };

@@ -1,9 +1,12 @@
 //! Shadow maps: one depth layer per shadowed light (sun: orthographic; spot and
-//! rect: perspective), standard depth (0 near, 1 far), slope-scaled bias.
+//! rect: perspective) and six per shadowed point light (cube faces, see
+//! `crate::lights`), standard depth (0 near, 1 far), slope-scaled bias. The
+//! layers' view-projections are also kept in a storage buffer
+//! ([`ShadowPass::matrices`]) that the lighting pass indexes by layer.
 
 use crate::frame::{Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
-use crate::lights::{GpuLight, NO_SHADOW};
+
 use crate::scene_gpu::{GpuScene, VERTEX_LAYOUT};
 
 /// Settings for shadow mapping.
@@ -25,17 +28,20 @@ pub struct ShadowPass {
     pipeline: wgpu::RenderPipeline,
     views_buffer: wgpu::Buffer,
     views_group: wgpu::BindGroup,
-    /// Depth array, one layer per shadowed light (at least one layer).
+    /// Depth array: the layers of [`crate::lights::shadow_matrices`] (at least one).
     pub maps: wgpu::Texture,
     pub array_view: wgpu::TextureView,
+    /// Every layer's view-projection, tightly packed (`array<mat4x4f>`).
+    pub matrices: wgpu::Buffer,
     layer_views: Vec<wgpu::TextureView>,
-    layer_slots: Vec<u32>,
 }
 
 impl ShadowPass {
-    pub fn new(gpu: &GpuContext, scene: &GpuScene, lights: &[GpuLight], settings: &ShadowSettings) -> Self {
+    /// `matrices`: one view-projection per shadow-map layer
+    /// ([`crate::lights::shadow_matrices`]); none renders no map.
+    pub fn new(gpu: &GpuContext, scene: &GpuScene, matrices: &[[[f32; 4]; 4]], settings: &ShadowSettings) -> Self {
         let device = &gpu.device;
-        let layers = crate::lights::shadow_layer_count(lights).max(1);
+        let layers = (matrices.len() as u32).max(1);
         let maps = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow maps"),
             size: wgpu::Extent3d {
@@ -56,22 +62,30 @@ impl ShadowPass {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let mut bytes = vec![0u8; (STRIDE * lights.len().max(1) as u64) as usize];
+        let mut bytes = vec![0u8; (STRIDE * layers as u64) as usize];
         let mut layer_views = Vec::new();
-        let mut layer_slots = Vec::new();
-        for (i, l) in lights.iter().enumerate() {
+        for (i, m) in matrices.iter().enumerate() {
             let s = i * STRIDE as usize;
-            bytes[s..s + 64].copy_from_slice(bytemuck::bytes_of(&l.shadow_view_proj));
-            if l.kind[1] != NO_SHADOW {
-                layer_views.push(maps.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: l.kind[1],
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                }));
-                layer_slots.push(i as u32);
-            }
+            bytes[s..s + 64].copy_from_slice(bytemuck::bytes_of(m));
+            layer_views.push(maps.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: i as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            }));
         }
+        let mut packed: Vec<[[f32; 4]; 4]> = matrices.to_vec();
+        if packed.is_empty() {
+            packed.push([[0.0; 4]; 4]);
+        }
+        let matrices_buffer = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("shadow matrices"),
+                contents: bytemuck::cast_slice(&packed),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            },
+        );
         let views_buffer = wgpu::util::DeviceExt::create_buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {
@@ -146,19 +160,17 @@ impl ShadowPass {
             views_group,
             maps,
             array_view,
+            matrices: matrices_buffer,
             layer_views,
-            layer_slots,
         }
     }
 
-    /// Re-uploads light matrices (animated scenes move the fitted bounds).
-    pub fn update(&self, gpu: &GpuContext, lights: &[GpuLight]) {
-        for (i, l) in lights.iter().enumerate() {
-            gpu.queue.write_buffer(
-                &self.views_buffer,
-                i as u64 * STRIDE,
-                bytemuck::bytes_of(&l.shadow_view_proj),
-            );
+    /// Re-uploads the layers' matrices (animated scenes move the fitted bounds
+    /// and the lights); the layer count is fixed at creation.
+    pub fn update(&self, gpu: &GpuContext, matrices: &[[[f32; 4]; 4]]) {
+        for (i, m) in matrices.iter().enumerate().take(self.layer_views.len()) {
+            gpu.queue.write_buffer(&self.views_buffer, i as u64 * STRIDE, bytemuck::bytes_of(m));
+            gpu.queue.write_buffer(&self.matrices, i as u64 * 64, bytemuck::bytes_of(m));
         }
     }
 }
@@ -173,7 +185,7 @@ impl Pass for ShadowPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        for (view, &slot) in self.layer_views.iter().zip(&self.layer_slots) {
+        for (slot, view) in self.layer_views.iter().enumerate() {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
                 color_attachments: &[],
