@@ -125,7 +125,9 @@ fn print_lights(scene: &strata_scene::Scene) {
     use strata_scene::Light;
     let v = |v: glam::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
     println!("lights of '{}': {}", scene.name, scene.lights.len());
+    let gpu_lights = strata_render::lights::gpu_lights(scene, 0.0, 64);
     for (i, l) in scene.lights.iter().enumerate() {
+        let shadowed = gpu_lights.get(i).is_some_and(|g| g.kind[1] != strata_render::lights::NO_SHADOW);
         let line = match l {
             Light::Sun { direction, color, illuminance } => {
                 format!("sun   direction {} color {color:?} illuminance {illuminance}", v(*direction))
@@ -145,7 +147,14 @@ fn print_lights(scene: &strata_scene::Scene) {
                 v(*half_v)
             ),
         };
-        println!("  {i}: {line}");
+        println!("  {i}: {line}{}", if shadowed { "" } else { " (no shadow)" });
+    }
+    let unshadowed = strata_render::lights::unshadowed_point_lights(scene);
+    if unshadowed > 0 {
+        println!(
+            "  {unshadowed} point light(s) unshadowed: only the {} most intense get cube shadow maps",
+            strata_render::lights::POINT_SHADOW_BUDGET
+        );
     }
     println!("cameras in the file: {}", scene.cameras.len());
     for (i, c) in scene.cameras.iter().enumerate() {
