@@ -42,6 +42,8 @@ pub mod gi;
 pub mod layers;
 pub mod probes;
 pub mod sampling;
+pub mod tracer;
+pub mod wide;
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -56,6 +58,8 @@ pub use ao::{AoBinarySettings, DiskSampling, ObscuranceSettings};
 pub use bvh::{Bvh, Hit, SurfaceHit};
 pub use gi::{GiImages, GiSettings};
 pub use layers::{DeepLayers, Layer, LayerSettings, NO_ID};
+pub use tracer::{AnyTracer, Tracer, TracerKind};
+pub use wide::WideBvh;
 
 /// Counters accumulated over every computation run on a [`Reference`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -102,7 +106,7 @@ impl Throughput {
 pub struct Reference<'s> {
     scene: &'s Scene,
     frame: f32,
-    bvh: Bvh,
+    bvh: AnyTracer,
     lights: gi::EmissiveLights,
     epsilon: f32,
     progress: bool,
@@ -114,11 +118,22 @@ pub struct Reference<'s> {
 static DEFAULT_MATERIAL: std::sync::LazyLock<Material> = std::sync::LazyLock::new(Material::default);
 
 impl<'s> Reference<'s> {
-    /// Flattens `scene` at `frame` and builds the BVH and the emissive-triangle
-    /// table. An empty scene is fine: every ray misses.
+    /// Flattens `scene` at `frame` and builds the default tracer
+    /// ([`TracerKind::Wide`]) and the emissive-triangle table. An empty scene is
+    /// fine: every ray misses.
     pub fn new(scene: &'s Scene, frame: f32) -> Self {
+        Self::with_tracer(scene, frame, TracerKind::default())
+    }
+
+    /// [`Reference::new`] with a chosen tracer backend (every backend gives the
+    /// same answers; they differ in speed).
+    pub fn with_tracer(scene: &'s Scene, frame: f32, kind: TracerKind) -> Self {
         let start = Instant::now();
-        let bvh = Bvh::build(scene.world_triangles(frame));
+        let triangles = scene.world_triangles(frame);
+        let bvh = match kind {
+            TracerKind::Binary => Bvh::build(triangles),
+            TracerKind::Wide => wide::base_tree(triangles),
+        };
         let epsilon = match bvh.bounds() {
             Some((lo, hi)) => {
                 let scale = (hi - lo)
@@ -134,6 +149,7 @@ impl<'s> Reference<'s> {
             None => 1e-4,
         };
         let lights = gi::EmissiveLights::new(&bvh, &scene.materials);
+        let bvh = AnyTracer::from_binary(bvh, kind);
         Self {
             scene,
             frame,
@@ -167,8 +183,14 @@ impl<'s> Reference<'s> {
         self.scene.camera_at(self.frame)
     }
 
-    pub fn bvh(&self) -> &Bvh {
+    /// The tracer (dispatching to the backend chosen at construction).
+    pub fn bvh(&self) -> &AnyTracer {
         &self.bvh
+    }
+
+    /// The backend in use.
+    pub fn tracer_kind(&self) -> TracerKind {
+        self.bvh.kind()
     }
 
     /// Seconds spent flattening the scene and building the BVH.

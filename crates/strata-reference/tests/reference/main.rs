@@ -6,3 +6,4 @@ mod bvh;
 mod gi;
 mod layers;
 mod scenes;
+mod tracer;
