@@ -2,7 +2,7 @@
 //! tested against.
 //!
 //! A [`Reference`] is built once per `(scene, frame)`: it flattens the scene to
-//! world-space triangles, builds a [`bvh::Bvh`] and a light-sampling table for
+//! world-space triangles, builds a [`Tracer`] and a light-sampling table for
 //! emissive triangles, and then computes, for any camera and image size:
 //!
 //! - [`Reference::ao_binary`]: ambient visibility from cosine-weighted hemisphere
@@ -25,18 +25,24 @@
 //! `(seed, pixel)`, and rows run in parallel with rayon, so results never
 //! depend on thread count or scheduling.
 //!
+//! **Tracers.** Rays go through the [`Tracer`] interface; [`TracerKind::Wide`]
+//! (the default, an 8-wide SIMD BVH, [`wide`]) and [`TracerKind::Binary`] (the
+//! binned-SAH binary BVH, [`bvh`]) return bitwise-identical answers
+//! ([`Reference::with_tracer`] picks one).
+//!
 //! **Why our own BVH.** The oracle must be exact and reproducible, and its
 //! failure modes must be ours to reason about: the watertight intersection
 //! (Woop et al. 2013) never leaks rays through shared edges, ties at equal `t`
 //! are broken by triangle index so results do not depend on traversal order,
-//! and [`bvh::Bvh::intersect_all`] enumerates every surface along a ray, which
+//! and [`Tracer::intersect_all`] enumerates every surface along a ray, which
 //! the layer and obscurance oracles need and general-purpose BVH crates rarely
-//! expose. A binned-SAH builder is ~300 lines and adds no dependency.
+//! expose.
 
 // `!(a < b)` is used on purpose where NaN must take the "reject" branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod ao;
+pub mod bench;
 pub mod bvh;
 pub mod gi;
 pub mod layers;
@@ -55,6 +61,7 @@ use rayon::prelude::*;
 use strata_scene::{Camera, Material, Scene};
 
 pub use ao::{AoBinarySettings, DiskSampling, ObscuranceSettings};
+pub use bench::RayKind;
 pub use bvh::{Bvh, Hit, SurfaceHit};
 pub use gi::{GiImages, GiSettings};
 pub use layers::{DeepLayers, Layer, LayerSettings, NO_ID};
