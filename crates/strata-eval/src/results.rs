@@ -132,6 +132,28 @@ pub struct ReferenceBench {
     pub rays: u64,
     pub seconds: f64,
     pub mrays_per_s: f64,
+    /// Throughput per tracer backend and kind of ray (empty in results written
+    /// before these were measured). The fields above are the default backend's
+    /// mixed primary + bounce measurement.
+    #[serde(default)]
+    pub kinds: Vec<RayKindBench>,
+}
+
+/// One tracer backend on one kind of ray (`strata bench reference`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RayKindBench {
+    /// `"wide"` (the default) or `"binary"`.
+    pub tracer: String,
+    /// `"primary"` (camera rays, closest hit), `"ao"` (occlusion rays of length
+    /// `ao_radius`, any hit) or `"diffuse"` (cosine bounce rays, closest hit).
+    pub kind: String,
+    pub build_s: f64,
+    pub rays: u64,
+    pub seconds: f64,
+    pub mrays_per_s: f64,
+    /// AO ray length (only for `"ao"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ao_radius: Option<f32>,
 }
 
 /// Any benchmark's result, tagged by `"bench"`.

@@ -2,10 +2,15 @@
 //!
 //! `cargo run --release -p strata-reference --example throughput -- [scene] [width] [height] [seconds]`
 //! (scene: a built-in name or a .gltf/.glb/.obj/.toml path; default `cornell`).
+//! First a table of M rays/s per tracer backend and kind of ray, then the mixed
+//! primary + bounce measurement and the oracles' timings with the default backend
+//! (skipped with `STRATA_KINDS_ONLY=1`).
 
 use std::time::Duration;
 
-use strata_reference::{AoBinarySettings, GiSettings, LayerSettings, ObscuranceSettings, Reference};
+use strata_reference::{
+    AoBinarySettings, GiSettings, LayerSettings, ObscuranceSettings, RayKind, Reference, TracerKind,
+};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -39,14 +44,53 @@ fn main() {
         };
         scene.camera_path = None;
     }
-    let r = Reference::new(&scene, 0.0);
+    // Per tracer backend and kind of ray (primary: coherent closest hit; ao: short
+    // any-hit rays of the scene's AO radius; diffuse: incoherent closest hit).
+    let per_kind = (seconds / 3.0).max(0.2);
     println!(
-        "{}: {} triangles, BVH {} nodes built in {:.3} s",
+        "{}: {} triangles, {width}x{height}, {} threads, AO radius {}",
         scene.name,
-        r.bvh().triangles().len(),
-        r.bvh().node_count(),
-        r.build_seconds()
+        scene.world_triangles(0.0).len(),
+        rayon::current_num_threads(),
+        scene.settings.ao_radius
     );
+    println!(
+        "{:<8} {:>9} {:>7} {:>14} {:>14} {:>14}",
+        "tracer", "build s", "nodes", "primary Mr/s", "ao Mr/s", "diffuse Mr/s"
+    );
+    for kind in TracerKind::ALL {
+        let r = Reference::with_tracer(&scene, 0.0, kind);
+        let cam = r.camera();
+        let rates: Vec<f64> = RayKind::ALL
+            .iter()
+            .map(|&k| {
+                r.measure_rays(
+                    &cam,
+                    width,
+                    height,
+                    k,
+                    scene.settings.ao_radius,
+                    u64::MAX,
+                    Duration::from_secs_f64(per_kind),
+                )
+                .mrays_per_second()
+            })
+            .collect();
+        println!(
+            "{:<8} {:>9.3} {:>7} {:>14.2} {:>14.2} {:>14.2}",
+            kind.name(),
+            r.build_seconds(),
+            r.bvh().node_count(),
+            rates[0],
+            rates[1],
+            rates[2]
+        );
+    }
+    if std::env::var_os("STRATA_KINDS_ONLY").is_some() {
+        return;
+    }
+
+    let r = Reference::new(&scene, 0.0);
     let t = r.measure_throughput(&r.camera(), width, height, u64::MAX, Duration::from_secs_f64(seconds));
     println!(
         "{width}x{height}, primary + 1 diffuse bounce (closest hit): {} rays in {:.2} s on {} threads = {:.2} Mrays/s",

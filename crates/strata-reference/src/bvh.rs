@@ -13,8 +13,11 @@
 //!   triangles, and the result does not depend on traversal order.
 //! - **Traversal**: the box test scales the far distance by `1 + 2γ₃` (Ize 2013)
 //!   so boxes are never culled by rounding; slabs are picked by the direction's
-//!   signs, and zero direction components use a finite ±1e30 reciprocal so no
-//!   NaN can arise; closest-hit visits the nearer child first.
+//!   signs; zero direction components give infinite reciprocals and the NaN of
+//!   `0 · ∞` (a ray lying in a slab plane) counts as inside, so a ray along a
+//!   box face still enters it; the `[tmin, tmax]` range of the box tests is
+//!   widened by a small margin ([`BOX_SLACK`]) so culling never depends on
+//!   traversal order; closest-hit visits the nearer child first.
 //!
 //! `t` is measured in units of the ray direction as given (directions need not be
 //! normalised: primary rays use [`strata_scene::Camera::pixel_dir`], so `t` is the
@@ -22,7 +25,7 @@
 
 use std::mem::MaybeUninit;
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use strata_scene::WorldTriangle;
 
 /// Most triangles in one leaf.
@@ -34,7 +37,26 @@ pub const BINS: usize = 16;
 const MAX_SAH_DEPTH: usize = 96;
 const STACK: usize = 128;
 /// `1 + 2γ₃` with γₙ = nε/(1 − nε), ε = 2⁻²⁴: conservative slab-test scale.
-const BOX_SCALE: f32 = 1.000_000_4;
+pub(crate) const BOX_SCALE: f32 = 1.000_000_4;
+/// Slack of the `[tmin, tmax]` range the *box* tests use (the triangle test
+/// uses the exact range): relative to the range ends, plus an absolute margin
+/// of `BOX_SLACK ×` the coordinate magnitude along the ray (see
+/// [`Ray::margin`]). A box whose computed entry distance lies a few ulps
+/// beyond a triangle hit's computed `t` (a triangle lying in the box's entry
+/// face; a ray starting on the triangle it hits) is still visited, so culling
+/// never depends on the order boxes are visited in, and every backend finds the
+/// same hits. 2⁻¹⁸ ≈ 4e-6.
+pub(crate) const BOX_SLACK: f32 = 1.0 / 262_144.0;
+
+/// The `[tmin, tmax]` range widened by [`BOX_SLACK`] and the absolute `margin`
+/// for box tests.
+#[inline(always)]
+pub(crate) fn box_range(tmin: f32, tmax: f32, margin: f32) -> (f32, f32) {
+    (
+        tmin - tmin.abs() * BOX_SLACK - margin,
+        tmax + tmax.abs() * BOX_SLACK + margin,
+    )
+}
 
 /// A ray–triangle hit: parametric distance, triangle index into the triangle
 /// list the BVH was built from, and barycentric weights of vertices 1 and 2
@@ -88,43 +110,44 @@ impl SurfaceHit {
 }
 
 /// A reference to a child: an interior node index, or (high bit set) a leaf
-/// holding `count ≤ MAX_LEAF` triangles starting at `first` in leaf order,
-/// packed as `LEAF | first << 3 | count`.
-type ChildRef = u32;
-const LEAF: u32 = 1 << 31;
+/// holding `count ≤ 15` triangles (≤ [`MAX_LEAF`] in [`Bvh::build`]'s trees)
+/// starting at `first` in leaf order, packed as `LEAF | first << 4 | count`.
+pub(crate) type ChildRef = u32;
+pub(crate) const LEAF: u32 = 1 << 31;
 
 #[inline(always)]
 fn leaf_ref(first: usize, count: usize) -> ChildRef {
-    debug_assert!(count <= MAX_LEAF && first < (1 << 28));
-    LEAF | (first as u32) << 3 | count as u32
+    debug_assert!(count <= 15 && first < (1 << 27));
+    LEAF | (first as u32) << 4 | count as u32
 }
 
 /// Interior node holding both children's boxes (one 64-byte cache line per
 /// visit), flattened depth-first.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node {
+pub(crate) struct Node {
     /// `[left, right]` child boxes.
-    min: [[f32; 3]; 2],
-    max: [[f32; 3]; 2],
-    child: [ChildRef; 2],
+    pub(crate) min: [[f32; 3]; 2],
+    pub(crate) max: [[f32; 3]; 2],
+    pub(crate) child: [ChildRef; 2],
 }
 
 /// Precomputed per-ray data for the slab and watertight tests.
-struct Ray {
-    org: Vec3,
-    inv: [f32; 3],
-    neg: [bool; 3],
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+pub(crate) struct Ray {
+    pub(crate) org: Vec3,
+    pub(crate) inv: [f32; 3],
+    pub(crate) neg: [bool; 3],
+    pub(crate) kx: usize,
+    pub(crate) ky: usize,
+    pub(crate) kz: usize,
+    pub(crate) sx: f32,
+    pub(crate) sy: f32,
+    pub(crate) sz: f32,
 }
 
 impl Ray {
-    fn new(org: Vec3, dir: Vec3) -> Self {
+    #[inline]
+    pub(crate) fn new(org: Vec3, dir: Vec3) -> Self {
         let a = dir.abs();
         let kz = if a.x >= a.y && a.x >= a.z {
             0
@@ -138,10 +161,16 @@ impl Ray {
         if dir[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        // A zero component becomes ±1e-30 so 1/d stays finite: slabs the ray
-        // runs parallel to then give ±huge distances (conservative) instead of
-        // 0·∞ = NaN. The triangle test uses the exact direction.
-        let inv = [safe_inv(dir.x), safe_inv(dir.y), safe_inv(dir.z)];
+        // A zero component gives an infinite reciprocal: a slab the ray runs
+        // parallel to yields ±∞ (origin inside / outside) or NaN (origin exactly
+        // on a slab plane), and the slab test's selects treat NaN as "no
+        // constraint", so a ray lying in a box face still enters the box (the
+        // boundary is inclusive). The triangle test uses the exact direction.
+        // The six divisions in two 4-lane divides (IEEE-exact per lane, so the
+        // values are those of the scalar `safe_inv`, `dir[kx] / dir[kz]`, ...).
+        let q = Vec4::ONE / Vec4::new(dir.x, dir.y, dir.z, dir[kz]);
+        let s = Vec4::new(dir[kx], dir[ky], 0.0, 0.0) / Vec4::splat(dir[kz]);
+        let inv = [q.x, q.y, q.z];
         Self {
             org,
             inv,
@@ -149,18 +178,27 @@ impl Ray {
             kx,
             ky,
             kz,
-            sx: dir[kx] / dir[kz],
-            sy: dir[ky] / dir[kz],
-            sz: 1.0 / dir[kz],
+            sx: s.x,
+            sy: s.y,
+            sz: q.w,
         }
+    }
+
+    /// Absolute box-range margin (see [`BOX_SLACK`]) for a tree whose
+    /// coordinates are at most `scale` in magnitude: the rounding of a hit's `t`
+    /// grows with the coordinates' magnitude over the direction's length.
+    #[inline(always)]
+    pub(crate) fn margin(&self, dir: Vec3, scale: f32) -> f32 {
+        (scale + self.org.abs().max_element()) * BOX_SLACK / dir.length()
     }
 
     /// Entry distance into the node's box if the ray overlaps it within
     /// `[tmin, tmax]`, else `f32::INFINITY`. The near/far slab planes are picked
-    /// by the direction's signs; `inv` is finite (see [`Ray::new`]), so no NaN
-    /// can arise, and the far distance is scaled by `1 + 2γ₃` to stay conservative.
+    /// by the direction's signs; a NaN slab distance (`0 · ∞`, see [`Ray::new`])
+    /// fails both selects and so constrains nothing; the far distance is scaled
+    /// by `1 + 2γ₃` to stay conservative.
     #[inline(always)]
-    fn hit_box(&self, min: &[f32; 3], max: &[f32; 3], tmin: f32, tmax: f32) -> f32 {
+    pub(crate) fn hit_box(&self, min: &[f32; 3], max: &[f32; 3], tmin: f32, tmax: f32) -> f32 {
         let mut near = tmin;
         let mut far = tmax;
         for k in 0..3 {
@@ -183,7 +221,7 @@ impl Ray {
 
     /// Watertight ray–triangle test; returns (t, b1, b2) for `tmin < t < tmax`.
     #[inline]
-    fn hit_triangle(&self, p: &[Vec3; 3], tmin: f32, tmax: f32) -> Option<(f32, f32, f32)> {
+    pub(crate) fn hit_triangle(&self, p: &[Vec3; 3], tmin: f32, tmax: f32) -> Option<(f32, f32, f32)> {
         let (kx, ky, kz) = (self.kx, self.ky, self.kz);
         let a = p[0] - self.org;
         let b = p[1] - self.org;
@@ -232,14 +270,31 @@ pub fn intersect_triangle(p: &[Vec3; 3], origin: Vec3, dir: Vec3, tmin: f32, tma
 /// A BVH over a list of world-space triangles. Triangles with non-finite
 /// vertices are left out; zero-area triangles are kept but never hit.
 pub struct Bvh {
-    nodes: Vec<Node>,
+    pub(crate) nodes: Vec<Node>,
     /// The root: a node or a leaf, with the world bounds (`None` when empty).
-    root: Option<(ChildRef, [f32; 3], [f32; 3])>,
+    pub(crate) root: Option<(ChildRef, [f32; 3], [f32; 3])>,
     /// Vertex positions in leaf order.
-    verts: Vec<[Vec3; 3]>,
+    pub(crate) verts: Vec<[Vec3; 3]>,
     /// Leaf order → index into `triangles`.
-    ids: Vec<u32>,
-    triangles: Vec<WorldTriangle>,
+    pub(crate) ids: Vec<u32>,
+    pub(crate) triangles: Vec<WorldTriangle>,
+}
+
+/// Leaf sizes of a build: at most `max` triangles per leaf, and the SAH counts
+/// a leaf's intersection cost per `block` triangles (4 for a backend that tests
+/// 4 triangles at once).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LeafPolicy {
+    pub(crate) max: usize,
+    pub(crate) block: usize,
+}
+
+impl LeafPolicy {
+    /// [`Bvh::build`]: ≤ [`MAX_LEAF`] triangles, cost 1 per triangle.
+    pub(crate) const BINARY: LeafPolicy = LeafPolicy {
+        max: MAX_LEAF,
+        block: 1,
+    };
 }
 
 struct BuildPrim {
@@ -272,6 +327,21 @@ fn half_area(lo: Vec3, hi: Vec3) -> f32 {
 impl Bvh {
     /// Builds the hierarchy (single-threaded, O(n log n)).
     pub fn build(triangles: Vec<WorldTriangle>) -> Self {
+        Self::build_impl(triangles, 0.0, LeafPolicy::BINARY)
+    }
+
+    /// Like [`Bvh::build`], but first splits the references of triangles whose
+    /// boxes are large into up to `extra × triangles` more references with
+    /// tighter boxes (pre-splitting, Ernst and Greiner 2007 "Early split
+    /// clipping"; priorities and power-of-two grid planes after Karras and Aila
+    /// 2013). A triangle can then sit in several leaves: closest-hit and any-hit
+    /// answers are unchanged, but [`Bvh::intersect_all`] may list a hit twice, so
+    /// only the wide backend (which removes duplicates) builds from this.
+    pub(crate) fn build_split(triangles: Vec<WorldTriangle>, extra: f32, policy: LeafPolicy) -> Self {
+        Self::build_impl(triangles, extra, policy)
+    }
+
+    fn build_impl(triangles: Vec<WorldTriangle>, extra: f32, policy: LeafPolicy) -> Self {
         let mut prims: Vec<BuildPrim> = triangles
             .iter()
             .enumerate()
@@ -287,12 +357,21 @@ impl Bvh {
                 }
             })
             .collect();
+        // World bounds from the whole triangles (pre-split boxes are subsets).
+        let (mut wlo, mut whi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for p in &prims {
+            wlo = wlo.min(p.lo);
+            whi = whi.max(p.hi);
+        }
+        if extra > 0.0 && !prims.is_empty() {
+            presplit(&mut prims, &triangles, extra, wlo, whi);
+        }
         let mut nodes = Vec::with_capacity(prims.len() / 2 + 1);
         let root = if prims.is_empty() {
             None
         } else {
-            let (r, lo, hi) = build_node(&mut nodes, &mut prims, 0, 0);
-            Some((r, lo.into(), hi.into()))
+            let (r, _, _) = build_node(&mut nodes, &mut prims, 0, 0, policy);
+            Some((r, wlo.into(), whi.into()))
         };
         let ids: Vec<u32> = prims.iter().map(|p| p.id).collect();
         let verts = ids.iter().map(|&i| triangles[i as usize].p).collect();
@@ -388,7 +467,9 @@ impl Bvh {
             return;
         }
         let ray = Ray::new(origin, dir);
-        let root_near = ray.hit_box(&root_min, &root_max, tmin, *tmax);
+        let margin = ray.margin(dir, scale_of(&root_min, &root_max));
+        let (btmin, mut btmax) = box_range(tmin, *tmax, margin);
+        let root_near = ray.hit_box(&root_min, &root_max, btmin, btmax);
         if root_near == f32::INFINITY {
             return;
         }
@@ -398,10 +479,10 @@ impl Bvh {
         let mut cur = root;
         let mut cur_near = root_near;
         loop {
-            if cur_near <= *tmax {
+            if cur_near <= btmax {
                 if cur & LEAF != 0 {
-                    let first = ((cur & !LEAF) >> 3) as usize;
-                    let count = (cur & 7) as usize;
+                    let first = ((cur & !LEAF) >> 4) as usize;
+                    let count = (cur & 15) as usize;
                     for i in first..first + count {
                         if let Some((t, b1, b2)) = ray.hit_triangle(&self.verts[i], tmin, *tmax) {
                             let hit = Hit {
@@ -413,12 +494,13 @@ impl Bvh {
                             if on_hit(hit, tmax) {
                                 return;
                             }
+                            btmax = box_range(tmin, *tmax, margin).1;
                         }
                     }
                 } else {
                     let n = &self.nodes[cur as usize];
-                    let tl = ray.hit_box(&n.min[0], &n.max[0], tmin, *tmax);
-                    let tr = ray.hit_box(&n.min[1], &n.max[1], tmin, *tmax);
+                    let tl = ray.hit_box(&n.min[0], &n.max[0], btmin, btmax);
+                    let tr = ray.hit_box(&n.min[1], &n.max[1], btmin, btmax);
                     let (mut a, mut ta, mut b, mut tb) = (n.child[0], tl, n.child[1], tr);
                     if ordered && tr < tl {
                         std::mem::swap(&mut a, &mut b);
@@ -451,47 +533,48 @@ impl Bvh {
 
     /// Surface attributes of `hit` for a ray travelling along `dir`.
     pub fn surface(&self, hit: &Hit, dir: Vec3) -> SurfaceHit {
-        let tri = &self.triangles[hit.triangle as usize];
-        let (b1, b2) = (hit.b1, hit.b2);
-        let b0 = 1.0 - b1 - b2;
-        let position = tri.p[0] * b0 + tri.p[1] * b1 + tri.p[2] * b2;
-        let cross = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]);
-        let geometric_normal = cross.normalize_or_zero();
-        let shading = (tri.n[0] * b0 + tri.n[1] * b1 + tri.n[2] * b2).normalize_or_zero();
-        let shading_normal = if shading == Vec3::ZERO || !shading.is_finite() {
-            geometric_normal
-        } else {
-            shading
-        };
-        let uv = [
-            tri.uv[0][0] * b0 + tri.uv[1][0] * b1 + tri.uv[2][0] * b2,
-            tri.uv[0][1] * b0 + tri.uv[1][1] * b1 + tri.uv[2][1] * b2,
-        ];
-        SurfaceHit {
-            t: hit.t,
-            triangle: hit.triangle,
-            position,
-            geometric_normal,
-            shading_normal,
-            front_face: cross.dot(dir) < 0.0,
-            uv,
-            material: tri.material,
-            object: tri.object,
-        }
+        surface_of(&self.triangles[hit.triangle as usize], hit, dir)
     }
 }
 
-/// `1/d`, with zero (and subnormal) `d` replaced by `±1e-30`: always finite.
-fn safe_inv(d: f32) -> f32 {
-    if d.abs() < 1e-30 {
-        1.0 / 1e-30f32.copysign(d)
+/// Surface attributes of `hit` on triangle `tri` for a ray travelling along `dir`.
+pub(crate) fn surface_of(tri: &WorldTriangle, hit: &Hit, dir: Vec3) -> SurfaceHit {
+    let (b1, b2) = (hit.b1, hit.b2);
+    let b0 = 1.0 - b1 - b2;
+    let position = tri.p[0] * b0 + tri.p[1] * b1 + tri.p[2] * b2;
+    let cross = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]);
+    let geometric_normal = cross.normalize_or_zero();
+    let shading = (tri.n[0] * b0 + tri.n[1] * b1 + tri.n[2] * b2).normalize_or_zero();
+    let shading_normal = if shading == Vec3::ZERO || !shading.is_finite() {
+        geometric_normal
     } else {
-        1.0 / d
+        shading
+    };
+    let uv = [
+        tri.uv[0][0] * b0 + tri.uv[1][0] * b1 + tri.uv[2][0] * b2,
+        tri.uv[0][1] * b0 + tri.uv[1][1] * b1 + tri.uv[2][1] * b2,
+    ];
+    SurfaceHit {
+        t: hit.t,
+        triangle: hit.triangle,
+        position,
+        geometric_normal,
+        shading_normal,
+        front_face: cross.dot(dir) < 0.0,
+        uv,
+        material: tri.material,
+        object: tri.object,
     }
+}
+
+/// Largest coordinate magnitude of a box.
+#[inline(always)]
+pub(crate) fn scale_of(lo: &[f32; 3], hi: &[f32; 3]) -> f32 {
+    Vec3::from(*lo).abs().max(Vec3::from(*hi).abs()).max_element()
 }
 
 /// The smallest float greater than finite `x`.
-fn next_up(x: f32) -> f32 {
+pub(crate) fn next_up(x: f32) -> f32 {
     if x == 0.0 {
         f32::from_bits(1)
     } else if x > 0.0 {
@@ -504,7 +587,13 @@ fn next_up(x: f32) -> f32 {
 /// Recursively builds the subtree over `prims` (which start at `offset` in leaf
 /// order), appending interior nodes depth-first and reordering `prims` into
 /// leaf order. Returns the subtree's reference and bounds.
-fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, depth: usize) -> (ChildRef, Vec3, Vec3) {
+fn build_node(
+    nodes: &mut Vec<Node>,
+    prims: &mut [BuildPrim],
+    offset: usize,
+    depth: usize,
+    policy: LeafPolicy,
+) -> (ChildRef, Vec3, Vec3) {
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     let (mut clo, mut chi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     for p in prims.iter() {
@@ -521,13 +610,13 @@ fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, dep
     let split = if depth > MAX_SAH_DEPTH {
         None
     } else {
-        sah_split(prims, lo, hi, clo, chi)
+        sah_split(prims, lo, hi, clo, chi, policy)
     };
     let mid = match split {
         Some(None) => return leaf, // SAH prefers a leaf and it is small enough
         Some(Some(mid)) => mid,
         None => {
-            if n <= MAX_LEAF {
+            if n <= policy.max {
                 return leaf;
             }
             // Median split along the widest centroid axis (degenerate centroids
@@ -544,8 +633,8 @@ fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, dep
         child: [0; 2],
     });
     let (left, right) = prims.split_at_mut(mid);
-    let (l, llo, lhi) = build_node(nodes, left, offset, depth + 1);
-    let (r, rlo, rhi) = build_node(nodes, right, offset + mid, depth + 1);
+    let (l, llo, lhi) = build_node(nodes, left, offset, depth + 1, policy);
+    let (r, rlo, rhi) = build_node(nodes, right, offset + mid, depth + 1, policy);
     nodes[index] = Node {
         min: [llo.into(), rlo.into()],
         max: [lhi.into(), rhi.into()],
@@ -556,7 +645,15 @@ fn build_node(nodes: &mut Vec<Node>, prims: &mut [BuildPrim], offset: usize, dep
 
 /// Binned SAH over centroids. `None`: no usable split (degenerate centroids);
 /// `Some(None)`: make a leaf; `Some(Some(mid))`: prims partitioned at `mid`.
-fn sah_split(prims: &mut [BuildPrim], lo: Vec3, hi: Vec3, clo: Vec3, chi: Vec3) -> Option<Option<usize>> {
+fn sah_split(
+    prims: &mut [BuildPrim],
+    lo: Vec3,
+    hi: Vec3,
+    clo: Vec3,
+    chi: Vec3,
+    policy: LeafPolicy,
+) -> Option<Option<usize>> {
+    let blocks = |n: usize| n.div_ceil(policy.block) as f32;
     let n = prims.len();
     let extent = chi - clo;
     let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, bin)
@@ -593,7 +690,7 @@ fn sah_split(prims: &mut [BuildPrim], lo: Vec3, hi: Vec3, clo: Vec3, chi: Vec3) 
             if lc == 0 || rc == 0 {
                 continue;
             }
-            let cost = lc as f32 * half_area(llo, lhi) + rc as f32 * right_area[i + 1];
+            let cost = blocks(lc) * half_area(llo, lhi) + blocks(rc) * right_area[i + 1];
             if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, axis, i + 1));
             }
@@ -603,7 +700,7 @@ fn sah_split(prims: &mut [BuildPrim], lo: Vec3, hi: Vec3, clo: Vec3, chi: Vec3) 
     // Costs relative to the parent's area: traversal 1, intersection 1 per triangle.
     let parent = half_area(lo, hi).max(f32::MIN_POSITIVE);
     let split_cost = 1.0 + cost / parent;
-    if n <= MAX_LEAF && split_cost >= n as f32 {
+    if n <= policy.max && split_cost >= blocks(n) {
         return Some(None);
     }
     let scale = BINS as f32 / extent[axis];
@@ -619,4 +716,178 @@ fn sah_split(prims: &mut [BuildPrim], lo: Vec3, hi: Vec3, clo: Vec3, chi: Vec3) 
         return None;
     }
     Some(Some(mid))
+}
+
+/// Pre-splitting of triangle references (see [`Bvh::build_split`]): the
+/// reference whose box has the largest surface area not explained by its
+/// triangle is split at a power-of-two grid plane of the scene bounds across its
+/// longest axis; each half gets the box of the triangle's part on that side,
+/// clipped to the half (and widened by a few ulps so rounding never loses a
+/// piece of the triangle). Stops at `extra × n` new references.
+fn presplit(prims: &mut Vec<BuildPrim>, triangles: &[WorldTriangle], extra: f32, wlo: Vec3, whi: Vec3) {
+    use std::cmp::Ordering;
+    use std::collections::BinaryHeap;
+
+    struct Item {
+        priority: f32,
+        index: usize,
+    }
+    impl PartialEq for Item {
+        fn eq(&self, o: &Self) -> bool {
+            self.cmp(o) == Ordering::Equal
+        }
+    }
+    impl Eq for Item {}
+    impl PartialOrd for Item {
+        fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+            Some(self.cmp(o))
+        }
+    }
+    impl Ord for Item {
+        fn cmp(&self, o: &Self) -> Ordering {
+            self.priority.total_cmp(&o.priority).then(o.index.cmp(&self.index))
+        }
+    }
+
+    let budget = (prims.len() as f64 * extra as f64).min(1e8) as usize;
+    let tri_area = |id: u32| {
+        let p = &triangles[id as usize].p;
+        0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
+    };
+    // Wasted box area: the box's half surface area minus the triangle's area
+    // (a flat, axis-aligned triangle filling its box wastes nothing).
+    let priority = |p: &BuildPrim, area: f32| {
+        let w = half_area(p.lo, p.hi) - area.min(half_area(p.lo, p.hi));
+        if w.is_finite() {
+            w
+        } else {
+            0.0
+        }
+    };
+    let areas: Vec<f32> = prims.iter().map(|p| tri_area(p.id)).collect();
+    let mut heap: BinaryHeap<Item> = prims
+        .iter()
+        .enumerate()
+        .map(|(i, p)| Item {
+            priority: priority(p, areas[i]),
+            index: i,
+        })
+        .collect();
+    let mut ref_area = areas;
+    let mut added = 0;
+    let extent = whi - wlo;
+    while added < budget {
+        let Some(item) = heap.pop() else { break };
+        if !(item.priority > 0.0) {
+            break;
+        }
+        let p = &prims[item.index];
+        let axis = (p.hi - p.lo).max_position();
+        let Some(plane) = grid_plane(wlo[axis], extent[axis], p.lo[axis], p.hi[axis]) else {
+            continue; // too thin to split: leave it out of the heap
+        };
+        let tri = &triangles[p.id as usize].p;
+        let (Some((llo, lhi)), Some((rlo, rhi))) = (
+            clip_box(tri, axis, plane, true, p.lo, p.hi),
+            clip_box(tri, axis, plane, false, p.lo, p.hi),
+        ) else {
+            continue;
+        };
+        let id = p.id;
+        // Each piece's share of the triangle's area, by box area (priority only).
+        let total = ref_area[item.index];
+        let (la, ra) = (half_area(llo, lhi), half_area(rlo, rhi));
+        let lshare = if la + ra > 0.0 {
+            total * la / (la + ra)
+        } else {
+            0.5 * total
+        };
+        prims[item.index] = BuildPrim {
+            lo: llo,
+            hi: lhi,
+            centroid: 0.5 * (llo + lhi),
+            id,
+        };
+        ref_area[item.index] = lshare;
+        prims.push(BuildPrim {
+            lo: rlo,
+            hi: rhi,
+            centroid: 0.5 * (rlo + rhi),
+            id,
+        });
+        ref_area.push(total - lshare);
+        let n = prims.len() - 1;
+        heap.push(Item {
+            priority: priority(&prims[item.index], ref_area[item.index]),
+            index: item.index,
+        });
+        heap.push(Item {
+            priority: priority(&prims[n], ref_area[n]),
+            index: n,
+        });
+        added += 1;
+    }
+}
+
+/// The coarsest plane `lo + k·extent/2^m` strictly inside `(a, b)`, if any.
+fn grid_plane(lo: f32, extent: f32, a: f32, b: f32) -> Option<f32> {
+    if !(extent > 0.0) || !(b > a) {
+        return None;
+    }
+    let mut cell = extent;
+    for _ in 0..24 {
+        cell *= 0.5;
+        let k = ((b - lo) / cell).floor();
+        let plane = lo + k * cell;
+        if plane > a && plane < b {
+            return Some(plane);
+        }
+        if plane <= a && lo + (k + 1.0) * cell < b && lo + (k + 1.0) * cell > a {
+            return Some(lo + (k + 1.0) * cell);
+        }
+    }
+    // Fall back to the midpoint when the grid is too coarse near this box.
+    let mid = 0.5 * (a + b);
+    (mid > a && mid < b).then_some(mid)
+}
+
+/// Box of the part of triangle `p` on one side of the plane `x[axis] = plane`
+/// (`below`: `≤ plane`), intersected with the box `[lo, hi]`, or `None` when
+/// that part is empty. Edge–plane crossings are rounded, so the box is widened
+/// by a few ulps (relative) before the intersection: it always contains the
+/// exact part.
+fn clip_box(p: &[Vec3; 3], axis: usize, plane: f32, below: bool, lo: Vec3, hi: Vec3) -> Option<(Vec3, Vec3)> {
+    let inside = |v: Vec3| if below { v[axis] <= plane } else { v[axis] >= plane };
+    let (mut blo, mut bhi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for i in 0..3 {
+        let (a, b) = (p[i], p[(i + 1) % 3]);
+        if inside(a) {
+            blo = blo.min(a);
+            bhi = bhi.max(a);
+        }
+        if (a[axis] < plane && b[axis] > plane) || (a[axis] > plane && b[axis] < plane) {
+            let s = (plane - a[axis]) / (b[axis] - a[axis]);
+            let mut x = a + (b - a) * s;
+            x[axis] = plane;
+            blo = blo.min(x);
+            bhi = bhi.max(x);
+        }
+    }
+    if !(blo.x <= bhi.x) {
+        return None;
+    }
+    // Widen by 2⁻¹⁸ of the magnitude plus the box size (crossings carry a few
+    // roundings), then keep within the parent box.
+    let pad = (blo.abs().max(bhi.abs()) + (hi - lo)) * (1.0 / 262_144.0);
+    let mut nlo = (blo - pad).max(lo);
+    let mut nhi = (bhi + pad).min(hi);
+    if below {
+        nhi[axis] = nhi[axis].min(plane);
+    } else {
+        nlo[axis] = nlo[axis].max(plane);
+    }
+    if !(nlo.x <= nhi.x && nlo.y <= nhi.y && nlo.z <= nhi.z) || !nlo.is_finite() || !nhi.is_finite() {
+        return None;
+    }
+    Some((nlo, nhi))
 }

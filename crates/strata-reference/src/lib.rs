@@ -2,7 +2,7 @@
 //! tested against.
 //!
 //! A [`Reference`] is built once per `(scene, frame)`: it flattens the scene to
-//! world-space triangles, builds a [`bvh::Bvh`] and a light-sampling table for
+//! world-space triangles, builds a [`Tracer`] and a light-sampling table for
 //! emissive triangles, and then computes, for any camera and image size:
 //!
 //! - [`Reference::ao_binary`]: ambient visibility from cosine-weighted hemisphere
@@ -25,24 +25,32 @@
 //! `(seed, pixel)`, and rows run in parallel with rayon, so results never
 //! depend on thread count or scheduling.
 //!
+//! **Tracers.** Rays go through the [`Tracer`] interface; [`TracerKind::Wide`]
+//! (the default, an 8-wide SIMD BVH, [`wide`]) and [`TracerKind::Binary`] (the
+//! binned-SAH binary BVH, [`bvh`]) return bitwise-identical answers
+//! ([`Reference::with_tracer`] picks one).
+//!
 //! **Why our own BVH.** The oracle must be exact and reproducible, and its
 //! failure modes must be ours to reason about: the watertight intersection
 //! (Woop et al. 2013) never leaks rays through shared edges, ties at equal `t`
 //! are broken by triangle index so results do not depend on traversal order,
-//! and [`bvh::Bvh::intersect_all`] enumerates every surface along a ray, which
+//! and [`Tracer::intersect_all`] enumerates every surface along a ray, which
 //! the layer and obscurance oracles need and general-purpose BVH crates rarely
-//! expose. A binned-SAH builder is ~300 lines and adds no dependency.
+//! expose.
 
 // `!(a < b)` is used on purpose where NaN must take the "reject" branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod ao;
+pub mod bench;
 pub mod bvh;
 pub mod converge;
 pub mod gi;
 pub mod layers;
 pub mod probes;
 pub mod sampling;
+pub mod tracer;
+pub mod wide;
 pub mod vpl;
 
 use std::io::IsTerminal;
@@ -55,10 +63,13 @@ use rayon::prelude::*;
 use strata_scene::{Camera, Material, Scene};
 
 pub use ao::{AoBinarySettings, DiskSampling, ObscuranceSettings};
+pub use bench::RayKind;
 pub use bvh::{Bvh, Hit, SurfaceHit};
 pub use converge::{ConvergeRule, Converged, Estimator};
 pub use gi::{GiImages, GiSettings};
 pub use layers::{DeepLayers, Layer, LayerSettings, NO_ID};
+pub use tracer::{AnyTracer, Tracer, TracerKind};
+pub use wide::WideBvh;
 pub use vpl::{Vpl, VplSettings};
 
 /// Counters accumulated over every computation run on a [`Reference`].
@@ -106,7 +117,7 @@ impl Throughput {
 pub struct Reference<'s> {
     scene: &'s Scene,
     frame: f32,
-    bvh: Bvh,
+    bvh: AnyTracer,
     lights: gi::EmissiveLights,
     epsilon: f32,
     progress: bool,
@@ -118,11 +129,22 @@ pub struct Reference<'s> {
 static DEFAULT_MATERIAL: std::sync::LazyLock<Material> = std::sync::LazyLock::new(Material::default);
 
 impl<'s> Reference<'s> {
-    /// Flattens `scene` at `frame` and builds the BVH and the emissive-triangle
-    /// table. An empty scene is fine: every ray misses.
+    /// Flattens `scene` at `frame` and builds the default tracer
+    /// ([`TracerKind::Wide`]) and the emissive-triangle table. An empty scene is
+    /// fine: every ray misses.
     pub fn new(scene: &'s Scene, frame: f32) -> Self {
+        Self::with_tracer(scene, frame, TracerKind::default())
+    }
+
+    /// [`Reference::new`] with a chosen tracer backend (every backend gives the
+    /// same answers; they differ in speed).
+    pub fn with_tracer(scene: &'s Scene, frame: f32, kind: TracerKind) -> Self {
         let start = Instant::now();
-        let bvh = Bvh::build(scene.world_triangles(frame));
+        let triangles = scene.world_triangles(frame);
+        let bvh = match kind {
+            TracerKind::Binary => Bvh::build(triangles),
+            TracerKind::Wide => wide::base_tree(triangles),
+        };
         let epsilon = match bvh.bounds() {
             Some((lo, hi)) => {
                 let scale = (hi - lo)
@@ -138,6 +160,7 @@ impl<'s> Reference<'s> {
             None => 1e-4,
         };
         let lights = gi::EmissiveLights::new(&bvh, &scene.materials);
+        let bvh = AnyTracer::from_binary(bvh, kind);
         Self {
             scene,
             frame,
@@ -171,8 +194,14 @@ impl<'s> Reference<'s> {
         self.scene.camera_at(self.frame)
     }
 
-    pub fn bvh(&self) -> &Bvh {
+    /// The tracer (dispatching to the backend chosen at construction).
+    pub fn bvh(&self) -> &AnyTracer {
         &self.bvh
+    }
+
+    /// The backend in use.
+    pub fn tracer_kind(&self) -> TracerKind {
+        self.bvh.kind()
     }
 
     /// Seconds spent flattening the scene and building the BVH.

@@ -7,4 +7,5 @@ mod converge;
 mod gi;
 mod layers;
 mod scenes;
+mod tracer;
 mod vpl;
