@@ -257,7 +257,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
                 cameras.push((ni, c));
             }
         }
-        if let Some(l) = punctual_light(doc, ni, world).map_err(|m| fail(m))? {
+        if let Some(l) = punctual_light(doc, ni, world).map_err(&fail)? {
             lights.push(l);
         }
         for c in node.children() {
@@ -315,7 +315,8 @@ fn punctual_light(doc: &gltf::Document, ni: usize, world: Mat4) -> Result<Option
         )
     })?;
     let name = light.name.clone().unwrap_or_else(|| format!("light {index}"));
-    if !light.color.iter().all(|c| c.is_finite() && *c >= 0.0) || !(light.intensity.is_finite() && light.intensity >= 0.0) {
+    let valid = light.color.iter().all(|c| c.is_finite() && *c >= 0.0) && light.intensity.is_finite() && light.intensity >= 0.0;
+    if !valid {
         return Err(format!(
             "KHR_lights_punctual '{}': color and intensity must be finite and >= 0",
             short(&name)
