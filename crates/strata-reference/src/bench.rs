@@ -99,7 +99,7 @@ impl Reference<'_> {
                         let (mut n, mut c) = (0u64, 0u64);
                         for (x, hit) in row.iter().enumerate() {
                             let Some((origin, normal)) = *hit else { continue };
-                            let offset = pixel_offset(hash(&[0x6265_6e63_68, (y * w + x) as u64]));
+                            let offset = pixel_offset(hash(&[0x0062_656e_6368, (y * w + x) as u64]));
                             for i in 0..PER_PASS {
                                 let d =
                                     cosine_hemisphere(normal, r2(pass.wrapping_mul(PER_PASS).wrapping_add(i), offset));

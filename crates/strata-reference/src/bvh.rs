@@ -886,7 +886,8 @@ fn clip_box(p: &[Vec3; 3], axis: usize, plane: f32, below: bool, lo: Vec3, hi: V
     } else {
         nlo[axis] = nlo[axis].max(plane);
     }
-    if !(nlo.x <= nhi.x && nlo.y <= nhi.y && nlo.z <= nhi.z) || !nlo.is_finite() || !nhi.is_finite() {
+    let valid = nlo.x <= nhi.x && nlo.y <= nhi.y && nlo.z <= nhi.z && nlo.is_finite() && nhi.is_finite();
+    if !valid {
         return None;
     }
     Some((nlo, nhi))

@@ -298,7 +298,9 @@ impl WideBvh {
         }
         let ray = Ray::new(origin, dir);
         let (btmin, btmax) = box_range(tmin, tmax, ray.margin(dir, scale_of(&root_min, &root_max)));
-        if ray.hit_box(&root_min, &root_max, btmin, btmax) == f32::INFINITY {
+        // A root node tests its children's boxes at once; only a root leaf
+        // needs the bounds test.
+        if root & LEAF != 0 && ray.hit_box(&root_min, &root_max, btmin, btmax) == f32::INFINITY {
             return false;
         }
         let mut stack = [const { MaybeUninit::<ChildRef>::uninit() }; STACK];

@@ -28,12 +28,15 @@ fn builtin(name: &str) -> Vec<WorldTriangle> {
         .world_triangles(0.0)
 }
 
+/// Named backends under test.
+type Backends = Vec<(String, Box<dyn Tracer>)>;
+
 /// The binary BVH (the reference answer) and every other backend, including
 /// the wide BVH with its portable (non-SIMD) box test.
-fn backends(tris: &[WorldTriangle]) -> (Bvh, Vec<(String, Box<dyn Tracer>)>) {
+fn backends(tris: &[WorldTriangle]) -> (Bvh, Backends) {
     let wide = WideBvh::build(tris.to_vec());
     let simd = wide.simd();
-    let mut others: Vec<(String, Box<dyn Tracer>)> = vec![(format!("wide (simd {simd})"), Box::new(wide))];
+    let mut others: Backends = vec![(format!("wide (simd {simd})"), Box::new(wide))];
     if simd {
         others.push((
             "wide (portable)".into(),
