@@ -147,7 +147,7 @@ pub enum BenchResult {
     /// Any registered technique (`strata bench technique`).
     Technique(StageBench),
     /// Interleaved deferred shading vs its brute force (`strata bench ils`, ILS Table 4).
-    Ils(IlsBench),
+    Ils(Box<IlsBench>),
 }
 
 /// `strata bench ils`: ILS Table 4's "IS" and "no IS" columns as GPU times of

@@ -182,8 +182,8 @@ fn gpu_vpl_shading_equals_the_cpu_sum() {
             assert!(scale > 0.0, "{name}: the VPLs light the view");
             let mut worst = 0.0f32;
             for (i, px) in cpu.data.chunks_exact(3).enumerate() {
-                for c in 0..3 {
-                    let (a, b) = (gpu_e.data[i * 4 + c], px[c]);
+                for (c, &b) in px.iter().enumerate() {
+                    let a = gpu_e.data[i * 4 + c];
                     let err = (a - b).abs() / (0.002 * b.abs() + 2e-4 * scale);
                     worst = worst.max(err);
                     assert!(
