@@ -793,6 +793,8 @@ impl Renderer {
                 Ok(img)
             }
             "ils-split-csz" => Ok(normalise(self.read_target(gpu, "ils-gbuffer-split")?.channel(3))),
+            // §4.5's flag as grey
+            "ils-discontinuity" => Ok(self.read_target(gpu, base)?.channel(3)),
             "ils-irradiance" | "ils-irradiance-tiled" | "ils-blur-h" | "indirect" if self.ils.is_some() => {
                 Ok(pad_channels(&self.read_target(gpu, base)?, 3))
             }

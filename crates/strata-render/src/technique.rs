@@ -291,7 +291,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 11] = [
+static ILS_SETTINGS: [SettingInfo; 12] = [
     setting!(
         "vpls",
         "VPLs N the caller generates by instant radiosity (ILS Table 4: 480)",
@@ -370,6 +370,14 @@ static ILS_SETTINGS: [SettingInfo; 11] = [
         true,
         |s| Some(ils_of(s).bilinear as u32 as f64),
         |s, v| ils_mut(s).bilinear = v != 0.0
+    ),
+    setting!(
+        "per-axis-db",
+        "1 = each blur pass stops at discontinuities along its own axis only (not in ILS; sharper edges)",
+        Range::Closed(0.0, 1.0),
+        true,
+        |s| Some(ils_of(s).per_axis_discontinuities as u32 as f64),
+        |s, v| ils_mut(s).per_axis_discontinuities = v != 0.0
     ),
     setting!(
         "depth-threshold",

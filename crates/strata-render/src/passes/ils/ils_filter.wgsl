@@ -15,7 +15,9 @@ struct Filter {
     sigma: f32,
     dir: vec2i,
     bilinear: u32,
-    _pad: u32,
+    // B: the DB channel that stops the blur: 3 = §4.5's flag (three positive
+    // neighbours), 0 / 1 = differs from the +x / +y neighbour (per-axis option)
+    channel: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -45,9 +47,10 @@ fn differs(p: vec2i, q: vec2i) -> bool {
     return d > filt.depth_threshold * min(a.w, b.w);
 }
 
-// 1 where the pixel is not similar to one of its three "positive" neighbours
-// (x+1, y), (x, y+1), (x+1, y+1) (§4.5) or has no surface; neighbours outside
-// the image do not count (the blur stops at the border by itself).
+// a = §4.5's flag: 1 where the pixel is not similar to one of its three
+// "positive" neighbours (x+1, y), (x, y+1), (x+1, y+1), or has no surface;
+// r, g = the same against (x+1, y) and (x, y+1) alone (the per-axis option).
+// Neighbours outside the image do not count (the blur stops at the border).
 @fragment
 fn fs_discontinuity(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let p = vec2i(pos.xy);
@@ -55,15 +58,15 @@ fn fs_discontinuity(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     if (textureLoad(src, p, 0).w <= 0.0) {
         return vec4f(1.0);
     }
-    var d = false;
+    var d = vec3f(0.0);
     for (var k = 0; k < 3; k++) {
         let o = array<vec2i, 3>(vec2i(1, 0), vec2i(0, 1), vec2i(1, 1))[k];
         let q = p + o;
         if (all(q < size) && differs(p, q)) {
-            d = true;
+            d[k] = 1.0;
         }
     }
-    return vec4f(select(0.0, 1.0, d));
+    return vec4f(d.x, d.y, 0.0, max(d.x, max(d.y, d.z)));
 }
 
 // ---- B ----
@@ -73,7 +76,7 @@ fn gauss(k: f32) -> f32 {
 }
 
 fn flag(p: vec2i) -> bool {
-    return textureLoad(discontinuity, p, 0).r > 0.0;
+    return textureLoad(discontinuity, p, 0)[filt.channel] > 0.0;
 }
 
 // §4.5: from a pixel not on a discontinuity, both directions are explored; a
@@ -137,7 +140,7 @@ fn blur_bilinear(c: vec2i, size: vec2i) -> vec4f {
             }
             let off = f32(k) + wb / (wa + wb);
             let uv = (centre + f32(s) * off * vec2f(d)) * inv;
-            if (textureSampleLevel(discontinuity, bilinear_sampler, uv, 0.0).r > 0.0) {
+            if (textureSampleLevel(discontinuity, bilinear_sampler, uv, 0.0)[filt.channel] > 0.0) {
                 break;
             }
             sum += (wa + wb) * textureSampleLevel(src, bilinear_sampler, uv, 0.0).rgb;

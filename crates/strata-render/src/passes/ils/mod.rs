@@ -110,6 +110,11 @@ pub struct IlsSettings {
     pub blur: f32,
     /// Fig. 4 b: two texels per bilinear tap (false: Fig. 4 a, texel centres).
     pub bilinear: bool,
+    /// Not in the paper: the horizontal blur stops only at discontinuities
+    /// towards (x+1, y), the vertical one towards (x, y+1), instead of at
+    /// §4.5's flag over all three positive neighbours (which leaves pixels along
+    /// an edge unblurred across it, visible as speckled outlines).
+    pub per_axis_discontinuities: bool,
     /// DB: a neighbour is a discontinuity beyond this distance from the
     /// pixel's tangent plane, relative to its depth z (> 0).
     pub depth_threshold: f32,
@@ -129,6 +134,7 @@ impl Default for IlsSettings {
             all_vpls_per_sub_buffer: false,
             blur: 1.0,
             bilinear: true,
+            per_axis_discontinuities: false,
             depth_threshold: 0.02,
             normal_threshold_deg: 25.0,
         }
@@ -233,9 +239,9 @@ impl IlsSettings {
         let [n, m] = self.pattern;
         let tiled = (w.div_ceil(n.max(1)) * n.max(1)) as u64 * (h.div_ceil(m.max(1)) * m.max(1)) as u64;
         let px = w as u64 * h as u64;
-        // gbuffer 16 + irradiance 8 + DB 2 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8;
+        // gbuffer 16 + irradiance 8 + DB 8 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8;
         // the Blocks intermediates ≤ 2 more tiled-size buffers
-        px * 66 + tiled * (24 + 24) + self.vpls.len() as u64 * 48
+        px * 72 + tiled * (24 + 24) + self.vpls.len() as u64 * 48
     }
 }
 
@@ -266,9 +272,9 @@ pub const IRRADIANCE: TargetDesc = TargetDesc::new(
 );
 pub const DISCONTINUITY: TargetDesc = TargetDesc::new(
     "ils-discontinuity",
-    wgpu::TextureFormat::R16Float,
+    wgpu::TextureFormat::Rgba16Float,
     1,
-    "ILS §4.5 (Fig. 3 e): 1 where a pixel differs from a positive neighbour",
+    "ILS §4.5 (Fig. 3 e): a = 1 where a pixel differs from a positive neighbour; r, g: from (x+1, y), (x, y+1)",
 );
 pub const BLUR_H: TargetDesc = TargetDesc::new(
     "ils-blur-h",
@@ -304,7 +310,7 @@ struct FilterUniforms {
     sigma: f32,
     dir: [i32; 2],
     bilinear: u32,
-    _pad: u32,
+    channel: u32,
 }
 
 /// BS or BG of one target into another, as a frame pass.
@@ -357,7 +363,12 @@ fn filter_passes(
         sigma: radius.max(1) as f32,
         dir,
         bilinear: s.bilinear as u32,
-        _pad: 0,
+        // §4.5's three-neighbour flag (a), or the flag of the blur's own axis (r, g)
+        channel: if s.per_axis_discontinuities {
+            (dir[1] != 0) as u32
+        } else {
+            3
+        },
     };
     let discontinuity = PassBuilder::new(gpu, targets, "ils-db")
         .shader("ils-filter", include_str!("ils_filter.wgsl"))
@@ -630,7 +641,7 @@ mod tests {
             let bytes = gpu.read_texture(t, 0).unwrap();
             crate::renderer::decode_texels(&bytes, t.format(), w, h).unwrap()
         };
-        (read(INDIRECT.name).channel(0).data, read(DISCONTINUITY.name).data)
+        (read(INDIRECT.name).channel(0).data, read(DISCONTINUITY.name).channel(3).data)
     }
 
     fn settings(bilinear: bool) -> IlsSettings {
@@ -658,8 +669,12 @@ mod tests {
         let (w, h) = (40u32, 30u32);
         let quadrant = |x: u32, y: u32| (x >= 17) as u32 + 2 * (y >= 13) as u32;
         let values = [1.0f32, 4.0, 0.25, 2.0];
-        for bilinear in [false, true] {
-            let (out, db) = filter(&settings(bilinear), w, h, quadrant, |p| values[p as usize]);
+        for (bilinear, per_axis) in [(false, false), (true, false), (false, true), (true, true)] {
+            let s = IlsSettings {
+                per_axis_discontinuities: per_axis,
+                ..settings(bilinear)
+            };
+            let (out, db) = filter(&s, w, h, quadrant, |p| values[p as usize]);
             // DB: exactly the pixels before a boundary (x = 16 or y = 12)
             for y in 0..h {
                 for x in 0..w {
@@ -667,14 +682,17 @@ mod tests {
                     assert_eq!(db[(y * w + x) as usize] > 0.0, expect, "DB at ({x}, {y})");
                     let v = out[(y * w + x) as usize];
                     let want = values[quadrant(x, y) as usize];
-                    assert!((v - want).abs() <= 1e-3 * want, "bilinear {bilinear}: ({x}, {y}) = {v}, its plane's {want}");
+                    assert!(
+                        (v - want).abs() <= 1e-3 * want,
+                        "bilinear {bilinear} per-axis {per_axis}: ({x}, {y}) = {v}, its plane's {want}"
+                    );
                 }
             }
             // control: without discontinuities the same blur does mix the planes
             let blind = IlsSettings {
                 depth_threshold: 1e9,
                 normal_threshold_deg: 180.0,
-                ..settings(bilinear)
+                ..s
             };
             let (out, db) = filter(&blind, w, h, quadrant, |p| values[p as usize]);
             assert!(db.iter().all(|&d| d == 0.0));
