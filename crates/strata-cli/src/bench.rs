@@ -29,7 +29,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             let r = technique::run(&(&b.stage).into(), b.technique, b.preset.as_deref(), &b.set.values)?;
             (BenchResult::Technique(r), b.stage.json)
         }
-        BenchWhat::Ils(b) => (BenchResult::Ils(Box::new(ils::run(&(&b.stage).into(), &b.set.values)?)), b.stage.json),
+        BenchWhat::Ils(b) => (
+            BenchResult::Ils(Box::new(ils::run(&(&b.stage).into(), &b.set.values)?)),
+            b.stage.json,
+        ),
         BenchWhat::Reflections(b) => {
             let rs = ReflectionSettings {
                 steps: b.steps,

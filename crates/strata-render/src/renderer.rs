@@ -449,7 +449,13 @@ impl Renderer {
             None => None,
         };
         let ils = match &settings.ils {
-            Some(i) => Some(crate::passes::ils::IlsStage::new(gpu, &scene_gpu, &mut targets, i, scene)?),
+            Some(i) => Some(crate::passes::ils::IlsStage::new(
+                gpu,
+                &scene_gpu,
+                &mut targets,
+                i,
+                scene,
+            )?),
             None => None,
         };
         let shaded = if radiosity.is_some() || ils.is_some() {

@@ -597,7 +597,8 @@ static REGISTRY: [Technique; 4] = [
     },
     Technique {
         name: "ils",
-        doc: "direct + interleaved deferred shading of one-bounce VPLs, no VPL visibility (ILS §4, §6.2; 480 VPLs, 8x6)",
+        doc:
+            "direct + interleaved deferred shading of one-bounce VPLs, no VPL visibility (ILS §4, §6.2; 480 VPLs, 8x6)",
         output: "hdr-full",
         display: ("ldr", true),
         // not yet wired into `eval` (it would need the caller's VPLs there)

@@ -241,6 +241,9 @@ fn every_ils_view_renders_and_bad_settings_are_one_line_errors() {
     assert!(e.contains("block size") && !e.contains('\n'), "{e}");
     let mut s = t.settings(&RenderSettings::default(), None).unwrap();
     s.radiosity = Some(Default::default());
-    let e = Renderer::new(&gpu, &scene, s).err().expect("ils + radiosity refused").to_string();
+    let e = Renderer::new(&gpu, &scene, s)
+        .err()
+        .expect("ils + radiosity refused")
+        .to_string();
     assert!(e.contains("ils") && e.contains("radiosity"), "{e}");
 }

@@ -9,8 +9,8 @@
 mod common;
 
 use strata_render::frame::FrameCameras;
-use strata_render::passes::ils::GpuVpl;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
+use strata_render::passes::ils::GpuVpl;
 use strata_render::technique::registry;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::probes::IrradianceProbes;

@@ -35,7 +35,11 @@ pub fn run(
     let checked = configure(stage.layers)?;
     // ILS: the caller's VPLs, generated once (static scene)
     let vpls = match &checked.ils {
-        Some(i) => Some(crate::vpls::scene_vpls(&stage.scene.load()?.0, stage.scene.frame, i.vpl_count)),
+        Some(i) => Some(crate::vpls::scene_vpls(
+            &stage.scene.load()?.0,
+            stage.scene.frame,
+            i.vpl_count,
+        )),
         None => None,
     };
     let extra = json!({

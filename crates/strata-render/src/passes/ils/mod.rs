@@ -605,7 +605,13 @@ mod tests {
     /// Runs DB + blur over a synthetic `w`×`h` frame whose pixel (x, y) lies on
     /// plane `plane(x, y)` (facing the camera at depth 1 + plane) with
     /// irradiance `value(plane)`; returns the blurred irradiance (r) and the DB.
-    fn filter(s: &IlsSettings, w: u32, h: u32, plane: impl Fn(u32, u32) -> u32, value: impl Fn(u32) -> f32) -> (Vec<f32>, Vec<f32>) {
+    fn filter(
+        s: &IlsSettings,
+        w: u32,
+        h: u32,
+        plane: impl Fn(u32, u32) -> u32,
+        value: impl Fn(u32) -> f32,
+    ) -> (Vec<f32>, Vec<f32>) {
         let gpu = GpuContext::new(&crate::GpuOptions::default()).expect("a Vulkan adapter");
         let scene = strata_scene::procedural::plane();
         let scene_gpu = GpuScene::new(&gpu, &scene);
@@ -641,7 +647,10 @@ mod tests {
             let bytes = gpu.read_texture(t, 0).unwrap();
             crate::renderer::decode_texels(&bytes, t.format(), w, h).unwrap()
         };
-        (read(INDIRECT.name).channel(0).data, read(DISCONTINUITY.name).channel(3).data)
+        (
+            read(INDIRECT.name).channel(0).data,
+            read(DISCONTINUITY.name).channel(3).data,
+        )
     }
 
     fn settings(bilinear: bool) -> IlsSettings {
@@ -697,7 +706,10 @@ mod tests {
             let (out, db) = filter(&blind, w, h, quadrant, |p| values[p as usize]);
             assert!(db.iter().all(|&d| d == 0.0));
             let v = out[(5 * w + 16) as usize];
-            assert!((v - values[0]).abs() > 0.1, "bilinear {bilinear}: the control blur did not mix ({v})");
+            assert!(
+                (v - values[0]).abs() > 0.1,
+                "bilinear {bilinear}: the control blur did not mix ({v})"
+            );
         }
     }
 
@@ -707,14 +719,62 @@ mod tests {
         ok.validate().unwrap();
         assert_eq!(ok.blur_radius(), [4, 3]);
         let bad = [
-            (IlsSettings { vpl_count: 0, ..ok.clone() }, "vpls"),
-            (IlsSettings { pattern: [17, 1], ..ok.clone() }, "pattern n"),
-            (IlsSettings { method: SplitMethod::Blocks { block: 12 }, ..ok.clone() }, "block size"),
-            (IlsSettings { method: SplitMethod::Compute, ..ok.clone() }, "compute"),
-            (IlsSettings { blur: 5.0, ..ok.clone() }, "blur"),
-            (IlsSettings { clamp_distance: Some(0.0), ..ok.clone() }, "clamp-distance"),
-            (IlsSettings { depth_threshold: -1.0, ..ok.clone() }, "depth-threshold"),
-            (IlsSettings { normal_threshold_deg: 200.0, ..ok.clone() }, "normal-threshold"),
+            (
+                IlsSettings {
+                    vpl_count: 0,
+                    ..ok.clone()
+                },
+                "vpls",
+            ),
+            (
+                IlsSettings {
+                    pattern: [17, 1],
+                    ..ok.clone()
+                },
+                "pattern n",
+            ),
+            (
+                IlsSettings {
+                    method: SplitMethod::Blocks { block: 12 },
+                    ..ok.clone()
+                },
+                "block size",
+            ),
+            (
+                IlsSettings {
+                    method: SplitMethod::Compute,
+                    ..ok.clone()
+                },
+                "compute",
+            ),
+            (
+                IlsSettings {
+                    blur: 5.0,
+                    ..ok.clone()
+                },
+                "blur",
+            ),
+            (
+                IlsSettings {
+                    clamp_distance: Some(0.0),
+                    ..ok.clone()
+                },
+                "clamp-distance",
+            ),
+            (
+                IlsSettings {
+                    depth_threshold: -1.0,
+                    ..ok.clone()
+                },
+                "depth-threshold",
+            ),
+            (
+                IlsSettings {
+                    normal_threshold_deg: 200.0,
+                    ..ok.clone()
+                },
+                "normal-threshold",
+            ),
             (
                 IlsSettings {
                     vpls: Arc::from(vec![GpuVpl::new([0.0; 3], [0.0, 1.0, 0.0], [f32::NAN, 0.0, 0.0])]),
