@@ -542,6 +542,18 @@ pub enum BenchWhat {
     Reflections(BenchReflectionsArgs),
     /// GPU time of any registered technique's passes (`strata techniques`), k = 1 and k layers.
     Technique(BenchTechniqueArgs),
+    /// Interleaved deferred shading (ILS Table 4): per-pass GPU ms of the interleaved frame and
+    /// of the brute force of the same frame (all N VPLs per pixel), and the speed-up.
+    Ils(BenchIlsArgs),
+}
+
+#[derive(Args)]
+pub struct BenchIlsArgs {
+    #[command(flatten)]
+    pub stage: BenchStageArgs,
+    /// Settings of technique `ils` (e.g. --set vpls=480 --set interleave-n=8 --set interleave-m=6).
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 #[derive(Args)]

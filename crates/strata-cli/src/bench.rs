@@ -2,7 +2,7 @@
 //! object or a table.
 
 use anyhow::Result;
-use strata_eval::bench::{ao, deep, gbuffer, radiosity, reference, reflections, technique};
+use strata_eval::bench::{ao, deep, gbuffer, ils, radiosity, reference, reflections, technique};
 use strata_eval::results::{to_json_string, BenchResult, DeepBench, GbufferBench, ReferenceBench, StageBench};
 use strata_render::passes::reflections::ReflectionSettings;
 
@@ -29,6 +29,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             let r = technique::run(&(&b.stage).into(), b.technique, b.preset.as_deref(), &b.set.values)?;
             (BenchResult::Technique(r), b.stage.json)
         }
+        BenchWhat::Ils(b) => (
+            BenchResult::Ils(Box::new(ils::run(&(&b.stage).into(), &b.set.values)?)),
+            b.stage.json,
+        ),
         BenchWhat::Reflections(b) => {
             let rs = ReflectionSettings {
                 steps: b.steps,
@@ -55,6 +59,14 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 .and_then(|v| v.as_str())
                 .unwrap_or("technique");
             print_stage(name, s)
+        }
+        BenchResult::Ils(b) => {
+            print_stage("ils (IS)", &b.interleaved);
+            print_stage("ils (no IS: brute force)", &b.brute_force);
+            println!(
+                "speed-up (ILS Table 4): {:.2}x over the indirect passes, {:.2}x for the shading alone ({} VPL paths)",
+                b.speedup, b.shading_speedup, b.vpls_generated
+            );
         }
     }
     Ok(())

@@ -47,6 +47,8 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
             .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
     }
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    // ILS: VPLs by instant radiosity on the CPU, once per run (static scenes)
+    strata_eval::vpls::add_vpls(&mut settings, &scene, f.scene.frame);
     Ok((scene, cams, settings))
 }
 

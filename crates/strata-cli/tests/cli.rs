@@ -804,7 +804,7 @@ fn techniques_json_lists_settings_defaults_and_ranges() {
     let v = json_of(&strata(&["techniques", "--json"]));
     let ts = v["techniques"].as_array().expect("techniques");
     let names: Vec<&str> = ts.iter().map(|t| t["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["direct", "ao", "full"]);
+    assert_eq!(names, ["direct", "ao", "full", "ils"]);
     let full = &ts[2];
     assert_eq!(
         full["presets"],
@@ -935,4 +935,54 @@ fn render_lists_lights_and_checks_the_camera_index() {
     assert!(out.contains("spot ") && out.contains("cone 15.00°..19.00°") && out.contains("point position (4.000, 3.200, 2.500)"), "{out}");
     let o = strata(&["render", "--scene", "warehouse", "--camera", "0", "--list-lights"]);
     assert_one_line_error(&o, &["--camera 0", "no cameras"]);
+}
+
+/// Issue 11: `strata render --technique ils` generates the VPLs on the CPU and
+/// renders interleaved deferred shading; its debug views and `--set` work, bad
+/// settings are one-line errors; `strata bench ils` reports IS, brute force and
+/// the speed-up.
+#[test]
+fn ils_renders_benches_and_refuses_bad_settings() {
+    let out = scratch("ils.png");
+    let args = |extra: &[&'static str]| {
+        let mut v = vec!["render", "--scene", "cornell", "--technique", "ils", "--width", "48", "--height", "40"];
+        v.extend_from_slice(extra);
+        v.extend(["--out", out.to_str().unwrap(), "--force"]);
+        v.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    for extra in [
+        &[][..],
+        &["--set", "vpls=96", "--set", "interleave-n=4", "--set", "interleave-m=4", "--set", "split-block=16"][..],
+        &["--debug-view", "ils-irradiance-tiled"][..],
+        &["--debug-view", "ils-discontinuity", "--set", "bilinear=0"][..],
+        &["--set", "brute-force=1", "--set", "blur=0"][..],
+    ] {
+        let a = args(extra);
+        let o = strata(&a.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        assert!(out.exists());
+    }
+    for (extra, needles) in [
+        (&["--set", "interleave-m=0"][..], &["interleave-m", "1..=16"][..]),
+        (&["--set", "split-block=12"][..], &["block size 12", "8..=1024"][..]),
+        (&["--set", "vpls=70000"][..], &["vpls", "1..=65536"][..]),
+        (&["--set", "blur=9"][..], &["blur", "0..=4"][..]),
+    ] {
+        let a = args(extra);
+        let o = strata(&a.iter().map(String::as_str).collect::<Vec<_>>());
+        assert_one_line_error(&o, needles);
+    }
+    let v = json_of(&strata(&[
+        "bench", "ils", "--scene", "cornell", "--width", "64", "--height", "48", "--frames", "2", "--layers", "1",
+        "--set", "vpls=96", "--json",
+    ]));
+    assert_eq!(v["bench"], "ils", "{v}");
+    assert!(v["speedup"].as_f64().is_some_and(|x| x > 0.0), "{v}");
+    let names: Vec<&str> = v["brute_force"]["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert!(names.contains(&"ils-brute-force"), "{names:?}");
 }

@@ -168,6 +168,24 @@ pub enum BenchResult {
     Reference(ReferenceBench),
     /// Any registered technique (`strata bench technique`).
     Technique(StageBench),
+    /// Interleaved deferred shading vs its brute force (`strata bench ils`, ILS Table 4).
+    Ils(Box<IlsBench>),
+}
+
+/// `strata bench ils`: ILS Table 4's "IS" and "no IS" columns as GPU times of
+/// the same frame with the same VPLs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IlsBench {
+    /// VPL paths requested (N; the VPLs that hit a surface are shaded).
+    pub vpls_generated: u32,
+    /// Interleaved passes (ils-gbuffer, ils-bs, ils-snsm, ils-bg, ils-db, ils-blur-h/v, compose).
+    pub interleaved: StageBench,
+    /// Brute force (ils-gbuffer, ils-brute-force, compose).
+    pub brute_force: StageBench,
+    /// Brute force's total / the interleaved total (the indirect part of the frame).
+    pub speedup: f64,
+    /// ils-brute-force / ils-snsm: the shading alone.
+    pub shading_speedup: f64,
 }
 
 impl BenchResult {
@@ -181,6 +199,7 @@ impl BenchResult {
             BenchResult::Reflections(_) => "reflections",
             BenchResult::Reference(_) => "reference",
             BenchResult::Technique(_) => "technique",
+            BenchResult::Ils(_) => "ils",
         }
     }
 }

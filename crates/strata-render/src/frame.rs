@@ -185,11 +185,18 @@ impl Targets {
     }
 
     pub fn create(&mut self, gpu: &GpuContext, desc: TargetDesc) {
+        self.create_sized(gpu, desc, [self.width, self.height]);
+    }
+
+    /// A target of its own size (e.g. the tiled sub-buffers of interleaved
+    /// shading, which can be a few texels larger than the frame); read-back and
+    /// debug views show it whole (no guard-band crop).
+    pub fn create_sized(&mut self, gpu: &GpuContext, desc: TargetDesc, [width, height]: [u32; 2]) {
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(desc.name),
             size: wgpu::Extent3d {
-                width: self.width,
-                height: self.height,
+                width,
+                height,
                 depth_or_array_layers: desc.layers,
             },
             mip_level_count: desc.mips,

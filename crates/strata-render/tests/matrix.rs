@@ -10,6 +10,7 @@ mod common;
 
 use strata_render::frame::FrameCameras;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
+use strata_render::passes::ils::GpuVpl;
 use strata_render::technique::registry;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::probes::IrradianceProbes;
@@ -110,6 +111,11 @@ fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
     let (mut runs, mut images) = (0, 0);
     for scene_name in ["cornell", "atrium"] {
         let scene = procedural::builtin(scene_name).expect("built-in scene");
+        let vpls: std::sync::Arc<[GpuVpl]> = strata_reference::Reference::new(&scene, 0.0)
+            .vpls(&Default::default())
+            .iter()
+            .map(|v| GpuVpl::new(v.position.into(), v.normal.into(), v.flux.into()))
+            .collect();
         for t in registry() {
             let presets: Vec<Option<&str>> = if t.presets.is_empty() {
                 vec![None]
@@ -131,6 +137,10 @@ fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
                     let mut s = t.settings(&base, preset).expect("registered presets configure");
                     if s.radiosity.is_some() {
                         s.probes = Some(probes(&scene));
+                    }
+                    if let Some(ils) = &mut s.ils {
+                        // the caller's VPLs, as the probes are (generated once per scene)
+                        ils.vpls = vpls.clone();
                     }
                     let what = format!("{scene_name} {} {} k={layers} {variant}", t.name, preset.unwrap_or("-"));
                     images += check(&gpu, &scene, s, t.passes, &what);

@@ -37,6 +37,8 @@ fn estimate_bounds_what_a_renderer_allocates() {
         ("atrium", "ao", 256, 144, 2),
         ("atrium", "full", 256, 144, 2),
         ("warehouse", "full", 200, 100, 3),
+        ("cornell", "ils", 150, 100, 1),
+        ("atrium", "ils", 256, 144, 2),
     ] {
         let scene = procedural::builtin(scene_name).unwrap();
         let s = settings(technique, w, h, layers);

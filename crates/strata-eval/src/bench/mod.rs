@@ -13,6 +13,7 @@ use crate::stats::median_min;
 pub mod ao;
 pub mod deep;
 pub mod gbuffer;
+pub mod ils;
 pub mod radiosity;
 pub mod reference;
 pub mod reflections;

@@ -32,7 +32,16 @@ pub fn run(
         Ok(s)
     };
     // every error (preset, setting, range) before any GPU work
-    configure(stage.layers)?;
+    let checked = configure(stage.layers)?;
+    // ILS: the caller's VPLs, generated once (static scene)
+    let vpls = match &checked.ils {
+        Some(i) => Some(crate::vpls::scene_vpls(
+            &stage.scene.load()?.0,
+            stage.scene.frame,
+            i.vpl_count,
+        )),
+        None => None,
+    };
     let extra = json!({
         "technique": technique.name,
         "preset": preset.or(technique.presets.first().copied()),
@@ -42,7 +51,13 @@ pub fn run(
     stage::run(Stage {
         stage,
         passes: technique.passes,
-        settings: Box::new(move |layers| configure(layers).expect("checked before the GPU work")),
+        settings: Box::new(move |layers| {
+            let mut s = configure(layers).expect("checked before the GPU work");
+            if let (Some(i), Some(v)) = (&mut s.ils, &vpls) {
+                i.vpls = v.clone();
+            }
+            s
+        }),
         extra,
     })
 }

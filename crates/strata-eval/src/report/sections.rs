@@ -291,6 +291,18 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
         BenchResult::DeepGbuffer(d) => {
             section = deep_section(section, d, dir, prefix)?;
         }
+        BenchResult::Ils(b) => {
+            let caption = format!(
+                "ILS Table 4: speed-up {:.2}x (shading alone {:.2}x)",
+                b.speedup, b.shading_speedup
+            );
+            for (what, s) in [("IS", &b.interleaved), ("no IS (brute force)", &b.brute_force)] {
+                section = section.table(pass_table(
+                    format!("{caption}: {what}"),
+                    &[("", &s.passes, (s.total_median_ms, s.total_min_ms))],
+                ));
+            }
+        }
         BenchResult::Reference(_) => {}
     }
     Ok(vec![section])

@@ -6,6 +6,7 @@ pub(crate) mod builder;
 pub mod compose;
 pub mod deep_gbuffer;
 pub mod depth_mip;
+pub mod ils;
 pub mod interleave;
 pub mod lighting;
 pub mod radiosity;

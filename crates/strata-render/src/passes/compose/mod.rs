@@ -51,12 +51,14 @@ pub struct ComposePass {
 
 impl ComposePass {
     /// `probes`: the static fallback (Fig. 9); AO modulates it when target `ao` exists.
+    /// `indirect`: the target holding E (rgb) and the confidence (a), e.g. `indirect`.
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
         targets: &Targets,
         boost: bool,
         probes: Option<&IrradianceProbes>,
+        indirect: &'static str,
     ) -> Self {
         let use_ao = probes.is_some() && targets.try_get("ao").is_some();
         let u = ComposeUniforms {
@@ -96,10 +98,10 @@ impl ComposePass {
             .read_layer("hdr", 0)
             .read_layer("albedo", 0)
             .read_layer("normal", 0)
-            .read_layer("indirect", 0)
+            .read_layer(indirect, 0)
             .read_layer("csz", 0)
             // without AO the binding is filled by a target that is read anyway
-            .read_layer(if use_ao { "ao" } else { "indirect" }, 0)
+            .read_layer(if use_ao { "ao" } else { indirect }, 0)
             .storage(&probe_buf);
         for t in &OUTPUTS {
             b = b.write(t.name);

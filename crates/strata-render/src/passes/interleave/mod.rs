@@ -315,7 +315,8 @@ impl InterleaveGeometry {
         out
     }
 
-    fn uniforms(&self, padding: [f32; 4]) -> IlsUniforms {
+    /// The `Interleave` uniforms of `common/interleave.wgsl` for this geometry.
+    pub(crate) fn uniforms(&self, padding: [f32; 4]) -> IlsUniforms {
         IlsUniforms {
             size: [self.width, self.height],
             pattern: [self.n, self.m],
@@ -331,7 +332,7 @@ impl InterleaveGeometry {
 /// Mirrors `Interleave` in `common/interleave.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct IlsUniforms {
+pub(crate) struct IlsUniforms {
     size: [u32; 2],
     pattern: [u32; 2],
     tile: [u32; 2],

@@ -1,0 +1,30 @@
+// Virtual point lights of instant radiosity, the light samples of interleaved
+// deferred shading (ILS §6). A VPL at y with unit normal n_y and flux Φ is a
+// cosine emitter; a receiver x with unit normal n_x gets the irradiance-like term
+//   Φ/π · cos θ_y · cos θ_x / d²      (visibility ignored: SNSM, §4.3, §6.2)
+// with the geometry term cos θ_y cos θ_x / d² clamped to `max_geometry` (the
+// usual bound on the 1/d² singularity near a VPL). Multiply by ρ_x/π for the
+// reflected radiance. CPU twin: `strata_reference::Vpl::irradiance_at`.
+// Layout mirrors `passes::ils::GpuVpl` (w components unused).
+
+struct Vpl {
+    position: vec4f,
+    normal: vec4f,
+    flux: vec4f,
+}
+
+fn vpl_irradiance(v: Vpl, x: vec3f, n: vec3f, max_geometry: f32) -> vec3f {
+    let d = x - v.position.xyz;
+    let d2 = dot(d, d);
+    if (!(d2 > 0.0)) {
+        return vec3f(0.0);
+    }
+    let w = d / sqrt(d2);
+    let cos_y = dot(v.normal.xyz, w);
+    let cos_x = -dot(n, w);
+    if (cos_y <= 0.0 || cos_x <= 0.0) {
+        return vec3f(0.0);
+    }
+    let g = min(cos_y * cos_x / d2, max_geometry);
+    return v.flux.rgb * (g * 0.31830988618379067);
+}

@@ -1,0 +1,249 @@
+//! Interleaved deferred shading (ILS §4, §6.2) in the frame: the interleaved
+//! estimate against the brute force (same shading code) and both against the
+//! CPU sum of `strata_reference::Vpl::irradiance_at` over the same G-buffer.
+
+mod common;
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use strata_reference::vpl::{Vpl, VplSettings};
+use strata_reference::Reference;
+use strata_render::frame::FrameCameras;
+use strata_render::passes::ils::{GpuVpl, IlsSettings};
+use strata_render::passes::interleave::{InterleaveGeometry, SplitMethod};
+use strata_render::{GpuContext, RenderSettings, Renderer};
+use strata_scene::{procedural, ImageBuf, Scene};
+
+const W: u32 = 64;
+const H: u32 = 64;
+
+fn vpls(scene: &Scene, n: u32) -> Vec<Vpl> {
+    Reference::new(scene, 0.0).vpls(&VplSettings {
+        paths: n,
+        ..Default::default()
+    })
+}
+
+fn gpu_vpls(v: &[Vpl]) -> Arc<[GpuVpl]> {
+    v.iter()
+        .map(|v| GpuVpl::new(v.position.into(), v.normal.into(), v.flux.into()))
+        .collect()
+}
+
+fn render(gpu: &GpuContext, scene: &Scene, ils: IlsSettings) -> Renderer {
+    let t = strata_render::technique::find("ils").unwrap();
+    let base = RenderSettings {
+        width: W,
+        height: H,
+        ..Default::default()
+    };
+    let mut s = t.settings(&base, None).unwrap();
+    s.ils = Some(ils);
+    let mut r = Renderer::new(gpu, scene, s).expect("renderer builds without validation errors");
+    r.render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0)
+        .expect("frame renders without validation errors");
+    r
+}
+
+/// Largest |a − b| relative to the image's largest value.
+fn max_diff(a: &ImageBuf, b: &ImageBuf) -> (f32, f32) {
+    let scale = b.data.iter().cloned().fold(0.0f32, f32::max);
+    let d = a
+        .data
+        .iter()
+        .zip(&b.data)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f32, f32::max);
+    (d, scale)
+}
+
+fn irradiance(gpu: &GpuContext, r: &Renderer) -> ImageBuf {
+    let img = r.read_target(gpu, "ils-irradiance").unwrap();
+    gpu.check_errors().unwrap();
+    img
+}
+
+fn base(scene: &Scene, v: &[Vpl]) -> IlsSettings {
+    let _ = scene;
+    IlsSettings {
+        vpls: gpu_vpls(v),
+        blur: 0.0,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn one_by_one_pattern_and_all_vpls_per_sub_buffer_equal_the_brute_force() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("cornell").unwrap();
+    let v = vpls(&scene, 480);
+    assert!(v.len() > 300, "{} VPLs", v.len());
+    let brute = irradiance(
+        &gpu,
+        &render(
+            &gpu,
+            &scene,
+            IlsSettings {
+                brute_force: true,
+                ..base(&scene, &v)
+            },
+        ),
+    );
+    assert!(brute.data.iter().any(|&x| x > 0.0), "the VPLs light the box");
+    let cases = [
+        ("1x1", [1, 1], false, SplitMethod::Naive),
+        ("1x1 blocks", [1, 1], false, SplitMethod::Blocks { block: 16 }),
+        ("8x6 all VPLs", [8, 6], true, SplitMethod::Naive),
+        ("3x5 all VPLs blocks", [3, 5], true, SplitMethod::Blocks { block: 8 }),
+    ];
+    for (what, pattern, all, method) in cases {
+        let is = irradiance(
+            &gpu,
+            &render(
+                &gpu,
+                &scene,
+                IlsSettings {
+                    pattern,
+                    all_vpls_per_sub_buffer: all,
+                    method,
+                    ..base(&scene, &v)
+                },
+            ),
+        );
+        let (d, scale) = max_diff(&is, &brute);
+        // same f32 sums in the same order, both stored as f16: equal up to rounding
+        assert!(d <= 1e-3 * scale, "{what}: max |IS − brute force| = {d} (max {scale})");
+    }
+}
+
+/// World position of pixel (x, y) at camera-space depth z (common/camera.wgsl's twin).
+fn world(u: &strata_render::frame::FrameUniforms, x: u32, y: u32, z: f32) -> Vec3 {
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let ndc_x = (x as f32 + 0.5) * u.size[2] * 2.0 - 1.0;
+    let ndc_y = 1.0 - (y as f32 + 0.5) * u.size[3] * 2.0;
+    v(u.eye) + z * (v(u.cam_forward) + v(u.cam_right) * ndc_x + v(u.cam_up) * ndc_y)
+}
+
+/// The GPU's irradiance against the CPU sum over the same surface points and
+/// normals: the brute force against Σ_k, the interleaved 8×6 (no blur)
+/// against (N/N_s) Σ_{k ≡ s mod 48} for each pixel's sub-buffer s.
+#[test]
+fn gpu_vpl_shading_equals_the_cpu_sum() {
+    let gpu = common::gpu();
+    for name in ["cornell", "atrium"] {
+        let scene = procedural::builtin(name).unwrap();
+        let v = vpls(&scene, 480);
+        let ils = base(&scene, &v);
+        let max_g = ils.max_geometry(&scene);
+        for brute_force in [true, false] {
+            let r = render(
+                &gpu,
+                &scene,
+                IlsSettings {
+                    brute_force,
+                    ..ils.clone()
+                },
+            );
+            let gpu_e = irradiance(&gpu, &r);
+            let csz = r.read_target(&gpu, "csz").unwrap();
+            let normals = r.read_normals(&gpu).unwrap();
+            let u = r.frame_uniforms();
+            let geo = InterleaveGeometry::new(W, H, 8, 6, SplitMethod::Naive).unwrap();
+            let n_all = v.len() as u32;
+            let mut cpu = ImageBuf::new(W, H, 3);
+            for y in 0..H {
+                for x in 0..W {
+                    let i = (y * W + x) as usize;
+                    let z = csz.data[i];
+                    if z <= 0.0 {
+                        continue;
+                    }
+                    let p = world(&u, x, y, z);
+                    let n = Vec3::from_slice(&normals.data[i * 3..i * 3 + 3]);
+                    let [si, sj] = geo.sub_buffer(x, y);
+                    let s = sj * 8 + si;
+                    let (first, step) = if brute_force { (0, 1) } else { (s, 48) };
+                    let mut e = Vec3::ZERO;
+                    let mut count = 0;
+                    for k in (first..n_all).step_by(step as usize) {
+                        e += v[k as usize].irradiance_at(p, n, max_g);
+                        count += 1;
+                    }
+                    if count > 0 {
+                        e *= n_all as f32 / count as f32;
+                    }
+                    cpu.data[i * 3..i * 3 + 3].copy_from_slice(&e.to_array());
+                }
+            }
+            // per pixel: |GPU − CPU| ≤ 0.2 % of the pixel's value + 0.02 % of the image's largest
+            // (the GPU stores f16: 0.05 % rounding)
+            let scale = cpu.data.iter().cloned().fold(0.0f32, f32::max);
+            assert!(scale > 0.0, "{name}: the VPLs light the view");
+            let mut worst = 0.0f32;
+            for (i, px) in cpu.data.chunks_exact(3).enumerate() {
+                for (c, &b) in px.iter().enumerate() {
+                    let a = gpu_e.data[i * 4 + c];
+                    let err = (a - b).abs() / (0.002 * b.abs() + 2e-4 * scale);
+                    worst = worst.max(err);
+                    assert!(
+                        err <= 1.0,
+                        "{name} brute force {brute_force}: pixel {i} channel {c}: GPU {a} vs CPU {b} (scale {scale})"
+                    );
+                }
+            }
+            eprintln!("{name} brute force {brute_force}: worst error {worst:.3} of the tolerance (0.2 % + 0.02 % of max {scale:.4})");
+        }
+    }
+}
+
+#[test]
+fn every_ils_view_renders_and_bad_settings_are_one_line_errors() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("cornell").unwrap();
+    let v = vpls(&scene, 96);
+    for bilinear in [false, true] {
+        let r = render(
+            &gpu,
+            &scene,
+            IlsSettings {
+                vpls: gpu_vpls(&v),
+                bilinear,
+                ..Default::default()
+            },
+        );
+        let names = r.debug_view_names();
+        for view in [
+            "ils-split-normal",
+            "ils-split-csz",
+            "ils-gbuffer-split",
+            "ils-irradiance-tiled",
+            "ils-irradiance",
+            "ils-discontinuity",
+            "indirect",
+            "hdr-full",
+        ] {
+            assert!(names.iter().any(|n| n == view), "{view} in {names:?}");
+            let img = r.debug_view(&gpu, view, false).unwrap();
+            assert!(img.data.iter().all(|x| x.is_finite()), "{view}");
+        }
+        // the tiled buffer is (8·⌈64/8⌉) × (6·⌈64/6⌉) = 64 × 66
+        let t = r.debug_view(&gpu, "ils-irradiance-tiled", false).unwrap();
+        assert_eq!((t.width, t.height), (64, 66));
+        gpu.check_errors().unwrap();
+    }
+    let t = strata_render::technique::find("ils").unwrap();
+    let mut s = t.settings(&RenderSettings::default(), None).unwrap();
+    let e = t.set(&mut s, "interleave-n", 17.0).unwrap_err().to_string();
+    assert!(e.contains("interleave-n") && e.contains("1..=16"), "{e}");
+    t.set(&mut s, "split-block", 12.0).unwrap();
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("block size") && !e.contains('\n'), "{e}");
+    let mut s = t.settings(&RenderSettings::default(), None).unwrap();
+    s.radiosity = Some(Default::default());
+    let e = Renderer::new(&gpu, &scene, s)
+        .err()
+        .expect("ils + radiosity refused")
+        .to_string();
+    assert!(e.contains("ils") && e.contains("radiosity"), "{e}");
+}
