@@ -157,7 +157,14 @@ pub fn parse_set(kv: &str) -> Result<(String, f64), String> {
     let v: f64 = value
         .trim()
         .parse()
-        .map_err(|_| format!("--set {kv}: '{value}' is not a number"))?;
+        .ok()
+        .or_else(|| strata_render::technique::named_value(name.trim(), value))
+        .ok_or_else(|| {
+            format!(
+                "--set {kv}: '{value}' is not a number (nor a named value of '{}')",
+                name.trim()
+            )
+        })?;
     Ok((name.trim().to_string(), v))
 }
 
@@ -331,7 +338,8 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub gpu: GpuArgs,
     /// Registered technique to compare (`strata techniques`): its eval kind picks the reference —
-    /// `ao` against ray-traced obscurance and binary AO, `full` (alias `gi`) against the path tracer.
+    /// `ao` against ray-traced obscurance and binary AO, `full` (alias `gi`) against the path tracer,
+    /// `ils` against the brute force of the same VPLs and the one-bounce path tracer (`--bounces` ignored: 1).
     #[arg(long, default_value = "ao", value_parser = parse_eval_technique)]
     pub technique: &'static strata_render::technique::Technique,
     #[command(flatten)]
@@ -380,6 +388,9 @@ pub struct EvalArgs {
     /// Hide progress bars.
     #[arg(long)]
     pub quiet: bool,
+    /// --technique ils: its settings (e.g. --set vpls=480 --set shadows=vpl).
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 #[derive(Args)]

@@ -2,7 +2,7 @@
 //! one JSON object or a line of numbers.
 
 use anyhow::Result;
-use strata_eval::eval::{ao, gi, EvalSettings};
+use strata_eval::eval::{ao, gi, ils, EvalSettings};
 use strata_eval::results::{to_json_string, EvalResult};
 
 use strata_render::technique::EvalKind;
@@ -12,7 +12,11 @@ use crate::args::EvalArgs;
 pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
     // the registry's eval kind picks the comparison
+    if !a.set.values.is_empty() && a.technique.eval != EvalKind::VplRadiance {
+        anyhow::bail!("--set is only read by --technique ils in eval (ao and gi have their own flags)");
+    }
     let result = match a.technique.eval {
+        EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values)?),
         EvalKind::AmbientVisibility => EvalResult::Ao(ao::run(&s, &a.ao.settings())?),
         EvalKind::None => unreachable!("the argument parser admits only comparable techniques"),
         EvalKind::Radiance => {
@@ -53,6 +57,15 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             println!(
                 "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces, noise FLIP {:.4} indirect / {:.4} full)",
                 run.scene, i.flip, i.rmse, i.mae, f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
+            );
+        }
+        EvalResult::Ils(e) => {
+            let (i, f) = (&e.errors.indirect, &e.errors.full);
+            println!(
+                "{} ils {} {} VPLs shadows={} {w}x{h}: vs brute force FLIP {:.4} RMSE {:.4} (indirect FLIP {:.4} RMSE {:.4}); vs path tracer indirect FLIP {:.4} RMSE {:.4}, full FLIP {:.4} RMSE {:.4} (brute force: indirect FLIP {:.4}, full FLIP {:.4}; reference {} spp, 1 bounce, noise FLIP {:.4})",
+                run.scene, e.pattern, e.vpls, e.shadows, e.flip_vs_brute, e.rmse_vs_brute, e.indirect_flip_vs_brute,
+                e.indirect_rmse_vs_brute, i.flip, i.rmse, f.flip, f.rmse, e.brute_force.indirect.flip,
+                e.brute_force.full.flip, run.ref_spp, noise(i)
             );
         }
     }

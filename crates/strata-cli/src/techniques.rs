@@ -32,7 +32,7 @@ pub fn technique_json(t: &Technique) -> Result<serde_json::Value> {
         .map(|i| {
             serde_json::json!({
                 "name": i.name, "doc": i.doc, "default": (i.get)(&defaults).map(tidy),
-                "integer": i.integer, "range": range_json(i.range),
+                "integer": i.integer, "range": range_json(i.range), "values": i.values,
             })
         })
         .collect();

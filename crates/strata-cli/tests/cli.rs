@@ -334,7 +334,10 @@ fn eval_ao_prints_errors_and_caches_the_reference() {
     // 16 spp cannot reach the default ꟻLIP 0.02 between the halves: the run says so
     assert_eq!(v["ref_noise"]["converged"], false);
     let warnings = v["warnings"].as_array().expect("warnings");
-    assert!(warnings.iter().any(|w| w.as_str().unwrap().contains("--ref-spp cap")), "{warnings:?}");
+    assert!(
+        warnings.iter().any(|w| w.as_str().unwrap().contains("--ref-spp cap")),
+        "{warnings:?}"
+    );
     for key in ["flip", "rmse", "mae", "flicker"] {
         let x = v[key].as_f64().unwrap_or_else(|| panic!("{key} missing: {v}"));
         assert!((0.0..1.0).contains(&x), "{key} = {x}");
@@ -381,10 +384,28 @@ fn eval_rejects_out_of_range_parameters() {
     ]);
     assert_one_line_error(&o, &["alpha", "[0, 1)"]);
     let o = strata(&[
-        "eval", "--scene", "plane", "--ref-noise", "1.5", "--width", "16", "--height", "16",
+        "eval",
+        "--scene",
+        "plane",
+        "--ref-noise",
+        "1.5",
+        "--width",
+        "16",
+        "--height",
+        "16",
     ]);
     assert_one_line_error(&o, &["--ref-noise", "[0, 1)"]);
-    let o = strata(&["eval", "--scene", "plane", "--ref-spp", "1", "--width", "16", "--height", "16"]);
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "plane",
+        "--ref-spp",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ]);
     assert_one_line_error(&o, &["--ref-spp", "2..=65536"]);
 }
 
@@ -932,7 +953,12 @@ fn render_lists_lights_and_checks_the_camera_index() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     assert!(out.contains("lights of 'warehouse': 2"), "{out}");
-    assert!(out.contains("spot ") && out.contains("cone 15.00°..19.00°") && out.contains("point position (4.000, 3.200, 2.500)"), "{out}");
+    assert!(
+        out.contains("spot ")
+            && out.contains("cone 15.00°..19.00°")
+            && out.contains("point position (4.000, 3.200, 2.500)"),
+        "{out}"
+    );
     let o = strata(&["render", "--scene", "warehouse", "--camera", "0", "--list-lights"]);
     assert_one_line_error(&o, &["--camera 0", "no cameras"]);
 }
@@ -945,14 +971,33 @@ fn render_lists_lights_and_checks_the_camera_index() {
 fn ils_renders_benches_and_refuses_bad_settings() {
     let out = scratch("ils.png");
     let args = |extra: &[&'static str]| {
-        let mut v = vec!["render", "--scene", "cornell", "--technique", "ils", "--width", "48", "--height", "40"];
+        let mut v = vec![
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "ils",
+            "--width",
+            "48",
+            "--height",
+            "40",
+        ];
         v.extend_from_slice(extra);
         v.extend(["--out", out.to_str().unwrap(), "--force"]);
         v.iter().map(|s| s.to_string()).collect::<Vec<_>>()
     };
     for extra in [
         &[][..],
-        &["--set", "vpls=96", "--set", "interleave-n=4", "--set", "interleave-m=4", "--set", "split-block=16"][..],
+        &[
+            "--set",
+            "vpls=96",
+            "--set",
+            "interleave-n=4",
+            "--set",
+            "interleave-m=4",
+            "--set",
+            "split-block=16",
+        ][..],
         &["--debug-view", "ils-irradiance-tiled"][..],
         &["--debug-view", "ils-discontinuity", "--set", "bilinear=0"][..],
         &["--set", "brute-force=1", "--set", "blur=0"][..],
@@ -985,4 +1030,94 @@ fn ils_renders_benches_and_refuses_bad_settings() {
         .map(|p| p["name"].as_str().unwrap())
         .collect();
     assert!(names.contains(&"ils-brute-force"), "{names:?}");
+}
+
+/// Issue 11: `strata eval --technique ils` compares the interleaved image with
+/// the brute force of the same VPLs and with the one-bounce path tracer (low
+/// `--ref-spp` cap: the numbers are only checked to exist and be sane); `eval
+/// ao` and `eval gi` keep refusing `--set`; bad settings are one-line errors.
+#[test]
+fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
+    let cache = scratch("ils-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let base = [
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        "ils",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--ref-spp",
+        "4",
+        "--json",
+        "--quiet",
+        "--cache",
+    ];
+    let run = |extra: &[&str]| {
+        let mut a: Vec<&str> = base.to_vec();
+        a.push(cache.to_str().unwrap());
+        a.extend_from_slice(extra);
+        strata(&a)
+    };
+    let v = json_of(&run(&["--set", "vpls=96"]));
+    assert_eq!(v["technique"], "ils", "{v}");
+    assert_eq!(v["shadows"], "none");
+    assert_eq!(v["pattern"], "8x6");
+    for key in [
+        "flip_vs_brute",
+        "rmse_vs_brute",
+        "indirect_flip_vs_brute",
+        "indirect_rmse_vs_brute",
+    ] {
+        assert!(v[key].as_f64().is_some_and(|x| (0.0..1.0).contains(&x)), "{key}: {v}");
+    }
+    for key in ["flip", "rmse", "mae"] {
+        assert!(v[key].as_f64().is_some_and(|x| x >= 0.0), "{key}: {v}");
+        assert!(v["full"][key].as_f64().is_some_and(|x| x >= 0.0), "full.{key}: {v}");
+        assert!(
+            v["brute_force"][key].as_f64().is_some_and(|x| x >= 0.0),
+            "brute_force.{key}: {v}"
+        );
+    }
+    assert!(
+        v["reference"].as_str().unwrap().contains("SNSM ignores VPL visibility"),
+        "{v}"
+    );
+    assert_eq!(v["ref_spp"], 4);
+    // a 1x1 pattern is the brute force
+    let v = json_of(&run(&[
+        "--set",
+        "vpls=96",
+        "--set",
+        "interleave-n=1",
+        "--set",
+        "interleave-m=1",
+        "--set",
+        "blur=0",
+    ]));
+    assert!(v["flip_vs_brute"].as_f64().unwrap() < 0.01, "{v}");
+    for (extra, needles) in [
+        (&["--set", "interleave-n=20"][..], &["interleave-n", "1..=16"][..]),
+        (&["--set", "shadows=maybe"][..], &["shadows", "maybe"][..]),
+        (&["--layers", "2"][..], &["--layers", "must be 1"][..]),
+    ] {
+        assert_one_line_error(&run(extra), needles);
+    }
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "plane",
+        "--technique",
+        "ao",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--set",
+        "vpls=3",
+    ]);
+    assert_one_line_error(&o, &["--set", "ils"]);
 }

@@ -320,12 +320,45 @@ pub struct GiEval {
     pub by_layers: Vec<ByLayers<GiErrors>>,
 }
 
+/// Interleaved deferred shading (ILS §4, §6.2) against the brute force of the same VPLs and
+/// against the one-bounce path tracer.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IlsEval {
+    #[serde(flatten)]
+    pub run: EvalRun,
+    /// VPL light paths requested (N) and VPLs shaded (the paths that hit a surface).
+    pub vpl_paths: u32,
+    pub vpls: u32,
+    /// n×m.
+    pub pattern: String,
+    pub split: String,
+    pub blur: f32,
+    pub bilinear: bool,
+    /// `none` (SNSM: VPL visibility ignored) or `vpl` (SSM: per-VPL shadow maps, §4.3).
+    pub shadows: String,
+    /// Full image vs the brute force (every pixel, all N VPLs, same shadows): ꟻLIP and RMSE of
+    /// the tonemapped sRGB display values.
+    pub flip_vs_brute: f32,
+    pub rmse_vs_brute: f32,
+    /// The indirect part (composed − direct) alone vs the brute force's, tonemapped.
+    pub indirect_flip_vs_brute: f32,
+    pub indirect_rmse_vs_brute: f32,
+    /// Against the path tracer with one indirect bounce: `flip`, `rmse`, `mae` of the indirect
+    /// light (top level) and of the full image (`full`).
+    #[serde(flatten)]
+    pub errors: GiErrors,
+    /// The brute force against the same path tracer (what the interleaving itself adds is the
+    /// difference).
+    pub brute_force: GiErrors,
+}
+
 /// Any evaluation's result, tagged by `"technique"`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "technique", rename_all = "lowercase")]
 pub enum EvalResult {
     Ao(AoEval),
     Gi(GiEval),
+    Ils(IlsEval),
 }
 
 impl EvalResult {
@@ -333,6 +366,7 @@ impl EvalResult {
         match self {
             EvalResult::Ao(e) => &e.run,
             EvalResult::Gi(e) => &e.run,
+            EvalResult::Ils(e) => &e.run,
         }
     }
 }

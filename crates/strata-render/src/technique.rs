@@ -4,7 +4,7 @@
 //! iterate [`registry`]; a new technique adds one entry here and its own module.
 
 use crate::passes::interleave::SplitMethod;
-use crate::passes::{ao::AoSettings, ils::IlsSettings, radiosity, reflections::ReflectionSettings};
+use crate::passes::{ao::AoSettings, ils::IlsSettings, ils::VplShadows, radiosity, reflections::ReflectionSettings};
 use crate::{RenderError, RenderSettings};
 
 /// How `eval` compares a technique's output with the CPU reference.
@@ -16,6 +16,8 @@ pub enum EvalKind {
     AmbientVisibility,
     /// Radiance against the path tracer.
     Radiance,
+    /// VPL radiance (ILS): against the brute force of the same VPLs and the one-bounce path tracer.
+    VplRadiance,
 }
 
 impl EvalKind {
@@ -24,6 +26,7 @@ impl EvalKind {
             EvalKind::None => "none",
             EvalKind::AmbientVisibility => "ambient-visibility",
             EvalKind::Radiance => "radiance",
+            EvalKind::VplRadiance => "vpl-radiance",
         }
     }
 }
@@ -75,6 +78,28 @@ pub struct SettingInfo {
     pub integer: bool,
     pub get: fn(&RenderSettings) -> Option<f64>,
     pub set: fn(&mut RenderSettings, f64),
+    /// Names of the values 0, 1, … where the setting is a choice (`--set shadows=vpl`); empty otherwise.
+    pub values: &'static [&'static str],
+}
+
+impl SettingInfo {
+    /// The value `text` names: a number, or one of [`SettingInfo::values`].
+    pub fn parse_value(&self, text: &str) -> Option<f64> {
+        let t = text.trim();
+        t.parse()
+            .ok()
+            .or_else(|| self.values.iter().position(|v| *v == t).map(|i| i as f64))
+    }
+}
+
+/// `NAME=TEXT` of a setting whose values have names: the number `TEXT` stands for in any
+/// registered technique (`None`: no setting `name` names `text`).
+pub fn named_value(name: &str, text: &str) -> Option<f64> {
+    registry()
+        .iter()
+        .flat_map(|t| t.setting_list())
+        .filter(|i| i.name == name && !i.values.is_empty())
+        .find_map(|i| i.parse_value(text))
 }
 
 macro_rules! setting {
@@ -86,6 +111,7 @@ macro_rules! setting {
             integer: $int,
             get: |$s: &RenderSettings| $get,
             set: |$t: &mut RenderSettings, $v: f64| $set,
+            values: &[],
         }
     };
 }
@@ -291,7 +317,30 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 12] = [
+static ILS_SETTINGS: [SettingInfo; 14] = [
+    SettingInfo {
+        name: "shadows",
+        doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(ils_of(s).shadows as u32 as f64),
+        set: |s, v| {
+            ils_mut(s).shadows = if v == 0.0 {
+                VplShadows::None
+            } else {
+                VplShadows::ShadowMaps
+            }
+        },
+        values: &["none", "vpl"],
+    },
+    setting!(
+        "vpl-shadow-resolution",
+        "texels per side of each cube face of a VPL's shadow map (shadows = vpl; 6 faces per VPL)",
+        Range::Closed(8.0, 512.0),
+        true,
+        |s| Some(ils_of(s).vpl_shadow_resolution as f64),
+        |s, v| ils_mut(s).vpl_shadow_resolution = v as u32
+    ),
     setting!(
         "vpls",
         "VPLs N the caller generates by instant radiosity (ILS Table 4: 480)",
@@ -598,11 +647,11 @@ static REGISTRY: [Technique; 4] = [
     Technique {
         name: "ils",
         doc:
-            "direct + interleaved deferred shading of one-bounce VPLs, no VPL visibility (ILS §4, §6.2; 480 VPLs, 8x6)",
+            "direct + interleaved deferred shading of one-bounce VPLs (ILS §4, §6.2; 480 VPLs, 8x6), VPL visibility: none (SNSM) or shadow maps (SSM, §4.3)",
         output: "hdr-full",
         display: ("ldr", true),
-        // not yet wired into `eval` (it would need the caller's VPLs there)
-        eval: EvalKind::None,
+        // against the brute force of the same VPLs and the one-bounce path tracer
+        eval: EvalKind::VplRadiance,
         presets: &[],
         passes: ILS_PASSES,
         settings: &[&DIRECT_SETTINGS, &ILS_SETTINGS],

@@ -176,7 +176,7 @@ fn render_settings(s: &EvalSettings, layers: u32, radiosity: &RadiositySettings)
 
 /// Renders `renders` frames at the fixed `camera` (bounces and temporal history converge) and
 /// returns the composed image and its indirect part (composed − direct), RGB.
-fn render_indirect(
+pub(crate) fn render_indirect(
     r: &mut Renderer,
     gpu: &GpuContext,
     scene: &Scene,
@@ -211,7 +211,7 @@ fn channels3(img: &ImageBuf, first: usize) -> ImageBuf {
 }
 
 /// Direct + indirect of a 6-channel GI estimate (`Estimator::Gi`).
-fn total(img: &ImageBuf) -> ImageBuf {
+pub(crate) fn total(img: &ImageBuf) -> ImageBuf {
     let mut out = channels3(img, 0);
     for (o, i) in out.data.iter_mut().zip(channels3(img, 3).data) {
         *o += i;
@@ -220,7 +220,7 @@ fn total(img: &ImageBuf) -> ImageBuf {
 }
 
 /// The indirect part of a 6-channel GI estimate.
-fn indirect(img: &ImageBuf) -> ImageBuf {
+pub(crate) fn indirect(img: &ImageBuf) -> ImageBuf {
     channels3(img, 3)
 }
 

@@ -1,6 +1,7 @@
 //! Evaluations: a GPU technique against the CPU ground truth for the same camera and pixel
 //! centres ([`ao`]: deep-G-buffer AO against the ray-traced obscurance; [`gi`]: deep-G-buffer
-//! radiosity against the path tracer), with temporal flicker along the camera path
+//! radiosity against the path tracer; [`ils`]: interleaved VPL shading against its brute force
+//! and the one-bounce path tracer), with temporal flicker along the camera path
 //! ([`flicker`]) and an HTML report. What both share is here.
 
 use std::path::PathBuf;
@@ -20,6 +21,7 @@ use crate::scene::SceneSpec;
 
 pub mod ao;
 pub mod gi;
+pub mod ils;
 
 /// What every evaluation takes.
 #[derive(Clone, Debug)]

@@ -100,6 +100,16 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
                 e.fig10.as_ref(),
             )
         }
+        EvalResult::Ils(e) => (
+            "interleaved VPL shading against the one-bounce path tracer",
+            &GI_HEADER[..],
+            vec![ErrorRow {
+                layers: 1,
+                cells: [stats_cells(&e.errors.indirect), stats_cells(&e.errors.full)].concat(),
+                flip_mae: (e.errors.indirect.flip, e.errors.indirect.mae),
+            }],
+            None,
+        ),
     };
     let mut errors = Table::new(format!("Errors by layer count ({what})"), header);
     for r in &rows {
@@ -118,6 +128,7 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         "layers_1",
         "by_layers",
         "fig10",
+        "brute_force",
         "flicker_per_frame",
         "ref_noise",
         "outliers",
@@ -173,6 +184,7 @@ fn reference_table(r: &EvalResult) -> Table {
     let named: Vec<(&str, &ErrorStats)> = match r {
         EvalResult::Ao(e) => vec![("obscurance", &e.errors.obscurance), ("binary AO", &e.errors.binary)],
         EvalResult::Gi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
+        EvalResult::Ils(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
     };
     for (name, e) in named {
         let Some(n) = e.ref_noise else { continue };
@@ -194,6 +206,7 @@ fn technique(r: &EvalResult) -> &'static str {
     match r {
         EvalResult::Ao(_) => "eval ao",
         EvalResult::Gi(_) => "eval gi",
+        EvalResult::Ils(_) => "eval ils",
     }
 }
 

@@ -82,6 +82,31 @@ impl GpuVpl {
     }
 }
 
+/// VPL visibility in the shading (ILS §4.3).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VplShadows {
+    /// SNSM: visibility ignored (§6.2's interactive mode).
+    #[default]
+    None,
+    /// SSM: one omnidirectional shadow map per VPL (six cube faces, `crate::lights`' face
+    /// code), the hemisphere above the VPL looked up per receiver (§4.3, §6.3).
+    ShadowMaps,
+}
+
+impl VplShadows {
+    pub fn name(self) -> &'static str {
+        match self {
+            VplShadows::None => "none",
+            VplShadows::ShadowMaps => "vpl",
+        }
+    }
+
+    /// Whether the VPLs' visibility is part of the shading.
+    pub fn traced(self) -> bool {
+        self == VplShadows::ShadowMaps
+    }
+}
+
 /// Settings of interleaved deferred shading. Defaults: ILS Table 4 / Fig. 9
 /// (480 VPLs, 8×6 pattern), Fig. 4 b's bilinear blur with a kernel matched to
 /// the pattern.
@@ -120,6 +145,10 @@ pub struct IlsSettings {
     pub depth_threshold: f32,
     /// DB: … or when the normals differ by more than this (degrees, 0..=180).
     pub normal_threshold_deg: f32,
+    /// VPL visibility: SNSM (none) or SSM (per-VPL shadow maps).
+    pub shadows: VplShadows,
+    /// SSM: texels per side of each of a VPL's six cube faces, 8..=512.
+    pub vpl_shadow_resolution: u32,
 }
 
 impl Default for IlsSettings {
@@ -137,6 +166,8 @@ impl Default for IlsSettings {
             per_axis_discontinuities: false,
             depth_threshold: 0.02,
             normal_threshold_deg: 25.0,
+            shadows: VplShadows::None,
+            vpl_shadow_resolution: 64,
         }
     }
 }
@@ -183,6 +214,15 @@ impl IlsSettings {
                 "normal-threshold {} is out of range: must be in 0..=180",
                 self.normal_threshold_deg
             ));
+        }
+        if !(8..=512).contains(&self.vpl_shadow_resolution) {
+            return Err(format!(
+                "vpl-shadow-resolution {} is out of range: must be in 8..=512",
+                self.vpl_shadow_resolution
+            ));
+        }
+        if self.shadows == VplShadows::ShadowMaps {
+            return Err("shadows vpl is not available yet".into());
         }
         for (k, v) in self.vpls.iter().enumerate() {
             let finite = v.position.iter().chain(&v.normal).chain(&v.flux).all(|c| c.is_finite());

@@ -1,0 +1,165 @@
+//! Interleaved deferred shading (ILS §4, §6.2; `--technique ils`) measured twice:
+//!
+//! - against the **brute force of the same VPLs** (every pixel shades all N; Table 4's
+//!   "no IS"): what interleaving + the §4.5 blur cost in quality (`flip_vs_brute`,
+//!   `rmse_vs_brute` on the tonemapped images, full and indirect alone);
+//! - against the **path tracer with one indirect bounce** (the converged, cached GI
+//!   reference of `eval gi` with `--bounces 1`: light → surface → surface → eye is
+//!   exactly one VPL bounce). With `shadows = none` (SNSM) the VPLs' visibility is
+//!   ignored, so that distance includes the missing-occlusion bias; `shadows = vpl`
+//!   (SSM, §4.3) removes most of it.
+
+use anyhow::{bail, Result};
+use strata_reference::gi::GiSettings;
+use strata_reference::{Estimator, Reference};
+use strata_render::passes::lighting::LightingSettings;
+use strata_render::technique;
+use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+use strata_scene::ImageBuf;
+
+use super::gi::{indirect, render_indirect, total, DEFAULT_CAP};
+use super::{half_flip, noise_warnings, write_report, EvalSettings, RefImage};
+use crate::cache::{scene_fingerprint, RefCache};
+use crate::metrics::{compare, compare_radiance, display};
+use crate::results::{EvalResult, GiErrors, IlsEval};
+
+/// `set`: the `ils` technique's settings (`vpls`, `interleave-n`, `shadows`, …), applied last
+/// and range-checked; the brute force is the same with `brute-force = 1`.
+pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<IlsEval> {
+    let rule = s.check(DEFAULT_CAP, 8)?;
+    if s.deep.layers != 1 {
+        bail!(
+            "--layers {} is out of range for --technique ils: must be 1 (ILS shades layer 0)",
+            s.deep.layers
+        );
+    }
+    if s.frames.is_some() {
+        bail!("--frames is not available for --technique ils (static VPLs: no temporal filter to measure)");
+    }
+    let t = technique::find("ils")?;
+    let configure = |brute: bool| -> Result<RenderSettings> {
+        let base = RenderSettings {
+            // the reference is Lambertian
+            lighting: LightingSettings {
+                specular: false,
+                ..Default::default()
+            },
+            ..s.render_settings(1)
+        };
+        let mut r = t.settings(&base, None)?;
+        for (name, value) in set {
+            t.set(&mut r, name, *value)
+                .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+        }
+        if brute {
+            t.set(&mut r, "brute-force", 1.0)?;
+        }
+        r.validate()?;
+        Ok(r)
+    };
+    let (is_settings, brute_settings) = (configure(false)?, configure(true)?);
+    let ils = is_settings.ils.clone().expect("the ils technique turns ILS on");
+
+    let (mut scene, cams) = s.scene.load()?;
+    // as `eval gi`: the reference has no ambient term and the VPLs carry no sky light
+    scene.settings.ambient = [0.0; 3];
+    scene.settings.sky = [0.0; 3];
+    let (w, h) = (s.scene.width, s.scene.height);
+    let camera = cams.current;
+    let exposure = scene.settings.exposure;
+
+    // One indirect bounce = one VPL bounce (§6.2); the same cache entry as `eval gi --bounces 1`.
+    let estimator = Estimator::Gi(GiSettings {
+        bounces: 1,
+        russian_roulette: false,
+        ..Default::default()
+    });
+    let cache = RefCache::new(&s.cache);
+    let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
+    let description = format!(
+        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
+        scene_fingerprint(&scene, s.scene.frame)
+    );
+    let shown = |img: &ImageBuf| display(img, exposure);
+    let converged = cache.converged(s.no_cache, &description, &estimator, || {
+        reference.converge(&camera, w, h, &estimator, &rule, |a, b| {
+            half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown))
+        })
+    });
+    let ref_total = RefImage::of(&converged, total, shown)?;
+    let ref_indirect = RefImage::of(&converged, indirect, shown)?;
+
+    // one set of VPLs for both GPU images (static scene: generated once)
+    let vpls = crate::vpls::scene_vpls(&scene, s.scene.frame, ils.vpl_count);
+    let gpu = GpuContext::new(&GpuOptions {
+        adapter: s.adapter.clone(),
+    })?;
+    let render = |mut rs: RenderSettings| -> Result<(ImageBuf, ImageBuf)> {
+        if let Some(i) = &mut rs.ils {
+            i.vpls = vpls.clone();
+        }
+        let mut r = Renderer::new(&gpu, &scene, rs)?;
+        let out = render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, 1)?;
+        gpu.check_errors()?;
+        Ok(out)
+    };
+    let (full, ind) = render(is_settings)?;
+    let (brute_full, brute_ind) = render(brute_settings)?;
+
+    let vs_reference = |full: &ImageBuf, ind: &ImageBuf| -> Result<GiErrors> {
+        let (f, _) = compare_radiance(&ref_total.image, full, exposure)?;
+        let (i, _) = compare_radiance(&ref_indirect.image, ind, exposure)?;
+        Ok(GiErrors {
+            full: ref_total.annotate(f, &display(full, exposure)),
+            indirect: ref_indirect.annotate(i, &display(ind, exposure)),
+        })
+    };
+    let errors = vs_reference(&full, &ind)?;
+    let brute_force = vs_reference(&brute_full, &brute_ind)?;
+    // vs the brute force: ꟻLIP and RMSE of the tonemapped display values
+    let (vs_brute, _) = compare(&display(&brute_full, exposure), &display(&full, exposure))?;
+    let (vs_brute_ind, _) = compare(&display(&brute_ind, exposure), &display(&ind, exposure))?;
+
+    let shadows = ils.shadows.name();
+    let reference_text = format!(
+        "path-traced diffuse GI with 1 indirect bounce (= one VPL bounce, ILS §6.2), sky and ambient off; {}",
+        if ils.shadows.traced() {
+            "SSM: VPL visibility from per-VPL shadow maps (§4.3), so the distance to the path tracer is \
+             interleaving, blur, VPL sampling, the geometry-term clamp and shadow-map error"
+        } else {
+            "SNSM ignores VPL visibility, so the distance to the path tracer includes that bias \
+             (light through occluders) besides interleaving, blur, VPL sampling and the geometry-term clamp"
+        }
+    );
+    let out = IlsEval {
+        run: s.run_info(
+            converged.spp(),
+            &reference_text,
+            gpu.describe(),
+            None,
+            noise_warnings(&[("ils indirect", &errors.indirect), ("ils full", &errors.full)]),
+        ),
+        vpl_paths: ils.vpl_count,
+        vpls: vpls.len() as u32,
+        pattern: format!("{}x{}", ils.pattern[0], ils.pattern[1]),
+        split: ils.method.name().to_string(),
+        blur: ils.blur,
+        bilinear: ils.bilinear,
+        shadows: shadows.into(),
+        flip_vs_brute: vs_brute.flip,
+        rmse_vs_brute: vs_brute.rmse,
+        indirect_flip_vs_brute: vs_brute_ind.flip,
+        indirect_rmse_vs_brute: vs_brute_ind.rmse,
+        errors,
+        brute_force,
+    };
+    if let Some(dir) = &s.report {
+        write_report(
+            dir,
+            format!("strata eval: ILS on {}", s.scene.scene),
+            &EvalResult::Ils(out.clone()),
+            Vec::new(),
+        )?;
+    }
+    Ok(out)
+}
