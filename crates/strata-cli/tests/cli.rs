@@ -1042,6 +1042,10 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
         "{v}"
     );
     assert_eq!(v["ref_spp"], 4);
+    // §4.3 SSM: per-VPL shadow maps, named value on --set
+    let v = json_of(&run(&["--set", "vpls=48", "--set", "shadows=vpl", "--set", "vpl-shadow-resolution=16"]));
+    assert_eq!(v["shadows"], "vpl", "{v}");
+    assert!(v["reference"].as_str().unwrap().contains("SSM"), "{v}");
     // a 1x1 pattern is the brute force
     let v = json_of(&run(&[
         "--set",
@@ -1057,6 +1061,7 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
     for (extra, needles) in [
         (&["--set", "interleave-n=20"][..], &["interleave-n", "1..=16"][..]),
         (&["--set", "shadows=maybe"][..], &["shadows", "maybe"][..]),
+        (&["--set", "vpl-shadow-resolution=4"][..], &["vpl-shadow-resolution", "8..=512"][..]),
         (&["--layers", "2"][..], &["--layers", "must be 1"][..]),
     ] {
         assert_one_line_error(&run(extra), needles);

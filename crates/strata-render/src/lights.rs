@@ -208,7 +208,7 @@ fn perspective_shadow(pos: Vec3, dir: Vec3, fov: f32, scene_radius: f32, scene_c
 
 /// View-projection of face `face` (of [`CUBE_FACES`]) of a point light's
 /// shadow map: a [`CUBE_FACE_FOV_DEG`] perspective along the face's axis.
-fn cube_face_matrix(pos: Vec3, face: usize, scene_radius: f32, scene_center: Vec3) -> Mat4 {
+pub(crate) fn cube_face_matrix(pos: Vec3, face: usize, scene_radius: f32, scene_center: Vec3) -> Mat4 {
     let axis = CUBE_FACES[face];
     let (view, proj) = perspective_shadow(pos, axis, CUBE_FACE_FOV_DEG.to_radians(), scene_radius, scene_center);
     proj * view

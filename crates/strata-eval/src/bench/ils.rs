@@ -6,7 +6,7 @@
 
 use anyhow::Result;
 use serde_json::json;
-use strata_render::passes::ils::{BRUTE_FORCE_PASS, PASSES};
+use strata_render::passes::ils::BRUTE_FORCE_PASS;
 use strata_render::technique;
 
 use super::stage::{self, Stage, StageSettings};
@@ -49,25 +49,37 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<IlsBench> {
         "split": ils.method.name(),
         "blur": ils.blur,
         "bilinear": ils.bilinear,
+        "shadows": ils.shadows.name(),
     });
     let brute = configure(true)?;
+    // the frames' own pass lists (with `shadows = vpl`: ils-vpl-shadows, ils-ssm)
+    let is_passes = ils.passes();
+    // "no IS" (Table 4): the brute force's own passes, its DB and blur not counted
+    let brute_passes: Vec<&str> = brute
+        .ils
+        .as_ref()
+        .expect("ILS is on")
+        .passes()
+        .into_iter()
+        .filter(|p| !p.starts_with("ils-db") && !p.starts_with("ils-blur"))
+        .collect();
     let (w1, w2) = (with_vpls.clone(), with_vpls);
     let interleaved = stage::run(Stage {
         stage: &stage1,
-        passes: PASSES,
+        passes: &is_passes,
         settings: Box::new(move |_| w1(base.clone())),
         extra: extra.clone(),
     })?;
     let brute_force = stage::run(Stage {
         stage: &stage1,
-        passes: &["ils-gbuffer", BRUTE_FORCE_PASS, "compose"],
+        passes: &brute_passes,
         settings: Box::new(move |_| w2(brute.clone())),
         extra,
     })?;
     let time = |b: &crate::results::StageBench, n: &str| {
         b.passes.iter().find(|p| p.name == n).map_or(f64::NAN, |p| p.median_ms)
     };
-    let shading = time(&interleaved, "ils-snsm");
+    let shading = time(&interleaved, ils.shading_pass());
     let brute_shading = time(&brute_force, BRUTE_FORCE_PASS);
     Ok(IlsBench {
         vpls_generated: ils.vpl_count,

@@ -203,6 +203,21 @@ impl<'a> PassBuilder<'a> {
         )
     }
 
+    /// A depth texture view (`texture_depth_*`, read with a comparison sampler or `textureLoad`).
+    pub fn depth_view(mut self, input: &'static str, view: &'a wgpu::TextureView, dimension: wgpu::TextureViewDimension) -> Self {
+        if !input.is_empty() && !self.inputs.contains(&input) {
+            self.inputs.push(input);
+        }
+        self.push(
+            wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: dimension,
+                multisampled: false,
+            },
+            Some(wgpu::BindingResource::TextureView(view)),
+        )
+    }
+
     /// Target `name` as a whole (`D2Array` when it has several layers).
     pub fn read(self, name: &'static str) -> Self {
         let t = self.targets.get(name);

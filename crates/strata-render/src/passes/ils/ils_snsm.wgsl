@@ -1,5 +1,7 @@
 // ILS §4.3 SNSM: shading of the split G-buffer, visibility ignored (§6.2's
-// interactive mode), and the brute-force baseline on the unsplit G-buffer.
+// interactive mode), and the brute-force baseline on the unsplit G-buffer;
+// `fs_ssm` / `fs_brute_force_ssm`: the same with each VPL's visibility from its
+// shadow map (§4.3 SSM, passes/ils/ssm.rs).
 //
 // VPL assignment: the N VPLs are partitioned over the S = n·m sub-buffers,
 // VPL k → sub-buffer s = k mod S with s = j·n + i for sub-buffer (i, j). One
@@ -21,9 +23,11 @@ struct Shade {
     all_vpls: u32,
     _pad0: u32,
     max_geometry: f32,
-    _pad1: f32,
-    _pad2: f32,
-    _pad3: f32,
+    // SSM: the shadow-map eye's offset along the VPL normal, a shadow texel's size at
+    // distance 1, half a texel in face uv
+    eye_offset: f32,
+    texel_at_1: f32,
+    half_texel: f32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -31,6 +35,51 @@ struct Shade {
 // packed G-buffer: world normal (xyz), csz (w); split or not
 @group(1) @binding(1) var gbuffer: texture_2d<f32>;
 @group(1) @binding(2) var<storage, read> vpls: array<Vpl>;
+// SSM only: one layer per VPL, its six cube faces in a 3×2 atlas; 6 matrices per VPL
+@group(1) @binding(3) var vpl_shadow_maps: texture_depth_2d_array;
+@group(1) @binding(4) var vpl_shadow_sampler: sampler_comparison;
+@group(1) @binding(5) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
+
+// §4.3 SSM: visibility of surface point x (normal n) from VPL k, from its cube
+// shadow map (face by the major axis of the direction from the VPL, as a point
+// light's: lighting.wgsl), 2×2 PCF by the comparison sampler.
+fn vpl_visibility(k: u32, v: Vpl, x: vec3f, n: vec3f) -> f32 {
+    let eye = v.position.xyz + v.normal.xyz * shade.eye_offset;
+    // normal offset of 1.5 texels at the receiver's distance
+    let q = x + n * (1.5 * shade.texel_at_1 * length(x - eye));
+    let d = q - eye;
+    let a = abs(d);
+    var face = 4u;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = 0u;
+    } else if (a.y >= a.z) {
+        face = 2u;
+    }
+    if ((face == 0u && d.x < 0.0) || (face == 2u && d.y < 0.0) || (face == 4u && d.z < 0.0)) {
+        face += 1u;
+    }
+    let c = vpl_shadow_mats[k * 6u + face] * vec4f(q, 1.0);
+    let ndc = c.xyz / c.w;
+    if (c.w <= 0.0 || ndc.z > 1.0) {
+        return 1.0;
+    }
+    let uv_face = clamp(vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5), vec2f(shade.half_texel), vec2f(1.0 - shade.half_texel));
+    let uv = (vec2f(f32(face % 3u), f32(face / 3u)) + uv_face) / vec2f(3.0, 2.0);
+    return textureSampleCompareLevel(vpl_shadow_maps, vpl_shadow_sampler, uv, i32(k), ndc.z);
+}
+
+// vpl_sum with each VPL's term times its visibility (SSM).
+fn vpl_sum_ssm(g: vec4f, pix: vec2u, first: u32, step: u32) -> vec3f {
+    let x = world_from_csz(frame, vec2f(pix) + 0.5, g.w);
+    var e = vec3f(0.0);
+    for (var k = first; k < shade.vpl_count; k += step) {
+        let term = vpl_irradiance(vpls[k], x, g.xyz, shade.max_geometry);
+        if (any(term > vec3f(0.0))) {
+            e += term * vpl_visibility(k, vpls[k], x, g.xyz);
+        }
+    }
+    return e;
+}
 
 // Σ over VPLs first, first + step, … < N of Φ/π cos θ_y cos θ_x / d² at the
 // surface of image pixel `pix` with packed G-buffer texel `g`.
@@ -79,4 +128,41 @@ fn fs_brute_force(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         return vec4f(0.0);
     }
     return vec4f(vpl_sum(g, p, 0u, 1u), 1.0);
+}
+
+// SSM on the tiled sub-buffers (same assignment and scaling as fs_snsm).
+@fragment
+fn fs_ssm(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let t = vec2u(pos.xy);
+    if (ils_is_padding(t, shade.geo)) {
+        return vec4f(0.0);
+    }
+    let g = textureLoad(gbuffer, vec2i(t), 0);
+    if (g.w <= 0.0) {
+        return vec4f(0.0);
+    }
+    let pix = ils_gather_index(t, shade.geo);
+    if (shade.all_vpls != 0u) {
+        return vec4f(vpl_sum_ssm(g, pix, 0u, 1u), 1.0);
+    }
+    let ij = ils_sub_buffer(t, shade.geo);
+    let s = ij.y * shade.geo.pattern.x + ij.x;
+    let big_s = shade.sub_buffers;
+    if (s >= shade.vpl_count) {
+        return vec4f(0.0, 0.0, 0.0, 1.0);
+    }
+    let n_s = (shade.vpl_count - s + big_s - 1u) / big_s;
+    let e = vpl_sum_ssm(g, pix, s, big_s) * (f32(shade.vpl_count) / f32(n_s));
+    return vec4f(e, 1.0);
+}
+
+// Brute force with VPL shadows: every pixel, all N VPLs, each with its visibility.
+@fragment
+fn fs_brute_force_ssm(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let p = vec2u(pos.xy);
+    let g = textureLoad(gbuffer, vec2i(p), 0);
+    if (g.w <= 0.0) {
+        return vec4f(0.0);
+    }
+    return vec4f(vpl_sum_ssm(g, p, 0u, 1u), 1.0);
 }

@@ -42,6 +42,8 @@ use crate::passes::interleave::{Interleave, SplitMethod, PADDING_MARKER};
 use crate::scene_gpu::GpuScene;
 use crate::RenderError;
 
+pub mod ssm;
+
 /// Most VPLs one frame accepts.
 pub const MAX_VPLS: u32 = 65536;
 
@@ -56,6 +58,9 @@ pub const PASSES: &[&str] = &[
     "ils-blur-v",
     "compose",
 ];
+
+/// SSM's shadow-map pass (§4.3: one cube map per VPL, `ssm`).
+pub const VPL_SHADOW_PASS: &str = "ils-vpl-shadows";
 
 /// The brute-force baseline's pass (replaces BS, SNSM, BG).
 pub const BRUTE_FORCE_PASS: &str = "ils-brute-force";
@@ -221,9 +226,6 @@ impl IlsSettings {
                 self.vpl_shadow_resolution
             ));
         }
-        if self.shadows == VplShadows::ShadowMaps {
-            return Err("shadows vpl is not available yet".into());
-        }
         for (k, v) in self.vpls.iter().enumerate() {
             let finite = v.position.iter().chain(&v.normal).chain(&v.flux).all(|c| c.is_finite());
             if !finite || v.flux.iter().any(|&c| c < 0.0) {
@@ -262,16 +264,38 @@ impl IlsSettings {
     /// The frame's passes for these settings, in order.
     pub fn passes(&self) -> Vec<&'static str> {
         let mut v = vec!["ils-gbuffer"];
+        if self.shadows.traced() {
+            v.push(VPL_SHADOW_PASS);
+        }
         if self.brute_force {
             v.push(BRUTE_FORCE_PASS);
         } else {
-            v.extend(["ils-bs", "ils-snsm", "ils-bg"]);
+            v.extend(["ils-bs", self.shading_pass(), "ils-bg"]);
         }
         if self.blurs() {
             v.extend(["ils-db", "ils-blur-h", "ils-blur-v"]);
         }
         v.push("compose");
         v
+    }
+
+    /// The interleaved shading pass: `ils-snsm`, or `ils-ssm` with VPL shadows (§4.3).
+    pub fn shading_pass(&self) -> &'static str {
+        if self.shadows.traced() {
+            "ils-ssm"
+        } else {
+            "ils-snsm"
+        }
+    }
+
+    /// Bytes of the VPL shadow maps (SSM): N layers of six R² Depth32Float faces, plus the
+    /// face matrices (256-byte uniform stride + packed storage copy).
+    pub fn shadow_map_bytes(&self) -> u64 {
+        if !self.shadows.traced() {
+            return 0;
+        }
+        let r = self.vpl_shadow_resolution as u64;
+        self.vpls.len().max(1) as u64 * 6 * (r * r * 4 + 256 + 64)
     }
 
     /// Upper bound of the stage's target bytes at `w`×`h` (tiled buffers included).
@@ -281,7 +305,7 @@ impl IlsSettings {
         let px = w as u64 * h as u64;
         // gbuffer 16 + irradiance 8 + DB 8 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8;
         // the Blocks intermediates ≤ 2 more tiled-size buffers
-        px * 72 + tiled * (24 + 24) + self.vpls.len() as u64 * 48
+        px * 72 + tiled * (24 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
     }
 }
 
@@ -338,7 +362,8 @@ struct ShadeUniforms {
     all_vpls: u32,
     _pad0: u32,
     max_geometry: f32,
-    _pad1: [f32; 3],
+    /// SSM: eye offset, texel size at distance 1, half a texel in face uv.
+    ssm: [f32; 3],
 }
 
 #[repr(C)]
@@ -456,6 +481,8 @@ pub(crate) struct IlsStage {
     vpl_buffer: wgpu::Buffer,
     vpl_capacity: usize,
     shade_uniforms: ShadeUniforms,
+    /// SSM's shadow maps (`shadows = vpl`).
+    vpl_shadows: Option<ssm::VplShadowPass>,
 }
 
 fn vpl_buffer(gpu: &GpuContext, vpls: &[GpuVpl]) -> wgpu::Buffer {
@@ -516,6 +543,23 @@ impl IlsStage {
             };
             (Some(split), Some(gather), Some(geo))
         };
+        let vpl_shadows = match s.shadows {
+            VplShadows::None => None,
+            VplShadows::ShadowMaps => Some(ssm::VplShadowPass::new(
+                gpu,
+                scene_gpu,
+                scene,
+                &s.vpls,
+                s.vpl_shadow_resolution,
+            )?),
+        };
+        let ssm_uniforms = vpl_shadows.as_ref().map_or([0.0; 3], |p| {
+            [
+                p.eye_offset(),
+                ssm::texel_at_unit_distance(p.resolution()),
+                0.5 / p.resolution() as f32,
+            ]
+        });
         let shade_uniforms = ShadeUniforms {
             geo: geo.map_or(bytemuck::Zeroable::zeroed(), |g| g.uniforms(PADDING_MARKER)),
             vpl_count: s.vpls.len() as u32,
@@ -523,23 +567,35 @@ impl IlsStage {
             all_vpls: s.all_vpls_per_sub_buffer as u32,
             _pad0: 0,
             max_geometry: s.max_geometry(scene),
-            _pad1: [0.0; 3],
+            ssm: ssm_uniforms,
         };
         let shade = {
-            let (name, entry, input, output) = if s.brute_force {
-                (BRUTE_FORCE_PASS, "fs_brute_force", GBUFFER.name, IRRADIANCE.name)
-            } else {
-                ("ils-snsm", "fs_snsm", GBUFFER_SPLIT.name, IRRADIANCE_TILED.name)
+            let traced = vpl_shadows.is_some();
+            let (name, entry, input, output) = match (s.brute_force, traced) {
+                (true, false) => (BRUTE_FORCE_PASS, "fs_brute_force", GBUFFER.name, IRRADIANCE.name),
+                (true, true) => (BRUTE_FORCE_PASS, "fs_brute_force_ssm", GBUFFER.name, IRRADIANCE.name),
+                (false, false) => ("ils-snsm", "fs_snsm", GBUFFER_SPLIT.name, IRRADIANCE_TILED.name),
+                (false, true) => ("ils-ssm", "fs_ssm", GBUFFER_SPLIT.name, IRRADIANCE_TILED.name),
             };
-            PassBuilder::new(gpu, targets, name)
+            let b = PassBuilder::new(gpu, targets, name)
                 .shader("ils-snsm", include_str!("ils_snsm.wgsl"))
                 .entry(entry)
                 .frame(scene_gpu)
                 .uniforms(&shade_uniforms)
                 .read(input)
-                .storage(&vpl_buffer)
-                .write(output)
-                .build()
+                .storage(&vpl_buffer);
+            let b = match &vpl_shadows {
+                Some(p) => b
+                    .depth_view(
+                        "ils-vpl-shadow-maps",
+                        &p.array_view,
+                        wgpu::TextureViewDimension::D2Array,
+                    )
+                    .sampler(&p.sampler, wgpu::SamplerBindingType::Comparison)
+                    .storage(&p.matrices),
+                None => b,
+            };
+            b.write(output).build()
         };
 
         let (mut discontinuity, mut blur_h, mut blur_v) = (None, None, None);
@@ -566,6 +622,7 @@ impl IlsStage {
             vpl_capacity: s.vpls.len().max(1),
             vpl_buffer,
             shade_uniforms,
+            vpl_shadows,
         })
     }
 
@@ -579,6 +636,9 @@ impl IlsStage {
             )));
         }
         gpu.queue.write_buffer(&self.vpl_buffer, 0, bytemuck::cast_slice(vpls));
+        if let Some(p) = &mut self.vpl_shadows {
+            p.set_vpls(gpu, vpls);
+        }
         self.shade_uniforms.vpl_count = vpls.len() as u32;
         self.shade.set_uniforms(gpu, &self.shade_uniforms);
         Ok(())
@@ -586,6 +646,9 @@ impl IlsStage {
 
     pub(crate) fn passes(&self) -> Vec<&dyn Pass> {
         let mut v: Vec<&dyn Pass> = vec![&self.gbuffer];
+        if let Some(p) = &self.vpl_shadows {
+            v.push(p);
+        }
         if let Some(p) = &self.split {
             v.push(p);
         }
@@ -814,6 +877,13 @@ mod tests {
                     ..ok.clone()
                 },
                 "normal-threshold",
+            ),
+            (
+                IlsSettings {
+                    vpl_shadow_resolution: 4,
+                    ..ok.clone()
+                },
+                "vpl-shadow-resolution",
             ),
             (
                 IlsSettings {
