@@ -42,6 +42,14 @@ pub fn run(
         )),
         None => None,
     };
+    // ILS: the frame's own ILS passes (with `shadows = vpl`: ils-vpl-shadows, ils-ssm)
+    let passes: Vec<&str> = match &checked.ils {
+        Some(i) => {
+            let before = technique.passes.iter().copied().take_while(|p| !p.starts_with("ils-"));
+            before.chain(i.passes()).chain(["tonemap"]).collect()
+        }
+        None => technique.passes.to_vec(),
+    };
     let extra = json!({
         "technique": technique.name,
         "preset": preset.or(technique.presets.first().copied()),
@@ -50,7 +58,7 @@ pub fn run(
     });
     stage::run(Stage {
         stage,
-        passes: technique.passes,
+        passes: &passes,
         settings: Box::new(move |layers| {
             let mut s = configure(layers).expect("checked before the GPU work");
             if let (Some(i), Some(v)) = (&mut s.ils, &vpls) {
