@@ -346,7 +346,11 @@ fn vpl_shadow_maps_match_traced_visibility() {
             100.0 * ssm_off,
             100.0 * snsm_off
         );
-        assert!(ssm_off <= 0.05, "brute force {brute_force}: SSM off on {:.2} %", 100.0 * ssm_off);
+        assert!(
+            ssm_off <= 0.05,
+            "brute force {brute_force}: SSM off on {:.2} %",
+            100.0 * ssm_off
+        );
         // measured: 53 % (brute force), 9.9 % (8×6: ~5 VPLs per pixel, many unoccluded)
         let min_off = if brute_force { 0.2 } else { 0.05 };
         assert!(

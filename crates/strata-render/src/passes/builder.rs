@@ -204,7 +204,12 @@ impl<'a> PassBuilder<'a> {
     }
 
     /// A depth texture view (`texture_depth_*`, read with a comparison sampler or `textureLoad`).
-    pub fn depth_view(mut self, input: &'static str, view: &'a wgpu::TextureView, dimension: wgpu::TextureViewDimension) -> Self {
+    pub fn depth_view(
+        mut self,
+        input: &'static str,
+        view: &'a wgpu::TextureView,
+        dimension: wgpu::TextureViewDimension,
+    ) -> Self {
         if !input.is_empty() && !self.inputs.contains(&input) {
             self.inputs.push(input);
         }
