@@ -246,6 +246,27 @@ fn every_ils_view_renders_and_bad_settings_are_one_line_errors() {
         .expect("ils + radiosity refused")
         .to_string();
     assert!(e.contains("ils") && e.contains("radiosity"), "{e}");
+    // SSM: one shadow-map layer per VPL, bounded by the device's array layers
+    let layers = gpu.device.limits().max_texture_array_layers;
+    let many: Vec<GpuVpl> = (0..layers + 1)
+        .map(|_| GpuVpl::new([0.2, 0.2, 0.2], [0.0, 1.0, 0.0], [1.0; 3]))
+        .collect();
+    let mut s = t.settings(&RenderSettings::default(), None).unwrap();
+    s.ils = Some(IlsSettings {
+        vpls: Arc::from(many),
+        shadows: strata_render::passes::ils::VplShadows::ShadowMaps,
+        vpl_shadow_resolution: 8,
+        ..Default::default()
+    });
+    let e = Renderer::new(&gpu, &scene, s)
+        .err()
+        .expect("more VPLs than shadow-map layers refused")
+        .to_string();
+    assert!(
+        e.contains("vpls") && e.contains(&format!("1..={layers}")) && !e.contains('\n'),
+        "{e}"
+    );
+    gpu.check_errors().unwrap();
 }
 
 /// §4.3 SSM: the GPU's VPL sum with each VPL's visibility from its cube shadow
