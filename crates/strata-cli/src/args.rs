@@ -434,6 +434,10 @@ pub struct FrameArgs {
     /// Shadow map resolution per light, 64..=8192.
     #[arg(long, default_value_t = 2048)]
     pub shadow_resolution: u32,
+    /// How many point lights (the most intense) cast shadows through cube shadow maps
+    /// (six maps each); the rest are unshadowed. 0..=16.
+    #[arg(long, default_value_t = strata_render::lights::POINT_SHADOW_BUDGET, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=16))]
+    pub point_shadows: usize,
     /// --technique full: no light-probe fallback (the probes are baked once per scene by the CPU
     /// path tracer and cached in $STRATA_CACHE).
     #[arg(long)]
