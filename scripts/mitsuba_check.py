@@ -20,6 +20,10 @@ Usage:
       {"pair": "strata-vs-mitsuba", ...}   the check (seed 0 of each side)
       {"pair": "strata-noise", ...}        strata seed 0 vs seed 1 (noise floor)
       {"pair": "mitsuba-noise", ...}       Mitsuba seed 0 vs seed 1 (noise floor)
+      {"pair": "strata-vs-mitsuba-seed1"}  the check again with seed 1 of each side
+      {"pair": "summary", ...}             FLIP and the noise floors; the RMS of the
+          strata-Mitsuba difference that the noise floors do not explain
+          ("rmse_systematic" = sqrt(max(0, rmse^2 - (rmse_sn^2 + rmse_mn^2)/2))
     and `<out>/<scene>-<kind>.png` shows strata | Mitsuba | 4 x |difference|.
 
 How each side computes the image (the conventions matched):
@@ -433,12 +437,28 @@ def main():
             pairs += [("strata-noise", images[s0][0], images[s1][0], None),
                       ("mitsuba-noise", images[s0][1], images[s1][1], None),
                       ("strata-vs-mitsuba-seed1", images[s1][0], images[s1][1], None)]
+        results = {}
         for name, ref, test, fmap in pairs:
             r = compare(a, ref, test, exposure, fmap)
             out = {"pair": name, **common, **{k: r[k] for k in ("flip", "rmse", "mae", "mean_reference",
                                                                   "mean_test", "mean_difference")}}
             out["reference_image"], out["test_image"] = ref, test
+            results[name] = out
             print(json.dumps(out), flush=True)
+        if s1 is not None:
+            # Independent noise: E[rmse(strata, mitsuba)^2] = sigma_s^2 + sigma_m^2 + bias^2, and each
+            # side's seed-vs-seed RMSE^2 is 2 sigma^2. What is left over is a systematic difference.
+            rms = lambda n: results[n]["rmse"]
+            expected = math.sqrt((rms("strata-noise") ** 2 + rms("mitsuba-noise") ** 2) / 2)
+            cross = math.sqrt((rms("strata-vs-mitsuba") ** 2 + rms("strata-vs-mitsuba-seed1") ** 2) / 2)
+            print(json.dumps({"pair": "summary", **common,
+                              "flip": results["strata-vs-mitsuba"]["flip"],
+                              "flip_noise_strata": results["strata-noise"]["flip"],
+                              "flip_noise_mitsuba": results["mitsuba-noise"]["flip"],
+                              "rmse": cross, "rmse_expected_from_noise": expected,
+                              "rmse_systematic": math.sqrt(max(0.0, cross ** 2 - expected ** 2)),
+                              "mean_difference": results["strata-vs-mitsuba"]["mean_difference"],
+                              "seconds": seconds}), flush=True)
         side_by_side(images[s0], f"{base}-{kind}.png", exposure, radiance)
 
 
