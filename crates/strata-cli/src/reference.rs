@@ -42,7 +42,6 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
                 radius,
                 spp: a.spp,
                 seed: a.seed,
-                ..AoBinarySettings::new(radius)
             };
             vec![(a.out.clone(), reference.ao_binary(&camera, w, h, &s))]
         }
