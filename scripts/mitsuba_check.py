@@ -10,7 +10,9 @@ Usage:
     pip install mitsuba            # 3.9.1 was used; needs no GPU (LLVM backend)
     cargo build --release -p strata-cli
     python3 scripts/mitsuba_check.py --scene cornell --kind ao gi \\
-        --width 128 --height 128 --ao-spp 4096 --gi-spp 4096 --out out/mitsuba
+        --width 128 --height 128 --ao-spp 4096 --gi-spp 2048 --out out/mitsuba
+    python3 scripts/mitsuba_check.py --scene warehouse --kind gi --bounces 0 \\
+        --gi-spp 16 --mitsuba-gi-spp 4096 --eye=1.9,3.5,1.6 --target=-1.1,0,-1.4
     python3 scripts/mitsuba_check.py --scene scenes/sponza.toml --kind ao \\
         --width 160 --height 90 --ao-spp 4096 --out out/mitsuba
 
@@ -23,8 +25,12 @@ Usage:
       {"pair": "strata-vs-mitsuba-seed1"}  the check again with seed 1 of each side
       {"pair": "summary", ...}             FLIP and the noise floors; the RMS of the
           strata-Mitsuba difference that the noise floors do not explain
-          ("rmse_systematic" = sqrt(max(0, rmse^2 - (rmse_sn^2 + rmse_mn^2)/2))
-    and `<out>/<scene>-<kind>.png` shows strata | Mitsuba | 4 x |difference|.
+          ("rmse_systematic" = sqrt(max(0, rmse^2 - (rmse_sn^2 + rmse_mn^2)/2)), rmse
+          = RMS of the two strata-vs-mitsuba RMSEs, rmse_sn/rmse_mn = noise pairs)
+    and `<out>/<scene>-<size>-<kind>-<hash>.png` shows strata | Mitsuba |
+    4 x |difference| (`...-flip.png`: the FLIP map). Images are reused when
+    they exist: <hash> covers the scene flags, kind and settings; --force
+    re-renders.
 
 How each side computes the image (the conventions matched):
 
@@ -62,6 +68,7 @@ How each side computes the image (the conventions matched):
 """
 
 import argparse
+import hashlib
 import json
 import math
 import os
@@ -406,11 +413,15 @@ def main():
         spp = a.gi_spp if radiance else a.ao_spp
         m_spp = (a.mitsuba_gi_spp or a.gi_spp) if radiance else a.ao_spp
         radius = a.ao_radius if a.ao_radius is not None else doc["settings"]["ao_radius"]
+        # Images are reused when they exist (unless --force): their names carry a hash of
+        # everything that determines them.
+        key = json.dumps([scene_flags(a), kind, spp, m_spp, a.bounces if radiance else radius])
+        stem = f"{base}-{kind}-{hashlib.sha1(key.encode()).hexdigest()[:8]}"
         images, seconds = {}, {}
         for seed in a.seeds[:2]:
-            sp = f"{base}-{kind}-strata-s{seed}.exr"
+            sp = f"{stem}-strata-s{seed}.exr"
             seconds[f"strata-s{seed}"] = strata_reference(a, kind, spp, seed, sp)
-            mp = f"{base}-{kind}-mitsuba-s{seed}.exr"
+            mp = f"{stem}-mitsuba-s{seed}.exr"
             if os.path.exists(mp) and not a.force:
                 log(f"reusing {mp}")
                 seconds[f"mitsuba-s{seed}"] = 0.0
@@ -432,7 +443,7 @@ def main():
             common.update({"bounces": a.bounces, "mitsuba_max_depth": a.bounces + 2, "exposure": exposure})
         else:
             common["ao_radius"] = radius
-        pairs = [("strata-vs-mitsuba", images[s0][0], images[s0][1], f"{base}-{kind}-flip.png")]
+        pairs = [("strata-vs-mitsuba", images[s0][0], images[s0][1], f"{stem}-flip.png")]
         if s1 is not None:
             pairs += [("strata-noise", images[s0][0], images[s1][0], None),
                       ("mitsuba-noise", images[s0][1], images[s1][1], None),
@@ -459,7 +470,7 @@ def main():
                               "rmse_systematic": math.sqrt(max(0.0, cross ** 2 - expected ** 2)),
                               "mean_difference": results["strata-vs-mitsuba"]["mean_difference"],
                               "seconds": seconds}), flush=True)
-        side_by_side(images[s0], f"{base}-{kind}.png", exposure, radiance)
+        side_by_side(images[s0], f"{stem}.png", exposure, radiance)
 
 
 if __name__ == "__main__":
