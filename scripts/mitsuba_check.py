@@ -42,9 +42,9 @@ How each side computes the image (the conventions matched):
   each pixel centre, no filter, no jitter (strata never jitters). The script
   checks these rays against strata's `Camera::pixel_dir` before rendering.
 - AO (binary ambient visibility, radius r): Mitsuba 3 has no `ao` integrator,
-  so this script traces it with Mitsuba's ray queries: primary hit, facing
-  shading normal n and facing geometric normal ng (each flipped towards the
-  viewer, as strata does), N cosine-weighted directions around n
+  so this script traces it with Mitsuba's ray queries: primary hit, shading
+  normal n and geometric normal ng, both flipped when the ray meets the back
+  of the geometric surface (strata's facing rule), N cosine-weighted directions around n
   (`warp.square_to_cosine_hemisphere`, independent sampler), origin offset
   `ray_epsilon` (exported by strata) along ng, occluded when `ray_test` hits
   within r; AV = 1 - H/N, background 1. strata uses an R2 sequence with a
@@ -299,8 +299,10 @@ def render_ao(scene, sensor, cam, radius, eps, spp, seed):
         ray = pixel_rays(sensor, cam, k)
         si = scene.ray_intersect(mi.Ray3f(ray))
         valid = si.is_valid()
-        n_s = dr.select(dr.dot(si.sh_frame.n, ray.d) > 0, -si.sh_frame.n, si.sh_frame.n)
-        n_g = dr.select(dr.dot(si.n, ray.d) > 0, -si.n, si.n)
+        # both normals flipped by the geometric side, as strata's facing_normals
+        back = dr.dot(si.n, ray.d) > 0
+        n_s = dr.select(back, -si.sh_frame.n, si.sh_frame.n)
+        n_g = dr.select(back, -si.n, si.n)
         d = mi.Frame3f(n_s).to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d()))
         occ_ray = mi.Ray3f(si.p + n_g * eps, d)
         occ_ray.maxt = radius
