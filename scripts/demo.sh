@@ -38,11 +38,13 @@ $S eval --scene atrium --technique ao --layers 2 --width 320 --height 180 --fram
 cat "$OUT/eval-ao.json"
 echo "[strata demo] deep-G-buffer radiosity against the path tracer" >&2
 # the path tracer converges slowly (ꟻLIP ∝ spp^-0.35): the demo stops at ꟻLIP 0.05 between the
-# reference's halves (≈ 1,000 spp, minutes) instead of the default 0.02 (≈ 16,000 spp, most of an hour
-# on 2 cores); the JSON's ref_noise says which it reached
+# reference's halves (several hundred spp, minutes) instead of the default 0.02 (thousands of spp,
+# most of an hour on 2 cores); the JSON's ref_noise says which it reached
 $S eval --scene warehouse --technique gi --layers 2 --width 320 --height 180 --ref-noise 0.05 \
   --report "$OUT/gi-eval" --force --json --quiet > "$OUT/eval-gi.json"
 cat "$OUT/eval-gi.json"
+echo "[strata demo] interleaved deferred shading of 480 VPLs (ILS), 8x6 sub-buffers" >&2
+$S render --scene atrium --technique ils --width "$W" --height "$H" --out "$OUT/atrium-ils.png" --force
 echo "[strata demo] GPU timings" >&2
 $S bench gbuffer --scene atrium --width "$W" --height "$H" --frames 5 --json > "$OUT/bench-gbuffer.json"
 cat "$OUT/bench-gbuffer.json"
@@ -52,7 +54,7 @@ $S bench radiosity --scene atrium --width "$W" --height "$H" --layers 2 --frames
 cat "$OUT/bench-radiosity.json"
 echo "[strata demo] report: tables and plots of the JSON above, the images, links to the evaluation reports" >&2
 $S report --from "$OUT" --out "$OUT/report.html" --title "strata demo report" --force \
-  --figures "Renders=atrium-full.png,mirror-full.png,atrium.png,atrium-ao.png,cornell.png,warehouse.png" \
+  --figures "Renders=atrium-full.png,mirror-full.png,atrium.png,atrium-ao.png,atrium-ils.png,cornell.png,warehouse.png" \
   --figures "Fig. 9 views (atrium, full)=atrium-confidence.png,atrium-gbuffer-only.png,atrium-probe-only.png,atrium-blended.png" \
   --figures "atrium G-buffer and lighting targets=atrium-csz.png,atrium-normal.png,atrium-albedo.png,atrium-emission.png,atrium-direct-diffuse.png,atrium-shadow.png" \
   --figures "CPU reference (atrium AO with binary visibility; cornell path-traced GI)=atrium-ref-ao.png,cornell-ref-gi.png"

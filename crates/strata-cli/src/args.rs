@@ -43,6 +43,11 @@ pub enum Command {
     Eval(EvalArgs),
     /// Stitch the result JSON files, images and reports in a folder into one HTML page (tables, SVG plots).
     Report(crate::report_cmd::ReportArgs),
+    /// Write the scene at one frame with the camera for an external renderer: scene.json (camera,
+    /// materials, lights, settings) and one binary PLY of world-space triangles per material.
+    ExportScene(crate::export::ExportArgs),
+    /// Compare two images (EXR/PNG) with the metrics of `eval`: FLIP, RMSE, MAE and the mean difference.
+    Compare(crate::compare::CompareArgs),
 }
 
 #[derive(Args, Clone)]
@@ -445,6 +450,10 @@ pub struct FrameArgs {
     /// Shadow map resolution per light, 64..=8192.
     #[arg(long, default_value_t = 2048)]
     pub shadow_resolution: u32,
+    /// How many point lights (the most intense) cast shadows through cube shadow maps
+    /// (six maps each); the rest are unshadowed. 0..=16.
+    #[arg(long, default_value_t = strata_render::lights::POINT_SHADOW_BUDGET, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=16))]
+    pub point_shadows: usize,
     /// --technique full: no light-probe fallback (the probes are baked once per scene by the CPU
     /// path tracer and cached in $STRATA_CACHE).
     #[arg(long)]
@@ -510,6 +519,10 @@ pub struct ReferenceArgs {
     /// Indirect bounces for gi/indirect, 0..=64.
     #[arg(long, default_value_t = 3)]
     pub bounces: u32,
+    /// Seed of the sample sequences (ao, obscurance, gi, indirect): different seeds give
+    /// independent noise at the same settings.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
     /// Number of layers for --kind layers, 1..=8.
     #[arg(long, default_value_t = 2)]
     pub layers: u32,

@@ -2,8 +2,10 @@
 
 mod args;
 mod bench;
+mod compare;
 mod convert;
 mod eval;
+mod export;
 mod info;
 mod output;
 mod reference;
@@ -56,6 +58,8 @@ fn main() {
         args::Command::Techniques(a) => techniques::run(&a),
         args::Command::Eval(a) => eval::run(&a),
         args::Command::Report(a) => report_cmd::run(&a),
+        args::Command::ExportScene(a) => export::run(&a),
+        args::Command::Compare(a) => compare::run(&a),
     };
     if let Err(e) = result {
         // One line: what is wrong and what is valid.

@@ -41,7 +41,7 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
             let s = AoBinarySettings {
                 radius,
                 spp: a.spp,
-                ..AoBinarySettings::new(radius)
+                seed: a.seed,
             };
             vec![(a.out.clone(), reference.ao_binary(&camera, w, h, &s))]
         }
@@ -49,6 +49,7 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
             check_output(&a.out, a.force)?;
             let s = ObscuranceSettings {
                 spp: a.spp,
+                seed: a.seed,
                 ..ObscuranceSettings::new(radius)
             };
             vec![(a.out.clone(), reference.ao_obscurance(&camera, w, h, &s))]
@@ -58,6 +59,7 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
             let s = GiSettings {
                 spp: a.spp,
                 bounces: a.bounces,
+                seed: a.seed,
                 ..Default::default()
             };
             let g = reference.gi(&camera, w, h, &s);

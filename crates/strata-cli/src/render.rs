@@ -20,6 +20,7 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
         guard_band: f.deep.guard_band,
         shadow: strata_render::passes::shadow::ShadowSettings {
             resolution: f.shadow_resolution,
+            point_lights: f.point_shadows,
         },
         exposure: f.exposure,
         ao: Some(f.ao.settings()),
@@ -56,7 +57,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let f = &a.frame;
     let (scene, cams, settings) = prepare(f)?;
     if a.list_lights {
-        print_lights(&scene);
+        print_lights(&scene, f.point_shadows);
         return Ok(());
     }
     if let Some(out) = &a.out {
@@ -123,11 +124,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
 }
 
 /// `--list-lights`: one line per light and camera, in strata's units.
-fn print_lights(scene: &strata_scene::Scene) {
+fn print_lights(scene: &strata_scene::Scene, budget: usize) {
     use strata_scene::Light;
     let v = |v: glam::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
     println!("lights of '{}': {}", scene.name, scene.lights.len());
-    let gpu_lights = strata_render::lights::gpu_lights(scene, 0.0, 64);
+    let gpu_lights = strata_render::lights::gpu_lights(scene, 0.0, 64, budget);
     for (i, l) in scene.lights.iter().enumerate() {
         let shadowed = gpu_lights.get(i).is_some_and(|g| g.kind[1] != strata_render::lights::NO_SHADOW);
         let line = match l {
@@ -151,12 +152,9 @@ fn print_lights(scene: &strata_scene::Scene) {
         };
         println!("  {i}: {line}{}", if shadowed { "" } else { " (no shadow)" });
     }
-    let unshadowed = strata_render::lights::unshadowed_point_lights(scene);
+    let unshadowed = strata_render::lights::unshadowed_point_lights(scene, budget);
     if unshadowed > 0 {
-        println!(
-            "  {unshadowed} point light(s) unshadowed: only the {} most intense get cube shadow maps",
-            strata_render::lights::POINT_SHADOW_BUDGET
-        );
+        println!("  {unshadowed} point light(s) unshadowed: only the {budget} most intense get cube shadow maps (--point-shadows)");
     }
     println!("cameras in the file: {}", scene.cameras.len());
     for (i, c) in scene.cameras.iter().enumerate() {

@@ -1081,3 +1081,117 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
     ]);
     assert_one_line_error(&o, &["--set", "ils"]);
 }
+
+/// Issue 10: `export-scene` writes every world-space triangle (per material, unshared
+/// vertices in scene order) and the camera; a second run refuses to overwrite.
+#[test]
+fn export_scene_writes_the_triangles_and_camera_of_the_frame() {
+    let dir = scratch("export-cornell");
+    let _ = std::fs::remove_dir_all(&dir);
+    let args = [
+        "export-scene",
+        "--scene",
+        "cornell",
+        "--width",
+        "40",
+        "--height",
+        "30",
+        "--fov",
+        "50",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ];
+    let v = json_of(&strata(&args));
+    let scene = strata_scene::load_scene("cornell").unwrap();
+    let tris = scene.world_triangles(0.0);
+    assert_eq!(v["triangles"].as_u64(), Some(tris.len() as u64));
+
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("scene.json")).unwrap()).unwrap();
+    assert_eq!(doc["triangles"].as_u64(), Some(tris.len() as u64));
+    assert_eq!(doc["camera"]["width"], 40);
+    assert_eq!(doc["camera"]["height"], 30);
+    assert_eq!(doc["camera"]["fov_y_deg"].as_f64(), Some(50.0));
+    let eye: Vec<f32> = doc["camera"]["eye"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap() as f32)
+        .collect();
+    assert_eq!(eye, scene.camera.eye.to_array());
+
+    // Every material's PLY: header counts, and its triangles are the scene's, in order.
+    let mut total = 0;
+    for m in doc["materials"].as_array().unwrap() {
+        let Some(name) = m["mesh"].as_str() else { continue };
+        let index = m["index"].as_u64().unwrap() as u32;
+        let bytes = std::fs::read(dir.join(name)).unwrap();
+        let end = b"end_header\n";
+        let at = bytes.windows(end.len()).position(|w| w == end).unwrap() + end.len();
+        let header = String::from_utf8_lossy(&bytes[..at]);
+        let mine: Vec<_> = tris.iter().filter(|t| t.material == index).collect();
+        assert!(
+            header.contains(&format!("element vertex {}\n", 3 * mine.len())),
+            "{header}"
+        );
+        assert!(header.contains(&format!("element face {}\n", mine.len())), "{header}");
+        let f = |i: usize| f32::from_le_bytes(bytes[at + 4 * i..at + 4 * i + 4].try_into().unwrap());
+        // Vertex 3i + k = corner k of triangle i: 8 floats (position, normal, uv).
+        for (i, t) in mine.iter().enumerate() {
+            for k in 0..3 {
+                let base = (3 * i + k) * 8;
+                assert_eq!(
+                    [f(base), f(base + 1), f(base + 2)],
+                    t.p[k].to_array(),
+                    "{name} triangle {i}"
+                );
+            }
+        }
+        let faces = at + 3 * mine.len() * 32;
+        assert_eq!(bytes.len(), faces + mine.len() * 13, "{name}: face list size");
+        assert_eq!(bytes[faces], 3);
+        total += mine.len();
+    }
+    assert_eq!(total, tris.len());
+
+    let o = strata(&args);
+    assert_one_line_error(&o, &["exists", "--force"]);
+}
+
+/// `compare` of an image with itself is zero error; different sizes are one line.
+#[test]
+fn compare_reports_zero_for_identical_images_and_refuses_size_mismatch() {
+    let a = scratch("compare-a.exr");
+    let b = scratch("compare-b.exr");
+    for (p, w) in [(&a, "24"), (&b, "16")] {
+        let o = strata(&[
+            "reference",
+            "--scene",
+            "cornell",
+            "--kind",
+            "ao",
+            "--spp",
+            "4",
+            "--width",
+            w,
+            "--height",
+            "16",
+            "--quiet",
+            "--out",
+            p.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let v = json_of(&strata(&[
+        "compare",
+        a.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(v["flip"].as_f64(), Some(0.0));
+    assert_eq!(v["rmse"].as_f64(), Some(0.0));
+    assert_eq!(v["mean_difference"].as_f64(), Some(0.0));
+    let o = strata(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--exposure", "1"]);
+    assert_one_line_error(&o, &["same size"]);
+}

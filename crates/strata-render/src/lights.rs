@@ -1,8 +1,8 @@
 //! Lights as the GPU sees them, with shadow-map matrices.
 //!
 //! Shadowed: the sun (orthographic map fitted to the scene bounds), spot lights and
-//! rectangular area lights (perspective maps), and the [`POINT_SHADOW_BUDGET`]
-//! most intense point lights (omnidirectional: six cube-face perspective maps,
+//! rectangular area lights (perspective maps), and the most intense point lights
+//! (`ShadowSettings::point_lights`, default [`POINT_SHADOW_BUDGET`]) (omnidirectional: six cube-face perspective maps,
 //! layers `base..base + 6`, picked per pixel by the major axis of the direction
 //! from the light). Other point lights are unshadowed.
 //! A `Rect` light is an area light: its Lambertian irradiance is the exact
@@ -42,9 +42,9 @@ pub struct GpuLight {
 
 pub const NO_SHADOW: u32 = u32::MAX;
 
-/// Point lights with omnidirectional shadows (6 cube-face layers each): the
-/// [`POINT_SHADOW_BUDGET`] most intense; the rest are unshadowed (reported by
-/// [`unshadowed_point_lights`]).
+/// Default number of point lights with omnidirectional shadows (6 cube-face
+/// layers each): the most intense; the rest are unshadowed (reported by
+/// [`unshadowed_point_lights`]). `ShadowSettings::point_lights` overrides it.
 pub const POINT_SHADOW_BUDGET: usize = 2;
 
 /// Field of view of a cube face's shadow map: a little over 90° so that the
@@ -56,8 +56,9 @@ pub const CUBE_FACE_FOV_DEG: f32 = 95.0;
 /// the direction from the light.
 pub const CUBE_FACES: [Vec3; 6] = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
 
-/// Indices (into `scene.lights`) of the point lights that get a shadow map.
-fn shadowed_point_lights(scene: &Scene) -> Vec<usize> {
+/// Indices (into `scene.lights`) of the `budget` most intense point lights:
+/// those that get a shadow map.
+fn shadowed_point_lights(scene: &Scene, budget: usize) -> Vec<usize> {
     let mut points: Vec<(usize, f32)> = scene
         .lights
         .iter()
@@ -68,19 +69,20 @@ fn shadowed_point_lights(scene: &Scene) -> Vec<usize> {
         })
         .collect();
     points.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    points.into_iter().take(POINT_SHADOW_BUDGET).map(|(i, _)| i).collect()
+    points.into_iter().take(budget).map(|(i, _)| i).collect()
 }
 
-/// How many point lights go unshadowed because of [`POINT_SHADOW_BUDGET`].
-pub fn unshadowed_point_lights(scene: &Scene) -> usize {
+/// How many point lights go unshadowed with a shadow budget of `budget` point lights.
+pub fn unshadowed_point_lights(scene: &Scene, budget: usize) -> usize {
     let points = scene.lights.iter().filter(|l| matches!(l, Light::Point { .. })).count();
-    points - shadowed_point_lights(scene).len()
+    points - shadowed_point_lights(scene, budget).len()
 }
 
 /// Converts the scene's lights, assigning shadow-map layers in order (a
-/// shadowed point light takes six: one per cube face).
-pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32) -> Vec<GpuLight> {
-    let shadowed_points = shadowed_point_lights(scene);
+/// shadowed point light takes six: one per cube face; the `point_budget` most
+/// intense point lights are shadowed).
+pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32, point_budget: usize) -> Vec<GpuLight> {
+    let shadowed_points = shadowed_point_lights(scene, point_budget);
     let (lo, hi) = scene.bounds(frame);
     let (center, radius) = if lo.is_finite() && hi.is_finite() {
         ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3))

@@ -239,7 +239,7 @@ impl RenderSettings {
         }
         if self.shade {
             bytes += sum(crate::passes::lighting::OUTPUTS) + sum(crate::passes::tonemap::OUTPUTS);
-            let lights = gpu_lights(scene, 0.0, self.shadow.resolution);
+            let lights = gpu_lights(scene, 0.0, self.shadow.resolution, self.shadow.point_lights);
             let maps = crate::lights::shadow_layer_count(&lights).max(1) as u64;
             bytes += maps * (self.shadow.resolution as u64).pow(2) * 4;
         }
@@ -300,7 +300,7 @@ impl RenderSettings {
             )));
         }
         if self.shade {
-            let lights = gpu_lights(scene, 0.0, self.shadow.resolution);
+            let lights = gpu_lights(scene, 0.0, self.shadow.resolution, self.shadow.point_lights);
             let maps = crate::lights::shadow_layer_count(&lights);
             if maps > limits.max_texture_array_layers {
                 return Err(RenderError::Parameter(format!(
@@ -388,7 +388,7 @@ impl Renderer {
                 targets.create(gpu, *d);
             }
         }
-        let lights = gpu_lights(scene, 0.0, settings.shadow.resolution);
+        let lights = gpu_lights(scene, 0.0, settings.shadow.resolution, settings.shadow.point_lights);
         let geometry = deep_gbuffer::geometry_passes(gpu, &scene_gpu, &targets, &settings.deep)?;
         let pack = deep_gbuffer::PackPass::new(gpu, &targets, &settings.deep);
         let (shadow, lighting, tonemap) = if settings.shade {
@@ -629,7 +629,7 @@ impl Renderer {
         }
         if self.animated {
             if let (Some(s), Some(l)) = (&self.shadow, &self.lighting) {
-                self.lights = gpu_lights(scene, frame, self.settings.shadow.resolution);
+                self.lights = gpu_lights(scene, frame, self.settings.shadow.resolution, self.settings.shadow.point_lights);
                 s.update(gpu, &crate::lights::shadow_matrices(scene, frame, &self.lights));
                 l.update_lights(gpu, &self.lights);
             }

@@ -433,6 +433,11 @@ fn layer1_radiosity_equals_the_same_surface_seen_directly() {
                     min_separation: Some(0.7),
                     ..Default::default()
                 },
+                // unshadowed point light: B of the hidden wall must not depend on the column
+                shadow: strata_render::passes::shadow::ShadowSettings {
+                    point_lights: 0,
+                    ..Default::default()
+                },
                 ..Default::default()
             },
         )

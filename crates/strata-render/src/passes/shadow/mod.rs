@@ -14,11 +14,17 @@ use crate::scene_gpu::{GpuScene, VERTEX_LAYOUT};
 pub struct ShadowSettings {
     /// Shadow map resolution per light (texels per side). Default 2048.
     pub resolution: u32,
+    /// How many point lights (the most intense) get omnidirectional shadow maps;
+    /// the others are unshadowed. Default [`crate::lights::POINT_SHADOW_BUDGET`] (2).
+    pub point_lights: usize,
 }
 
 impl Default for ShadowSettings {
     fn default() -> Self {
-        Self { resolution: 2048 }
+        Self {
+            resolution: 2048,
+            point_lights: crate::lights::POINT_SHADOW_BUDGET,
+        }
     }
 }
 
