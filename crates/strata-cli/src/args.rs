@@ -280,10 +280,10 @@ pub struct AoArgs {
     #[arg(long, default_value_t = 0.01)]
     pub temporal_distance: f32,
     /// Bilateral filter taps on each side, 0..=32 (0 = no spatial reconstruction).
-    #[arg(long, default_value_t = 4)]
-    pub blur_radius: u32,
-    /// Pixels between bilateral taps, 1..=8.
     #[arg(long, default_value_t = 2)]
+    pub blur_radius: u32,
+    /// Pixels between bilateral taps, 1..=8 (SAO used 4 taps 2 px apart; see docs/ao.md).
+    #[arg(long, default_value_t = 1)]
     pub blur_step: u32,
     /// Depth MIP levels, 1..=12.
     #[arg(long, default_value_t = 5)]
