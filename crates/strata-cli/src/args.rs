@@ -454,6 +454,9 @@ pub struct FrameArgs {
     /// (six maps each); the rest are unshadowed. 0..=16.
     #[arg(long, default_value_t = strata_render::lights::POINT_SHADOW_BUDGET, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=16))]
     pub point_shadows: usize,
+    /// Lights that cast no shadow, by the index `--list-lights` prints (comma-separated, e.g. 0,2).
+    #[arg(long, value_delimiter = ',')]
+    pub no_shadow: Vec<usize>,
     /// --technique full: no light-probe fallback (the probes are baked once per scene by the CPU
     /// path tracer and cached in $STRATA_CACHE).
     #[arg(long)]

@@ -21,6 +21,7 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
         shadow: strata_render::passes::shadow::ShadowSettings {
             resolution: f.shadow_resolution,
             point_lights: f.point_shadows,
+            unshadowed: f.no_shadow.clone(),
         },
         exposure: f.exposure,
         ao: Some(f.ao.settings()),
@@ -57,7 +58,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let f = &a.frame;
     let (scene, cams, settings) = prepare(f)?;
     if a.list_lights {
-        print_lights(&scene, f.point_shadows);
+        print_lights(&scene, &settings.shadow);
         return Ok(());
     }
     if let Some(out) = &a.out {
@@ -124,13 +125,16 @@ pub fn run(a: &RenderArgs) -> Result<()> {
 }
 
 /// `--list-lights`: one line per light and camera, in strata's units.
-fn print_lights(scene: &strata_scene::Scene, budget: usize) {
+fn print_lights(scene: &strata_scene::Scene, shadow: &strata_render::passes::shadow::ShadowSettings) {
+    let budget = shadow.point_lights;
     use strata_scene::Light;
     let v = |v: glam::Vec3| format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z);
     println!("lights of '{}': {}", scene.name, scene.lights.len());
-    let gpu_lights = strata_render::lights::gpu_lights(scene, 0.0, 64, budget);
+    let gpu_lights = strata_render::lights::gpu_lights_for(scene, 0.0, shadow);
     for (i, l) in scene.lights.iter().enumerate() {
-        let shadowed = gpu_lights.get(i).is_some_and(|g| g.kind[1] != strata_render::lights::NO_SHADOW);
+        let shadowed = gpu_lights
+            .get(i)
+            .is_some_and(|g| g.kind[1] != strata_render::lights::NO_SHADOW);
         let line = match l {
             Light::Sun { direction, color, illuminance } => {
                 format!("sun   direction {} color {color:?} illuminance {illuminance}", v(*direction))
@@ -150,7 +154,14 @@ fn print_lights(scene: &strata_scene::Scene, budget: usize) {
                 v(*half_v)
             ),
         };
-        println!("  {i}: {line}{}", if shadowed { "" } else { " (no shadow)" });
+        let why = if shadowed {
+            ""
+        } else if shadow.unshadowed.contains(&i) {
+            " (no shadow: --no-shadow)"
+        } else {
+            " (no shadow)"
+        };
+        println!("  {i}: {line}{why}");
     }
     let unshadowed = strata_render::lights::unshadowed_point_lights(scene, budget);
     if unshadowed > 0 {

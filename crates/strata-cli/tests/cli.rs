@@ -334,7 +334,10 @@ fn eval_ao_prints_errors_and_caches_the_reference() {
     // 16 spp cannot reach the default ꟻLIP 0.02 between the halves: the run says so
     assert_eq!(v["ref_noise"]["converged"], false);
     let warnings = v["warnings"].as_array().expect("warnings");
-    assert!(warnings.iter().any(|w| w.as_str().unwrap().contains("--ref-spp cap")), "{warnings:?}");
+    assert!(
+        warnings.iter().any(|w| w.as_str().unwrap().contains("--ref-spp cap")),
+        "{warnings:?}"
+    );
     for key in ["flip", "rmse", "mae", "flicker"] {
         let x = v[key].as_f64().unwrap_or_else(|| panic!("{key} missing: {v}"));
         assert!((0.0..1.0).contains(&x), "{key} = {x}");
@@ -381,10 +384,28 @@ fn eval_rejects_out_of_range_parameters() {
     ]);
     assert_one_line_error(&o, &["alpha", "[0, 1)"]);
     let o = strata(&[
-        "eval", "--scene", "plane", "--ref-noise", "1.5", "--width", "16", "--height", "16",
+        "eval",
+        "--scene",
+        "plane",
+        "--ref-noise",
+        "1.5",
+        "--width",
+        "16",
+        "--height",
+        "16",
     ]);
     assert_one_line_error(&o, &["--ref-noise", "[0, 1)"]);
-    let o = strata(&["eval", "--scene", "plane", "--ref-spp", "1", "--width", "16", "--height", "16"]);
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "plane",
+        "--ref-spp",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ]);
     assert_one_line_error(&o, &["--ref-spp", "2..=65536"]);
 }
 
@@ -932,7 +953,12 @@ fn render_lists_lights_and_checks_the_camera_index() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     assert!(out.contains("lights of 'warehouse': 2"), "{out}");
-    assert!(out.contains("spot ") && out.contains("cone 15.00°..19.00°") && out.contains("point position (4.000, 3.200, 2.500)"), "{out}");
+    assert!(
+        out.contains("spot ")
+            && out.contains("cone 15.00°..19.00°")
+            && out.contains("point position (4.000, 3.200, 2.500)"),
+        "{out}"
+    );
     let o = strata(&["render", "--scene", "warehouse", "--camera", "0", "--list-lights"]);
     assert_one_line_error(&o, &["--camera 0", "no cameras"]);
 }
@@ -945,14 +971,33 @@ fn render_lists_lights_and_checks_the_camera_index() {
 fn ils_renders_benches_and_refuses_bad_settings() {
     let out = scratch("ils.png");
     let args = |extra: &[&'static str]| {
-        let mut v = vec!["render", "--scene", "cornell", "--technique", "ils", "--width", "48", "--height", "40"];
+        let mut v = vec![
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "ils",
+            "--width",
+            "48",
+            "--height",
+            "40",
+        ];
         v.extend_from_slice(extra);
         v.extend(["--out", out.to_str().unwrap(), "--force"]);
         v.iter().map(|s| s.to_string()).collect::<Vec<_>>()
     };
     for extra in [
         &[][..],
-        &["--set", "vpls=96", "--set", "interleave-n=4", "--set", "interleave-m=4", "--set", "split-block=16"][..],
+        &[
+            "--set",
+            "vpls=96",
+            "--set",
+            "interleave-n=4",
+            "--set",
+            "interleave-m=4",
+            "--set",
+            "split-block=16",
+        ][..],
         &["--debug-view", "ils-irradiance-tiled"][..],
         &["--debug-view", "ils-discontinuity", "--set", "bilinear=0"][..],
         &["--set", "brute-force=1", "--set", "blur=0"][..],
@@ -1043,7 +1088,14 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
     );
     assert_eq!(v["ref_spp"], 4);
     // §4.3 SSM: per-VPL shadow maps, named value on --set
-    let v = json_of(&run(&["--set", "vpls=48", "--set", "shadows=vpl", "--set", "vpl-shadow-resolution=16"]));
+    let v = json_of(&run(&[
+        "--set",
+        "vpls=48",
+        "--set",
+        "shadows=vpl",
+        "--set",
+        "vpl-shadow-resolution=16",
+    ]));
     assert_eq!(v["shadows"], "vpl", "{v}");
     assert!(v["reference"].as_str().unwrap().contains("SSM"), "{v}");
     // a 1x1 pattern is the brute force
@@ -1061,7 +1113,10 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
     for (extra, needles) in [
         (&["--set", "interleave-n=20"][..], &["interleave-n", "1..=16"][..]),
         (&["--set", "shadows=maybe"][..], &["shadows", "maybe"][..]),
-        (&["--set", "vpl-shadow-resolution=4"][..], &["vpl-shadow-resolution", "8..=512"][..]),
+        (
+            &["--set", "vpl-shadow-resolution=4"][..],
+            &["vpl-shadow-resolution", "8..=512"][..],
+        ),
         (&["--layers", "2"][..], &["--layers", "must be 1"][..]),
     ] {
         assert_one_line_error(&run(extra), needles);

@@ -58,11 +58,12 @@ pub const CUBE_FACES: [Vec3; 6] = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, V
 
 /// Indices (into `scene.lights`) of the `budget` most intense point lights:
 /// those that get a shadow map.
-fn shadowed_point_lights(scene: &Scene, budget: usize) -> Vec<usize> {
+fn shadowed_point_lights(scene: &Scene, budget: usize, off: &[usize]) -> Vec<usize> {
     let mut points: Vec<(usize, f32)> = scene
         .lights
         .iter()
         .enumerate()
+        .filter(|(i, _)| !off.contains(i))
         .filter_map(|(i, l)| match l {
             Light::Point { color, intensity, .. } => Some((i, intensity * (color[0] + color[1] + color[2]))),
             _ => None,
@@ -75,14 +76,29 @@ fn shadowed_point_lights(scene: &Scene, budget: usize) -> Vec<usize> {
 /// How many point lights go unshadowed with a shadow budget of `budget` point lights.
 pub fn unshadowed_point_lights(scene: &Scene, budget: usize) -> usize {
     let points = scene.lights.iter().filter(|l| matches!(l, Light::Point { .. })).count();
-    points - shadowed_point_lights(scene, budget).len()
+    points - shadowed_point_lights(scene, budget, &[]).len()
 }
 
 /// Converts the scene's lights, assigning shadow-map layers in order (a
 /// shadowed point light takes six: one per cube face; the `point_budget` most
 /// intense point lights are shadowed).
 pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32, point_budget: usize) -> Vec<GpuLight> {
-    let shadowed_points = shadowed_point_lights(scene, point_budget);
+    gpu_lights_for(
+        scene,
+        frame,
+        &crate::passes::shadow::ShadowSettings {
+            resolution: shadow_resolution,
+            point_lights: point_budget,
+            unshadowed: Vec::new(),
+        },
+    )
+}
+
+/// [`gpu_lights`] with every shadow setting: also the per-light switch
+/// (`ShadowSettings::unshadowed`), whose lights get no shadow-map layer.
+pub fn gpu_lights_for(scene: &Scene, frame: f32, shadow: &crate::passes::shadow::ShadowSettings) -> Vec<GpuLight> {
+    let (shadow_resolution, point_budget) = (shadow.resolution, shadow.point_lights);
+    let shadowed_points = shadowed_point_lights(scene, point_budget, &shadow.unshadowed);
     let (lo, hi) = scene.bounds(frame);
     let (center, radius) = if lo.is_finite() && hi.is_finite() {
         ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3))
@@ -96,7 +112,7 @@ pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32, point_budge
     };
     let next_layer = || next_layers(1);
     let res = shadow_resolution as f32;
-    scene
+    let lights: Vec<GpuLight> = scene
         .lights
         .iter()
         .enumerate()
@@ -193,6 +209,26 @@ pub fn gpu_lights(scene: &Scene, frame: f32, shadow_resolution: u32, point_budge
                     shadow_view_proj: (proj * view).to_cols_array_2d(),
                 }
             }
+        })
+        .collect();
+    if shadow.unshadowed.is_empty() {
+        return lights;
+    }
+    // Per-light shadows off: drop those lights' layers and renumber the rest.
+    let mut layer = 0u32;
+    lights
+        .into_iter()
+        .enumerate()
+        .map(|(index, mut g)| {
+            if g.kind[1] != NO_SHADOW {
+                if shadow.unshadowed.contains(&index) {
+                    g.kind[1] = NO_SHADOW;
+                } else {
+                    g.kind[1] = layer;
+                    layer += if g.kind[0] == KIND_POINT { 6 } else { 1 };
+                }
+            }
+            g
         })
         .collect()
 }

@@ -6,7 +6,7 @@ use strata_scene::{ImageBuf, Scene};
 
 use crate::frame::{validate_pass_order, FrameCameras, FrameUniforms, Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
-use crate::lights::{gpu_lights, GpuLight};
+use crate::lights::{gpu_lights_for, GpuLight};
 use crate::passes::ao::stage::AoStage;
 use crate::passes::ao::{AoSettings, AoUniforms};
 use crate::passes::deep_gbuffer::{self, DeepGBufferSettings, Variant};
@@ -239,7 +239,7 @@ impl RenderSettings {
         }
         if self.shade {
             bytes += sum(crate::passes::lighting::OUTPUTS) + sum(crate::passes::tonemap::OUTPUTS);
-            let lights = gpu_lights(scene, 0.0, self.shadow.resolution, self.shadow.point_lights);
+            let lights = gpu_lights_for(scene, 0.0, &self.shadow);
             let maps = crate::lights::shadow_layer_count(&lights).max(1) as u64;
             bytes += maps * (self.shadow.resolution as u64).pow(2) * 4;
         }
@@ -299,8 +299,16 @@ impl RenderSettings {
                 limits.max_texture_array_layers
             )));
         }
+        if let Some(&i) = self.shadow.unshadowed.iter().find(|&&i| i >= scene.lights.len()) {
+            return Err(RenderError::Parameter(format!(
+                "no-shadow light {i} is out of range: scene '{}' has {} lights (0..{})",
+                scene.name,
+                scene.lights.len(),
+                scene.lights.len()
+            )));
+        }
         if self.shade {
-            let lights = gpu_lights(scene, 0.0, self.shadow.resolution, self.shadow.point_lights);
+            let lights = gpu_lights_for(scene, 0.0, &self.shadow);
             let maps = crate::lights::shadow_layer_count(&lights);
             if maps > limits.max_texture_array_layers {
                 return Err(RenderError::Parameter(format!(
@@ -388,7 +396,7 @@ impl Renderer {
                 targets.create(gpu, *d);
             }
         }
-        let lights = gpu_lights(scene, 0.0, settings.shadow.resolution, settings.shadow.point_lights);
+        let lights = gpu_lights_for(scene, 0.0, &settings.shadow);
         let geometry = deep_gbuffer::geometry_passes(gpu, &scene_gpu, &targets, &settings.deep)?;
         let pack = deep_gbuffer::PackPass::new(gpu, &targets, &settings.deep);
         let (shadow, lighting, tonemap) = if settings.shade {
@@ -629,7 +637,7 @@ impl Renderer {
         }
         if self.animated {
             if let (Some(s), Some(l)) = (&self.shadow, &self.lighting) {
-                self.lights = gpu_lights(scene, frame, self.settings.shadow.resolution, self.settings.shadow.point_lights);
+                self.lights = gpu_lights_for(scene, frame, &self.settings.shadow);
                 s.update(gpu, &crate::lights::shadow_matrices(scene, frame, &self.lights));
                 l.update_lights(gpu, &self.lights);
             }

@@ -178,7 +178,11 @@ fn light_test_scene(light: Light) -> Scene {
     };
     let mut geo = MeshBuilder::new();
     geo.rect(Vec3::ZERO, Vec3::new(0.0, 0.0, 5.0), Vec3::new(5.0, 0.0, 0.0)); // floor, +Y
-    geo.rect(Vec3::new(0.0, 2.5, -3.0), Vec3::new(5.0, 0.0, 0.0), Vec3::new(0.0, 2.5, 0.0)); // wall, +Z
+    geo.rect(
+        Vec3::new(0.0, 2.5, -3.0),
+        Vec3::new(5.0, 0.0, 0.0),
+        Vec3::new(0.0, 2.5, 0.0),
+    ); // wall, +Z
     s.meshes.push(geo.build("room", 0));
     s.objects.push(Object {
         name: "room".into(),
@@ -304,5 +308,58 @@ fn direct_light_per_type_matches_the_reference() {
         let e = direct_light_error(light);
         eprintln!("{name}: relative MAE of the direct light {e:.4}");
         assert!(e < tolerance, "{name}: relative MAE {e:.4} >= {tolerance}");
+    }
+}
+
+/// Issue 17's per-light switch: with `ShadowSettings::unshadowed = [0]` the
+/// atrium's sun (light 0) casts no shadow — its visibility is exactly 1 wherever
+/// it faces the surface (0 on back-facing pixels, as with shadows on) — while
+/// with shadows on, a real share of the pixels is in its shadow; an index past
+/// the scene's lights is a one-line error naming the setting.
+#[test]
+fn per_light_shadow_switch_turns_a_lights_shadow_off() {
+    use strata_render::frame::FrameCameras;
+    use strata_render::passes::shadow::ShadowSettings;
+    use strata_render::{RenderError, RenderSettings, Renderer};
+    let scene = procedural::builtin("atrium").unwrap();
+    assert!(matches!(scene.lights.first(), Some(Light::Sun { .. })));
+    let gpu = common::gpu();
+    let (w, h) = (96, 54);
+    let settings = |unshadowed: Vec<usize>| RenderSettings {
+        width: w,
+        height: h,
+        shadow: ShadowSettings {
+            unshadowed,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let visibility = |unshadowed: Vec<usize>| -> Vec<f32> {
+        let mut r = Renderer::new(&gpu, &scene, settings(unshadowed)).expect("renderer builds");
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders");
+        r.read_target(&gpu, "shadow").unwrap().data
+    };
+    let on = visibility(Vec::new());
+    let off = visibility(vec![0]);
+    let lifted = on.iter().zip(&off).filter(|(a, b)| **b > **a + 0.5).count();
+    eprintln!(
+        "atrium: the sun's shadow switched off lifts {:.1}% of the pixels",
+        100.0 * lifted as f64 / on.len() as f64
+    );
+    for (a, b) in on.iter().zip(&off) {
+        assert!(
+            *b == 0.0 || *b == 1.0,
+            "unshadowed visibility must be 0 (back-facing) or 1, got {b}"
+        );
+        assert!(*b >= *a, "switching a shadow off cannot darken ({a} -> {b})");
+    }
+    assert!(lifted * 20 > on.len(), "the sun should shadow part of the atrium");
+    match Renderer::new(&gpu, &scene, settings(vec![scene.lights.len()])) {
+        Err(RenderError::Parameter(m)) => {
+            assert!(m.contains("no-shadow light") && !m.contains('\n'), "{m}")
+        }
+        Err(e) => panic!("wrong error: {e}"),
+        Ok(_) => panic!("an out-of-range light index must be refused"),
     }
 }

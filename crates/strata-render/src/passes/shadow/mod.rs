@@ -17,6 +17,9 @@ pub struct ShadowSettings {
     /// How many point lights (the most intense) get omnidirectional shadow maps;
     /// the others are unshadowed. Default [`crate::lights::POINT_SHADOW_BUDGET`] (2).
     pub point_lights: usize,
+    /// Lights (indices into the scene's list, as `strata render --list-lights`
+    /// numbers them) that cast no shadow: per-light shadows off. Default none.
+    pub unshadowed: Vec<usize>,
 }
 
 impl Default for ShadowSettings {
@@ -24,6 +27,7 @@ impl Default for ShadowSettings {
         Self {
             resolution: 2048,
             point_lights: crate::lights::POINT_SHADOW_BUDGET,
+            unshadowed: Vec::new(),
         }
     }
 }
@@ -175,8 +179,10 @@ impl ShadowPass {
     /// and the lights); the layer count is fixed at creation.
     pub fn update(&self, gpu: &GpuContext, matrices: &[[[f32; 4]; 4]]) {
         for (i, m) in matrices.iter().enumerate().take(self.layer_views.len()) {
-            gpu.queue.write_buffer(&self.views_buffer, i as u64 * STRIDE, bytemuck::bytes_of(m));
-            gpu.queue.write_buffer(&self.matrices, i as u64 * 64, bytemuck::bytes_of(m));
+            gpu.queue
+                .write_buffer(&self.views_buffer, i as u64 * STRIDE, bytemuck::bytes_of(m));
+            gpu.queue
+                .write_buffer(&self.matrices, i as u64 * 64, bytemuck::bytes_of(m));
         }
     }
 }
