@@ -1250,3 +1250,116 @@ fn compare_reports_zero_for_identical_images_and_refuses_size_mismatch() {
     let o = strata(&["compare", a.to_str().unwrap(), b.to_str().unwrap(), "--exposure", "1"]);
     assert_one_line_error(&o, &["same size"]);
 }
+
+/// Writes a glTF (JSON + external .bin) of a 4 × 4 floor quad at y = 0 (normal
+/// +Y) seen from above by a camera node; `extension` is inserted at the top
+/// level and `light_nodes` appended to the nodes (the scene lists nodes 0.. all).
+fn floor_gltf(name: &str, extension: &str, light_nodes: &[&str]) -> PathBuf {
+    let floats: [f32; 24] = [
+        -2.0, 0.0, -2.0, 0.0, 1.0, 0.0, //
+        -2.0, 0.0, 2.0, 0.0, 1.0, 0.0, //
+        2.0, 0.0, 2.0, 0.0, 1.0, 0.0, //
+        2.0, 0.0, -2.0, 0.0, 1.0, 0.0,
+    ];
+    let mut bin: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    bin.extend([0u16, 1, 2, 0, 2, 3].iter().flat_map(|i| i.to_le_bytes()));
+    let bin_path = scratch(&format!("{name}.bin"));
+    std::fs::write(&bin_path, &bin).unwrap();
+    let mut nodes = vec![
+        r#"{"mesh": 0}"#.to_string(),
+        // camera 3 m above, looking straight down (−Z rotated onto −Y)
+        r#"{"camera": 0, "translation": [0, 3, 0], "rotation": [-0.70710677, 0, 0, 0.70710677]}"#.to_string(),
+    ];
+    nodes.extend(light_nodes.iter().map(|s| s.to_string()));
+    let all: Vec<String> = (0..nodes.len()).map(|i| i.to_string()).collect();
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, {extension}
+  "scene": 0, "scenes": [{{"nodes": [{all}]}}],
+  "nodes": [{nodes}],
+  "cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.9, "znear": 0.05}}}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1}}, "indices": 2, "material": 0}}]}}],
+  "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0}}}}],
+  "buffers": [{{"uri": "{name}.bin", "byteLength": {len}}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 96, "byteStride": 24}}, {{"buffer": 0, "byteOffset": 96, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "byteOffset": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]}},
+    {{"bufferView": 0, "byteOffset": 12, "componentType": 5126, "count": 4, "type": "VEC3"}},
+    {{"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]}}"#,
+        all = all.join(", "),
+        nodes = nodes.join(",\n    "),
+        len = bin.len()
+    );
+    let p = scratch(&format!("{name}.gltf"));
+    std::fs::write(&p, json).unwrap();
+    p
+}
+
+/// Mean linear-ish RGB of the central quarter of a PNG.
+fn centre_rgb(path: &Path) -> [f64; 3] {
+    let img = image::open(path).unwrap().to_rgb8();
+    let (w, h) = img.dimensions();
+    let mut sum = [0.0; 3];
+    let mut n = 0.0;
+    for y in h * 3 / 8..h * 5 / 8 {
+        for x in w * 3 / 8..w * 5 / 8 {
+            let p = img.get_pixel(x, y);
+            for c in 0..3 {
+                sum[c] += p[c] as f64;
+            }
+            n += 1.0;
+        }
+    }
+    sum.map(|s| s / n)
+}
+
+/// Issue 17's must-show: `strata render` of a glTF carrying `KHR_lights_punctual`
+/// lights it with those lights (a red point light above the floor makes the floor
+/// red; the same file without the extension gets the default white sun), and
+/// `--list-lights` lists them in strata's units (candela ÷ 683).
+#[test]
+fn gltf_punctual_lights_light_the_render() {
+    let lit = floor_gltf(
+        "red-bulb",
+        r#""extensionsUsed": ["KHR_lights_punctual"], "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "color": [1.0, 0.1, 0.1], "intensity": 1366.0}]}},"#,
+        &[r#"{"translation": [0, 1.5, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}"#],
+    );
+    let plain = floor_gltf("no-lights", "", &[]);
+    let o = strata(&["render", "--scene", lit.to_str().unwrap(), "--list-lights"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains("lights of")
+            && out.contains("point position (0.000, 1.500, 0.000)")
+            && out.contains("intensity 2"),
+        "{out}"
+    );
+    let mut rgb = Vec::new();
+    for (scene, png) in [(&lit, "red-bulb.png"), (&plain, "no-lights.png")] {
+        let out = scratch(png);
+        let o = strata(&[
+            "render",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        rgb.push(centre_rgb(&out));
+    }
+    eprintln!("centre RGB: red bulb {:?}, default sun {:?}", rgb[0], rgb[1]);
+    assert!(
+        rgb[0][0] > 1.5 * rgb[0][1] + 10.0,
+        "the red bulb lights the floor red: {:?}",
+        rgb[0]
+    );
+    assert!(
+        (rgb[1][0] - rgb[1][1]).abs() < 0.25 * rgb[1][0] + 5.0,
+        "the default sun is near white: {:?}",
+        rgb[1]
+    );
+}
