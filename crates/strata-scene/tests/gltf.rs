@@ -55,6 +55,11 @@ fn tiny_glb(last_index: u16) -> Vec<u8> {
 /// appended to the node list (indices 4, 5, …) and `scene_nodes` appended to
 /// the scene's root nodes.
 fn tiny_glb_with(last_index: u16, root: &str, nodes: &str, scene_nodes: &str) -> Vec<u8> {
+    tiny_glb_alpha(last_index, root, nodes, scene_nodes, r#""alphaMode": "BLEND""#)
+}
+
+/// [`tiny_glb_with`] with the material's `alphaMode` entry (and its cutoff) given as JSON.
+fn tiny_glb_alpha(last_index: u16, root: &str, nodes: &str, scene_nodes: &str, alpha: &str) -> Vec<u8> {
     let positions = f32_bytes(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0]);
     let uvs = f32_bytes(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]);
     let indices: Vec<u8> = [0u16, 1, 2, 0, 2, last_index]
@@ -87,7 +92,7 @@ fn tiny_glb_with(last_index: u16, root: &str, nodes: &str, scene_nodes: &str) ->
     "pbrMetallicRoughness": {{"baseColorFactor": [0.5, 0.25, 1.0, 0.5], "baseColorTexture": {{"index": 0}}, "metallicFactor": 0.3, "roughnessFactor": 0.6}},
     "emissiveFactor": [1.0, 0.5, 0.0],
     "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": 4.0}}}},
-    "alphaMode": "BLEND"
+    {alpha}
   }}],
   "textures": [{{"source": 0}}],
   "images": [{{"bufferView": 3, "mimeType": "image/png"}}],
@@ -278,4 +283,34 @@ fn garbage_gltf_is_an_error() {
     );
     let e = load_path(&p).expect_err("missing buffer loaded").to_string();
     assert!(e.contains("missing_buffer.gltf"), "{e}");
+}
+
+#[test]
+fn alpha_modes_set_cutoff_and_texture_alpha() {
+    // BLEND: opacity = factor alpha, texture alpha multiplies it, no cutoff.
+    let s = load_path(&write("blend.glb", &tiny_glb(3))).unwrap();
+    let m = &s.materials[0];
+    assert_eq!((m.opacity, m.alpha_cutoff, m.texture_alpha), (0.5, None, true));
+    assert_eq!(m.fragment_alpha(0.5), Some(0.25));
+    // MASK with an explicit cutoff: kept iff 0.5 × texture alpha ≥ 0.3, then opaque.
+    let mask = tiny_glb_alpha(3, "", "", "", r#""alphaMode": "MASK", "alphaCutoff": 0.3"#);
+    let s = load_path(&write("mask.glb", &mask)).unwrap();
+    let m = &s.materials[0];
+    assert_eq!((m.alpha_cutoff, m.texture_alpha), (Some(0.3), true));
+    assert_eq!(m.fragment_alpha(1.0), Some(1.0));
+    assert_eq!(m.fragment_alpha(0.5), None);
+    assert!(!m.is_opaque());
+    // MASK without a cutoff: the glTF default 0.5.
+    let mask = tiny_glb_alpha(3, "", "", "", r#""alphaMode": "MASK""#);
+    let s = load_path(&write("mask5.glb", &mask)).unwrap();
+    assert_eq!(s.materials[0].alpha_cutoff, Some(0.5));
+    assert_eq!(s.materials[0].fragment_alpha(1.0), Some(1.0));
+    assert_eq!(s.materials[0].fragment_alpha(0.99), None, "0.5 × 0.99 < 0.5");
+    // OPAQUE: factor and texture alpha are both ignored.
+    let opaque = tiny_glb_alpha(3, "", "", "", r#""alphaMode": "OPAQUE""#);
+    let s = load_path(&write("opaque.glb", &opaque)).unwrap();
+    let m = &s.materials[0];
+    assert_eq!((m.opacity, m.alpha_cutoff, m.texture_alpha), (1.0, None, false));
+    assert_eq!(m.fragment_alpha(0.0), Some(1.0));
+    assert!(m.is_opaque());
 }

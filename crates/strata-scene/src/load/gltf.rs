@@ -61,6 +61,9 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
             },
             roughness: pbr.roughness_factor(),
             metallic: pbr.metallic_factor(),
+            alpha_cutoff: (m.alpha_mode() == gltf::material::AlphaMode::Mask)
+                .then(|| m.alpha_cutoff().unwrap_or(0.5)),
+            texture_alpha: m.alpha_mode() != gltf::material::AlphaMode::Opaque,
         };
         check_material(path, &mut mat)?;
         let mut uv_set = 0;
