@@ -55,8 +55,8 @@ pub mod oit;
 pub mod probes;
 pub mod sampling;
 pub mod tracer;
-pub mod wide;
 pub mod vpl;
+pub mod wide;
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -75,8 +75,8 @@ pub use gi::{GiImages, GiSettings};
 pub use layers::{DeepLayers, Layer, LayerSettings, NO_ID};
 pub use oit::{Crossing, OpacityAo};
 pub use tracer::{AnyTracer, Tracer, TracerKind};
-pub use wide::WideBvh;
 pub use vpl::{Vpl, VplSettings};
+pub use wide::WideBvh;
 
 /// Counters accumulated over every computation run on a [`Reference`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -189,7 +189,11 @@ pub fn light_irradiance(light: &Light, x: Vec3, n: Vec3) -> Vec3 {
         } => {
             let (e, to_x) = point(position, Vec3::from(color) * intensity);
             let axis = direction.normalize_or_zero();
-            e * smoothstep(outer_deg.to_radians().cos(), inner_deg.to_radians().cos(), axis.dot(to_x))
+            e * smoothstep(
+                outer_deg.to_radians().cos(),
+                inner_deg.to_radians().cos(),
+                axis.dot(to_x),
+            )
         }
         Light::Rect {
             center,
@@ -305,6 +309,7 @@ impl Reference<'_> {
         out
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn crossings_into(
         &self,
         camera: &Camera,
@@ -317,7 +322,8 @@ impl Reference<'_> {
     ) {
         out.clear();
         let dir = camera.pixel_dir(x, y, width, height);
-        self.bvh().intersect_all(camera.eye, dir, camera.near, f32::INFINITY, hits);
+        self.bvh()
+            .intersect_all(camera.eye, dir, camera.near, f32::INFINITY, hits);
         let scene = self.scene();
         let ambient = Vec3::from(scene.settings.ambient);
         let mut last: Option<(f32, u32, u32, bool)> = None; // (t, object, material, front)

@@ -187,11 +187,23 @@ fn lit_glb(spot: &str) -> Vec<u8> {
 
 #[test]
 fn gltf_punctual_lights_and_cameras_load_with_the_extension_units() {
-    let p = write("lit.glb", &lit_glb(r#", "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}"#));
+    let p = write(
+        "lit.glb",
+        &lit_glb(r#", "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}"#),
+    );
     let s = load_path(&p).expect("lit glb");
-    assert_eq!(s.lights.len(), 3, "the file's lights replace the default sun: {:?}", s.lights);
+    assert_eq!(
+        s.lights.len(),
+        3,
+        "the file's lights replace the default sun: {:?}",
+        s.lights
+    );
     let sun = s.lights.iter().find_map(|l| match l {
-        strata_scene::Light::Sun { direction, color, illuminance } => Some((*direction, *color, *illuminance)),
+        strata_scene::Light::Sun {
+            direction,
+            color,
+            illuminance,
+        } => Some((*direction, *color, *illuminance)),
         _ => None,
     });
     let (dir, color, lux) = sun.expect("a sun");
@@ -199,21 +211,37 @@ fn gltf_punctual_lights_and_cameras_load_with_the_extension_units() {
     assert_eq!(color, [1.0, 0.9, 0.8]);
     assert!((lux - 1.0).abs() < 1e-6, "683 lux = 1 W/m²: {lux}");
     let point = s.lights.iter().find_map(|l| match l {
-        strata_scene::Light::Point { position, intensity, color } => Some((*position, *intensity, *color)),
+        strata_scene::Light::Point {
+            position,
+            intensity,
+            color,
+        } => Some((*position, *intensity, *color)),
         _ => None,
     });
     let (pos, cd, white) = point.expect("a point light");
-    assert!(pos.abs_diff_eq(Vec3::new(1.0, 3.0, 0.0), 1e-6), "parent × child translation: {pos}");
+    assert!(
+        pos.abs_diff_eq(Vec3::new(1.0, 3.0, 0.0), 1e-6),
+        "parent × child translation: {pos}"
+    );
     assert!((cd - 2.0).abs() < 1e-6 && white == [1.0; 3]);
     let spot = s.lights.iter().find_map(|l| match l {
-        strata_scene::Light::Spot { position, direction, intensity, inner_deg, outer_deg, .. } => {
-            Some((*position, *direction, *intensity, *inner_deg, *outer_deg))
-        }
+        strata_scene::Light::Spot {
+            position,
+            direction,
+            intensity,
+            inner_deg,
+            outer_deg,
+            ..
+        } => Some((*position, *direction, *intensity, *inner_deg, *outer_deg)),
         _ => None,
     });
     let (pos, dir, i, inner, outer) = spot.expect("a spot");
     assert!(pos.abs_diff_eq(Vec3::new(0.0, 2.0, 0.0), 1e-6) && dir.abs_diff_eq(-Vec3::Z, 1e-6));
-    assert!((i - 0.1).abs() < 1e-6 && (inner - 0.2f32.to_degrees()).abs() < 1e-4 && (outer - 0.5f32.to_degrees()).abs() < 1e-4);
+    assert!(
+        (i - 0.1).abs() < 1e-6
+            && (inner - 0.2f32.to_degrees()).abs() < 1e-4
+            && (outer - 0.5f32.to_degrees()).abs() < 1e-4
+    );
     // both cameras, in node order; the first is the camera
     assert_eq!(s.cameras.len(), 2);
     assert_eq!(s.camera, s.cameras[0]);
@@ -227,8 +255,14 @@ fn gltf_punctual_lights_and_cameras_load_with_the_extension_units() {
 #[test]
 fn bad_punctual_lights_are_one_line_errors() {
     for (spot, words) in [
-        (r#", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.5}"#, &["cone", "inner < outer"][..]),
-        (r#", "spot": {"innerConeAngle": 0.1, "outerConeAngle": 2.0}"#, &["π/2"][..]),
+        (
+            r#", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.5}"#,
+            &["cone", "inner < outer"][..],
+        ),
+        (
+            r#", "spot": {"innerConeAngle": 0.1, "outerConeAngle": 2.0}"#,
+            &["π/2"][..],
+        ),
     ] {
         let p = write("badspot.glb", &lit_glb(spot));
         let e = load_path(&p).unwrap_err().to_string();

@@ -171,7 +171,11 @@ fn material_overrides_by_name_and_wildcard() {
     assert_eq!(s.materials.len(), base.materials.len());
     for (m, b) in s.materials.iter().zip(&base.materials) {
         assert_eq!(m.opacity, 0.3, "{}", m.name);
-        let want = if m.name == "wall" { [0.1, 0.2, 0.3] } else { b.base_color };
+        let want = if m.name == "wall" {
+            [0.1, 0.2, 0.3]
+        } else {
+            b.base_color
+        };
         assert_eq!(m.base_color, want, "{}", m.name);
         assert_eq!((m.roughness, m.emission), (b.roughness, b.emission), "{}", m.name);
     }
@@ -186,7 +190,10 @@ fn material_overrides_by_name_and_wildcard() {
 
 #[test]
 fn material_override_errors_name_file_material_and_range() {
-    let e = toml_err("bad.toml", "builtin = \"plane\"\n[[material]]\nname = \"glass\"\nopacity = 0.5\n");
+    let e = toml_err(
+        "bad.toml",
+        "builtin = \"plane\"\n[[material]]\nname = \"glass\"\nopacity = 0.5\n",
+    );
     assert!(
         e.starts_with("bad.toml") && e.contains("'glass'") && e.contains("grey") && !e.contains('\n'),
         "{e}"
@@ -197,7 +204,10 @@ fn material_override_errors_name_file_material_and_range() {
             &format!("builtin = \"plane\"\n[[material]]\nname = \"grey\"\nopacity = {value}\n"),
         );
         assert!(
-            e.starts_with("range.toml") && e.contains("material[0].opacity") && e.contains(shown) && e.contains("0..=1"),
+            e.starts_with("range.toml")
+                && e.contains("material[0].opacity")
+                && e.contains(shown)
+                && e.contains("0..=1"),
             "{e}"
         );
     }
@@ -206,7 +216,10 @@ fn material_override_errors_name_file_material_and_range() {
         "builtin = \"plane\"\n[[material]]\nname = \"grey\"\nbase_color = [0.5, 2, 0]\n",
     );
     assert!(e.contains("material[0].base_color") && e.contains("0..=1"), "{e}");
-    let e = toml_err("key.toml", "builtin = \"plane\"\n[[material]]\nname = \"grey\"\nalpha = 0.5\n");
+    let e = toml_err(
+        "key.toml",
+        "builtin = \"plane\"\n[[material]]\nname = \"grey\"\nalpha = 0.5\n",
+    );
     assert!(e.starts_with("key.toml") && e.contains("alpha"), "{e}");
 }
 
@@ -250,7 +263,10 @@ fn repeat_count_and_offset_are_checked() {
             "{e}"
         );
     }
-    let e = toml_err("off.toml", "builtin = \"plane\"\n[repeat]\ncount = 2\noffset = [0, inf, 1]\n");
+    let e = toml_err(
+        "off.toml",
+        "builtin = \"plane\"\n[repeat]\ncount = 2\noffset = [0, inf, 1]\n",
+    );
     assert!(e.contains("repeat.offset") && e.contains("finite"), "{e}");
     let e = toml_err("miss.toml", "builtin = \"plane\"\n[repeat]\ncount = 2\n");
     assert!(e.starts_with("miss.toml") && e.contains("offset"), "{e}");

@@ -59,7 +59,10 @@ fn glasshouse_centre_ray_crosses_every_pane_in_order() {
     let cam = s.camera;
     // The centre of a 9×9 image looks exactly at the camera target.
     let list = r.crossings(&cam, 4, 4, 9, 9);
-    let names: Vec<&str> = list.iter().map(|c| s.materials[c.material as usize].name.as_str()).collect();
+    let names: Vec<&str> = list
+        .iter()
+        .map(|c| s.materials[c.material as usize].name.as_str())
+        .collect();
     let want = [
         "glass_red",
         "glass_red",
@@ -92,7 +95,10 @@ fn glasshouse_centre_ray_crosses_every_pane_in_order() {
     assert_eq!(transparent, 12, "≥ 8 transparent crossings before the block");
     // Over a whole (small) image, a good share of the pixels sees ≥ 8 transparent layers.
     let all = r.crossings_image(&cam, 48, 27);
-    let deep = all.iter().filter(|l| l.iter().filter(|c| c.alpha < 1.0).count() >= 8).count();
+    let deep = all
+        .iter()
+        .filter(|l| l.iter().filter(|c| c.alpha < 1.0).count() >= 8)
+        .count();
     assert!(deep >= 48 * 27 / 10, "{deep} pixels with ≥ 8 transparent crossings");
     assert_eq!(all[13 * 48 + 24], r.crossings(&cam, 24, 13, 48, 27));
 }
@@ -139,7 +145,10 @@ fn mask_and_texture_alpha_decide_fragment_alpha() {
     let cam = axis_camera(0.05);
     let mut s = pane_scene(&[(glass("m", [0.5; 3], 0.4), 0.3)], [0.0; 3], [0.0; 3]);
     s.materials[0].alpha_cutoff = Some(0.5);
-    assert!(Reference::new(&s, 0.0).crossings(&cam, 0, 0, 1, 1).is_empty(), "0.4 < cutoff 0.5: discarded");
+    assert!(
+        Reference::new(&s, 0.0).crossings(&cam, 0, 0, 1, 1).is_empty(),
+        "0.4 < cutoff 0.5: discarded"
+    );
     s.materials[0].opacity = 0.6;
     let list = Reference::new(&s, 0.0).crossings(&cam, 0, 0, 1, 1);
     assert_eq!((list.len(), list[0].alpha), (1, 1.0), "kept MASK fragments are opaque");
@@ -178,7 +187,11 @@ fn one_pane_over_an_opaque_plane_composites_in_closed_form() {
     let img = r.composite(&s.camera, 1, 1);
     let (l1, l2) = (albedo1 * Vec3::from(amb), albedo2 * Vec3::from(amb));
     let want = a1 * l1 + (1.0 - a1) * l2; // the opaque wall hides the sky
-    assert!(close(Vec3::from_slice(&img.data), want, 1e-6), "{:?} vs {want}", img.data);
+    assert!(
+        close(Vec3::from_slice(&img.data), want, 1e-6),
+        "{:?} vs {want}",
+        img.data
+    );
 }
 
 #[test]
@@ -223,12 +236,17 @@ fn an_opaque_crossing_ends_the_list() {
     let want = 0.5 * Vec3::new(0.8, 0.8, 0.1) + 0.5 * Vec3::from(wall.base_color);
     assert!(close(c, want, 1e-6), "{c} vs {want}");
     // Many transparent layers: stops once T < 1e-4 (10 layers of α = 0.7 leave 0.3^10).
-    let many: Vec<_> = (0..10).map(|i| (glass("g", [1.0; 3], 0.7), 2.0 - 0.3 * i as f32)).collect();
+    let many: Vec<_> = (0..10)
+        .map(|i| (glass("g", [1.0; 3], 0.7), 2.0 - 0.3 * i as f32))
+        .collect();
     let s = pane_scene(&many, amb, [0.0; 3]);
     let list = Reference::new(&s, 0.0).crossings(&s.camera, 0, 0, 1, 1);
     assert_eq!(list.len(), 10);
     let (c, t) = composite_crossings(&list, Vec3::ZERO);
-    assert!((t - 0.3f32.powi(8)).abs() < 1e-9, "stopped after the 8th layer: T = {t}");
+    assert!(
+        (t - 0.3f32.powi(8)).abs() < 1e-9,
+        "stopped after the 8th layer: T = {t}"
+    );
     assert!((c.x - (1.0 - 0.3f32.powi(8))).abs() < 1e-5, "{c}");
 }
 
@@ -242,7 +260,14 @@ fn shading_model_matches_analytic_lights() {
         illuminance: 2.0,
     };
     let e = light_irradiance(&sun, x, n);
-    assert!(close(e, Vec3::new(1.0, 0.5, 0.25) * 2.0 * std::f32::consts::FRAC_1_SQRT_2, 1e-6), "{e}");
+    assert!(
+        close(
+            e,
+            Vec3::new(1.0, 0.5, 0.25) * 2.0 * std::f32::consts::FRAC_1_SQRT_2,
+            1e-6
+        ),
+        "{e}"
+    );
     assert_eq!(light_irradiance(&sun, x, -n), Vec3::ZERO);
     let point = Light::Point {
         position: Vec3::new(0.0, 2.0, 0.0),
@@ -258,11 +283,22 @@ fn shading_model_matches_analytic_lights() {
         inner_deg: 20.0,
         outer_deg: 30.0,
     };
-    assert!(close(light_irradiance(&spot(-Vec3::Y), x, n), Vec3::splat(2.0), 1e-6), "on the axis");
-    assert_eq!(light_irradiance(&spot(Vec3::new(1.0, -1.0, 0.0)), x, n), Vec3::ZERO, "45° off axis");
+    assert!(
+        close(light_irradiance(&spot(-Vec3::Y), x, n), Vec3::splat(2.0), 1e-6),
+        "on the axis"
+    );
+    assert_eq!(
+        light_irradiance(&spot(Vec3::new(1.0, -1.0, 0.0)), x, n),
+        Vec3::ZERO,
+        "45° off axis"
+    );
     // Halfway between the cone angles: smoothstep(cos 30°, cos 20°, cos 25°).
     let axis = Vec3::new(25f32.to_radians().sin(), -25f32.to_radians().cos(), 0.0);
-    let (c0, c1, c) = (30f32.to_radians().cos(), 20f32.to_radians().cos(), 25f32.to_radians().cos());
+    let (c0, c1, c) = (
+        30f32.to_radians().cos(),
+        20f32.to_radians().cos(),
+        25f32.to_radians().cos(),
+    );
     let u = (c - c0) / (c1 - c0);
     let got = light_irradiance(&spot(axis), x, n).x;
     assert!((got - 2.0 * u * u * (3.0 - 2.0 * u)).abs() < 1e-5, "{got}");
@@ -295,20 +331,27 @@ fn rect_irradiance_mc(p: Vec3, n: Vec3, c: Vec3, hu: Vec3, hv: Vec3, samples: u3
 
 #[test]
 fn rect_irradiance_matches_monte_carlo() {
-    let (c, hu, hv) = (Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.5));
+    let (c, hu, hv) = (
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.5),
+    );
     // normal hu × hv = −Y: the light faces down.
     let cases = [
-        (Vec3::ZERO, Vec3::Y),                                    // below, facing it
-        (Vec3::new(1.5, 0.0, 0.3), Vec3::new(-0.3, 1.0, 0.2)),    // off to the side, tilted
-        (Vec3::new(0.0, 1.9, 0.0), Vec3::X),                      // just below: half the light is behind
-        (Vec3::new(0.7, 1.8, 0.1), Vec3::new(1.0, 0.3, 0.0)),     // clipped by the horizon
+        (Vec3::ZERO, Vec3::Y),                                 // below, facing it
+        (Vec3::new(1.5, 0.0, 0.3), Vec3::new(-0.3, 1.0, 0.2)), // off to the side, tilted
+        (Vec3::new(0.0, 1.9, 0.0), Vec3::X),                   // just below: half the light is behind
+        (Vec3::new(0.7, 1.8, 0.1), Vec3::new(1.0, 0.3, 0.0)),  // clipped by the horizon
     ];
     for (p, n) in cases {
         let n = n.normalize();
         let exact = rect_irradiance(p, n, c, hu, hv, hu.cross(hv).normalize()) as f64;
         let mc = rect_irradiance_mc(p, n, c, hu, hv, 400_000);
         assert!(exact > 0.0);
-        assert!((exact - mc).abs() < 0.01 * mc + 1e-4, "p {p} n {n}: exact {exact} vs MC {mc}");
+        assert!(
+            (exact - mc).abs() < 0.01 * mc + 1e-4,
+            "p {p} n {n}: exact {exact} vs MC {mc}"
+        );
     }
     // Behind the one-sided light, or facing away: nothing.
     let nl = hu.cross(hv).normalize();
@@ -322,7 +365,11 @@ fn rect_irradiance_matches_monte_carlo() {
         radiance: [2.0, 1.0, 0.0],
     };
     let f = rect_irradiance(Vec3::ZERO, Vec3::Y, c, hu, hv, nl);
-    assert!(close(light_irradiance(&rect, Vec3::ZERO, Vec3::Y), Vec3::new(2.0, 1.0, 0.0) * f, 1e-6));
+    assert!(close(
+        light_irradiance(&rect, Vec3::ZERO, Vec3::Y),
+        Vec3::new(2.0, 1.0, 0.0) * f,
+        1e-6
+    ));
 }
 
 // ---------------------------------------------------------------- AO with opacity
@@ -368,7 +415,11 @@ fn floor_with_occluder(occluder: Material) -> Scene {
     add_triangles(
         &mut s,
         "occluder",
-        &quad(Vec3::new(0.2, 0.3, 0.0), Vec3::new(0.0, 0.0, 0.3), Vec3::new(0.3, 0.0, 0.0)),
+        &quad(
+            Vec3::new(0.2, 0.3, 0.0),
+            Vec3::new(0.0, 0.0, 0.3),
+            Vec3::new(0.3, 0.0, 0.0),
+        ),
         1,
     );
     s
@@ -388,8 +439,16 @@ fn a_single_occluder_of_opacity_alpha_darkens_by_alpha_times_opaque_occlusion() 
             let rs = Reference::new(&s, 0.0);
             let ao = rs.ao_with_opacity(p, Vec3::Y, Vec3::Y, 1.0, true, &set, key);
             let want = 1.0 - alpha * (1.0 - v);
-            assert!((ao.strongest - want).abs() < 1e-5, "α {alpha}: {} vs {want}", ao.strongest);
-            assert!((ao.transmittance - want).abs() < 1e-5, "α {alpha}: {} vs {want}", ao.transmittance);
+            assert!(
+                (ao.strongest - want).abs() < 1e-5,
+                "α {alpha}: {} vs {want}",
+                ao.strongest
+            );
+            assert!(
+                (ao.transmittance - want).abs() < 1e-5,
+                "α {alpha}: {} vs {want}",
+                ao.transmittance
+            );
         }
     }
 }
@@ -407,9 +466,17 @@ fn a_two_layer_stack_separates_the_two_models() {
     }
     let r = Reference::new(&s, 0.0);
     let ao = r.ao_with_opacity(Vec3::ZERO, Vec3::Y, Vec3::Y, 1.0, true, &ao_settings(1.0, 128), 5);
-    assert!((ao.strongest - (1.0 - alpha)).abs() < 1e-5, "strongest {}", ao.strongest);
+    assert!(
+        (ao.strongest - (1.0 - alpha)).abs() < 1e-5,
+        "strongest {}",
+        ao.strongest
+    );
     let want = (1.0 - alpha) * (1.0 - alpha); // 1 − occlusion 1 − (1 − α)²
-    assert!((ao.transmittance - want).abs() < 1e-5, "transmittance {}", ao.transmittance);
+    assert!(
+        (ao.transmittance - want).abs() < 1e-5,
+        "transmittance {}",
+        ao.transmittance
+    );
     // One shell: the models agree.
     s.objects.truncate(1);
     let r = Reference::new(&s, 0.0);
@@ -422,7 +489,16 @@ fn a_transparent_receiver_combines_exterior_and_interior_ao_by_facing() {
     // Receiver on a plane at y = 0 (normal +Y towards the camera); an opaque
     // floor 0.2 below it occludes only the interior hemisphere (around −n).
     let mut s = scene_with(vec![Material::diffuse("under", [0.5; 3])], axis_camera(0.05));
-    add_triangles(&mut s, "under", &quad(Vec3::new(0.0, -0.2, 0.0), Vec3::new(0.0, 0.0, 0.4), Vec3::new(0.4, 0.0, 0.0)), 0);
+    add_triangles(
+        &mut s,
+        "under",
+        &quad(
+            Vec3::new(0.0, -0.2, 0.0),
+            Vec3::new(0.0, 0.0, 0.4),
+            Vec3::new(0.4, 0.0, 0.0),
+        ),
+        0,
+    );
     let r = Reference::new(&s, 0.0);
     let set = ao_settings(1.0, 256);
     let key = 77;
@@ -435,7 +511,11 @@ fn a_transparent_receiver_combines_exterior_and_interior_ao_by_facing() {
     for (front, w) in [(true, alpha), (false, 1.0 - alpha)] {
         let ao = r.ao_with_opacity(p, n, n, alpha, front, &set, key);
         let want = w * exterior + (1.0 - w) * interior; // Eq. 3–4
-        assert!((ao.strongest - want).abs() < 1e-6, "front {front}: {} vs {want}", ao.strongest);
+        assert!(
+            (ao.strongest - want).abs() < 1e-6,
+            "front {front}: {} vs {want}",
+            ao.strongest
+        );
         assert!((ao.transmittance - want).abs() < 1e-6);
     }
 }
@@ -446,9 +526,21 @@ fn per_pixel_ao_blends_fragments_with_colour_weights() {
     // α · AO_pane + (1 − α) · AO_floor (the floor ends the list: T_n = 0).
     let alpha = 0.35f32;
     let cam = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::NEG_Z, 30.0, 0.05);
-    let mut s = scene_with(vec![Material::diffuse("floor", [0.5; 3]), glass("pane", [0.5; 3], alpha)], cam);
+    let mut s = scene_with(
+        vec![Material::diffuse("floor", [0.5; 3]), glass("pane", [0.5; 3], alpha)],
+        cam,
+    );
     add_triangles(&mut s, "floor", &floor(10.0), 0);
-    add_triangles(&mut s, "pane", &quad(Vec3::new(0.05, 0.25, 0.03), Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 0.0)), 1);
+    add_triangles(
+        &mut s,
+        "pane",
+        &quad(
+            Vec3::new(0.05, 0.25, 0.03),
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+        ),
+        1,
+    );
     let r = Reference::new(&s, 0.0);
     let set = ao_settings(1.0, 64);
     let img = r.ao_with_opacity_image(&cam, 3, 3, &set);
@@ -457,7 +549,15 @@ fn per_pixel_ao_blends_fragments_with_colour_weights() {
     let key0 = strata_reference::sampling::hash(&[set.seed, 3 + 1]);
     let key1 = strata_reference::sampling::hash(&[key0, 1]);
     let ao = |c: &strata_reference::Crossing, key| {
-        r.ao_with_opacity(c.position, c.normal, c.geometric_normal, c.alpha, c.front_facing, &set, key)
+        r.ao_with_opacity(
+            c.position,
+            c.normal,
+            c.geometric_normal,
+            c.alpha,
+            c.front_facing,
+            &set,
+            key,
+        )
     };
     let (a0, a1) = (ao(&list[0], key0), ao(&list[1], key1));
     let want = alpha * a0.strongest + (1.0 - alpha) * a1.strongest;
@@ -485,7 +585,10 @@ fn dragon_glass_has_32_layers() {
     let counts: Vec<usize> = all.iter().map(|l| l.iter().filter(|c| c.alpha < 1.0).count()).collect();
     let max = *counts.iter().max().unwrap();
     let deep = counts.iter().filter(|&&c| c >= 32).count();
-    eprintln!("dragon-glass: max {max} transparent crossings, {deep} of {} pixels with ≥ 32", w * h);
+    eprintln!(
+        "dragon-glass: max {max} transparent crossings, {deep} of {} pixels with ≥ 32",
+        w * h
+    );
     assert!(max >= 32 && deep >= 3, "max {max}, {deep} pixels ≥ 32");
     assert!(all.iter().flatten().all(|c| c.alpha == 0.3 || c.alpha == 1.0));
 }
