@@ -603,9 +603,10 @@ fn build_node(
         chi = chi.max(p.centroid);
     }
     let n = prims.len();
-    let leaf = (leaf_ref(offset, n), lo, hi);
+    // Built only where a leaf is returned: `leaf_ref` debug-asserts n ≤ 15.
+    let leaf = || (leaf_ref(offset, n), lo, hi);
     if n <= 1 {
-        return leaf;
+        return leaf();
     }
     let split = if depth > MAX_SAH_DEPTH {
         None
@@ -613,11 +614,11 @@ fn build_node(
         sah_split(prims, lo, hi, clo, chi, policy)
     };
     let mid = match split {
-        Some(None) => return leaf, // SAH prefers a leaf and it is small enough
+        Some(None) => return leaf(), // SAH prefers a leaf and it is small enough
         Some(Some(mid)) => mid,
         None => {
             if n <= policy.max {
-                return leaf;
+                return leaf();
             }
             // Median split along the widest centroid axis (degenerate centroids
             // or deep recursion): always balanced, so depth stays logarithmic.

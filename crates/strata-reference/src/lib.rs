@@ -13,7 +13,11 @@
 //! - [`Reference::gi`]: path-traced diffuse global illumination split into
 //!   direct and indirect radiance ([`gi`]);
 //! - [`Reference::layers`]: the exact k-layer deep G-buffer with minimum
-//!   separation (DGB §2) ([`layers`]).
+//!   separation (DGB §2) ([`layers`]);
+//! - [`Reference::crossings`], [`Reference::composite`],
+//!   [`Reference::ao_with_opacity`]: every surface crossing of a primary ray,
+//!   their order-independent-transparency composite and AO with occluder and
+//!   receiver opacity (the A-buffer paper's ground truth) ([`oit`]).
 //!
 //! Conventions are those of [`strata_scene::Camera`]: rays go through pixel
 //! centres `(x + 0.5, y + 0.5)` (no anti-aliasing jitter, so every value refers
@@ -47,11 +51,12 @@ pub mod bvh;
 pub mod converge;
 pub mod gi;
 pub mod layers;
+pub mod oit;
 pub mod probes;
 pub mod sampling;
 pub mod tracer;
-pub mod wide;
 pub mod vpl;
+pub mod wide;
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -68,9 +73,10 @@ pub use bvh::{Bvh, Hit, SurfaceHit};
 pub use converge::{ConvergeRule, Converged, Estimator};
 pub use gi::{GiImages, GiSettings};
 pub use layers::{DeepLayers, Layer, LayerSettings, NO_ID};
+pub use oit::{Crossing, OpacityAo};
 pub use tracer::{AnyTracer, Tracer, TracerKind};
-pub use wide::WideBvh;
 pub use vpl::{Vpl, VplSettings};
+pub use wide::WideBvh;
 
 /// Counters accumulated over every computation run on a [`Reference`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -240,7 +246,8 @@ impl<'s> Reference<'s> {
     }
 
     /// Diffuse albedo at a hit: `base_color × texture.rgb` (linear; texture
-    /// alpha and material opacity are ignored — every surface is opaque).
+    /// alpha and material opacity are not part of it: see [`Reference::opacity`],
+    /// which only the [`oit`] oracles use — the others treat every surface as opaque).
     pub fn albedo(&self, hit: &SurfaceHit) -> Vec3 {
         let m = self.material(hit.material);
         let mut a = Vec3::from(m.base_color);

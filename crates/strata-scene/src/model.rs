@@ -80,10 +80,24 @@ pub struct Material {
     pub base_color_texture: Option<usize>,
     /// Emitted radiance (linear RGB, scene radiance units).
     pub emission: [f32; 3],
-    /// 1 = opaque.
+    /// Opacity α of the surface, 1 = opaque (glTF: `baseColorFactor.a` unless
+    /// `alphaMode` is OPAQUE; OBJ: `d` or `1 − Tr`). For a MASK material this
+    /// is the alpha the cutoff test uses, not the opacity of kept fragments
+    /// (which is 1): see [`Material::fragment_alpha`].
     pub opacity: f32,
     pub roughness: f32,
     pub metallic: f32,
+    /// glTF `alphaMode` MASK: a fragment is kept iff its alpha
+    /// (`opacity × texture alpha`) is ≥ the cutoff (glTF default 0.5), and a
+    /// kept fragment is opaque. `None` for OPAQUE and BLEND materials.
+    #[serde(default)]
+    pub alpha_cutoff: Option<f32>,
+    /// Whether the base-colour texture's alpha multiplies `opacity`: true for
+    /// glTF BLEND and MASK materials, false for OPAQUE ones (whose alpha the
+    /// glTF spec says to ignore) and for OBJ/MTL (`map_Kd` alpha is not
+    /// opacity there; only `d`/`Tr` are).
+    #[serde(default)]
+    pub texture_alpha: bool,
 }
 
 impl Default for Material {
@@ -96,6 +110,8 @@ impl Default for Material {
             opacity: 1.0,
             roughness: 0.8,
             metallic: 0.0,
+            alpha_cutoff: None,
+            texture_alpha: false,
         }
     }
 }
@@ -118,6 +134,34 @@ impl Material {
     }
     pub fn is_emissive(&self) -> bool {
         self.emission.iter().any(|&e| e > 0.0)
+    }
+
+    /// The alpha of a fragment of this material whose base-colour texture
+    /// alpha is `texture_alpha` (pass 1 where there is no texture), or `None`
+    /// when the fragment is discarded (MASK below the cutoff). The one rule the
+    /// GPU and the CPU reference share:
+    ///
+    /// - `a = opacity × (texture_alpha if self.texture_alpha else 1)`;
+    /// - MASK (`alpha_cutoff = Some(c)`): kept iff `a ≥ c`, with alpha 1;
+    /// - otherwise (OPAQUE: opacity 1; BLEND): kept, with alpha `a`.
+    ///
+    /// A BLEND fragment of alpha 0 is kept (it is a crossing that adds
+    /// nothing), so fragment counts do not depend on texture contents.
+    pub fn fragment_alpha(&self, texture_alpha: f32) -> Option<f32> {
+        let a = if self.texture_alpha {
+            self.opacity * texture_alpha
+        } else {
+            self.opacity
+        };
+        match self.alpha_cutoff {
+            Some(c) => (a >= c).then_some(1.0),
+            None => Some(a),
+        }
+    }
+
+    /// True when every fragment of this material is opaque (α = 1, no cutoff).
+    pub fn is_opaque(&self) -> bool {
+        self.alpha_cutoff.is_none() && self.opacity >= 1.0 && !self.texture_alpha
     }
 }
 
@@ -323,8 +367,8 @@ impl Scene {
     ///   normals and finite UVs as positions; a multiple of 3 indices, each in
     ///   range; a material in range;
     /// - objects: a mesh in range, a finite transform;
-    /// - materials: finite values with colours, opacity, roughness and metallic
-    ///   in [0, 1] (emission >= 0); a texture in range;
+    /// - materials: finite values with colours, opacity, roughness, metallic
+    ///   and alpha cutoff in [0, 1] (emission >= 0); a texture in range;
     /// - textures: non-empty, `width × height × 4` bytes;
     /// - the camera passes [`Camera::validate`]; camera path keyframes are finite;
     /// - lights and settings finite (settings' lengths and exposure > 0);
@@ -396,10 +440,11 @@ impl Scene {
                 && m.emission.iter().all(|&c| c.is_finite() && c >= 0.0)
                 && unit(m.opacity)
                 && unit(m.roughness)
-                && unit(m.metallic))
+                && unit(m.metallic)
+                && m.alpha_cutoff.is_none_or(unit))
             {
                 return Err(format!(
-                    "material '{}': a value is out of range (base colour, opacity, roughness, metallic in [0, 1]; emission finite and >= 0)",
+                    "material '{}': a value is out of range (base colour, opacity, roughness, metallic, alpha cutoff in [0, 1]; emission finite and >= 0)",
                     short(&m.name)
                 ));
             }

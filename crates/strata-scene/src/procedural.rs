@@ -8,6 +8,7 @@
 //! | `plane` | one 40 × 40 m grey Lambertian plane under a sun (analytic tests) |
 //! | `column-wall` | a column standing 0.5 m in front of a wall (AO tests) |
 //! | `mirror` | a mirror floor before a grey board that hides a red panel from the camera but not from the mirror (DGB §3.6) |
+//! | `glasshouse` | coloured glass panes overlapping in view, a translucent sphere before opaque blocks: ≥ 8 transparent crossings per pixel (A-buffer OIT, ABA) |
 //!
 //! Static geometry is merged into one object per material, named after the
 //! material (e.g. `banner_red`); animated parts are separate objects.
@@ -28,6 +29,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "column-wall",
     "dense",
     "mirror",
+    "glasshouse",
 ];
 
 /// The built-in scene called `name`, or `None` when there is none.
@@ -40,6 +42,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "column-wall" => Some(column_wall()),
         "dense" => Some(dense()),
         "mirror" => Some(mirror()),
+        "glasshouse" => Some(glasshouse()),
         _ => None,
     }
 }
@@ -632,4 +635,79 @@ pub fn mirror() -> Scene {
         ambient: [0.03; 3],
     };
     b.finish(camera, vec![sun], settings)
+}
+
+/// A-buffer / order-independent-transparency test scene (ABA): an opaque room
+/// (floor, back and left walls), opaque blocks and a column, and five
+/// coloured glass panes — thin boxes, so each pane is two transparent
+/// surfaces — standing one behind the other across the view at different
+/// heights and widths, so that they overlap in different combinations; a
+/// translucent sphere (α 0.4) in front of an opaque block. Through the
+/// centre of the default view a primary ray crosses all five panes (10
+/// transparent surfaces) before the sphere and the opaque block behind it.
+/// A sun and a point light, a sky, a small ambient term; 1,822 triangles.
+pub fn glasshouse() -> Scene {
+    let mut b = SceneBuilder::new("glasshouse");
+    let floor = b.material(Material::diffuse("floor", [0.55, 0.55, 0.52]));
+    let wall = b.material(Material::diffuse("wall", [0.75, 0.72, 0.68]));
+    let block = b.material(Material::diffuse("block", [0.7, 0.35, 0.2]));
+    let column = b.material(Material::diffuse("column", [0.3, 0.45, 0.7]));
+    let glass = |name: &str, rgb: [f32; 3], opacity: f32| Material {
+        opacity,
+        roughness: 0.1,
+        ..Material::diffuse(name, rgb)
+    };
+    let panes = [
+        // (material, centre, half width, half height)
+        (glass("glass_red", [0.9, 0.15, 0.1], 0.35), v(-0.3, 1.3, 2.0), 1.6, 1.1),
+        (glass("glass_green", [0.15, 0.85, 0.2], 0.3), v(0.5, 1.1, 1.2), 1.5, 1.0),
+        (glass("glass_blue", [0.1, 0.3, 0.9], 0.45), v(-0.2, 1.5, 0.4), 1.8, 1.2),
+        (
+            glass("glass_amber", [0.95, 0.7, 0.1], 0.25),
+            v(0.3, 1.0, -0.4),
+            1.4,
+            0.9,
+        ),
+        (glass("glass_violet", [0.6, 0.2, 0.8], 0.5), v(0.0, 1.4, -1.2), 1.7, 1.0),
+    ];
+    let sphere = b.material(glass("glass_sphere", [0.9, 0.9, 0.95], 0.4));
+
+    // Room: 12 × 12 m floor, back wall at z = −4, left wall at x = −4.
+    b.geo(floor).rect(v(0.0, 0.0, 0.0), v(0.0, 0.0, 6.0), v(6.0, 0.0, 0.0));
+    b.geo(wall).cuboid(v(-6.0, 0.0, -4.3), v(6.0, 4.0, -4.0));
+    b.geo(wall).cuboid(v(-4.3, 0.0, -4.0), v(-4.0, 4.0, 6.0));
+    // Opaque objects: a block behind the sphere, a low block and a column.
+    b.geo(block).cuboid(v(-0.7, 0.0, -3.2), v(0.9, 1.8, -2.6));
+    b.geo(block).cuboid(v(1.8, 0.0, -1.8), v(2.6, 0.6, -1.0));
+    b.geo(column).cylinder(v(-2.2, 0.0, -2.0), 0.35, 2.8, 48, true);
+    // Glass panes, 2 cm thick, perpendicular to the view.
+    for (m, c, hw, hh) in panes {
+        let mi = b.material(m);
+        b.geo(mi).cuboid(c - v(hw, hh, 0.01), c + v(hw, hh, 0.01));
+    }
+    // The translucent sphere in front of the block.
+    b.geo(sphere).sphere(v(0.1, 1.2, -2.0), 0.45, 40, 20);
+
+    let lights = vec![
+        Light::Sun {
+            direction: v(0.35, -1.0, -0.45).normalize(),
+            color: [1.0, 0.96, 0.9],
+            illuminance: 3.0,
+        },
+        Light::Point {
+            position: v(1.5, 2.6, 1.6),
+            color: [1.0, 0.85, 0.7],
+            intensity: 6.0,
+        },
+    ];
+    let camera = Camera::new(v(0.4, 1.5, 6.0), v(0.1, 1.2, -2.0), Vec3::Y, 50.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.5,
+        min_separation: 0.1,
+        radiosity_radius: 4.0,
+        exposure: 1.0,
+        sky: [0.3, 0.4, 0.55],
+        ambient: [0.05; 3],
+    };
+    b.finish(camera, lights, settings)
 }

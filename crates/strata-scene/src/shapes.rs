@@ -178,6 +178,39 @@ impl MeshBuilder {
         }
     }
 
+    /// Adds a UV sphere of radius `radius` around `c` with smooth outward
+    /// normals: `rings` ≥ 2 latitude bands (triangle fans at the poles) and
+    /// `segments` ≥ 3 longitude slices, `2 · segments · (rings − 1)` triangles.
+    pub fn sphere(&mut self, c: Vec3, radius: f32, segments: u32, rings: u32) {
+        let (segments, rings) = (segments.max(3), rings.max(2));
+        let point = |i: u32, j: u32| {
+            let theta = std::f32::consts::PI * j as f32 / rings as f32; // from +Y
+            let phi = std::f32::consts::TAU * i as f32 / segments as f32;
+            Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin())
+        };
+        let first = self.positions.len() as u32;
+        // Rows j = 0..=rings of segments + 1 vertices (seam duplicated for the UVs).
+        for j in 0..=rings {
+            for i in 0..=segments {
+                let d = point(i, j);
+                self.vertex(c + d * radius, d, [i as f32 / segments as f32, j as f32 / rings as f32]);
+            }
+        }
+        let at = |i: u32, j: u32| first + j * (segments + 1) + i;
+        for j in 0..rings {
+            for i in 0..segments {
+                // phi grows counter-clockwise seen from +Y, theta downwards:
+                // (j, i) → (j + 1, i) → (j + 1, i + 1) is counter-clockwise from outside.
+                if j > 0 {
+                    self.index_triangle(at(i, j), at(i, j + 1), at(i + 1, j));
+                }
+                if j + 1 < rings {
+                    self.index_triangle(at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
+                }
+            }
+        }
+    }
+
     /// Adds an arcade panel: the solid spandrel around a semicircular arch
     /// opening, in the XY plane and extruded along Z from `z0` to `z1`.
     ///
@@ -358,6 +391,17 @@ mod tests {
         m.cylinder(Vec3::new(1.0, 0.0, -2.0), 0.5, 3.0, 64, true);
         let v = std::f32::consts::PI * 0.25 * 3.0;
         assert!((signed_volume(&m) - v).abs() < 0.01 * v, "{}", signed_volume(&m));
+        normals_agree_with_winding(&m);
+    }
+
+    #[test]
+    fn sphere_is_outward_and_closed() {
+        let mut m = MeshBuilder::new();
+        m.sphere(Vec3::new(1.0, 2.0, 3.0), 0.5, 32, 16);
+        assert_eq!(m.triangle_count(), 2 * 32 * 15);
+        let v = 4.0 / 3.0 * std::f32::consts::PI * 0.125;
+        // Signed volume is translation-invariant only for closed meshes.
+        assert!((signed_volume(&m) - v).abs() < 0.03 * v, "{}", signed_volume(&m));
         normals_agree_with_winding(&m);
     }
 

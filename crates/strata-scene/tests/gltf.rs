@@ -55,6 +55,11 @@ fn tiny_glb(last_index: u16) -> Vec<u8> {
 /// appended to the node list (indices 4, 5, …) and `scene_nodes` appended to
 /// the scene's root nodes.
 fn tiny_glb_with(last_index: u16, root: &str, nodes: &str, scene_nodes: &str) -> Vec<u8> {
+    tiny_glb_alpha(last_index, root, nodes, scene_nodes, r#""alphaMode": "BLEND""#)
+}
+
+/// [`tiny_glb_with`] with the material's `alphaMode` entry (and its cutoff) given as JSON.
+fn tiny_glb_alpha(last_index: u16, root: &str, nodes: &str, scene_nodes: &str, alpha: &str) -> Vec<u8> {
     let positions = f32_bytes(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0]);
     let uvs = f32_bytes(&[0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]);
     let indices: Vec<u8> = [0u16, 1, 2, 0, 2, last_index]
@@ -87,7 +92,7 @@ fn tiny_glb_with(last_index: u16, root: &str, nodes: &str, scene_nodes: &str) ->
     "pbrMetallicRoughness": {{"baseColorFactor": [0.5, 0.25, 1.0, 0.5], "baseColorTexture": {{"index": 0}}, "metallicFactor": 0.3, "roughnessFactor": 0.6}},
     "emissiveFactor": [1.0, 0.5, 0.0],
     "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": 4.0}}}},
-    "alphaMode": "BLEND"
+    {alpha}
   }}],
   "textures": [{{"source": 0}}],
   "images": [{{"bufferView": 3, "mimeType": "image/png"}}],
@@ -182,11 +187,23 @@ fn lit_glb(spot: &str) -> Vec<u8> {
 
 #[test]
 fn gltf_punctual_lights_and_cameras_load_with_the_extension_units() {
-    let p = write("lit.glb", &lit_glb(r#", "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}"#));
+    let p = write(
+        "lit.glb",
+        &lit_glb(r#", "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}"#),
+    );
     let s = load_path(&p).expect("lit glb");
-    assert_eq!(s.lights.len(), 3, "the file's lights replace the default sun: {:?}", s.lights);
+    assert_eq!(
+        s.lights.len(),
+        3,
+        "the file's lights replace the default sun: {:?}",
+        s.lights
+    );
     let sun = s.lights.iter().find_map(|l| match l {
-        strata_scene::Light::Sun { direction, color, illuminance } => Some((*direction, *color, *illuminance)),
+        strata_scene::Light::Sun {
+            direction,
+            color,
+            illuminance,
+        } => Some((*direction, *color, *illuminance)),
         _ => None,
     });
     let (dir, color, lux) = sun.expect("a sun");
@@ -194,21 +211,37 @@ fn gltf_punctual_lights_and_cameras_load_with_the_extension_units() {
     assert_eq!(color, [1.0, 0.9, 0.8]);
     assert!((lux - 1.0).abs() < 1e-6, "683 lux = 1 W/m²: {lux}");
     let point = s.lights.iter().find_map(|l| match l {
-        strata_scene::Light::Point { position, intensity, color } => Some((*position, *intensity, *color)),
+        strata_scene::Light::Point {
+            position,
+            intensity,
+            color,
+        } => Some((*position, *intensity, *color)),
         _ => None,
     });
     let (pos, cd, white) = point.expect("a point light");
-    assert!(pos.abs_diff_eq(Vec3::new(1.0, 3.0, 0.0), 1e-6), "parent × child translation: {pos}");
+    assert!(
+        pos.abs_diff_eq(Vec3::new(1.0, 3.0, 0.0), 1e-6),
+        "parent × child translation: {pos}"
+    );
     assert!((cd - 2.0).abs() < 1e-6 && white == [1.0; 3]);
     let spot = s.lights.iter().find_map(|l| match l {
-        strata_scene::Light::Spot { position, direction, intensity, inner_deg, outer_deg, .. } => {
-            Some((*position, *direction, *intensity, *inner_deg, *outer_deg))
-        }
+        strata_scene::Light::Spot {
+            position,
+            direction,
+            intensity,
+            inner_deg,
+            outer_deg,
+            ..
+        } => Some((*position, *direction, *intensity, *inner_deg, *outer_deg)),
         _ => None,
     });
     let (pos, dir, i, inner, outer) = spot.expect("a spot");
     assert!(pos.abs_diff_eq(Vec3::new(0.0, 2.0, 0.0), 1e-6) && dir.abs_diff_eq(-Vec3::Z, 1e-6));
-    assert!((i - 0.1).abs() < 1e-6 && (inner - 0.2f32.to_degrees()).abs() < 1e-4 && (outer - 0.5f32.to_degrees()).abs() < 1e-4);
+    assert!(
+        (i - 0.1).abs() < 1e-6
+            && (inner - 0.2f32.to_degrees()).abs() < 1e-4
+            && (outer - 0.5f32.to_degrees()).abs() < 1e-4
+    );
     // both cameras, in node order; the first is the camera
     assert_eq!(s.cameras.len(), 2);
     assert_eq!(s.camera, s.cameras[0]);
@@ -222,8 +255,14 @@ fn gltf_punctual_lights_and_cameras_load_with_the_extension_units() {
 #[test]
 fn bad_punctual_lights_are_one_line_errors() {
     for (spot, words) in [
-        (r#", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.5}"#, &["cone", "inner < outer"][..]),
-        (r#", "spot": {"innerConeAngle": 0.1, "outerConeAngle": 2.0}"#, &["π/2"][..]),
+        (
+            r#", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.5}"#,
+            &["cone", "inner < outer"][..],
+        ),
+        (
+            r#", "spot": {"innerConeAngle": 0.1, "outerConeAngle": 2.0}"#,
+            &["π/2"][..],
+        ),
     ] {
         let p = write("badspot.glb", &lit_glb(spot));
         let e = load_path(&p).unwrap_err().to_string();
@@ -278,4 +317,34 @@ fn garbage_gltf_is_an_error() {
     );
     let e = load_path(&p).expect_err("missing buffer loaded").to_string();
     assert!(e.contains("missing_buffer.gltf"), "{e}");
+}
+
+#[test]
+fn alpha_modes_set_cutoff_and_texture_alpha() {
+    // BLEND: opacity = factor alpha, texture alpha multiplies it, no cutoff.
+    let s = load_path(&write("blend.glb", &tiny_glb(3))).unwrap();
+    let m = &s.materials[0];
+    assert_eq!((m.opacity, m.alpha_cutoff, m.texture_alpha), (0.5, None, true));
+    assert_eq!(m.fragment_alpha(0.5), Some(0.25));
+    // MASK with an explicit cutoff: kept iff 0.5 × texture alpha ≥ 0.3, then opaque.
+    let mask = tiny_glb_alpha(3, "", "", "", r#""alphaMode": "MASK", "alphaCutoff": 0.3"#);
+    let s = load_path(&write("mask.glb", &mask)).unwrap();
+    let m = &s.materials[0];
+    assert_eq!((m.alpha_cutoff, m.texture_alpha), (Some(0.3), true));
+    assert_eq!(m.fragment_alpha(1.0), Some(1.0));
+    assert_eq!(m.fragment_alpha(0.5), None);
+    assert!(!m.is_opaque());
+    // MASK without a cutoff: the glTF default 0.5.
+    let mask = tiny_glb_alpha(3, "", "", "", r#""alphaMode": "MASK""#);
+    let s = load_path(&write("mask5.glb", &mask)).unwrap();
+    assert_eq!(s.materials[0].alpha_cutoff, Some(0.5));
+    assert_eq!(s.materials[0].fragment_alpha(1.0), Some(1.0));
+    assert_eq!(s.materials[0].fragment_alpha(0.99), None, "0.5 × 0.99 < 0.5");
+    // OPAQUE: factor and texture alpha are both ignored.
+    let opaque = tiny_glb_alpha(3, "", "", "", r#""alphaMode": "OPAQUE""#);
+    let s = load_path(&write("opaque.glb", &opaque)).unwrap();
+    let m = &s.materials[0];
+    assert_eq!((m.opacity, m.alpha_cutoff, m.texture_alpha), (1.0, None, false));
+    assert_eq!(m.fragment_alpha(0.0), Some(1.0));
+    assert!(m.is_opaque());
 }

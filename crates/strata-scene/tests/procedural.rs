@@ -443,3 +443,32 @@ fn column_wall_column_occludes_wall() {
         .fold(f32::INFINITY, f32::min);
     assert!((back - (-1.0) - 0.5).abs() < 0.02, "gap {}", back + 1.0);
 }
+
+#[test]
+fn glasshouse_has_coloured_glass_before_opaque_objects() {
+    let s = scene("glasshouse");
+    assert!(s.triangle_count() < 10_000, "{} triangles", s.triangle_count());
+    let glass: Vec<_> = s.materials.iter().filter(|m| m.opacity < 1.0).collect();
+    assert!(glass.len() >= 6, "{} transparent materials", glass.len());
+    for m in &glass {
+        assert!((0.25..=0.5).contains(&m.opacity), "{}: {}", m.name, m.opacity);
+    }
+    // Different colours: no two glass materials share a base colour.
+    for (i, a) in glass.iter().enumerate() {
+        for b in &glass[i + 1..] {
+            assert_ne!(a.base_color, b.base_color, "{} vs {}", a.name, b.name);
+        }
+    }
+    assert!(s.materials.iter().filter(|m| m.opacity == 1.0).count() >= 3);
+    assert!(s.lights.iter().any(|l| matches!(l, Light::Sun { .. })));
+    assert!(s.lights.iter().any(|l| matches!(l, Light::Point { .. })));
+    // Every transparent object lies in view of the default camera.
+    for o in &s.objects {
+        let m = &s.materials[s.meshes[o.mesh].material];
+        if m.opacity < 1.0 {
+            let c: Vec3 = s.meshes[o.mesh].positions.iter().map(|p| Vec3::from(*p)).sum::<Vec3>()
+                / s.meshes[o.mesh].positions.len() as f32;
+            assert!(in_frustum(&s.camera, c, ASPECT), "{} at {c}", m.name);
+        }
+    }
+}

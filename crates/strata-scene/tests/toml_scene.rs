@@ -150,3 +150,137 @@ fn mesh_file_with_ground_and_defaults() {
     assert!(matches!(s.lights[..], [Light::Sun { .. }]));
     assert!(s.settings.ao_radius > 0.0);
 }
+
+/// The error text of loading `text` as `name`.
+fn toml_err(name: &str, text: &str) -> String {
+    load_toml_str(text, std::path::Path::new(name))
+        .expect_err("must be rejected")
+        .to_string()
+}
+
+#[test]
+fn material_overrides_by_name_and_wildcard() {
+    let base = builtin("glasshouse").unwrap();
+    let s = load_toml_str(
+        "builtin = \"glasshouse\"\n\
+         [[material]]\nname = \"*\"\nopacity = 0.3\n\
+         [[material]]\nname = \"wall\"\nbase_color = [0.1, 0.2, 0.3]\n",
+        std::path::Path::new("m.toml"),
+    )
+    .expect("loads");
+    assert_eq!(s.materials.len(), base.materials.len());
+    for (m, b) in s.materials.iter().zip(&base.materials) {
+        assert_eq!(m.opacity, 0.3, "{}", m.name);
+        let want = if m.name == "wall" {
+            [0.1, 0.2, 0.3]
+        } else {
+            b.base_color
+        };
+        assert_eq!(m.base_color, want, "{}", m.name);
+        assert_eq!((m.roughness, m.emission), (b.roughness, b.emission), "{}", m.name);
+    }
+    // Overrides apply in file order: a later named entry wins over "*".
+    let s = load_toml_str(
+        "builtin = \"plane\"\n[[material]]\nname = \"*\"\nopacity = 0.3\n[[material]]\nname = \"grey\"\nopacity = 1\n",
+        std::path::Path::new("o.toml"),
+    )
+    .unwrap();
+    assert_eq!(s.materials[0].opacity, 1.0);
+}
+
+#[test]
+fn material_override_errors_name_file_material_and_range() {
+    let e = toml_err(
+        "bad.toml",
+        "builtin = \"plane\"\n[[material]]\nname = \"glass\"\nopacity = 0.5\n",
+    );
+    assert!(
+        e.starts_with("bad.toml") && e.contains("'glass'") && e.contains("grey") && !e.contains('\n'),
+        "{e}"
+    );
+    for (value, shown) in [("1.5", "1.5"), ("-0.1", "-0.1"), ("nan", "NaN")] {
+        let e = toml_err(
+            "range.toml",
+            &format!("builtin = \"plane\"\n[[material]]\nname = \"grey\"\nopacity = {value}\n"),
+        );
+        assert!(
+            e.starts_with("range.toml")
+                && e.contains("material[0].opacity")
+                && e.contains(shown)
+                && e.contains("0..=1"),
+            "{e}"
+        );
+    }
+    let e = toml_err(
+        "col.toml",
+        "builtin = \"plane\"\n[[material]]\nname = \"grey\"\nbase_color = [0.5, 2, 0]\n",
+    );
+    assert!(e.contains("material[0].base_color") && e.contains("0..=1"), "{e}");
+    let e = toml_err(
+        "key.toml",
+        "builtin = \"plane\"\n[[material]]\nname = \"grey\"\nalpha = 0.5\n",
+    );
+    assert!(e.starts_with("key.toml") && e.contains("alpha"), "{e}");
+}
+
+#[test]
+fn repeat_stacks_translated_copies() {
+    let base = builtin("plane").unwrap();
+    let s = load_toml_str(
+        "builtin = \"plane\"\n[repeat]\ncount = 4\noffset = [0, 0.5, -1]\n",
+        std::path::Path::new("r.toml"),
+    )
+    .unwrap();
+    assert_eq!(s.objects.len(), 4 * base.objects.len());
+    assert_eq!(s.triangle_count(), 4 * base.triangle_count());
+    let (blo, bhi) = base.bounds(0.0);
+    let (lo, hi) = s.bounds(0.0);
+    let off = Vec3::new(0.0, 0.5, -1.0);
+    assert!(lo.abs_diff_eq(blo.min(blo + 3.0 * off), 1e-5), "{lo}");
+    assert!(hi.abs_diff_eq(bhi.max(bhi + 3.0 * off), 1e-5), "{hi}");
+    for (i, o) in s.objects.iter().enumerate() {
+        let want = Mat4::from_translation(off * i as f32) * base.objects[0].transform;
+        assert!(o.transform.abs_diff_eq(want, 1e-6), "copy {i}");
+    }
+    // The ground comes after the copies and is not repeated.
+    let s = load_toml_str(
+        "builtin = \"plane\"\n[repeat]\ncount = 3\noffset = [1, 0, 0]\n[ground]\n",
+        std::path::Path::new("g.toml"),
+    )
+    .unwrap();
+    assert_eq!(s.objects.iter().filter(|o| o.name == "ground").count(), 1);
+}
+
+#[test]
+fn repeat_count_and_offset_are_checked() {
+    for count in ["0", "65", "-3"] {
+        let e = toml_err(
+            "rep.toml",
+            &format!("builtin = \"plane\"\n[repeat]\ncount = {count}\noffset = [0, 0, 1]\n"),
+        );
+        assert!(
+            e.starts_with("rep.toml") && e.contains("repeat.count") && e.contains("1..=64") && e.contains(count),
+            "{e}"
+        );
+    }
+    let e = toml_err(
+        "off.toml",
+        "builtin = \"plane\"\n[repeat]\ncount = 2\noffset = [0, inf, 1]\n",
+    );
+    assert!(e.contains("repeat.offset") && e.contains("finite"), "{e}");
+    let e = toml_err("miss.toml", "builtin = \"plane\"\n[repeat]\ncount = 2\n");
+    assert!(e.starts_with("miss.toml") && e.contains("offset"), "{e}");
+}
+
+#[test]
+fn dragon_glass_toml_is_transparent_and_stacked() {
+    let Some(_) = common::shared_scenes() else { return };
+    let s = load_path(&common::repo_scenes().join("dragon-glass.toml")).expect("dragon-glass.toml");
+    let ground = s.objects.iter().filter(|o| o.name == "ground").count();
+    let dragons = s.objects.len() - ground;
+    assert!(dragons >= 2, "{dragons} dragon copies");
+    for o in s.objects.iter().filter(|o| o.name != "ground") {
+        let m = &s.materials[s.meshes[o.mesh].material];
+        assert_eq!(m.opacity, 0.3, "{}", m.name);
+    }
+}

@@ -6,6 +6,7 @@ mod bvh;
 mod converge;
 mod gi;
 mod layers;
+mod oit;
 mod scenes;
 mod tracer;
 mod vpl;

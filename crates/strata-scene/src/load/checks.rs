@@ -50,7 +50,7 @@ pub(super) fn check_vertices(path: &Path, what: &str, m: &Mesh) -> Result<(), Sc
 }
 
 /// Checks a material's values (an error for non-finite ones) and clamps them
-/// to their ranges: base colour, opacity, roughness, metallic to [0, 1],
+/// to their ranges: base colour, opacity, roughness, metallic, alpha cutoff to [0, 1],
 /// emission to >= 0.
 pub(super) fn check_material(path: &Path, m: &mut Material) -> Result<(), SceneError> {
     let named = |field: &str, v: &dyn std::fmt::Debug| {
@@ -76,6 +76,12 @@ pub(super) fn check_material(path: &Path, m: &mut Material) -> Result<(), SceneE
         if !v.is_finite() {
             return Err(named(field, &v));
         }
+    }
+    if let Some(c) = m.alpha_cutoff {
+        if !c.is_finite() {
+            return Err(named("alpha cutoff", &c));
+        }
+        m.alpha_cutoff = Some(c.clamp(0.0, 1.0));
     }
     m.base_color = m.base_color.map(|c| c.clamp(0.0, 1.0));
     m.emission = m.emission.map(|c| c.max(0.0));

@@ -61,6 +61,8 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
             },
             roughness: pbr.roughness_factor(),
             metallic: pbr.metallic_factor(),
+            alpha_cutoff: (m.alpha_mode() == gltf::material::AlphaMode::Mask).then(|| m.alpha_cutoff().unwrap_or(0.5)),
+            texture_alpha: m.alpha_mode() != gltf::material::AlphaMode::Opaque,
         };
         check_material(path, &mut mat)?;
         let mut uv_set = 0;
@@ -315,7 +317,8 @@ fn punctual_light(doc: &gltf::Document, ni: usize, world: Mat4) -> Result<Option
         )
     })?;
     let name = light.name.clone().unwrap_or_else(|| format!("light {index}"));
-    let valid = light.color.iter().all(|c| c.is_finite() && *c >= 0.0) && light.intensity.is_finite() && light.intensity >= 0.0;
+    let valid =
+        light.color.iter().all(|c| c.is_finite() && *c >= 0.0) && light.intensity.is_finite() && light.intensity >= 0.0;
     if !valid {
         return Err(format!(
             "KHR_lights_punctual '{}': color and intensity must be finite and >= 0",
@@ -328,7 +331,10 @@ fn punctual_light(doc: &gltf::Document, ni: usize, world: Mat4) -> Result<Option
     let radiometric = light.intensity / LUMENS_PER_WATT;
     let needs_direction = || {
         if direction == Vec3::ZERO || !direction.is_finite() {
-            Err(format!("KHR_lights_punctual '{}' on node {ni}: the node's transform collapses its −Z direction", short(&name)))
+            Err(format!(
+                "KHR_lights_punctual '{}' on node {ni}: the node's transform collapses its −Z direction",
+                short(&name)
+            ))
         } else {
             Ok(())
         }
@@ -349,10 +355,9 @@ fn punctual_light(doc: &gltf::Document, ni: usize, world: Mat4) -> Result<Option
         },
         Checked::Valid(Type::Spot) => {
             needs_direction()?;
-            let (inner, outer) = light
-                .spot
-                .as_ref()
-                .map_or((0.0, std::f32::consts::FRAC_PI_4), |s| (s.inner_cone_angle, s.outer_cone_angle));
+            let (inner, outer) = light.spot.as_ref().map_or((0.0, std::f32::consts::FRAC_PI_4), |s| {
+                (s.inner_cone_angle, s.outer_cone_angle)
+            });
             if !(inner >= 0.0 && inner < outer && outer <= std::f32::consts::FRAC_PI_2) {
                 return Err(format!(
                     "KHR_lights_punctual '{}': spot cone angles inner {inner} and outer {outer} are out of range: \

@@ -10,7 +10,10 @@
 //!   a mesh becomes one [`Object`](crate::model::Object) per primitive, with
 //!   the node hierarchy's world transform.
 //!   Materials: `baseColorFactor` (linear RGB; its alpha is the opacity unless
-//!   `alphaMode` is OPAQUE), `baseColorTexture` (converted to RGBA8),
+//!   `alphaMode` is OPAQUE), `alphaMode` MASK → `alpha_cutoff` (`alphaCutoff`,
+//!   default 0.5), the texture's alpha multiplies the opacity for BLEND and
+//!   MASK (`texture_alpha`; see `Material::fragment_alpha`),
+//!   `baseColorTexture` (converted to RGBA8),
 //!   `emissiveFactor` × `KHR_materials_emissive_strength`, roughness, metallic.
 //!   Every perspective camera node is kept in [`Scene::cameras`](crate::model::Scene)
 //!   (node order; the first becomes the camera, `--camera N` picks another).

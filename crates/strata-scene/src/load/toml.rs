@@ -1,7 +1,7 @@
 //! TOML scene files (format in the [`super`] docs): a mesh file (loaded
 //! through [`super::load_mesh_file`]) or a built-in scene, placed by `scale`
-//! and `translate`, with camera, camera path, lights, settings, ground quad
-//! and animations set on top.
+//! and `translate`, with material overrides, stacked copies (`[repeat]`),
+//! camera, camera path, lights, settings, ground quad and animations set on top.
 //!
 //! Checks: the text must be UTF-8 TOML; unknown keys are errors
 //! (`deny_unknown_fields`); every value is range-checked by [`Check`], whose
@@ -58,7 +58,32 @@ struct TomlScene {
     ground: Option<TomlGround>,
     #[serde(default)]
     animate: Vec<TomlAnimate>,
+    #[serde(default)]
+    material: Vec<TomlMaterial>,
+    repeat: Option<TomlRepeat>,
 }
+
+/// `[[material]]`: overrides of the base scene's materials called `name`
+/// (`"*"`: all of them).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlMaterial {
+    name: String,
+    opacity: Option<f32>,
+    base_color: Option<[f32; 3]>,
+}
+
+/// `[repeat]`: `count` copies of the base scene's objects, copy i translated
+/// by `i × offset`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TomlRepeat {
+    count: i64,
+    offset: [f32; 3],
+}
+
+/// Most copies `[repeat]` may make.
+const MAX_REPEAT: i64 = 64;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -232,6 +257,12 @@ fn build_scene(doc: TomlScene, path: &Path, files: &dyn FileSource) -> Result<Sc
     let dir = path.parent().unwrap_or(Path::new(""));
     let (mut scene, has_camera, from_file) = base_scene(&doc, &ck, dir, files)?;
     place(&doc, &ck, &mut scene)?;
+    for (i, m) in doc.material.iter().enumerate() {
+        override_material(i, m, &ck, &mut scene)?;
+    }
+    if let Some(r) = &doc.repeat {
+        repeat(r, &ck, &mut scene)?;
+    }
 
     // Defaults that depend on the placed geometry (before the ground is added,
     // so that the default camera frames the mesh, not the ground).
@@ -332,6 +363,80 @@ fn place(doc: &TomlScene, ck: &Check, scene: &mut Scene) -> Result<(), SceneErro
     let place = Mat4::from_translation(translate) * Mat4::from_scale(Vec3::splat(scale));
     if place != Mat4::IDENTITY {
         transform_scene(scene, place, scale);
+    }
+    Ok(())
+}
+
+/// `[[material]]` number `i`: sets the given values on every material of the
+/// base scene called `name` (all of them for `"*"`); an unknown name is an
+/// error listing the material names.
+fn override_material(i: usize, m: &TomlMaterial, ck: &Check, scene: &mut Scene) -> Result<(), SceneError> {
+    let k = |f: &str| format!("material[{i}].{f}");
+    let opacity = match m.opacity {
+        Some(a) if !(a.is_finite() && (0.0..=1.0).contains(&a)) => {
+            return Err(ck.err(&k("opacity"), format!("{a} is out of range: must be in 0..=1")));
+        }
+        a => a,
+    };
+    let base_color = match m.base_color {
+        Some(c) if !c.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x)) => {
+            return Err(ck.err(
+                &k("base_color"),
+                format!("{c:?} is out of range: components must be in 0..=1"),
+            ));
+        }
+        c => c,
+    };
+    let mut found = false;
+    for mat in scene.materials.iter_mut().filter(|x| m.name == "*" || x.name == m.name) {
+        if let Some(a) = opacity {
+            mat.opacity = a;
+        }
+        if let Some(c) = base_color {
+            mat.base_color = c;
+        }
+        found = true;
+    }
+    if !found {
+        let mut names: Vec<&str> = scene.materials.iter().map(|x| x.name.as_str()).collect();
+        names.sort_unstable();
+        names.dedup();
+        let more = if names.len() > 20 {
+            format!(", … ({} in all)", names.len())
+        } else {
+            String::new()
+        };
+        names.truncate(20);
+        return Err(ck.err(
+            &k("name"),
+            format!(
+                "no material named '{}' (materials: {}{more}; \"*\" matches all)",
+                crate::error::short(&m.name),
+                names.join(", ")
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `[repeat]`: `count` (1..=[`MAX_REPEAT`]) copies of every object of the base
+/// scene, copy i translated by `i × offset` (copy 0 is the original; copies
+/// keep the object's name, mesh and animation).
+fn repeat(r: &TomlRepeat, ck: &Check, scene: &mut Scene) -> Result<(), SceneError> {
+    if !(1..=MAX_REPEAT).contains(&r.count) {
+        return Err(ck.err(
+            "repeat.count",
+            format!("{} is out of range: must be in 1..={MAX_REPEAT}", r.count),
+        ));
+    }
+    let offset = ck.vec("repeat.offset", r.offset)?;
+    let originals = scene.objects.clone();
+    for i in 1..r.count {
+        let shift = Mat4::from_translation(offset * i as f32);
+        scene.objects.extend(originals.iter().map(|o| Object {
+            transform: shift * o.transform,
+            ..o.clone()
+        }));
     }
     Ok(())
 }
