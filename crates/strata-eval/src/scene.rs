@@ -57,7 +57,10 @@ impl SceneSpec {
                     scene.camera_path = None;
                 }
                 None if k == 0 => bail!("--camera {n} is out of range: the scene file defines no cameras"),
-                None => bail!("--camera {n} is out of range: the scene file defines {k} camera(s), 0..={}", k - 1),
+                None => bail!(
+                    "--camera {n} is out of range: the scene file defines {k} camera(s), 0..={}",
+                    k - 1
+                ),
             }
         }
         if !self.frame.is_finite() || self.frame < 0.0 {

@@ -186,8 +186,30 @@ pub fn scene_fingerprint(scene: &Scene, frame: f32) -> String {
         eat(bytemuck::cast_slice(&o.transform_at(frame).to_cols_array()));
         eat(&(o.mesh as u64).to_le_bytes());
     }
-    eat(format!("{:?}{:?}", scene.materials, scene.settings).as_bytes());
+    eat(format!("{}{:?}", materials_fingerprint(&scene.materials), scene.settings).as_bytes());
     format!("scene={} tris={} geometry={h:016x}", scene.name, scene.triangle_count(),)
+}
+
+/// The materials as text for [`scene_fingerprint`]: the fields every material had
+/// when converged references were first cached, in their `Debug` form (so those
+/// keys stay valid), then each later field only where it differs from its
+/// default — a field added to the model changes no key of a scene that does not
+/// use it, and every key of one that does.
+fn materials_fingerprint(materials: &[strata_scene::Material]) -> String {
+    let one = |m: &strata_scene::Material| {
+        let mut t = format!(
+            "Material {{ name: {:?}, base_color: {:?}, base_color_texture: {:?}, emission: {:?}, opacity: {:?}, roughness: {:?}, metallic: {:?} }}",
+            m.name, m.base_color, m.base_color_texture, m.emission, m.opacity, m.roughness, m.metallic
+        );
+        if let Some(c) = m.alpha_cutoff {
+            t += &format!(" alpha_cutoff={c:?}");
+        }
+        if m.texture_alpha {
+            t += " texture_alpha";
+        }
+        t
+    };
+    format!("[{}]", materials.iter().map(one).collect::<Vec<_>>().join(", "))
 }
 
 /// [`RefCache::default_dir`] with the environment given as a function (testable without touching
@@ -386,6 +408,21 @@ mod tests {
         // storing again repairs the entry
         cache.store(&key, &sample(), "y").unwrap();
         assert!(cache.load(&key).is_some());
+    }
+
+    #[test]
+    fn material_fingerprint_is_the_old_debug_text_until_a_new_field_is_set() {
+        let mut m = vec![strata_scene::Material::diffuse("a", [0.5, 0.25, 1.0])];
+        let old = format!(
+            "[Material {{ name: \"a\", base_color: [0.5, 0.25, 1.0], base_color_texture: None, emission: [0.0, 0.0, 0.0], opacity: 1.0, roughness: {:?}, metallic: 0.0 }}]",
+            m[0].roughness
+        );
+        assert_eq!(materials_fingerprint(&m), old);
+        m[0].alpha_cutoff = Some(0.5);
+        assert_ne!(materials_fingerprint(&m), old);
+        m[0].alpha_cutoff = None;
+        m[0].texture_alpha = true;
+        assert_ne!(materials_fingerprint(&m), old);
     }
 
     #[test]

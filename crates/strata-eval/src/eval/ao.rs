@@ -78,7 +78,10 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
         let (obscurance, obscurance_map) = compare(&ref_obscurance.image, &av)?;
         let (binary, binary_map) = compare(&ref_binary.image, &av)?;
-        let (obscurance, binary) = (ref_obscurance.annotate(obscurance, &av), ref_binary.annotate(binary, &av));
+        let (obscurance, binary) = (
+            ref_obscurance.annotate(obscurance, &av),
+            ref_binary.annotate(binary, &av),
+        );
         Ok(AoResult {
             layers,
             av,
@@ -118,7 +121,15 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         by_layers: s.by_layers(results.iter().chain([&main]).map(|r| (r.layers, r.errors))),
     };
     if let Some(dir) = &s.report {
-        write_ao_report(dir, s, &out, &main, results.first(), &ref_obscurance.image, &ref_binary.image)?;
+        write_ao_report(
+            dir,
+            s,
+            &out,
+            &main,
+            results.first(),
+            &ref_obscurance.image,
+            &ref_binary.image,
+        )?;
     }
     Ok(out)
 }

@@ -136,7 +136,13 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         "warnings",
     ];
     let mut section = Section::new(format!("{} on {}: numbers", technique(r), run.scene))
-        .text(run.warnings.iter().map(|w| format!("Warning: {w}")).collect::<Vec<_>>().join(" "))
+        .text(
+            run.warnings
+                .iter()
+                .map(|w| format!("Warning: {w}"))
+                .collect::<Vec<_>>()
+                .join(" "),
+        )
         .table(settings_table("Settings", r, &skip)?)
         .table(errors)
         .table(reference_table(r));
