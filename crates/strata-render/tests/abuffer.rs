@@ -236,7 +236,12 @@ fn overflow_drops_and_counts_fragments_and_every_list_stays_well_formed() {
     let n = 12;
     let scene = stack(n);
     let px = (W * H) as usize;
-    let full = lists(&gpu, &render(&gpu, &scene, with(ABufferMethod::LinkedList)));
+    // unclipped: room for every fragment (the default pool is 8 per pixel)
+    let roomy = ABufferSettings {
+        pool: Some((n * px) as u32),
+        ..Default::default()
+    };
+    let full = lists(&gpu, &render(&gpu, &scene, roomy));
     let total = full.stored();
     assert_eq!(total, n * px);
     assert_eq!(full.overflow, 0);
@@ -328,6 +333,7 @@ fn oit_resolve_equals_a_cpu_front_to_back_blend_of_the_lists() {
         &deep,
         ABufferSettings {
             compress: None,
+            pool: Some(40 * W * H),
             ..Default::default()
         },
     );
