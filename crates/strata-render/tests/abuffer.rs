@@ -97,7 +97,13 @@ fn layered() -> Scene {
 /// `n` parallel panes (α 0.2 … ) covering the whole view, 0.25 apart.
 fn stack(n: usize) -> Scene {
     let materials = (0..n)
-        .map(|i| glass(&format!("pane{i}"), [0.2 + 0.05 * i as f32, 0.5, 0.8], 0.2 + 0.04 * i as f32))
+        .map(|i| {
+            glass(
+                &format!("pane{i}"),
+                [0.2 + 0.05 * i as f32, 0.5, 0.8],
+                0.2 + 0.04 * i as f32,
+            )
+        })
         .collect();
     let q: Vec<_> = (0..n)
         .map(|i| (1.0 - 0.25 * i as f32, [-20.0, 20.0], [-20.0, 20.0], i))
@@ -118,11 +124,18 @@ fn render(gpu: &GpuContext, scene: &Scene, a: ABufferSettings) -> Renderer {
     let timings = r
         .render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0)
         .expect("frame renders without validation errors");
+    let method = r.settings.abuffer.as_ref().unwrap().method;
     if !timings.passes.is_empty() {
-        for p in r.settings.abuffer.as_ref().unwrap().method.passes() {
+        for p in method.passes() {
             assert!(timings.get(p).is_some(), "pass {p} is timed: {timings:?}");
         }
     }
+    let stages: Vec<String> = method
+        .passes()
+        .iter()
+        .map(|p| format!("{p} {:.3} ms", timings.get(p).unwrap_or(f64::NAN)))
+        .collect();
+    eprintln!("{method} on '{}' {W}x{H}: {}", scene.name, stages.join(", "));
     r
 }
 
@@ -148,14 +161,21 @@ fn four_methods_store_the_same_sorted_fragment_lists() {
     assert_eq!(reference.stored(), reference.total as usize);
     let deepest = reference.lists.iter().map(|l| l.len()).max().unwrap();
     assert_eq!(deepest, 5, "the test scene has pixels with 4 panes over the plane");
-    for method in [ABufferMethod::Linear, ABufferMethod::FixedArray, ABufferMethod::DualPeel] {
+    for method in [
+        ABufferMethod::Linear,
+        ABufferMethod::FixedArray,
+        ABufferMethod::DualPeel,
+    ] {
         let other = lists(&gpu, &render(&gpu, &scene, with(method)));
         assert_eq!(other.overflow, 0, "{method}");
         assert_eq!(other.total, reference.total, "{method}: fragments rasterised");
         for (p, (a, b)) in reference.lists.iter().zip(&other.lists).enumerate() {
             assert_eq!(a.len(), b.len(), "{method}: pixel {p} fragment count");
             for (fa, fb) in a.iter().zip(b) {
-                assert!((fa.depth - fb.depth).abs() <= 1e-6 * fa.depth, "{method} pixel {p}: depth");
+                assert!(
+                    (fa.depth - fb.depth).abs() <= 1e-6 * fa.depth,
+                    "{method} pixel {p}: depth"
+                );
                 assert_eq!(fa.alpha, fb.alpha, "{method} pixel {p}: alpha");
                 for k in 0..3 {
                     assert!(
@@ -184,9 +204,12 @@ fn crossings(scene: &Scene, x: u32, y: u32) -> usize {
             let z = m.positions[0][2];
             let t = (z - cam.eye.z) / d.z;
             let p = cam.eye + t * d;
-            let (lo, hi) = m.positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), q| {
-                (lo.min(Vec3::from(*q)), hi.max(Vec3::from(*q)))
-            });
+            let (lo, hi) = m
+                .positions
+                .iter()
+                .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), q| {
+                    (lo.min(Vec3::from(*q)), hi.max(Vec3::from(*q)))
+                });
             t > 0.0 && p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y
         })
         .count()
@@ -261,7 +284,11 @@ fn overflow_drops_and_counts_fragments_and_every_list_stays_well_formed() {
         );
         assert_eq!(l.total as usize, total, "{method}");
         assert_eq!(l.stored(), pool as usize, "{method}: the pool is full");
-        assert_eq!(l.overflow as usize, total - pool as usize, "{method}: dropped = total − pool");
+        assert_eq!(
+            l.overflow as usize,
+            total - pool as usize,
+            "{method}: dropped = total − pool"
+        );
         // every kept fragment is one of the pixel's real fragments
         for (p, list) in l.lists.iter().enumerate() {
             for f in list {
@@ -287,7 +314,11 @@ fn overflow_drops_and_counts_fragments_and_every_list_stays_well_formed() {
                 },
             ),
         );
-        assert_eq!(l.overflow as usize, total - k as usize * px, "{method}: dropped = total − K·pixels");
+        assert_eq!(
+            l.overflow as usize,
+            total - k as usize * px,
+            "{method}: dropped = total − K·pixels"
+        );
         for (p, list) in l.lists.iter().enumerate() {
             assert_eq!(list.len(), k as usize, "{method}: pixel {p}");
             if method == ABufferMethod::DualPeel {
@@ -307,9 +338,8 @@ fn resolve_error(gpu: &GpuContext, r: &Renderer, l: &FragmentLists, sky: [f32; 3
     let mut worst = 0.0f32;
     for (p, list) in l.lists.iter().enumerate() {
         let want = blend_front_to_back(list, sky);
-        for k in 0..3 {
-            let got = img.data[p * 4 + k];
-            worst = worst.max((got - want[k]).abs() / (want[k].abs() + 1e-3));
+        for (got, w) in img.data[p * 4..p * 4 + 3].iter().zip(want) {
+            worst = worst.max((got - w).abs() / (w.abs() + 1e-3));
         }
     }
     worst
@@ -350,16 +380,18 @@ fn one_pane_over_an_opaque_plane_matches_the_closed_form() {
     let (rho_p, rho_g, alpha) = ([0.8f32, 0.3, 0.1], [0.5f32, 0.5, 0.5], 0.4f32);
     let scene = quads(
         vec![Material::diffuse("plane", rho_g), glass("pane", rho_p, alpha)],
-        &[(-2.0, [-0.8, 0.8], [-20.0, 20.0], 0), (0.5, [-0.4, 20.0], [-0.5, 0.5], 1)],
+        &[
+            (-2.0, [-0.8, 0.8], [-20.0, 20.0], 0),
+            (0.5, [-0.4, 20.0], [-0.5, 0.5], 1),
+        ],
     );
     let Light::Sun { color, illuminance, .. } = scene.lights[0] else {
         unreachable!()
     };
     let amb = scene.settings.ambient;
     // sun along −z, panes facing +z: n·l = 1; L = ρ·ambient + ρ/π·E
-    let radiance = |rho: [f32; 3]| {
-        [0, 1, 2].map(|k| rho[k] * amb[k] + rho[k] / std::f32::consts::PI * color[k] * illuminance)
-    };
+    let radiance =
+        |rho: [f32; 3]| [0, 1, 2].map(|k| rho[k] * amb[k] + rho[k] / std::f32::consts::PI * color[k] * illuminance);
     let (lp, lg) = (radiance(rho_p), radiance(rho_g));
     let sky = scene.settings.sky;
     for method in ABufferMethod::ALL {
@@ -382,13 +414,11 @@ fn one_pane_over_an_opaque_plane_matches_the_closed_form() {
                 });
                 seen[pane as usize * 2 + plane as usize] += 1;
                 let p = ((y * W + x) * 4) as usize;
-                for k in 0..3 {
+                for (k, (got, w)) in img.data[p..p + 3].iter().zip(want).enumerate() {
                     // radiance is stored as f16: 1e-3 relative
                     assert!(
-                        (img.data[p + k] - want[k]).abs() <= 2e-3 * want[k] + 1e-5,
-                        "{method} ({x}, {y}) channel {k}: {} vs {}",
-                        img.data[p + k],
-                        want[k]
+                        (got - w).abs() <= 2e-3 * w + 1e-5,
+                        "{method} ({x}, {y}) channel {k}: {got} vs {w}"
                     );
                 }
             }
@@ -417,7 +447,12 @@ fn compressed_nodes_equal_the_cpu_twin_of_eq5_bit_for_bit() {
                 },
             );
             let l = lists(&gpu, &r);
-            let gpu_nodes = r.abuffer().unwrap().read_compressed(&gpu).unwrap().expect("compression on");
+            let gpu_nodes = r
+                .abuffer()
+                .unwrap()
+                .read_compressed(&gpu)
+                .unwrap()
+                .expect("compression on");
             let scale = r.abuffer().unwrap().depth_scale();
             let want_scale = compress::ONE16 as f32 / far_depth(scene, &scene.camera, 0.0);
             assert_eq!(scale, want_scale);

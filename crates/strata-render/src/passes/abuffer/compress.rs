@@ -50,7 +50,7 @@ impl CompressedList {
         let m = self.nodes.len();
         let pos = self.nodes.iter().position(|n| n.0 > z).unwrap_or(m);
         self.nodes.insert(pos, (z, a));
-        let lo = if back_half { (m + 1) / 2 } else { 0 };
+        let lo = if back_half { m.div_ceil(2) } else { 0 };
         let mut evict = lo;
         let mut best = u32::MAX;
         for j in lo..=m {
@@ -72,7 +72,12 @@ impl CompressedList {
 
 /// Compresses a list of fragments `(csz, α)` given in resolve order (sorted by
 /// depth, ties by node index) into M nodes.
-pub fn compress(fragments: impl IntoIterator<Item = (f32, f32)>, m: u32, back_half: bool, depth_scale: f32) -> CompressedList {
+pub fn compress(
+    fragments: impl IntoIterator<Item = (f32, f32)>,
+    m: u32,
+    back_half: bool,
+    depth_scale: f32,
+) -> CompressedList {
     let mut c = CompressedList::new(m);
     for (csz, alpha) in fragments {
         c.insert(quantise_depth(csz, depth_scale), quantise_alpha(alpha), back_half);

@@ -315,14 +315,14 @@ pub fn blend_front_to_back(list: &[StoredFragment], sky: [f32; 3]) -> [f32; 3] {
         if t < T_MIN {
             break;
         }
-        for k in 0..3 {
-            c[k] += t * f.alpha * f.radiance[k];
+        for (ck, lk) in c.iter_mut().zip(f.radiance) {
+            *ck += t * f.alpha * lk;
         }
         t *= 1.0 - f.alpha;
     }
     if t >= T_MIN {
-        for k in 0..3 {
-            c[k] += t * sky[k];
+        for (ck, sk) in c.iter_mut().zip(sky) {
+            *ck += t * sk;
         }
     }
     c
@@ -474,7 +474,7 @@ impl ABufferStage {
             px * slots as u64 * NODE_BYTES
         };
         let limits = device.limits();
-        let max = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size);
+        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if node_bytes > max {
             let what = if pooled {
                 format!("pool {pool} nodes")
@@ -683,7 +683,11 @@ impl ABufferStage {
                 device,
                 "abuffer-prefix-sum",
                 &layout,
-                &[u.as_entire_binding(), counts.as_entire_binding(), offsets.as_entire_binding()],
+                &[
+                    u.as_entire_binding(),
+                    counts.as_entire_binding(),
+                    offsets.as_entire_binding(),
+                ],
             );
             let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("abuffer-prefix-sum"),
@@ -888,7 +892,10 @@ impl ABufferStage {
                 let mut expected = 0u64;
                 for p in 0..px {
                     if offsets[p] as u64 != expected {
-                        return Err(bad(p, format!("offset {} is not the prefix sum {expected}", offsets[p])));
+                        return Err(bad(
+                            p,
+                            format!("offset {} is not the prefix sum {expected}", offsets[p]),
+                        ));
                     }
                     expected += counts[p] as u64;
                     let o = offsets[p].min(pool);
@@ -933,7 +940,7 @@ impl ABufferStage {
             }
         }
         for l in &mut lists {
-            l.sort_by(|a, b| (a.depth.to_bits(), a.node).cmp(&(b.depth.to_bits(), b.node)));
+            l.sort_by_key(|a| (a.depth.to_bits(), a.node));
         }
         Ok(FragmentLists {
             width: w,
