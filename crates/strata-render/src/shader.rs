@@ -13,6 +13,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/reproject.wgsl", include_str!("shaders/common/reproject.wgsl")),
     ("common/interleave.wgsl", include_str!("shaders/common/interleave.wgsl")),
     ("common/vpl.wgsl", include_str!("shaders/common/vpl.wgsl")),
+    ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
 ];
 
 /// Expands `#import "…"` lines recursively; panics only on a missing module,

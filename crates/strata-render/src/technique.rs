@@ -3,6 +3,7 @@
 //! must cover every technique (the validation matrix test, `strata techniques`)
 //! iterate [`registry`]; a new technique adds one entry here and its own module.
 
+use crate::passes::abuffer::{ABufferMethod, ABufferSettings};
 use crate::passes::interleave::SplitMethod;
 use crate::passes::{ao::AoSettings, ils::IlsSettings, ils::VplShadows, radiosity, reflections::ReflectionSettings};
 use crate::{RenderError, RenderSettings};
@@ -446,6 +447,59 @@ static ILS_SETTINGS: [SettingInfo; 14] = [
     ),
 ];
 
+fn abuffer_mut(s: &mut RenderSettings) -> &mut ABufferSettings {
+    s.abuffer.get_or_insert_with(Default::default)
+}
+
+fn abuffer_of(s: &RenderSettings) -> ABufferSettings {
+    s.abuffer.clone().unwrap_or_default()
+}
+
+/// The A-buffer's settings (ABA §IV, §III-B).
+static ABUFFER_SETTINGS: [SettingInfo; 5] = [
+    SettingInfo {
+        name: "abuffer",
+        doc: "A-buffer construction: linked-list (PPLL), linear (count + prefix sum + fill), fixed-array (K slots, Texture3D), dual-peel (DDP baseline)",
+        range: Range::Closed(0.0, 3.0),
+        integer: true,
+        get: |s| Some(ABufferMethod::ALL.iter().position(|m| *m == abuffer_of(s).method).unwrap_or(0) as f64),
+        set: |s, v| abuffer_mut(s).method = ABufferMethod::ALL[(v.max(0.0) as usize).min(3)],
+        values: &["linked-list", "linear", "fixed-array", "dual-peel"],
+    },
+    setting!(
+        "pool",
+        "node pool of the linked-list and linear methods (default: 8 nodes per pixel); extra fragments are dropped and counted",
+        Range::Closed(1.0, crate::passes::abuffer::MAX_POOL as f64),
+        true,
+        |s| abuffer_of(s).pool.map(f64::from),
+        |s, v| abuffer_mut(s).pool = Some(v as u32)
+    ),
+    setting!(
+        "max-layers",
+        "K: fixed-array slots per pixel and dual-peel layers L (ABA: 16)",
+        Range::Closed(1.0, crate::passes::abuffer::MAX_LAYERS as f64),
+        true,
+        |s| Some(abuffer_of(s).max_layers as f64),
+        |s, v| abuffer_mut(s).max_layers = v as u32
+    ),
+    setting!(
+        "compress",
+        "M nodes of the compressed list (ABA Eq. 5); 0 = no compression",
+        Range::Closed(0.0, crate::passes::abuffer::compress::MAX_NODES as f64),
+        true,
+        |s| Some(abuffer_of(s).compress.unwrap_or(0) as f64),
+        |s, v| abuffer_mut(s).compress = (v != 0.0).then_some(v as u32)
+    ),
+    setting!(
+        "compress-back-half",
+        "1 = Eq. 5 evicts only from the back half of the array (the nearest nodes stay)",
+        Range::Closed(0.0, 1.0),
+        true,
+        |s| Some(abuffer_of(s).compress_back_half as u32 as f64),
+        |s, v| abuffer_mut(s).compress_back_half = v != 0.0
+    ),
+];
+
 /// One registered technique.
 pub struct Technique {
     pub name: &'static str,
@@ -517,6 +571,7 @@ fn no_preset(name: &str, preset: Option<&str>) -> Result<(), RenderError> {
 fn configure_direct(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), RenderError> {
     no_preset("direct", preset)?;
     s.shade = true;
+    s.abuffer = None;
     s.ils = None;
     s.ao = None;
     s.radiosity = None;
@@ -528,6 +583,7 @@ fn configure_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Rend
     no_preset("ao", preset)?;
     // AO alone needs no lighting passes
     s.shade = false;
+    s.abuffer = None;
     s.ils = None;
     s.ao = Some(s.ao.clone().unwrap_or_default());
     s.radiosity = None;
@@ -539,6 +595,7 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
     let name = preset.unwrap_or(radiosity::PRESETS[1].0);
     let p = radiosity::Preset::named(name).map_err(RenderError::Parameter)?;
     s.shade = true;
+    s.abuffer = None;
     s.ils = None;
     s.ao = Some(s.ao.clone().unwrap_or_default());
     s.radiosity = Some(p.apply(radiosity::RadiositySettings::default()));
@@ -551,6 +608,7 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
 fn configure_ils(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), RenderError> {
     no_preset("ils", preset)?;
     s.shade = true;
+    s.abuffer = None;
     s.ao = None;
     s.radiosity = None;
     s.reflections = None;
@@ -558,6 +616,24 @@ fn configure_ils(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Ren
     s.ils = Some(s.ils.clone().unwrap_or_default());
     Ok(())
 }
+
+/// ABA OIT: every fragment in an A-buffer, sorted and blended front to back.
+fn configure_oit(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), RenderError> {
+    no_preset("oit", preset)?;
+    // the A-buffer shades its own fragments: no deferred lighting
+    s.shade = false;
+    s.ao = None;
+    s.radiosity = None;
+    s.reflections = None;
+    s.probes = None;
+    s.ils = None;
+    s.abuffer = Some(s.abuffer.clone().unwrap_or_default());
+    Ok(())
+}
+
+/// The OIT frame with the default (linked-list) A-buffer; `linear` adds
+/// `abuffer-count` and `abuffer-prefix-sum` ([`ABufferMethod::passes`]).
+const OIT_PASSES: &[&str] = &["abuffer-clear", "abuffer-draw", "abuffer-resolve", "tonemap"];
 
 const ILS_PASSES: &[&str] = &[
     "shadow",
@@ -610,7 +686,7 @@ const FULL_PASSES: &[&str] = &[
 /// Preset names of the DGB radiosity (Table 2), default first.
 const FULL_PRESETS: &[&str] = &["balanced", "high-performance", "high-quality"];
 
-static REGISTRY: [Technique; 4] = [
+static REGISTRY: [Technique; 5] = [
     Technique {
         name: "direct",
         doc: "direct light (shadowed sun, point, spot, rect) and emission from G-buffer layer 0, tonemapped",
@@ -656,6 +732,18 @@ static REGISTRY: [Technique; 4] = [
         passes: ILS_PASSES,
         settings: &[&DIRECT_SETTINGS, &ILS_SETTINGS],
         configure: configure_ils,
+    },
+    Technique {
+        name: "oit",
+        doc: "order-independent transparency from an A-buffer of every fragment (ABA §IV: linked-list, linear, fixed-array or dual-peel), sorted and blended front to back; lists compressed to M nodes (Eq. 5)",
+        output: "hdr-oit",
+        display: ("ldr", true),
+        // eval against the CPU compositing comes with strata_reference::Reference::composite
+        eval: EvalKind::None,
+        presets: &[],
+        passes: OIT_PASSES,
+        settings: &[&ABUFFER_SETTINGS],
+        configure: configure_oit,
     },
 ];
 

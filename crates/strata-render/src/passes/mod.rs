@@ -1,5 +1,6 @@
 //! One module per technique, each with its WGSL beside it.
 
+pub mod abuffer;
 pub mod ao;
 pub mod bilateral;
 pub(crate) mod builder;

@@ -3,22 +3,8 @@
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
 #import "common/fullscreen.wgsl"
+#import "common/lights.wgsl"
 
-struct GpuLight {
-    // kind, shadow layer (0xffffffff = none)
-    kind: vec4u,
-    position: vec4f,
-    // direction light travels (sun, spot axis) or rect normal
-    direction: vec4f,
-    // intensity x colour
-    color: vec4f,
-    // cos outer, cos inner, shadow texel size, 0
-    cone: vec4f,
-    // rect: half-edge vectors
-    half_u: vec4f,
-    half_v: vec4f,
-    shadow_view_proj: mat4x4f,
-}
 
 struct LightingParams {
     light_count: u32,
@@ -124,55 +110,6 @@ struct LightingOut {
     @location(2) shadow: vec4f,
     // DGB Table 1 radiosity B of layer 0 (R11G11B10): Lambertian direct + emission
     @location(3) radiosity: vec4f,
-}
-
-// Irradiance factor of a one-sided rectangle (centre c, half-edges hu, hv,
-// emitting towards nl) at p with unit normal n: E / L = ½ Σ_i Θ_i (n · Γ_i),
-// Lambert's polygon formula over the rectangle clipped to the hemisphere above
-// p (Sutherland–Hodgman against n · x ≥ 0; at most 5 vertices). Exact for a
-// Lambertian receiver without occlusion.
-fn rect_irradiance(p: vec3f, n: vec3f, c: vec3f, hu: vec3f, hv: vec3f, nl: vec3f) -> f32 {
-    if (dot(p - c, nl) <= 0.0) {
-        return 0.0;
-    }
-    let q = array<vec3f, 4>(c - hu - hv - p, c + hu - hv - p, c + hu + hv - p, c - hu + hv - p);
-    var poly: array<vec3f, 5>;
-    var k = 0u;
-    for (var i = 0u; i < 4u; i++) {
-        let a = q[i];
-        let b = q[(i + 1u) % 4u];
-        let da = dot(a, n);
-        let db = dot(b, n);
-        if (da >= 0.0) {
-            poly[k] = a;
-            k++;
-        }
-        if ((da >= 0.0) != (db >= 0.0)) {
-            poly[k] = a + (b - a) * (da / (da - db));
-            k++;
-        }
-    }
-    if (k < 3u) {
-        return 0.0;
-    }
-    var sum = 0.0;
-    for (var i = 0u; i < k; i++) {
-        let a = poly[i];
-        let b = poly[(i + 1u) % k];
-        let la = length(a);
-        let lb = length(b);
-        if (la < 1e-12 || lb < 1e-12) {
-            continue;
-        }
-        let ua = a / la;
-        let ub = b / lb;
-        let cr = cross(ua, ub);
-        let s = length(cr);
-        if (s > 1e-9) {
-            sum += atan2(s, dot(ua, ub)) * dot(n, cr / s);
-        }
-    }
-    return 0.5 * abs(sum);
 }
 
 // Direct light at the surface of pixel `px` of the bound layer (z > 0).

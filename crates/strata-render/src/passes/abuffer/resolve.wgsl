@@ -1,0 +1,243 @@
+// OIT resolve (ABA §III, §IV) and list compression (§III-B, Eq. 5) in one
+// full-screen pass: per pixel, the fragment list is visited in depth order and
+// blended front to back, C += T·α·L, T *= 1 − α, while T ≥ 1e-4; the
+// background (sky) gets the remaining T (none once T < 1e-4). With compression on, every fragment
+// (in the same order) is also inserted into an M-node array of (depth, α),
+// written packed into `compressed`.
+//
+// Sort: keys (depth bits, node index) — positive floats order as their bits,
+// the index breaks ties. Rounds of a bounded insertion sort: each round walks
+// the whole list and keeps the SORT_BOUND smallest keys greater than the last
+// key blended; a list of n ≤ SORT_BOUND fragments takes one round, longer ones
+// ceil(n / SORT_BOUND) rounds (O(n²/SORT_BOUND) reads, O(SORT_BOUND) memory).
+#import "common/frame.wgsl"
+#import "common/fullscreen.wgsl"
+
+struct Fragment {
+    depth: f32,
+    rg: u32,
+    ba: u32,
+    normal_facing: u32,
+}
+
+struct ResolveParams {
+    width: u32,
+    height: u32,
+    pool: u32,
+    slots: u32,
+    // 0 linked list, 1 linear, 2 fixed array, 3 dual peel
+    method: u32,
+    // M (0 = no compression)
+    compress: u32,
+    // 1 = Eq. 5 searches only the back half
+    back_half: u32,
+    _pad: u32,
+    // normalised depth z = min(csz · depth_scale, 65535) / 65535
+    depth_scale: f32,
+    _pad1: f32,
+    _pad2: f32,
+    _pad3: f32,
+}
+
+const SORT_BOUND: u32 = 16u;
+const MAX_M: u32 = 16u;
+const ONE16: u32 = 65535u;
+const T_MIN: f32 = 1e-4;
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> params: ResolveParams;
+@group(1) @binding(1) var<storage, read> nodes: array<Fragment>;
+@group(1) @binding(2) var<storage, read> links: array<u32>;
+@group(1) @binding(3) var<storage, read> counts: array<u32>;
+@group(1) @binding(4) var<storage, read> offsets: array<u32>;
+@group(1) @binding(5) var compressed: texture_storage_2d_array<rgba32uint, write>;
+
+// A walk over one pixel's stored fragments (any method), in storage order.
+struct Walk {
+    // linked list: next node + 1 (0 = end); others: next position k
+    next: u32,
+    // stored fragments (array methods) / steps taken (linked list)
+    n: u32,
+    base: u32,
+    // dual peel: stored front layers
+    fronts: u32,
+}
+
+fn walk_begin(p: u32) -> Walk {
+    var w: Walk;
+    switch params.method {
+        case 0u: {
+            w.next = counts[p];
+        }
+        case 1u: {
+            let o = offsets[p];
+            w.base = o;
+            w.n = min(counts[p], params.pool - min(o, params.pool));
+        }
+        case 2u: {
+            w.base = p * params.slots;
+            w.n = min(counts[p], params.slots);
+        }
+        default: {
+            w.base = p * params.slots;
+            w.fronts = countOneBits(counts[2u * p]);
+            w.n = w.fronts + countOneBits(counts[2u * p + 1u]);
+        }
+    }
+    return w;
+}
+
+// The next node index, or 0xffffffff at the end (a linked list is cut after
+// `pool` steps or at an index outside the pool: never a hang, never out of bounds).
+fn walk_next(w: ptr<function, Walk>) -> u32 {
+    if (params.method == 0u) {
+        let nx = (*w).next;
+        if (nx == 0u || nx > params.pool || (*w).n >= params.pool) {
+            return 0xffffffffu;
+        }
+        (*w).n += 1u;
+        (*w).next = links[nx - 1u];
+        return nx - 1u;
+    }
+    let k = (*w).next;
+    if (k >= (*w).n) {
+        return 0xffffffffu;
+    }
+    (*w).next = k + 1u;
+    if (params.method == 3u && k >= (*w).fronts) {
+        return (*w).base + params.slots - 1u - (k - (*w).fronts);
+    }
+    return (*w).base + k;
+}
+
+fn key_less(d0: u32, i0: u32, d1: u32, i1: u32) -> bool {
+    return d0 < d1 || (d0 == d1 && i0 < i1);
+}
+
+// Eq. 5 state: M nodes sorted by depth, 16-bit depth and α each.
+var<private> cz: array<u32, 17>;
+var<private> ca: array<u32, 17>;
+
+// Inserts (z, a) after the nodes of depth ≤ z, then removes node
+// i = argmin_j a_j·(1 − z_j) over the M + 1 nodes (integer: a_j·(65535 − z_j);
+// ties: the largest j), searching j ≥ ⌊(M + 1)/2⌋ only with `back_half`.
+// CPU twin: passes::abuffer::compress::insert.
+fn compress_insert(z: u32, a: u32) {
+    let m = params.compress;
+    var pos = m;
+    for (var j = 0u; j < m; j++) {
+        if (cz[j] > z) {
+            pos = j;
+            break;
+        }
+    }
+    for (var j = m; j > pos; j--) {
+        cz[j] = cz[j - 1u];
+        ca[j] = ca[j - 1u];
+    }
+    cz[pos] = z;
+    ca[pos] = a;
+    var lo = 0u;
+    if (params.back_half == 1u) {
+        lo = (m + 1u) / 2u;
+    }
+    var evict = lo;
+    var best = 0xffffffffu;
+    for (var j = lo; j <= m; j++) {
+        let metric = ca[j] * (ONE16 - cz[j]);
+        if (metric <= best) {
+            best = metric;
+            evict = j;
+        }
+    }
+    for (var j = evict; j < m; j++) {
+        cz[j] = cz[j + 1u];
+        ca[j] = ca[j + 1u];
+    }
+}
+
+@fragment
+fn fs_main(@builtin(position) frag: vec4f) -> @location(0) vec4f {
+    let px = vec2u(frag.xy);
+    let p = px.y * params.width + px.x;
+    let m = params.compress;
+    for (var j = 0u; j < MAX_M; j++) {
+        cz[j] = ONE16;
+        ca[j] = 0u;
+    }
+    var c = vec3f(0.0);
+    var t = 1.0;
+    // last key blended (none yet)
+    var last_d = 0u;
+    var last_i = 0u;
+    var started = false;
+    loop {
+        var kd: array<u32, SORT_BOUND>;
+        var ki: array<u32, SORT_BOUND>;
+        var k = 0u;
+        var w = walk_begin(p);
+        loop {
+            let i = walk_next(&w);
+            if (i == 0xffffffffu) {
+                break;
+            }
+            let d = bitcast<u32>(nodes[i].depth);
+            if (started && !key_less(last_d, last_i, d, i)) {
+                continue;
+            }
+            if (k == SORT_BOUND && !key_less(d, i, kd[k - 1u], ki[k - 1u])) {
+                continue;
+            }
+            // insertion into the sorted bounded array
+            var j = min(k, SORT_BOUND - 1u);
+            while (j > 0u && key_less(d, i, kd[j - 1u], ki[j - 1u])) {
+                kd[j] = kd[j - 1u];
+                ki[j] = ki[j - 1u];
+                j--;
+            }
+            kd[j] = d;
+            ki[j] = i;
+            k = min(k + 1u, SORT_BOUND);
+        }
+        for (var j = 0u; j < k; j++) {
+            let f = nodes[ki[j]];
+            let rg = unpack2x16float(f.rg);
+            let ba = unpack2x16float(f.ba);
+            let a = ba.y;
+            if (t >= T_MIN) {
+                c += t * a * vec3f(rg, ba.x);
+                t *= 1.0 - a;
+            }
+            if (m > 0u) {
+                let z = u32(min(f.depth * params.depth_scale, 65535.0));
+                let qa = u32(min(a * 65535.0, 65535.0));
+                compress_insert(z, qa);
+            }
+        }
+        if (k < SORT_BOUND || (m == 0u && t < T_MIN)) {
+            break;
+        }
+        last_d = kd[k - 1u];
+        last_i = ki[k - 1u];
+        started = true;
+    }
+    if (t < T_MIN) {
+        t = 0.0;
+    }
+    if (m > 0u) {
+        let layers = (m + 3u) / 4u;
+        for (var l = 0u; l < layers; l++) {
+            var v = vec4u(0u);
+            for (var e = 0u; e < 4u; e++) {
+                let j = 4u * l + e;
+                var word = ONE16 << 16u;
+                if (j < m) {
+                    word = (cz[j] << 16u) | ca[j];
+                }
+                v[e] = word;
+            }
+            textureStore(compressed, vec2i(px), i32(l), v);
+        }
+    }
+    return vec4f(c + t * frame.sky.rgb, 1.0);
+}
