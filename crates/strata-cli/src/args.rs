@@ -112,8 +112,8 @@ pub struct DeepArgs {
     /// Minimum separation Δz between layers in scene units, >= 0 (default: the scene's; the paper uses 0.5 m).
     #[arg(long, allow_negative_numbers = true)]
     pub min_separation: Option<f32>,
-    /// Guard band rendered around the image and cropped: pixels per side (e.g. 32) or percent of the height (e.g. 10%).
-    #[arg(long, default_value = "0", value_parser = parse_guard_band)]
+    /// Guard band rendered around the image and cropped: pixels per side (e.g. 32), percent of the height (e.g. 10%), or auto (the technique's default: 10% for ao and full, else 0).
+    #[arg(long, default_value = "auto", value_parser = parse_guard_band)]
     pub guard_band: GuardBand,
 }
 

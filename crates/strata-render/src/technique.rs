@@ -555,6 +555,7 @@ impl Technique {
     pub fn settings(&self, base: &RenderSettings, preset: Option<&str>) -> Result<RenderSettings, RenderError> {
         let mut s = base.clone();
         (self.configure)(&mut s, preset)?;
+        s.guard_band = s.guard_band.or_default(crate::renderer::GuardBand::Pixels(0));
         Ok(s)
     }
 }
@@ -588,6 +589,7 @@ fn configure_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Rend
     s.ao = Some(s.ao.clone().unwrap_or_default());
     s.radiosity = None;
     s.reflections = None;
+    s.guard_band = s.guard_band.or_default(crate::renderer::AO_GUARD_BAND);
     Ok(())
 }
 
@@ -600,6 +602,7 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
     s.ao = Some(s.ao.clone().unwrap_or_default());
     s.radiosity = Some(p.apply(radiosity::RadiositySettings::default()));
     s.reflections = Some(s.reflections.unwrap_or_default());
+    s.guard_band = s.guard_band.or_default(crate::renderer::AO_GUARD_BAND);
     Ok(())
 }
 
@@ -766,6 +769,36 @@ pub fn find(name: &str) -> Result<&'static Technique, RenderError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn auto_guard_band_is_the_techniques_default_and_an_explicit_one_wins() {
+        use crate::renderer::{GuardBand, AO_GUARD_BAND};
+        let auto = RenderSettings {
+            guard_band: GuardBand::Auto,
+            ..Default::default()
+        };
+        for t in registry() {
+            let s = t.settings(&auto, None).unwrap();
+            let want = if t.name == "ao" || t.name == "full" {
+                AO_GUARD_BAND
+            } else {
+                GuardBand::Pixels(0)
+            };
+            assert_eq!(s.guard_band, want, "{}", t.name);
+            let explicit = RenderSettings {
+                guard_band: GuardBand::Pixels(7),
+                ..Default::default()
+            };
+            assert_eq!(
+                t.settings(&explicit, None).unwrap().guard_band,
+                GuardBand::Pixels(7),
+                "{}",
+                t.name
+            );
+        }
+        assert_eq!("auto".parse::<GuardBand>().unwrap(), GuardBand::Auto);
+        assert_eq!(GuardBand::Auto.pixels(360), 0);
+    }
 
     #[test]
     fn names_are_unique_and_found() {

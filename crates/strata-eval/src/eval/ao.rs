@@ -32,6 +32,8 @@ fn render_settings(s: &EvalSettings, layers: u32, ao: &AoSettings) -> RenderSett
     RenderSettings {
         shade: false,
         ao: Some(ao.clone()),
+        // `--guard-band auto`: what `render --technique ao` uses
+        guard_band: s.guard_band.or_default(strata_render::renderer::AO_GUARD_BAND),
         ..s.render_settings(layers)
     }
 }

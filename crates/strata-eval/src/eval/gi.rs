@@ -170,6 +170,8 @@ fn render_settings(s: &EvalSettings, layers: u32, radiosity: &RadiositySettings)
             ..Default::default()
         },
         radiosity: Some(radiosity.clone()),
+        // `--guard-band auto`: what `render --technique full` uses
+        guard_band: s.guard_band.or_default(strata_render::renderer::AO_GUARD_BAND),
         ..s.render_settings(layers)
     }
 }
