@@ -87,7 +87,14 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 run.ref_spp,
                 noise(&e.errors.binary)
             );
-            line(if e.visibility == Some(false) { "bzb-ao (visibility off)" } else { "bzb-ao (bounced z-buffer)" }, &e.errors);
+            line(
+                if e.visibility == Some(false) {
+                    "bzb-ao (visibility off)"
+                } else {
+                    "bzb-ao (bounced z-buffer)"
+                },
+                &e.errors,
+            );
             if let Some(x) = &e.no_visibility {
                 line("AOV, no visibility", x);
             }

@@ -462,7 +462,13 @@ impl Renderer {
             None => None,
         };
         let bzb = match &settings.bzb {
-            Some(b) => Some(crate::passes::bzb::BzbStage::new(gpu, &scene_gpu, &mut targets, b, scene)?),
+            Some(b) => Some(crate::passes::bzb::BzbStage::new(
+                gpu,
+                &scene_gpu,
+                &mut targets,
+                b,
+                scene,
+            )?),
             None => None,
         };
         let radiosity = match &settings.radiosity {

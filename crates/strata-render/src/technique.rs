@@ -657,7 +657,13 @@ fn configure_bzb_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), 
     Ok(())
 }
 
-const BZB_AO_PASSES: &[&str] = &["bzb-directions", "bzb-splat", "bzb-reconstruct", "bzb-blur-h", "bzb-blur-v"];
+const BZB_AO_PASSES: &[&str] = &[
+    "bzb-directions",
+    "bzb-splat",
+    "bzb-reconstruct",
+    "bzb-blur-h",
+    "bzb-blur-v",
+];
 
 const ILS_PASSES: &[&str] = &[
     "shadow",

@@ -57,10 +57,18 @@ fn quads_scene(name: &str, quads: &[(Vec3, Vec3, Vec3)], camera: Camera, ao_radi
 /// it, 0.15 apart behind z = 0, seen from the front and above: floor pixels in
 /// front of the stack look at occluders behind each other.
 fn plate_stack(plates: usize) -> Scene {
-    let mut quads = vec![(Vec3::new(-3.0, 0.0, 3.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0))];
+    let mut quads = vec![(
+        Vec3::new(-3.0, 0.0, 3.0),
+        Vec3::new(6.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -6.0),
+    )];
     for k in 0..plates {
         let z = -0.15 * k as f32;
-        quads.push((Vec3::new(-1.5, 0.0, z), Vec3::new(3.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)));
+        quads.push((
+            Vec3::new(-1.5, 0.0, z),
+            Vec3::new(3.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ));
     }
     let camera = Camera::new(Vec3::new(0.0, 2.0, 2.6), Vec3::new(0.0, 0.1, -0.2), Vec3::Y, 50.0, 0.05);
     quads_scene("plate-stack", &quads, camera, 1.0)
@@ -225,8 +233,16 @@ fn bounced_zbuffer_equals_cpu_nearest_hits() {
     let mut scene = plate_stack(3);
     // plus a tilted triangle and a small plate hovering over the floor
     scene = {
-        let mut quads = vec![(Vec3::new(0.5, 0.3, 0.9), Vec3::new(0.6, 0.2, 0.0), Vec3::new(0.0, 0.3, 0.5))];
-        quads.push((Vec3::new(-1.0, 0.35, 0.3), Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.6, 0.0, 0.0)));
+        let mut quads = vec![(
+            Vec3::new(0.5, 0.3, 0.9),
+            Vec3::new(0.6, 0.2, 0.0),
+            Vec3::new(0.0, 0.3, 0.5),
+        )];
+        quads.push((
+            Vec3::new(-1.0, 0.35, 0.3),
+            Vec3::new(0.0, 0.0, 0.5),
+            Vec3::new(0.6, 0.0, 0.0),
+        ));
         let mut extra = quads_scene("extra", &quads, scene.camera, 1.0);
         let base = scene.meshes.len();
         for (i, m) in extra.meshes.drain(..).enumerate() {
@@ -274,7 +290,10 @@ fn bounced_zbuffer_equals_cpu_nearest_hits() {
         wrong.len(),
         &wrong[..wrong.len().min(5)]
     );
-    assert!(hits * 10 > samples, "only {hits} of {samples} rays hit: the scene tests too little");
+    assert!(
+        hits * 10 > samples,
+        "only {hits} of {samples} rays hit: the scene tests too little"
+    );
     eprintln!("{hits} of {samples} rays hit, {} differ from the CPU", wrong.len());
 }
 
@@ -287,9 +306,21 @@ fn nearer_occluder_wins_regardless_of_draw_order() {
     // (x < -1.6) at heights 0.3 (near) and 0.6 (far): grazing floor rays towards -x
     // pass through both
     let camera = Camera::new(Vec3::new(0.0, 3.0, 0.01), Vec3::ZERO, Vec3::Y, 40.0, 0.05);
-    let floor = (Vec3::new(-2.0, 0.0, 2.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0));
-    let near = (Vec3::new(-5.0, 0.3, -2.0), Vec3::new(3.4, 0.0, 0.0), Vec3::new(0.0, 0.0, 4.0));
-    let far = (Vec3::new(-5.0, 0.6, -2.0), Vec3::new(3.4, 0.0, 0.0), Vec3::new(0.0, 0.0, 4.0));
+    let floor = (
+        Vec3::new(-2.0, 0.0, 2.0),
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -4.0),
+    );
+    let near = (
+        Vec3::new(-5.0, 0.3, -2.0),
+        Vec3::new(3.4, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 4.0),
+    );
+    let far = (
+        Vec3::new(-5.0, 0.6, -2.0),
+        Vec3::new(3.4, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 4.0),
+    );
     let b = BzbSettings {
         radius: Some(10.0),
         ..Default::default()
@@ -328,7 +359,10 @@ fn nearer_occluder_wins_regardless_of_draw_order() {
         assert!(both > 100, "only {both} rays pass through both plates");
         depths.push(depth);
     }
-    assert_eq!(depths[0].data, depths[1].data, "the bounced z-buffer depends on the draw order");
+    assert_eq!(
+        depths[0].data, depths[1].data,
+        "the bounced z-buffer depends on the draw order"
+    );
 }
 
 #[test]
@@ -405,8 +439,14 @@ fn visibility_removes_the_over_occlusion_of_stacked_occluders() {
     let with4 = run(true, 4);
     let without = run(false, 4);
     if let Ok(dir) = std::env::var("STRATA_TEST_IMAGES") {
-        for (img, n) in [(&reference, "ref"), (&with, "vis16"), (&with4, "vis4"), (&without, "novis")] {
-            img.save(&std::path::Path::new(&dir).join(format!("bzb-stack-{n}.png")), true).unwrap();
+        for (img, n) in [
+            (&reference, "ref"),
+            (&with, "vis16"),
+            (&with4, "vis4"),
+            (&without, "novis"),
+        ] {
+            img.save(&std::path::Path::new(&dir).join(format!("bzb-stack-{n}.png")), true)
+                .unwrap();
         }
     }
     let (e_with, e_with4, e_without) = (
@@ -424,13 +464,22 @@ fn visibility_removes_the_over_occlusion_of_stacked_occluders() {
          mean AV over {n_occluded} occluded pixels: reference {m_ref:.4}, visibility {m_with:.4}, no visibility {m_without:.4}"
     );
     // without visibility the stack over-occludes
-    assert!(m_without < m_ref - 0.05, "no over-occlusion without visibility: {m_without} vs {m_ref}");
+    assert!(
+        m_without < m_ref - 0.05,
+        "no over-occlusion without visibility: {m_without} vs {m_ref}"
+    );
     // with visibility: within 0.03 of the reference on average over the occluded region, and
     // per-pixel MAE within 0.04 (S = 16) / 0.06 (S = 4, the paper's)
-    assert!((m_with - m_ref).abs() < 0.03, "visibility: mean AV {m_with} vs reference {m_ref}");
+    assert!(
+        (m_with - m_ref).abs() < 0.03,
+        "visibility: mean AV {m_with} vs reference {m_ref}"
+    );
     assert!(e_with < 0.04, "visibility S=16: MAE {e_with}");
     assert!(e_with4 < 0.06, "visibility S=4: MAE {e_with4}");
-    assert!(e_with4 < e_without, "S=4 with visibility {e_with4} not closer than without {e_without}");
+    assert!(
+        e_with4 < e_without,
+        "S=4 with visibility {e_with4} not closer than without {e_without}"
+    );
 }
 
 #[test]
@@ -453,7 +502,10 @@ fn settings_errors_name_the_parameter_and_range() {
             "radius -1 is out of range",
         ),
     ] {
-        let e = Renderer::new(&gpu, &scene, settings(b)).err().expect("rejected").to_string();
+        let e = Renderer::new(&gpu, &scene, settings(b))
+            .err()
+            .expect("rejected")
+            .to_string();
         assert!(e.contains(needle), "{e}");
         assert_eq!(e.lines().count(), 1, "{e}");
     }

@@ -55,7 +55,10 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
         let (obscurance, obscurance_map) = compare(&ref_obscurance.image, &av)?;
         let (binary, binary_map) = compare(&ref_binary.image, &av)?;
-        let (obscurance, binary) = (ref_obscurance.annotate(obscurance, &av), ref_binary.annotate(binary, &av));
+        let (obscurance, binary) = (
+            ref_obscurance.annotate(obscurance, &av),
+            ref_binary.annotate(binary, &av),
+        );
         Ok(AoResult {
             layers,
             av,
@@ -99,7 +102,15 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         dgb_2_layers: None,
     };
     if let Some(dir) = &s.report {
-        write_ao_report(dir, s, &out, &main, results.first(), &ref_obscurance.image, &ref_binary.image)?;
+        write_ao_report(
+            dir,
+            s,
+            &out,
+            &main,
+            results.first(),
+            &ref_obscurance.image,
+            &ref_binary.image,
+        )?;
     }
     Ok(out)
 }
@@ -139,7 +150,13 @@ pub(crate) fn references(
 
 /// Renders frame `f` (after frame f − 1 when the first frame has no history
 /// yet and the variant needs it) and returns AV, cropped to the image.
-pub(crate) fn render_frame(r: &mut Renderer, gpu: &GpuContext, scene: &Scene, s: &EvalSettings, f: f32) -> Result<ImageBuf> {
+pub(crate) fn render_frame(
+    r: &mut Renderer,
+    gpu: &GpuContext,
+    scene: &Scene,
+    s: &EvalSettings,
+    f: f32,
+) -> Result<ImageBuf> {
     if r.settings.deep.uses_history() {
         r.render(gpu, scene, &s.scene.cameras_at(scene, f - 1.0), f - 1.0)?;
     }

@@ -58,7 +58,10 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
         let mut r = Renderer::new(&gpu, &scene, rs)?;
         let start = std::time::Instant::now();
         let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
-        eprintln!("{what}: frame rendered and read back in {:.2} s", start.elapsed().as_secs_f64());
+        eprintln!(
+            "{what}: frame rendered and read back in {:.2} s",
+            start.elapsed().as_secs_f64()
+        );
         let (obscurance, _) = compare(&ref_obscurance.image, &av)?;
         let (binary, _) = compare(&ref_binary.image, &av)?;
         Ok(AoErrors {

@@ -136,7 +136,13 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         "warnings",
     ];
     let mut section = Section::new(format!("{} on {}: numbers", technique(r), run.scene))
-        .text(run.warnings.iter().map(|w| format!("Warning: {w}")).collect::<Vec<_>>().join(" "))
+        .text(
+            run.warnings
+                .iter()
+                .map(|w| format!("Warning: {w}"))
+                .collect::<Vec<_>>()
+                .join(" "),
+        )
         .table(settings_table("Settings", r, &skip)?)
         .table(errors)
         .table(reference_table(r));
@@ -182,7 +188,9 @@ fn reference_table(r: &EvalResult) -> Table {
         ],
     );
     let named: Vec<(&str, &ErrorStats)> = match r {
-        EvalResult::Ao(e) | EvalResult::Bzb(e) => vec![("obscurance", &e.errors.obscurance), ("binary AO", &e.errors.binary)],
+        EvalResult::Ao(e) | EvalResult::Bzb(e) => {
+            vec![("obscurance", &e.errors.obscurance), ("binary AO", &e.errors.binary)]
+        }
         EvalResult::Gi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
         EvalResult::Ils(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
     };

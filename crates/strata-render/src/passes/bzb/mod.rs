@@ -460,14 +460,24 @@ impl BzbStage {
         }
         for d in [
             RAW,
-            TargetDesc::new("bzb-blur-h", wgpu::TextureFormat::R16Float, 1, "BZB AV after the horizontal bilateral pass"),
+            TargetDesc::new(
+                "bzb-blur-h",
+                wgpu::TextureFormat::R16Float,
+                1,
+                "BZB AV after the horizontal bilateral pass",
+            ),
         ] {
             targets.create(gpu, d);
         }
         if targets.try_get("ao").is_none() {
             targets.create(
                 gpu,
-                TargetDesc::new("ao", wgpu::TextureFormat::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
+                TargetDesc::new(
+                    "ao",
+                    wgpu::TextureFormat::R16Float,
+                    1,
+                    "ambient visibility AV (1 = unoccluded)",
+                ),
             );
         }
         let data = triangle_data(scene, 0.0);
@@ -513,8 +523,26 @@ impl BzbStage {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let splat = Self::splat_pass(gpu, scene_gpu, targets, s, &uniforms, &buffer, count);
-        let blur_h = BilateralPass::new(gpu, scene_gpu, targets, &s.filter, "bzb-blur-h", RAW.name, "bzb-blur-h", false);
-        let blur_v = BilateralPass::new(gpu, scene_gpu, targets, &s.filter, "bzb-blur-v", "bzb-blur-h", "ao", true);
+        let blur_h = BilateralPass::new(
+            gpu,
+            scene_gpu,
+            targets,
+            &s.filter,
+            "bzb-blur-h",
+            RAW.name,
+            "bzb-blur-h",
+            false,
+        );
+        let blur_v = BilateralPass::new(
+            gpu,
+            scene_gpu,
+            targets,
+            &s.filter,
+            "bzb-blur-v",
+            "bzb-blur-h",
+            "ao",
+            true,
+        );
         Ok(Self {
             directions,
             splat,
@@ -613,11 +641,7 @@ impl BzbStage {
                 dst_factor: wgpu::BlendFactor::One,
                 operation: wgpu::BlendOperation::Add,
             };
-            (
-                "fs_additive",
-                Some(wgpu::BlendState { color: add, alpha: add }),
-                None,
-            )
+            ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
         };
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("bzb-splat"),
