@@ -258,7 +258,7 @@ pub fn bounced_depth(o: Vec3, d: Vec3, triangles: &[[Vec3; 3]], r: f32, t_min: f
 /// factor of T clipped to n·(y − x) ≥ β, times 1 − (h/r)² (h: x's distance to
 /// T's plane; exact binary AO within r for an infinite plane).
 pub fn aov_occlusion(x: Vec3, n: Vec3, v: [Vec3; 3], r: f32, beta: f32) -> f32 {
-    if !(triangle_dist2(x, v) < r * r) {
+    if triangle_dist2(x, v).partial_cmp(&(r * r)) != Some(std::cmp::Ordering::Less) {
         return 0.0;
     }
     let rel = v.map(|p| p - x);
@@ -483,7 +483,7 @@ impl BzbStage {
         let data = triangle_data(scene, 0.0);
         let count = (data.len() / 3) as u32;
         let bytes = (data.len() * 16).max(48) as u64;
-        let limit = gpu.device.limits().max_storage_buffer_binding_size as u64;
+        let limit = gpu.device.limits().max_storage_buffer_binding_size;
         if bytes > limit {
             return Err(crate::RenderError::Parameter(format!(
                 "scene '{}' has {count} triangles: {bytes} bytes of splat triangles exceed the adapter's storage buffer binding size {limit}",
