@@ -2,7 +2,7 @@
 //! one JSON object or a line of numbers.
 
 use anyhow::Result;
-use strata_eval::eval::{ao, gi, ils, EvalSettings};
+use strata_eval::eval::{ao, bzb, gi, ils, EvalSettings};
 use strata_eval::results::{to_json_string, EvalResult};
 
 use strata_render::technique::EvalKind;
@@ -12,11 +12,32 @@ use crate::args::EvalArgs;
 pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
     // the registry's eval kind picks the comparison
-    if !a.set.values.is_empty() && a.technique.eval != EvalKind::VplRadiance {
-        anyhow::bail!("--set is only read by --technique ils in eval (ao and gi have their own flags)");
+    let is_bzb = a.technique.name == "bzb-ao";
+    if !a.set.values.is_empty() && a.technique.eval != EvalKind::VplRadiance && !is_bzb {
+        anyhow::bail!("--set is only read by --technique ils and bzb-ao in eval (ao and gi have their own flags)");
     }
     let result = match a.technique.eval {
         EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values)?),
+        // the registry's settings (--set), with --ao-radius/--ao-bias carried over
+        EvalKind::AmbientVisibility if is_bzb => {
+            let mut rs = a
+                .technique
+                .settings(
+                    &strata_render::RenderSettings {
+                        ao: Some(a.ao.settings()),
+                        ..Default::default()
+                    },
+                    None,
+                )
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            for (name, value) in &a.set.values {
+                a.technique
+                    .set(&mut rs, name, *value)
+                    .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+            }
+            let b = rs.bzb.unwrap_or_default();
+            EvalResult::Bzb(bzb::run(&s, &b, &a.ao.settings())?)
+        }
         EvalKind::AmbientVisibility => EvalResult::Ao(ao::run(&s, &a.ao.settings())?),
         EvalKind::None => unreachable!("the argument parser admits only comparable techniques"),
         EvalKind::Radiance => {
@@ -50,6 +71,35 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                     f.mean,
                     100.0 * f.valid_fraction
                 );
+            }
+        }
+        EvalResult::Bzb(e) => {
+            let line = |what: &str, x: &strata_eval::results::AoErrors| {
+                println!(
+                    "  {what:<28} vs binary AO: FLIP {:.4}  RMSE {:.4}  MAE {:.4}; vs obscurance: FLIP {:.4}  MAE {:.4}",
+                    x.binary.flip, x.binary.rmse, x.binary.mae, x.obscurance.flip, x.obscurance.mae
+                )
+            };
+            println!(
+                "{} bzb-ao S={} {w}x{h} (reference {} spp, noise FLIP {:.4}):",
+                run.scene,
+                e.samples,
+                run.ref_spp,
+                noise(&e.errors.binary)
+            );
+            line(
+                if e.visibility == Some(false) {
+                    "bzb-ao (visibility off)"
+                } else {
+                    "bzb-ao (bounced z-buffer)"
+                },
+                &e.errors,
+            );
+            if let Some(x) = &e.no_visibility {
+                line("AOV, no visibility", x);
+            }
+            if let Some(x) = &e.dgb_2_layers {
+                line("DGB AO, 2 layers", x);
             }
         }
         EvalResult::Gi(e) => {

@@ -35,20 +35,21 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
     if settings.radiosity.is_some() {
         // the preset, then the radiosity flags
         settings.radiosity = Some(f.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?);
-        // blended with baked light probes (modulated by AO)
-        if !f.no_probes {
-            settings.probes = Some(strata_eval::cache::probes::scene_probes(
-                &scene,
-                &strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir()),
-                false,
-            )?);
-        }
     }
     for (name, value) in &f.set.values {
         t.set(&mut settings, name, *value)
             .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
     }
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    // blended with baked light probes (modulated by AO); baked only once the settings are
+    // known to be valid, so a bad flag is a one-line error without a bake before it
+    if settings.radiosity.is_some() && !f.no_probes {
+        settings.probes = Some(strata_eval::cache::probes::scene_probes(
+            &scene,
+            &strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir()),
+            false,
+        )?);
+    }
     // ILS: VPLs by instant radiosity on the CPU, once per run (static scenes)
     strata_eval::vpls::add_vpls(&mut settings, &scene, f.scene.frame);
     Ok((scene, cams, settings))

@@ -828,7 +828,7 @@ fn techniques_json_lists_settings_defaults_and_ranges() {
     let v = json_of(&strata(&["techniques", "--json"]));
     let ts = v["techniques"].as_array().expect("techniques");
     let names: Vec<&str> = ts.iter().map(|t| t["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["direct", "ao", "full", "ils", "oit"]);
+    assert_eq!(names, ["direct", "ao", "full", "ils", "oit", "bzb-ao"]);
     let full = &ts[2];
     assert_eq!(
         full["presets"],
@@ -1365,4 +1365,51 @@ fn gltf_punctual_lights_light_the_render() {
         "the default sun is near white: {:?}",
         rgb[1]
     );
+}
+
+/// Issue 13: `bzb-ao` renders through the registry, its baseline by a named
+/// value (`--set visibility=off`), and out-of-range settings are one line.
+#[test]
+fn bzb_ao_renders_with_and_without_visibility() {
+    for (set, name) in [("visibility=on", "bzb-on.png"), ("visibility=off", "bzb-off.png")] {
+        let out = scratch(name);
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "bzb-ao",
+            "--set",
+            set,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ]);
+        assert!(o.status.success(), "{set}: {}", stderr(&o));
+        assert!(out.exists());
+    }
+    let out = scratch("bzb-bad.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--technique",
+        "bzb-ao",
+        "--set",
+        "directions=17",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("directions") && e.contains("1..=16"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
 }

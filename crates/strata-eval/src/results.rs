@@ -272,6 +272,17 @@ pub struct AoEval {
     /// With a report: every k from 1 to `layers`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub by_layers: Vec<ByLayers<AoErrors>>,
+    /// `bzb-ao`: directions S per pixel and whether the bounced z-buffer was on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub directions: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub visibility: Option<bool>,
+    /// `bzb-ao`: the AOV baseline (same splats, additive, no depth test) for the same camera.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_visibility: Option<AoErrors>,
+    /// `bzb-ao`: DGB AO with 2 layers (its `--ao-*` flags) for the same camera.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dgb_2_layers: Option<AoErrors>,
 }
 
 /// Deep-G-buffer radiosity errors: the indirect light (top level) and direct + indirect.
@@ -357,6 +368,9 @@ pub struct IlsEval {
 #[serde(tag = "technique", rename_all = "lowercase")]
 pub enum EvalResult {
     Ao(AoEval),
+    /// Bounced-z-buffer AO (`bzb-ao`), with its baseline and DGB AO beside it.
+    #[serde(rename = "bzb-ao")]
+    Bzb(AoEval),
     Gi(GiEval),
     Ils(IlsEval),
 }
@@ -364,7 +378,7 @@ pub enum EvalResult {
 impl EvalResult {
     pub fn run(&self) -> &EvalRun {
         match self {
-            EvalResult::Ao(e) => &e.run,
+            EvalResult::Ao(e) | EvalResult::Bzb(e) => &e.run,
             EvalResult::Gi(e) => &e.run,
             EvalResult::Ils(e) => &e.run,
         }
@@ -415,6 +429,10 @@ mod tests {
             errors,
             layers_1: Some(errors),
             by_layers: vec![],
+            directions: None,
+            visibility: None,
+            no_visibility: None,
+            dgb_2_layers: None,
         };
         let v = serde_json::to_value(EvalResult::Ao(e.clone())).unwrap();
         for key in [

@@ -157,6 +157,9 @@ pub struct RenderSettings {
     /// into `hdr-oit` (OIT) and compressed (Eq. 5); `None` = off. Needs `shade`
     /// off (it replaces the deferred lighting; `tonemap` shows `hdr-oit`).
     pub abuffer: Option<crate::passes::abuffer::ABufferSettings>,
+    /// Bounced-z-buffer AO (BZB §3, AOV splats) into target `ao`; `None` = off.
+    /// Excludes `ao` (both write the `ao` target).
+    pub bzb: Option<crate::passes::bzb::BzbSettings>,
 }
 
 impl Default for RenderSettings {
@@ -176,6 +179,7 @@ impl Default for RenderSettings {
             probes: None,
             ils: None,
             abuffer: None,
+            bzb: None,
         }
     }
 }
@@ -218,6 +222,14 @@ impl RenderSettings {
         }
         if let Some(ao) = &self.ao {
             ao.validate().map_err(RenderError::Parameter)?;
+        }
+        if let Some(b) = &self.bzb {
+            b.validate().map_err(RenderError::Parameter)?;
+            if self.ao.is_some() {
+                return Err(RenderError::Parameter(
+                    "bzb and ao both write the ao target: turn one off".into(),
+                ));
+            }
         }
         if let Some(r) = &self.reflections {
             r.validate().map_err(RenderError::Parameter)?;
@@ -307,6 +319,9 @@ impl RenderSettings {
         }
         if let Some(a) = &self.abuffer {
             bytes += a.estimated_bytes(w, h) + sum(crate::passes::tonemap::OUTPUTS);
+        }
+        if let Some(b) = &self.bzb {
+            bytes += b.estimated_bytes(w, h, scene.triangle_count() as u64);
         }
         let geometry: u64 = scene
             .meshes
@@ -399,6 +414,7 @@ pub struct Renderer {
     ao: Option<AoStage>,
     radiosity: Option<RadiosityStage>,
     ils: Option<crate::passes::ils::IlsStage>,
+    bzb: Option<crate::passes::bzb::BzbStage>,
     reflections: Option<crate::passes::reflections::ReflectionPass>,
     abuffer: Option<crate::passes::abuffer::ABufferStage>,
     history: Option<HistoryPass>,
@@ -484,6 +500,16 @@ impl Renderer {
         }
         let ao = match &settings.ao {
             Some(a) => Some(AoStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, a)),
+            None => None,
+        };
+        let bzb = match &settings.bzb {
+            Some(b) => Some(crate::passes::bzb::BzbStage::new(
+                gpu,
+                &scene_gpu,
+                &mut targets,
+                b,
+                scene,
+            )?),
             None => None,
         };
         let radiosity = match &settings.radiosity {
@@ -581,6 +607,7 @@ impl Renderer {
             ao,
             radiosity,
             ils,
+            bzb,
             reflections,
             abuffer,
             history,
@@ -610,6 +637,9 @@ impl Renderer {
         }
         if let Some(a) = &self.ao {
             v.extend(a.passes());
+        }
+        if let Some(b) = &self.bzb {
+            v.extend(b.passes());
         }
         if let (Some(l), Some(t)) = (&self.lighting, &self.tonemap) {
             v.push(l);
@@ -684,6 +714,9 @@ impl Renderer {
             if let Some(t) = &stage.temporal {
                 t.set_frame(gpu, temporal_history);
             }
+        }
+        if let Some(b) = &self.bzb {
+            b.set_frame(gpu, scene, frame, self.animated);
         }
         if let (Some(stage), Some(s)) = (&self.radiosity, &self.settings.radiosity) {
             let ru = RadiosityUniforms::new(s, scene, &u, max_mip, self.frames_rendered);
@@ -763,6 +796,11 @@ impl Renderer {
     /// The AO pass's uniforms of the last rendered frame.
     pub fn ao_uniforms(&self) -> Option<AoUniforms> {
         self.ao.as_ref().map(|a| a.ao.uniforms())
+    }
+
+    /// The bounced-z-buffer pass's uniforms of the last rendered frame.
+    pub fn bzb_uniforms(&self) -> Option<crate::passes::bzb::BzbUniforms> {
+        self.bzb.as_ref().map(|b| b.uniforms())
     }
 
     /// MIP level `mip` of target `name` (layer 0, whole texture incl. guard band).

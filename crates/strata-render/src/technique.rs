@@ -4,6 +4,7 @@
 //! iterate [`registry`]; a new technique adds one entry here and its own module.
 
 use crate::passes::abuffer::{ABufferMethod, ABufferSettings};
+use crate::passes::bzb::{BzbSettings, Hemisphere};
 use crate::passes::interleave::SplitMethod;
 use crate::passes::{ao::AoSettings, ils::IlsSettings, ils::VplShadows, radiosity, reflections::ReflectionSettings};
 use crate::{RenderError, RenderSettings};
@@ -500,6 +501,81 @@ static ABUFFER_SETTINGS: [SettingInfo; 5] = [
     ),
 ];
 
+fn bzb_mut(s: &mut RenderSettings) -> &mut BzbSettings {
+    s.bzb.get_or_insert_with(BzbSettings::default)
+}
+
+fn bzb_of(s: &RenderSettings) -> BzbSettings {
+    s.bzb.clone().unwrap_or_default()
+}
+
+static BZB_SETTINGS: [SettingInfo; 7] = [
+    SettingInfo {
+        name: "visibility",
+        doc: "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_of(s).visibility as u32 as f64),
+        set: |s, v| bzb_mut(s).visibility = v != 0.0,
+        values: &["off", "on"],
+    },
+    setting!(
+        "directions",
+        "directions S per pixel, one interleaved sub-image each (BZB §3.1, §5: 4)",
+        Range::Closed(1.0, crate::passes::bzb::MAX_DIRECTIONS as f64),
+        true,
+        |s| Some(bzb_of(s).directions as f64),
+        |s, v| bzb_mut(s).directions = v as u32
+    ),
+    SettingInfo {
+        name: "hemisphere",
+        doc: "direction pdf (BZB §3.1): cosine (cos θ/π) or uniform (1/2π, the paper's AO choice)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_of(s).hemisphere as u32 as f64),
+        set: |s, v| {
+            bzb_mut(s).hemisphere = if v == 0.0 {
+                Hemisphere::Cosine
+            } else {
+                Hemisphere::Uniform
+            }
+        },
+        values: &["cosine", "uniform"],
+    },
+    setting!(
+        "ao-radius",
+        "world-space AO radius r = d_max of BZB §3.2 (default: the scene's ao_radius)",
+        Range::Above(0.0),
+        false,
+        |s| bzb_of(s).radius.map(f64::from),
+        |s, v| bzb_mut(s).radius = Some(v as f32)
+    ),
+    setting!(
+        "ao-bias",
+        "ray t_min in scene units: nearer hits do not occlude (default 0.01·r)",
+        Range::AtLeast(0.0),
+        false,
+        |s| bzb_of(s).bias.map(f64::from),
+        |s, v| bzb_mut(s).bias = Some(v as f32)
+    ),
+    setting!(
+        "filter-radius",
+        "cross-bilateral taps on each side (BZB §3.3; 0 = none)",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(bzb_of(s).filter.radius as f64),
+        |s, v| bzb_mut(s).filter.radius = v as u32
+    ),
+    setting!(
+        "filter-step",
+        "pixels between cross-bilateral taps",
+        Range::Closed(1.0, 8.0),
+        true,
+        |s| Some(bzb_of(s).filter.step as f64),
+        |s, v| bzb_mut(s).filter.step = v as u32
+    ),
+];
+
 /// One registered technique.
 pub struct Technique {
     pub name: &'static str,
@@ -577,6 +653,7 @@ fn configure_direct(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), 
     s.ao = None;
     s.radiosity = None;
     s.reflections = None;
+    s.bzb = None;
     Ok(())
 }
 
@@ -590,6 +667,7 @@ fn configure_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Rend
     s.radiosity = None;
     s.reflections = None;
     s.guard_band = s.guard_band.or_default(crate::renderer::AO_GUARD_BAND);
+    s.bzb = None;
     Ok(())
 }
 
@@ -603,6 +681,7 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
     s.radiosity = Some(p.apply(radiosity::RadiositySettings::default()));
     s.reflections = Some(s.reflections.unwrap_or_default());
     s.guard_band = s.guard_band.or_default(crate::renderer::AO_GUARD_BAND);
+    s.bzb = None;
     Ok(())
 }
 
@@ -617,6 +696,7 @@ fn configure_ils(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Ren
     s.reflections = None;
     s.probes = None;
     s.ils = Some(s.ils.clone().unwrap_or_default());
+    s.bzb = None;
     Ok(())
 }
 
@@ -630,6 +710,7 @@ fn configure_oit(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Ren
     s.reflections = None;
     s.probes = None;
     s.ils = None;
+    s.bzb = None;
     s.abuffer = Some(s.abuffer.clone().unwrap_or_default());
     Ok(())
 }
@@ -637,6 +718,32 @@ fn configure_oit(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Ren
 /// The OIT frame with the default (linked-list) A-buffer; `linear` adds
 /// `abuffer-count` and `abuffer-prefix-sum` ([`ABufferMethod::passes`]).
 const OIT_PASSES: &[&str] = &["abuffer-clear", "abuffer-draw", "abuffer-resolve", "tonemap"];
+/// BZB AO (AOV splats with a bounced z-buffer). The AO radius and bias of the
+/// caller's DGB AO settings (`--ao-radius`, `--ao-bias`) carry over, so they mean
+/// what they mean for `ao`.
+fn configure_bzb_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), RenderError> {
+    no_preset("bzb-ao", preset)?;
+    s.shade = false;
+    s.abuffer = None;
+    s.ils = None;
+    s.radiosity = None;
+    s.reflections = None;
+    let mut b = s.bzb.clone().unwrap_or_default();
+    if let Some(ao) = s.ao.take() {
+        b.radius = b.radius.or(ao.radius);
+        b.bias = b.bias.or(ao.bias);
+    }
+    s.bzb = Some(b);
+    Ok(())
+}
+
+const BZB_AO_PASSES: &[&str] = &[
+    "bzb-directions",
+    "bzb-splat",
+    "bzb-reconstruct",
+    "bzb-blur-h",
+    "bzb-blur-v",
+];
 
 const ILS_PASSES: &[&str] = &[
     "shadow",
@@ -689,7 +796,7 @@ const FULL_PASSES: &[&str] = &[
 /// Preset names of the DGB radiosity (Table 2), default first.
 const FULL_PRESETS: &[&str] = &["balanced", "high-performance", "high-quality"];
 
-static REGISTRY: [Technique; 5] = [
+static REGISTRY: [Technique; 6] = [
     Technique {
         name: "direct",
         doc: "direct light (shadowed sun, point, spot, rect) and emission from G-buffer layer 0, tonemapped",
@@ -747,6 +854,17 @@ static REGISTRY: [Technique; 5] = [
         passes: OIT_PASSES,
         settings: &[&ABUFFER_SETTINGS],
         configure: configure_oit,
+    },
+    Technique {
+        name: "bzb-ao",
+        doc: "ambient occlusion volumes splatted into a bounced z-buffer (BZB §3: S directions per pixel, nearest occluder wins; visibility=off: the additive AOV baseline)",
+        output: "ao",
+        display: ("ao", false),
+        eval: EvalKind::AmbientVisibility,
+        presets: &[],
+        passes: BZB_AO_PASSES,
+        settings: &[&BZB_SETTINGS],
+        configure: configure_bzb_ao,
     },
 ];
 

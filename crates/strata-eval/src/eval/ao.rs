@@ -28,7 +28,7 @@ struct AoResult {
     binary_map: ImageBuf,
 }
 
-fn render_settings(s: &EvalSettings, layers: u32, ao: &AoSettings) -> RenderSettings {
+pub(crate) fn render_settings(s: &EvalSettings, layers: u32, ao: &AoSettings) -> RenderSettings {
     RenderSettings {
         shade: false,
         ao: Some(ao.clone()),
@@ -44,33 +44,10 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
     render_settings(s, s.deep.layers, settings)
         .validate()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (w, h) = (s.scene.width, s.scene.height);
     let camera = cams.current;
     let (radius, beta, epsilon) = settings.resolve(&scene);
 
-    // Ground truth, converged to the noise target and cached: the obscurance of Eq. 2 over all
-    // surfaces with the spiral's radial density, and binary visibility within r.
-    let cache = RefCache::new(&s.cache);
-    let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
-    let obscurance = Estimator::Obscurance(ObscuranceSettings {
-        radius,
-        beta,
-        epsilon,
-        disk: DiskSampling::SpiralRadius,
-        ..ObscuranceSettings::new(radius)
-    });
-    let binary = Estimator::AoBinary(AoBinarySettings::new(radius));
-    let scene_id = scene_fingerprint(&scene, s.scene.frame);
-    let cam_id = format!("{camera:?} {w}x{h}");
-    let converge = |name: &str, est: &Estimator| {
-        let description = format!("v2 converged {name} {scene_id} {cam_id} {est:?} {rule:?}");
-        let c = cache.converged(s.no_cache, &description, est, || {
-            reference.converge(&camera, w, h, est, &rule, |a, b| half_flip(a, b, |i| i.clone()))
-        });
-        RefImage::of(&c, |i| i.clone(), |i| i.clone())
-    };
-    let ref_obscurance = converge("obscurance", &obscurance)?;
-    let ref_binary = converge("binary-ao", &binary)?;
+    let (ref_obscurance, ref_binary) = references(s, &scene, &camera, (radius, beta, epsilon), &rule)?;
 
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
@@ -121,6 +98,10 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
         by_layers: s.by_layers(results.iter().chain([&main]).map(|r| (r.layers, r.errors))),
+        directions: None,
+        visibility: None,
+        no_visibility: None,
+        dgb_2_layers: None,
     };
     if let Some(dir) = &s.report {
         write_ao_report(
@@ -136,9 +117,48 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
     Ok(out)
 }
 
+/// Ground truth for `camera`, converged to the noise target and cached: the obscurance of
+/// Eq. 2 over all surfaces with the spiral's radial density (r, β, ε), and binary
+/// visibility within r.
+pub(crate) fn references(
+    s: &EvalSettings,
+    scene: &Scene,
+    camera: &strata_scene::Camera,
+    (radius, beta, epsilon): (f32, f32, f32),
+    rule: &strata_reference::ConvergeRule,
+) -> Result<(RefImage, RefImage)> {
+    let (w, h) = (s.scene.width, s.scene.height);
+    let cache = RefCache::new(&s.cache);
+    let reference = Reference::new(scene, s.scene.frame).with_progress(s.progress);
+    let obscurance = Estimator::Obscurance(ObscuranceSettings {
+        radius,
+        beta,
+        epsilon,
+        disk: DiskSampling::SpiralRadius,
+        ..ObscuranceSettings::new(radius)
+    });
+    let binary = Estimator::AoBinary(AoBinarySettings::new(radius));
+    let scene_id = scene_fingerprint(scene, s.scene.frame);
+    let cam_id = format!("{camera:?} {w}x{h}");
+    let converge = |name: &str, est: &Estimator| {
+        let description = format!("v2 converged {name} {scene_id} {cam_id} {est:?} {rule:?}");
+        let c = cache.converged(s.no_cache, &description, est, || {
+            reference.converge(camera, w, h, est, rule, |a, b| half_flip(a, b, |i| i.clone()))
+        });
+        RefImage::of(&c, |i| i.clone(), |i| i.clone())
+    };
+    Ok((converge("obscurance", &obscurance)?, converge("binary-ao", &binary)?))
+}
+
 /// Renders frame `f` (after frame f − 1 when the first frame has no history
 /// yet and the variant needs it) and returns AV, cropped to the image.
-fn render_frame(r: &mut Renderer, gpu: &GpuContext, scene: &Scene, s: &EvalSettings, f: f32) -> Result<ImageBuf> {
+pub(crate) fn render_frame(
+    r: &mut Renderer,
+    gpu: &GpuContext,
+    scene: &Scene,
+    s: &EvalSettings,
+    f: f32,
+) -> Result<ImageBuf> {
     if r.settings.deep.uses_history() {
         r.render(gpu, scene, &s.scene.cameras_at(scene, f - 1.0), f - 1.0)?;
     }

@@ -20,6 +20,7 @@ use crate::results::{ByLayers, EvalResult, EvalRun, Flicker};
 use crate::scene::SceneSpec;
 
 pub mod ao;
+pub mod bzb;
 pub mod gi;
 pub mod ils;
 

@@ -65,7 +65,7 @@ fn stats_cells(s: &ErrorStats) -> Vec<Cell> {
 pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Section>> {
     let run = r.run();
     let (what, header, rows, fig10): (_, &[&str], Vec<ErrorRow>, Option<&Fig10>) = match r {
-        EvalResult::Ao(e) => {
+        EvalResult::Ao(e) | EvalResult::Bzb(e) => {
             let row = |layers: u32, x: &crate::results::AoErrors| ErrorRow {
                 layers,
                 cells: [
@@ -188,7 +188,9 @@ fn reference_table(r: &EvalResult) -> Table {
         ],
     );
     let named: Vec<(&str, &ErrorStats)> = match r {
-        EvalResult::Ao(e) => vec![("obscurance", &e.errors.obscurance), ("binary AO", &e.errors.binary)],
+        EvalResult::Ao(e) | EvalResult::Bzb(e) => {
+            vec![("obscurance", &e.errors.obscurance), ("binary AO", &e.errors.binary)]
+        }
         EvalResult::Gi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
         EvalResult::Ils(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
     };
@@ -211,6 +213,7 @@ fn reference_table(r: &EvalResult) -> Table {
 fn technique(r: &EvalResult) -> &'static str {
     match r {
         EvalResult::Ao(_) => "eval ao",
+        EvalResult::Bzb(_) => "eval bzb-ao",
         EvalResult::Gi(_) => "eval gi",
         EvalResult::Ils(_) => "eval ils",
     }

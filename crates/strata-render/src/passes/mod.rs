@@ -4,6 +4,7 @@ pub mod abuffer;
 pub mod ao;
 pub mod bilateral;
 pub(crate) mod builder;
+pub mod bzb;
 pub mod compose;
 pub mod deep_gbuffer;
 pub mod depth_mip;

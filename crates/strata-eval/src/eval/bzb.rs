@@ -1,0 +1,97 @@
+//! Bounced-z-buffer AO (`bzb-ao`, BZB §3 with AOV splats) against the CPU ground truth
+//! of the same camera — ray-traced binary AO within r, the quantity its estimator
+//! targets, and DGB's obscurance — with, in the same result, the errors of the
+//! no-visibility AOV baseline and of 2-layer deep-G-buffer AO, so one run says
+//! which is closest.
+
+use anyhow::{bail, Result};
+use strata_render::passes::ao::AoSettings;
+use strata_render::passes::bzb::BzbSettings;
+use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+
+use super::ao::{references, render_frame, render_settings, DEFAULT_CAP};
+use super::{noise_warnings, EvalSettings};
+use crate::metrics::compare;
+use crate::results::{AoErrors, AoEval};
+
+/// `bzb` as configured (its radius and bias default to `ao`'s, then the scene's);
+/// `ao` are the DGB AO settings of the 2-layer comparison.
+pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEval> {
+    if s.report.is_some() {
+        bail!("--report is not available for --technique bzb-ao yet: drop --report (the JSON has every error)");
+    }
+    if s.frames.is_some() {
+        bail!("--frames is not available for --technique bzb-ao (it has no temporal filter): drop --frames");
+    }
+    let rule = s.check(DEFAULT_CAP, 16)?;
+    let (scene, cams) = s.scene.load()?;
+    let camera = cams.current;
+    // one radius for BZB, DGB AO and both references
+    let radius = bzb.radius.or(ao.radius).unwrap_or(scene.settings.ao_radius);
+    let ao = AoSettings {
+        radius: Some(radius),
+        ..ao.clone()
+    };
+    let (_, beta, epsilon) = ao.resolve(&scene);
+    let bzb = BzbSettings {
+        radius: Some(radius),
+        bias: bzb.bias.or(ao.bias),
+        ..bzb.clone()
+    };
+    let bzb_settings = |visibility: bool| RenderSettings {
+        shade: false,
+        bzb: Some(BzbSettings {
+            visibility,
+            ..bzb.clone()
+        }),
+        // BZB reads layer 0 only
+        ..s.render_settings(1)
+    };
+    for rs in [bzb_settings(bzb.visibility), render_settings(s, 2, &ao)] {
+        rs.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    let (ref_obscurance, ref_binary) = references(s, &scene, &camera, (radius, beta, epsilon), &rule)?;
+    let gpu = GpuContext::new(&GpuOptions {
+        adapter: s.adapter.clone(),
+    })?;
+    let evaluate = |rs: RenderSettings, what: &str| -> Result<AoErrors> {
+        let mut r = Renderer::new(&gpu, &scene, rs)?;
+        let start = std::time::Instant::now();
+        let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
+        eprintln!(
+            "{what}: frame rendered and read back in {:.2} s",
+            start.elapsed().as_secs_f64()
+        );
+        let (obscurance, _) = compare(&ref_obscurance.image, &av)?;
+        let (binary, _) = compare(&ref_binary.image, &av)?;
+        Ok(AoErrors {
+            obscurance: ref_obscurance.annotate(obscurance, &av),
+            binary: ref_binary.annotate(binary, &av),
+        })
+    };
+    let main = evaluate(bzb_settings(bzb.visibility), "bzb-ao")?;
+    let no_visibility = evaluate(bzb_settings(false), "bzb-ao visibility=off")?;
+    let dgb = evaluate(render_settings(s, 2, &ao), "ao k=2")?;
+    let mut run = s.run_info(
+        ref_binary.noise.spp,
+        "binary AO within r (cosine-weighted hemisphere rays), and DGB Eq. 2 obscurance over all surfaces",
+        gpu.describe(),
+        None,
+        noise_warnings(&[("bzb-ao vs binary AO", &main.binary)]),
+    );
+    run.layers = 1;
+    Ok(AoEval {
+        run,
+        samples: bzb.directions,
+        radius,
+        bias: bzb.bias.unwrap_or(0.01 * radius),
+        epsilon,
+        errors: main,
+        layers_1: None,
+        by_layers: Vec::new(),
+        directions: Some(bzb.directions),
+        visibility: Some(bzb.visibility),
+        no_visibility: Some(no_visibility),
+        dgb_2_layers: Some(dgb),
+    })
+}

@@ -1,0 +1,716 @@
+//! The bounced z-buffer (BZB, Nalbach, Ritschel, Seidel 2016) for ambient
+//! occlusion with ambient occlusion volumes (AOV, McGuire 2010) as the
+//! splatting algorithm: indirect visibility by rasterisation, no ray-tracing
+//! hierarchy.
+//!
+//! Passes (profiler names), after the deep G-buffer's packing:
+//!
+//! 1. `bzb-directions` (§3.1): every texel of the bounced z-buffer — S
+//!    interleaved sub-images of the frame's size, direction s of pixel p in
+//!    sub-image s — gets the ray origin x_p (layer 0) and a direction ω on the
+//!    hemisphere around n_p (cosine-weighted by default, or uniform as the
+//!    paper's AO) from a hash of (p, s, seed), with its pdf α
+//!    ([`sample_uniforms`], [`direction`] are the CPU twins).
+//! 2. `bzb-splat` (§3.2): one instanced draw, one instance per (triangle, s),
+//!    six vertices pulled from a storage buffer of world-space triangles (wgpu
+//!    has no geometry or tessellation shaders, so no per-triangle volume is
+//!    emitted): the screen rectangle of the triangle's AABB grown by r, a
+//!    conservative bound of its occlusion volume {x : dist(x, T) < r}, in
+//!    sub-image s. Each covered texel intersects its own ray with the triangle
+//!    ([`ray_triangle`]); a hit at t ∈ (t_min, r) writes depth t²/r² and payload
+//!    1 with the depth test on and blending off, so the nearest occluder along ω
+//!    wins; a miss discards. With `visibility = false` (the baseline) the same
+//!    splats add McGuire's analytic AOV occlusion ([`aov_occlusion`]) with
+//!    additive blending and no depth test.
+//! 3. `bzb-reconstruct` (§3.3, weighting): per pixel the mean over its S
+//!    directions of occlusion · (cos θ/π)/α — an unbiased estimate of binary
+//!    AO with the cosine-weighted measure, the quantity the CPU reference
+//!    `ao_binary` integrates — and AV = 1 − AO into `bzb-raw`.
+//! 4. `bzb-blur-h`, `bzb-blur-v` (§3.3, filtering): the cross-bilateral filter
+//!    of [`crate::passes::bilateral`] (position and normal weights) into `ao`,
+//!    the target DGB AO writes, so compose and `eval` treat both alike.
+
+use bytemuck::Zeroable;
+use glam::Vec3;
+use strata_scene::Scene;
+
+use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::passes::bilateral::{BilateralPass, BilateralSettings};
+use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::scene_gpu::GpuScene;
+use crate::spiral::pcg_hash;
+
+/// Largest accepted directions per pixel S.
+pub const MAX_DIRECTIONS: u32 = 16;
+
+/// How §3.1 distributes the bounced directions on the hemisphere.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Hemisphere {
+    /// pdf cos θ/π: the weight of §3.3 cancels (each sample is 0 or 1), the
+    /// lowest-variance choice for cosine-weighted AO (default).
+    #[default]
+    Cosine,
+    /// pdf 1/(2π): the paper's choice for AO (§3.1); §3.3 weights by 2 cos θ.
+    Uniform,
+}
+
+/// Bounced-z-buffer AO settings. Defaults: S = 4 directions per pixel (the
+/// paper's, §5), the bounced z-buffer on, cosine-weighted directions, the
+/// scene's AO radius r as d_max, t_min = 0.01·r (DGB AO's bias convention),
+/// seed 0, and a cross-bilateral filter of 4 taps each side, 1 px apart.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BzbSettings {
+    /// S: directions per pixel, one sub-image each (1..=16).
+    pub directions: u32,
+    /// true: the bounced z-buffer (§3.2, nearest occluder wins); false: the
+    /// AOV baseline (additive blending of the analytic occlusion, no depth test).
+    pub visibility: bool,
+    /// World-space AO radius r = d_max; `None` = the scene's `ao_radius`.
+    pub radius: Option<f32>,
+    /// Ray t_min (world units): hits nearer than this do not occlude (the
+    /// receiver's own surface); `None` = 0.01·r.
+    pub bias: Option<f32>,
+    pub hemisphere: Hemisphere,
+    /// Seed of the direction hash (§3.1).
+    pub seed: u32,
+    /// The cross-bilateral reconstruction filter (§3.3).
+    pub filter: BilateralSettings,
+}
+
+impl Default for BzbSettings {
+    fn default() -> Self {
+        Self {
+            directions: 4,
+            visibility: true,
+            radius: None,
+            bias: None,
+            hemisphere: Hemisphere::Cosine,
+            seed: 0,
+            filter: BilateralSettings {
+                radius: 4,
+                step: 1,
+                ..BilateralSettings::default()
+            },
+        }
+    }
+}
+
+impl BzbSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=MAX_DIRECTIONS).contains(&self.directions) {
+            return Err(format!(
+                "bzb directions {} is out of range: must be in 1..={MAX_DIRECTIONS}",
+                self.directions
+            ));
+        }
+        if let Some(r) = self.radius {
+            if !(r > 0.0 && r.is_finite()) {
+                return Err(format!("bzb AO radius {r} is out of range: must be > 0"));
+            }
+        }
+        if let Some(b) = self.bias {
+            if !(b >= 0.0 && b.is_finite()) {
+                return Err(format!("bzb AO bias {b} is out of range: must be >= 0"));
+            }
+        }
+        self.filter.validate()
+    }
+
+    /// r and t_min for `scene`.
+    pub fn resolve(&self, scene: &Scene) -> (f32, f32) {
+        let r = self.radius.unwrap_or(scene.settings.ao_radius);
+        (r, self.bias.unwrap_or(0.01 * r))
+    }
+
+    /// Sub-image grid (cols, rows) holding S sub-images: cols = ⌈√S⌉.
+    pub fn grid(&self) -> (u32, u32) {
+        let cols = (self.directions as f32).sqrt().ceil() as u32;
+        (cols, self.directions.div_ceil(cols))
+    }
+
+    /// GPU bytes for a `w`×`h` frame and `triangles` triangles: the bounced
+    /// z-buffer (origins, directions, payload, depth) and the reconstruction targets.
+    pub fn estimated_bytes(&self, w: u32, h: u32, triangles: u64) -> u64 {
+        let (c, r) = self.grid();
+        let px = w as u64 * h as u64;
+        px * (c * r) as u64 * (16 + 16 + 2 + 4) + px * (4 + 2 + 2) + triangles * 48
+    }
+}
+
+/// Mirrors `Bzb` in `bzb.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BzbUniforms {
+    pub radius: f32,
+    pub t_min: f32,
+    pub inv_r2: f32,
+    pub _pad0: f32,
+    pub directions: u32,
+    pub cols: u32,
+    pub rows: u32,
+    pub seed: u32,
+    pub hemisphere: u32,
+    pub visibility: u32,
+    pub triangles: u32,
+    pub _pad1: u32,
+}
+
+impl BzbUniforms {
+    pub fn new(s: &BzbSettings, scene: &Scene, triangles: u32) -> Self {
+        let (radius, t_min) = s.resolve(scene);
+        let (cols, rows) = s.grid();
+        Self {
+            radius,
+            t_min,
+            inv_r2: 1.0 / (radius * radius),
+            _pad0: 0.0,
+            directions: s.directions,
+            cols,
+            rows,
+            seed: s.seed,
+            hemisphere: s.hemisphere as u32,
+            visibility: s.visibility as u32,
+            triangles,
+            _pad1: 0,
+        }
+    }
+}
+
+// ---- CPU twins of bzb.wgsl ----
+
+/// `bzb_sample_uniforms`: two uniforms in [0, 1) from a hash of pixel `p`, direction `s`, `seed`.
+pub fn sample_uniforms(p: [u32; 2], s: u32, seed: u32) -> [f32; 2] {
+    let h1 = pcg_hash(p[0].wrapping_add(pcg_hash(p[1].wrapping_add(pcg_hash(s.wrapping_add(pcg_hash(seed)))))));
+    let h2 = pcg_hash(h1 ^ 0x9e37_79b9);
+    [(h1 >> 8) as f32 / 16_777_216.0, (h2 >> 8) as f32 / 16_777_216.0]
+}
+
+/// `bzb_direction` (§3.1): ω on the hemisphere around unit `n` from uniforms `u`, and its pdf α.
+pub fn direction(n: Vec3, u: [f32; 2], hemisphere: Hemisphere) -> (Vec3, f32) {
+    use std::f32::consts::PI;
+    let phi = 2.0 * PI * u[1];
+    let (l, pdf) = match hemisphere {
+        Hemisphere::Cosine => {
+            let r = u[0].sqrt();
+            let z = (1.0 - u[0]).max(0.0).sqrt();
+            (Vec3::new(r * phi.cos(), r * phi.sin(), z), z / PI)
+        }
+        Hemisphere::Uniform => {
+            let r = (1.0 - u[0] * u[0]).max(0.0).sqrt();
+            (Vec3::new(r * phi.cos(), r * phi.sin(), u[0]), 0.5 / PI)
+        }
+    };
+    let sgn = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sgn + n.z);
+    let b = n.x * n.y * a;
+    let t = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+    let bt = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
+    (t * l.x + bt * l.y + n * l.z, pdf)
+}
+
+/// The pdf α(ω | n) of [`direction`] (0 below the horizon).
+pub fn pdf(n: Vec3, w: Vec3, hemisphere: Hemisphere) -> f32 {
+    let c = n.dot(w);
+    if c <= 0.0 {
+        return 0.0;
+    }
+    match hemisphere {
+        Hemisphere::Cosine => c / std::f32::consts::PI,
+        Hemisphere::Uniform => 0.5 / std::f32::consts::PI,
+    }
+}
+
+/// `bzb_ray_triangle` (§3.2): t of o + t·d on triangle `v` (both faces), `None` on a miss.
+pub fn ray_triangle(o: Vec3, d: Vec3, v: [Vec3; 3]) -> Option<f32> {
+    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+    let pv = d.cross(e2);
+    let det = e1.dot(pv);
+    if det == 0.0 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let tv = o - v[0];
+    let u = tv.dot(pv) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let qv = tv.cross(e1);
+    let w = d.dot(qv) * inv;
+    if w < 0.0 || u + w > 1.0 {
+        return None;
+    }
+    Some(e2.dot(qv) * inv)
+}
+
+/// The bounced z-buffer's content for one ray: the nearest hit t ∈ (t_min, r)
+/// over `triangles`, as the depth t²/r² the splat pass keeps (1 = no hit).
+pub fn bounced_depth(o: Vec3, d: Vec3, triangles: &[[Vec3; 3]], r: f32, t_min: f32) -> f32 {
+    triangles
+        .iter()
+        .filter_map(|v| ray_triangle(o, d, *v))
+        .filter(|t| *t > t_min && *t < r)
+        .fold(1.0f32, |z, t| z.min(t * t / (r * r)))
+}
+
+/// `bzb_aov_occlusion`: the no-visibility baseline's analytic occlusion of
+/// triangle `v` at `x` (unit normal `n`): 0 when dist(x, T) ≥ r; else the form
+/// factor of T clipped to n·(y − x) ≥ β, times 1 − (h/r)² (h: x's distance to
+/// T's plane; exact binary AO within r for an infinite plane).
+pub fn aov_occlusion(x: Vec3, n: Vec3, v: [Vec3; 3], r: f32, beta: f32) -> f32 {
+    if triangle_dist2(x, v).partial_cmp(&(r * r)) != Some(std::cmp::Ordering::Less) {
+        return 0.0;
+    }
+    let rel = v.map(|p| p - x);
+    let mut poly = Vec::with_capacity(4);
+    for i in 0..3 {
+        let (p, q) = (rel[i], rel[(i + 1) % 3]);
+        let (hp, hq) = (n.dot(p) - beta, n.dot(q) - beta);
+        if hp >= 0.0 {
+            poly.push(p);
+        }
+        if (hp >= 0.0) != (hq >= 0.0) {
+            poly.push(p + (q - p) * (hp / (hp - hq)));
+        }
+    }
+    if poly.len() < 3 {
+        return 0.0;
+    }
+    let mut sum = 0.0;
+    for i in 0..poly.len() {
+        let (u0, u1) = (poly[i].normalize(), poly[(i + 1) % poly.len()].normalize());
+        let c = u0.cross(u1);
+        let len = c.length();
+        if len > 1e-12 {
+            sum += len.atan2(u0.dot(u1)) * n.dot(c) / len;
+        }
+    }
+    let nor = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+    let h = nor.dot(x - v[0]).abs();
+    (sum.abs() / (2.0 * std::f32::consts::PI)).min(1.0) * (1.0 - h * h / (r * r)).max(0.0)
+}
+
+/// Squared distance from `p` to triangle `v`.
+pub fn triangle_dist2(p: Vec3, v: [Vec3; 3]) -> f32 {
+    let [a, b, c] = v;
+    let (ba, pa, cb, pb, ac, pc) = (b - a, p - a, c - b, p - b, a - c, p - c);
+    let nor = ba.cross(ac);
+    let sign = |x: f32| {
+        if x > 0.0 {
+            1.0
+        } else if x < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    };
+    let outside = sign(ba.cross(nor).dot(pa)) + sign(cb.cross(nor).dot(pb)) + sign(ac.cross(nor).dot(pc)) < 2.0;
+    if outside {
+        let e = |e: Vec3, p: Vec3| (e * (e.dot(p) / e.dot(e)).clamp(0.0, 1.0) - p).length_squared();
+        e(ba, pa).min(e(cb, pb)).min(e(ac, pc))
+    } else {
+        let h = nor.dot(pa);
+        h * h / nor.dot(nor)
+    }
+}
+
+/// World-space triangles of `scene` at `frame` as the splat pass pulls them
+/// (3 × vec4 per triangle).
+pub fn triangle_data(scene: &Scene, frame: f32) -> Vec<[f32; 4]> {
+    scene
+        .world_triangles(frame)
+        .iter()
+        .flat_map(|t| t.p.map(|p| p.extend(0.0).to_array()))
+        .collect()
+}
+
+// ---- passes ----
+
+pub const ORIGINS: TargetDesc = TargetDesc::new(
+    "bzb-origins",
+    wgpu::TextureFormat::Rgba32Float,
+    1,
+    "BZB §3.1 ray origin x_p per sub-image texel (w = 1: has a sample)",
+);
+pub const DIRECTIONS: TargetDesc = TargetDesc::new(
+    "bzb-directions",
+    wgpu::TextureFormat::Rgba32Float,
+    1,
+    "BZB §3.1 direction ω (xyz) and its pdf α (w; 0 = no sample), sub-image s = direction s",
+);
+pub const PAYLOAD: TargetDesc = TargetDesc::new(
+    "bzb-payload",
+    wgpu::TextureFormat::R16Float,
+    1,
+    "BZB §3.2 payload per sub-image texel: occlusion of the nearest hit (or the AOV sum without visibility)",
+);
+pub const DEPTH: TargetDesc = TargetDesc::new(
+    "bzb-depth",
+    wgpu::TextureFormat::Depth32Float,
+    1,
+    "the bounced z-buffer: |x_p - y|² / r² of the nearest hit (1 = none)",
+);
+pub const RAW: TargetDesc = TargetDesc::new(
+    "bzb-raw",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "BZB §3.3 AV = 1 - mean weighted occlusion over the S directions, before filtering",
+);
+
+/// The triangles of the scene in a storage buffer (vertex pulling).
+struct TriangleBuffer {
+    buffer: wgpu::Buffer,
+    count: u32,
+}
+
+/// §3.2's splat pass: instanced draw of T × S screen rectangles.
+pub struct SplatPass {
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    visibility: bool,
+    instances: u32,
+}
+
+impl Pass for SplatPass {
+    fn info(&self) -> PassInfo {
+        let mut outputs = vec![PAYLOAD.name];
+        if self.visibility {
+            outputs.push(DEPTH.name);
+        }
+        PassInfo {
+            name: "bzb-splat",
+            inputs: vec!["scene", ORIGINS.name, DIRECTIONS.name, "npack"],
+            outputs,
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let depth = self.visibility.then(|| wgpu::RenderPassDepthStencilAttachment {
+            view: &targets.get(DEPTH.name).view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("bzb-splat"),
+            color_attachments: &[crate::passes::clear_attachment(&targets.get(PAYLOAD.name).view)],
+            depth_stencil_attachment: depth,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if self.instances == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.draw(0..6, 0..self.instances);
+    }
+}
+
+/// The WGSL of a BZB pass with the shared functions prepended.
+macro_rules! bzb_shader {
+    ($file:literal) => {
+        concat!(include_str!("bzb.wgsl"), "\n", include_str!($file))
+    };
+}
+
+/// The BZB AO passes of a frame, into target `ao`.
+pub(crate) struct BzbStage {
+    pub(crate) directions: FullscreenPass,
+    pub(crate) splat: SplatPass,
+    pub(crate) reconstruct: FullscreenPass,
+    pub(crate) blur_h: BilateralPass,
+    pub(crate) blur_v: BilateralPass,
+    uniforms: wgpu::Buffer,
+    triangles: TriangleBuffer,
+    settings: BzbSettings,
+    last: std::cell::Cell<BzbUniforms>,
+}
+
+impl BzbStage {
+    pub fn new(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &mut Targets,
+        s: &BzbSettings,
+        scene: &Scene,
+    ) -> Result<Self, crate::RenderError> {
+        use wgpu::util::DeviceExt;
+        let (w, h) = (targets.width, targets.height);
+        let (cols, rows) = s.grid();
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if w * cols > max || h * rows > max {
+            return Err(crate::RenderError::Parameter(format!(
+                "bzb directions {}: the bounced z-buffer of {cols}x{rows} sub-images is {}x{}, over the adapter's largest texture {max}x{max} (lower the directions or the size)",
+                s.directions,
+                w * cols,
+                h * rows
+            )));
+        }
+        let big = [w * cols, h * rows];
+        for d in [ORIGINS, DIRECTIONS, PAYLOAD] {
+            targets.create_sized(gpu, d, big);
+        }
+        if s.visibility {
+            targets.create_sized(gpu, DEPTH, big);
+        }
+        for d in [
+            RAW,
+            TargetDesc::new(
+                "bzb-blur-h",
+                wgpu::TextureFormat::R16Float,
+                1,
+                "BZB AV after the horizontal bilateral pass",
+            ),
+        ] {
+            targets.create(gpu, d);
+        }
+        if targets.try_get("ao").is_none() {
+            targets.create(
+                gpu,
+                TargetDesc::new(
+                    "ao",
+                    wgpu::TextureFormat::R16Float,
+                    1,
+                    "ambient visibility AV (1 = unoccluded)",
+                ),
+            );
+        }
+        let data = triangle_data(scene, 0.0);
+        let count = (data.len() / 3) as u32;
+        let bytes = (data.len() * 16).max(48) as u64;
+        let limit = gpu.device.limits().max_storage_buffer_binding_size;
+        if bytes > limit {
+            return Err(crate::RenderError::Parameter(format!(
+                "scene '{}' has {count} triangles: {bytes} bytes of splat triangles exceed the adapter's storage buffer binding size {limit}",
+                scene.name
+            )));
+        }
+        let mut contents = bytemuck::cast_slice::<[f32; 4], u8>(&data).to_vec();
+        contents.resize(bytes as usize, 0);
+        let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("bzb-triangles"),
+            contents: &contents,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        });
+        let u = BzbUniforms::new(s, scene, count);
+        let directions = PassBuilder::new(gpu, targets, "bzb-directions")
+            .shader("bzb-directions", bzb_shader!("bzb_directions.wgsl"))
+            .frame(scene_gpu)
+            .uniforms(&u)
+            .read("zpack")
+            .read("npack")
+            .write(ORIGINS.name)
+            .write(DIRECTIONS.name)
+            .build();
+        let reconstruct = PassBuilder::new(gpu, targets, "bzb-reconstruct")
+            .shader("bzb-reconstruct", bzb_shader!("bzb_reconstruct.wgsl"))
+            .frame(scene_gpu)
+            .uniforms(&u)
+            .read(PAYLOAD.name)
+            .read(DIRECTIONS.name)
+            .read("zpack")
+            .read("npack")
+            .write(RAW.name)
+            .build();
+        let uniforms = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("bzb-splat"),
+            contents: bytemuck::bytes_of(&u),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let splat = Self::splat_pass(gpu, scene_gpu, targets, s, &uniforms, &buffer, count);
+        let blur_h = BilateralPass::new(
+            gpu,
+            scene_gpu,
+            targets,
+            &s.filter,
+            "bzb-blur-h",
+            RAW.name,
+            "bzb-blur-h",
+            false,
+        );
+        let blur_v = BilateralPass::new(
+            gpu,
+            scene_gpu,
+            targets,
+            &s.filter,
+            "bzb-blur-v",
+            "bzb-blur-h",
+            "ao",
+            true,
+        );
+        Ok(Self {
+            directions,
+            splat,
+            reconstruct,
+            blur_h,
+            blur_v,
+            uniforms,
+            triangles: TriangleBuffer { buffer, count },
+            settings: s.clone(),
+            last: std::cell::Cell::new(u),
+        })
+    }
+
+    fn splat_pass(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &Targets,
+        s: &BzbSettings,
+        uniforms: &wgpu::Buffer,
+        triangles: &wgpu::Buffer,
+        count: u32,
+    ) -> SplatPass {
+        let device = &gpu.device;
+        let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let tex = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bzb-splat"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: vf,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: vf,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                tex(2),
+                tex(3),
+                tex(4),
+            ],
+        });
+        let group = crate::passes::bind_group(
+            device,
+            "bzb-splat",
+            &layout,
+            &[
+                uniforms.as_entire_binding(),
+                triangles.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+                wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
+                wgpu::BindingResource::TextureView(&targets.get("npack").view),
+            ],
+        );
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("bzb-splat"),
+            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(device, "bzb-splat", bzb_shader!("bzb_splat.wgsl"));
+        let (entry, blend, depth_stencil) = if s.visibility {
+            (
+                "fs_visibility",
+                None,
+                Some(wgpu::DepthStencilState {
+                    format: DEPTH.format,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+            )
+        } else {
+            let add = wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            };
+            ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
+        };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("bzb-splat"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_splat"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: PAYLOAD.format,
+                    blend,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        SplatPass {
+            pipeline,
+            group,
+            visibility: s.visibility,
+            instances: count.saturating_mul(s.directions),
+        }
+    }
+
+    /// Uploads this frame's uniforms (and, for animated scenes, the triangles at `frame`).
+    pub fn set_frame(&self, gpu: &GpuContext, scene: &Scene, frame: f32, animated: bool) {
+        let u = BzbUniforms::new(&self.settings, scene, self.triangles.count);
+        self.directions.set_uniforms(gpu, &u);
+        self.reconstruct.set_uniforms(gpu, &u);
+        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        if animated && self.triangles.count > 0 {
+            let data = triangle_data(scene, frame);
+            gpu.queue
+                .write_buffer(&self.triangles.buffer, 0, bytemuck::cast_slice(&data));
+        }
+        self.last.set(u);
+    }
+
+    /// The uniforms of the last frame.
+    pub fn uniforms(&self) -> BzbUniforms {
+        self.last.get()
+    }
+
+    pub fn passes(&self) -> Vec<&dyn Pass> {
+        vec![
+            &self.directions,
+            &self.splat,
+            &self.reconstruct,
+            &self.blur_h,
+            &self.blur_v,
+        ]
+    }
+}
+
+impl Default for BzbUniforms {
+    fn default() -> Self {
+        Self::zeroed()
+    }
+}
