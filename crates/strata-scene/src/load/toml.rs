@@ -398,15 +398,7 @@ fn override_material(i: usize, m: &TomlMaterial, ck: &Check, scene: &mut Scene) 
         found = true;
     }
     if !found {
-        let mut names: Vec<&str> = scene.materials.iter().map(|x| x.name.as_str()).collect();
-        names.sort_unstable();
-        names.dedup();
-        let more = if names.len() > 20 {
-            format!(", … ({} in all)", names.len())
-        } else {
-            String::new()
-        };
-        names.truncate(20);
+        let (names, more) = name_list(scene.materials.iter().map(|x| x.name.as_str()));
         return Err(ck.err(
             &k("name"),
             format!(
@@ -650,15 +642,7 @@ fn animate(i: usize, a: &TomlAnimate, ck: &Check, scene: &mut Scene) -> Result<(
         found = true;
     }
     if !found {
-        let mut names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
-        names.sort_unstable();
-        names.dedup();
-        let more = if names.len() > 20 {
-            format!(", … ({} in all)", names.len())
-        } else {
-            String::new()
-        };
-        names.truncate(20);
+        let (names, more) = name_list(scene.objects.iter().map(|o| o.name.as_str()));
         return Err(ck.err(
             &k("object"),
             format!("no object named '{object}' (objects: {}{more})", names.join(", ")),
@@ -732,4 +716,19 @@ fn transform_scene(scene: &mut Scene, xf: Mat4, scale: f32) {
     scene.settings.ao_radius *= scale;
     scene.settings.min_separation *= scale;
     scene.settings.radiosity_radius *= scale;
+}
+
+/// The first 20 distinct names, sorted, for an error listing the valid ones, and
+/// the `, … (N in all)` suffix when there are more.
+fn name_list<'a>(names: impl Iterator<Item = &'a str>) -> (Vec<&'a str>, String) {
+    let mut names: Vec<&str> = names.collect();
+    names.sort_unstable();
+    names.dedup();
+    let more = if names.len() > 20 {
+        format!(", … ({} in all)", names.len())
+    } else {
+        String::new()
+    };
+    names.truncate(20);
+    (names, more)
 }
