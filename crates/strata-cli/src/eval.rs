@@ -2,7 +2,7 @@
 //! one JSON object or a line of numbers.
 
 use anyhow::Result;
-use strata_eval::eval::{ao, bzb, gi, ils, EvalSettings};
+use strata_eval::eval::{ao, bzb, gi, ils, oit, EvalSettings};
 use strata_eval::results::{to_json_string, EvalResult};
 
 use strata_render::technique::EvalKind;
@@ -13,11 +13,12 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
-    if !a.set.values.is_empty() && a.technique.eval != EvalKind::VplRadiance && !is_bzb {
-        anyhow::bail!("--set is only read by --technique ils and bzb-ao in eval (ao and gi have their own flags)");
+    if !a.set.values.is_empty() && !matches!(a.technique.eval, EvalKind::VplRadiance | EvalKind::Composite) && !is_bzb {
+        anyhow::bail!("--set is only read by --technique ils, oit and bzb-ao in eval (ao and gi have their own flags)");
     }
     let result = match a.technique.eval {
         EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values)?),
+        EvalKind::Composite => EvalResult::Oit(oit::run(&s, &a.set.values)?),
         // the registry's settings (--set), with --ao-radius/--ao-bias carried over
         EvalKind::AmbientVisibility if is_bzb => {
             let mut rs = a
@@ -107,6 +108,20 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             println!(
                 "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces, noise FLIP {:.4} indirect / {:.4} full)",
                 run.scene, i.flip, i.rmse, i.mae, f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
+            );
+        }
+        EvalResult::Oit(e) => {
+            println!(
+                "{} oit {} {w}x{h}: FLIP {:.4}  RMSE {:.4}  MAE {:.4} vs the CPU compositing; {} fragments ({} dropped, at most {} per pixel), A-buffer {:.1} MiB",
+                run.scene,
+                e.method,
+                e.errors.flip,
+                e.errors.rmse,
+                e.errors.mae,
+                e.fragments,
+                e.dropped,
+                e.max_fragments_per_pixel,
+                e.memory_bytes as f64 / (1024.0 * 1024.0)
             );
         }
         EvalResult::Ils(e) => {

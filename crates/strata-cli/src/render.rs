@@ -110,6 +110,18 @@ pub fn run(a: &RenderArgs) -> Result<()> {
 
     // ldr/albedo are already linear after read-back decode; PNG re-encodes sRGB.
     save(&img, out, srgb)?;
+    // A-buffer overflow (ABA): fragments dropped for lack of room are reported, never silent
+    if let Some(a) = r.abuffer() {
+        let lists = a.read_lists(&gpu)?;
+        if lists.overflow > 0 {
+            eprintln!(
+                "A-buffer: dropped {} of {} fragments (pool {} nodes; raise --set pool=N or max-layers=K)",
+                lists.overflow,
+                lists.total,
+                a.pool()
+            );
+        }
+    }
     if a.timings {
         for (n, ms) in &t.passes {
             eprintln!("{n:<12} {ms:8.3} ms");

@@ -1413,3 +1413,92 @@ fn bzb_ao_renders_with_and_without_visibility() {
     assert!(e.contains("directions") && e.contains("1..=16"), "{e}");
     assert_eq!(e.trim().lines().count(), 1, "{e}");
 }
+
+/// Issue 12: `strata eval --technique oit` compares the A-buffer's composite with the CPU
+/// compositing of every crossing (glasshouse: ≤ 0.02 ꟻLIP, the issue's bound) for every
+/// construction; a pool too small for the fragments drops some, says how many in the JSON and
+/// warns; `render --technique oit` writes the image.
+#[test]
+fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
+    for method in ["linked-list", "linear", "fixed-array", "dual-peel"] {
+        let set = format!("abuffer={method}");
+        let v = json_of(&strata(&[
+            "eval",
+            "--scene",
+            "glasshouse",
+            "--technique",
+            "oit",
+            "--width",
+            "96",
+            "--height",
+            "54",
+            "--json",
+            "--set",
+            &set,
+        ]));
+        let flip = v["flip"].as_f64().unwrap();
+        assert!(flip <= 0.02, "{method}: ꟻLIP {flip}");
+        assert!(v["fragments"].as_u64().unwrap() > 96 * 54, "{method}: {v}");
+        assert!(
+            v["max_fragments_per_pixel"].as_u64().unwrap() >= 8,
+            "glasshouse has ≥ 8 layers somewhere: {v}"
+        );
+    }
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "glasshouse",
+        "--technique",
+        "oit",
+        "--width",
+        "96",
+        "--height",
+        "54",
+        "--json",
+        "--set",
+        "pool=500",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (total, dropped) = (v["fragments"].as_u64().unwrap(), v["dropped"].as_u64().unwrap());
+    assert_eq!(dropped, total - 500, "{v}");
+    assert!(stderr(&o).contains("dropped"), "{}", stderr(&o));
+    let out = scratch("oit.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "glasshouse",
+        "--technique",
+        "oit",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+    let o = strata(&[
+        "render",
+        "--scene",
+        "glasshouse",
+        "--technique",
+        "oit",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--set",
+        "pool=100",
+        "--force",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("A-buffer: dropped") && stderr(&o).contains("(pool 100 nodes"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -331,6 +331,24 @@ pub struct GiEval {
     pub by_layers: Vec<ByLayers<GiErrors>>,
 }
 
+/// A-buffer OIT (ABA §IV) against the CPU compositing of every crossing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OitEval {
+    #[serde(flatten)]
+    pub run: EvalRun,
+    /// The A-buffer construction (`linked-list`, `linear`, `fixed-array`, `dual-peel`).
+    pub method: String,
+    /// Fragments rasterised, and those dropped for lack of room (overflow).
+    pub fragments: u32,
+    pub dropped: u32,
+    pub max_fragments_per_pixel: u32,
+    /// Bytes of the A-buffer structure at the evaluated size.
+    pub memory_bytes: u64,
+    /// Linear radiance vs the CPU compositing: HDR ꟻLIP through the eval tonemap, RMSE, MAE.
+    #[serde(flatten)]
+    pub errors: ErrorStats,
+}
+
 /// Interleaved deferred shading (ILS §4, §6.2) against the brute force of the same VPLs and
 /// against the one-bounce path tracer.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -368,6 +386,8 @@ pub struct IlsEval {
 #[serde(tag = "technique", rename_all = "lowercase")]
 pub enum EvalResult {
     Ao(AoEval),
+    /// A-buffer OIT (`oit`) against the CPU compositing.
+    Oit(OitEval),
     /// Bounced-z-buffer AO (`bzb-ao`), with its baseline and DGB AO beside it.
     #[serde(rename = "bzb-ao")]
     Bzb(AoEval),
@@ -381,6 +401,7 @@ impl EvalResult {
             EvalResult::Ao(e) | EvalResult::Bzb(e) => &e.run,
             EvalResult::Gi(e) => &e.run,
             EvalResult::Ils(e) => &e.run,
+            EvalResult::Oit(e) => &e.run,
         }
     }
 }

@@ -20,6 +20,8 @@ pub enum EvalKind {
     Radiance,
     /// VPL radiance (ILS): against the brute force of the same VPLs and the one-bounce path tracer.
     VplRadiance,
+    /// Composited radiance (OIT): against the CPU compositing of every surface crossing.
+    Composite,
 }
 
 impl EvalKind {
@@ -29,6 +31,7 @@ impl EvalKind {
             EvalKind::AmbientVisibility => "ambient-visibility",
             EvalKind::Radiance => "radiance",
             EvalKind::VplRadiance => "vpl-radiance",
+            EvalKind::Composite => "composite",
         }
     }
 }
@@ -848,8 +851,7 @@ static REGISTRY: [Technique; 6] = [
         doc: "order-independent transparency from an A-buffer of every fragment (ABA §IV: linked-list, linear, fixed-array or dual-peel), sorted and blended front to back; lists compressed to M nodes (Eq. 5)",
         output: "hdr-oit",
         display: ("ldr", true),
-        // eval against the CPU compositing comes with strata_reference::Reference::composite
-        eval: EvalKind::None,
+        eval: EvalKind::Composite,
         presets: &[],
         passes: OIT_PASSES,
         settings: &[&ABUFFER_SETTINGS],

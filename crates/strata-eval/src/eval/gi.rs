@@ -226,7 +226,7 @@ pub(crate) fn indirect(img: &ImageBuf) -> ImageBuf {
     channels3(img, 3)
 }
 
-fn rgb(img: &ImageBuf) -> ImageBuf {
+pub(crate) fn rgb(img: &ImageBuf) -> ImageBuf {
     let mut out = ImageBuf::new(img.width, img.height, 3);
     for (o, p) in out
         .data

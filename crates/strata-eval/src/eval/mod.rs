@@ -23,6 +23,7 @@ pub mod ao;
 pub mod bzb;
 pub mod gi;
 pub mod ils;
+pub mod oit;
 
 /// What every evaluation takes.
 #[derive(Clone, Debug)]

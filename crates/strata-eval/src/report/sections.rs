@@ -37,6 +37,8 @@ const AO_HEADER: [&str; 7] = [
     "flicker",
 ];
 
+const OIT_HEADER: [&str; 5] = ["layers k", "FLIP", "RMSE", "MAE", "flicker"];
+
 const GI_HEADER: [&str; 8] = [
     "layers k",
     "indirect FLIP",
@@ -100,6 +102,16 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
                 e.fig10.as_ref(),
             )
         }
+        EvalResult::Oit(e) => (
+            "A-buffer OIT against the CPU compositing",
+            &OIT_HEADER[..],
+            vec![ErrorRow {
+                layers: 1,
+                cells: stats_cells(&e.errors),
+                flip_mae: (e.errors.flip, e.errors.mae),
+            }],
+            None,
+        ),
         EvalResult::Ils(e) => (
             "interleaved VPL shading against the one-bounce path tracer",
             &GI_HEADER[..],
@@ -193,6 +205,7 @@ fn reference_table(r: &EvalResult) -> Table {
         }
         EvalResult::Gi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
         EvalResult::Ils(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
+        EvalResult::Oit(e) => vec![("composite", &e.errors)],
     };
     for (name, e) in named {
         let Some(n) = e.ref_noise else { continue };
@@ -216,6 +229,7 @@ fn technique(r: &EvalResult) -> &'static str {
         EvalResult::Bzb(_) => "eval bzb-ao",
         EvalResult::Gi(_) => "eval gi",
         EvalResult::Ils(_) => "eval ils",
+        EvalResult::Oit(_) => "eval oit",
     }
 }
 
