@@ -572,6 +572,18 @@ pub enum BenchWhat {
     /// Interleaved deferred shading (ILS Table 4): per-pass GPU ms of the interleaved frame and
     /// of the brute force of the same frame (all N VPLs per pixel), and the speed-up.
     Ils(BenchIlsArgs),
+    /// A-buffer constructions (ABA Table I): per-stage GPU ms of linked-list, linear,
+    /// fixed-array, dual-peel and the compressed path, memory and overflow per method.
+    Abuffer(BenchAbufferArgs),
+}
+
+#[derive(Args)]
+pub struct BenchAbufferArgs {
+    #[command(flatten)]
+    pub stage: BenchStageArgs,
+    /// Settings of technique `oit` (e.g. --set pool=8000000 --set max-layers=16 --set compress=6).
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 #[derive(Args)]

@@ -2,7 +2,7 @@
 //! object or a table.
 
 use anyhow::Result;
-use strata_eval::bench::{ao, deep, gbuffer, ils, radiosity, reference, reflections, technique};
+use strata_eval::bench::{abuffer, ao, deep, gbuffer, ils, radiosity, reference, reflections, technique};
 use strata_eval::results::{to_json_string, BenchResult, DeepBench, GbufferBench, ReferenceBench, StageBench};
 use strata_render::passes::reflections::ReflectionSettings;
 
@@ -33,6 +33,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             BenchResult::Ils(Box::new(ils::run(&(&b.stage).into(), &b.set.values)?)),
             b.stage.json,
         ),
+        BenchWhat::Abuffer(b) => (
+            BenchResult::Abuffer(Box::new(abuffer::run(&(&b.stage).into(), &b.set.values)?)),
+            b.stage.json,
+        ),
         BenchWhat::Reflections(b) => {
             let rs = ReflectionSettings {
                 steps: b.steps,
@@ -59,6 +63,37 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 .and_then(|v| v.as_str())
                 .unwrap_or("technique");
             print_stage(name, s)
+        }
+        BenchResult::Abuffer(b) => {
+            let ms = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.3}"));
+            println!(
+                "{:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>10} {:>10} {:>8}",
+                "ABA Table I",
+                "clear",
+                "count",
+                "prefix sum",
+                "draw",
+                "resolve",
+                "total",
+                "MiB",
+                "fragments",
+                "dropped"
+            );
+            for key in abuffer::KEYS {
+                let Some(m) = b.methods.get(key) else { continue };
+                println!(
+                    "{key:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9.3} {:>10.1} {:>10} {:>8}",
+                    ms(m.clear_ms),
+                    ms(m.count_ms),
+                    ms(m.prefix_sum_ms),
+                    ms(m.draw_ms),
+                    ms(m.resolve_ms),
+                    m.total_ms,
+                    m.memory_bytes as f64 / (1024.0 * 1024.0),
+                    m.fragments,
+                    m.dropped
+                );
+            }
         }
         BenchResult::Ils(b) => {
             print_stage("ils (IS)", &b.interleaved);

@@ -1502,3 +1502,38 @@ fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
         stderr(&o)
     );
 }
+
+/// Issue 12: `strata bench abuffer --json` carries ABA Table I's stages for the four
+/// constructions and the compressed path, with memory and overflow per method; only
+/// `linear` has count and prefix-sum passes; every method stores the same fragments.
+#[test]
+fn bench_abuffer_reports_table_one_per_method() {
+    let v = json_of(&strata(&[
+        "bench",
+        "abuffer",
+        "--scene",
+        "glasshouse",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--frames",
+        "1",
+        "--json",
+    ]));
+    let m = &v["methods"];
+    let fragments = m["linked-list"]["fragments"].as_u64().unwrap();
+    assert!(fragments > 64 * 36, "{v}");
+    for key in ["linked-list", "linear", "fixed-array", "dual-peel", "compressed"] {
+        let x = &m[key];
+        assert!(x["total_ms"].as_f64().unwrap() > 0.0, "{key}: {x}");
+        assert!(
+            x["draw_ms"].as_f64().unwrap() > 0.0 && x["resolve_ms"].as_f64().unwrap() > 0.0,
+            "{key}"
+        );
+        assert!(x["memory_bytes"].as_u64().unwrap() > 0, "{key}");
+        assert_eq!(x["fragments"].as_u64().unwrap(), fragments, "{key}: the same geometry");
+        assert_eq!(x["count_ms"].is_null(), key != "linear", "{key}: {x}");
+        assert_eq!(x["prefix_sum_ms"].is_null(), key != "linear", "{key}");
+    }
+}

@@ -170,6 +170,34 @@ pub enum BenchResult {
     Technique(StageBench),
     /// Interleaved deferred shading vs its brute force (`strata bench ils`, ILS Table 4).
     Ils(Box<IlsBench>),
+    /// A-buffer constructions and the compressed path (`strata bench abuffer`, ABA Table I).
+    Abuffer(Box<AbufferBench>),
+}
+
+/// `strata bench abuffer`: ABA Table I's stages per construction, keyed `dual-peel`,
+/// `linked-list`, `linear`, `fixed-array`, `compressed`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AbufferBench {
+    pub methods: std::collections::BTreeMap<String, AbufferMethodBench>,
+}
+
+/// One column of ABA Table I: median GPU ms per stage (absent: the method has no such
+/// pass), the A-buffer's memory and the fragments it stored and dropped.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AbufferMethodBench {
+    pub clear_ms: Option<f64>,
+    pub count_ms: Option<f64>,
+    pub prefix_sum_ms: Option<f64>,
+    pub draw_ms: Option<f64>,
+    pub resolve_ms: Option<f64>,
+    pub total_ms: f64,
+    /// Bytes of the structure (nodes, heads/counters) and of the compressed nodes.
+    pub memory_bytes: u64,
+    /// Fragments rasterised, and those dropped for lack of room (overflow).
+    pub fragments: u32,
+    pub dropped: u32,
+    /// The full per-pass timing.
+    pub stage: StageBench,
 }
 
 /// `strata bench ils`: ILS Table 4's "IS" and "no IS" columns as GPU times of
@@ -200,6 +228,7 @@ impl BenchResult {
             BenchResult::Reference(_) => "reference",
             BenchResult::Technique(_) => "technique",
             BenchResult::Ils(_) => "ils",
+            BenchResult::Abuffer(_) => "abuffer",
         }
     }
 }

@@ -10,6 +10,7 @@ use crate::results::{BenchRun, PassTime};
 use crate::scene::SceneSpec;
 use crate::stats::median_min;
 
+pub mod abuffer;
 pub mod ao;
 pub mod deep;
 pub mod gbuffer;

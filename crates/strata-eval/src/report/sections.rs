@@ -339,6 +339,20 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
                 ));
             }
         }
+        BenchResult::Abuffer(b) => {
+            for (key, m) in &b.methods {
+                let s = &m.stage;
+                section = section.table(pass_table(
+                    format!(
+                        "ABA Table I, {key}: {} fragments, {} dropped, {:.1} MiB",
+                        m.fragments,
+                        m.dropped,
+                        m.memory_bytes as f64 / (1024.0 * 1024.0)
+                    ),
+                    &[("", &s.passes, (s.total_median_ms, s.total_min_ms))],
+                ));
+            }
+        }
         BenchResult::Reference(_) => {}
     }
     Ok(vec![section])

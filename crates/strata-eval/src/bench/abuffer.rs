@@ -1,0 +1,97 @@
+//! `strata bench abuffer`: ABA Table I's stages (clear, count, prefix sum, draw,
+//! resolve; AO is not built yet) per A-buffer construction — `linked-list`,
+//! `linear`, `fixed-array`, `dual-peel` — and the `compressed` path (the linked
+//! list resolved with Eq. 5 compression), each with the memory of its structure
+//! at the bench size and the fragments it stored and dropped (overflow).
+
+use std::collections::BTreeMap;
+
+use anyhow::Result;
+use serde_json::json;
+use strata_render::frame::FrameCameras;
+use strata_render::passes::abuffer::{ABufferMethod, ABufferSettings};
+use strata_render::technique;
+use strata_render::{RenderSettings, Renderer};
+
+use super::stage::{self, Stage, StageSettings};
+use super::timing_gpu;
+use crate::results::{AbufferBench, AbufferMethodBench};
+
+/// The bench keys in Table I's column order.
+pub const KEYS: [&str; 5] = ["dual-peel", "linked-list", "linear", "fixed-array", "compressed"];
+
+/// `set`: the `oit` technique's settings (`pool`, `max-layers`, `compress`, …), applied
+/// last and range-checked; `abuffer` and (for the compressed run) `compress` are the bench's.
+pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench> {
+    let t = technique::find("oit")?;
+    let (scene, cams) = stage.scene.load()?;
+    let stage1 = StageSettings {
+        layers: 1,
+        ..stage.clone()
+    };
+    let configure = |key: &str| -> Result<RenderSettings> {
+        let mut s = t.settings(&stage1.render_settings(1), None)?;
+        for (name, value) in set {
+            t.set(&mut s, name, *value)
+                .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+        }
+        let a = s.abuffer.get_or_insert_with(ABufferSettings::default);
+        if key == "compressed" {
+            a.method = ABufferMethod::LinkedList;
+            a.compress = a.compress.or(ABufferSettings::default().compress).or(Some(6));
+        } else {
+            a.method = key.parse().map_err(|e: String| anyhow::anyhow!(e))?;
+            a.compress = None;
+        }
+        s.validate()?;
+        Ok(s)
+    };
+    let gpu = timing_gpu(&stage.adapter)?;
+    let (w, h) = (stage.scene.width, stage.scene.height);
+    let mut methods = BTreeMap::new();
+    for key in KEYS {
+        let settings = configure(key)?;
+        let a = settings.abuffer.clone().expect("oit has an A-buffer");
+        // fragments stored and dropped, from one frame's lists
+        let (fragments, dropped) = {
+            let mut r = Renderer::new(&gpu, &scene, settings.clone())?;
+            r.render(&gpu, &scene, &FrameCameras::fixed(cams.current), stage.scene.frame)?;
+            let lists = r.abuffer().expect("A-buffer").read_lists(&gpu)?;
+            gpu.check_errors()?;
+            (lists.total, lists.overflow)
+        };
+        let passes = a.method.passes();
+        let extra = json!({
+            "technique": "oit",
+            "abuffer": a.method.name(),
+            "pool": a.pool_nodes(w, h),
+            "max_layers": a.max_layers,
+            "compress": a.compress,
+            "compress_back_half": a.compress_back_half,
+        });
+        let s2 = settings.clone();
+        let bench = stage::run(Stage {
+            stage: &stage1,
+            passes,
+            settings: Box::new(move |_| s2.clone()),
+            extra,
+        })?;
+        let ms = |name: &str| bench.passes.iter().find(|p| p.name == name).map(|p| p.median_ms);
+        methods.insert(
+            key.to_string(),
+            AbufferMethodBench {
+                clear_ms: ms("abuffer-clear"),
+                count_ms: ms("abuffer-count"),
+                prefix_sum_ms: ms("abuffer-prefix-sum"),
+                draw_ms: ms("abuffer-draw"),
+                resolve_ms: ms("abuffer-resolve"),
+                total_ms: bench.total_median_ms,
+                memory_bytes: a.memory_bytes(w, h) + a.compressed_bytes(w, h),
+                fragments,
+                dropped,
+                stage: bench,
+            },
+        );
+    }
+    Ok(AbufferBench { methods })
+}
