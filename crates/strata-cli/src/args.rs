@@ -504,6 +504,9 @@ pub enum ReferenceKind {
     Indirect,
     /// The exact deep G-buffer: first surface beyond z0 + Δz, for --layers layers.
     Layers,
+    /// Order-independent transparency: every surface crossing of the pixel-centre ray
+    /// composited front to back (ABA's ground truth; unshadowed fragment shading).
+    Composite,
 }
 
 #[derive(Args)]

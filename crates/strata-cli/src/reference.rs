@@ -54,6 +54,16 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
             };
             vec![(a.out.clone(), reference.ao_obscurance(&camera, w, h, &s))]
         }
+        ReferenceKind::Composite => {
+            check_output(&a.out, a.force)?;
+            let img = reference.composite(&camera, w, h);
+            let img = if is_png(&a.out) {
+                tonemap(&img, scene.settings.exposure)
+            } else {
+                img
+            };
+            vec![(a.out.clone(), img)]
+        }
         ReferenceKind::Gi | ReferenceKind::Indirect => {
             check_output(&a.out, a.force)?;
             let s = GiSettings {
