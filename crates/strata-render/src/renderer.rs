@@ -948,6 +948,19 @@ impl Renderer {
                 let t = self.read_target_layer(gpu, "normal", layer)?;
                 Ok(t.channel(if base == "roughness" { 2 } else { 3 }))
             }
+            // fragments per pixel: raw counts in EXR, a heat map (0 black … max white) in PNG
+            "abuffer-count" => {
+                let c = self.read_target(gpu, base)?;
+                if exr_raw {
+                    return Ok(c);
+                }
+                let c = normalise(c);
+                let mut img = ImageBuf::new(c.width, c.height, 3);
+                for (o, v) in img.data.chunks_exact_mut(3).zip(&c.data) {
+                    o.copy_from_slice(&heat(*v));
+                }
+                Ok(img)
+            }
             "csz" | "depth" | "csz-history" => Ok(normalise(self.read_target_layer(gpu, base, layer)?.channel(0))),
             "zpack" | "zpack23" => {
                 let z = normalise(self.read_target(gpu, base)?);
@@ -1114,4 +1127,19 @@ pub fn rg11b10_to_f32(p: u32) -> [f32; 3] {
         small_float((p >> 11) & 0x7ff, 6),
         small_float(p >> 22, 5),
     ]
+}
+
+/// A heat-map colour of `v` in [0, 1]: black → blue → red → yellow → white.
+fn heat(v: f32) -> [f32; 3] {
+    const STOPS: [[f32; 3]; 5] = [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [1.0, 1.0, 1.0],
+    ];
+    let x = v.clamp(0.0, 1.0) * 4.0;
+    let i = (x.floor() as usize).min(3);
+    let f = x - i as f32;
+    std::array::from_fn(|c| STOPS[i][c] + f * (STOPS[i + 1][c] - STOPS[i][c]))
 }

@@ -545,11 +545,18 @@ fn glasshouse_fragment_lists_equal_the_reference_crossings() {
     let l = lists(&gpu, &r);
     assert_eq!(l.overflow, 0);
     let reference = strata_reference::Reference::new(&scene, 0.0).with_progress(false);
+    // the `abuffer-count` debug view holds each pixel's stored fragments
+    let count = r.read_target(&gpu, "abuffer-count").unwrap();
     let (mut differ, mut deep, mut compared) = (0usize, 0usize, 0usize);
     for y in 0..H {
         for x in 0..W {
             let want = reference.crossings(&scene.camera, x, y, W, H);
             let got = l.at(x, y);
+            assert_eq!(
+                count.data[(y * W + x) as usize],
+                got.len() as f32,
+                "abuffer-count at ({x}, {y})"
+            );
             deep = deep.max(want.len());
             if want.len() != got.len() {
                 differ += 1;

@@ -145,6 +145,14 @@ impl Default for ABufferSettings {
     }
 }
 
+/// Stored fragments per pixel (the `--debug-view abuffer-count` heat map).
+pub const COUNT: TargetDesc = TargetDesc::new(
+    "abuffer-count",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "A-buffer: fragments stored per pixel (after overflow)",
+);
+
 /// The composited colour (linear HDR, sky behind).
 pub const OUTPUT: TargetDesc = TargetDesc::new(
     "hdr-oit",
@@ -221,11 +229,11 @@ impl ABufferSettings {
         w as u64 * h as u64 * 16 * self.compress.map_or(0, |m| m.div_ceil(4)) as u64
     }
 
-    /// Everything the stage allocates: structure, output colour, compressed
-    /// lists and the 1-byte-per-pixel dummy attachment.
+    /// Everything the stage allocates: structure, output colour, fragment
+    /// counts, compressed lists and the 1-byte-per-pixel dummy attachment.
     pub fn estimated_bytes(&self, w: u32, h: u32) -> u64 {
         let px = w as u64 * h as u64;
-        self.memory_bytes(w, h) + self.compressed_bytes(w, h) + px * 16 + px
+        self.memory_bytes(w, h) + self.compressed_bytes(w, h) + px * 16 + px * 4 + px
     }
 }
 
@@ -488,6 +496,7 @@ impl ABufferStage {
             )));
         }
         targets.create(gpu, OUTPUT);
+        targets.create(gpu, COUNT);
         let dummy = || storage_buffer(gpu, "abuffer-unused", 16);
         let nodes = storage_buffer(gpu, "abuffer-nodes", node_bytes);
         let links = if method == ABufferMethod::LinkedList {
@@ -766,7 +775,7 @@ impl ABufferStage {
             "abuffer-resolve",
             &resolve_pl,
             &resolve_module,
-            &crate::passes::color_targets(&[OUTPUT]),
+            &crate::passes::color_targets(&[OUTPUT, COUNT]),
         );
         let shared = Arc::new(Shared {
             settings: settings.clone(),
@@ -1061,7 +1070,7 @@ impl Pass for ABufferPass {
             Kind::Count => (vec!["scene", "abuffer"], vec!["abuffer-counts"]),
             Kind::PrefixSum => (vec!["abuffer-counts"], vec!["abuffer-offsets"]),
             Kind::Draw => (vec!["scene", "abuffer"], vec!["abuffer-lists"]),
-            Kind::Resolve => (vec!["abuffer-lists"], vec![OUTPUT.name]),
+            Kind::Resolve => (vec!["abuffer-lists"], vec![OUTPUT.name, COUNT.name]),
         };
         PassInfo {
             name: self.name(),
@@ -1107,11 +1116,12 @@ impl Pass for ABufferPass {
             }
             Kind::Resolve => {
                 let out = &targets.get(OUTPUT.name).view;
+                let count = &targets.get(COUNT.name).view;
                 crate::passes::fullscreen_pass(
                     encoder,
                     "abuffer-resolve",
                     &s.resolve_pipeline,
-                    &[out],
+                    &[out, count],
                     &[&scene.frame_bind_group, &s.resolve_group],
                 );
             }

@@ -156,10 +156,21 @@ fn compress_insert(z: u32, a: u32) {
     }
 }
 
+struct ResolveOut {
+    @location(0) color: vec4f,
+    // fragments stored for this pixel (the `abuffer-count` debug view)
+    @location(1) count: f32,
+}
+
 @fragment
-fn fs_main(@builtin(position) frag: vec4f) -> @location(0) vec4f {
+fn fs_main(@builtin(position) frag: vec4f) -> ResolveOut {
     let px = vec2u(frag.xy);
     let p = px.y * params.width + px.x;
+    var stored = 0u;
+    var cw = walk_begin(p);
+    while (walk_next(&cw) != 0xffffffffu) {
+        stored += 1u;
+    }
     let m = params.compress;
     for (var j = 0u; j < MAX_M; j++) {
         cz[j] = ONE16;
@@ -239,5 +250,8 @@ fn fs_main(@builtin(position) frag: vec4f) -> @location(0) vec4f {
             textureStore(compressed, vec2i(px), i32(l), v);
         }
     }
-    return vec4f(c + t * frame.sky.rgb, 1.0);
+    var out: ResolveOut;
+    out.color = vec4f(c + t * frame.sky.rgb, 1.0);
+    out.count = f32(stored);
+    return out;
 }
