@@ -52,9 +52,9 @@ pub const OBJECT_STRIDE: u64 = 256;
 pub struct MaterialUniforms {
     /// rgb linear base colour, a = opacity
     pub base_color: [f32; 4],
-    /// rgb emitted radiance
+    /// rgb emitted radiance, w = 1 when the texture's alpha multiplies the opacity
     pub emission: [f32; 4],
-    /// roughness, metallic, has_texture (0/1), alpha cutoff
+    /// roughness, metallic, has_texture (0/1), alpha cutoff (< 0: none)
     pub params: [f32; 4],
 }
 
@@ -190,12 +190,13 @@ impl GpuScene {
             .map(|m| {
                 let u = MaterialUniforms {
                     base_color: [m.base_color[0], m.base_color[1], m.base_color[2], m.opacity],
-                    emission: [m.emission[0], m.emission[1], m.emission[2], 0.0],
+                    emission: [m.emission[0], m.emission[1], m.emission[2], m.texture_alpha as u32 as f32],
+                    // the alpha rule of `Material::fragment_alpha` (`fragment_alpha` in scene.wgsl)
                     params: [
                         m.roughness,
                         m.metallic,
                         m.base_color_texture.is_some() as u32 as f32,
-                        0.5,
+                        m.alpha_cutoff.unwrap_or(-1.0),
                     ],
                 };
                 let buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

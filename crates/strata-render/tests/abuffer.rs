@@ -588,3 +588,40 @@ fn glasshouse_fragment_lists_equal_the_reference_crossings() {
     assert!(deep >= 8, "glasshouse must have ≥ 8 layers somewhere ({deep})");
     assert!(differ * 50 <= (W * H) as usize, "{differ} of {} pixels differ", W * H);
 }
+
+#[test]
+fn mask_materials_cut_or_keep_opaque_by_material_fragment_alpha() {
+    // the GPU twin of `Material::fragment_alpha`: a MASK pane below its cutoff
+    // leaves no fragment, one above it is stored opaque, a BLEND pane keeps
+    // its opacity; every pane covers the whole view
+    let gpu = common::gpu();
+    let mask = |name: &str, opacity: f32| Material {
+        opacity,
+        alpha_cutoff: Some(0.6),
+        ..Material::diffuse(name, [0.5, 0.5, 0.5])
+    };
+    let materials = vec![
+        mask("cut", 0.5),
+        glass("blend", [0.2, 0.6, 0.9], 0.4),
+        mask("kept", 0.7),
+    ];
+    let all = [-20.0, 20.0];
+    let scene = quads(materials.clone(), &[(1.0, all, all, 0), (0.0, all, all, 1), (-1.0, all, all, 2)]);
+    for method in ABufferMethod::ALL {
+        let l = lists(&gpu, &render(&gpu, &scene, with(method)));
+        for y in 0..H {
+            for x in 0..W {
+                let got: Vec<f32> = l.at(x, y).iter().map(|f| f.alpha).collect();
+                let want: Vec<f32> = materials
+                    .iter()
+                    .filter_map(|m| m.fragment_alpha(1.0))
+                    .collect();
+                assert_eq!(got.len(), 2, "{method}: pixel ({x}, {y}) keeps blend + kept: {got:?}");
+                for (g, w) in got.iter().zip(&want) {
+                    // α is stored as f16
+                    assert!((g - w).abs() < 1e-3, "{method}: pixel ({x}, {y}) α {got:?} vs {want:?}");
+                }
+            }
+        }
+    }
+}

@@ -108,9 +108,8 @@ fn shade(in: VsOut, front: bool) -> Shaded {
     if (material.params.z > 0.5) {
         base = base * tex;
     }
-    // The cutoff slot applies to materials of opacity 1 (texture cut-outs);
-    // blended materials (opacity < 1) keep every fragment (docs/abuffer.md).
-    let cutoff = select(0.0, material.params.w, material.base_color.a >= 1.0);
+    // α by `Material::fragment_alpha`'s rule (MASK cut or opaque, else blended)
+    let alpha = fragment_alpha(material, tex);
     var n = normalize(in.normal);
     if (dot(n, frame.eye.xyz - in.world) < 0.0) {
         n = -n;
@@ -125,9 +124,9 @@ fn shade(in: VsOut, front: bool) -> Shaded {
     var s: Shaded;
     s.frag.depth = in.csz;
     s.frag.rg = pack2x16float(radiance.rg);
-    s.frag.ba = pack2x16float(vec2f(radiance.b, base.a));
+    s.frag.ba = pack2x16float(vec2f(radiance.b, max(alpha, 0.0)));
     s.frag.normal_facing = q.x | (q.y << 8u) | (select(0u, 1u, front) << 16u);
-    s.cut = base.a < cutoff;
+    s.cut = alpha < 0.0;
     return s;
 }
 

@@ -151,10 +151,14 @@ struct GBufferOut {
 // back faces get their normal flipped toward the viewer.
 fn shade(in: VsOut, front: bool) -> GBufferOut {
     var base = material.base_color;
+    var tex = vec4f(1.0);
     if (material.params.z > 0.5) {
-        base = base * textureSample(base_tex, base_sampler, in.uv);
+        tex = textureSample(base_tex, base_sampler, in.uv);
+        base = base * tex;
     }
-    if (base.a < material.params.w) {
+    // MASK cut-outs only: the deep G-buffer holds surfaces, and a blended
+    // (transparent) surface is a surface here as in the CPU reference
+    if (fragment_alpha(material, tex) < 0.0) {
         discard;
     }
     var n = normalize(in.normal);
