@@ -2,7 +2,7 @@
 //! one JSON object or a line of numbers.
 
 use anyhow::Result;
-use strata_eval::eval::{ao, bzb, gi, ils, oit, EvalSettings};
+use strata_eval::eval::{aba, ao, bzb, gi, ils, oit, EvalSettings};
 use strata_eval::results::{to_json_string, EvalResult};
 
 use strata_render::technique::EvalKind;
@@ -13,14 +13,19 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
-    if !a.set.values.is_empty() && !matches!(a.technique.eval, EvalKind::VplRadiance | EvalKind::Composite) && !is_bzb {
-        anyhow::bail!("--set is only read by --technique ils, oit and bzb-ao in eval (ao and gi have their own flags)");
+    let is_aba = a.technique.name == "aba-ao";
+    if !a.set.values.is_empty()
+        && !matches!(a.technique.eval, EvalKind::VplRadiance | EvalKind::Composite)
+        && !is_bzb
+        && !is_aba
+    {
+        anyhow::bail!("--set is only read by --technique ils, oit, bzb-ao and aba-ao in eval (ao and gi have their own flags)");
     }
     let result = match a.technique.eval {
         EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values)?),
         EvalKind::Composite => EvalResult::Oit(oit::run(&s, &a.set.values)?),
         // the registry's settings (--set), with --ao-radius/--ao-bias carried over
-        EvalKind::AmbientVisibility if is_bzb => {
+        EvalKind::AmbientVisibility if is_bzb || is_aba => {
             let mut rs = a
                 .technique
                 .settings(
@@ -36,8 +41,13 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                     .set(&mut rs, name, *value)
                     .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
             }
-            let b = rs.bzb.unwrap_or_default();
-            EvalResult::Bzb(bzb::run(&s, &b, &a.ao.settings())?)
+            if is_aba {
+                let ab = rs.abuffer.unwrap_or_default();
+                EvalResult::AbaAo(aba::run(&s, &ab, &a.ao.settings())?)
+            } else {
+                let b = rs.bzb.unwrap_or_default();
+                EvalResult::Bzb(bzb::run(&s, &b, &a.ao.settings())?)
+            }
         }
         EvalKind::AmbientVisibility => EvalResult::Ao(ao::run(&s, &a.ao.settings())?),
         EvalKind::None => unreachable!("the argument parser admits only comparable techniques"),
@@ -98,6 +108,28 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             );
             if let Some(x) = &e.no_visibility {
                 line("AOV, no visibility", x);
+            }
+            if let Some(x) = &e.dgb_2_layers {
+                line("DGB AO, 2 layers", x);
+            }
+        }
+        EvalResult::AbaAo(e) => {
+            let line = |what: &str, x: &strata_eval::results::AoErrors| {
+                println!(
+                    "  {what:<28} vs obscurance: FLIP {:.4}  RMSE {:.4}  MAE {:.4}; vs binary AO: FLIP {:.4}  MAE {:.4}",
+                    x.obscurance.flip, x.obscurance.rmse, x.obscurance.mae, x.binary.flip, x.binary.mae
+                )
+            };
+            println!(
+                "{} aba-ao N={} {w}x{h} (reference {} spp, noise FLIP {:.4}):",
+                run.scene,
+                e.samples,
+                run.ref_spp,
+                noise(&e.errors.obscurance)
+            );
+            line("aba-ao (multilayer)", &e.errors);
+            if let Some(x) = &e.layers_1 {
+                line("aba-ao (nearest layer only)", x);
             }
             if let Some(x) = &e.dgb_2_layers {
                 line("DGB AO, 2 layers", x);

@@ -420,6 +420,9 @@ pub enum EvalResult {
     /// Bounced-z-buffer AO (`bzb-ao`), with its baseline and DGB AO beside it.
     #[serde(rename = "bzb-ao")]
     Bzb(AoEval),
+    /// A-buffer multilayer AO (`aba-ao`), with its single-layer variant (`layers_1`) and DGB AO beside it.
+    #[serde(rename = "aba-ao")]
+    AbaAo(AoEval),
     Gi(GiEval),
     Ils(IlsEval),
 }
@@ -427,7 +430,7 @@ pub enum EvalResult {
 impl EvalResult {
     pub fn run(&self) -> &EvalRun {
         match self {
-            EvalResult::Ao(e) | EvalResult::Bzb(e) => &e.run,
+            EvalResult::Ao(e) | EvalResult::Bzb(e) | EvalResult::AbaAo(e) => &e.run,
             EvalResult::Gi(e) => &e.run,
             EvalResult::Ils(e) => &e.run,
             EvalResult::Oit(e) => &e.run,

@@ -267,6 +267,11 @@ impl RenderSettings {
                     "abuffer needs shading off: the A-buffer shades its own fragments (technique oit)".into(),
                 ));
             }
+            if a.ao.is_some() && (self.ao.is_some() || self.bzb.is_some()) {
+                return Err(RenderError::Parameter(
+                    "abuffer AO and ao/bzb all write the ao target: turn one off".into(),
+                ));
+            }
         }
         self.deep.validate()
     }
@@ -742,6 +747,10 @@ impl Renderer {
         }
         if let Some(a) = &self.abuffer {
             a.set_frame(gpu, crate::passes::abuffer::far_depth(scene, &cams.current, frame));
+            if let Some(s) = &a.settings().ao {
+                let compressed = a.settings().compress.is_some();
+                a.set_ao_frame(gpu, crate::passes::abuffer::ao::AbaAoUniforms::new(s, scene, &u, compressed));
+            }
         }
         if self.animated {
             if let (Some(s), Some(l)) = (&self.shadow, &self.lighting) {

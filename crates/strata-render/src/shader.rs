@@ -1,4 +1,4 @@
-//! WGSL composition: `#import "common/NAME.wgsl"` lines are replaced by the shared
+//! WGSL composition: `#import "common/NAME.wgsl"` (and `"abuffer/lists.wgsl"`) lines are replaced by the shared
 //! module's text (each module once per shader), so shared code lives once.
 
 /// Shared WGSL modules, by import path.
@@ -14,6 +14,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/interleave.wgsl", include_str!("shaders/common/interleave.wgsl")),
     ("common/vpl.wgsl", include_str!("shaders/common/vpl.wgsl")),
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
+    ("abuffer/lists.wgsl", include_str!("passes/abuffer/lists.wgsl")),
 ];
 
 /// Expands `#import "…"` lines recursively; panics only on a missing module,

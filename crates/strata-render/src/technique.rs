@@ -3,6 +3,7 @@
 //! must cover every technique (the validation matrix test, `strata techniques`)
 //! iterate [`registry`]; a new technique adds one entry here and its own module.
 
+use crate::passes::abuffer::ao::AbaAoSettings;
 use crate::passes::abuffer::{ABufferMethod, ABufferSettings};
 use crate::passes::bzb::{BzbSettings, Hemisphere};
 use crate::passes::interleave::SplitMethod;
@@ -504,6 +505,75 @@ static ABUFFER_SETTINGS: [SettingInfo; 5] = [
     ),
 ];
 
+fn aba_ao_mut(s: &mut RenderSettings) -> &mut AbaAoSettings {
+    abuffer_mut(s).ao.get_or_insert_with(Default::default)
+}
+
+fn aba_ao_of(s: &RenderSettings) -> AbaAoSettings {
+    abuffer_of(s).ao.unwrap_or_default()
+}
+
+/// ABA multilayer AO (Algorithm 1); the names mean what DGB AO's mean.
+static ABA_AO_SETTINGS: [SettingInfo; 7] = [
+    setting!(
+        "ao-radius",
+        "world-space AO radius r (DGB Eq. 1-2, as for ao; default: the scene's ao_radius)",
+        Range::Above(0.0),
+        false,
+        |s| aba_ao_of(s).radius.map(f64::from),
+        |s, v| aba_ao_mut(s).radius = Some(v as f32)
+    ),
+    setting!(
+        "ao-bias",
+        "bias β in scene units (default 0.01·r)",
+        Range::AtLeast(0.0),
+        false,
+        |s| aba_ao_of(s).bias.map(f64::from),
+        |s, v| aba_ao_mut(s).bias = Some(v as f32)
+    ),
+    setting!(
+        "ao-intensity",
+        "multiplies the sum in DGB Eq. 1",
+        Range::AtLeast(0.0),
+        false,
+        |s| Some(aba_ao_of(s).intensity as f64),
+        |s, v| aba_ao_mut(s).intensity = v as f32
+    ),
+    setting!(
+        "samples",
+        "AO taps N per receiver hemisphere (ABA §V: 16)",
+        Range::Closed(1.0, crate::passes::abuffer::ao::MAX_SAMPLES as f64),
+        true,
+        |s| Some(aba_ao_of(s).samples as f64),
+        |s, v| aba_ao_mut(s).samples = v as u32
+    ),
+    SettingInfo {
+        name: "multilayer",
+        doc: "on: every fragment of a tap pixel occludes (ABA Algorithm 1); off: the nearest only (single-layer SSAO)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(aba_ao_of(s).multilayer as u32 as f64),
+        set: |s, v| aba_ao_mut(s).multilayer = v != 0.0,
+        values: &["off", "on"],
+    },
+    setting!(
+        "blur-radius",
+        "bilateral taps on each side (0 = none)",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(aba_ao_of(s).blur.radius as f64),
+        |s, v| aba_ao_mut(s).blur.radius = v as u32
+    ),
+    setting!(
+        "blur-step",
+        "pixels between bilateral taps",
+        Range::Closed(1.0, 8.0),
+        true,
+        |s| Some(aba_ao_of(s).blur.step as f64),
+        |s, v| aba_ao_mut(s).blur.step = v as u32
+    ),
+];
+
 fn bzb_mut(s: &mut RenderSettings) -> &mut BzbSettings {
     s.bzb.get_or_insert_with(BzbSettings::default)
 }
@@ -714,9 +784,40 @@ fn configure_oit(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Ren
     s.probes = None;
     s.ils = None;
     s.bzb = None;
-    s.abuffer = Some(s.abuffer.clone().unwrap_or_default());
+    let mut a = s.abuffer.clone().unwrap_or_default();
+    a.ao = None;
+    s.abuffer = Some(a);
     Ok(())
 }
+
+/// ABA AO: the A-buffer of `oit` plus opacity-aware multilayer AO (Algorithm 1).
+/// The caller's DGB AO radius, bias, ε and intensity (`--ao-radius`, …) carry
+/// over, so they mean what they mean for `ao`; the guard band defaults to AO's.
+fn configure_aba_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), RenderError> {
+    no_preset("aba-ao", preset)?;
+    let dgb = s.ao.take();
+    let own = s.abuffer.as_ref().and_then(|a| a.ao.clone());
+    configure_oit(s, None)?;
+    let a = abuffer_mut(s).ao.insert(own.unwrap_or_default());
+    if let Some(d) = dgb {
+        a.radius = a.radius.or(d.radius);
+        a.bias = a.bias.or(d.bias);
+        a.epsilon = a.epsilon.or(d.epsilon);
+        a.intensity = d.intensity;
+    }
+    s.guard_band = s.guard_band.or_default(crate::renderer::AO_GUARD_BAND);
+    Ok(())
+}
+
+const ABA_AO_PASSES: &[&str] = &[
+    "abuffer-clear",
+    "abuffer-draw",
+    "abuffer-resolve",
+    "aba-ao",
+    "ao-blur-h",
+    "ao-blur-v",
+    "tonemap",
+];
 
 /// The OIT frame with the default (linked-list) A-buffer; `linear` adds
 /// `abuffer-count` and `abuffer-prefix-sum` ([`ABufferMethod::passes`]).
@@ -799,7 +900,7 @@ const FULL_PASSES: &[&str] = &[
 /// Preset names of the DGB radiosity (Table 2), default first.
 const FULL_PRESETS: &[&str] = &["balanced", "high-performance", "high-quality"];
 
-static REGISTRY: [Technique; 6] = [
+static REGISTRY: [Technique; 7] = [
     Technique {
         name: "direct",
         doc: "direct light (shadowed sun, point, spot, rect) and emission from G-buffer layer 0, tonemapped",
@@ -856,6 +957,17 @@ static REGISTRY: [Technique; 6] = [
         passes: OIT_PASSES,
         settings: &[&ABUFFER_SETTINGS],
         configure: configure_oit,
+    },
+    Technique {
+        name: "aba-ao",
+        doc: "opacity-aware multilayer AO over the A-buffer (ABA Algorithm 1, Eq. 3-4: every layer occludes, weighted by α; transparent receivers blend exterior and interior AO), blended like the colour, bilateral filtered",
+        output: "ao",
+        display: ("ao", false),
+        eval: EvalKind::AmbientVisibility,
+        presets: &[],
+        passes: ABA_AO_PASSES,
+        settings: &[&ABUFFER_SETTINGS, &ABA_AO_SETTINGS],
+        configure: configure_aba_ao,
     },
     Technique {
         name: "bzb-ao",

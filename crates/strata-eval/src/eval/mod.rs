@@ -19,6 +19,7 @@ use crate::report::{sections, Page, ReportImage, Section};
 use crate::results::{ByLayers, EvalResult, EvalRun, Flicker};
 use crate::scene::SceneSpec;
 
+pub mod aba;
 pub mod ao;
 pub mod bzb;
 pub mod gi;

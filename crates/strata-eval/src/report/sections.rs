@@ -67,7 +67,7 @@ fn stats_cells(s: &ErrorStats) -> Vec<Cell> {
 pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Section>> {
     let run = r.run();
     let (what, header, rows, fig10): (_, &[&str], Vec<ErrorRow>, Option<&Fig10>) = match r {
-        EvalResult::Ao(e) | EvalResult::Bzb(e) => {
+        EvalResult::Ao(e) | EvalResult::Bzb(e) | EvalResult::AbaAo(e) => {
             let row = |layers: u32, x: &crate::results::AoErrors| ErrorRow {
                 layers,
                 cells: [
@@ -200,7 +200,7 @@ fn reference_table(r: &EvalResult) -> Table {
         ],
     );
     let named: Vec<(&str, &ErrorStats)> = match r {
-        EvalResult::Ao(e) | EvalResult::Bzb(e) => {
+        EvalResult::Ao(e) | EvalResult::Bzb(e) | EvalResult::AbaAo(e) => {
             vec![("obscurance", &e.errors.obscurance), ("binary AO", &e.errors.binary)]
         }
         EvalResult::Gi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
@@ -227,6 +227,7 @@ fn technique(r: &EvalResult) -> &'static str {
     match r {
         EvalResult::Ao(_) => "eval ao",
         EvalResult::Bzb(_) => "eval bzb-ao",
+        EvalResult::AbaAo(_) => "eval aba-ao",
         EvalResult::Gi(_) => "eval gi",
         EvalResult::Ils(_) => "eval ils",
         EvalResult::Oit(_) => "eval oit",

@@ -10,6 +10,8 @@
 //! | `abuffer-prefix-sum` | §IV-B, Table I "prefix sum" | linear lists only: first node of each pixel |
 //! | `abuffer-draw` | Table I "draw" | every fragment shaded and stored (dual peel: 1 + ⌈L/2⌉ geometry passes) |
 //! | `abuffer-resolve` | Table I "resolve OIT" | per pixel: sort by depth, blend front to back, compress (Eq. 5) |
+//! | `aba-ao` | Table I "AO", Algorithm 1 | with [`ABufferSettings::ao`]: opacity-aware multilayer AO of every fragment, blended ([`ao`]) |
+//! | `ao-blur-h`, `ao-blur-v` | §III ("separate" integration) | bilateral reconstruction of the blended AO into `ao` |
 //!
 //! Four constructions ([`ABufferMethod`]) store the same fragments: a
 //! per-pixel linked list (PPLL, §IV-A), linear lists (count, prefix sum, fill;
@@ -31,6 +33,7 @@
 //! ones, and a second fragment at exactly the depth of a peeled one.
 //! See `docs/abuffer.md` for memory, sort, packing and deviations.
 
+pub mod ao;
 pub mod compress;
 
 use std::sync::Arc;
@@ -131,6 +134,8 @@ pub struct ABufferSettings {
     pub compress: Option<u32>,
     /// Eq. 5 searches only the back half of the array.
     pub compress_back_half: bool,
+    /// Opacity-aware multilayer AO (Algorithm 1) into target `ao`; `None` = off.
+    pub ao: Option<ao::AbaAoSettings>,
 }
 
 impl Default for ABufferSettings {
@@ -141,6 +146,7 @@ impl Default for ABufferSettings {
             max_layers: 16,
             compress: Some(6),
             compress_back_half: true,
+            ao: None,
         }
     }
 }
@@ -151,6 +157,14 @@ pub const COUNT: TargetDesc = TargetDesc::new(
     wgpu::TextureFormat::R32Float,
     1,
     "A-buffer: fragments stored per pixel (after overflow)",
+);
+
+/// The multilayer AO before the bilateral reconstruction.
+pub const AO_RAW: TargetDesc = TargetDesc::new(
+    "ao-raw",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "ABA multilayer AO (Algorithm 1), blended over the fragments, before reconstruction (1 = unoccluded)",
 );
 
 /// The composited colour (linear HDR, sky behind).
@@ -181,6 +195,9 @@ impl ABufferSettings {
                     compress::MAX_NODES
                 ));
             }
+        }
+        if let Some(a) = &self.ao {
+            a.validate()?;
         }
         Ok(())
     }
@@ -233,7 +250,9 @@ impl ABufferSettings {
     /// counts, compressed lists and the 1-byte-per-pixel dummy attachment.
     pub fn estimated_bytes(&self, w: u32, h: u32) -> u64 {
         let px = w as u64 * h as u64;
-        self.memory_bytes(w, h) + self.compressed_bytes(w, h) + px * 16 + px * 4 + px
+        // AO: ao-raw (4 bytes), ao-blur-h and ao (2 bytes each)
+        let ao = if self.ao.is_some() { px * 8 } else { 0 };
+        self.memory_bytes(w, h) + self.compressed_bytes(w, h) + px * 16 + px * 4 + px + ao
     }
 }
 
@@ -393,6 +412,15 @@ struct Shared {
     prefix: Option<(wgpu::ComputePipeline, wgpu::BindGroup)>,
     resolve_pipeline: wgpu::RenderPipeline,
     resolve_group: wgpu::BindGroup,
+    /// multilayer AO: pipeline, lists group (1), AO group (2), its uniform buffer
+    ao: Option<AoResources>,
+}
+
+struct AoResources {
+    pipeline: wgpu::RenderPipeline,
+    lists_group: wgpu::BindGroup,
+    group: wgpu::BindGroup,
+    uniforms: wgpu::Buffer,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -402,6 +430,7 @@ enum Kind {
     PrefixSum,
     Draw,
     Resolve,
+    Ao,
 }
 
 /// One of the A-buffer's passes in the frame.
@@ -414,7 +443,10 @@ pub struct ABufferPass {
 pub struct ABufferStage {
     shared: Arc<Shared>,
     passes: Vec<ABufferPass>,
+    /// the AO's bilateral reconstruction (horizontal, vertical)
+    blur: Vec<crate::passes::bilateral::BilateralPass>,
     depth_scale: std::cell::Cell<f32>,
+    ao_uniforms: std::cell::Cell<Option<ao::AbaAoUniforms>>,
 }
 
 fn storage_buffer(gpu: &GpuContext, label: &str, size: u64) -> wgpu::Buffer {
@@ -547,7 +579,9 @@ impl ABufferStage {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::Rgba32Uint,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         let compressed_view = compressed.create_view(&wgpu::TextureViewDescriptor {
@@ -777,6 +811,87 @@ impl ABufferStage {
             &resolve_module,
             &crate::passes::color_targets(&[OUTPUT, COUNT]),
         );
+        // --- multilayer AO (Algorithm 1), then the bilateral reconstruction
+        let mut blur = Vec::new();
+        let ao = settings.ao.as_ref().map(|a| {
+            use wgpu::TextureFormat as F;
+            targets.create(gpu, AO_RAW);
+            targets.create(
+                gpu,
+                TargetDesc::new("ao-blur-h", F::R16Float, 1, "AO after the horizontal bilateral pass"),
+            );
+            targets.create(
+                gpu,
+                TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
+            );
+            blur.push(crate::passes::bilateral::BilateralPass::new(
+                gpu, scene, targets, &a.blur, "ao-blur-h", AO_RAW.name, "ao-blur-h", false,
+            ));
+            blur.push(crate::passes::bilateral::BilateralPass::new(
+                gpu, scene, targets, &a.blur, "ao-blur-v", "ao-blur-h", "ao", true,
+            ));
+            let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("aba-ao-lists"),
+                entries: &[
+                    layout_entry(0, frag, UNIFORM_TY),
+                    layout_entry(1, frag, storage_ty(true)),
+                    layout_entry(2, frag, storage_ty(true)),
+                    layout_entry(3, frag, storage_ty(true)),
+                    layout_entry(4, frag, storage_ty(true)),
+                ],
+            });
+            let lists_group = crate::passes::bind_group(
+                device,
+                "aba-ao-lists",
+                &lists_layout,
+                &[
+                    resolve_params.as_entire_binding(),
+                    nodes.as_entire_binding(),
+                    links.as_entire_binding(),
+                    counts.as_entire_binding(),
+                    offsets.as_entire_binding(),
+                ],
+            );
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("aba-ao"),
+                entries: &[
+                    layout_entry(0, frag, UNIFORM_TY),
+                    layout_entry(
+                        1,
+                        frag,
+                        wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Uint,
+                            view_dimension: wgpu::TextureViewDimension::D2Array,
+                            multisampled: false,
+                        },
+                    ),
+                ],
+            });
+            let uniforms = uniform_buffer(gpu, "aba-ao", &<ao::AbaAoUniforms as bytemuck::Zeroable>::zeroed());
+            let group = crate::passes::bind_group(
+                device,
+                "aba-ao",
+                &layout,
+                &[
+                    uniforms.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&compressed_view),
+                ],
+            );
+            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("aba-ao"),
+                bind_group_layouts: &[Some(&scene.frame_layout), Some(&lists_layout), Some(&layout)],
+                immediate_size: 0,
+            });
+            let module = crate::shader::module(device, "aba-ao", include_str!("aba_ao.wgsl"));
+            let pipeline =
+                crate::passes::fullscreen_pipeline(device, "aba-ao", &pl, &module, &crate::passes::color_targets(&[AO_RAW]));
+            AoResources {
+                pipeline,
+                lists_group,
+                group,
+                uniforms,
+            }
+        });
         let shared = Arc::new(Shared {
             settings: settings.clone(),
             width: w,
@@ -799,9 +914,13 @@ impl ABufferStage {
             prefix,
             resolve_pipeline,
             resolve_group,
+            ao,
         });
-        let passes = method
-            .passes()
+        let mut names = method.passes().to_vec();
+        if settings.ao.is_some() {
+            names.push("aba-ao");
+        }
+        let passes = names
             .iter()
             .map(|n| ABufferPass {
                 kind: match *n {
@@ -809,6 +928,7 @@ impl ABufferStage {
                     "abuffer-count" => Kind::Count,
                     "abuffer-prefix-sum" => Kind::PrefixSum,
                     "abuffer-draw" => Kind::Draw,
+                    "aba-ao" => Kind::Ao,
                     _ => Kind::Resolve,
                 },
                 shared: shared.clone(),
@@ -817,13 +937,31 @@ impl ABufferStage {
         Ok(Self {
             shared,
             passes,
+            blur,
             depth_scale: std::cell::Cell::new(1.0),
+            ao_uniforms: std::cell::Cell::new(None),
         })
     }
 
     /// The stage's passes in frame order.
     pub fn passes(&self) -> impl Iterator<Item = &dyn Pass> {
-        self.passes.iter().map(|p| p as &dyn Pass)
+        self.passes
+            .iter()
+            .map(|p| p as &dyn Pass)
+            .chain(self.blur.iter().map(|p| p as &dyn Pass))
+    }
+
+    /// Sets the multilayer AO's uniforms of the next frame (no-op without AO).
+    pub fn set_ao_frame(&self, gpu: &GpuContext, u: ao::AbaAoUniforms) {
+        if let Some(a) = &self.shared.ao {
+            gpu.queue.write_buffer(&a.uniforms, 0, bytemuck::bytes_of(&u));
+            self.ao_uniforms.set(Some(u));
+        }
+    }
+
+    /// The multilayer AO's uniforms of the last frame (for the CPU twin).
+    pub fn ao_uniforms(&self) -> Option<ao::AbaAoUniforms> {
+        self.ao_uniforms.get()
     }
 
     pub fn settings(&self) -> &ABufferSettings {
@@ -1030,6 +1168,7 @@ impl ABufferPass {
             Kind::PrefixSum => "abuffer-prefix-sum",
             Kind::Draw => "abuffer-draw",
             Kind::Resolve => "abuffer-resolve",
+            Kind::Ao => "aba-ao",
         }
     }
 
@@ -1071,6 +1210,7 @@ impl Pass for ABufferPass {
             Kind::PrefixSum => (vec!["abuffer-counts"], vec!["abuffer-offsets"]),
             Kind::Draw => (vec!["scene", "abuffer"], vec!["abuffer-lists"]),
             Kind::Resolve => (vec!["abuffer-lists"], vec![OUTPUT.name, COUNT.name]),
+            Kind::Ao => (vec!["abuffer-lists"], vec![AO_RAW.name]),
         };
         PassInfo {
             name: self.name(),
@@ -1123,6 +1263,16 @@ impl Pass for ABufferPass {
                     &s.resolve_pipeline,
                     &[out, count],
                     &[&scene.frame_bind_group, &s.resolve_group],
+                );
+            }
+            Kind::Ao => {
+                let a = s.ao.as_ref().expect("the stage has AO");
+                crate::passes::fullscreen_pass(
+                    encoder,
+                    "aba-ao",
+                    &a.pipeline,
+                    &[&targets.get(AO_RAW.name).view],
+                    &[&scene.frame_bind_group, &a.lists_group, &a.group],
                 );
             }
         }

@@ -13,106 +13,10 @@
 #import "common/frame.wgsl"
 #import "common/fullscreen.wgsl"
 
-struct Fragment {
-    depth: f32,
-    rg: u32,
-    ba: u32,
-    normal_facing: u32,
-}
-
-struct ResolveParams {
-    width: u32,
-    height: u32,
-    pool: u32,
-    slots: u32,
-    // 0 linked list, 1 linear, 2 fixed array, 3 dual peel
-    method: u32,
-    // M (0 = no compression)
-    compress: u32,
-    // 1 = Eq. 5 searches only the back half
-    back_half: u32,
-    _pad: u32,
-    // normalised depth z = min(csz · depth_scale, 65535) / 65535
-    depth_scale: f32,
-    _pad1: f32,
-    _pad2: f32,
-    _pad3: f32,
-}
-
-const SORT_BOUND: u32 = 16u;
-const MAX_M: u32 = 16u;
-const ONE16: u32 = 65535u;
-const T_MIN: f32 = 1e-4;
+#import "abuffer/lists.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(1) @binding(0) var<uniform> params: ResolveParams;
-@group(1) @binding(1) var<storage, read> nodes: array<Fragment>;
-@group(1) @binding(2) var<storage, read> links: array<u32>;
-@group(1) @binding(3) var<storage, read> counts: array<u32>;
-@group(1) @binding(4) var<storage, read> offsets: array<u32>;
 @group(1) @binding(5) var compressed: texture_storage_2d_array<rgba32uint, write>;
-
-// A walk over one pixel's stored fragments (any method), in storage order.
-struct Walk {
-    // linked list: next node + 1 (0 = end); others: next position k
-    next: u32,
-    // stored fragments (array methods) / steps taken (linked list)
-    n: u32,
-    base: u32,
-    // dual peel: stored front layers
-    fronts: u32,
-}
-
-fn walk_begin(p: u32) -> Walk {
-    var w: Walk;
-    switch params.method {
-        case 0u: {
-            w.next = counts[p];
-        }
-        case 1u: {
-            let o = offsets[p];
-            w.base = o;
-            w.n = min(counts[p], params.pool - min(o, params.pool));
-        }
-        case 2u: {
-            w.base = p * params.slots;
-            w.n = min(counts[p], params.slots);
-        }
-        default: {
-            w.base = p * params.slots;
-            w.fronts = countOneBits(counts[2u * p]);
-            w.n = w.fronts + countOneBits(counts[2u * p + 1u]);
-        }
-    }
-    return w;
-}
-
-// The next node index, or 0xffffffff at the end (a linked list is cut after
-// `pool` steps or at an index outside the pool: never a hang, never out of bounds).
-fn walk_next(w: ptr<function, Walk>) -> u32 {
-    if (params.method == 0u) {
-        let nx = (*w).next;
-        if (nx == 0u || nx > params.pool || (*w).n >= params.pool) {
-            return 0xffffffffu;
-        }
-        (*w).n += 1u;
-        (*w).next = links[nx - 1u];
-        return nx - 1u;
-    }
-    let k = (*w).next;
-    if (k >= (*w).n) {
-        return 0xffffffffu;
-    }
-    (*w).next = k + 1u;
-    if (params.method == 3u && k >= (*w).fronts) {
-        return (*w).base + params.slots - 1u - (k - (*w).fronts);
-    }
-    return (*w).base + k;
-}
-
-fn key_less(d0: u32, i0: u32, d1: u32, i1: u32) -> bool {
-    return d0 < d1 || (d0 == d1 && i0 < i1);
-}
 
 // Eq. 5 state: M nodes sorted by depth, 16-bit depth and α each.
 var<private> cz: array<u32, 17>;
@@ -185,31 +89,7 @@ fn fs_main(@builtin(position) frag: vec4f) -> ResolveOut {
     loop {
         var kd: array<u32, SORT_BOUND>;
         var ki: array<u32, SORT_BOUND>;
-        var k = 0u;
-        var w = walk_begin(p);
-        loop {
-            let i = walk_next(&w);
-            if (i == 0xffffffffu) {
-                break;
-            }
-            let d = bitcast<u32>(nodes[i].depth);
-            if (started && !key_less(last_d, last_i, d, i)) {
-                continue;
-            }
-            if (k == SORT_BOUND && !key_less(d, i, kd[k - 1u], ki[k - 1u])) {
-                continue;
-            }
-            // insertion into the sorted bounded array
-            var j = min(k, SORT_BOUND - 1u);
-            while (j > 0u && key_less(d, i, kd[j - 1u], ki[j - 1u])) {
-                kd[j] = kd[j - 1u];
-                ki[j] = ki[j - 1u];
-                j--;
-            }
-            kd[j] = d;
-            ki[j] = i;
-            k = min(k + 1u, SORT_BOUND);
-        }
+        let k = sorted_batch(p, started, last_d, last_i, &kd, &ki);
         for (var j = 0u; j < k; j++) {
             let f = nodes[ki[j]];
             let rg = unpack2x16float(f.rg);

@@ -1,0 +1,126 @@
+//! A-buffer multilayer AO (`aba-ao`, ABA Algorithm 1) against the CPU ground truth
+//! of the same camera — DGB's obscurance over every surface (the estimator both
+//! `aba-ao` and `ao` use) and ray-traced binary AO — with, in the same result, the
+//! single-layer variant of the same A-buffer AO (`multilayer=off`: the nearest
+//! fragment of each tap pixel only) and 2-layer deep-G-buffer AO (`ao`, same
+//! radius, bias and ε), so one run says what the extra layers buy.
+//!
+//! Opaque scenes only: with transparent surfaces the obscurance reference has no
+//! opacity; there the oracle is `Reference::ao_with_opacity_image` (tests) and the
+//! images of `docs/abuffer.md`.
+
+use anyhow::{bail, Result};
+use strata_render::passes::abuffer::ao::AbaAoSettings;
+use strata_render::passes::abuffer::ABufferSettings;
+use strata_render::passes::ao::AoSettings;
+use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+
+use super::ao::{references, render_frame, render_settings, DEFAULT_CAP};
+use super::{noise_warnings, EvalSettings};
+use crate::metrics::compare;
+use crate::results::{AoErrors, AoEval};
+
+/// `abuffer` with its `ao` as configured (radius, bias, ε default to `ao`'s, then the
+/// scene's); `ao` are the DGB AO settings of the 2-layer comparison.
+pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Result<AoEval> {
+    if s.report.is_some() {
+        bail!("--report is not available for --technique aba-ao yet: drop --report (the JSON has every error)");
+    }
+    if s.frames.is_some() {
+        bail!("--frames is not available for --technique aba-ao (it has no temporal filter): drop --frames");
+    }
+    let rule = s.check(DEFAULT_CAP, 16)?;
+    let (scene, cams) = s.scene.load()?;
+    if let Some(m) = scene.materials.iter().find(|m| !m.is_opaque()) {
+        bail!(
+            "scene '{}' has a transparent material ('{}'): eval --technique aba-ao compares opaque scenes only (the obscurance reference has no opacity)",
+            scene.name,
+            m.name
+        );
+    }
+    let camera = cams.current;
+    let own = abuffer.ao.clone().unwrap_or_default();
+    // one radius, bias and ε for ABA AO, DGB AO and both references
+    let radius = own.radius.or(ao.radius).unwrap_or(scene.settings.ao_radius);
+    let ao = AoSettings {
+        radius: Some(radius),
+        bias: own.bias.or(ao.bias),
+        epsilon: own.epsilon.or(ao.epsilon),
+        ..ao.clone()
+    };
+    let (_, beta, epsilon) = ao.resolve(&scene);
+    let aba = AbaAoSettings {
+        radius: Some(radius),
+        bias: Some(beta),
+        epsilon: Some(epsilon),
+        ..own
+    };
+    let aba_settings = |multilayer: bool| RenderSettings {
+        shade: false,
+        abuffer: Some(ABufferSettings {
+            ao: Some(AbaAoSettings {
+                multilayer,
+                ..aba.clone()
+            }),
+            ..abuffer.clone()
+        }),
+        guard_band: s.guard_band.or_default(strata_render::renderer::AO_GUARD_BAND),
+        ..s.render_settings(1)
+    };
+    for rs in [aba_settings(aba.multilayer), render_settings(s, 2, &ao)] {
+        rs.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    let (ref_obscurance, ref_binary) = references(s, &scene, &camera, (radius, beta, epsilon), &rule)?;
+    let gpu = GpuContext::new(&GpuOptions {
+        adapter: s.adapter.clone(),
+    })?;
+    let evaluate = |rs: RenderSettings, what: &str| -> Result<AoErrors> {
+        let mut r = Renderer::new(&gpu, &scene, rs)?;
+        let start = std::time::Instant::now();
+        let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
+        let overflow = r.abuffer().map(|a| a.read_lists(&gpu)).transpose()?.map_or(0, |l| l.overflow);
+        eprintln!(
+            "{what}: frame rendered and read back in {:.2} s{}",
+            start.elapsed().as_secs_f64(),
+            if overflow > 0 {
+                format!(" ({overflow} fragments dropped: raise --set pool=N)")
+            } else {
+                String::new()
+            }
+        );
+        let (obscurance, _) = compare(&ref_obscurance.image, &av)?;
+        let (binary, _) = compare(&ref_binary.image, &av)?;
+        Ok(AoErrors {
+            obscurance: ref_obscurance.annotate(obscurance, &av),
+            binary: ref_binary.annotate(binary, &av),
+        })
+    };
+    let main = evaluate(aba_settings(aba.multilayer), "aba-ao")?;
+    let single = evaluate(aba_settings(false), "aba-ao multilayer=off")?;
+    let dgb = evaluate(render_settings(s, 2, &ao), "ao k=2")?;
+    let mut run = s.run_info(
+        ref_obscurance.noise.spp,
+        "obscurance (DGB Eq. 2 over all surfaces, spiral radial density), and binary AO within r",
+        gpu.describe(),
+        None,
+        noise_warnings(&[
+            ("aba-ao vs obscurance", &main.obscurance),
+            ("aba-ao vs binary AO", &main.binary),
+        ]),
+    );
+    run.layers = 0;
+    Ok(AoEval {
+        run,
+        samples: aba.samples,
+        radius,
+        bias: beta,
+        epsilon,
+        errors: main,
+        layers_1: Some(single),
+        by_layers: Vec::new(),
+        directions: None,
+        visibility: None,
+        no_visibility: None,
+        dgb_2_layers: Some(dgb),
+    })
+}

@@ -1,0 +1,179 @@
+// Opacity-aware multilayer ambient occlusion over the A-buffer (ABA §III,
+// Algorithm 1, Eq. 3–4), "separate" integration: every fragment of the pixel's
+// list (in depth order) is a receiver; its AO is blended front to back with
+// the colour's weights into one ambient visibility, over a background of 1.
+//
+// getAO is DGB's obscurance (Eq. 2) at the spiral's taps (a Poisson-like disk,
+// DGB §3.4) and the estimator of DGB Eq. 1, so `aba-ao` and `ao` mean the same
+// thing on one camera. Algorithm 1: per tap, the strongest occluder over every
+// fragment of the tap pixel's list, each weighted by its α (ABA: "occluder
+// opacity weights its occlusion"). The CPU twin is
+// `passes::abuffer::ao::ambient_visibility_cpu`.
+#import "common/frame.wgsl"
+#import "common/fullscreen.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
+#import "common/spiral.wgsl"
+#import "abuffer/lists.wgsl"
+
+// Matches `ao::AbaAoUniforms`.
+struct AbaAo {
+    radius: f32,
+    bias: f32,
+    epsilon: f32,
+    intensity: f32,
+    proj_scale: f32,
+    tau: f32,
+    samples: u32,
+    seed: u32,
+    // 1 = rotate the spiral per pixel
+    rotate: u32,
+    // 0 = only the nearest fragment of a tap pixel occludes (single-layer SSAO)
+    multilayer: u32,
+    // 1 = taps read the M compressed nodes (Eq. 5) instead of walking the list
+    compressed: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(2) @binding(0) var<uniform> ao: AbaAo;
+@group(2) @binding(1) var nodes_m: texture_2d_array<u32>;
+
+// DGB Eq. 2: obscurance at X (normal n) due to a surface point at v = Y − X.
+fn obscurance(v: vec3f, n: vec3f) -> f32 {
+    let vv = dot(v, v);
+    let r2 = ao.radius * ao.radius;
+    if (!(vv < r2)) {
+        return 0.0;
+    }
+    return (1.0 - vv / r2) * max((dot(v, n) - ao.bias) / sqrt(vv + ao.epsilon), 0.0);
+}
+
+// Algorithm 1's inner loop at tap pixel q: max over the occluders f of
+// α_f · getAO(x, f); without `multilayer`, the nearest fragment alone.
+fn tap_occlusion(q: vec2i, x: vec3f, n: vec3f) -> f32 {
+    let centre = vec2f(q) + 0.5;
+    var a = 0.0;
+    if (ao.compressed == 1u) {
+        // nodes sorted by depth; empty ones have α = 0
+        for (var l = 0u; l < (params.compress + 3u) / 4u; l++) {
+            let v = textureLoad(nodes_m, q, i32(l), 0);
+            for (var e = 0u; e < 4u; e++) {
+                let j = 4u * l + e;
+                if (j >= params.compress) {
+                    break;
+                }
+                let alpha = f32(v[e] & 0xffffu) / 65535.0;
+                if (alpha <= 0.0) {
+                    continue;
+                }
+                let z = (f32(v[e] >> 16u) + 0.5) / params.depth_scale;
+                a = max(a, alpha * obscurance(world_from_csz(frame, centre, z) - x, n));
+                if (ao.multilayer == 0u) {
+                    return a;
+                }
+            }
+        }
+        return a;
+    }
+    let p = u32(q.y) * params.width + u32(q.x);
+    var w = walk_begin(p);
+    var nearest = 0xffffffffu;
+    var nearest_d = 0xffffffffu;
+    loop {
+        let i = walk_next(&w);
+        if (i == 0xffffffffu) {
+            break;
+        }
+        let f = nodes[i];
+        if (ao.multilayer == 0u) {
+            let d = bitcast<u32>(f.depth);
+            if (key_less(d, i, nearest_d, nearest)) {
+                nearest_d = d;
+                nearest = i;
+            }
+            continue;
+        }
+        let alpha = unpack2x16float(f.ba).y;
+        a = max(a, alpha * obscurance(world_from_csz(frame, centre, f.depth) - x, n));
+    }
+    if (ao.multilayer == 0u && nearest != 0xffffffffu) {
+        let f = nodes[nearest];
+        let alpha = unpack2x16float(f.ba).y;
+        a = alpha * obscurance(world_from_csz(frame, centre, f.depth) - x, n);
+    }
+    return a;
+}
+
+// DGB Eq. 1 over the hemisphere around n at x (camera depth z) seen from pixel p.
+fn hemisphere_av(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
+    let r_p = ao.proj_scale * ao.radius / z;
+    let size = vec2i(i32(params.width), i32(params.height));
+    var sum = 0.0;
+    for (var i = 0u; i < ao.samples; i++) {
+        let tap = spiral_tap(i, ao.samples, ao.tau, r_p, phi);
+        let q = p + tap_texel(tap.offset);
+        if (any(q < vec2i(0)) || any(q >= size)) {
+            continue;
+        }
+        sum += tap_occlusion(q, x, n);
+    }
+    return max(0.0, 1.0 - sqrt(ao.intensity * 3.14159265358979 / f32(ao.samples) * sum));
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    let p = vec2i(pos.xy);
+    let pix = u32(p.y) * params.width + u32(p.x);
+    var phi = 0.0;
+    if (ao.rotate != 0u) {
+        phi = pixel_angle(vec2u(p), ao.seed);
+    }
+    var av = 0.0;
+    var t = 1.0;
+    var last_d = 0u;
+    var last_i = 0u;
+    var started = false;
+    loop {
+        var kd: array<u32, SORT_BOUND>;
+        var ki: array<u32, SORT_BOUND>;
+        let k = sorted_batch(pix, started, last_d, last_i, &kd, &ki);
+        for (var j = 0u; j < k; j++) {
+            if (t < T_MIN) {
+                break;
+            }
+            let f = nodes[ki[j]];
+            let alpha = unpack2x16float(f.ba).y;
+            if (alpha <= 0.0) {
+                continue;
+            }
+            let x = world_from_csz(frame, vec2f(p) + 0.5, f.depth);
+            let b = f.normal_facing;
+            let n = oct_decode(vec2f(f32(b & 0xffu), f32((b >> 8u) & 0xffu)) / 255.0);
+            // Eq. 3–4: w = α (front face) or 1 − α (back face); n faces the camera
+            var wt = alpha;
+            if (((b >> 16u) & 1u) == 0u) {
+                wt = 1.0 - alpha;
+            }
+            var a = 0.0;
+            if (wt > 0.0) {
+                a += wt * hemisphere_av(p, x, n, f.depth, phi);
+            }
+            if (wt < 1.0) {
+                a += (1.0 - wt) * hemisphere_av(p, x, -n, f.depth, phi);
+            }
+            av += t * alpha * a;
+            t *= 1.0 - alpha;
+        }
+        if (k < SORT_BOUND || t < T_MIN) {
+            break;
+        }
+        last_d = kd[k - 1u];
+        last_i = ki[k - 1u];
+        started = true;
+    }
+    if (t >= T_MIN) {
+        av += t;
+    }
+    return vec4f(av);
+}
