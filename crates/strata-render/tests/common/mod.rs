@@ -1,6 +1,8 @@
 //! Shared helpers for GPU tests (run on lavapipe when no GPU is present).
 #![allow(dead_code)]
 
+pub mod quads;
+
 use strata_render::frame::FrameCameras;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, Scene};

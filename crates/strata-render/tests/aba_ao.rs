@@ -1,0 +1,305 @@
+//! ABA multilayer AO (Algorithm 1, Eq. 3–4) over the A-buffer: the GPU equals
+//! its CPU twin over the read-back lists (list walk and compressed nodes, one
+//! and all layers), an unoccluded plane is 1, an occluder hidden behind the
+//! first layer darkens only in multilayer AO, an α-weighted occluder darkens by
+//! α × the opaque occlusion, and with α = 1 everywhere the opacity-aware AO
+//! equals the opaque multilayer AO. Every frame fails on any wgpu validation
+//! error (the renderer checks after each frame).
+
+mod common;
+
+use glam::{Mat4, Vec3};
+use strata_render::frame::FrameCameras;
+use strata_render::passes::abuffer::ao::{ambient_visibility_cpu, AbaAoSettings, Occluders};
+use strata_render::passes::abuffer::{ABufferMethod, ABufferSettings};
+use strata_render::renderer::GuardBand;
+use strata_render::{GpuContext, RenderSettings, Renderer};
+use strata_scene::shapes::MeshBuilder;
+use strata_scene::{ImageBuf, Material, Object, Scene};
+
+use common::quads::{glass, quads, v};
+
+const W: u32 = 64;
+const H: u32 = 48;
+
+fn aba(multilayer: bool, compress: Option<u32>) -> ABufferSettings {
+    aba_with(ABufferMethod::LinkedList, multilayer, compress)
+}
+
+fn aba_with(method: ABufferMethod, multilayer: bool, compress: Option<u32>) -> ABufferSettings {
+    ABufferSettings {
+        method,
+        compress,
+        ao: Some(AbaAoSettings {
+            multilayer,
+            ..Default::default()
+        }),
+        ..Default::default()
+    }
+}
+
+fn render(gpu: &GpuContext, scene: &Scene, a: ABufferSettings) -> Renderer {
+    let t = strata_render::technique::find("aba-ao").unwrap();
+    let base = RenderSettings {
+        width: W,
+        height: H,
+        guard_band: GuardBand::Pixels(0),
+        ..Default::default()
+    };
+    let mut s = t.settings(&base, None).unwrap();
+    s.abuffer = Some(a);
+    let mut r = Renderer::new(gpu, scene, s).expect("renderer builds without validation errors");
+    let timings = r
+        .render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0)
+        .expect("frame renders without validation errors");
+    if !timings.passes.is_empty() {
+        assert!(timings.get("aba-ao").is_some(), "aba-ao is timed: {timings:?}");
+    }
+    r
+}
+
+fn raw(gpu: &GpuContext, r: &Renderer) -> ImageBuf {
+    r.read_target(gpu, "ao-raw").unwrap()
+}
+
+/// `mesh` of one quad facing `n` (±z) at depth z over x, y ranges.
+fn pane(scene: &mut Scene, z: f32, [x0, x1]: [f32; 2], [y0, y1]: [f32; 2], n: Vec3, material: usize) {
+    let mut b = MeshBuilder::new();
+    b.quad_facing([v(x0, y0, z), v(x1, y0, z), v(x1, y1, z), v(x0, y1, z)], n);
+    scene.meshes.push(b.build("pane", material));
+    scene.objects.push(Object {
+        name: "pane".into(),
+        mesh: scene.meshes.len() - 1,
+        transform: Mat4::IDENTITY,
+        animation: None,
+    });
+}
+
+/// An opaque plane at z = 0 with panes of every kind in front of it: an
+/// opaque box-like occluder, transparent panes (front- and back-facing), so
+/// receivers, occluders and the blend all take part.
+fn mixed() -> Scene {
+    let materials = vec![
+        Material::diffuse("plane", [0.6, 0.6, 0.6]),
+        Material::diffuse("block", [0.5, 0.4, 0.3]),
+        glass("red", [0.9, 0.1, 0.1], 0.5),
+        glass("blue", [0.1, 0.2, 0.9], 0.25),
+    ];
+    let mut s = quads(
+        materials,
+        &[
+            (0.0, [-20.0, 20.0], [-20.0, 20.0], 0),
+            (0.4, [-0.9, -0.2], [-0.6, 0.5], 1),
+            (0.25, [-0.3, 1.1], [-1.0, 0.2], 2),
+        ],
+    );
+    pane(&mut s, 0.6, [0.2, 1.4], [-0.2, 0.9], -Vec3::Z, 3);
+    s.settings.ao_radius = 0.8;
+    s
+}
+
+#[test]
+fn gpu_multilayer_ao_equals_the_cpu_twin_of_algorithm_1() {
+    let gpu = common::gpu();
+    let scene = mixed();
+    let mut cases: Vec<_> = ABufferMethod::ALL.iter().map(|&m| (m, true, None)).collect();
+    cases.extend([
+        (ABufferMethod::LinkedList, false, None),
+        (ABufferMethod::Linear, true, Some(6)),
+        (ABufferMethod::FixedArray, false, Some(4)),
+    ]);
+    for (method, multilayer, compress) in cases {
+        let r = render(&gpu, &scene, aba_with(method, multilayer, compress));
+        let ab = r.abuffer().unwrap();
+        let lists = ab.read_lists(&gpu).unwrap();
+        assert_eq!(lists.overflow, 0);
+        let nodes = ab.read_compressed(&gpu).unwrap();
+        let occ = match &nodes {
+            Some(n) => Occluders::Compressed {
+                nodes: n,
+                depth_scale: ab.depth_scale(),
+            },
+            None => Occluders::Lists,
+        };
+        let u = ab.ao_uniforms().expect("AO uniforms were set");
+        let frame = r.frame_uniforms();
+        let gpu_av = raw(&gpu, &r);
+        let (mut worst, mut sum, mut dark) = (0.0f32, 0.0f64, 0);
+        for y in 0..H {
+            for x in 0..W {
+                let want = ambient_visibility_cpu(&lists, &occ, &frame, &u, x, y);
+                let got = gpu_av.pixel(x, y)[0];
+                let d = (got - want).abs();
+                worst = worst.max(d);
+                sum += d as f64;
+                dark += (want < 0.9) as u32;
+                assert!(
+                    d < 2e-3,
+                    "{method} multilayer={multilayer} compress={compress:?}: pixel ({x}, {y}) GPU {got} vs CPU {want}"
+                );
+            }
+        }
+        let mean = sum / (W * H) as f64;
+        eprintln!("{method} multilayer={multilayer} compress={compress:?}: |GPU − CPU| max {worst:.2e}, mean {mean:.2e}, {dark} pixels below 0.9");
+        assert!(mean < 1e-4, "mean difference {mean}");
+        assert!(dark > 50, "the scene occludes: {dark} pixels below 0.9");
+    }
+}
+
+#[test]
+fn an_unoccluded_plane_is_one() {
+    let gpu = common::gpu();
+    let scene = quads(
+        vec![Material::diffuse("plane", [0.6, 0.6, 0.6])],
+        &[(0.0, [-20.0, 20.0], [-20.0, 20.0], 0)],
+    );
+    for compress in [None, Some(6)] {
+        let av = raw(&gpu, &render(&gpu, &scene, aba(true, compress)));
+        assert!(
+            av.data.iter().all(|&a| a == 1.0),
+            "compress={compress:?}: min AV {}",
+            av.data.iter().cloned().fold(1.0, f32::min)
+        );
+    }
+}
+
+/// A plane at z = 0 (visible left of x = 0), an occluder at z = 0.3 over
+/// x ∈ [0, 2] and an opaque pane at z = 2.5 over x ∈ [0, 4] that hides the
+/// occluder from the camera (both project right of the image's centre column).
+fn hidden_occluder() -> Scene {
+    let m = vec![
+        Material::diffuse("plane", [0.6, 0.6, 0.6]),
+        Material::diffuse("occluder", [0.5, 0.5, 0.5]),
+        Material::diffuse("pane", [0.7, 0.7, 0.7]),
+    ];
+    let mut s = quads(
+        m,
+        &[
+            (0.0, [-20.0, 20.0], [-20.0, 20.0], 0),
+            (0.3, [0.0, 2.0], [-2.0, 2.0], 1),
+            (2.5, [0.0, 4.0], [-4.0, 4.0], 2),
+        ],
+    );
+    s.settings.ao_radius = 1.0;
+    s
+}
+
+#[test]
+fn an_occluder_hidden_behind_the_first_layer_darkens_only_multilayer_ao() {
+    let gpu = common::gpu();
+    let scene = hidden_occluder();
+    let multi = raw(&gpu, &render(&gpu, &scene, aba(true, None)));
+    let single = raw(&gpu, &render(&gpu, &scene, aba(false, None)));
+    // receivers on the plane next to the hidden occluder (left of the centre)
+    let near: Vec<(u32, u32)> = (0..H).flat_map(|y| (W / 2 - 4..W / 2).map(move |x| (x, y))).collect();
+    let mut darker = 0;
+    for &(x, y) in &near {
+        let (m, s) = (multi.pixel(x, y)[0], single.pixel(x, y)[0]);
+        assert!(m <= s + 1e-6, "({x}, {y}): multilayer {m} > single {s}");
+        // the single layer sees only the plane and the far pane: unoccluded
+        assert_eq!(s, 1.0, "({x}, {y}): single-layer AO sees no occluder");
+        darker += (m < s - 0.05) as u32;
+    }
+    assert!(darker as usize > near.len() / 2, "{darker} of {} receivers darkened", near.len());
+    // far from the occluder (taps reach ≈ 12 px) both see one layer: equal
+    for y in 0..H {
+        for x in 0..W / 2 - 16 {
+            assert_eq!(multi.pixel(x, y)[0], single.pixel(x, y)[0], "({x}, {y})");
+        }
+    }
+}
+
+#[test]
+fn an_alpha_weighted_occluder_darkens_by_alpha_times_the_opaque_occlusion() {
+    let gpu = common::gpu();
+    // the occluder of `hidden_occluder` without the pane, opaque or α = 0.5
+    let scene = |alpha: f32| {
+        let mut s = quads(
+            vec![
+                Material::diffuse("plane", [0.6, 0.6, 0.6]),
+                glass("occluder", [0.5, 0.5, 0.5], alpha),
+            ],
+            &[(0.0, [-20.0, 20.0], [-20.0, 20.0], 0), (0.3, [0.0, 2.0], [-2.0, 2.0], 1)],
+        );
+        s.settings.ao_radius = 1.0;
+        s
+    };
+    let alpha = 0.5f32;
+    for compress in [None, Some(6)] {
+        let opaque = raw(&gpu, &render(&gpu, &scene(1.0), aba(true, compress)));
+        let half = raw(&gpu, &render(&gpu, &scene(alpha), aba(true, compress)));
+        let mut checked = 0;
+        // receivers on the plane left of the occluder (they see no pane): DGB
+        // Eq. 1's sum S = (1 − AV)²·N/π is linear in the occluder's α
+        for y in 0..H {
+            for x in 0..W / 2 - 1 {
+                let s1 = (1.0 - opaque.pixel(x, y)[0]).powi(2);
+                let sa = (1.0 - half.pixel(x, y)[0]).powi(2);
+                if s1 > 1e-3 {
+                    checked += 1;
+                    assert!(
+                        (sa - alpha * s1).abs() <= 1e-3 * s1 + 1e-6,
+                        "compress={compress:?} ({x}, {y}): S_α {sa} vs α·S_1 {}",
+                        alpha * s1
+                    );
+                } else {
+                    assert!(sa <= 1e-3, "({x}, {y}): unoccluded when opaque, occluded at α");
+                }
+            }
+        }
+        assert!(checked > 50, "{checked} occluded receivers");
+    }
+}
+
+#[test]
+fn with_alpha_one_everywhere_the_opacity_aware_ao_is_the_opaque_multilayer_ao() {
+    // opaque Algorithm 1 written out without opacity: the nearest fragment is
+    // the receiver (exterior hemisphere only), and every fragment of a tap
+    // pixel occludes with weight 1 (DGB Eq. 1's max over layers)
+    use strata_render::passes::ao::{obscurance, world_from_csz, AoUniforms};
+    use strata_render::spiral;
+    let gpu = common::gpu();
+    let scene = hidden_occluder();
+    let r = render(&gpu, &scene, aba(true, None));
+    let ab = r.abuffer().unwrap();
+    let lists = ab.read_lists(&gpu).unwrap();
+    let u = ab.ao_uniforms().unwrap();
+    let frame = r.frame_uniforms();
+    let got = raw(&gpu, &r);
+    assert!(lists.lists.iter().flatten().all(|f| f.alpha == 1.0 && f.front_facing));
+    let eq2 = AoUniforms {
+        radius: u.radius,
+        bias: u.bias,
+        epsilon: u.epsilon,
+        ..bytemuck::Zeroable::zeroed()
+    };
+    let mut occluded = 0;
+    for y in 0..H {
+        for x in 0..W {
+            let f = lists.at(x, y)[0];
+            let pos = world_from_csz(&frame, [x as f32 + 0.5, y as f32 + 0.5], f.depth);
+            let n = Vec3::from(f.normal);
+            let phi = spiral::pixel_angle(x, y, u.seed);
+            let r_p = u.proj_scale * u.radius / f.depth;
+            let mut sum = 0.0f32;
+            for i in 0..u.samples {
+                let d = spiral::tap_texel(spiral::spiral_tap(i, u.samples, u.tau, r_p, phi).offset);
+                let (qx, qy) = (x as i32 + d[0], y as i32 + d[1]);
+                if qx < 0 || qy < 0 || qx >= W as i32 || qy >= H as i32 {
+                    continue;
+                }
+                let c = [qx as f32 + 0.5, qy as f32 + 0.5];
+                sum += lists
+                    .at(qx as u32, qy as u32)
+                    .iter()
+                    .map(|g| obscurance(&eq2, world_from_csz(&frame, c, g.depth) - pos, n))
+                    .fold(0.0, f32::max);
+            }
+            let want = (1.0 - (u.intensity * std::f32::consts::PI / u.samples as f32 * sum).sqrt()).max(0.0);
+            let have = got.pixel(x, y)[0];
+            occluded += (want < 0.95) as u32;
+            assert!((have - want).abs() < 2e-3, "({x}, {y}): {have} vs opaque {want}");
+        }
+    }
+    assert!(occluded > 50, "{occluded} occluded pixels");
+}
