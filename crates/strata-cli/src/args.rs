@@ -507,6 +507,10 @@ pub enum ReferenceKind {
     /// Order-independent transparency: every surface crossing of the pixel-centre ray
     /// composited front to back (ABA's ground truth; unshadowed fragment shading).
     Composite,
+    /// Ambient visibility with opacity (ABA Eq. 3–4): every crossing's binary AO within
+    /// --ao-radius, occluders weighted by α (strongest occluder), transparent receivers
+    /// exterior + interior, blended front to back like the colour (the ground truth of aba-ao).
+    AoOpacity,
 }
 
 #[derive(Args)]

@@ -67,13 +67,15 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         BenchResult::Abuffer(b) => {
             let ms = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.3}"));
             println!(
-                "{:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>10} {:>10} {:>8}",
+                "{:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>8}",
                 "ABA Table I",
                 "clear",
                 "count",
                 "prefix sum",
                 "draw",
                 "resolve",
+                "AO",
+                "AO blur",
                 "total",
                 "MiB",
                 "fragments",
@@ -82,17 +84,22 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             for key in abuffer::KEYS {
                 let Some(m) = b.methods.get(key) else { continue };
                 println!(
-                    "{key:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9.3} {:>10.1} {:>10} {:>8}",
+                    "{key:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9.3} {:>10.1} {:>10} {:>8}",
                     ms(m.clear_ms),
                     ms(m.count_ms),
                     ms(m.prefix_sum_ms),
                     ms(m.draw_ms),
                     ms(m.resolve_ms),
+                    ms(m.ao_ms),
+                    ms(m.ao_blur_ms),
                     m.total_ms,
                     m.memory_bytes as f64 / (1024.0 * 1024.0),
                     m.fragments,
                     m.dropped
                 );
+            }
+            if let (Some(s), Some(f)) = (b.ao_speedup, b.ao_flip_compressed_vs_brute) {
+                println!("multilayer AO, compressed vs brute force (linked list): {s:.2}x faster, FLIP {f:.4} between the AO images");
             }
         }
         BenchResult::Ils(b) => {

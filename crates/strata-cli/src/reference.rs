@@ -54,6 +54,23 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
             };
             vec![(a.out.clone(), reference.ao_obscurance(&camera, w, h, &s))]
         }
+        ReferenceKind::AoOpacity => {
+            check_output(&a.out, a.force)?;
+            let s = AoBinarySettings {
+                radius,
+                spp: a.spp,
+                seed: a.seed,
+            };
+            // channel 0: the strongest-occluder model (ABA Algorithm 1's max)
+            let img = reference.ao_with_opacity_image(&camera, w, h, &s);
+            let av = ImageBuf {
+                width: w,
+                height: h,
+                channels: 1,
+                data: img.data.chunks(3).map(|p| p[0]).collect(),
+            };
+            vec![(a.out.clone(), av)]
+        }
         ReferenceKind::Composite => {
             check_output(&a.out, a.force)?;
             let img = reference.composite(&camera, w, h);

@@ -179,6 +179,13 @@ pub enum BenchResult {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AbufferBench {
     pub methods: std::collections::BTreeMap<String, AbufferMethodBench>,
+    /// The multilayer AO pass alone (ABA §III-B, heavy workload): brute force
+    /// (linked lists walked per tap) over compressed (M nodes per tap).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ao_speedup: Option<f64>,
+    /// ꟻLIP between the compressed and the brute-force AO images (`ao`, after the blur).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ao_flip_compressed_vs_brute: Option<f32>,
 }
 
 /// One column of ABA Table I: median GPU ms per stage (absent: the method has no such
@@ -190,6 +197,11 @@ pub struct AbufferMethodBench {
     pub prefix_sum_ms: Option<f64>,
     pub draw_ms: Option<f64>,
     pub resolve_ms: Option<f64>,
+    /// Table I "AO": the multilayer AO pass (`aba-ao`) and its bilateral blur.
+    #[serde(default)]
+    pub ao_ms: Option<f64>,
+    #[serde(default)]
+    pub ao_blur_ms: Option<f64>,
     pub total_ms: f64,
     /// Bytes of the structure (nodes, heads/counters) and of the compressed nodes.
     pub memory_bytes: u64,

@@ -11,7 +11,7 @@ mod common;
 use glam::{Mat4, Vec3};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::abuffer::ao::{ambient_visibility_cpu, AbaAoSettings, Occluders};
-use strata_render::passes::abuffer::{ABufferMethod, ABufferSettings};
+use strata_render::passes::abuffer::{compress, ABufferMethod, ABufferSettings};
 use strata_render::renderer::GuardBand;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::shapes::MeshBuilder;
@@ -114,13 +114,36 @@ fn gpu_multilayer_ao_equals_the_cpu_twin_of_algorithm_1() {
         let lists = ab.read_lists(&gpu).unwrap();
         assert_eq!(lists.overflow, 0);
         let nodes = ab.read_compressed(&gpu).unwrap();
-        let occ = match &nodes {
-            Some(n) => Occluders::Compressed {
+        let normals = ab.read_compressed_normals(&gpu).unwrap();
+        let occ = match (&nodes, &normals) {
+            (Some(n), Some(nf)) => Occluders::Compressed {
                 nodes: n,
+                normals: nf,
                 depth_scale: ab.depth_scale(),
             },
-            None => Occluders::Lists,
+            _ => Occluders::Lists,
         };
+        if let (Some(nodes), Some(normals)) = (&nodes, &normals) {
+            // every kept node carries the normal and facing of its fragment
+            let scale = ab.depth_scale();
+            for (p, (ns, nfs)) in nodes.iter().zip(normals).enumerate() {
+                for (&word, &nf) in ns.iter().zip(nfs) {
+                    if word & 0xffff == 0 {
+                        continue;
+                    }
+                    let f = lists.lists[p]
+                        .iter()
+                        .find(|f| {
+                            compress::quantise_depth(f.depth, scale) == word >> 16
+                                && compress::quantise_alpha(f.alpha) == word & 0xffff
+                        })
+                        .expect("a kept node is one of the pixel's fragments");
+                    let n = strata_render::packing::oct16_unpack([nf as u8, (nf >> 8) as u8]);
+                    assert_eq!(n.to_array(), f.normal, "pixel {p}: node normal");
+                    assert_eq!((nf >> 16) & 1 == 1, f.front_facing, "pixel {p}: node facing");
+                }
+            }
+        }
         let u = ab.ao_uniforms().expect("AO uniforms were set");
         let frame = r.frame_uniforms();
         let gpu_av = raw(&gpu, &r);

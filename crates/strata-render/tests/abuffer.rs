@@ -403,7 +403,7 @@ fn compressed_nodes_equal_the_cpu_twin_of_eq5_bit_for_bit() {
                 .unwrap()
                 .expect("compression on");
             let scale = r.abuffer().unwrap().depth_scale();
-            let want_scale = compress::ONE16 as f32 / far_depth(scene, &scene.camera, 0.0);
+            let want_scale = (compress::ONE16 - 1) as f32 / far_depth(scene, &scene.camera, 0.0);
             assert_eq!(scale, want_scale);
             let mut evicting = 0;
             for (p, list) in l.lists.iter().enumerate() {

@@ -1,8 +1,11 @@
 //! `strata bench abuffer`: ABA Table I's stages (clear, count, prefix sum, draw,
-//! resolve; AO is not built yet) per A-buffer construction — `linked-list`,
-//! `linear`, `fixed-array`, `dual-peel` — and the `compressed` path (the linked
-//! list resolved with Eq. 5 compression), each with the memory of its structure
-//! at the bench size and the fragments it stored and dropped (overflow).
+//! resolve, AO) per A-buffer construction — `linked-list`, `linear`,
+//! `fixed-array`, `dual-peel` — and the `compressed` path (the linked list
+//! resolved with Eq. 5 compression, AO taps reading the M nodes), each with the
+//! memory of its structure at the bench size and the fragments it stored and
+//! dropped (overflow). The frame is the `aba-ao` technique's (OIT + multilayer
+//! AO); the AO speed-up of compression and the ꟻLIP between the two AO images
+//! come last (ABA §V's heavy-workload comparison).
 
 use std::collections::BTreeMap;
 
@@ -23,7 +26,7 @@ pub const KEYS: [&str; 5] = ["dual-peel", "linked-list", "linear", "fixed-array"
 /// `set`: the `oit` technique's settings (`pool`, `max-layers`, `compress`, …), applied
 /// last and range-checked; `abuffer` and (for the compressed run) `compress` are the bench's.
 pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench> {
-    let t = technique::find("oit")?;
+    let t = technique::find("aba-ao")?;
     let (scene, cams) = stage.scene.load()?;
     let stage1 = StageSettings {
         layers: 1,
@@ -49,6 +52,7 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
     let gpu = timing_gpu(&stage.adapter)?;
     let (w, h) = (stage.scene.width, stage.scene.height);
     let mut methods = BTreeMap::new();
+    let mut ao_images = BTreeMap::new();
     for key in KEYS {
         let settings = configure(key)?;
         let a = settings.abuffer.clone().expect("oit has an A-buffer");
@@ -57,12 +61,16 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
             let mut r = Renderer::new(&gpu, &scene, settings.clone())?;
             r.render(&gpu, &scene, &FrameCameras::fixed(cams.current), stage.scene.frame)?;
             let lists = r.abuffer().expect("A-buffer").read_lists(&gpu)?;
+            if key == "linked-list" || key == "compressed" {
+                ao_images.insert(key, r.read_target(&gpu, "ao")?);
+            }
             gpu.check_errors()?;
             (lists.total, lists.overflow)
         };
-        let passes = a.method.passes();
+        let mut passes = a.method.passes().to_vec();
+        passes.extend(["aba-ao", "ao-blur-h", "ao-blur-v"]);
         let extra = json!({
-            "technique": "oit",
+            "technique": "aba-ao",
             "abuffer": a.method.name(),
             "pool": a.pool_nodes(w, h),
             "max_layers": a.max_layers,
@@ -72,7 +80,7 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
         let s2 = settings.clone();
         let bench = stage::run(Stage {
             stage: &stage1,
-            passes,
+            passes: &passes,
             settings: Box::new(move |_| s2.clone()),
             extra,
         })?;
@@ -85,6 +93,8 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
                 prefix_sum_ms: ms("abuffer-prefix-sum"),
                 draw_ms: ms("abuffer-draw"),
                 resolve_ms: ms("abuffer-resolve"),
+                ao_ms: ms("aba-ao"),
+                ao_blur_ms: ms("ao-blur-h").zip(ms("ao-blur-v")).map(|(a, b)| a + b),
                 total_ms: bench.total_median_ms,
                 memory_bytes: a.memory_bytes(w, h) + a.compressed_bytes(w, h),
                 fragments,
@@ -93,5 +103,15 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
             },
         );
     }
-    Ok(AbufferBench { methods })
+    let ao = |k: &str| methods.get(k).and_then(|m: &AbufferMethodBench| m.ao_ms);
+    let ao_speedup = ao("linked-list").zip(ao("compressed")).map(|(b, c)| b / c);
+    let ao_flip = match (ao_images.get("compressed"), ao_images.get("linked-list")) {
+        (Some(c), Some(b)) => Some(crate::metrics::compare(b, c)?.0.flip),
+        _ => None,
+    };
+    Ok(AbufferBench {
+        methods,
+        ao_speedup,
+        ao_flip_compressed_vs_brute: ao_flip,
+    })
 }

@@ -2,6 +2,8 @@
 // Algorithm 1, Eq. 3–4), "separate" integration: every fragment of the pixel's
 // list (in depth order) is a receiver; its AO is blended front to back with
 // the colour's weights into one ambient visibility, over a background of 1.
+// With compression (§III-B) the receivers and the occluders of every tap are
+// the M compressed nodes: one texel fetch per tap, no list walk.
 //
 // getAO is DGB's obscurance (Eq. 2) at the spiral's taps (a Poisson-like disk,
 // DGB §3.4) and the estimator of DGB Eq. 1, so `aba-ao` and `ao` mean the same
@@ -121,6 +123,25 @@ fn hemisphere_av(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
     return max(0.0, 1.0 - sqrt(ao.intensity * 3.14159265358979 / f32(ao.samples) * sum));
 }
 
+// Eq. 3–4 for one receiver fragment: w = α (front face) or 1 − α (back
+// face); n (decoded from `nf`) faces the camera.
+fn receiver_av(p: vec2i, alpha: f32, depth: f32, nf: u32, phi: f32) -> f32 {
+    let x = world_from_csz(frame, vec2f(p) + 0.5, depth);
+    let n = oct_decode(vec2f(f32(nf & 0xffu), f32((nf >> 8u) & 0xffu)) / 255.0);
+    var wt = alpha;
+    if (((nf >> 16u) & 1u) == 0u) {
+        wt = 1.0 - alpha;
+    }
+    var a = 0.0;
+    if (wt > 0.0) {
+        a += wt * hemisphere_av(p, x, n, depth, phi);
+    }
+    if (wt < 1.0) {
+        a += (1.0 - wt) * hemisphere_av(p, x, -n, depth, phi);
+    }
+    return a;
+}
+
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let p = vec2i(pos.xy);
@@ -131,6 +152,30 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     }
     var av = 0.0;
     var t = 1.0;
+    if (ao.compressed == 1u) {
+        // receivers: the M compressed nodes (sorted by depth) with their normals
+        let layers = (params.compress + 3u) / 4u;
+        for (var l = 0u; l < layers; l++) {
+            let v = textureLoad(nodes_m, p, i32(l), 0);
+            let nv = textureLoad(nodes_m, p, i32(l + layers), 0);
+            for (var e = 0u; e < 4u; e++) {
+                if (4u * l + e >= params.compress || t < T_MIN) {
+                    break;
+                }
+                let alpha = f32(v[e] & 0xffffu) / 65535.0;
+                if (alpha <= 0.0) {
+                    continue;
+                }
+                let z = (f32(v[e] >> 16u) + 0.5) / params.depth_scale;
+                av += t * alpha * receiver_av(p, alpha, z, nv[e], phi);
+                t *= 1.0 - alpha;
+            }
+        }
+        if (t >= T_MIN) {
+            av += t;
+        }
+        return vec4f(av);
+    }
     var last_d = 0u;
     var last_i = 0u;
     var started = false;
@@ -147,22 +192,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
             if (alpha <= 0.0) {
                 continue;
             }
-            let x = world_from_csz(frame, vec2f(p) + 0.5, f.depth);
-            let b = f.normal_facing;
-            let n = oct_decode(vec2f(f32(b & 0xffu), f32((b >> 8u) & 0xffu)) / 255.0);
-            // Eq. 3–4: w = α (front face) or 1 − α (back face); n faces the camera
-            var wt = alpha;
-            if (((b >> 16u) & 1u) == 0u) {
-                wt = 1.0 - alpha;
-            }
-            var a = 0.0;
-            if (wt > 0.0) {
-                a += wt * hemisphere_av(p, x, n, f.depth, phi);
-            }
-            if (wt < 1.0) {
-                a += (1.0 - wt) * hemisphere_av(p, x, -n, f.depth, phi);
-            }
-            av += t * alpha * a;
+            av += t * alpha * receiver_av(p, alpha, f.depth, f.normal_facing, phi);
             t *= 1.0 - alpha;
         }
         if (k < SORT_BOUND || t < T_MIN) {

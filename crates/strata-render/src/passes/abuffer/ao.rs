@@ -15,9 +15,12 @@
 //! every fragment of that pixel's list, each weighted by its opacity,
 //! `max_f α_f · O(x, f)`. Without `multilayer` only the nearest fragment of
 //! the tap pixel occludes (classic single-layer SSAO). With compression (Eq. 5
-//! on: the A-buffer's `compress`), the taps read the M nodes of the
-//! compressed list (16-bit depth decoded at the bucket's centre, 16-bit α)
-//! instead of walking the list; the receivers are always the full list.
+//! on: the A-buffer's `compress`), the receivers and every tap read the M
+//! nodes of the compressed lists (16-bit depth decoded at the bucket's centre,
+//! 16-bit α, the fragment's Oct16 normal and facing kept beside them) instead
+//! of walking the lists (ABA §III-B: one texel fetch per sample). Fragments
+//! Eq. 5 evicted neither receive nor occlude; their share of the blend goes
+//! to the background (visibility 1).
 
 use glam::Vec3;
 
@@ -156,7 +159,12 @@ impl AbaAoUniforms {
 /// (`ABufferStage::read_compressed`) with the frame's depth scale.
 pub enum Occluders<'a> {
     Lists,
-    Compressed { nodes: &'a [Vec<u32>], depth_scale: f32 },
+    /// `nodes`: `read_compressed`; `normals`: `read_compressed_normals`.
+    Compressed {
+        nodes: &'a [Vec<u32>],
+        normals: &'a [Vec<u32>],
+        depth_scale: f32,
+    },
 }
 
 /// Algorithm 1's inner loop at tap pixel (qx, qy).
@@ -174,7 +182,7 @@ fn tap_occlusion(
     let o = |z: f32, alpha: f32| alpha * obscurance(&eq2, world_from_csz(frame, centre, z) - x, n);
     let mut a = 0.0f32;
     match occ {
-        Occluders::Compressed { nodes, depth_scale } => {
+        Occluders::Compressed { nodes, depth_scale, .. } => {
             for &word in &nodes[(q.1 * lists.width + q.0) as usize] {
                 let alpha = (word & 0xffff) as f32 / 65535.0;
                 if alpha <= 0.0 {
@@ -245,28 +253,55 @@ pub fn ambient_visibility_cpu(
     } else {
         0.0
     };
+    // receivers: (α, depth, normal, front facing) in depth order
+    let receivers: Vec<(f32, f32, Vec3, bool)> = match occ {
+        Occluders::Lists => lists
+            .at(x, y)
+            .iter()
+            .map(|f| (f.alpha, f.depth, Vec3::from(f.normal), f.front_facing))
+            .collect(),
+        Occluders::Compressed {
+            nodes,
+            normals,
+            depth_scale,
+        } => {
+            let p = (y * lists.width + x) as usize;
+            nodes[p]
+                .iter()
+                .zip(&normals[p])
+                .map(|(&word, &nf)| {
+                    let n = crate::packing::oct16_unpack([nf as u8, (nf >> 8) as u8]);
+                    (
+                        (word & 0xffff) as f32 / 65535.0,
+                        ((word >> 16) as f32 + 0.5) / depth_scale,
+                        n,
+                        (nf >> 16) & 1 == 1,
+                    )
+                })
+                .collect()
+        }
+    };
     let mut av = 0.0f32;
     let mut t = 1.0f32;
-    for f in lists.at(x, y) {
+    for (alpha, depth, n, front) in receivers {
         if t < T_MIN {
             break;
         }
-        if f.alpha <= 0.0 {
+        if alpha <= 0.0 {
             continue;
         }
-        let pos = world_from_csz(frame, [x as f32 + 0.5, y as f32 + 0.5], f.depth);
-        let n = Vec3::from(f.normal);
+        let pos = world_from_csz(frame, [x as f32 + 0.5, y as f32 + 0.5], depth);
         // Eq. 3–4
-        let wt = if f.front_facing { f.alpha } else { 1.0 - f.alpha };
+        let wt = if front { alpha } else { 1.0 - alpha };
         let mut a = 0.0f32;
         if wt > 0.0 {
-            a += wt * hemisphere_av(lists, occ, frame, u, (x, y), pos, n, f.depth, phi);
+            a += wt * hemisphere_av(lists, occ, frame, u, (x, y), pos, n, depth, phi);
         }
         if wt < 1.0 {
-            a += (1.0 - wt) * hemisphere_av(lists, occ, frame, u, (x, y), pos, -n, f.depth, phi);
+            a += (1.0 - wt) * hemisphere_av(lists, occ, frame, u, (x, y), pos, -n, depth, phi);
         }
-        av += t * f.alpha * a;
-        t *= 1.0 - f.alpha;
+        av += t * alpha * a;
+        t *= 1.0 - alpha;
     }
     if t >= T_MIN {
         av += t;

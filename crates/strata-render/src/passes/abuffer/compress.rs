@@ -3,8 +3,8 @@
 //! bit for bit.
 //!
 //! A node is (z, α), both 16-bit: z = ⌊min(csz · depth_scale, 65535)⌋ (the
-//! normalised depth z/65535 ∈ [0, 1], `depth_scale` = 65535 / the farthest
-//! scene depth of the frame, so all geometry maps below 1) and
+//! normalised depth z/65535 ∈ [0, 1], `depth_scale` = 65534 / the farthest
+//! scene depth of the frame, so all geometry maps below 1, the empty nodes' depth) and
 //! α = ⌊min(α · 65535, 65535)⌋. The array of M nodes starts as M copies of
 //! (65535, 0) ("initialised with depth 1") and stays sorted by z. Inserting a
 //! fragment puts it after the nodes of equal or smaller z, then removes

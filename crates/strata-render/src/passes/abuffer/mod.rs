@@ -241,9 +241,10 @@ impl ABufferSettings {
         }
     }
 
-    /// Bytes of the compressed lists: ⌈M/4⌉ RGBA32Uint texels per pixel.
+    /// Bytes of the compressed lists: 2·⌈M/4⌉ RGBA32Uint texels per pixel
+    /// (depth + α words, then normal + facing words).
     pub fn compressed_bytes(&self, w: u32, h: u32) -> u64 {
-        w as u64 * h as u64 * 16 * self.compress.map_or(0, |m| m.div_ceil(4)) as u64
+        w as u64 * h as u64 * 32 * self.compress.map_or(0, |m| m.div_ceil(4)) as u64
     }
 
     /// Everything the stage allocates: structure, output colour, fragment
@@ -573,7 +574,7 @@ impl ABufferStage {
             size: wgpu::Extent3d {
                 width: if m > 0 { w } else { 1 },
                 height: if m > 0 { h } else { 1 },
-                depth_or_array_layers: m.div_ceil(4).max(1),
+                depth_or_array_layers: (2 * m.div_ceil(4)).max(1),
             },
             mip_level_count: 1,
             sample_count: 1,
@@ -1101,6 +1102,17 @@ impl ABufferStage {
     /// The compressed lists (Eq. 5) as packed words, M per pixel (row-major);
     /// `None` without compression.
     pub fn read_compressed(&self, gpu: &GpuContext) -> Result<Option<Vec<Vec<u32>>>, RenderError> {
+        self.read_compressed_layers(gpu, 0)
+    }
+
+    /// The compressed nodes' normal and facing words (the fragment's
+    /// `normal_facing`; 0 for an empty node), M per pixel, in node order.
+    pub fn read_compressed_normals(&self, gpu: &GpuContext) -> Result<Option<Vec<Vec<u32>>>, RenderError> {
+        let first = self.shared.settings.compress.map_or(0, |m| m.div_ceil(4));
+        self.read_compressed_layers(gpu, first)
+    }
+
+    fn read_compressed_layers(&self, gpu: &GpuContext, first: u32) -> Result<Option<Vec<Vec<u32>>>, RenderError> {
         let s = &self.shared;
         let Some(m) = s.settings.compress else {
             return Ok(None);
@@ -1108,7 +1120,7 @@ impl ABufferStage {
         let px = (s.width * s.height) as usize;
         let mut out = vec![Vec::with_capacity(m as usize); px];
         for l in 0..m.div_ceil(4) {
-            let bytes = gpu.read_texture(&s.compressed, l)?;
+            let bytes = gpu.read_texture(&s.compressed, first + l)?;
             let words: &[u32] = bytemuck::cast_slice(&bytes);
             for (p, o) in out.iter_mut().enumerate() {
                 for e in 0..4 {
@@ -1122,9 +1134,13 @@ impl ABufferStage {
     }
 }
 
-/// 65535 / `far` (the scale of the 16-bit normalised depth).
+/// 65534 / `far` (the scale of the 16-bit normalised depth): the farthest
+/// geometry maps to 65534, below the empty nodes' 65535, so Eq. 5's metric
+/// α·(65535 − z) of any real fragment is > 0 and an empty node is evicted
+/// first (with 65535 / far an opaque fragment at the far bound scored 0 and,
+/// losing the tie, evicted itself: found by the multilayer AO tests).
 pub fn depth_scale(far: f32) -> f32 {
-    65535.0 / far
+    65534.0 / far
 }
 
 /// The farthest camera-space depth of any point of `scene` at `frame` seen by

@@ -3,7 +3,8 @@
 // blended front to back, C += T·α·L, T *= 1 − α, while T ≥ 1e-4; the
 // background (sky) gets the remaining T (none once T < 1e-4). With compression on, every fragment
 // (in the same order) is also inserted into an M-node array of (depth, α),
-// written packed into `compressed`.
+// written packed into `compressed` (layers 0…⌈M/4⌉−1: depth and α words;
+// the next ⌈M/4⌉ layers: each node's normal and facing word).
 //
 // Sort: keys (depth bits, node index) — positive floats order as their bits,
 // the index breaks ties. Rounds of a bounded insertion sort: each round walks
@@ -20,13 +21,15 @@
 
 // Eq. 5 state: M nodes sorted by depth, 16-bit depth and α each.
 var<private> cz: array<u32, 17>;
+// each node's Oct16 normal and facing (the fragment's `normal_facing`), moved with it
+var<private> cn: array<u32, 17>;
 var<private> ca: array<u32, 17>;
 
 // Inserts (z, a) after the nodes of depth ≤ z, then removes node
 // i = argmin_j a_j·(1 − z_j) over the M + 1 nodes (integer: a_j·(65535 − z_j);
 // ties: the largest j), searching j ≥ ⌊(M + 1)/2⌋ only with `back_half`.
 // CPU twin: passes::abuffer::compress::insert.
-fn compress_insert(z: u32, a: u32) {
+fn compress_insert(z: u32, a: u32, nf: u32) {
     let m = params.compress;
     var pos = m;
     for (var j = 0u; j < m; j++) {
@@ -38,9 +41,11 @@ fn compress_insert(z: u32, a: u32) {
     for (var j = m; j > pos; j--) {
         cz[j] = cz[j - 1u];
         ca[j] = ca[j - 1u];
+        cn[j] = cn[j - 1u];
     }
     cz[pos] = z;
     ca[pos] = a;
+    cn[pos] = nf;
     var lo = 0u;
     if (params.back_half == 1u) {
         lo = (m + 1u) / 2u;
@@ -57,6 +62,7 @@ fn compress_insert(z: u32, a: u32) {
     for (var j = evict; j < m; j++) {
         cz[j] = cz[j + 1u];
         ca[j] = ca[j + 1u];
+        cn[j] = cn[j + 1u];
     }
 }
 
@@ -79,6 +85,7 @@ fn fs_main(@builtin(position) frag: vec4f) -> ResolveOut {
     for (var j = 0u; j < MAX_M; j++) {
         cz[j] = ONE16;
         ca[j] = 0u;
+        cn[j] = 0u;
     }
     var c = vec3f(0.0);
     var t = 1.0;
@@ -102,7 +109,7 @@ fn fs_main(@builtin(position) frag: vec4f) -> ResolveOut {
             if (m > 0u) {
                 let z = u32(min(f.depth * params.depth_scale, 65535.0));
                 let qa = u32(min(a * 65535.0, 65535.0));
-                compress_insert(z, qa);
+                compress_insert(z, qa, f.normal_facing);
             }
         }
         if (k < SORT_BOUND || (m == 0u && t < T_MIN)) {
@@ -128,6 +135,15 @@ fn fs_main(@builtin(position) frag: vec4f) -> ResolveOut {
                 v[e] = word;
             }
             textureStore(compressed, vec2i(px), i32(l), v);
+            // layers ⌈M/4⌉…: the nodes' normal and facing words (the AO's receivers)
+            var nv = vec4u(0u);
+            for (var e = 0u; e < 4u; e++) {
+                let j = 4u * l + e;
+                if (j < m) {
+                    nv[e] = cn[j];
+                }
+            }
+            textureStore(compressed, vec2i(px), i32(l + layers), nv);
         }
     }
     var out: ResolveOut;
