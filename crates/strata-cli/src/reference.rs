@@ -134,8 +134,11 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
             v
         }
     };
+    // ambient visibility PNGs hold raw bytes 255·AV, as `render`'s AO PNGs do
+    // (so the two compare directly); everything else is sRGB-encoded
+    let raw = matches!(a.kind, ReferenceKind::Ao | ReferenceKind::Obscurance | ReferenceKind::AoOpacity);
     for (p, img) in &outputs {
-        save(img, p, true)?;
+        save(img, p, !raw)?;
         eprintln!("wrote {}", p.display());
     }
     let s = reference.stats();

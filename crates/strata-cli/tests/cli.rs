@@ -251,6 +251,31 @@ fn reference_ao_of_cornell_is_a_visibility_image() {
 }
 
 #[test]
+fn reference_ao_png_holds_raw_visibility_like_render_ao() {
+    // `render --technique ao` writes byte = 255·AV; the reference's AO PNGs must
+    // be the same encoding (not sRGB) for the two to compare
+    for kind in ["ao", "obscurance", "ao-opacity"] {
+        let (png, exr) = (scratch(&format!("raw-{kind}.png")), scratch(&format!("raw-{kind}.exr")));
+        for out in [&png, &exr] {
+            let o = strata(&[
+                "reference", "--scene", "cornell", "--kind", kind, "--spp", "8", "--width", "16", "--height", "16",
+                "--quiet", "--force", "--out", out.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+        let bytes = image::open(&png).unwrap().to_luma8();
+        let av = image::open(&exr).unwrap().to_rgb32f();
+        let mut mid = 0;
+        for (b, a) in bytes.pixels().zip(av.pixels()) {
+            let want = (a.0[0].clamp(0.0, 1.0) * 255.0).round();
+            assert!((b.0[0] as f32 - want).abs() <= 1.0, "{kind}: byte {} vs 255·AV {want}", b.0[0]);
+            mid += (want > 20.0 && want < 200.0) as u32;
+        }
+        assert!(mid > 0, "{kind}: some pixels are partly occluded (sRGB would move them)");
+    }
+}
+
+#[test]
 fn bench_gbuffer_json_has_per_pass_times() {
     let o = strata(&[
         "bench", "gbuffer", "--scene", "plane", "--width", "32", "--height", "32", "--frames", "2", "--json",
