@@ -514,7 +514,7 @@ fn aba_ao_of(s: &RenderSettings) -> AbaAoSettings {
 }
 
 /// ABA multilayer AO (Algorithm 1); the names mean what DGB AO's mean.
-static ABA_AO_SETTINGS: [SettingInfo; 7] = [
+static ABA_AO_SETTINGS: [SettingInfo; 10] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1-2, as for ao; default: the scene's ao_radius)",
@@ -556,6 +556,37 @@ static ABA_AO_SETTINGS: [SettingInfo; 7] = [
         set: |s, v| aba_ao_mut(s).multilayer = v != 0.0,
         values: &["off", "on"],
     },
+    SettingInfo {
+        name: "kernel",
+        doc: "getAO kernel extended by Algorithm 1: ssao (Poisson-disk: DGB Eq. 1 over `samples` spiral taps) or hbao (horizon-based: `directions` x `steps`)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(aba_ao_of(s).kernel as u32 as f64),
+        set: |s, v| {
+            aba_ao_mut(s).kernel = if v == 0.0 {
+                crate::passes::abuffer::ao::AoKernel::Ssao
+            } else {
+                crate::passes::abuffer::ao::AoKernel::Hbao
+            }
+        },
+        values: &["ssao", "hbao"],
+    },
+    setting!(
+        "directions",
+        "HBAO screen directions D per hemisphere (rotated per pixel)",
+        Range::Closed(1.0, crate::passes::abuffer::ao::MAX_DIRECTIONS as f64),
+        true,
+        |s| Some(aba_ao_of(s).directions as f64),
+        |s, v| aba_ao_mut(s).directions = v as u32
+    ),
+    setting!(
+        "steps",
+        "HBAO steps S along each direction (ABA Table III: 8)",
+        Range::Closed(1.0, crate::passes::abuffer::ao::MAX_STEPS as f64),
+        true,
+        |s| Some(aba_ao_of(s).steps as f64),
+        |s, v| aba_ao_mut(s).steps = v as u32
+    ),
     setting!(
         "blur-radius",
         "bilateral taps on each side (0 = none)",

@@ -10,7 +10,7 @@ mod common;
 
 use glam::{Mat4, Vec3};
 use strata_render::frame::FrameCameras;
-use strata_render::passes::abuffer::ao::{ambient_visibility_cpu, AbaAoSettings, Occluders};
+use strata_render::passes::abuffer::ao::{ambient_visibility_cpu, AbaAoSettings, AoKernel, Occluders};
 use strata_render::passes::abuffer::{compress, ABufferMethod, ABufferSettings};
 use strata_render::renderer::GuardBand;
 use strata_render::{GpuContext, RenderSettings, Renderer};
@@ -36,6 +36,12 @@ fn aba_with(method: ABufferMethod, multilayer: bool, compress: Option<u32>) -> A
         }),
         ..Default::default()
     }
+}
+
+fn hbao(a: ABufferSettings) -> ABufferSettings {
+    let mut a = a;
+    a.ao.as_mut().unwrap().kernel = AoKernel::Hbao;
+    a
 }
 
 fn render(gpu: &GpuContext, scene: &Scene, a: ABufferSettings) -> Renderer {
@@ -108,8 +114,16 @@ fn gpu_multilayer_ao_equals_the_cpu_twin_of_algorithm_1() {
         (ABufferMethod::Linear, true, Some(6)),
         (ABufferMethod::FixedArray, false, Some(4)),
     ]);
-    for (method, multilayer, compress) in cases {
-        let r = render(&gpu, &scene, aba_with(method, multilayer, compress));
+    let mut cases: Vec<_> = cases.into_iter().map(|(m, ml, c)| (m, ml, c, AoKernel::Ssao)).collect();
+    cases.extend([
+        (ABufferMethod::LinkedList, true, None, AoKernel::Hbao),
+        (ABufferMethod::LinkedList, false, None, AoKernel::Hbao),
+        (ABufferMethod::Linear, true, Some(6), AoKernel::Hbao),
+    ]);
+    for (method, multilayer, compress, kernel) in cases {
+        let mut settings = aba_with(method, multilayer, compress);
+        settings.ao.as_mut().unwrap().kernel = kernel;
+        let r = render(&gpu, &scene, settings);
         let ab = r.abuffer().unwrap();
         let lists = ab.read_lists(&gpu).unwrap();
         assert_eq!(lists.overflow, 0);
@@ -158,12 +172,12 @@ fn gpu_multilayer_ao_equals_the_cpu_twin_of_algorithm_1() {
                 dark += (want < 0.9) as u32;
                 assert!(
                     d < 2e-3,
-                    "{method} multilayer={multilayer} compress={compress:?}: pixel ({x}, {y}) GPU {got} vs CPU {want}"
+                    "{method} {kernel:?} multilayer={multilayer} compress={compress:?}: pixel ({x}, {y}) GPU {got} vs CPU {want}"
                 );
             }
         }
         let mean = sum / (W * H) as f64;
-        eprintln!("{method} multilayer={multilayer} compress={compress:?}: |GPU − CPU| max {worst:.2e}, mean {mean:.2e}, {dark} pixels below 0.9");
+        eprintln!("{method} {kernel:?} multilayer={multilayer} compress={compress:?}: |GPU − CPU| max {worst:.2e}, mean {mean:.2e}, {dark} pixels below 0.9");
         assert!(mean < 1e-4, "mean difference {mean}");
         assert!(dark > 50, "the scene occludes: {dark} pixels below 0.9");
     }
@@ -211,19 +225,29 @@ fn hidden_occluder() -> Scene {
 fn an_occluder_hidden_behind_the_first_layer_darkens_only_multilayer_ao() {
     let gpu = common::gpu();
     let scene = hidden_occluder();
-    let multi = raw(&gpu, &render(&gpu, &scene, aba(true, None)));
-    let single = raw(&gpu, &render(&gpu, &scene, aba(false, None)));
+    for (multi, single) in [
+        (aba(true, None), aba(false, None)),
+        (hbao(aba(true, None)), hbao(aba(false, None))),
+    ] {
+        let kernel = multi.ao.as_ref().unwrap().kernel;
+        let multi = raw(&gpu, &render(&gpu, &scene, multi));
+        let single = raw(&gpu, &render(&gpu, &scene, single));
+        hidden_occluder_darkens(&multi, &single, kernel);
+    }
+}
+
+fn hidden_occluder_darkens(multi: &ImageBuf, single: &ImageBuf, kernel: AoKernel) {
     // receivers on the plane next to the hidden occluder (left of the centre)
     let near: Vec<(u32, u32)> = (0..H).flat_map(|y| (W / 2 - 4..W / 2).map(move |x| (x, y))).collect();
     let mut darker = 0;
     for &(x, y) in &near {
         let (m, s) = (multi.pixel(x, y)[0], single.pixel(x, y)[0]);
-        assert!(m <= s + 1e-6, "({x}, {y}): multilayer {m} > single {s}");
+        assert!(m <= s + 1e-6, "{kernel:?} ({x}, {y}): multilayer {m} > single {s}");
         // the single layer sees only the plane and the far pane: unoccluded
         assert_eq!(s, 1.0, "({x}, {y}): single-layer AO sees no occluder");
         darker += (m < s - 0.05) as u32;
     }
-    assert!(darker as usize > near.len() / 2, "{darker} of {} receivers darkened", near.len());
+    assert!(darker as usize > near.len() / 2, "{kernel:?}: {darker} of {} receivers darkened", near.len());
     // far from the occluder (taps reach ≈ 12 px) both see one layer: equal
     for y in 0..H {
         for x in 0..W / 2 - 16 {
@@ -248,21 +272,37 @@ fn an_alpha_weighted_occluder_darkens_by_alpha_times_the_opaque_occlusion() {
         s
     };
     let alpha = 0.5f32;
-    for compress in [None, Some(6)] {
-        let opaque = raw(&gpu, &render(&gpu, &scene(1.0), aba(true, compress)));
-        let half = raw(&gpu, &render(&gpu, &scene(alpha), aba(true, compress)));
+    for (kernel, compress) in [
+        (AoKernel::Ssao, None),
+        (AoKernel::Ssao, Some(6)),
+        (AoKernel::Hbao, None),
+        (AoKernel::Hbao, Some(6)),
+    ] {
+        let settings = || {
+            let mut a = aba(true, compress);
+            a.ao.as_mut().unwrap().kernel = kernel;
+            a
+        };
+        let opaque = raw(&gpu, &render(&gpu, &scene(1.0), settings()));
+        let half = raw(&gpu, &render(&gpu, &scene(alpha), settings()));
+        // the kernel's sum of per-tap (SSAO) or per-direction (HBAO)
+        // occlusion, which Algorithm 1 makes linear in the occluder's α: DGB
+        // Eq. 1's S = (1 − AV)²·N/π, HBAO's 1 − AV
+        let sum = |av: f32| match kernel {
+            AoKernel::Ssao => (1.0 - av).powi(2),
+            AoKernel::Hbao => 1.0 - av,
+        };
         let mut checked = 0;
-        // receivers on the plane left of the occluder (they see no pane): DGB
-        // Eq. 1's sum S = (1 − AV)²·N/π is linear in the occluder's α
+        // receivers on the plane left of the occluder (they see no pane)
         for y in 0..H {
             for x in 0..W / 2 - 1 {
-                let s1 = (1.0 - opaque.pixel(x, y)[0]).powi(2);
-                let sa = (1.0 - half.pixel(x, y)[0]).powi(2);
+                let s1 = sum(opaque.pixel(x, y)[0]);
+                let sa = sum(half.pixel(x, y)[0]);
                 if s1 > 1e-3 {
                     checked += 1;
                     assert!(
                         (sa - alpha * s1).abs() <= 1e-3 * s1 + 1e-6,
-                        "compress={compress:?} ({x}, {y}): S_α {sa} vs α·S_1 {}",
+                        "{kernel:?} compress={compress:?} ({x}, {y}): S_α {sa} vs α·S_1 {}",
                         alpha * s1
                     );
                 } else {
@@ -270,7 +310,7 @@ fn an_alpha_weighted_occluder_darkens_by_alpha_times_the_opaque_occlusion() {
                 }
             }
         }
-        assert!(checked > 50, "{checked} occluded receivers");
+        assert!(checked > 50, "{kernel:?}: {checked} occluded receivers");
     }
 }
 

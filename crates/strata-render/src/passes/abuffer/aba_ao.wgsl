@@ -34,7 +34,12 @@ struct AbaAo {
     multilayer: u32,
     // 1 = taps read the M compressed nodes (Eq. 5) instead of walking the list
     compressed: u32,
-    _pad: u32,
+    // 0 = Poisson-disk SSAO (DGB Eq. 1 over spiral taps), 1 = HBAO
+    kernel: u32,
+    // HBAO: directions D and steps S per direction
+    directions: u32,
+    steps: u32,
+    _pad0: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -134,12 +139,46 @@ fn receiver_av(p: vec2i, alpha: f32, depth: f32, nf: u32, phi: f32) -> f32 {
     }
     var a = 0.0;
     if (wt > 0.0) {
-        a += wt * hemisphere_av(p, x, n, depth, phi);
+        a += wt * hemisphere(p, x, n, depth, phi);
     }
     if (wt < 1.0) {
-        a += (1.0 - wt) * hemisphere_av(p, x, -n, depth, phi);
+        a += (1.0 - wt) * hemisphere(p, x, -n, depth, phi);
     }
     return a;
+}
+
+// HBAO (Bavoil, Sainz, Dimitrov 2008) with Algorithm 1 inside: D screen
+// directions (rotated by φ), S steps each out to r_p; a direction's occlusion
+// is its highest horizon, max over its steps of the strongest occluder of
+// every layer — Eq. 2's (v·n − β)/|v| is the sine of the sample's elevation
+// above the tangent plane, (1 − |v|²/r²) HBAO's attenuation W; AV = 1 −
+// intensity · mean over the directions.
+fn hemisphere_hbao(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
+    let r_p = ao.proj_scale * ao.radius / z;
+    let size = vec2i(i32(params.width), i32(params.height));
+    var sum = 0.0;
+    for (var d = 0u; d < ao.directions; d++) {
+        let ang = phi + 6.28318530717959 * f32(d) / f32(ao.directions);
+        let dir = vec2f(cos(ang), sin(ang));
+        var horizon = 0.0;
+        for (var s = 0u; s < ao.steps; s++) {
+            let h = r_p * (f32(s) + 0.5) / f32(ao.steps);
+            let q = p + tap_texel(dir * h);
+            if (any(q < vec2i(0)) || any(q >= size)) {
+                break;
+            }
+            horizon = max(horizon, tap_occlusion(q, x, n));
+        }
+        sum += horizon;
+    }
+    return max(0.0, 1.0 - ao.intensity * sum / f32(ao.directions));
+}
+
+fn hemisphere(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
+    if (ao.kernel == 1u) {
+        return hemisphere_hbao(p, x, n, z, phi);
+    }
+    return hemisphere_av(p, x, n, z, phi);
 }
 
 @fragment

@@ -34,6 +34,22 @@ use strata_scene::Scene;
 /// Largest accepted tap count N.
 pub const MAX_SAMPLES: u32 = 256;
 
+/// The AO kernel Algorithm 1 extends (ABA §V: a single-pass Poisson-disk SSAO
+/// and, for opaque multilayer AO, HBAO).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AoKernel {
+    /// DGB Eq. 1 over N spiral taps (a Poisson-like disk): AV = 1 − √(π/N · Σ a).
+    Ssao = 0,
+    /// Horizon-based (Bavoil et al. 2008): D directions × S steps, the highest
+    /// horizon per direction; AV = 1 − mean over directions (ABA Table III: 8
+    /// samples along x and y; here D = 4 directions rotated per pixel, S = 8).
+    Hbao = 1,
+}
+
+/// Largest HBAO directions D and steps S.
+pub const MAX_DIRECTIONS: u32 = 16;
+pub const MAX_STEPS: u32 = 32;
+
 /// Multilayer AO settings. Defaults: N = 16 taps (ABA §V: "16 uniformly
 /// distributed sample directions with depth-dependent length"), multilayer on,
 /// the scene's AO radius r with β = 0.01·r and ε = 0.01·r² (as DGB AO and the
@@ -54,6 +70,12 @@ pub struct AbaAoSettings {
     pub rotate: bool,
     /// Algorithm 1 (every layer occludes); false: the nearest layer only.
     pub multilayer: bool,
+    /// getAO's kernel (ABA extends both).
+    pub kernel: AoKernel,
+    /// HBAO: screen directions D per receiver hemisphere.
+    pub directions: u32,
+    /// HBAO: steps S along each direction.
+    pub steps: u32,
     /// Bilateral reconstruction after the blend (ABA: possible because the AO is separate).
     pub blur: BilateralSettings,
 }
@@ -70,6 +92,9 @@ impl Default for AbaAoSettings {
             turns: SpiralTurns::Optimal,
             rotate: true,
             multilayer: true,
+            kernel: AoKernel::Ssao,
+            directions: 4,
+            steps: 8,
             blur: dgb.blur,
         }
     }
@@ -89,6 +114,15 @@ impl AbaAoSettings {
             ..Default::default()
         };
         dgb.validate()?;
+        if !(1..=MAX_DIRECTIONS).contains(&self.directions) {
+            return Err(format!(
+                "AO directions {} is out of range: must be in 1..={MAX_DIRECTIONS}",
+                self.directions
+            ));
+        }
+        if !(1..=MAX_STEPS).contains(&self.steps) {
+            return Err(format!("AO steps {} is out of range: must be in 1..={MAX_STEPS}", self.steps));
+        }
         if !(1..=MAX_SAMPLES).contains(&self.samples) {
             return Err(format!(
                 "AO samples {} is out of range: must be in 1..={MAX_SAMPLES}",
@@ -120,6 +154,10 @@ pub struct AbaAoUniforms {
     pub rotate: u32,
     pub multilayer: u32,
     pub compressed: u32,
+    /// 0 = Poisson-disk SSAO, 1 = HBAO ([`AoKernel`]).
+    pub kernel: u32,
+    pub directions: u32,
+    pub steps: u32,
     pub _pad: u32,
 }
 
@@ -140,6 +178,9 @@ impl AbaAoUniforms {
             rotate: s.rotate as u32,
             multilayer: s.multilayer as u32,
             compressed: compressed as u32,
+            kernel: s.kernel as u32,
+            directions: s.directions,
+            steps: s.steps,
             _pad: 0,
         }
     }
@@ -237,6 +278,60 @@ fn hemisphere_av(
     (1.0 - (u.intensity * std::f32::consts::PI / u.samples as f32 * sum).sqrt()).max(0.0)
 }
 
+/// `hemisphere_hbao` of `aba_ao.wgsl`.
+#[allow(clippy::too_many_arguments)]
+fn hemisphere_hbao(
+    lists: &FragmentLists,
+    occ: &Occluders,
+    frame: &FrameUniforms,
+    u: &AbaAoUniforms,
+    p: (u32, u32),
+    x: Vec3,
+    n: Vec3,
+    z: f32,
+    phi: f32,
+) -> f32 {
+    let r_p = u.proj_scale * u.radius / z;
+    let (w, h) = (lists.width as i32, lists.height as i32);
+    let mut sum = 0.0f32;
+    for d in 0..u.directions {
+        let ang = phi + std::f32::consts::TAU * d as f32 / u.directions as f32;
+        let dir = [ang.cos(), ang.sin()];
+        let mut horizon = 0.0f32;
+        for s in 0..u.steps {
+            let len = r_p * (s as f32 + 0.5) / u.steps as f32;
+            let t = spiral::tap_texel([dir[0] * len, dir[1] * len]);
+            let (qx, qy) = (p.0 as i32 + t[0], p.1 as i32 + t[1]);
+            if qx < 0 || qy < 0 || qx >= w || qy >= h {
+                break;
+            }
+            horizon = horizon.max(tap_occlusion(lists, occ, frame, u, (qx as u32, qy as u32), x, n));
+        }
+        sum += horizon;
+    }
+    (1.0 - u.intensity * sum / u.directions as f32).max(0.0)
+}
+
+/// The receiver hemisphere's AV with the uniforms' kernel.
+#[allow(clippy::too_many_arguments)]
+fn hemisphere(
+    lists: &FragmentLists,
+    occ: &Occluders,
+    frame: &FrameUniforms,
+    u: &AbaAoUniforms,
+    p: (u32, u32),
+    x: Vec3,
+    n: Vec3,
+    z: f32,
+    phi: f32,
+) -> f32 {
+    if u.kernel == AoKernel::Hbao as u32 {
+        hemisphere_hbao(lists, occ, frame, u, p, x, n, z, phi)
+    } else {
+        hemisphere_av(lists, occ, frame, u, p, x, n, z, phi)
+    }
+}
+
 /// CPU evaluation of exactly what `aba_ao.wgsl` writes at pixel (x, y) (before
 /// the bilateral filter), from the read-back lists (sorted as the GPU visits
 /// them) and, for compressed taps, the compressed nodes.
@@ -295,10 +390,10 @@ pub fn ambient_visibility_cpu(
         let wt = if front { alpha } else { 1.0 - alpha };
         let mut a = 0.0f32;
         if wt > 0.0 {
-            a += wt * hemisphere_av(lists, occ, frame, u, (x, y), pos, n, depth, phi);
+            a += wt * hemisphere(lists, occ, frame, u, (x, y), pos, n, depth, phi);
         }
         if wt < 1.0 {
-            a += (1.0 - wt) * hemisphere_av(lists, occ, frame, u, (x, y), pos, -n, depth, phi);
+            a += (1.0 - wt) * hemisphere(lists, occ, frame, u, (x, y), pos, -n, depth, phi);
         }
         av += t * alpha * a;
         t *= 1.0 - alpha;
