@@ -897,6 +897,16 @@ impl Renderer {
             // Fig. 9's views: confidence, G-buffer-only, probe-only, blended
             v.extend(["confidence", "gbuffer-only", "probe-only", "blended"].map(String::from));
         }
+        if let Some(a) = &self.abuffer {
+            // the k-th nearest fragment of every list, and the compressed nodes
+            for k in 0..ABUFFER_LAYER_VIEWS {
+                v.push(format!("abuffer-layer{k}"));
+            }
+            for j in 0..a.settings().compress.unwrap_or(0).min(ABUFFER_LAYER_VIEWS) {
+                v.push(format!("abuffer-node{j}-depth"));
+                v.push(format!("abuffer-node{j}-alpha"));
+            }
+        }
         v.sort();
         v
     }
@@ -922,6 +932,11 @@ impl Renderer {
             }
             img
         };
+        if let (Some(a), Some(rest)) = (&self.abuffer, name.strip_prefix("abuffer-")) {
+            if let Some(img) = self.abuffer_view(gpu, a, rest, exr_raw)? {
+                return Ok(img);
+            }
+        }
         match base {
             "confidence" => Ok(self.read_target(gpu, "indirect")?.channel(3)),
             "ils-split-normal" => {
@@ -981,6 +996,60 @@ impl Renderer {
         }
     }
 
+    /// The A-buffer views read back on the CPU (`rest` = the name after
+    /// `abuffer-`): `layer{k}` = the k-th nearest fragment's radiance × α (black
+    /// where the list is shorter), `node{j}-depth` / `node{j}-alpha` = compressed
+    /// node j's normalised depth (empty: black) and opacity. `None`: not one of them.
+    fn abuffer_view(
+        &self,
+        gpu: &GpuContext,
+        a: &crate::passes::abuffer::ABufferStage,
+        rest: &str,
+        exr_raw: bool,
+    ) -> Result<Option<ImageBuf>, RenderError> {
+        let (w, h) = (self.targets.width, self.targets.height);
+        let mut img;
+        if let Some(k) = rest.strip_prefix("layer").and_then(|k| k.parse::<usize>().ok()) {
+            let lists = a.read_lists(gpu)?;
+            img = ImageBuf::new(w, h, 3);
+            for (o, l) in img.data.chunks_exact_mut(3).zip(&lists.lists) {
+                if let Some(f) = l.get(k) {
+                    for c in 0..3 {
+                        o[c] = f.radiance[c] * f.alpha;
+                    }
+                }
+            }
+            if !exr_raw {
+                // the PNG shows it tonemapped like the frame
+                let e = self.settings.exposure.unwrap_or(1.0);
+                img.data.iter_mut().for_each(|v| *v = (*v * e / (1.0 + *v * e)).clamp(0.0, 1.0));
+            }
+        } else if let Some((j, what)) = rest
+            .strip_prefix("node")
+            .and_then(|r| r.split_once('-'))
+            .and_then(|(j, w)| Some((j.parse::<usize>().ok()?, w)))
+        {
+            let Some(nodes) = a.read_compressed(gpu)? else {
+                return Ok(None);
+            };
+            img = ImageBuf::new(w, h, 1);
+            for (o, n) in img.data.iter_mut().zip(&nodes) {
+                let word = n.get(j).copied().unwrap_or(0xffff_0000);
+                let alpha = (word & 0xffff) as f32 / 65535.0;
+                *o = match what {
+                    "alpha" => alpha,
+                    // normalised depth z/65535; an empty node (α = 0) is black
+                    _ if alpha > 0.0 => (word >> 16) as f32 / 65535.0,
+                    _ => 0.0,
+                };
+            }
+        } else {
+            return Ok(None);
+        }
+        let g = self.settings.guard_pixels();
+        Ok(Some(crop(&img, g, g, self.settings.width, self.settings.height)))
+    }
+
     /// World-space normals of layer 0 (decoded Oct16), 3 channels; zero where no surface.
     pub fn read_normals(&self, gpu: &GpuContext) -> Result<ImageBuf, RenderError> {
         self.read_normals_layer(gpu, 0)
@@ -1006,6 +1075,9 @@ impl Renderer {
 const PER_LAYER_VIEWS: [&str; 7] = ["csz", "depth", "normal", "albedo", "emission", "roughness", "metallic"];
 
 /// The `w`×`h` window of `img` starting at (`x0`, `y0`).
+/// The `abuffer-layer{k}` debug views (and at most this many `abuffer-node{j}-*`).
+pub const ABUFFER_LAYER_VIEWS: u32 = 4;
+
 pub fn crop(img: &ImageBuf, x0: u32, y0: u32, w: u32, h: u32) -> ImageBuf {
     if x0 == 0 && y0 == 0 && w == img.width && h == img.height {
         return img.clone();

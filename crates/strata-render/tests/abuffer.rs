@@ -574,3 +574,29 @@ fn mask_materials_cut_or_keep_opaque_by_material_fragment_alpha() {
         }
     }
 }
+
+#[test]
+fn layer_and_node_debug_views_show_the_read_back_lists() {
+    let gpu = common::gpu();
+    let scene = layered();
+    let r = render(&gpu, &scene, with(ABufferMethod::LinkedList));
+    let names = r.debug_view_names();
+    for v in ["abuffer-layer0", "abuffer-layer3", "abuffer-node0-depth", "abuffer-node3-alpha"] {
+        assert!(names.iter().any(|n| n == v), "{v} is listed: {names:?}");
+    }
+    let l = lists(&gpu, &r);
+    let nodes = r.abuffer().unwrap().read_compressed(&gpu).unwrap().unwrap();
+    let layer1 = r.debug_view(&gpu, "abuffer-layer1", true).unwrap();
+    let alpha0 = r.debug_view(&gpu, "abuffer-node0-alpha", true).unwrap();
+    let mut second = 0;
+    for y in 0..H {
+        for x in 0..W {
+            let want = l.at(x, y).get(1).map_or([0.0; 3], |f| f.radiance.map(|c| c * f.alpha));
+            assert_eq!(layer1.pixel(x, y), &want[..], "({x}, {y})");
+            second += l.at(x, y).len().min(2) / 2;
+            let word = nodes[(y * W + x) as usize][0];
+            assert_eq!(alpha0.pixel(x, y)[0], (word & 0xffff) as f32 / 65535.0, "({x}, {y})");
+        }
+    }
+    assert!(second > 100, "{second} pixels have a second layer");
+}
