@@ -514,7 +514,7 @@ fn aba_ao_of(s: &RenderSettings) -> AbaAoSettings {
 }
 
 /// ABA multilayer AO (Algorithm 1); the names mean what DGB AO's mean.
-static ABA_AO_SETTINGS: [SettingInfo; 10] = [
+static ABA_AO_SETTINGS: [SettingInfo; 11] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1-2, as for ao; default: the scene's ao_radius)",
@@ -570,6 +570,15 @@ static ABA_AO_SETTINGS: [SettingInfo; 10] = [
             }
         },
         values: &["ssao", "hbao"],
+    },
+    SettingInfo {
+        name: "integration",
+        doc: "separate: AO blended apart from the colour (ABA's choice, then filtered); inside: also write the colour with AO inside the OIT blend and the separate product (hdr-aba-inside, hdr-aba-separate; needs compress=0)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(aba_ao_of(s).inside as u32 as f64),
+        set: |s, v| aba_ao_mut(s).inside = v != 0.0,
+        values: &["separate", "inside"],
     },
     setting!(
         "directions",

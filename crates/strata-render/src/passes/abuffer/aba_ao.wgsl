@@ -181,16 +181,28 @@ fn hemisphere(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
     return hemisphere_av(p, x, n, z, phi);
 }
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
-    let p = vec2i(pos.xy);
+// The pixel's blended AV and, for the list path, the two ways ABA §III
+// integrates AO with the OIT colour: `inside` = Σ T_i α_i AV_i L_i + T·sky
+// (AO applied to each fragment inside the blend) and `separate` = (Σ T_i α_i
+// L_i + T·sky) × AV_pixel (the colour and the AO blended apart, then
+// multiplied: what the bilateral-filtered pipeline does, here before the blur).
+struct Integrated {
+    av: f32,
+    inside: vec3f,
+    separate: vec3f,
+}
+
+fn integrate(p: vec2i) -> Integrated {
     let pix = u32(p.y) * params.width + u32(p.x);
     var phi = 0.0;
     if (ao.rotate != 0u) {
         phi = pixel_angle(vec2u(p), ao.seed);
     }
+    var r: Integrated;
     var av = 0.0;
     var t = 1.0;
+    var colour = vec3f(0.0);
+    var inside = vec3f(0.0);
     if (ao.compressed == 1u) {
         // receivers: the M compressed nodes (sorted by depth) with their normals
         let layers = (params.compress + 3u) / 4u;
@@ -210,39 +222,68 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
                 t *= 1.0 - alpha;
             }
         }
-        if (t >= T_MIN) {
-            av += t;
-        }
-        return vec4f(av);
-    }
-    var last_d = 0u;
-    var last_i = 0u;
-    var started = false;
-    loop {
-        var kd: array<u32, SORT_BOUND>;
-        var ki: array<u32, SORT_BOUND>;
-        let k = sorted_batch(pix, started, last_d, last_i, &kd, &ki);
-        for (var j = 0u; j < k; j++) {
-            if (t < T_MIN) {
+    } else {
+        var last_d = 0u;
+        var last_i = 0u;
+        var started = false;
+        loop {
+            var kd: array<u32, SORT_BOUND>;
+            var ki: array<u32, SORT_BOUND>;
+            let k = sorted_batch(pix, started, last_d, last_i, &kd, &ki);
+            for (var j = 0u; j < k; j++) {
+                if (t < T_MIN) {
+                    break;
+                }
+                let f = nodes[ki[j]];
+                let ba = unpack2x16float(f.ba);
+                let alpha = ba.y;
+                if (alpha <= 0.0) {
+                    continue;
+                }
+                let a = receiver_av(p, alpha, f.depth, f.normal_facing, phi);
+                let radiance = vec3f(unpack2x16float(f.rg), ba.x);
+                av += t * alpha * a;
+                colour += t * alpha * radiance;
+                inside += t * alpha * a * radiance;
+                t *= 1.0 - alpha;
+            }
+            if (k < SORT_BOUND || t < T_MIN) {
                 break;
             }
-            let f = nodes[ki[j]];
-            let alpha = unpack2x16float(f.ba).y;
-            if (alpha <= 0.0) {
-                continue;
-            }
-            av += t * alpha * receiver_av(p, alpha, f.depth, f.normal_facing, phi);
-            t *= 1.0 - alpha;
+            last_d = kd[k - 1u];
+            last_i = ki[k - 1u];
+            started = true;
         }
-        if (k < SORT_BOUND || t < T_MIN) {
-            break;
-        }
-        last_d = kd[k - 1u];
-        last_i = ki[k - 1u];
-        started = true;
     }
     if (t >= T_MIN) {
         av += t;
+        colour += t * frame.sky.rgb;
+        inside += t * frame.sky.rgb;
     }
-    return vec4f(av);
+    r.av = av;
+    r.inside = inside;
+    r.separate = colour * av;
+    return r;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    return vec4f(integrate(vec2i(pos.xy)).av);
+}
+
+struct InsideOut {
+    @location(0) av: vec4f,
+    @location(1) inside: vec4f,
+    @location(2) separate: vec4f,
+}
+
+// `integration = inside`: also the two colour integrations (list path only).
+@fragment
+fn fs_inside(@builtin(position) pos: vec4f) -> InsideOut {
+    let r = integrate(vec2i(pos.xy));
+    var o: InsideOut;
+    o.av = vec4f(r.av);
+    o.inside = vec4f(r.inside, 1.0);
+    o.separate = vec4f(r.separate, 1.0);
+    return o;
 }

@@ -76,6 +76,10 @@ pub struct AbaAoSettings {
     pub directions: u32,
     /// HBAO: steps S along each direction.
     pub steps: u32,
+    /// Also write the colour with AO applied inside the OIT blend and the
+    /// separate product (targets `hdr-aba-inside`, `hdr-aba-separate`; ABA §III's
+    /// comparison). Needs uncompressed lists (the nodes hold no colour).
+    pub inside: bool,
     /// Bilateral reconstruction after the blend (ABA: possible because the AO is separate).
     pub blur: BilateralSettings,
 }
@@ -95,6 +99,7 @@ impl Default for AbaAoSettings {
             kernel: AoKernel::Ssao,
             directions: 4,
             steps: 8,
+            inside: false,
             blur: dgb.blur,
         }
     }
@@ -332,6 +337,16 @@ fn hemisphere(
     }
 }
 
+/// What `aba_ao.wgsl`'s `integrate` returns for a pixel: the blended AV and
+/// (list path; zero with compressed receivers) the colour with AO applied
+/// inside the blend and the separate product (colour blend × AV blend).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Integrated {
+    pub av: f32,
+    pub inside: [f32; 3],
+    pub separate: [f32; 3],
+}
+
 /// CPU evaluation of exactly what `aba_ao.wgsl` writes at pixel (x, y) (before
 /// the bilateral filter), from the read-back lists (sorted as the GPU visits
 /// them) and, for compressed taps, the compressed nodes.
@@ -343,17 +358,29 @@ pub fn ambient_visibility_cpu(
     x: u32,
     y: u32,
 ) -> f32 {
+    integrate_cpu(lists, occ, frame, u, x, y).av
+}
+
+/// [`ambient_visibility_cpu`] with the two colour integrations (`fs_inside`).
+pub fn integrate_cpu(
+    lists: &FragmentLists,
+    occ: &Occluders,
+    frame: &FrameUniforms,
+    u: &AbaAoUniforms,
+    x: u32,
+    y: u32,
+) -> Integrated {
     let phi = if u.rotate != 0 {
         spiral::pixel_angle(x, y, u.seed)
     } else {
         0.0
     };
-    // receivers: (α, depth, normal, front facing) in depth order
-    let receivers: Vec<(f32, f32, Vec3, bool)> = match occ {
+    // receivers: (α, depth, normal, front facing, radiance) in depth order
+    let receivers: Vec<(f32, f32, Vec3, bool, Vec3)> = match occ {
         Occluders::Lists => lists
             .at(x, y)
             .iter()
-            .map(|f| (f.alpha, f.depth, Vec3::from(f.normal), f.front_facing))
+            .map(|f| (f.alpha, f.depth, Vec3::from(f.normal), f.front_facing, Vec3::from(f.radiance)))
             .collect(),
         Occluders::Compressed {
             nodes,
@@ -371,14 +398,16 @@ pub fn ambient_visibility_cpu(
                         ((word >> 16) as f32 + 0.5) / depth_scale,
                         n,
                         (nf >> 16) & 1 == 1,
+                        Vec3::ZERO,
                     )
                 })
                 .collect()
         }
     };
-    let mut av = 0.0f32;
-    let mut t = 1.0f32;
-    for (alpha, depth, n, front) in receivers {
+    let compressed = matches!(occ, Occluders::Compressed { .. });
+    let (mut av, mut t) = (0.0f32, 1.0f32);
+    let (mut colour, mut inside) = (Vec3::ZERO, Vec3::ZERO);
+    for (alpha, depth, n, front, radiance) in receivers {
         if t < T_MIN {
             break;
         }
@@ -396,10 +425,22 @@ pub fn ambient_visibility_cpu(
             a += (1.0 - wt) * hemisphere(lists, occ, frame, u, (x, y), pos, -n, depth, phi);
         }
         av += t * alpha * a;
+        colour += t * alpha * radiance;
+        inside += t * alpha * a * radiance;
         t *= 1.0 - alpha;
     }
     if t >= T_MIN {
+        let sky = Vec3::new(frame.sky[0], frame.sky[1], frame.sky[2]);
         av += t;
+        colour += t * sky;
+        inside += t * sky;
     }
-    av
+    if compressed {
+        (colour, inside) = (Vec3::ZERO, Vec3::ZERO);
+    }
+    Integrated {
+        av,
+        inside: inside.to_array(),
+        separate: (colour * av).to_array(),
+    }
 }

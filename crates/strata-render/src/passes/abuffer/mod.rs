@@ -167,6 +167,22 @@ pub const AO_RAW: TargetDesc = TargetDesc::new(
     "ABA multilayer AO (Algorithm 1), blended over the fragments, before reconstruction (1 = unoccluded)",
 );
 
+/// The OIT colour with each fragment's AO applied inside the blend (ABA §III).
+pub const AO_INSIDE: TargetDesc = TargetDesc::new(
+    "hdr-aba-inside",
+    wgpu::TextureFormat::Rgba32Float,
+    1,
+    "OIT colour with AO inside the blend: Σ T_i α_i AV_i L_i + T·sky (linear HDR; integration=inside)",
+);
+
+/// The OIT colour times the separately blended AO, before the AO's blur.
+pub const AO_SEPARATE: TargetDesc = TargetDesc::new(
+    "hdr-aba-separate",
+    wgpu::TextureFormat::Rgba32Float,
+    1,
+    "OIT colour × separately blended AO, before the blur (linear HDR; integration=inside)",
+);
+
 /// The composited colour (linear HDR, sky behind).
 pub const OUTPUT: TargetDesc = TargetDesc::new(
     "hdr-oit",
@@ -198,6 +214,11 @@ impl ABufferSettings {
         }
         if let Some(a) = &self.ao {
             a.validate()?;
+            if a.inside && self.compress.is_some() {
+                return Err(
+                    "integration inside needs compress 0: the compressed nodes hold no colour (set compress=0)".into(),
+                );
+            }
         }
         Ok(())
     }
@@ -251,8 +272,8 @@ impl ABufferSettings {
     /// counts, compressed lists and the 1-byte-per-pixel dummy attachment.
     pub fn estimated_bytes(&self, w: u32, h: u32) -> u64 {
         let px = w as u64 * h as u64;
-        // AO: ao-raw (4 bytes), ao-blur-h and ao (2 bytes each)
-        let ao = if self.ao.is_some() { px * 8 } else { 0 };
+        // AO: ao-raw (4 bytes), ao-blur-h and ao (2 bytes each); inside: two RGBA32F
+        let ao = self.ao.as_ref().map_or(0, |a| px * 8 + if a.inside { px * 32 } else { 0 });
         self.memory_bytes(w, h) + self.compressed_bytes(w, h) + px * 16 + px * 4 + px + ao
     }
 }
@@ -418,6 +439,8 @@ struct Shared {
 }
 
 struct AoResources {
+    /// the colour integrations are written too (`AbaAoSettings::inside`)
+    inside: bool,
     pipeline: wgpu::RenderPipeline,
     lists_group: wgpu::BindGroup,
     group: wgpu::BindGroup,
@@ -884,9 +907,23 @@ impl ABufferStage {
                 immediate_size: 0,
             });
             let module = crate::shader::module(device, "aba-ao", include_str!("aba_ao.wgsl"));
-            let pipeline =
-                crate::passes::fullscreen_pipeline(device, "aba-ao", &pl, &module, &crate::passes::color_targets(&[AO_RAW]));
+            let pipeline = if a.inside {
+                targets.create(gpu, AO_INSIDE);
+                targets.create(gpu, AO_SEPARATE);
+                crate::passes::fullscreen_pipeline_with(
+                    device,
+                    "aba-ao",
+                    &pl,
+                    &module,
+                    "fs_inside",
+                    &[],
+                    &crate::passes::color_targets(&[AO_RAW, AO_INSIDE, AO_SEPARATE]),
+                )
+            } else {
+                crate::passes::fullscreen_pipeline(device, "aba-ao", &pl, &module, &crate::passes::color_targets(&[AO_RAW]))
+            };
             AoResources {
+                inside: a.inside,
                 pipeline,
                 lists_group,
                 group,
@@ -1226,7 +1263,14 @@ impl Pass for ABufferPass {
             Kind::PrefixSum => (vec!["abuffer-counts"], vec!["abuffer-offsets"]),
             Kind::Draw => (vec!["scene", "abuffer"], vec!["abuffer-lists"]),
             Kind::Resolve => (vec!["abuffer-lists"], vec![OUTPUT.name, COUNT.name]),
-            Kind::Ao => (vec!["abuffer-lists"], vec![AO_RAW.name]),
+            Kind::Ao => (
+                vec!["abuffer-lists"],
+                if self.shared.ao.as_ref().is_some_and(|a| a.inside) {
+                    vec![AO_RAW.name, AO_INSIDE.name, AO_SEPARATE.name]
+                } else {
+                    vec![AO_RAW.name]
+                },
+            ),
         };
         PassInfo {
             name: self.name(),
@@ -1283,11 +1327,15 @@ impl Pass for ABufferPass {
             }
             Kind::Ao => {
                 let a = s.ao.as_ref().expect("the stage has AO");
+                let mut views = vec![&targets.get(AO_RAW.name).view];
+                if a.inside {
+                    views.extend([&targets.get(AO_INSIDE.name).view, &targets.get(AO_SEPARATE.name).view]);
+                }
                 crate::passes::fullscreen_pass(
                     encoder,
                     "aba-ao",
                     &a.pipeline,
-                    &[&targets.get(AO_RAW.name).view],
+                    &views,
                     &[&scene.frame_bind_group, &a.lists_group, &a.group],
                 );
             }
