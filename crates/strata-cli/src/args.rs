@@ -584,8 +584,9 @@ pub enum BenchWhat {
     /// Interleaved deferred shading (ILS Table 4): per-pass GPU ms of the interleaved frame and
     /// of the brute force of the same frame (all N VPLs per pixel), and the speed-up.
     Ils(BenchIlsArgs),
-    /// A-buffer constructions (ABA Table I): per-stage GPU ms of linked-list, linear,
-    /// fixed-array, dual-peel and the compressed path, memory and overflow per method.
+    /// A-buffer constructions (ABA Table I): per-stage GPU ms (AO included) of linked-list, linear,
+    /// fixed-array, dual-peel and the compressed path, memory and overflow per method, and the
+    /// compressed-vs-brute-force AO speed-up.
     Abuffer(BenchAbufferArgs),
 }
 
@@ -593,7 +594,8 @@ pub enum BenchWhat {
 pub struct BenchAbufferArgs {
     #[command(flatten)]
     pub stage: BenchStageArgs,
-    /// Settings of technique `oit` (e.g. --set pool=8000000 --set max-layers=16 --set compress=6).
+    /// Settings of technique `aba-ao` (e.g. --set pool=8000000 --set max-layers=16 --set compress=6
+    /// --set kernel=hbao); `abuffer` and `compress` are the bench's own per column.
     #[command(flatten)]
     pub set: SetArgs,
 }
