@@ -588,6 +588,18 @@ pub enum BenchWhat {
     /// fixed-array, dual-peel and the compressed path, memory and overflow per method, and the
     /// compressed-vs-brute-force AO speed-up.
     Abuffer(BenchAbufferArgs),
+    /// Bounced z-buffer AO (BZB Table 1): per-pass GPU ms with the bounced z-buffer and
+    /// with the additive AOV baseline (no visibility), the visibility step's cost, memory.
+    Bzb(BenchBzbArgs),
+}
+
+#[derive(Args)]
+pub struct BenchBzbArgs {
+    #[command(flatten)]
+    pub stage: BenchStageArgs,
+    /// Settings of technique `bzb-ao` (e.g. --set directions=4 --set ao-radius=1); visibility is the bench's.
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 #[derive(Args)]

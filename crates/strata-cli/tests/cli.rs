@@ -853,7 +853,7 @@ fn techniques_json_lists_settings_defaults_and_ranges() {
     let v = json_of(&strata(&["techniques", "--json"]));
     let ts = v["techniques"].as_array().expect("techniques");
     let names: Vec<&str> = ts.iter().map(|t| t["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["direct", "ao", "full", "ils", "oit", "bzb-ao"]);
+    assert_eq!(names, ["direct", "ao", "full", "ils", "oit", "aba-ao", "bzb-ao"]);
     let full = &ts[2];
     assert_eq!(
         full["presets"],

@@ -172,6 +172,25 @@ pub enum BenchResult {
     Ils(Box<IlsBench>),
     /// A-buffer constructions and the compressed path (`strata bench abuffer`, ABA Table I).
     Abuffer(Box<AbufferBench>),
+    /// Bounced z-buffer AO with and without visibility (`strata bench bzb`, BZB Table 1/3).
+    Bzb(Box<BzbBench>),
+}
+
+/// `strata bench bzb`: the `bzb-ao` frame with the bounced z-buffer (depth test, nearest
+/// occluder) and without (additive AOV baseline), same splats.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BzbBench {
+    pub triangles: u64,
+    /// S directions per pixel.
+    pub directions: u32,
+    /// `bzb-splat` with visibility / without: what the visibility step costs.
+    pub splat_ratio: f64,
+    /// The whole technique's ratio.
+    pub total_ratio: f64,
+    /// Bytes of the bounced z-buffer, its payload and the splat inputs at the bench size.
+    pub memory_bytes: u64,
+    pub visibility: StageBench,
+    pub no_visibility: StageBench,
 }
 
 /// `strata bench abuffer`: ABA Table I's stages per construction, keyed `dual-peel`,
@@ -241,6 +260,7 @@ impl BenchResult {
             BenchResult::Technique(_) => "technique",
             BenchResult::Ils(_) => "ils",
             BenchResult::Abuffer(_) => "abuffer",
+            BenchResult::Bzb(_) => "bzb",
         }
     }
 }
