@@ -14,6 +14,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/interleave.wgsl", include_str!("shaders/common/interleave.wgsl")),
     ("common/vpl.wgsl", include_str!("shaders/common/vpl.wgsl")),
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
+    ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),
     ("abuffer/lists.wgsl", include_str!("passes/abuffer/lists.wgsl")),
 ];
 

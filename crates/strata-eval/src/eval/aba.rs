@@ -13,12 +13,11 @@ use anyhow::{bail, Result};
 use strata_render::passes::abuffer::ao::AbaAoSettings;
 use strata_render::passes::abuffer::ABufferSettings;
 use strata_render::passes::ao::AoSettings;
-use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+use strata_render::{GpuContext, GpuOptions, RenderSettings};
 
-use super::ao::{references, render_frame, render_settings, DEFAULT_CAP};
+use super::ao::{evaluate_av, references, render_settings, DEFAULT_CAP};
 use super::{noise_warnings, EvalSettings};
-use crate::metrics::compare;
-use crate::results::{AoErrors, AoEval};
+use crate::results::AoEval;
 
 /// `abuffer` with its `ao` as configured (radius, bias, ε default to `ao`'s, then the
 /// scene's); `ao` are the DGB AO settings of the 2-layer comparison.
@@ -74,27 +73,17 @@ pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Resu
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
     })?;
-    let evaluate = |rs: RenderSettings, what: &str| -> Result<AoErrors> {
-        let mut r = Renderer::new(&gpu, &scene, rs)?;
-        let start = std::time::Instant::now();
-        let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
+    let refs = (&ref_obscurance, &ref_binary);
+    // dropped fragments, if any: the lists were too small for the scene
+    let dropped = |r: &strata_render::Renderer| -> Result<String> {
         let overflow = r.abuffer().map(|a| a.read_lists(&gpu)).transpose()?.map_or(0, |l| l.overflow);
-        eprintln!(
-            "{what}: frame rendered and read back in {:.2} s{}",
-            start.elapsed().as_secs_f64(),
-            if overflow > 0 {
-                format!(" ({overflow} fragments dropped: raise --set pool=N)")
-            } else {
-                String::new()
-            }
-        );
-        let (obscurance, _) = compare(&ref_obscurance.image, &av)?;
-        let (binary, _) = compare(&ref_binary.image, &av)?;
-        Ok(AoErrors {
-            obscurance: ref_obscurance.annotate(obscurance, &av),
-            binary: ref_binary.annotate(binary, &av),
+        Ok(if overflow > 0 {
+            format!(" ({overflow} fragments dropped: raise --set pool=N)")
+        } else {
+            String::new()
         })
     };
+    let evaluate = |rs: RenderSettings, what: &str| evaluate_av(&gpu, &scene, s, rs, what, refs, dropped);
     let main = evaluate(aba_settings(aba.multilayer), "aba-ao")?;
     let single = evaluate(aba_settings(false), "aba-ao multilayer=off")?;
     let dgb = evaluate(render_settings(s, 2, &ao), "ao k=2")?;

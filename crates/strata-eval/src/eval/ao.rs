@@ -150,6 +150,34 @@ pub(crate) fn references(
     Ok((converge("obscurance", &obscurance)?, converge("binary-ao", &binary)?))
 }
 
+/// One GPU configuration's AV (`rs`, frame of `s`) against both references, the
+/// frame's wall time and `note` (e.g. dropped fragments) printed under `what`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn evaluate_av(
+    gpu: &GpuContext,
+    scene: &Scene,
+    s: &EvalSettings,
+    rs: RenderSettings,
+    what: &str,
+    (ref_obscurance, ref_binary): (&RefImage, &RefImage),
+    note: impl Fn(&Renderer) -> Result<String>,
+) -> Result<AoErrors> {
+    let mut r = Renderer::new(gpu, scene, rs)?;
+    let start = std::time::Instant::now();
+    let av = render_frame(&mut r, gpu, scene, s, s.scene.frame)?;
+    eprintln!(
+        "{what}: frame rendered and read back in {:.2} s{}",
+        start.elapsed().as_secs_f64(),
+        note(&r)?
+    );
+    let (obscurance, _) = compare(&ref_obscurance.image, &av)?;
+    let (binary, _) = compare(&ref_binary.image, &av)?;
+    Ok(AoErrors {
+        obscurance: ref_obscurance.annotate(obscurance, &av),
+        binary: ref_binary.annotate(binary, &av),
+    })
+}
+
 /// Renders frame `f` (after frame f − 1 when the first frame has no history
 /// yet and the variant needs it) and returns AV, cropped to the image.
 pub(crate) fn render_frame(

@@ -7,12 +7,11 @@
 use anyhow::{bail, Result};
 use strata_render::passes::ao::AoSettings;
 use strata_render::passes::bzb::BzbSettings;
-use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
+use strata_render::{GpuContext, GpuOptions, RenderSettings};
 
-use super::ao::{references, render_frame, render_settings, DEFAULT_CAP};
+use super::ao::{evaluate_av, references, render_settings, DEFAULT_CAP};
 use super::{noise_warnings, EvalSettings};
-use crate::metrics::compare;
-use crate::results::{AoErrors, AoEval};
+use crate::results::AoEval;
 
 /// `bzb` as configured (its radius and bias default to `ao`'s, then the scene's);
 /// `ao` are the DGB AO settings of the 2-layer comparison.
@@ -54,21 +53,8 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
     })?;
-    let evaluate = |rs: RenderSettings, what: &str| -> Result<AoErrors> {
-        let mut r = Renderer::new(&gpu, &scene, rs)?;
-        let start = std::time::Instant::now();
-        let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
-        eprintln!(
-            "{what}: frame rendered and read back in {:.2} s",
-            start.elapsed().as_secs_f64()
-        );
-        let (obscurance, _) = compare(&ref_obscurance.image, &av)?;
-        let (binary, _) = compare(&ref_binary.image, &av)?;
-        Ok(AoErrors {
-            obscurance: ref_obscurance.annotate(obscurance, &av),
-            binary: ref_binary.annotate(binary, &av),
-        })
-    };
+    let refs = (&ref_obscurance, &ref_binary);
+    let evaluate = |rs: RenderSettings, what: &str| evaluate_av(&gpu, &scene, s, rs, what, refs, |_| Ok(String::new()));
     let main = evaluate(bzb_settings(bzb.visibility), "bzb-ao")?;
     let no_visibility = evaluate(bzb_settings(false), "bzb-ao visibility=off")?;
     let dgb = evaluate(render_settings(s, 2, &ao), "ao k=2")?;

@@ -16,6 +16,7 @@
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
 #import "common/spiral.wgsl"
+#import "common/obscurance.wgsl"
 #import "abuffer/lists.wgsl"
 
 // Matches `ao::AbaAoUniforms`.
@@ -46,14 +47,9 @@ struct AbaAo {
 @group(2) @binding(0) var<uniform> ao: AbaAo;
 @group(2) @binding(1) var nodes_m: texture_2d_array<u32>;
 
-// DGB Eq. 2: obscurance at X (normal n) due to a surface point at v = Y − X.
+// DGB Eq. 2 with this pass's r, β, ε.
 fn obscurance(v: vec3f, n: vec3f) -> f32 {
-    let vv = dot(v, v);
-    let r2 = ao.radius * ao.radius;
-    if (!(vv < r2)) {
-        return 0.0;
-    }
-    return (1.0 - vv / r2) * max((dot(v, n) - ao.bias) / sqrt(vv + ao.epsilon), 0.0);
+    return eq2_obscurance(v, n, ao.radius, ao.bias, ao.epsilon);
 }
 
 // Algorithm 1's inner loop at tap pixel q: max over the occluders f of

@@ -215,127 +215,107 @@ pub enum Occluders<'a> {
     },
 }
 
-/// Algorithm 1's inner loop at tap pixel (qx, qy).
-fn tap_occlusion(
-    lists: &FragmentLists,
-    occ: &Occluders,
-    frame: &FrameUniforms,
-    u: &AbaAoUniforms,
-    q: (u32, u32),
-    x: Vec3,
-    n: Vec3,
-) -> f32 {
-    let centre = [q.0 as f32 + 0.5, q.1 as f32 + 0.5];
-    let eq2 = u.eq2();
-    let o = |z: f32, alpha: f32| alpha * obscurance(&eq2, world_from_csz(frame, centre, z) - x, n);
-    let mut a = 0.0f32;
-    match occ {
-        Occluders::Compressed { nodes, depth_scale, .. } => {
-            for &word in &nodes[(q.1 * lists.width + q.0) as usize] {
-                let alpha = (word & 0xffff) as f32 / 65535.0;
-                if alpha <= 0.0 {
-                    continue;
-                }
-                let z = ((word >> 16) as f32 + 0.5) / depth_scale;
-                a = a.max(o(z, alpha));
-                if u.multilayer == 0 {
-                    return a;
-                }
-            }
-        }
-        Occluders::Lists => {
-            let list = lists.at(q.0, q.1);
-            if u.multilayer == 0 {
-                // lists are sorted by (depth, node): the first is the nearest
-                return list.first().map_or(0.0, |f| o(f.depth, f.alpha));
-            }
-            for f in list {
-                a = a.max(o(f.depth, f.alpha));
-            }
-        }
-    }
-    a
+/// What every tap of one pixel's evaluation reads.
+struct Twin<'a> {
+    lists: &'a FragmentLists,
+    occ: &'a Occluders<'a>,
+    frame: &'a FrameUniforms,
+    u: &'a AbaAoUniforms,
 }
 
-/// DGB Eq. 1 over the hemisphere around `n` at `x` (depth `z`) from pixel (x, y).
-#[allow(clippy::too_many_arguments)]
-fn hemisphere_av(
-    lists: &FragmentLists,
-    occ: &Occluders,
-    frame: &FrameUniforms,
-    u: &AbaAoUniforms,
+/// A receiver: pixel `p`, position `x`, hemisphere normal `n`, depth `z`, rotation `phi`.
+struct Receiver {
     p: (u32, u32),
     x: Vec3,
     n: Vec3,
     z: f32,
     phi: f32,
-) -> f32 {
-    let r_p = u.proj_scale * u.radius / z;
-    let (w, h) = (lists.width as i32, lists.height as i32);
-    let mut sum = 0.0f32;
-    for i in 0..u.samples {
-        let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
-        let d = spiral::tap_texel(tap.offset);
+}
+
+impl Twin<'_> {
+    /// The pixel at offset `d` from `p`, if inside the image.
+    fn tap_pixel(&self, p: (u32, u32), d: [i32; 2]) -> Option<(u32, u32)> {
         let (qx, qy) = (p.0 as i32 + d[0], p.1 as i32 + d[1]);
-        if qx < 0 || qy < 0 || qx >= w || qy >= h {
-            continue;
-        }
-        sum += tap_occlusion(lists, occ, frame, u, (qx as u32, qy as u32), x, n);
+        let inside = qx >= 0 && qy >= 0 && qx < self.lists.width as i32 && qy < self.lists.height as i32;
+        inside.then_some((qx as u32, qy as u32))
     }
-    (1.0 - (u.intensity * std::f32::consts::PI / u.samples as f32 * sum).sqrt()).max(0.0)
-}
 
-/// `hemisphere_hbao` of `aba_ao.wgsl`.
-#[allow(clippy::too_many_arguments)]
-fn hemisphere_hbao(
-    lists: &FragmentLists,
-    occ: &Occluders,
-    frame: &FrameUniforms,
-    u: &AbaAoUniforms,
-    p: (u32, u32),
-    x: Vec3,
-    n: Vec3,
-    z: f32,
-    phi: f32,
-) -> f32 {
-    let r_p = u.proj_scale * u.radius / z;
-    let (w, h) = (lists.width as i32, lists.height as i32);
-    let mut sum = 0.0f32;
-    for d in 0..u.directions {
-        let ang = phi + std::f32::consts::TAU * d as f32 / u.directions as f32;
-        let dir = [ang.cos(), ang.sin()];
-        let mut horizon = 0.0f32;
-        for s in 0..u.steps {
-            let len = r_p * (s as f32 + 0.5) / u.steps as f32;
-            let t = spiral::tap_texel([dir[0] * len, dir[1] * len]);
-            let (qx, qy) = (p.0 as i32 + t[0], p.1 as i32 + t[1]);
-            if qx < 0 || qy < 0 || qx >= w || qy >= h {
-                break;
+    /// Algorithm 1's inner loop at tap pixel `q`.
+    fn tap_occlusion(&self, q: (u32, u32), x: Vec3, n: Vec3) -> f32 {
+        let centre = [q.0 as f32 + 0.5, q.1 as f32 + 0.5];
+        let eq2 = self.u.eq2();
+        let o = |z: f32, alpha: f32| alpha * obscurance(&eq2, world_from_csz(self.frame, centre, z) - x, n);
+        let mut a = 0.0f32;
+        match self.occ {
+            Occluders::Compressed { nodes, depth_scale, .. } => {
+                for &word in &nodes[(q.1 * self.lists.width + q.0) as usize] {
+                    let alpha = (word & 0xffff) as f32 / 65535.0;
+                    if alpha <= 0.0 {
+                        continue;
+                    }
+                    let z = ((word >> 16) as f32 + 0.5) / depth_scale;
+                    a = a.max(o(z, alpha));
+                    if self.u.multilayer == 0 {
+                        return a;
+                    }
+                }
             }
-            horizon = horizon.max(tap_occlusion(lists, occ, frame, u, (qx as u32, qy as u32), x, n));
+            Occluders::Lists => {
+                let list = self.lists.at(q.0, q.1);
+                if self.u.multilayer == 0 {
+                    // lists are sorted by (depth, node): the first is the nearest
+                    return list.first().map_or(0.0, |f| o(f.depth, f.alpha));
+                }
+                for f in list {
+                    a = a.max(o(f.depth, f.alpha));
+                }
+            }
         }
-        sum += horizon;
+        a
     }
-    (1.0 - u.intensity * sum / u.directions as f32).max(0.0)
-}
 
-/// The receiver hemisphere's AV with the uniforms' kernel.
-#[allow(clippy::too_many_arguments)]
-fn hemisphere(
-    lists: &FragmentLists,
-    occ: &Occluders,
-    frame: &FrameUniforms,
-    u: &AbaAoUniforms,
-    p: (u32, u32),
-    x: Vec3,
-    n: Vec3,
-    z: f32,
-    phi: f32,
-) -> f32 {
-    if u.kernel == AoKernel::Hbao as u32 {
-        hemisphere_hbao(lists, occ, frame, u, p, x, n, z, phi)
-    } else {
-        hemisphere_av(lists, occ, frame, u, p, x, n, z, phi)
+    /// DGB Eq. 1 over the receiver's hemisphere (`hemisphere_av` of `aba_ao.wgsl`).
+    fn ssao(&self, r: &Receiver) -> f32 {
+        let u = self.u;
+        let r_p = u.proj_scale * u.radius / r.z;
+        let mut sum = 0.0f32;
+        for i in 0..u.samples {
+            let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, r.phi);
+            if let Some(q) = self.tap_pixel(r.p, spiral::tap_texel(tap.offset)) {
+                sum += self.tap_occlusion(q, r.x, r.n);
+            }
+        }
+        (1.0 - (u.intensity * std::f32::consts::PI / u.samples as f32 * sum).sqrt()).max(0.0)
+    }
+
+    /// `hemisphere_hbao` of `aba_ao.wgsl`.
+    fn hbao(&self, r: &Receiver) -> f32 {
+        let u = self.u;
+        let r_p = u.proj_scale * u.radius / r.z;
+        let mut sum = 0.0f32;
+        for d in 0..u.directions {
+            let ang = r.phi + std::f32::consts::TAU * d as f32 / u.directions as f32;
+            let dir = [ang.cos(), ang.sin()];
+            let mut horizon = 0.0f32;
+            for s in 0..u.steps {
+                let len = r_p * (s as f32 + 0.5) / u.steps as f32;
+                let Some(q) = self.tap_pixel(r.p, spiral::tap_texel([dir[0] * len, dir[1] * len])) else {
+                    break;
+                };
+                horizon = horizon.max(self.tap_occlusion(q, r.x, r.n));
+            }
+            sum += horizon;
+        }
+        (1.0 - u.intensity * sum / u.directions as f32).max(0.0)
+    }
+
+    /// The receiver hemisphere's AV with the uniforms' kernel.
+    fn hemisphere(&self, r: &Receiver) -> f32 {
+        if self.u.kernel == AoKernel::Hbao as u32 {
+            self.hbao(r)
+        } else {
+            self.ssao(r)
+        }
     }
 }
 
@@ -407,6 +387,7 @@ pub fn integrate_cpu(
         }
     };
     let compressed = matches!(occ, Occluders::Compressed { .. });
+    let twin = Twin { lists, occ, frame, u };
     let (mut av, mut t) = (0.0f32, 1.0f32);
     let (mut colour, mut inside) = (Vec3::ZERO, Vec3::ZERO);
     for (alpha, depth, n, front, radiance) in receivers {
@@ -417,14 +398,21 @@ pub fn integrate_cpu(
             continue;
         }
         let pos = world_from_csz(frame, [x as f32 + 0.5, y as f32 + 0.5], depth);
+        let at = |n: Vec3| Receiver {
+            p: (x, y),
+            x: pos,
+            n,
+            z: depth,
+            phi,
+        };
         // Eq. 3–4
         let wt = if front { alpha } else { 1.0 - alpha };
         let mut a = 0.0f32;
         if wt > 0.0 {
-            a += wt * hemisphere(lists, occ, frame, u, (x, y), pos, n, depth, phi);
+            a += wt * twin.hemisphere(&at(n));
         }
         if wt < 1.0 {
-            a += (1.0 - wt) * hemisphere(lists, occ, frame, u, (x, y), pos, -n, depth, phi);
+            a += (1.0 - wt) * twin.hemisphere(&at(-n));
         }
         av += t * alpha * a;
         colour += t * alpha * radiance;

@@ -833,22 +833,8 @@ impl ABufferStage {
         // --- multilayer AO (Algorithm 1), then the bilateral reconstruction
         let mut blur = Vec::new();
         let ao = settings.ao.as_ref().map(|a| {
-            use wgpu::TextureFormat as F;
             targets.create(gpu, AO_RAW);
-            targets.create(
-                gpu,
-                TargetDesc::new("ao-blur-h", F::R16Float, 1, "AO after the horizontal bilateral pass"),
-            );
-            targets.create(
-                gpu,
-                TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
-            );
-            blur.push(crate::passes::bilateral::BilateralPass::new(
-                gpu, scene, targets, &a.blur, "ao-blur-h", AO_RAW.name, "ao-blur-h", false,
-            ));
-            blur.push(crate::passes::bilateral::BilateralPass::new(
-                gpu, scene, targets, &a.blur, "ao-blur-v", "ao-blur-h", "ao", true,
-            ));
+            blur.extend(crate::passes::ao::stage::reconstruction(gpu, scene, targets, &a.blur, AO_RAW.name));
             let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("aba-ao-lists"),
                 entries: &[

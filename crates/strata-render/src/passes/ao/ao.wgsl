@@ -5,6 +5,7 @@
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
 #import "common/spiral.wgsl"
+#import "common/obscurance.wgsl"
 
 override LAYERS: u32 = 2u;
 
@@ -32,14 +33,9 @@ struct Ao {
 @group(1) @binding(1) var zmip: texture_2d<f32>;
 @group(1) @binding(2) var npack: texture_2d<f32>;
 
-// Eq. 2: obscurance at X (normal n) due to a surface point at v = Y − X.
+// DGB Eq. 2 with this pass's r, β, ε.
 fn obscurance(v: vec3f, n: vec3f) -> f32 {
-    let vv = dot(v, v);
-    let r2 = ao.radius * ao.radius;
-    if (!(vv < r2)) {
-        return 0.0;
-    }
-    return (1.0 - vv / r2) * max((dot(v, n) - ao.bias) / sqrt(vv + ao.epsilon), 0.0);
+    return eq2_obscurance(v, n, ao.radius, ao.bias, ao.epsilon);
 }
 
 @fragment

@@ -38,14 +38,6 @@ impl AoStage {
             }
             filtered = "ao-temporal";
         }
-        targets.create(
-            gpu,
-            TargetDesc::new("ao-blur-h", F::R16Float, 1, "AO after the horizontal bilateral pass"),
-        );
-        targets.create(
-            gpu,
-            TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
-        );
         let ao = AoPass::new(gpu, scene, targets, deep.layers);
         let temporal = s.temporal.as_ref().map(|t| {
             TemporalPass::new(
@@ -60,8 +52,7 @@ impl AoStage {
                 deep.layers,
             )
         });
-        let blur_h = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-h", filtered, "ao-blur-h", false);
-        let blur_v = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-v", "ao-blur-h", "ao", true);
+        let [blur_h, blur_v] = reconstruction(gpu, scene, targets, &s.blur, filtered);
         Self {
             ao,
             temporal,
@@ -79,4 +70,28 @@ impl AoStage {
         v.push(&self.blur_v);
         v
     }
+}
+
+/// The AO's bilateral reconstruction (horizontal, vertical) from `input` into
+/// `ao`, with its targets `ao-blur-h` and `ao` (every AO technique ends so).
+pub(crate) fn reconstruction(
+    gpu: &GpuContext,
+    scene: &GpuScene,
+    targets: &mut Targets,
+    blur: &crate::passes::bilateral::BilateralSettings,
+    input: &'static str,
+) -> [BilateralPass; 2] {
+    use wgpu::TextureFormat as F;
+    targets.create(
+        gpu,
+        TargetDesc::new("ao-blur-h", F::R16Float, 1, "AO after the horizontal bilateral pass"),
+    );
+    targets.create(
+        gpu,
+        TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
+    );
+    [
+        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-h", input, "ao-blur-h", false),
+        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-v", "ao-blur-h", "ao", true),
+    ]
 }
