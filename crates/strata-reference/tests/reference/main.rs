@@ -5,6 +5,7 @@ mod ao;
 mod bvh;
 mod converge;
 mod gi;
+mod glossy;
 mod layers;
 mod oit;
 mod scenes;
