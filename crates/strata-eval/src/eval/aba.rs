@@ -78,11 +78,7 @@ pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Resu
         let mut r = Renderer::new(&gpu, &scene, rs)?;
         let start = std::time::Instant::now();
         let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
-        let overflow = r
-            .abuffer()
-            .map(|a| a.read_lists(&gpu))
-            .transpose()?
-            .map_or(0, |l| l.overflow);
+        let overflow = r.abuffer().map(|a| a.read_lists(&gpu)).transpose()?.map_or(0, |l| l.overflow);
         eprintln!(
             "{what}: frame rendered and read back in {:.2} s{}",
             start.elapsed().as_secs_f64(),
