@@ -2,6 +2,7 @@
 //! One test binary (faster to link); one module per oracle.
 
 mod ao;
+mod builtin_scenes;
 mod bvh;
 mod converge;
 mod gi;
