@@ -736,7 +736,7 @@ pub mod still_life_dims {
 /// ("LIT"), a glossy gold sphere (metal, roughness 0.25), a glossy blue vase
 /// (dielectric, roughness 0.15), two diffuse pears, and the "skull": a hollow
 /// bone-white box open toward the camera (+Z). The only light is an orange
-/// emissive quad (radiance (8, 3.6, 1.2)) at x = −3.6 facing +X, outside the
+/// emissive quad (radiance (16, 7.2, 2.4)) at x = −3.6 facing +X, outside the
 /// view (≥ 40° off the camera axis) but lighting the objects from the left,
 /// with a matching [`Light::Rect`] for the GPU; black sky. Every point of
 /// the emitter has z ≤ −0.5 while the skull's opening is the plane z = 0.05, so
@@ -767,7 +767,7 @@ pub fn still_life() -> Scene {
     });
     let gold = b.material(Material::glossy("gold", [1.0, 0.78, 0.34], 0.25, 1.0));
     let vase = b.material(Material::glossy("vase", [0.08, 0.2, 0.65], 0.15, 0.0));
-    let light_rgb = [8.0, 3.6, 1.2];
+    let light_rgb = [16.0, 7.2, 2.4];
     let lamp = b.material(Material::emissive("lamp", light_rgb));
 
     // cloth (floor) 8 × 6 m, back wall at z = −1.5
@@ -866,7 +866,7 @@ pub fn dominoes() -> Scene {
         color: [1.0, 0.9, 0.75],
         illuminance: 3.0,
     };
-    let camera = Camera::new(v(0.4, 1.6, 3.0), v(0.0, 0.0, 0.1), Vec3::Y, 40.0, 0.05);
+    let camera = Camera::new(v(0.3, 1.15, 2.1), v(0.0, 0.0, 0.05), Vec3::Y, 40.0, 0.05);
     let settings = SceneSettings {
         ao_radius: 0.12,
         min_separation: 0.02,
