@@ -1,8 +1,10 @@
-//! Path-traced diffuse global illumination.
+//! Path-traced global illumination, diffuse and glossy.
 //!
-//! Every surface is Lambertian with albedo ρ = `base_color × texture.rgb`
-//! (metallic, roughness, opacity and texture alpha are ignored). Light comes
-//! from:
+//! A surface is Lambertian with albedo ρ = `base_color × texture.rgb` unless
+//! its material is `glossy`: then it has the metallic-roughness GGX BRDF of
+//! [`crate::brdf`] with base colour ρ (opacity and texture alpha are ignored
+//! either way; so are metallic and roughness of non-glossy materials). Light
+//! comes from:
 //!
 //! - `Light::Sun`: irradiance `illuminance × color` on a surface facing it,
 //!   arriving from `−direction`; a shadow ray to infinity;
@@ -25,6 +27,16 @@
 //! emitter — everywhere else NEE accounts for it, so nothing is counted twice.
 //! Bounce directions below the geometric surface end the path.
 //!
+//! Glossy vertices sample [`Ggx::sample`] (lobe selection, visible normals)
+//! instead of the cosine, weight the path by f·cos/pdf, and combine the two
+//! ways of reaching an emissive triangle by multiple importance sampling
+//! (power heuristic, β = 2): the NEE sample is weighted by p_light² / (p_light²
+//! + p_brdf²), and a bounce ray that hits an emitter's front face adds its
+//! emission weighted by p_brdf² / (p_light² + p_brdf²), both pdfs per solid
+//! angle (p_light = P(triangle) / area · d² / cos θ_light). Lambertian vertices
+//! keep NEE alone (weight 1, no emission on bounce hits), exactly as before.
+//! Point, spot and sun lights are deltas: NEE only, f evaluated toward them.
+//!
 //! Split of the result: **direct** = emission seen by the camera ray + sky seen
 //! by the camera ray + all light reaching the primary hit straight from an
 //! emitter (NEE at vertex 0 and the sky through vertex 0's bounce ray);
@@ -34,6 +46,7 @@
 use glam::Vec3;
 use strata_scene::{Camera, ImageBuf, Light, Material};
 
+use crate::brdf::Ggx;
 use crate::bvh::Bvh;
 use crate::sampling::{cosine_hemisphere, hash, triangle_barycentrics, Rng};
 use crate::Reference;
@@ -122,6 +135,25 @@ impl EmissiveLights {
 
     pub(crate) fn is_empty(&self) -> bool {
         self.tris.is_empty()
+    }
+
+    /// (probability of picking, area) of the emitter with triangle index `tri`, if it is one.
+    pub(crate) fn find(&self, tri: u32) -> Option<(f32, f32)> {
+        let i = self.tris.binary_search_by_key(&tri, |e| e.0).ok()?;
+        let (_, area, le) = self.tris[i];
+        Some(((area as f64 * luminance(le) as f64 / self.total) as f32, area))
+    }
+}
+
+/// Power heuristic (β = 2) weight of the strategy with pdf `a` against `b`.
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
+        a2 / (a2 + b2)
+    } else if a.is_infinite() {
+        1.0
+    } else {
+        0.0
     }
 }
 
@@ -235,11 +267,21 @@ impl Reference<'_> {
                 n,
                 ng,
             };
-            *sink += throughput * albedo * self.direct_irradiance(&sp, rng, rays) * std::f32::consts::FRAC_1_PI;
+            let m = self.material(hit.material);
+            let ggx = m.glossy.then(|| Ggx::new(n, -wo, albedo, m.roughness, m.metallic));
+            match &ggx {
+                None => {
+                    *sink +=
+                        throughput * albedo * self.direct_irradiance(&sp, None, rng, rays) * std::f32::consts::FRAC_1_PI
+                }
+                Some(g) => *sink += throughput * self.direct_irradiance(&sp, Some(g), rng, rays),
+            }
+            // MIS: a glossy vertex also collects emitters its bounce ray hits.
+            let mis = ggx.is_some() && !self.lights.is_empty();
 
-            // Bounce: at the last vertex only to collect the sky.
+            // Bounce: at the last vertex only to collect the sky (and, glossy, emitters).
             let last = depth == settings.bounces;
-            if last && sky == Vec3::ZERO {
+            if last && sky == Vec3::ZERO && !mis {
                 break;
             }
             let u = match (depth, first_bounces) {
@@ -247,12 +289,23 @@ impl Reference<'_> {
                 (1, Some(u)) => [u[2], u[3]],
                 _ => rng.next_2d(),
             };
-            let wi = cosine_hemisphere(n, u);
+            let (wi, weight, brdf_pdf) = match &ggx {
+                None => (cosine_hemisphere(n, u), albedo, 0.0),
+                Some(g) => {
+                    let wi = g.sample(rng.next_f32(), u);
+                    let c = n.dot(wi);
+                    let pdf = g.pdf(wi);
+                    if !(c > 0.0 && pdf > 0.0) {
+                        break;
+                    }
+                    (wi, g.eval(wi) * (c / pdf), pdf)
+                }
+            };
             if wi.dot(ng) <= 0.0 {
                 break;
             }
-            throughput *= albedo;
-            if throughput.max_element() <= 0.0 {
+            throughput *= weight;
+            if !(throughput.max_element() > 0.0) || !throughput.is_finite() {
                 break;
             }
             *rays += 1;
@@ -260,6 +313,18 @@ impl Reference<'_> {
                 *sink += throughput * sky;
                 break;
             };
+            if mis {
+                if let Some((prob, area)) = self.lights.find(next.triangle) {
+                    let tri = &self.bvh.triangles()[next.triangle as usize];
+                    let nl = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize_or_zero();
+                    let cl = -nl.dot(wi);
+                    if cl > 0.0 {
+                        let le = Vec3::from(self.material(tri.material).emission).max(Vec3::ZERO);
+                        let light_pdf = prob / area * next.t * next.t / cl;
+                        *sink += throughput * le * power_heuristic(brdf_pdf, light_pdf);
+                    }
+                }
+            }
             if last {
                 break;
             }
@@ -278,7 +343,13 @@ impl Reference<'_> {
 
     /// Irradiance-like sum at a shading point from all lights: Σ E·max(n·l, 0)·V,
     /// to be multiplied by ρ/π. Emissive triangles contribute one NEE sample.
-    fn direct_irradiance(&self, sp: &ShadingPoint, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+    /// With a GGX BRDF `brdf`, each term is also multiplied by f(v, l) (the
+    /// sum is then outgoing radiance) and the emissive sample by its MIS weight.
+    fn direct_irradiance(&self, sp: &ShadingPoint, brdf: Option<&Ggx>, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+        let weigh = |l: Vec3, e: Vec3| match brdf {
+            None => e,
+            Some(g) => g.eval(l) * e,
+        };
         let mut e = Vec3::ZERO;
         for light in &self.scene.lights {
             match *light {
@@ -292,7 +363,7 @@ impl Reference<'_> {
                     if c > 0.0 {
                         *rays += 1;
                         if !self.bvh.occluded(sp.origin, l, 0.0, f32::INFINITY) {
-                            e += Vec3::from(color) * illuminance * c;
+                            e += weigh(l, Vec3::from(color) * illuminance * c);
                         }
                     }
                 }
@@ -301,7 +372,8 @@ impl Reference<'_> {
                     color,
                     intensity,
                 } => {
-                    e += self.point_light(sp, position, Vec3::from(color) * intensity, rays, |_| 1.0);
+                    let (li, l) = self.point_light(sp, position, Vec3::from(color) * intensity, rays, |_| 1.0);
+                    e += weigh(l, li);
                 }
                 Light::Spot {
                     position,
@@ -313,40 +385,49 @@ impl Reference<'_> {
                 } => {
                     let axis = direction.normalize_or_zero();
                     let (ci, co) = (inner_deg.to_radians().cos(), outer_deg.to_radians().cos());
-                    e += self.point_light(sp, position, Vec3::from(color) * intensity, rays, |to_x| {
+                    let (li, l) = self.point_light(sp, position, Vec3::from(color) * intensity, rays, |to_x| {
                         smoothstep(co, ci, axis.dot(to_x))
                     });
+                    e += weigh(l, li);
                 }
                 Light::Rect { .. } => {}
             }
         }
         if !self.lights.is_empty() {
-            e += self.sample_emissive(sp, rng, rays);
+            e += self.sample_emissive(sp, brdf, rng, rays);
         }
         e
     }
 
-    /// Point-like light at `pos` with intensity `i`, times `cone(unit direction light → x)`.
-    fn point_light(&self, sp: &ShadingPoint, pos: Vec3, i: Vec3, rays: &mut u64, cone: impl Fn(Vec3) -> f32) -> Vec3 {
+    /// Point-like light at `pos` with intensity `i`, times `cone(unit direction light → x)`:
+    /// (irradiance-like term, unit direction toward the light).
+    fn point_light(
+        &self,
+        sp: &ShadingPoint,
+        pos: Vec3,
+        i: Vec3,
+        rays: &mut u64,
+        cone: impl Fn(Vec3) -> f32,
+    ) -> (Vec3, Vec3) {
         let to_light = pos - sp.x;
         let d2 = to_light.length_squared();
         if !(d2 > 0.0) {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, Vec3::Z);
         }
         let l = to_light / d2.sqrt();
         let c = sp.cos(l);
         if c <= 0.0 {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, l);
         }
         let k = cone(-l);
         if k <= 0.0 || !self.visible(sp.origin, pos, rays) {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, l);
         }
-        i * (k * c / d2)
+        (i * (k * c / d2), l)
     }
 
     /// One next-event-estimation sample of the emissive triangles.
-    fn sample_emissive(&self, sp: &ShadingPoint, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+    fn sample_emissive(&self, sp: &ShadingPoint, brdf: Option<&Ggx>, rng: &mut Rng, rays: &mut u64) -> Vec3 {
         let (i, prob) = self.lights.pick(rng.next_f32());
         let (tri_index, area, le) = self.lights.tris[i];
         let tri = &self.bvh.triangles()[tri_index as usize];
@@ -365,7 +446,15 @@ impl Reference<'_> {
             return Vec3::ZERO;
         }
         // pdf over the light's area = prob / area.
-        le * (c * cl / d2 * area / prob)
+        let e = le * (c * cl / d2 * area / prob);
+        match brdf {
+            None => e,
+            Some(g) => {
+                // per solid angle: prob / area · d² / cos θ_light
+                let light_pdf = prob / area * d2 / cl;
+                g.eval(l) * e * power_heuristic(light_pdf, g.pdf(l))
+            }
+        }
     }
 
     /// Shadow ray from the offset origin `p` to the point `q`, stopping
@@ -495,7 +584,8 @@ impl Reference<'_> {
                     n: ny,
                     ng: ngy,
                 };
-                let b = self.albedo(&hy) * self.direct_irradiance(&sp, &mut rng, rays) * std::f32::consts::FRAC_1_PI;
+                let b =
+                    self.albedo(&hy) * self.direct_irradiance(&sp, None, &mut rng, rays) * std::f32::consts::FRAC_1_PI;
                 e += b * (cos_x * cos_y / d2);
             }
             e * (total as f32 / settings.spp.max(1) as f32) * self.albedo(&hx) * std::f32::consts::FRAC_1_PI

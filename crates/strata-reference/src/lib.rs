@@ -47,6 +47,7 @@
 
 pub mod ao;
 pub mod bench;
+pub mod brdf;
 pub mod bvh;
 pub mod converge;
 pub mod gi;

@@ -117,6 +117,23 @@ pub fn cosine_hemisphere(n: Vec3, u: [f32; 2]) -> Vec3 {
     (t * x + b * y + n * z).normalize()
 }
 
+/// A GGX (Trowbridge-Reitz) microfacet normal sampled from the distribution
+/// of normals visible from `v` (Heitz 2018, D_v(h) = G1(v) max(v·h, 0) D(h) / v_z),
+/// in the local frame where the macro normal is +Z and `v.z > 0`; isotropic
+/// roughness `alpha`. Dupuy & Benyoub 2023 ("Sampling Visible GGX Normals with
+/// Spherical Caps"): stretch `v` to the α = 1 configuration, sample the
+/// spherical cap of directions c with c_z ≥ −v_z uniformly, h_std = v_std + c,
+/// then unstretch.
+#[inline]
+pub fn ggx_vndf_local(v: Vec3, alpha: f32, u: [f32; 2]) -> Vec3 {
+    let vs = Vec3::new(v.x * alpha, v.y * alpha, v.z).normalize();
+    let phi = std::f32::consts::TAU * u[0];
+    let z = (1.0 - u[1]) * (1.0 + vs.z) - vs.z;
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    let hs = Vec3::new(s * phi.cos(), s * phi.sin(), z) + vs;
+    Vec3::new(hs.x * alpha, hs.y * alpha, hs.z.max(0.0)).normalize_or(Vec3::Z)
+}
+
 /// Uniform point on a triangle as barycentric weights (b1, b2) of vertices 1 and 2.
 #[inline]
 pub fn triangle_barycentrics(u: [f32; 2]) -> (f32, f32) {

@@ -98,6 +98,15 @@ pub struct Material {
     /// opacity there; only `d`/`Tr` are).
     #[serde(default)]
     pub texture_alpha: bool,
+    /// How the CPU reference's path tracer shades the surface: `true` = the
+    /// metallic-roughness GGX model (Lambert lobe + Trowbridge-Reitz specular
+    /// lobe from `roughness`, `metallic`, `base_color`; docs/reference.md,
+    /// "Glossy GI"); `false` (default) = Lambert with albedo `base_color`,
+    /// whatever `roughness` and `metallic` say — the reference's model before
+    /// GGX, so materials that do not opt in keep their results and cache keys.
+    /// The GPU renderer ignores it (it always adds its GGX lobe).
+    #[serde(default)]
+    pub glossy: bool,
 }
 
 impl Default for Material {
@@ -112,6 +121,7 @@ impl Default for Material {
             metallic: 0.0,
             alpha_cutoff: None,
             texture_alpha: false,
+            glossy: false,
         }
     }
 }
@@ -129,6 +139,17 @@ impl Material {
             name: name.into(),
             base_color: [0.0; 3],
             emission: radiance,
+            ..Default::default()
+        }
+    }
+    /// A glossy material for the CPU reference's GGX model ([`Material::glossy`]).
+    pub fn glossy(name: &str, rgb: [f32; 3], roughness: f32, metallic: f32) -> Self {
+        Self {
+            name: name.into(),
+            base_color: rgb,
+            roughness,
+            metallic,
+            glossy: true,
             ..Default::default()
         }
     }

@@ -9,6 +9,8 @@
 //! | `column-wall` | a column standing 0.5 m in front of a wall (AO tests) |
 //! | `mirror` | a mirror floor before a grey board that hides a red panel from the camera but not from the mirror (DGB §3.6) |
 //! | `glasshouse` | coloured glass panes overlapping in view, a translucent sphere before opaque blocks: ≥ 8 transparent crossings per pixel (A-buffer OIT, ABA) |
+//! | `still-life` | glossy and diffuse objects on a cloth, an orange emitter hidden from the camera, a hollow "skull" box whose inside the emitter cannot see (bounced z-buffer Fig. 1 / Fig. 8 rows 2–3) |
+//! | `dominoes` | 115 coloured dominoes in a spiral on a glossy metal floor, 1,382 triangles (bounced z-buffer Fig. 8, last rows) |
 //!
 //! Static geometry is merged into one object per material, named after the
 //! material (e.g. `banner_red`); animated parts are separate objects.
@@ -30,6 +32,8 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "dense",
     "mirror",
     "glasshouse",
+    "still-life",
+    "dominoes",
 ];
 
 /// The built-in scene called `name`, or `None` when there is none.
@@ -43,6 +47,8 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "dense" => Some(dense()),
         "mirror" => Some(mirror()),
         "glasshouse" => Some(glasshouse()),
+        "still-life" => Some(still_life()),
+        "dominoes" => Some(dominoes()),
         _ => None,
     }
 }
@@ -710,4 +716,164 @@ pub fn glasshouse() -> Scene {
         ambient: [0.05; 3],
     };
     b.finish(camera, lights, settings)
+}
+
+/// `still-life` dimensions (metres) the tests need.
+pub mod still_life_dims {
+    use glam::Vec3;
+    /// The emitter quad: centre, half extents (it faces +X).
+    pub const EMITTER_CENTRE: Vec3 = Vec3::new(-3.6, 1.0, -0.9);
+    pub const EMITTER_HALF_Y: f32 = 0.6;
+    pub const EMITTER_HALF_Z: f32 = 0.4;
+    /// The hollow "skull" box: outer bounds and wall thickness; open toward +Z.
+    pub const SKULL_MIN: Vec3 = Vec3::new(0.15, 0.0, -0.45);
+    pub const SKULL_MAX: Vec3 = Vec3::new(0.75, 0.45, 0.05);
+    pub const SKULL_WALL: f32 = 0.04;
+}
+
+/// Bounced z-buffer (Nalbach et al. 2016) Fig. 1 / Fig. 8 "still life", built
+/// from primitives: a red cloth, a back wall with raised yellow letters
+/// ("LIT"), a glossy gold sphere (metal, roughness 0.25), a glossy blue vase
+/// (dielectric, roughness 0.15), two diffuse pears, and the "skull": a hollow
+/// bone-white box open toward the camera (+Z). The only light is an orange
+/// emissive quad (radiance (16, 7.2, 2.4)) at x = −3.6 facing +X, outside the
+/// view (≥ 40° off the camera axis) but lighting the objects from the left,
+/// with a matching [`Light::Rect`] for the GPU; black sky. Every point of
+/// the emitter has z ≤ −0.5 while the skull's opening is the plane z = 0.05, so
+/// no segment from the emitter reaches its inside: only indirect light can
+/// (screen-space GI wrongly lights it from the cloth, as in the paper).
+pub fn still_life() -> Scene {
+    use still_life_dims::*;
+    let mut b = SceneBuilder::new("still-life");
+    let cloth = b.material(Material {
+        roughness: 1.0,
+        ..Material::diffuse("cloth", [0.55, 0.1, 0.08])
+    });
+    let wall = b.material(Material {
+        roughness: 1.0,
+        ..Material::diffuse("wall", [0.7, 0.68, 0.62])
+    });
+    let letters = b.material(Material {
+        roughness: 1.0,
+        ..Material::diffuse("letters", [0.85, 0.65, 0.1])
+    });
+    let bone = b.material(Material {
+        roughness: 1.0,
+        ..Material::diffuse("skull", [0.8, 0.77, 0.68])
+    });
+    let pear = b.material(Material {
+        roughness: 1.0,
+        ..Material::diffuse("pear", [0.45, 0.55, 0.08])
+    });
+    let gold = b.material(Material::glossy("gold", [1.0, 0.78, 0.34], 0.25, 1.0));
+    let vase = b.material(Material::glossy("vase", [0.08, 0.2, 0.65], 0.15, 0.0));
+    let light_rgb = [16.0, 7.2, 2.4];
+    let lamp = b.material(Material::emissive("lamp", light_rgb));
+
+    // cloth (floor) 8 × 6 m, back wall at z = −1.5
+    b.geo(cloth).rect(v(0.0, 0.0, 0.5), v(0.0, 0.0, 3.0), v(4.0, 0.0, 0.0));
+    b.geo(wall).rect(v(0.0, 1.5, -1.5), v(4.0, 0.0, 0.0), v(0.0, 1.5, 0.0));
+    // raised letters "LIT" on the wall (5 cm deep)
+    let (z0, z1) = (-1.5, -1.45);
+    let bar = |b: &mut SceneBuilder, x0: f32, y0: f32, x1: f32, y1: f32| {
+        b.geo(letters).cuboid(v(x0, y0, z0), v(x1, y1, z1));
+    };
+    // L
+    bar(&mut b, -1.3, 0.8, -1.2, 1.5);
+    bar(&mut b, -1.2, 0.8, -0.9, 0.9);
+    // I
+    bar(&mut b, -0.6, 0.8, -0.5, 1.5);
+    // T
+    bar(&mut b, -0.2, 1.4, 0.3, 1.5);
+    bar(&mut b, 0.0, 0.8, 0.1, 1.4);
+    // the skull: five walls, open toward +Z
+    let (lo, hi, t) = (SKULL_MIN, SKULL_MAX, SKULL_WALL);
+    b.geo(bone).cuboid(lo, v(hi.x, lo.y + t, hi.z)); // bottom
+    b.geo(bone).cuboid(v(lo.x, hi.y - t, lo.z), hi); // top
+    b.geo(bone).cuboid(v(lo.x, lo.y + t, lo.z), v(lo.x + t, hi.y - t, hi.z)); // left
+    b.geo(bone).cuboid(v(hi.x - t, lo.y + t, lo.z), v(hi.x, hi.y - t, hi.z)); // right
+    b.geo(bone).cuboid(v(lo.x + t, lo.y + t, lo.z), v(hi.x - t, hi.y - t, lo.z + t)); // back
+    // glossy objects
+    b.geo(gold).sphere(v(-0.55, 0.3, -0.3), 0.3, 48, 24);
+    b.geo(vase).cylinder(v(1.25, 0.0, -0.6), 0.16, 0.7, 40, true);
+    // pears
+    b.geo(pear).sphere(v(-1.15, 0.14, 0.45), 0.14, 32, 16);
+    b.geo(pear).sphere(v(-1.0, 0.27, 0.45), 0.09, 32, 16);
+    b.geo(pear).sphere(v(-0.7, 0.12, 0.7), 0.12, 32, 16);
+    // the emitter, facing +X (half_u × half_v = Y × Z = +X)
+    let (hu, hv) = (v(0.0, EMITTER_HALF_Y, 0.0), v(0.0, 0.0, EMITTER_HALF_Z));
+    b.geo(lamp).rect(EMITTER_CENTRE, hu, hv);
+    let lights = vec![Light::Rect {
+        center: EMITTER_CENTRE,
+        half_u: hu,
+        half_v: hv,
+        radiance: light_rgb,
+    }];
+    let camera = Camera::new(v(0.3, 1.1, 3.2), v(0.0, 0.35, -0.3), Vec3::Y, 38.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.3,
+        min_separation: 0.05,
+        radiosity_radius: 1.5,
+        exposure: 1.0,
+        sky: [0.0; 3],
+        ambient: [0.01; 3],
+    };
+    b.finish(camera, lights, settings)
+}
+
+/// Number of dominoes in [`dominoes`].
+pub const DOMINO_COUNT: usize = 115;
+
+/// Bounced z-buffer Fig. 8 (last rows): [`DOMINO_COUNT`] dominoes (10 × 20 × 3
+/// cm boxes, 12 triangles each) in six glossy
+/// plastic colours (dielectric, roughness 0.4), standing along an Archimedean
+/// spiral 8 cm apart, on a polished metal floor (metallic 1, roughness 0.12):
+/// 1,382 triangles. A low warm sun from the side and a blue sky; much of the
+/// coloured light the floor and the dominoes exchange comes from faces the
+/// camera does not see.
+pub fn dominoes() -> Scene {
+    let mut b = SceneBuilder::new("dominoes");
+    let floor = b.material(Material::glossy("floor", [0.62, 0.62, 0.64], 0.12, 1.0));
+    let colours: [(&str, [f32; 3]); 6] = [
+        ("domino_red", [0.8, 0.08, 0.06]),
+        ("domino_orange", [0.9, 0.4, 0.05]),
+        ("domino_yellow", [0.85, 0.75, 0.1]),
+        ("domino_green", [0.1, 0.6, 0.15]),
+        ("domino_blue", [0.06, 0.2, 0.8]),
+        ("domino_purple", [0.5, 0.1, 0.7]),
+    ];
+    let mats: Vec<usize> = colours
+        .iter()
+        .map(|(n, c)| b.material(Material::glossy(n, *c, 0.4, 0.0)))
+        .collect();
+    b.geo(floor).rect(v(0.0, 0.0, 0.0), v(0.0, 0.0, 4.0), v(4.0, 0.0, 0.0));
+    let (half_w, half_h, half_t) = (0.05, 0.1, 0.015);
+    let (r0, pitch, spacing) = (0.35f32, 0.22f32, 0.08f32);
+    let mut theta = 0.0f32;
+    for i in 0..DOMINO_COUNT {
+        let r = r0 + pitch * theta / std::f32::consts::TAU;
+        let p = v(r * theta.cos(), half_h, r * theta.sin());
+        // tangent of the spiral: d/dθ (r cos θ, r sin θ)
+        let dr = pitch / std::f32::consts::TAU;
+        let tangent = v(dr * theta.cos() - r * theta.sin(), 0.0, dr * theta.sin() + r * theta.cos()).normalize();
+        let across = Vec3::Y.cross(tangent);
+        b.geo(mats[i % mats.len()])
+            .oriented_box(p, [across * half_w, Vec3::Y * half_h, tangent * half_t]);
+        theta += spacing / r;
+    }
+    let sun = Light::Sun {
+        direction: v(-0.7, -0.45, -0.35).normalize(),
+        color: [1.0, 0.9, 0.75],
+        illuminance: 3.0,
+    };
+    let camera = Camera::new(v(0.3, 1.15, 2.1), v(0.0, 0.0, 0.05), Vec3::Y, 40.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.12,
+        min_separation: 0.02,
+        radiosity_radius: 0.6,
+        exposure: 1.0,
+        sky: [0.25, 0.3, 0.4],
+        ambient: [0.03; 3],
+    };
+    b.finish(camera, vec![sun], settings)
 }

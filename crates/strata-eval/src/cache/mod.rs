@@ -207,6 +207,9 @@ fn materials_fingerprint(materials: &[strata_scene::Material]) -> String {
         if m.texture_alpha {
             t += " texture_alpha";
         }
+        if m.glossy {
+            t += " glossy";
+        }
         t
     };
     format!("[{}]", materials.iter().map(one).collect::<Vec<_>>().join(", "))
@@ -422,6 +425,9 @@ mod tests {
         assert_ne!(materials_fingerprint(&m), old);
         m[0].alpha_cutoff = None;
         m[0].texture_alpha = true;
+        assert_ne!(materials_fingerprint(&m), old);
+        m[0].texture_alpha = false;
+        m[0].glossy = true;
         assert_ne!(materials_fingerprint(&m), old);
     }
 

@@ -2,9 +2,11 @@
 //! One test binary (faster to link); one module per oracle.
 
 mod ao;
+mod builtin_scenes;
 mod bvh;
 mod converge;
 mod gi;
+mod glossy;
 mod layers;
 mod oit;
 mod scenes;

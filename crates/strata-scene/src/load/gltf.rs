@@ -63,6 +63,7 @@ pub(super) fn mesh_file(bytes: &[u8], path: &Path, files: &dyn FileSource) -> Re
             metallic: pbr.metallic_factor(),
             alpha_cutoff: (m.alpha_mode() == gltf::material::AlphaMode::Mask).then(|| m.alpha_cutoff().unwrap_or(0.5)),
             texture_alpha: m.alpha_mode() != gltf::material::AlphaMode::Opaque,
+            glossy: false,
         };
         check_material(path, &mut mat)?;
         let mut uv_set = 0;
