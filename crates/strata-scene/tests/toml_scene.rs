@@ -284,3 +284,25 @@ fn dragon_glass_toml_is_transparent_and_stacked() {
         assert_eq!(m.opacity, 0.3, "{}", m.name);
     }
 }
+
+#[test]
+fn material_override_sets_glossy_roughness_and_metallic_in_range() {
+    let s = load_toml_str(
+        "builtin = \"plane\"\n[[material]]\nname = \"*\"\nglossy = true\nroughness = 0.2\nmetallic = 1\n",
+        std::path::Path::new("g.toml"),
+    )
+    .unwrap();
+    assert!(s.materials.iter().all(|m| m.glossy && m.roughness == 0.2 && m.metallic == 1.0));
+    let base = builtin("plane").unwrap();
+    assert!(base.materials.iter().all(|m| !m.glossy), "the override is what set it");
+    for f in ["roughness", "metallic"] {
+        let e = toml_err(
+            "gl.toml",
+            &format!("builtin = \"plane\"\n[[material]]\nname = \"grey\"\n{f} = 1.5\n"),
+        );
+        assert!(
+            e.starts_with("gl.toml") && e.contains(&format!("material[0].{f}")) && e.contains("0..=1"),
+            "{e}"
+        );
+    }
+}

@@ -71,6 +71,10 @@ struct TomlMaterial {
     name: String,
     opacity: Option<f32>,
     base_color: Option<[f32; 3]>,
+    roughness: Option<f32>,
+    metallic: Option<f32>,
+    /// The CPU reference's GGX model (`Material::glossy`).
+    glossy: Option<bool>,
 }
 
 /// `[repeat]`: `count` copies of the base scene's objects, copy i translated
@@ -387,10 +391,26 @@ fn override_material(i: usize, m: &TomlMaterial, ck: &Check, scene: &mut Scene) 
         }
         c => c,
     };
+    let unit = |v: Option<f32>, f: &str| match v {
+        Some(x) if !(x.is_finite() && (0.0..=1.0).contains(&x)) => {
+            Err(ck.err(&k(f), format!("{x} is out of range: must be in 0..=1")))
+        }
+        x => Ok(x),
+    };
+    let (roughness, metallic) = (unit(m.roughness, "roughness")?, unit(m.metallic, "metallic")?);
     let mut found = false;
     for mat in scene.materials.iter_mut().filter(|x| m.name == "*" || x.name == m.name) {
         if let Some(a) = opacity {
             mat.opacity = a;
+        }
+        if let Some(r) = roughness {
+            mat.roughness = r;
+        }
+        if let Some(v) = metallic {
+            mat.metallic = v;
+        }
+        if let Some(g) = m.glossy {
+            mat.glossy = g;
         }
         if let Some(c) = base_color {
             mat.base_color = c;
