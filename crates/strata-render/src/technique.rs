@@ -622,7 +622,7 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
     s.bzb.clone().unwrap_or_default()
 }
 
-static BZB_SETTINGS: [SettingInfo; 7] = [
+static BZB_SETTINGS: [SettingInfo; 8] = [
     SettingInfo {
         name: "visibility",
         doc: "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
@@ -630,6 +630,15 @@ static BZB_SETTINGS: [SettingInfo; 7] = [
         integer: true,
         get: |s| Some(bzb_of(s).visibility as u32 as f64),
         set: |s, v| bzb_mut(s).visibility = v != 0.0,
+        values: &["off", "on"],
+    },
+    SettingInfo {
+        name: "culling",
+        doc: "cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_of(s).culling as u32 as f64),
+        set: |s, v| bzb_mut(s).culling = v != 0.0,
         values: &["off", "on"],
     },
     setting!(
@@ -883,6 +892,7 @@ fn configure_bzb_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), 
 
 const BZB_AO_PASSES: &[&str] = &[
     "bzb-directions",
+    "bzb-zminmax",
     "bzb-splat",
     "bzb-reconstruct",
     "bzb-blur-h",

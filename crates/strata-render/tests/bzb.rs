@@ -514,3 +514,32 @@ fn settings_errors_name_the_parameter_and_range() {
     s.ao = Some(Default::default());
     assert!(s.validate().unwrap_err().to_string().contains("ao target"));
 }
+
+#[test]
+fn depth_tile_culling_leaves_the_image_unchanged() {
+    // issue 13 item 4: splats are culled only where no receiver under them is
+    // within their depth range, so the bounced z-buffer, the payload and the
+    // AO are the same bits with and without culling, in both modes
+    let gpu = common::gpu();
+    for scene in [
+        strata_scene::procedural::builtin("atrium").unwrap(),
+        strata_scene::procedural::builtin("cornell").unwrap(),
+    ] {
+        for visibility in [true, false] {
+            let b = |culling: bool| BzbSettings {
+                visibility,
+                culling,
+                ..Default::default()
+            };
+            let (on, off) = (render(&gpu, &scene, b(true)), render(&gpu, &scene, b(false)));
+            for t in ["bzb-payload", "bzb-raw", "ao"] {
+                let (a, c) = (on.read_target(&gpu, t).unwrap(), off.read_target(&gpu, t).unwrap());
+                let differ = a.data.iter().zip(&c.data).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
+                assert_eq!(differ, 0, "{} visibility={visibility} {t}: {differ} values differ", scene.name);
+            }
+            let mean = on.read_target(&gpu, "ao").unwrap();
+            let occluded = mean.data.iter().filter(|&&v| v < 0.9).count();
+            assert!(occluded > 20, "{}: the scene occludes ({occluded})", scene.name);
+        }
+    }
+}

@@ -25,7 +25,16 @@ struct Bzb {
     // 1 = bounced z-buffer (depth test), 0 = additive AOV baseline
     visibility: u32,
     triangles: u32,
-    _pad1: u32,
+    // 1 = splats whose depth range misses every receiver under them are culled
+    culling: u32,
+}
+
+// The min/max depth tiles (bzb_zminmax.wgsl): ZMINMAX_LEVELS levels of square
+// tiles, 8, 32, 128 pixels, then one tile over the whole image.
+const ZMINMAX_LEVELS: u32 = 4u;
+
+fn zminmax_tile(level: u32) -> u32 {
+    return select(8u << (2u * level), 0x40000000u, level == ZMINMAX_LEVELS - 1u);
 }
 
 // §3.1 / Fig. 5: direction s of pixel p lives in sub-image s; sub-image s is the

@@ -17,6 +17,36 @@
 @group(1) @binding(2) var origins: texture_2d<f32>;
 @group(1) @binding(3) var directions: texture_2d<f32>;
 @group(1) @binding(4) var npack: texture_2d<f32>;
+// min/max receiver depth per tile (bzb_zminmax.wgsl)
+@group(1) @binding(5) var<storage, read> tiles: array<vec2f>;
+
+// Whether some receiver under the pixel rectangle [rmin, rmax) has a camera
+// depth in [zlo, zhi]: the tiles of the finest level on which the rectangle
+// spans at most 3 × 3 of them.
+fn receivers_in_range(rmin: vec2f, rmax: vec2f, zlo: f32, zhi: f32) -> bool {
+    let size = vec2u(frame.size.xy);
+    let extent = max(rmax.x - rmin.x, rmax.y - rmin.y);
+    var offset = 0u;
+    for (var level = 0u; level < ZMINMAX_LEVELS; level++) {
+        let t = zminmax_tile(level);
+        let n = (size + vec2u(t - 1u)) / t;
+        if (extent <= 2.0 * f32(t) || level == ZMINMAX_LEVELS - 1u) {
+            let t0 = min(vec2u(rmin) / t, n - 1u);
+            let t1 = min(vec2u(max(rmax - 1.0, rmin)) / t, n - 1u);
+            for (var y = t0.y; y <= t1.y; y++) {
+                for (var x = t0.x; x <= t1.x; x++) {
+                    let r = tiles[offset + y * n.x + x];
+                    if (r.x <= zhi && r.y >= zlo) {
+                        return true;
+                    }
+                }
+            }
+            return false;
+        }
+        offset += n.x * n.y;
+    }
+    return true;
+}
 
 struct SplatVertex {
     @builtin(position) position: vec4f,
@@ -56,8 +86,14 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     var rmin = vec2f(1e30);
     var rmax = vec2f(-1e30);
     var in_front = 0u;
+    // camera-depth range of the grown box: every receiver it can occlude is in it
+    var zlo = 1e30;
+    var zhi = -1e30;
     for (var k = 0u; k < 8u; k++) {
         let q = select(lo, hi, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
+        let zq = dot(q - frame.eye.xyz, frame.cam_forward.xyz);
+        zlo = min(zlo, zq);
+        zhi = max(zhi, zq);
         let p = project(q);
         if (p.z > 0.0) {
             in_front++;
@@ -77,6 +113,10 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     rmin = clamp(floor(rmin) - 1.0, vec2f(0.0), size);
     rmax = clamp(ceil(rmax) + 1.0, vec2f(0.0), size);
     if (any(rmax <= rmin)) {
+        return out;
+    }
+    // issue 13 item 4: no receiver under the splat within its depth range
+    if (bzb.culling == 1u && !receivers_in_range(rmin, rmax, zlo, zhi)) {
         return out;
     }
     // corners of two triangles: (0,0) (1,0) (0,1) / (0,1) (1,0) (1,1)

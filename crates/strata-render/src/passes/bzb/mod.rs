@@ -76,6 +76,10 @@ pub struct BzbSettings {
     pub seed: u32,
     /// The cross-bilateral reconstruction filter (§3.3).
     pub filter: BilateralSettings,
+    /// Cull splats whose camera-depth range misses every receiver under them,
+    /// from min/max depth tiles (issue 13 item 4, BZB Table 3's "MIP map"); the
+    /// image is the same either way.
+    pub culling: bool,
 }
 
 impl Default for BzbSettings {
@@ -92,6 +96,7 @@ impl Default for BzbSettings {
                 step: 1,
                 ..BilateralSettings::default()
             },
+            culling: true,
         }
     }
 }
@@ -134,7 +139,10 @@ impl BzbSettings {
     pub fn estimated_bytes(&self, w: u32, h: u32, triangles: u64) -> u64 {
         let (c, r) = self.grid();
         let px = w as u64 * h as u64;
-        px * (c * r) as u64 * (16 + 16 + 2 + 4) + px * (4 + 2 + 2) + triangles * 48
+        px * (c * r) as u64 * (16 + 16 + 2 + 4)
+            + px * (4 + 2 + 2)
+            + triangles * 48
+            + zminmax_tile_count(w, h) as u64 * 8
     }
 }
 
@@ -153,7 +161,7 @@ pub struct BzbUniforms {
     pub hemisphere: u32,
     pub visibility: u32,
     pub triangles: u32,
-    pub _pad1: u32,
+    pub culling: u32,
 }
 
 impl BzbUniforms {
@@ -172,7 +180,7 @@ impl BzbUniforms {
             hemisphere: s.hemisphere as u32,
             visibility: s.visibility as u32,
             triangles,
-            _pad1: 0,
+            culling: s.culling as u32,
         }
     }
 }
@@ -357,6 +365,43 @@ pub const RAW: TargetDesc = TargetDesc::new(
     "BZB §3.3 AV = 1 - mean weighted occlusion over the S directions, before filtering",
 );
 
+/// Square tile sizes of the min/max depth tiles (`zminmax_tile` in bzb.wgsl);
+/// the last level is one tile over the whole image.
+pub const ZMINMAX_TILES: [u32; 3] = [8, 32, 128];
+
+/// Tiles of every level at `w`×`h` (the `bzb-zminmax` buffer holds one vec2 each).
+pub fn zminmax_tile_count(w: u32, h: u32) -> u32 {
+    ZMINMAX_TILES.iter().map(|t| w.div_ceil(*t) * h.div_ceil(*t)).sum::<u32>() + 1
+}
+
+/// Min/max receiver depth per tile (compute), for the splat pass's culling.
+pub struct ZMinMaxPass {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    tiles: u32,
+}
+
+impl Pass for ZMinMaxPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: "bzb-zminmax",
+            inputs: vec![ORIGINS.name],
+            outputs: vec!["bzb-zminmax"],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("bzb-zminmax"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.dispatch_workgroups(self.tiles.div_ceil(64), 1, 1);
+    }
+}
+
 /// The triangles of the scene in a storage buffer (vertex pulling).
 struct TriangleBuffer {
     buffer: wgpu::Buffer,
@@ -379,7 +424,7 @@ impl Pass for SplatPass {
         }
         PassInfo {
             name: "bzb-splat",
-            inputs: vec!["scene", ORIGINS.name, DIRECTIONS.name, "npack"],
+            inputs: vec!["scene", ORIGINS.name, DIRECTIONS.name, "npack", "bzb-zminmax"],
             outputs,
         }
     }
@@ -421,6 +466,7 @@ macro_rules! bzb_shader {
 /// The BZB AO passes of a frame, into target `ao`.
 pub(crate) struct BzbStage {
     pub(crate) directions: FullscreenPass,
+    pub(crate) zminmax: ZMinMaxPass,
     pub(crate) splat: SplatPass,
     pub(crate) reconstruct: FullscreenPass,
     pub(crate) blur_h: BilateralPass,
@@ -522,7 +568,15 @@ impl BzbStage {
             contents: bytemuck::bytes_of(&u),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        let splat = Self::splat_pass(gpu, scene_gpu, targets, s, &uniforms, &buffer, count);
+        let tile_count = zminmax_tile_count(w, h);
+        let tiles = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bzb-zminmax"),
+            size: tile_count as u64 * 8,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let zminmax = Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count);
+        let splat = Self::splat_pass(gpu, scene_gpu, targets, s, &uniforms, &buffer, &tiles, count);
         let blur_h = BilateralPass::new(
             gpu,
             scene_gpu,
@@ -545,6 +599,7 @@ impl BzbStage {
         );
         Ok(Self {
             directions,
+            zminmax,
             splat,
             reconstruct,
             blur_h,
@@ -556,6 +611,71 @@ impl BzbStage {
         })
     }
 
+    fn zminmax_pass(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &Targets,
+        tiles: &wgpu::Buffer,
+        tile_count: u32,
+    ) -> ZMinMaxPass {
+        let device = &gpu.device;
+        let comp = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bzb-zminmax"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let group = crate::passes::bind_group(
+            device,
+            "bzb-zminmax",
+            &layout,
+            &[
+                wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+                tiles.as_entire_binding(),
+            ],
+        );
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("bzb-zminmax"),
+            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(device, "bzb-zminmax", bzb_shader!("bzb_zminmax.wgsl"));
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("bzb-zminmax"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("cs_main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        ZMinMaxPass {
+            pipeline,
+            group,
+            tiles: tile_count,
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn splat_pass(
         gpu: &GpuContext,
         scene_gpu: &GpuScene,
@@ -563,6 +683,7 @@ impl BzbStage {
         s: &BzbSettings,
         uniforms: &wgpu::Buffer,
         triangles: &wgpu::Buffer,
+        tiles: &wgpu::Buffer,
         count: u32,
     ) -> SplatPass {
         let device = &gpu.device;
@@ -603,6 +724,16 @@ impl BzbStage {
                 tex(2),
                 tex(3),
                 tex(4),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::VERTEX,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
             ],
         });
         let group = crate::passes::bind_group(
@@ -615,6 +746,7 @@ impl BzbStage {
                 wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
                 wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
                 wgpu::BindingResource::TextureView(&targets.get("npack").view),
+                tiles.as_entire_binding(),
             ],
         );
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -701,6 +833,7 @@ impl BzbStage {
     pub fn passes(&self) -> Vec<&dyn Pass> {
         vec![
             &self.directions,
+            &self.zminmax,
             &self.splat,
             &self.reconstruct,
             &self.blur_h,
