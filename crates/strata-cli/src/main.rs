@@ -13,6 +13,7 @@ mod render;
 mod report_cmd;
 mod soak;
 mod techniques;
+mod view;
 
 use clap::Parser;
 
@@ -60,6 +61,7 @@ fn main() {
         args::Command::Report(a) => report_cmd::run(&a),
         args::Command::ExportScene(a) => export::run(&a),
         args::Command::Compare(a) => compare::run(&a),
+        args::Command::View(a) => view::run(&a),
     };
     if let Err(e) = result {
         // One line: what is wrong and what is valid.
