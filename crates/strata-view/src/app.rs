@@ -323,6 +323,7 @@ impl App {
                         self.say(format!("motion scale {s} is out of range: must be in 0.1..=1"), true);
                     }
                 }
+                Action::Fit(on) => self.fit_window = on,
                 Action::Resize(w, h) => {
                     if let Some(g) = &self.gfx {
                         let _ = g.window.request_inner_size(winit::dpi::PhysicalSize::new(w, h));

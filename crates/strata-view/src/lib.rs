@@ -107,6 +107,8 @@ pub enum Action {
     Record(Option<PathBuf>),
     MotionScale(f32),
     Resize(u32, u32),
+    /// The render size follows the viewport's size.
+    Fit(bool),
 }
 
 /// Everything `strata view` starts from.

@@ -16,6 +16,7 @@
 //! record-start | record-stop PATH           record a camera path to a TOML scene file
 //! motion-scale 0.5     internal resolution while the camera moves (1 = off)
 //! resize W H           request a new window inner size (physical pixels)
+//! fit on|off           render size follows the viewport (on) or stays --width × --height
 //! ```
 //!
 //! Key presses and drags become the same [`crate::camera::Input`]s as real events, and
@@ -115,6 +116,11 @@ impl Script {
                 "record-stop" => act(Action::Record(Some(rest.join(" ").into()))),
                 "motion-scale" => act(Action::MotionScale(num(0)?)),
                 "resize" => act(Action::Resize(frames(0)?, frames(1)?)),
+                "fit" => act(Action::Fit(match arg(0)? {
+                    "on" => true,
+                    "off" => false,
+                    v => return Err(err(format!("'{v}': use on or off"))),
+                })),
                 _ => return Err(err(format!("unknown command '{cmd}'"))),
             }
         }

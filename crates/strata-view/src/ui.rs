@@ -231,7 +231,10 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
 
     // resolution
     ui.label(format!("render size {}×{}", app.render_size.0, app.render_size.1));
-    ui.checkbox(&mut app.fit_window, "fit render size to the window");
+    let mut fit = app.fit_window;
+    if ui.checkbox(&mut fit, "fit render size to the window").changed() {
+        app.actions.push(Action::Fit(fit));
+    }
     let mut m = app.motion_scale;
     if ui
         .add(egui::Slider::new(&mut m, 0.1..=1.0).text("scale while moving"))

@@ -1,0 +1,419 @@
+//! `strata view` in a real window under Xvfb (lavapipe when no GPU): the viewport equals
+//! `strata render` of the same camera and settings, scripted input moves the camera and
+//! switches technique and debug view through the viewer's own input path, and a bad file
+//! leaves the viewer running. Skipped (and logged in `$STRATA_SKIP_LOG`) only when no
+//! `Xvfb` binary exists (`scripts/setup.sh` installs it).
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+/// The most ꟻLIP allowed between a viewer screenshot and `strata render` of its command:
+/// both are the same target read back and encoded by the same code, so they are expected
+/// to be identical (measured: 0 on lavapipe); the bound leaves room for GPU
+/// non-determinism on other adapters.
+const FLIP_BOUND: f32 = 0.01;
+
+/// An `Xvfb` server on its own display, killed when dropped.
+struct XServer {
+    child: Child,
+    display: String,
+}
+
+impl Drop for XServer {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn find_xvfb() -> Option<PathBuf> {
+    std::env::var_os("PATH")?
+        .to_str()?
+        .split(':')
+        .map(|d| Path::new(d).join("Xvfb"))
+        .find(|p| p.is_file())
+}
+
+static NEXT_DISPLAY: AtomicU32 = AtomicU32::new(0);
+
+/// Starts Xvfb, or records why the test cannot run and returns None.
+fn xvfb(test: &str) -> Option<XServer> {
+    let Some(bin) = find_xvfb() else {
+        strata_scene::skip::note_skip(test, "Xvfb not found on PATH (scripts/setup.sh installs the xvfb package)");
+        return None;
+    };
+    for _ in 0..50 {
+        let n = 200 + (std::process::id() % 300) * 8 + NEXT_DISPLAY.fetch_add(1, Ordering::SeqCst) % 2000;
+        if Path::new(&format!("/tmp/.X{n}-lock")).exists() || Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
+            continue;
+        }
+        let child = Command::new(&bin)
+            .args([format!(":{n}").as_str(), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("Xvfb exists but does not start");
+        let server = XServer {
+            child,
+            display: format!(":{n}"),
+        };
+        let t0 = Instant::now();
+        while t0.elapsed() < Duration::from_secs(20) {
+            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
+                return Some(server);
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+    panic!("Xvfb did not come up on any display");
+}
+
+fn strata(display: Option<&str>, args: &[&str]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
+    cmd.args(args);
+    if let Some(d) = display {
+        cmd.env("DISPLAY", d);
+    }
+    cmd.env_remove("WAYLAND_DISPLAY");
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = std::env::temp_dir().join("strata-xdg-view-tests");
+        std::fs::create_dir_all(&dir).unwrap();
+        cmd.env("XDG_RUNTIME_DIR", dir);
+    }
+    cmd.output().expect("failed to start strata")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn ok(o: &Output) -> &Output {
+    assert!(o.status.success(), "strata failed: {}\n{}", text(&o.stderr), text(&o.stdout));
+    o
+}
+
+fn scratch(test: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("view").join(test);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// `strata view --frames N --screenshot shot.png [--script]` in the X server; returns
+/// (output, screenshot path).
+fn view(x: &XServer, dir: &Path, name: &str, frames: u32, script: Option<&str>, extra: &[&str]) -> (Output, PathBuf) {
+    let shot = dir.join(format!("{name}.png"));
+    let frames = frames.to_string();
+    let mut args = vec!["view", "--frames", &frames, "--screenshot", shot.to_str().unwrap()];
+    let script_path = dir.join(format!("{name}.script"));
+    if let Some(s) = script {
+        std::fs::write(&script_path, s).unwrap();
+        args.extend(["--script", script_path.to_str().unwrap()]);
+    }
+    args.extend(extra);
+    let o = strata(Some(&x.display), &args);
+    (o, shot)
+}
+
+/// RGB8 pixels of a PNG.
+fn rgb(path: &Path) -> (u32, u32, Vec<u8>) {
+    let img = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8();
+    let (w, h) = img.dimensions();
+    (w, h, img.into_raw())
+}
+
+/// Mean ꟻLIP between two PNGs of the same size (sRGB bytes, as strata-eval's metrics).
+fn flip(a: &Path, b: &Path) -> f32 {
+    let (wa, ha, pa) = rgb(a);
+    let (wb, hb, pb) = rgb(b);
+    assert_eq!((wa, ha), (wb, hb), "{} vs {}: sizes differ", a.display(), b.display());
+    let e = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(wa, ha, &pa),
+        nv_flip::FlipImageRgb8::with_data(wb, hb, &pb),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    nv_flip::FlipPool::from_image(&e).mean()
+}
+
+/// Not a flat image: luma spread and many distinct colours.
+fn assert_not_flat(path: &Path) {
+    let (_, _, p) = rgb(path);
+    let luma: Vec<f64> = p.chunks_exact(3).map(|c| 0.3 * c[0] as f64 + 0.59 * c[1] as f64 + 0.11 * c[2] as f64).collect();
+    let mean = luma.iter().sum::<f64>() / luma.len() as f64;
+    let sd = (luma.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / luma.len() as f64).sqrt();
+    let mut colours: Vec<[u8; 3]> = p.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    colours.sort();
+    colours.dedup();
+    assert!(sd > 10.0 && colours.len() > 50, "{} is nearly flat: luma sd {sd:.1}, {} colours", path.display(), colours.len());
+}
+
+/// Runs the `strata render …` command a screenshot's `.cmd.txt` holds, writing `out`.
+fn run_cmd_txt(shot: &Path, out: &Path) -> String {
+    let cmd_path = shot.with_extension("cmd.txt");
+    let line = std::fs::read_to_string(&cmd_path).unwrap_or_else(|e| panic!("{}: {e}", cmd_path.display()));
+    let line = line.lines().next().unwrap().to_string();
+    let mut words: Vec<String> = line.split(' ').map(String::from).collect();
+    assert_eq!(&words[..2], ["strata", "render"], "{line}");
+    let i = words.iter().position(|w| w == "--out").expect("--out in the command");
+    words[i + 1] = out.display().to_string();
+    let args: Vec<&str> = words[1..].iter().map(|s| s.as_str()).collect();
+    ok(&strata(None, &args));
+    line
+}
+
+const SIZE: [&str; 4] = ["--width", "160", "--height", "120"];
+
+#[test]
+fn viewport_matches_render_and_is_not_flat() {
+    let Some(x) = xvfb("view::viewport_matches_render_and_is_not_flat") else {
+        return;
+    };
+    let dir = scratch("viewport");
+    let (o, shot) = view(&x, &dir, "shot", 6, None, &[&["--scene", "cornell"][..], &SIZE].concat());
+    ok(&o);
+    let err = text(&o.stderr);
+    assert!(err.contains("strata view: adapter "), "the adapter is named: {err}");
+    assert_not_flat(&shot);
+    // an independent render of the scene's own camera, no camera flags
+    let r = dir.join("render.png");
+    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
+    let f = flip(&shot, &r);
+    eprintln!("FLIP(viewer, render) = {f}");
+    assert!(f < FLIP_BOUND, "viewer vs render FLIP {f} >= {FLIP_BOUND}");
+    // and the command it printed reproduces it
+    let r2 = dir.join("cmd.png");
+    let line = run_cmd_txt(&shot, &r2);
+    assert!(text(&o.stdout).contains(&line), "the command is printed too");
+    assert!(flip(&shot, &r2) < FLIP_BOUND);
+}
+
+#[test]
+fn scripted_keys_and_drag_move_the_camera_like_render_with_the_printed_command() {
+    let Some(x) = xvfb("view::scripted_keys_and_drag_move_the_camera") else {
+        return;
+    };
+    let dir = scratch("move");
+    let base = [&["--scene", "cornell"][..], &SIZE].concat();
+    let (o0, still) = view(&x, &dir, "still", 3, None, &base);
+    ok(&o0);
+    let (o, moved) = view(&x, &dir, "moved", 16, Some("wait 1\nkey W 6\nmouse-drag 80 -30\nkey D 3\nwait 2\n"), &base);
+    ok(&o);
+    assert_not_flat(&moved);
+    let d = flip(&still, &moved);
+    assert!(d > 0.05, "moving the camera changes the frame (FLIP {d})");
+    let cmd = std::fs::read_to_string(moved.with_extension("cmd.txt")).unwrap();
+    let still_cmd = std::fs::read_to_string(still.with_extension("cmd.txt")).unwrap();
+    let eye = |c: &str| c.split(" --eye ").nth(1).unwrap().split(' ').next().unwrap().to_string();
+    assert_ne!(eye(&cmd), eye(&still_cmd), "the command names the moved camera");
+    let r = dir.join("render.png");
+    run_cmd_txt(&moved, &r);
+    let f = flip(&moved, &r);
+    eprintln!("FLIP(moved viewer, render of its command) = {f}");
+    assert!(f < FLIP_BOUND, "moved viewer vs render FLIP {f}");
+}
+
+#[test]
+fn scripted_technique_and_debug_view_switch_match_render() {
+    let Some(x) = xvfb("view::scripted_technique_and_debug_view_switch") else {
+        return;
+    };
+    let dir = scratch("switch");
+    let base = [&["--scene", "cornell"][..], &SIZE].concat();
+    let (o0, direct) = view(&x, &dir, "direct", 3, None, &base);
+    ok(&o0);
+    let ao_shot = dir.join("ao.png");
+    let script = format!("technique ao\nwait 3\nscreenshot {}\nwait 1\ndebug-view layer0-normal\nwait 2\n", ao_shot.display());
+    let (o, normal) = view(&x, &dir, "normal", 8, Some(&script), &base);
+    ok(&o);
+    // AO shows ambient visibility as grey
+    let (_, _, p) = rgb(&ao_shot);
+    assert!(p.chunks_exact(3).all(|c| c[0] == c[1] && c[1] == c[2]), "the ao frame is grey");
+    assert_not_flat(&ao_shot);
+    assert!(flip(&direct, &ao_shot) > 0.05, "switching technique changes the frame");
+    let line = run_cmd_txt(&ao_shot, &dir.join("ao-render.png"));
+    assert!(line.contains("--technique ao"), "{line}");
+    let f = flip(&ao_shot, &dir.join("ao-render.png"));
+    eprintln!("FLIP(ao viewer, render) = {f}");
+    assert!(f < FLIP_BOUND, "ao: viewer vs render FLIP {f}");
+    // the debug view
+    let line = run_cmd_txt(&normal, &dir.join("normal-render.png"));
+    assert!(line.contains("--debug-view layer0-normal"), "{line}");
+    assert!(flip(&normal, &dir.join("normal-render.png")) < FLIP_BOUND);
+    assert!(flip(&ao_shot, &normal) > 0.05, "switching debug view changes the frame");
+    // normals as colours: not grey
+    let (_, _, p) = rgb(&normal);
+    assert!(p.chunks_exact(3).filter(|c| c[0] != c[1] || c[1] != c[2]).count() > p.len() / 3 / 4);
+}
+
+#[test]
+fn bad_settings_show_the_cli_error_and_keep_the_frame() {
+    let Some(x) = xvfb("view::bad_settings_show_the_cli_error") else {
+        return;
+    };
+    let dir = scratch("badset");
+    let base = [&["--scene", "cornell", "--technique", "ao"][..], &SIZE].concat();
+    let (o, shot) = view(&x, &dir, "shot", 5, Some("set samples 99999\nlayers 9\ntechnique nope\ndebug-view nope\n"), &base);
+    ok(&o);
+    let err = text(&o.stderr);
+    // render's own messages, one line each
+    for needle in ["--set samples=99999", "out of range", "layers", "unknown technique 'nope'", "unknown debug view 'nope'"] {
+        assert!(err.contains(needle), "stderr lacks '{needle}': {err}");
+    }
+    let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
+    assert!(!cmd.contains("99999") && cmd.contains("--layers 1"), "bad values are not applied: {cmd}");
+    let r = dir.join("render.png");
+    run_cmd_txt(&shot, &r);
+    assert!(flip(&shot, &r) < FLIP_BOUND);
+}
+
+/// A one-quad GLB (no texture).
+fn quad_glb() -> Vec<u8> {
+    let f: Vec<u8> = [-1.0f32, 0.0, -1.0, 1.0, 0.0, -1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 1.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let idx: Vec<u8> = [0u16, 2, 1, 0, 3, 2].iter().flat_map(|i| i.to_le_bytes()).collect();
+    let mut bin = f.clone();
+    bin.extend(&idx);
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+"buffers":[{{"byteLength":{}}}],
+"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":12}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-1,0,-1],"max":[1,0,1]}},
+{{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}}]}}"#,
+        bin.len()
+    );
+    let mut j = json.into_bytes();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let total = 12 + 8 + j.len() + 8 + bin.len();
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((j.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(&j);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(&bin);
+    out
+}
+
+#[test]
+fn truncated_glb_shows_the_error_and_keeps_the_scene() {
+    let Some(x) = xvfb("view::truncated_glb_shows_the_error") else {
+        return;
+    };
+    let dir = scratch("open");
+    let good = dir.join("quad.glb");
+    let bad = dir.join("truncated.glb");
+    let bytes = quad_glb();
+    std::fs::write(&good, &bytes).unwrap();
+    std::fs::write(&bad, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    assert!(strata_scene::load_scene(good.to_str().unwrap()).is_ok(), "the untruncated GLB loads");
+    let base = [&["--scene", "cornell"][..], &SIZE].concat();
+    let (o, shot) = view(&x, &dir, "kept", 6, Some(&format!("wait 1\nopen {}\nwait 2\n", bad.display())), &base);
+    ok(&o);
+    let err = text(&o.stderr);
+    let line = err.lines().find(|l| l.contains("open:")).unwrap_or_else(|| panic!("no open error: {err}"));
+    assert!(line.contains("truncated.glb"), "the error names the file: {line}");
+    // still cornell: equal to its render
+    let r = dir.join("render.png");
+    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
+    assert!(flip(&shot, &r) < FLIP_BOUND, "the current scene is kept");
+    // the good file opens through the same path, and the command names it
+    let (o2, shot2) = view(&x, &dir, "opened", 6, Some(&format!("wait 1\nopen {}\nwait 2\n", good.display())), &base);
+    ok(&o2);
+    assert!(text(&o2.stderr).contains("opened"), "{}", text(&o2.stderr));
+    let cmd = std::fs::read_to_string(shot2.with_extension("cmd.txt")).unwrap();
+    assert!(cmd.contains("quad.glb"), "{cmd}");
+    let r2 = dir.join("render2.png");
+    run_cmd_txt(&shot2, &r2);
+    assert!(flip(&shot2, &r2) < FLIP_BOUND);
+}
+
+#[test]
+fn recorded_path_loads_as_a_scene_and_resize_and_fit_survive() {
+    let Some(x) = xvfb("view::recorded_path_loads_as_a_scene") else {
+        return;
+    };
+    let dir = scratch("record");
+    let path = dir.join("path.toml");
+    let script = format!(
+        "record-start\nkey D 25\nmouse-drag 50 0\nkey W 10\nrecord-stop {}\nresize 500 380\nwait 2\nfit on\nwait 2\nresize 900 700\nwait 3\n",
+        path.display()
+    );
+    let (o, shot) = view(&x, &dir, "shot", 45, Some(&script), &[&["--scene", "cornell"][..], &SIZE].concat());
+    ok(&o);
+    let scene = strata_scene::load_scene(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{e}"));
+    let p = scene.camera_path.clone().expect("a camera path");
+    assert!(p.keyframes.len() >= 3, "{} keyframes", p.keyframes.len());
+    assert_eq!(scene.triangle_count(), strata_scene::load_scene("cornell").unwrap().triangle_count());
+    let first = p.keyframes[0];
+    let last = p.keyframes[p.keyframes.len() - 1];
+    assert!((last.eye - first.eye).length() > 0.05, "the path moves");
+    // fit on: the render size followed the window
+    let (w, h, _) = rgb(&shot);
+    assert_ne!((w, h), (160, 120), "fit to window changed the render size");
+    let r = dir.join("render.png");
+    run_cmd_txt(&shot, &r);
+    assert!(flip(&shot, &r) < FLIP_BOUND);
+    // the recorded file renders along its path
+    let out = dir.join("along.png");
+    ok(&strata(None, &["render", "--scene", path.to_str().unwrap(), "--frame", "10", "--width", "64", "--height", "48", "--out", out.to_str().unwrap()]));
+}
+
+#[test]
+fn every_technique_and_debug_view_is_reachable() {
+    let Some(x) = xvfb("view::every_technique_and_debug_view_is_reachable") else {
+        return;
+    };
+    let dir = scratch("all");
+    let small = ["--width", "64", "--height", "48"];
+    let mut script = String::new();
+    let techniques: Vec<&str> = strata_render::technique::registry().iter().map(|t| t.name).collect();
+    for t in &techniques {
+        script += &format!("technique {t}\nwait 1\nscreenshot {}\nwait 1\n", dir.join(format!("t-{t}.png")).display());
+    }
+    // every debug view of a two-layer full frame, as `render --list-passes` lists them
+    let lp = ok(&strata(None, &[&["render", "--scene", "cornell", "--technique", "full", "--layers", "2", "--list-passes"][..], &small].concat())).stdout.clone();
+    let lp = text(&lp);
+    let views: Vec<&str> = lp
+        .lines()
+        .find_map(|l| l.strip_prefix("debug views: "))
+        .expect("debug views line")
+        .split(", ")
+        .collect();
+    assert!(views.len() > 20, "{views:?}");
+    script += "technique full\nlayers 2\nwait 1\n";
+    for v in &views {
+        script += &format!("debug-view {v}\nwait 1\nscreenshot {}\n", dir.join(format!("v-{v}.png")).display());
+    }
+    script += "wait 1\n";
+    let frames = (techniques.len() * 2 + 2 + views.len() + 2) as u32;
+    let (o, _) = view(&x, &dir, "end", frames, Some(&script), &[&["--scene", "cornell"][..], &small].concat());
+    ok(&o);
+    let err = text(&o.stderr);
+    assert!(!err.contains("strata view: error"), "{err}");
+    for t in &techniques {
+        assert!(dir.join(format!("t-{t}.png")).exists(), "technique {t} shown");
+        let cmd = std::fs::read_to_string(dir.join(format!("t-{t}.cmd.txt"))).unwrap();
+        assert!(cmd.contains(&format!("--technique {t} ")), "{cmd}");
+    }
+    for v in &views {
+        assert!(dir.join(format!("v-{v}.png")).exists(), "debug view {v} shown");
+    }
+    // spot-check one debug view against render
+    let v = views.iter().find(|v| v.starts_with("layer1-")).expect("a layer-1 view");
+    let shot = dir.join(format!("v-{v}.png"));
+    let r = dir.join("render.png");
+    run_cmd_txt(&shot, &r);
+    assert!(flip(&shot, &r) < 0.05, "debug view {v}: viewer vs render");
+}
