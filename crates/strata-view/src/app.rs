@@ -21,10 +21,10 @@ use crate::script::{Event, Script};
 use crate::{Action, RenderSpec, SettingsFn, ViewOptions};
 
 /// Frames of timing history in the chart.
-pub const HISTORY: usize = 120;
+pub const HISTORY: usize = 90;
 /// Width of the settings panel and height of the timing panel, in points.
 pub const PANEL_WIDTH: f32 = 360.0;
-pub const BOTTOM_HEIGHT: f32 = 190.0;
+pub const BOTTOM_HEIGHT: f32 = 200.0;
 
 pub struct FrameTiming {
     pub passes: Vec<(String, f64)>,
@@ -71,6 +71,7 @@ pub struct App {
     pub(crate) looping: bool,
     pub(crate) recording: Option<Vec<Keyframe>>,
     pub(crate) record_path: String,
+    record_start: u32,
     pub(crate) debug_view: Option<String>,
     pub(crate) view_names: Vec<String>,
     pub(crate) texture: Option<egui::TextureHandle>,
@@ -134,6 +135,7 @@ impl App {
             looping: true,
             recording: None,
             record_path: "recorded-path.toml".into(),
+            record_start: 0,
             debug_view: o.debug_view,
             view_names: Vec::new(),
             texture: None,
@@ -312,6 +314,7 @@ impl App {
                 Action::Loop(on) => self.looping = on,
                 Action::Record(None) => {
                     self.recording = Some(Vec::new());
+                    self.record_start = self.frames_done;
                     self.say("recording the camera path".into(), false);
                 }
                 Action::Record(Some(path)) => self.stop_recording(&path),
@@ -577,9 +580,10 @@ impl App {
         }
         let cam = self.cam.camera();
         if let Some(keys) = &mut self.recording {
-            let k = keys.len() as f32 * 10.0;
+            // a keyframe every 10 frames while the camera moves; frame = frames since the start
+            let k = self.frames_done.saturating_sub(self.record_start) as f32;
             let changed = keys.last().is_none_or(|l: &Keyframe| l.eye != cam.eye || l.target != cam.target);
-            if changed && (self.frames_done % 10 == 0 || keys.is_empty()) {
+            if changed && (keys.is_empty() || k - keys.last().map_or(0.0, |l| l.frame) >= 10.0) {
                 keys.push(Keyframe {
                     frame: k,
                     eye: cam.eye,
@@ -678,6 +682,24 @@ impl App {
         }
         self.frames_done += 1;
         if last {
+            // frame-time summary (the first frame, with shader compilation, left out), full
+            // and reduced-resolution frames apart
+            for reduced in [false, true] {
+                let v: Vec<&FrameTiming> = self.timings.iter().skip(1).filter(|t| t.reduced == reduced).collect();
+                if v.is_empty() {
+                    continue;
+                }
+                let n = v.len() as f64;
+                let frame = v.iter().map(|t| t.frame_ms).sum::<f64>() / n;
+                let gpu = v.iter().map(|t| t.passes.iter().map(|p| p.1).sum::<f64>()).sum::<f64>() / n;
+                let (w, h) = self.render_size;
+                let what = if reduced {
+                    format!("reduced ×{} while moving", self.motion_scale)
+                } else {
+                    format!("{w}x{h}")
+                };
+                eprintln!("strata view: {what}: {} frames, mean frame {frame:.1} ms, GPU passes {gpu:.1} ms", v.len());
+            }
             if let Some(p) = self.screenshot.take() {
                 self.save_screenshot(Some(p));
             }

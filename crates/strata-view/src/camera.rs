@@ -66,6 +66,8 @@ pub struct CameraControl {
     pub near: f32,
     /// Fly speed, scene units per second.
     pub speed: f32,
+    /// Smallest orbit radius (a scene camera may look at a point 1 mm ahead).
+    min_orbit: f32,
     held: [bool; 7],
     drag: (f32, f32),
     wheel: f32,
@@ -90,6 +92,7 @@ impl CameraControl {
             fov_y_deg: cam.fov_y_deg,
             near: cam.near,
             speed: (scale * 0.25).max(1e-3),
+            min_orbit: scale * 0.25,
             held: [false; 7],
             drag: (0.0, 0.0),
             wheel: 0.0,
@@ -177,6 +180,7 @@ impl CameraControl {
                 self.eye += (f * fwd + r * side + Vec3::Y * lift) * v;
             }
             Mode::Orbit => {
+                self.distance = self.distance.max(self.min_orbit);
                 let centre = self.eye + dir(self.yaw, self.pitch) * self.distance;
                 self.yaw -= dx * LOOK_SENSITIVITY + side * 1.5 * dt;
                 self.pitch = (self.pitch - dy * LOOK_SENSITIVITY + lift * 1.5 * dt).clamp(-MAX_PITCH, MAX_PITCH);

@@ -24,7 +24,7 @@ pub fn draw(app: &mut App, ui: &mut egui::Ui) {
     egui::Panel::bottom("timings")
         .resizable(true)
         .default_size(BOTTOM_HEIGHT)
-        .min_size(120.0)
+        .min_size(BOTTOM_HEIGHT)
         .show(ui, |ui| timing_panel(app, ui));
     egui::Panel::right("settings")
         .resizable(true)
@@ -179,7 +179,7 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
     });
 
     // every setting of the technique, applied through the CLI's validation
-    ui.collapsing("settings", |ui| {
+    egui::CollapsingHeader::new("settings").default_open(true).show(ui, |ui| {
         egui::Grid::new("settings-grid").num_columns(3).striped(true).show(ui, |ui| {
             for info in tech.setting_list() {
                 let current = app.settings.as_ref().and_then(|s| (info.get)(s));
@@ -191,7 +191,7 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
                 ui.label(info.name).on_hover_text(format!("{} (range {})", info.doc, info.range));
                 if info.values.is_empty() {
                     let text = app.setting_text.entry(info.name.to_string()).or_insert_with(|| shown.clone());
-                    let r = ui.add(egui::TextEdit::singleline(text).desired_width(70.0));
+                    let r = ui.add_sized([80.0, 18.0], egui::TextEdit::singleline(text));
                     if entered(ui, &r) {
                         app.actions.push(Action::Set(info.name.to_string(), text.trim().to_string()));
                     }
@@ -263,9 +263,11 @@ fn timing_panel(app: &mut App, ui: &mut egui::Ui) {
         gpu,
         if last.is_some_and(|t| t.reduced) { " — reduced resolution while moving" } else { "" }
     ));
+    let ch = (ui.available_height() - 6.0).max(80.0);
     ui.horizontal(|ui| {
+        ui.set_height(ch);
         // rolling stacked bars: one per frame, one segment per pass
-        let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width() * 0.62, ui.available_height().max(60.0)), egui::Sense::hover());
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width() * 0.62, ch), egui::Sense::hover());
         let p = ui.painter_at(rect);
         p.rect_filled(rect, 2.0, Color32::from_gray(25));
         let max = app
@@ -273,12 +275,14 @@ fn timing_panel(app: &mut App, ui: &mut egui::Ui) {
             .iter()
             .map(|t| t.passes.iter().map(|p| p.1).sum::<f64>())
             .fold(1e-3, f64::max);
+        // newest on the right
         let bw = rect.width() / HISTORY as f32;
+        let first = HISTORY - app.timings.len().min(HISTORY);
         for (i, t) in app.timings.iter().enumerate() {
-            let x = rect.left() + i as f32 * bw;
+            let x = rect.left() + (first + i) as f32 * bw;
             let mut y = rect.bottom();
             for (name, ms) in &t.passes {
-                let hgt = (*ms / max) as f32 * rect.height();
+                let hgt = (*ms / max) as f32 * (rect.height() - 16.0);
                 p.rect_filled(
                     egui::Rect::from_min_max(egui::pos2(x, y - hgt), egui::pos2(x + bw * 0.85, y)),
                     0.0,
@@ -287,9 +291,9 @@ fn timing_panel(app: &mut App, ui: &mut egui::Ui) {
                 y -= hgt;
             }
         }
-        p.text(rect.left_top() + egui::vec2(4.0, 2.0), egui::Align2::LEFT_TOP, format!("{max:.1} ms"), egui::FontId::monospace(11.0), Color32::GRAY);
+        p.text(rect.left_top() + egui::vec2(4.0, 2.0), egui::Align2::LEFT_TOP, format!("GPU per frame, last {HISTORY} frames; top = {max:.1} ms"), egui::FontId::monospace(11.0), Color32::GRAY);
         // legend: pass, last and mean ms
-        egui::ScrollArea::vertical().id_salt("legend").show(ui, |ui| {
+        egui::ScrollArea::vertical().id_salt("legend").max_height(ch).show(ui, |ui| {
             egui::Grid::new("legend-grid").num_columns(3).show(ui, |ui| {
                 if let Some(t) = last {
                     for (name, ms) in &t.passes {
