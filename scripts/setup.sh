@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs what strata needs on a Debian machine: a Vulkan loader + driver
+# Installs what strata needs on a Debian machine: a Vulkan loader + driver, Xvfb for the viewer tests
 # (Mesa lavapipe, software Vulkan) when none is present, and a Rust toolchain
 # when cargo is missing. Idempotent; prints what it does.
 set -euo pipefail
