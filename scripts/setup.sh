@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs what strata needs on a Debian machine: a Vulkan loader + driver, Xvfb for the viewer tests
-# (Mesa lavapipe, software Vulkan) when none is present, and a Rust toolchain
-# when cargo is missing. Idempotent; prints what it does.
+# Installs what strata needs on a Debian machine: a Vulkan loader + driver
+# (Mesa lavapipe, software Vulkan) when none is present, Xvfb and the X11 client
+# libraries for the `strata view` tests when missing, and a Rust toolchain when
+# cargo is missing. Idempotent; prints what it does.
 set -euo pipefail
 
 say() { echo "[strata setup] $*" >&2; }

@@ -249,7 +249,14 @@ impl App {
     }
 
     fn process_actions(&mut self) {
-        for a in std::mem::take(&mut self.actions) {
+        let mut list = std::mem::take(&mut self.actions);
+        let mut done = 0;
+        while done < list.len() {
+            let a = list[done].clone();
+            if matches!(a, Action::Screenshot(_)) && self.pending_shot.is_some() {
+                break;
+            }
+            done += 1;
             match a {
                 Action::Technique(name) => match strata_render::technique::find(&name) {
                     Ok(t) => {
@@ -296,7 +303,11 @@ impl App {
                 },
                 Action::Mode(m) => self.cam.mode = m,
                 Action::Open(p) => self.open(p.trim()),
-                Action::Screenshot(p) => self.pending_shot = Some(p),
+                Action::Screenshot(p) => {
+                    // it shows the state up to here: later actions wait for the next frame
+                    self.pending_shot = Some(p);
+                    break;
+                }
                 Action::Play(on) => {
                     if self.scene.camera_path.is_some() {
                         self.playing = on;
@@ -334,6 +345,9 @@ impl App {
                 }
             }
         }
+        // the rest (after a screenshot) go first next frame
+        let rest = list.split_off(done);
+        self.actions = rest.into_iter().chain(std::mem::take(&mut self.actions)).collect();
     }
 
     /// Loads a scene file; a bad one leaves the current scene and shows the loader's error.

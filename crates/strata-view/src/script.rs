@@ -11,7 +11,8 @@
 //! preset balanced | layers 2 | variant peel | guard-band 10% | set samples 32
 //! debug-view layer0-normal   (final = the technique's output)
 //! open PATH            load a glTF/GLB/OBJ/TOML scene (errors keep the current one)
-//! screenshot PATH      save the viewport PNG and PATH.cmd.txt (as F12 does)
+//! screenshot PATH      save the viewport PNG and PATH.cmd.txt (as F12 does) of the state up
+//!                      to this line; the commands after it apply from the next frame
 //! play | pause | seek 30 | loop on|off      camera-path playback
 //! record-start | record-stop PATH           record a camera path to a TOML scene file
 //! motion-scale 0.5     internal resolution while the camera moves (1 = off)
