@@ -71,8 +71,15 @@ fn xvfb(test: &str) -> Option<XServer> {
 }
 
 fn strata(display: Option<&str>, args: &[&str]) -> Output {
+    strata_env(display, args, &[])
+}
+
+fn strata_env(display: Option<&str>, args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
     cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
     if let Some(d) = display {
         cmd.env("DISPLAY", d);
     }
@@ -187,6 +194,29 @@ fn viewport_matches_render_and_is_not_flat() {
     let line = run_cmd_txt(&shot, &r2);
     assert!(text(&o.stdout).contains(&line), "the command is printed too");
     assert!(flip(&shot, &r2) < FLIP_BOUND);
+}
+
+#[test]
+fn hidpi_scale_factor_keeps_the_viewport_exact() {
+    let Some(x) = xvfb("view::hidpi_scale_factor_keeps_the_viewport_exact") else {
+        return;
+    };
+    let dir = scratch("hidpi");
+    let shot = dir.join("shot.png");
+    let win = dir.join("window.png");
+    let args = [
+        &["view", "--scene", "cornell", "--frames", "4", "--screenshot", shot.to_str().unwrap()][..],
+        &["--window-screenshot", win.to_str().unwrap()],
+        &SIZE,
+    ]
+    .concat();
+    // winit's X11 backend takes the DPI scale from this variable
+    ok(&strata_env(Some(&x.display), &args, &[("WINIT_X11_SCALE_FACTOR", "2")]));
+    let (ww, _, _) = rgb(&win);
+    assert!(ww >= 2 * 160 + 600, "the window is laid out at scale 2 ({ww} px wide)");
+    let r = dir.join("render.png");
+    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
+    assert!(flip(&shot, &r) < FLIP_BOUND, "the render size does not depend on the DPI");
 }
 
 #[test]
