@@ -90,6 +90,8 @@ pub struct App {
     pub(crate) fit_window: bool,
     pub(crate) render_size: (u32, u32),
     pub(crate) viewport_px: (u32, u32),
+    /// The viewport panel in physical pixels (x0, y0, x1, y1).
+    pub(crate) viewport_rect: Option<[f32; 4]>,
     pub(crate) motion_scale: f32,
     pub(crate) gain: f32,
     pub(crate) false_colour: bool,
@@ -152,6 +154,7 @@ impl App {
             fit_window: false,
             render_size: (o.width, o.height),
             viewport_px: (o.width, o.height),
+            viewport_rect: None,
             motion_scale: o.motion_scale,
             gain: 1.0,
             false_colour: false,
@@ -165,6 +168,14 @@ impl App {
             last_instant: Instant::now(),
             fatal: None,
             broken: false,
+        }
+    }
+
+    /// The pointer is over the 3D viewport (not a panel).
+    fn cursor_in_viewport(&self) -> bool {
+        match (self.last_cursor, self.viewport_rect) {
+            (Some((x, y)), Some([x0, y0, x1, y1])) => (x0..x1).contains(&(x as f32)) && (y0..y1).contains(&(y as f32)),
+            _ => false,
         }
     }
 
@@ -627,6 +638,10 @@ impl App {
 
     fn frame(&mut self, gfx: &mut Gfx, el: &ActiveEventLoop, moved: bool, cam: Camera, now: Instant) {
         let scripted = self.frames.is_some();
+        let title = format!("strata view — {} — {}", self.scene.name, self.adapter_name);
+        if gfx.window.title() != title {
+            gfx.window.set_title(&title);
+        }
         let want_shot = self.pending_shot.is_some() || (scripted && self.frames_done + 1 >= self.frames.unwrap_or(0));
         let reduced = moved && self.motion_scale < 1.0 && !want_shot;
         let mut timing = match self.render_3d(&gfx.gpu, reduced, cam) {
@@ -899,12 +914,11 @@ impl ApplicationHandler for Handler {
         let ctx = gfx.egui_state.egui_ctx().clone();
         match event {
             WindowEvent::CloseRequested => el.exit(),
-            WindowEvent::Resized(s) => {
-                if s.width > 0 && s.height > 0 {
-                    gfx.config.width = s.width;
-                    gfx.config.height = s.height;
-                    gfx.surface.configure(&gfx.gpu.device, &gfx.config);
-                }
+            // zero size (minimised): keep the old configuration, frames are skipped
+            WindowEvent::Resized(s) if s.width > 0 && s.height > 0 => {
+                gfx.config.width = s.width;
+                gfx.config.height = s.height;
+                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
             }
             WindowEvent::RedrawRequested => app.redraw(el),
             WindowEvent::DroppedFile(p) => app.actions.push(Action::Open(p.display().to_string())),
@@ -941,25 +955,24 @@ impl ApplicationHandler for Handler {
             }
             WindowEvent::Focused(false) => app.cam.release_all(),
             WindowEvent::MouseInput { state, button: MouseButton::Right, .. } => {
-                app.look_active = state == ElementState::Pressed && !ctx.egui_wants_pointer_input();
-                app.last_cursor = None;
+                // look / orbit drags start on the 3D viewport only
+                app.look_active = state == ElementState::Pressed && app.cursor_in_viewport();
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if app.look_active {
                     if let Some((x, y)) = app.last_cursor {
                         app.cam.apply(Input::Drag((position.x - x) as f32, (position.y - y) as f32));
                     }
-                    app.last_cursor = Some((position.x, position.y));
                 }
+                app.last_cursor = Some((position.x, position.y));
             }
-            WindowEvent::MouseWheel { delta, .. } => {
-                if !resp.consumed && !ctx.egui_wants_pointer_input() {
-                    let n = match delta {
-                        MouseScrollDelta::LineDelta(_, y) => y,
-                        MouseScrollDelta::PixelDelta(p) => (p.y / 40.0) as f32,
-                    };
-                    app.cam.apply(Input::Wheel(n));
-                }
+            WindowEvent::CursorLeft { .. } => app.last_cursor = None,
+            WindowEvent::MouseWheel { delta, .. } if !resp.consumed && app.cursor_in_viewport() => {
+                let n = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => (p.y / 40.0) as f32,
+                };
+                app.cam.apply(Input::Wheel(n));
             }
             _ => {}
         }

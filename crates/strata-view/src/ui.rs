@@ -41,6 +41,8 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
     let avail = ui.available_size();
     let ppp = ui.ctx().pixels_per_point();
     app.viewport_px = ((avail.x * ppp).floor().max(0.0) as u32, (avail.y * ppp).floor().max(0.0) as u32);
+    let r = ui.max_rect();
+    app.viewport_rect = Some([r.min.x * ppp, r.min.y * ppp, r.max.x * ppp, r.max.y * ppp]);
     let Some(t) = &app.texture else {
         ui.centered_and_justified(|ui| ui.label("no frame yet"));
         return;
