@@ -67,12 +67,13 @@ has_x_libs() {
   compgen -G '/usr/lib/*/libX11-xcb.so.1' >/dev/null && compgen -G '/usr/lib/*/libxkbcommon-x11.so.0' >/dev/null \
     && compgen -G '/usr/lib/*/libXcursor.so.1' >/dev/null && compgen -G '/usr/lib/*/libXi.so.6' >/dev/null
 }
-if command -v Xvfb >/dev/null 2>&1 && has_x_libs; then
-  say "Xvfb and the X11 client libraries found"
+# xdotool sends real X key and mouse events to the viewer's window in one test.
+if command -v Xvfb >/dev/null 2>&1 && command -v xdotool >/dev/null 2>&1 && has_x_libs; then
+  say "Xvfb, xdotool and the X11 client libraries found"
 else
-  say "installing Xvfb and X11 client libraries for the strata view tests (xvfb, libx11-xcb1, libxkbcommon-x11-0, libxcursor1, libxi6, libxrandr2)"
+  say "installing Xvfb, xdotool and X11 client libraries for the strata view tests (xvfb, xdotool, libx11-xcb1, libxkbcommon-x11-0, libxcursor1, libxi6, libxrandr2)"
   as_root apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq xvfb libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxi6 libxrandr2 >/dev/null
+  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq xvfb xdotool libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxi6 libxrandr2 >/dev/null
   command -v Xvfb >/dev/null 2>&1 || { say "Xvfb still not found after install"; exit 1; }
 fi
 

@@ -28,12 +28,16 @@ impl Drop for XServer {
     }
 }
 
-fn find_xvfb() -> Option<PathBuf> {
+fn find_on_path(name: &str) -> Option<PathBuf> {
     std::env::var_os("PATH")?
         .to_str()?
         .split(':')
-        .map(|d| Path::new(d).join("Xvfb"))
+        .map(|d| Path::new(d).join(name))
         .find(|p| p.is_file())
+}
+
+fn find_xvfb() -> Option<PathBuf> {
+    find_on_path("Xvfb")
 }
 
 static NEXT_DISPLAY: AtomicU32 = AtomicU32::new(0);
@@ -194,6 +198,65 @@ fn viewport_matches_render_and_is_not_flat() {
     let line = run_cmd_txt(&shot, &r2);
     assert!(text(&o.stdout).contains(&line), "the command is printed too");
     assert!(flip(&shot, &r2) < FLIP_BOUND);
+}
+
+/// `xdotool ARGS` on display `d`; panics when it fails.
+fn xdotool(d: &str, args: &[&str]) -> String {
+    let o = Command::new("xdotool").args(args).env("DISPLAY", d).output().expect("xdotool runs");
+    assert!(o.status.success(), "xdotool {args:?}: {}", text(&o.stderr));
+    text(&o.stdout)
+}
+
+#[test]
+fn real_x_key_and_mouse_events_move_the_camera() {
+    let Some(x) = xvfb("view::real_x_key_and_mouse_events_move_the_camera") else {
+        return;
+    };
+    if find_on_path("xdotool").is_none() {
+        strata_scene::skip::note_skip(
+            "view::real_x_key_and_mouse_events_move_the_camera",
+            "xdotool not found on PATH (scripts/setup.sh installs it)",
+        );
+        return;
+    }
+    let dir = scratch("xevents");
+    let shot = dir.join("shot.png");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args([&["view", "--scene", "cornell", "--frames", "300", "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
+        .env("DISPLAY", &x.display)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // the window, then real X events through XTEST: hold W, right-drag to the right
+    let t0 = Instant::now();
+    let id = loop {
+        let o = Command::new("xdotool").args(["search", "--name", "strata view"]).env("DISPLAY", &x.display).output().unwrap();
+        if let Some(id) = text(&o.stdout).lines().next().map(String::from) {
+            break id;
+        }
+        assert!(t0.elapsed() < Duration::from_secs(60), "no viewer window");
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    xdotool(&x.display, &["windowfocus", "--sync", &id]);
+    xdotool(&x.display, &["keydown", "w"]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&x.display, &["keyup", "w"]);
+    xdotool(&x.display, &["mousemove", "--window", &id, "60", "60", "mousedown", "3", "mousemove_relative", "--sync", "50", "0", "mouseup", "3"]);
+    let o = child.wait_with_output().unwrap();
+    ok(&o);
+    let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
+    let flag = |f: &str| -> Vec<f32> {
+        cmd.split(&format!(" {f} ")).nth(1).unwrap().split(' ').next().unwrap().split(',').map(|v| v.parse().unwrap()).collect()
+    };
+    let (eye, target) = (flag("--eye"), flag("--target"));
+    // cornell's camera: eye (0.278, 0.273, -0.8) looking down +z
+    assert!(eye[2] > -0.79, "W moved the camera forward: {cmd}");
+    assert!((target[0] - eye[0]).abs() > 1e-5, "the right-drag turned the camera: {cmd}");
+    let r = dir.join("render.png");
+    run_cmd_txt(&shot, &r);
+    assert!(flip(&shot, &r) < FLIP_BOUND);
 }
 
 #[test]
