@@ -69,6 +69,8 @@ pub struct CameraControl {
     /// Smallest orbit radius (a scene camera may look at a point 1 mm ahead).
     min_orbit: f32,
     held: [bool; 7],
+    /// Pressed since the last step: a tap shorter than a frame still moves one step.
+    tapped: [bool; 7],
     drag: (f32, f32),
     wheel: f32,
     /// The camera as given (scene or path) until the first move: shown exactly, with
@@ -94,6 +96,7 @@ impl CameraControl {
             speed: (scale * 0.25).max(1e-3),
             min_orbit: scale * 0.25,
             held: [false; 7],
+            tapped: [false; 7],
             drag: (0.0, 0.0),
             wheel: 0.0,
             exact: None,
@@ -136,6 +139,7 @@ impl CameraControl {
             Input::Key(k, down) => {
                 let i = Key::ALL.iter().position(|x| *x == k).unwrap_or(0);
                 self.held[i] = down;
+                self.tapped[i] |= down;
             }
             Input::Drag(dx, dy) => {
                 self.drag.0 += dx;
@@ -147,10 +151,12 @@ impl CameraControl {
 
     pub fn release_all(&mut self) {
         self.held = [false; 7];
+        self.tapped = [false; 7];
     }
 
     fn down(&self, k: Key) -> bool {
-        self.held[Key::ALL.iter().position(|x| *x == k).unwrap_or(0)]
+        let i = Key::ALL.iter().position(|x| *x == k).unwrap_or(0);
+        self.held[i] || self.tapped[i]
     }
 
     /// Advances by `dt` seconds; true when the camera moved.
@@ -161,6 +167,7 @@ impl CameraControl {
         let axis = |p: Key, n: Key| (self.down(p) as i32 - self.down(n) as i32) as f32;
         let (fwd, side, lift) = (axis(Key::W, Key::S), axis(Key::D, Key::A), axis(Key::E, Key::Q));
         let boost = if self.down(Key::Shift) { 4.0 } else { 1.0 };
+        self.tapped = [false; 7];
         let any = dx != 0.0 || dy != 0.0 || wheel != 0.0 || fwd != 0.0 || side != 0.0 || lift != 0.0;
         if !any {
             return false;
@@ -211,6 +218,16 @@ mod tests {
         assert!((d.normalize() - f).length() < 1e-4, "moved along the view direction");
         assert!((d.length() - c.speed * 0.1).abs() < 1e-5);
         assert!((moved.forward() - f).length() < 1e-4);
+    }
+
+    #[test]
+    fn a_tap_within_one_frame_still_moves_one_step() {
+        let cam = Camera::new(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 60.0, 0.05);
+        let mut c = CameraControl::new(cam, 4.0);
+        c.apply(Input::Key(Key::W, true));
+        c.apply(Input::Key(Key::W, false));
+        assert!(c.step(0.1));
+        assert!(!c.step(0.1), "released: no more motion");
     }
 
     #[test]
