@@ -261,6 +261,37 @@ fn real_x_key_and_mouse_events_move_the_camera() {
 }
 
 #[test]
+fn camera_path_playback_follows_the_scene_path() {
+    let Some(x) = xvfb("view::camera_path_playback_follows_the_scene_path") else {
+        return;
+    };
+    let dir = scratch("playback");
+    let small = ["--width", "64", "--height", "48"];
+    let seek = dir.join("seek.png");
+    let script = format!("play\nwait 12\npause\nwait 2\nseek 30.5\nwait 1\nscreenshot {}\nwait 1\nplay\nwait 3\npause\nwait 1\n", seek.display());
+    let (o, shot) = view(&x, &dir, "played", 22, Some(&script), &[&["--scene", "atrium"][..], &small].concat());
+    ok(&o);
+    let atrium = strata_scene::load_scene("atrium").unwrap();
+    assert!(atrium.camera_path.is_some(), "atrium has a camera path");
+    let check = |png: &Path, lo: f32, hi: f32| {
+        let cmd = std::fs::read_to_string(png.with_extension("cmd.txt")).unwrap();
+        let flag = |f: &str| cmd.split(&format!(" {f} ")).nth(1).unwrap().split(' ').next().unwrap().to_string();
+        let frame: f32 = flag("--frame").parse().unwrap();
+        assert!((lo..=hi).contains(&frame), "frame {frame} not in {lo}..={hi}: {cmd}");
+        let eye: Vec<f32> = flag("--eye").split(',').map(|v| v.parse().unwrap()).collect();
+        let c = atrium.camera_at(frame);
+        assert!((glam::Vec3::new(eye[0], eye[1], eye[2]) - c.eye).length() < 1e-4, "the camera is the path's at frame {frame}: {cmd}");
+        frame
+    };
+    assert_eq!(check(&seek, 30.5, 30.5), 30.5);
+    // play advances one path frame per rendered frame in --frames runs
+    check(&shot, 33.0, 35.0);
+    let r = dir.join("render.png");
+    run_cmd_txt(&shot, &r);
+    assert!(flip(&shot, &r) < FLIP_BOUND);
+}
+
+#[test]
 fn hidpi_scale_factor_keeps_the_viewport_exact() {
     let Some(x) = xvfb("view::hidpi_scale_factor_keeps_the_viewport_exact") else {
         return;
