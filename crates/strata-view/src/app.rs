@@ -660,11 +660,11 @@ impl App {
         if let Some(s) = &self.shown {
             let bytes = self.display_bytes(s);
             let img = egui::ColorImage::from_rgba_unmultiplied([s.image.width as usize, s.image.height as usize], &bytes);
+            // full frames are shown 1:1 (nearest); reduced ones are upscaled (linear)
+            let filter = if s.full { egui::TextureOptions::NEAREST } else { egui::TextureOptions::LINEAR };
             match &mut self.texture {
-                Some(t) => t.set(img, egui::TextureOptions::NEAREST),
-                None => {
-                    self.texture = Some(gfx.egui_state.egui_ctx().load_texture("viewport", img, egui::TextureOptions::NEAREST))
-                }
+                Some(t) => t.set(img, filter),
+                None => self.texture = Some(gfx.egui_state.egui_ctx().load_texture("viewport", img, filter)),
             }
         }
         if let Some(p) = self.pending_shot.take() {
