@@ -913,7 +913,7 @@ impl ApplicationHandler for Handler {
         let resp = gfx.egui_state.on_window_event(&gfx.window, &event);
         let ctx = gfx.egui_state.egui_ctx().clone();
         match event {
-            WindowEvent::CloseRequested => el.exit(),
+            WindowEvent::CloseRequested | WindowEvent::Destroyed => el.exit(),
             // zero size (minimised): keep the old configuration, frames are skipped
             WindowEvent::Resized(s) if s.width > 0 && s.height > 0 => {
                 gfx.config.width = s.width;
