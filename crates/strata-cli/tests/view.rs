@@ -292,6 +292,45 @@ fn camera_path_playback_follows_the_scene_path() {
 }
 
 #[test]
+fn unmapped_window_keeps_running_and_finishes() {
+    let Some(x) = xvfb("view::unmapped_window_keeps_running_and_finishes") else {
+        return;
+    };
+    if find_on_path("xdotool").is_none() {
+        strata_scene::skip::note_skip("view::unmapped_window_keeps_running_and_finishes", "xdotool not found on PATH (scripts/setup.sh installs it)");
+        return;
+    }
+    let dir = scratch("unmap");
+    let shot = dir.join("shot.png");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args([&["view", "--scene", "cornell", "--frames", "150", "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
+        .env("DISPLAY", &x.display)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    let id = loop {
+        let o = Command::new("xdotool").args(["search", "--name", "strata view"]).env("DISPLAY", &x.display).output().unwrap();
+        if let Some(id) = text(&o.stdout).lines().next().map(String::from) {
+            break id;
+        }
+        assert!(t0.elapsed() < Duration::from_secs(60), "no viewer window");
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    // hidden (what minimising does without a window manager), then shown again
+    xdotool(&x.display, &["windowunmap", "--sync", &id]);
+    std::thread::sleep(Duration::from_millis(800));
+    xdotool(&x.display, &["windowmap", "--sync", &id]);
+    let o = child.wait_with_output().unwrap();
+    ok(&o);
+    let r = dir.join("render.png");
+    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
+    assert!(flip(&shot, &r) < FLIP_BOUND);
+}
+
+#[test]
 fn hidpi_scale_factor_keeps_the_viewport_exact() {
     let Some(x) = xvfb("view::hidpi_scale_factor_keeps_the_viewport_exact") else {
         return;
