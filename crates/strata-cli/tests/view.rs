@@ -576,11 +576,21 @@ fn every_technique_and_debug_view_is_reachable() {
         assert!(shot.exists(), "technique {t}, view {v} not shown");
         let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
         assert!(cmd.contains(&format!("--technique {t} ")) && cmd.contains("--layers 2"), "{cmd}");
+        assert!(cmd.contains("--width 64 --height 48"), "the frame's size, whatever the view's: {cmd}");
         if v != "final" {
             assert!(cmd.contains(&format!("--debug-view {v} ")), "{cmd}");
         }
     }
     eprintln!("{} technique/view pairs shown", shots.len());
+    // every technique's final frame equals `render` of its command
+    for t in &techniques {
+        let shot = dir.join(format!("{t}.png"));
+        let r = dir.join(format!("{t}-render.png"));
+        run_cmd_txt(&shot, &r);
+        let f = flip(&shot, &r);
+        eprintln!("FLIP({t} viewer, render) = {f}");
+        assert!(f < FLIP_BOUND, "{t}: viewer vs render FLIP {f}");
+    }
     // spot-check a layer-1 view of full against render
     let shot = dir.join("full--layer1-normal.png");
     let r = dir.join("render.png");

@@ -171,6 +171,12 @@ impl App {
         }
     }
 
+    /// The shown frame is one `strata render` reproduces (see [`App::reproduce_command`]).
+    fn shot_ready(&self) -> bool {
+        let need = 1 + self.settings.as_ref().is_some_and(|s| s.deep.uses_history()) as u32;
+        self.broken || (self.shown.as_ref().is_some_and(|s| s.full) && self.still_frames >= need)
+    }
+
     /// The pointer is over the 3D viewport (not a panel).
     fn cursor_in_viewport(&self) -> bool {
         match (self.last_cursor, self.viewport_rect) {
@@ -260,13 +266,14 @@ impl App {
     }
 
     fn process_actions(&mut self) {
+        if self.pending_shot.is_some() {
+            // a screenshot waits for its frame: nothing after it applies before it is saved
+            return;
+        }
         let mut list = std::mem::take(&mut self.actions);
         let mut done = 0;
         while done < list.len() {
             let a = list[done].clone();
-            if matches!(a, Action::Screenshot(_)) && self.pending_shot.is_some() {
-                break;
-            }
             done += 1;
             match a {
                 Action::Technique(name) => match strata_render::technique::find(&name) {
@@ -494,7 +501,9 @@ impl App {
 
     /// The exact `strata render` command for the shown frame, writing `out`.
     pub(crate) fn reproduce_command(&self, cam: &Camera, out: &Path) -> String {
-        let (w, h) = self.shown.as_ref().map_or(self.render_size, |s| (s.image.width, s.image.height));
+        // the frame's size (a debug view of a target with its own size, e.g. ILS's tiled
+        // buffers, is an image of another size)
+        let (w, h) = self.settings.as_ref().map_or(self.render_size, |s| (s.width, s.height));
         let mut a = vec!["strata".to_string(), "render".into()];
         let v = |p: glam::Vec3| format!("{},{},{}", p.x, p.y, p.z);
         let mut r = self.render_args(&self.spec, w, h);
@@ -642,8 +651,14 @@ impl App {
         if gfx.window.title() != title {
             gfx.window.set_title(&title);
         }
-        let want_shot = self.pending_shot.is_some() || (scripted && self.frames_done + 1 >= self.frames.unwrap_or(0));
-        let reduced = moved && self.motion_scale < 1.0 && !want_shot;
+        let frames = self.frames.unwrap_or(0);
+        let at_end = scripted && self.frames_done + 1 >= frames;
+        if at_end && self.pending_shot.is_none() {
+            if let Some(p) = self.screenshot.take() {
+                self.pending_shot = Some(Some(p));
+            }
+        }
+        let reduced = moved && self.motion_scale < 1.0 && self.pending_shot.is_none();
         let mut timing = match self.render_3d(&gfx.gpu, reduced, cam) {
             Ok(t) => t,
             Err(e) => {
@@ -667,9 +682,20 @@ impl App {
                 None => self.texture = Some(gfx.egui_state.egui_ctx().load_texture("viewport", img, filter)),
             }
         }
-        if let Some(p) = self.pending_shot.take() {
+        // saved once `render --warmup` can reproduce the frame: full resolution, and a
+        // second still frame where single-pass layers need last frame's depths
+        if self.pending_shot.is_some() && self.shot_ready() {
+            let p = self.pending_shot.take().expect("checked");
             self.save_screenshot(p);
         }
+        // --frames: done when the frames are rendered and nothing is left to apply or save
+        // (a screenshot may take a few more frames; give up after 100)
+        let over = scripted && self.frames_done >= frames + 100;
+        if over && self.pending_shot.is_some() {
+            self.say("screenshot: the frame did not settle within 100 extra frames".into(), true);
+            self.fatal = Some("screenshot not saved: the camera or settings kept changing".into());
+        }
+        let last = at_end && ((self.pending_shot.is_none() && self.actions.is_empty()) || over);
         // UI
         let ctx = gfx.egui_state.egui_ctx().clone();
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
@@ -685,7 +711,6 @@ impl App {
             size_in_pixels: [gfx.config.width, gfx.config.height],
             pixels_per_point: out.pixels_per_point,
         };
-        let last = scripted && self.frames_done + 1 >= self.frames.unwrap_or(0);
         if last {
             if let Some(p) = self.window_screenshot.take() {
                 if let Err(e) = window_screenshot(gfx, &prims, &sd, &p) {
@@ -728,9 +753,6 @@ impl App {
                     format!("{w}x{h}")
                 };
                 eprintln!("strata view: {what}: {} frames, mean frame {frame:.1} ms, GPU passes {gpu:.1} ms", v.len());
-            }
-            if let Some(p) = self.screenshot.take() {
-                self.save_screenshot(Some(p));
             }
             if let Some(s) = &self.script {
                 if s.end > self.frames_done {
