@@ -221,7 +221,7 @@ fn real_x_key_and_mouse_events_move_the_camera() {
     }
     let dir = scratch("xevents");
     let shot = dir.join("shot.png");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
+    let child = Command::new(env!("CARGO_BIN_EXE_strata"))
         .args([&["view", "--scene", "cornell", "--frames", "300", "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
         .env("DISPLAY", &x.display)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
@@ -302,7 +302,7 @@ fn unmapped_window_keeps_running_and_finishes() {
     }
     let dir = scratch("unmap");
     let shot = dir.join("shot.png");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
+    let child = Command::new(env!("CARGO_BIN_EXE_strata"))
         .args([&["view", "--scene", "cornell", "--frames", "150", "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
         .env("DISPLAY", &x.display)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
@@ -451,10 +451,10 @@ fn quad_glb() -> Vec<u8> {
         bin.len()
     );
     let mut j = json.into_bytes();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + j.len() + 8 + bin.len();
