@@ -62,6 +62,7 @@ pub struct App {
     pub(crate) settings: Option<RenderSettings>,
     full: Option<Renderer>,
     reduced: Option<Renderer>,
+    reduced_tried: bool,
     /// Which renderer drew the last frame: 0 none, 1 full, 2 reduced.
     used_last: u8,
     pub(crate) cam: CameraControl,
@@ -130,6 +131,7 @@ impl App {
             settings: None,
             full: None,
             reduced: None,
+            reduced_tried: false,
             used_last: 0,
             prev_cam: None,
             frame_t: o.frame,
@@ -239,6 +241,7 @@ impl App {
                 self.view_names = r.debug_view_names();
                 self.full = Some(r);
                 self.reduced = None;
+                self.reduced_tried = false;
                 self.used_last = 0;
                 self.settings = Some(settings);
                 self.spec = spec;
@@ -351,6 +354,7 @@ impl App {
                     if (0.1..=1.0).contains(&s) {
                         self.motion_scale = s;
                         self.reduced = None;
+                        self.reduced_tried = false;
                     } else {
                         self.say(format!("motion scale {s} is out of range: must be in 0.1..=1"), true);
                     }
@@ -433,7 +437,9 @@ impl App {
         if self.full.is_none() || self.broken {
             return Ok(None);
         }
-        if reduced && self.reduced.is_none() {
+        if reduced && self.reduced.is_none() && !self.reduced_tried {
+            // once per settings: when it cannot be built, moving frames stay full size
+            self.reduced_tried = true;
             if let Some(s) = self.reduced_settings() {
                 self.reduced = Renderer::new(gpu, &self.scene, s).ok();
             }
