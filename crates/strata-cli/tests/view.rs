@@ -331,6 +331,32 @@ fn unmapped_window_keeps_running_and_finishes() {
 }
 
 #[test]
+fn moving_renders_at_reduced_size_and_still_at_full() {
+    let Some(x) = xvfb("view::moving_renders_at_reduced_size_and_still_at_full") else {
+        return;
+    };
+    let dir = scratch("motion");
+    let base = [&["--scene", "cornell", "--motion-scale", "0.5"][..], &SIZE].concat();
+    let (o, shot) = view(&x, &dir, "shot", 30, Some("wait 2\nkey W 20\nwait 3\n"), &base);
+    ok(&o);
+    let err = text(&o.stderr);
+    // the run's summary: frames per kind
+    let count = |prefix: &str| -> u32 {
+        let l = err.lines().find(|l| l.starts_with(prefix)).unwrap_or_else(|| panic!("no '{prefix}' line: {err}"));
+        l[prefix.len()..].trim().split(' ').next().unwrap().parse().unwrap()
+    };
+    let moving = count("strata view: reduced ×0.5 while moving:");
+    let still = count("strata view: 160x120:");
+    assert!((18..=20).contains(&moving), "the 20 moving frames (less the first) are reduced: {moving}");
+    assert!(still >= 5, "still frames are full size: {still}");
+    let (w, h, _) = rgb(&shot);
+    assert_eq!((w, h), (160, 120), "the screenshot is full resolution");
+    let r = dir.join("render.png");
+    run_cmd_txt(&shot, &r);
+    assert!(flip(&shot, &r) < FLIP_BOUND);
+}
+
+#[test]
 fn hidpi_scale_factor_keeps_the_viewport_exact() {
     let Some(x) = xvfb("view::hidpi_scale_factor_keeps_the_viewport_exact") else {
         return;
