@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what strata needs on a Debian machine: a Vulkan loader + driver
-# (Mesa lavapipe, software Vulkan) when none is present, and a Rust toolchain
-# when cargo is missing. Idempotent; prints what it does.
+# (Mesa lavapipe, software Vulkan) when none is present, Xvfb and the X11 client
+# libraries for the `strata view` tests when missing, and a Rust toolchain when
+# cargo is missing. Idempotent; prints what it does.
 set -euo pipefail
 
 say() { echo "[strata setup] $*" >&2; }
@@ -58,6 +59,22 @@ if [ "$codename" = bookworm ] && [ -n "$mesa_version" ] && dpkg --compare-versio
     DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq -t bookworm-backports mesa-vulkan-drivers >/dev/null
     say "lavapipe now $(dpkg-query -W -f='${Version}' mesa-vulkan-drivers)"
   fi
+fi
+
+# `strata view`'s tests open real windows on a virtual X server (Xvfb); winit loads
+# libX11/libxcursor/libxkbcommon-x11 at run time.
+has_x_libs() {
+  compgen -G '/usr/lib/*/libX11-xcb.so.1' >/dev/null && compgen -G '/usr/lib/*/libxkbcommon-x11.so.0' >/dev/null \
+    && compgen -G '/usr/lib/*/libXcursor.so.1' >/dev/null && compgen -G '/usr/lib/*/libXi.so.6' >/dev/null
+}
+# xdotool sends real X key and mouse events to the viewer's window in one test.
+if command -v Xvfb >/dev/null 2>&1 && command -v xdotool >/dev/null 2>&1 && has_x_libs; then
+  say "Xvfb, xdotool and the X11 client libraries found"
+else
+  say "installing Xvfb, xdotool and X11 client libraries for the strata view tests (xvfb, xdotool, libx11-xcb1, libxkbcommon-x11-0, libxcursor1, libxi6, libxrandr2)"
+  as_root apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq xvfb xdotool libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxi6 libxrandr2 >/dev/null
+  command -v Xvfb >/dev/null 2>&1 || { say "Xvfb still not found after install"; exit 1; }
 fi
 
 if ! command -v cargo >/dev/null 2>&1; then

@@ -48,6 +48,38 @@ pub enum Command {
     ExportScene(crate::export::ExportArgs),
     /// Compare two images (EXR/PNG) with the metrics of `eval`: FLIP, RMSE, MAE and the mean difference.
     Compare(crate::compare::CompareArgs),
+    /// Interactive viewer: fly through a scene, switch techniques, settings and debug views, watch
+    /// per-pass GPU time, save a frame with the `strata render` command that reproduces it.
+    View(ViewArgs),
+}
+
+/// `strata view`: the flags of `render` (scene, camera, technique, settings) plus the viewer's.
+#[derive(Args)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    pub frame: FrameArgs,
+    /// Debug view shown first (`strata render --list-passes` lists them; the panel too).
+    #[arg(long)]
+    pub debug_view: Option<String>,
+    /// Non-interactive: render this many frames in the window, write --screenshot, exit. 1..=100000.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: Option<u32>,
+    /// With --frames: the viewport PNG written at the end (and FILE.cmd.txt: the `strata render` command).
+    #[arg(long, requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+    /// With --frames: also a PNG of the whole window (panels included) at the end.
+    #[arg(long, requires = "frames")]
+    pub window_screenshot: Option<PathBuf>,
+    /// Scripted input, one command a line (key W 10, mouse-drag 40 0, technique ao, debug-view normal, …;
+    /// docs/viewer.md lists them).
+    #[arg(long)]
+    pub script: Option<PathBuf>,
+    /// Internal-resolution scale while the camera moves, 0.1..=1 (1: always full resolution).
+    #[arg(long, default_value_t = 0.5)]
+    pub motion_scale: f32,
+    /// Overwrite --screenshot / --window-screenshot if they exist.
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Args, Clone)]

@@ -13,6 +13,7 @@ mod render;
 mod report_cmd;
 mod soak;
 mod techniques;
+mod view;
 
 use clap::Parser;
 
@@ -25,7 +26,7 @@ fn main() {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG").unwrap_or_else(|_| "warn".into()))
+        .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG").unwrap_or_else(|_| "warn,winit=error,egui_wgpu=error".into()))
         .with_writer(std::io::stderr)
         .init();
     // Ctrl-C: outputs and cache entries are written to temporaries and renamed, so an
@@ -60,6 +61,7 @@ fn main() {
         args::Command::Report(a) => report_cmd::run(&a),
         args::Command::ExportScene(a) => export::run(&a),
         args::Command::Compare(a) => compare::run(&a),
+        args::Command::View(a) => view::run(&a),
     };
     if let Err(e) = result {
         // One line: what is wrong and what is valid.

@@ -12,6 +12,14 @@ use crate::output::{cameras_at, check_output, save, scene_and_camera};
 /// The scene, its cameras and the render settings that `f` asks for (validated).
 pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
     let (scene, cams) = scene_and_camera(&f.scene)?;
+    let settings = settings_for(f, &scene)?;
+    Ok((scene, cams, settings))
+}
+
+/// The render settings that `f` asks for on the loaded `scene` (validated; probes baked
+/// and VPLs generated where the technique uses them). `strata view` applies its panel
+/// edits through this function too, so both accept and reject the same values.
+pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
     let t = f.technique;
     let base = RenderSettings {
         width: f.scene.width,
@@ -45,14 +53,14 @@ pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
     // known to be valid, so a bad flag is a one-line error without a bake before it
     if settings.radiosity.is_some() && !f.no_probes {
         settings.probes = Some(strata_eval::cache::probes::scene_probes(
-            &scene,
+            scene,
             &strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir()),
             false,
         )?);
     }
     // ILS: VPLs by instant radiosity on the CPU, once per run (static scenes)
-    strata_eval::vpls::add_vpls(&mut settings, &scene, f.scene.frame);
-    Ok((scene, cams, settings))
+    strata_eval::vpls::add_vpls(&mut settings, scene, f.scene.frame);
+    Ok(settings)
 }
 
 pub fn run(a: &RenderArgs) -> Result<()> {

@@ -75,6 +75,12 @@ impl GpuContext {
     /// Opens a headless device on Vulkan (falling back to any backend wgpu finds),
     /// requesting every feature in [`STRATA_FEATURES`] the adapter has.
     pub fn new(opts: &GpuOptions) -> Result<Self, RenderError> {
+        Self::with_instance(opts, Self::instance(), None)
+    }
+
+    /// The instance [`GpuContext::new`] opens its device from (Vulkan first). A window
+    /// creates its surface from it and passes both to [`GpuContext::with_instance`].
+    pub fn instance() -> wgpu::Instance {
         if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
             // Mesa's loaders warn loudly without it; a private tmp dir is enough headless.
             let dir = std::env::temp_dir().join("strata-xdg");
@@ -86,9 +92,21 @@ impl GpuContext {
         if std::env::var_os("WGPU_BACKEND").is_none() {
             desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12;
         }
-        let instance = wgpu::Instance::new(desc);
+        wgpu::Instance::new(desc)
+    }
+
+    /// Like [`GpuContext::new`] on `instance`; with `compatible`, only adapters that can
+    /// present to that surface (created from `instance`) are considered.
+    pub fn with_instance(
+        opts: &GpuOptions,
+        instance: wgpu::Instance,
+        compatible: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self, RenderError> {
         let wanted = opts.adapter.clone().or_else(|| std::env::var("STRATA_ADAPTER").ok());
-        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        if let Some(s) = compatible {
+            adapters.retain(|a| a.is_surface_supported(s));
+        }
         if adapters.is_empty() {
             return Err(RenderError::NoAdapter(
                 "no GPU adapter found: install a Vulkan driver (run scripts/setup.sh; on Debian it installs mesa-vulkan-drivers and libvulkan1)"

@@ -60,6 +60,22 @@ impl ImageBuf {
             .collect()
     }
 
+    /// The 8-bit RGBA bytes a PNG of this image holds (values clamped to [0, 1],
+    /// sRGB-encoded unless `srgb` is false); `strata view` displays these same bytes.
+    pub fn to_rgba8(&self, srgb: bool) -> Vec<u8> {
+        let px = self.to_rgba32();
+        let mut bytes = Vec::with_capacity(px.len() * 4);
+        for p in px {
+            for c in 0..3 {
+                let v = p[c].clamp(0.0, 1.0);
+                let v = if srgb { linear_to_srgb(v) } else { v };
+                bytes.push((v * 255.0 + 0.5) as u8);
+            }
+            bytes.push((p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
+        }
+        bytes
+    }
+
     /// Writes by extension: `.png` (values clamped to [0, 1], sRGB-encoded unless
     /// `srgb` is false) or `.exr` (linear float RGBA). Atomic: the file is encoded
     /// beside `path` and renamed into place ([`crate::atomic`]).
@@ -70,16 +86,7 @@ impl ImageBuf {
             .map(|e| e.to_ascii_lowercase());
         match ext.as_deref() {
             Some("png") => {
-                let px = self.to_rgba32();
-                let mut bytes = Vec::with_capacity(px.len() * 4);
-                for p in px {
-                    for c in 0..3 {
-                        let v = p[c].clamp(0.0, 1.0);
-                        let v = if srgb { linear_to_srgb(v) } else { v };
-                        bytes.push((v * 255.0 + 0.5) as u8);
-                    }
-                    bytes.push((p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
-                }
+                let bytes = self.to_rgba8(srgb);
                 let img = image::RgbaImage::from_raw(self.width, self.height, bytes).expect("size matches");
                 crate::atomic::write_with(path, |tmp| {
                     img.save(tmp)
