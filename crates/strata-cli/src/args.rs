@@ -294,6 +294,9 @@ pub struct AoArgs {
     /// Deinterleaved AO: "off" or an NxM pattern, N, M in 1..=4 (e.g. 2x2, 4x4; docs/ao.md).
     #[arg(long, default_value = "off", value_parser = parse_pattern)]
     pub deinterleave: Deinterleave,
+    /// Filter Eq. 1's obscurance mean before the square root, then AV = 1 − √ (not in the paper; docs/ao.md).
+    #[arg(long)]
+    pub filter_obscurance: bool,
 }
 
 /// `--deinterleave`: `None` = off.
@@ -325,6 +328,7 @@ impl AoArgs {
                 max_distance: self.temporal_distance,
             }),
             deinterleave: self.deinterleave.0,
+            filter_obscurance: self.filter_obscurance,
             ..d
         }
     }

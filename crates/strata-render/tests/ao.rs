@@ -8,7 +8,8 @@ use strata_reference::ao::{DiskSampling, ObscuranceSettings};
 use strata_reference::Reference;
 use strata_render::frame::FrameCameras;
 use strata_render::passes::ao::{
-    ambient_visibility_cpu, deinterleaved_visibility_cpu, snap_tap, sub_buffer_taps, AoSettings,
+    ambient_visibility_cpu, deinterleaved_obscurance_cpu, deinterleaved_visibility_cpu, snap_tap, sub_buffer_taps,
+    AoSettings,
 };
 use strata_render::passes::bilateral::BilateralSettings;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
@@ -518,4 +519,69 @@ fn bad_deinterleave_settings_are_one_line_errors() {
     assert_eq!(s.ao.as_ref().unwrap().deinterleave, Some([4, 4]));
     let e = t.set(&mut s, "deinterleave", 4.0).unwrap_err().to_string();
     assert!(e.contains("deinterleave") && e.contains("0..=3") && !e.contains('\n'), "{e}");
+}
+
+/// `filter_obscurance`: `ao-raw` holds S = π/N_s·Σ (the twin's obscurance
+/// mean, 0 where there is no surface), and with no temporal or spatial filter
+/// `ao-resolve` turns it into exactly the AV the default order writes.
+#[test]
+fn filtered_obscurance_is_eq1_before_the_square_root_and_resolves_to_av() {
+    let gpu = common::gpu();
+    let scene = frozen("atrium");
+    let (w, h, layers) = (96u32, 64u32, 2u32);
+    for pattern in [None, Some([2u32, 2])] {
+        let unfiltered = AoSettings {
+            temporal: None,
+            blur: BilateralSettings {
+                radius: 0,
+                ..AoSettings::default().blur
+            },
+            ..deint(pattern)
+        };
+        let mut r = ao_renderer(
+            &gpu,
+            &scene,
+            w,
+            h,
+            layers,
+            AoSettings {
+                filter_obscurance: true,
+                ..unfiltered.clone()
+            },
+        );
+        assert!(r.pass_infos().iter().any(|p| p.name == "ao-resolve"));
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let raw = r.read_target_full(&gpu, "ao-raw", 0).unwrap();
+        let u = r.ao_uniforms().unwrap();
+        assert_eq!(u.output_obscurance, 1);
+        let zmip: Vec<ImageBuf> = (0..=u.max_mip)
+            .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
+            .collect();
+        let normals = common::npack_normals(&r.read_target_full(&gpu, "npack", 0).unwrap(), 0);
+        let f = r.frame_uniforms();
+        let p = pattern.unwrap_or([1, 1]);
+        let (mut close, mut positive) = (0usize, 0usize);
+        for y in 0..h {
+            for x in 0..w {
+                let cpu = deinterleaved_obscurance_cpu(&zmip, &normals, &f, &u, layers, p, x, y);
+                close += ((cpu - raw.pixel(x, y)[0]).abs() <= 1e-4 * (1.0 + cpu)) as usize;
+                positive += (cpu > 0.01) as usize;
+            }
+        }
+        let n = (w * h) as usize;
+        assert!(close as f32 >= 0.995 * n as f32, "{pattern:?}: {close}/{n} S within 1e-4");
+        assert!(positive > n / 10, "{pattern:?}: test is weak, {positive} pixels with S > 0.01");
+        let resolved = r.read_target(&gpu, "ao").unwrap();
+        let plain = render_ao(&gpu, &scene, w, h, layers, unfiltered);
+        // both through R16F (`ao-obscurance` / `ao`): S to ~5e-4 relative, then 1 − √S
+        let worst = resolved
+            .data
+            .iter()
+            .zip(&plain.data)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 2e-3, "{pattern:?}: resolve differs from AV by {worst}");
+        eprintln!("{pattern:?}: {close}/{n} S within 1e-4, resolve vs AV worst {worst}");
+    }
 }

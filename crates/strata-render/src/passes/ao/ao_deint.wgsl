@@ -28,7 +28,8 @@ struct Ao {
     samples: u32,
     max_mip: u32,
     seed: u32,
-    _pad: u32,
+    // 1: return the obscurance mean S (Eq. 1 before the square root) instead of AV
+    output_obscurance: u32,
 }
 
 // Matches `ao::DeintUniforms`.
@@ -66,7 +67,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let t = vec2u(pos.xy);
     if (ils_is_padding(t, u.ils)) {
         // no image pixel (never gathered)
-        return vec4f(1.0);
+        return vec4f(f32(u.ao.output_obscurance == 0u));
     }
     let sub = t / u.ils.tile;
     let origin = vec2i(sub * u.ils.tile);
@@ -76,7 +77,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let p = local * pat + vec2i(sub);
     let z = textureLoad(zsplit, t, 0).r;
     if (z <= 0.0) {
-        return vec4f(1.0);
+        // no surface: unoccluded (AV 1, S 0)
+        return vec4f(f32(u.ao.output_obscurance == 0u));
     }
     // everything below is in full-resolution pixels: the frame's projection applies as is
     let x = world_from_csz(frame, vec2f(p) + 0.5, z);
@@ -122,6 +124,10 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         }
         sum += a;
     }
-    let av = max(0.0, 1.0 - sqrt(u.ao.intensity * 3.14159265358979 / f32(taps_here) * sum));
+    let s_mean = u.ao.intensity * 3.14159265358979 / f32(taps_here) * sum;
+    if (u.ao.output_obscurance != 0u) {
+        return vec4f(s_mean);
+    }
+    let av = max(0.0, 1.0 - sqrt(s_mean));
     return vec4f(av);
 }

@@ -23,13 +23,14 @@ pub const MAX_SAMPLES: u32 = 256;
 pub const MAX_DEINTERLEAVE: u32 = 4;
 
 /// The passes the deinterleaved AO adds or substitutes, in frame order (the
-/// `ao` pass is replaced by `ao-deint`).
+/// `ao` pass is replaced by `ao-deint`), and `filter_obscurance`'s last pass.
 pub const DEINTERLEAVED_PASSES: &[&str] = &[
     "ao-deint-copy",
     "ao-deint-split-z",
     "ao-deint-split-n",
     "ao-deint",
     "ao-deint-gather",
+    "ao-resolve",
 ];
 
 /// AO settings. Defaults: N = 19 taps (SAO's and the DGB demo's default; the
@@ -68,6 +69,13 @@ pub struct AoSettings {
     /// evaluates the spiral taps k ≡ s (mod n·m) on its quarter-resolution
     /// (for 2×2) depth layout. `None` = the single full-resolution pass.
     pub deinterleave: Option<[u32; 2]>,
+    /// Not in the paper: `ao-raw` holds the obscurance mean S = π/N·Σ A_i
+    /// (Eq. 1 before the square root); the temporal and bilateral filters
+    /// average S and a last pass `ao-resolve` writes AV = max(0, 1 − √S).
+    /// Averaging after the square root is lighter than before it (Jensen),
+    /// which the deinterleaved AO's few taps per pixel make large
+    /// (`docs/ao.md`). Default false (DGB's order).
+    pub filter_obscurance: bool,
 }
 
 impl Default for AoSettings {
@@ -94,6 +102,7 @@ impl Default for AoSettings {
             },
             temporal: Some(TemporalSettings::default()),
             deinterleave: None,
+            filter_obscurance: false,
         }
     }
 }
@@ -166,7 +175,9 @@ pub struct AoUniforms {
     pub samples: u32,
     pub max_mip: u32,
     pub seed: u32,
-    pub _pad: u32,
+    /// 1: write the obscurance mean S = π·intensity/N·Σ instead of AV = max(0, 1 − √S)
+    /// ([`AoSettings::filter_obscurance`]).
+    pub output_obscurance: u32,
 }
 
 impl AoUniforms {
@@ -185,7 +196,7 @@ impl AoUniforms {
             samples: s.samples,
             max_mip,
             seed: if s.temporal_noise { frame_index } else { 0 },
-            _pad: 0,
+            output_obscurance: s.filter_obscurance as u32,
         }
     }
 }
@@ -367,9 +378,30 @@ pub fn deinterleaved_visibility_cpu(
     x: u32,
     y: u32,
 ) -> f32 {
+    visibility_from_obscurance(deinterleaved_obscurance_cpu(zmip, normals, frame, u, layers, pattern, x, y))
+}
+
+/// Eq. 1's AV = max(0, 1 − √S) of an obscurance mean S (`ao-resolve`).
+pub fn visibility_from_obscurance(s: f32) -> f32 {
+    (1.0 - s.sqrt()).max(0.0)
+}
+
+/// The obscurance mean S = π·intensity/N_s·Σ of [`deinterleaved_visibility_cpu`]
+/// (what `ao-raw` holds with [`AoSettings::filter_obscurance`]; 0 = no surface).
+#[allow(clippy::too_many_arguments)]
+pub fn deinterleaved_obscurance_cpu(
+    zmip: &[ImageBuf],
+    normals: &ImageBuf,
+    frame: &FrameUniforms,
+    u: &AoUniforms,
+    layers: u32,
+    pattern: [u32; 2],
+    x: u32,
+    y: u32,
+) -> f32 {
     let z = zmip[0].pixel(x, y)[0];
     if z <= 0.0 {
-        return 1.0;
+        return 0.0;
     }
     let px = normals.pixel(x, y);
     let n = Vec3::new(px[0], px[1], px[2]);
@@ -403,7 +435,7 @@ pub fn deinterleaved_visibility_cpu(
         }
         sum += a;
     }
-    (1.0 - (u.intensity * std::f32::consts::PI / taps_here as f32 * sum).sqrt()).max(0.0)
+    u.intensity * std::f32::consts::PI / taps_here as f32 * sum
 }
 
 /// DGB Eq. 2.

@@ -26,6 +26,8 @@ pub(crate) struct AoStage {
     pub(crate) temporal: Option<TemporalPass>,
     pub(crate) blur_h: BilateralPass,
     pub(crate) blur_v: BilateralPass,
+    /// `filter_obscurance`: AV = max(0, 1 − √S) of the filtered S into `ao`.
+    pub(crate) resolve: Option<crate::passes::builder::FullscreenPass>,
 }
 
 impl AoStage {
@@ -76,8 +78,29 @@ impl AoStage {
                 deep.layers,
             )
         });
+        let blurred = if s.filter_obscurance {
+            targets.create(
+                gpu,
+                TargetDesc::new(
+                    "ao-obscurance",
+                    F::R16Float,
+                    1,
+                    "filtered obscurance mean S (Eq. 1 before the square root; filter_obscurance)",
+                ),
+            );
+            "ao-obscurance"
+        } else {
+            "ao"
+        };
         let blur_h = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-h", filtered, "ao-blur-h", false);
-        let blur_v = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-v", "ao-blur-h", "ao", true);
+        let blur_v = BilateralPass::new(gpu, scene, targets, &s.blur, "ao-blur-v", "ao-blur-h", blurred, true);
+        let resolve = s.filter_obscurance.then(|| {
+            crate::passes::builder::PassBuilder::new(gpu, targets, "ao-resolve")
+                .shader("ao-resolve", include_str!("ao_resolve.wgsl"))
+                .read("ao-obscurance")
+                .write("ao")
+                .build()
+        });
         Ok(Self {
             deint_before,
             ao,
@@ -85,6 +108,7 @@ impl AoStage {
             temporal,
             blur_h,
             blur_v,
+            resolve,
         })
     }
 
@@ -99,6 +123,9 @@ impl AoStage {
         }
         v.push(&self.blur_h);
         v.push(&self.blur_v);
+        if let Some(r) = &self.resolve {
+            v.push(r);
+        }
         v
     }
 }
