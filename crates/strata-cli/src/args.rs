@@ -388,6 +388,11 @@ pub struct EvalArgs {
     /// Indirect bounces of the path-traced reference (gi), 1..=64.
     #[arg(long, default_value_t = 4)]
     pub bounces: u32,
+    /// ils: also run §6.3's physically-based mode — up to K frames with fresh VPL sets of
+    /// --bounces bounces and VPL shadow maps, accumulated until within 1 % RMS of the mean of
+    /// K independent sets, for 1x1 and 2x2 (Table 5), and that mean against the path tracer; 2..=4096.
+    #[arg(long)]
+    pub progressive: Option<u32>,
     /// gi: also run DGB Fig. 10's error-source study — single-bounce GPU radiosity with and
     /// without the n_Y test against single-bounce references with and without visibility.
     #[arg(long)]
@@ -603,16 +608,30 @@ pub enum BenchWhat {
     /// Interleaved deferred shading (ILS Table 4): per-pass GPU ms of the interleaved frame and
     /// of the brute force of the same frame (all N VPLs per pixel), and the speed-up.
     Ils(BenchIlsArgs),
-    /// A-buffer constructions (ABA Table I): per-stage GPU ms of linked-list, linear,
-    /// fixed-array, dual-peel and the compressed path, memory and overflow per method.
+    /// A-buffer constructions (ABA Table I): per-stage GPU ms (AO included) of linked-list, linear,
+    /// fixed-array, dual-peel and the compressed path, memory and overflow per method, and the
+    /// compressed-vs-brute-force AO speed-up.
     Abuffer(BenchAbufferArgs),
+    /// Bounced z-buffer AO (BZB Table 1): per-pass GPU ms with the bounced z-buffer and
+    /// with the additive AOV baseline (no visibility), the visibility step's cost, memory.
+    Bzb(BenchBzbArgs),
+}
+
+#[derive(Args)]
+pub struct BenchBzbArgs {
+    #[command(flatten)]
+    pub stage: BenchStageArgs,
+    /// Settings of technique `bzb-ao` (e.g. --set directions=4 --set ao-radius=1); visibility is the bench's.
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 #[derive(Args)]
 pub struct BenchAbufferArgs {
     #[command(flatten)]
     pub stage: BenchStageArgs,
-    /// Settings of technique `oit` (e.g. --set pool=8000000 --set max-layers=16 --set compress=6).
+    /// Settings of technique `aba-ao` (e.g. --set pool=8000000 --set max-layers=16 --set compress=6
+    /// --set kernel=hbao); `abuffer` and `compress` are the bench's own per column.
     #[command(flatten)]
     pub set: SetArgs,
 }

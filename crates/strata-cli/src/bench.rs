@@ -2,7 +2,7 @@
 //! object or a table.
 
 use anyhow::Result;
-use strata_eval::bench::{abuffer, ao, deep, gbuffer, ils, radiosity, reference, reflections, technique};
+use strata_eval::bench::{abuffer, ao, bzb, deep, gbuffer, ils, radiosity, reference, reflections, technique};
 use strata_eval::results::{to_json_string, BenchResult, DeepBench, GbufferBench, ReferenceBench, StageBench};
 use strata_render::passes::reflections::ReflectionSettings;
 
@@ -35,6 +35,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         ),
         BenchWhat::Abuffer(b) => (
             BenchResult::Abuffer(Box::new(abuffer::run(&(&b.stage).into(), &b.set.values)?)),
+            b.stage.json,
+        ),
+        BenchWhat::Bzb(b) => (
+            BenchResult::Bzb(Box::new(bzb::run(&(&b.stage).into(), &b.set.values)?)),
             b.stage.json,
         ),
         BenchWhat::Reflections(b) => {
@@ -101,6 +105,18 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             if let (Some(s), Some(f)) = (b.ao_speedup, b.ao_flip_compressed_vs_brute) {
                 println!("multilayer AO, compressed vs brute force (linked list): {s:.2}x faster, FLIP {f:.4} between the AO images");
             }
+        }
+        BenchResult::Bzb(b) => {
+            print_stage("bzb-ao (bounced z-buffer)", &b.visibility);
+            print_stage("bzb-ao visibility=off (AOV baseline)", &b.no_visibility);
+            println!(
+                "visibility step: splat {:.2}x, whole technique {:.2}x the baseline; {} triangles, S = {}, {:.1} MiB",
+                b.splat_ratio,
+                b.total_ratio,
+                b.triangles,
+                b.directions,
+                b.memory_bytes as f64 / (1024.0 * 1024.0)
+            );
         }
         BenchResult::Ils(b) => {
             print_stage("ils (IS)", &b.interleaved);

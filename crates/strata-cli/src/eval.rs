@@ -21,8 +21,11 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     {
         anyhow::bail!("--set is only read by --technique ils, oit, bzb-ao and aba-ao in eval (ao and gi have their own flags)");
     }
+    if a.progressive.is_some() && a.technique.eval != EvalKind::VplRadiance {
+        anyhow::bail!("--progressive is only read by --technique ils (ILS §6.3's physically-based mode)");
+    }
     let result = match a.technique.eval {
-        EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values)?),
+        EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values, a.progressive.map(|k| (k, a.bounces)))?),
         EvalKind::Composite => EvalResult::Oit(oit::run(&s, &a.set.values)?),
         // the registry's settings (--set), with --ao-radius/--ao-bias carried over
         EvalKind::AmbientVisibility if is_bzb || is_aba => {
@@ -164,6 +167,28 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 e.indirect_rmse_vs_brute, i.flip, i.rmse, f.flip, f.rmse, e.brute_force.indirect.flip,
                 e.brute_force.full.flip, run.ref_spp, noise(i)
             );
+            if let Some(p) = &e.progressive {
+                for q in &p.patterns {
+                    match (q.frames_to_target, q.gpu_ms_to_target, q.vpl_ms_to_target) {
+                        (Some(k), Some(g), Some(v)) => println!(
+                            "  §6.3 {}: < {:.0} % RMS after {k} frames: {g:.0} ms GPU + {v:.0} ms VPL generation ({:.0} ms GPU per frame)",
+                            q.pattern, 100.0 * p.target_rms, q.gpu_ms_per_frame
+                        ),
+                        _ => println!(
+                            "  §6.3 {}: {:.0} % RMS not reached in {} frames (last {:.4})",
+                            q.pattern,
+                            100.0 * p.target_rms,
+                            p.sets,
+                            q.rms_curve.last().map_or(f64::NAN, |c| c.1)
+                        ),
+                    }
+                }
+                let d = &p.converged_vs_path_tracer;
+                println!(
+                    "  §6.3 converged ({} sets x {} paths, {} bounces) vs path tracer: FLIP {:.4}  RMSE {:.4}  MAE {:.4} ({} spp)",
+                    p.sets, p.vpl_paths, p.bounces, d.flip, d.rmse, d.mae, p.ref_spp
+                );
+            }
         }
     }
     Ok(())

@@ -853,7 +853,7 @@ fn techniques_json_lists_settings_defaults_and_ranges() {
     let v = json_of(&strata(&["techniques", "--json"]));
     let ts = v["techniques"].as_array().expect("techniques");
     let names: Vec<&str> = ts.iter().map(|t| t["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["direct", "ao", "full", "ils", "oit", "bzb-ao"]);
+    assert_eq!(names, ["direct", "ao", "full", "ils", "oit", "aba-ao", "bzb-ao"]);
     let full = &ts[2];
     assert_eq!(
         full["presets"],
@@ -1561,4 +1561,41 @@ fn bench_abuffer_reports_table_one_per_method() {
         assert_eq!(x["count_ms"].is_null(), key != "linear", "{key}: {x}");
         assert_eq!(x["prefix_sum_ms"].is_null(), key != "linear", "{key}");
     }
+}
+
+#[test]
+fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
+    // ILS §6.3: fresh VPL sets per frame (2 bounces, VPL shadow maps); the running
+    // mean reaches 1 % RMS of the converged image of the same estimator, and its
+    // distance to the path tracer falls with the frames down to the clamp bias
+    let cache = scratch("ils-progressive-cache");
+    let v = json_of(&strata(&[
+        "eval", "--scene", "cornell", "--technique", "ils", "--width", "48", "--height", "48", "--set", "vpls=24",
+        "--progressive", "16", "--bounces", "2", "--ref-noise", "0.03", "--cache", cache.to_str().unwrap(), "--json",
+    ]));
+    let p = &v["progressive"];
+    assert_eq!(p["bounces"].as_u64(), Some(2));
+    let patterns = p["patterns"].as_array().expect("patterns");
+    assert_eq!(patterns.len(), 2, "1x1 and 2x2");
+    for q in patterns {
+        let curve: Vec<f64> = q["rms_curve"].as_array().unwrap().iter().map(|e| e[1].as_f64().unwrap()).collect();
+        assert!(curve.first().unwrap() > curve.last().unwrap(), "{}: {curve:?}", q["pattern"]);
+    }
+    let one = &patterns[0];
+    assert_eq!(one["pattern"], "1x1");
+    let pt: Vec<(u64, f64)> = one["rms_vs_path_tracer"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| (e[0].as_u64().unwrap(), e[1].as_f64().unwrap()))
+        .collect();
+    assert_eq!(pt.iter().map(|e| e.0).collect::<Vec<_>>(), vec![1, 2, 4, 8, 16]);
+    // monotone within noise (each count at most 10 % above the previous) and falling overall
+    for w in pt.windows(2) {
+        assert!(w[1].1 <= 1.1 * w[0].1, "{pt:?}");
+    }
+    assert!(pt[4].1 < 0.8 * pt[0].1, "{pt:?}");
+    // what remains is the bias of the converged image (clamp, singularities)
+    let bias = p["converged_vs_path_tracer"]["rmse"].as_f64().unwrap();
+    assert!(bias > 0.0);
 }

@@ -172,6 +172,25 @@ pub enum BenchResult {
     Ils(Box<IlsBench>),
     /// A-buffer constructions and the compressed path (`strata bench abuffer`, ABA Table I).
     Abuffer(Box<AbufferBench>),
+    /// Bounced z-buffer AO with and without visibility (`strata bench bzb`, BZB Table 1/3).
+    Bzb(Box<BzbBench>),
+}
+
+/// `strata bench bzb`: the `bzb-ao` frame with the bounced z-buffer (depth test, nearest
+/// occluder) and without (additive AOV baseline), same splats.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BzbBench {
+    pub triangles: u64,
+    /// S directions per pixel.
+    pub directions: u32,
+    /// `bzb-splat` with visibility / without: what the visibility step costs.
+    pub splat_ratio: f64,
+    /// The whole technique's ratio.
+    pub total_ratio: f64,
+    /// Bytes of the bounced z-buffer, its payload and the splat inputs at the bench size.
+    pub memory_bytes: u64,
+    pub visibility: StageBench,
+    pub no_visibility: StageBench,
 }
 
 /// `strata bench abuffer`: ABA Table I's stages per construction, keyed `dual-peel`,
@@ -241,6 +260,7 @@ impl BenchResult {
             BenchResult::Technique(_) => "technique",
             BenchResult::Ils(_) => "ils",
             BenchResult::Abuffer(_) => "abuffer",
+            BenchResult::Bzb(_) => "bzb",
         }
     }
 }
@@ -420,6 +440,43 @@ pub struct IlsEval {
     /// The brute force against the same path tracer (what the interleaving itself adds is the
     /// difference).
     pub brute_force: GiErrors,
+    /// §6.3's physically-based mode (`--progressive K`), when run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub progressive: Option<IlsProgressive>,
+}
+
+/// ILS §6.3 / Table 5: frames with fresh VPL sets accumulated until the running mean is
+/// within `target_rms` (relative RMS) of the converged image of the same estimator.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IlsProgressive {
+    /// K: VPL sets of the converged image, and the most frames accumulated.
+    pub sets: u32,
+    /// B: VPL bounces (instant radiosity) and indirect bounces of the path tracer.
+    pub bounces: u32,
+    pub vpl_paths: u32,
+    pub target_rms: f64,
+    /// n×m = 1×1 and 2×2.
+    pub patterns: Vec<IlsProgressivePattern>,
+    /// The 1×1 converged image against the path tracer with B bounces (full image,
+    /// HDR ꟻLIP / RMSE / MAE): the bias of the geometry-term clamp and VPL singularities.
+    pub converged_vs_path_tracer: ErrorStats,
+    pub ref_spp: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IlsProgressivePattern {
+    pub pattern: String,
+    /// Frames until the relative RMS fell below the target (`None`: not within K).
+    pub frames_to_target: Option<u32>,
+    /// GPU milliseconds of those frames, and the CPU milliseconds that generated their VPLs.
+    pub gpu_ms_to_target: Option<f64>,
+    pub vpl_ms_to_target: Option<f64>,
+    pub gpu_ms_per_frame: f64,
+    /// (frames accumulated, relative RMS against the converged image).
+    pub rms_curve: Vec<(u32, f64)>,
+    /// (frames accumulated = 1, 2, 4, …, relative RMS of the running mean against the path
+    /// tracer's full image): falls with the frames down to the clamp/singularity bias.
+    pub rms_vs_path_tracer: Vec<(u32, f64)>,
 }
 
 /// Any evaluation's result, tagged by `"technique"`.

@@ -1070,7 +1070,7 @@ mod tests {
         };
         for t in registry() {
             let s = t.settings(&auto, None).unwrap();
-            let want = if t.name == "ao" || t.name == "full" {
+            let want = if matches!(t.name, "ao" | "full" | "aba-ao") {
                 AO_GUARD_BAND
             } else {
                 GuardBand::Pixels(0)

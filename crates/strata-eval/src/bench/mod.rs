@@ -11,6 +11,7 @@ use crate::scene::SceneSpec;
 use crate::stats::median_min;
 
 pub mod abuffer;
+pub mod bzb;
 pub mod ao;
 pub mod deep;
 pub mod gbuffer;

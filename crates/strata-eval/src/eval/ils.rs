@@ -25,7 +25,8 @@ use crate::results::{EvalResult, GiErrors, IlsEval};
 
 /// `set`: the `ils` technique's settings (`vpls`, `interleave-n`, `shadows`, …), applied last
 /// and range-checked; the brute force is the same with `brute-force = 1`.
-pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<IlsEval> {
+/// `progressive`: §6.3's physically-based mode with (K sets, B bounces) ([`super::ils_progressive`]).
+pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u32)>) -> Result<IlsEval> {
     let rule = s.check(DEFAULT_CAP, 8)?;
     if s.deep.layers != 1 {
         bail!(
@@ -103,6 +104,10 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<IlsEval> {
         gpu.check_errors()?;
         Ok(out)
     };
+    let progressive = match progressive {
+        Some((k, b)) => Some(super::ils_progressive::run(s, &is_settings, &scene, camera, &gpu, k, b)?),
+        None => None,
+    };
     let (full, ind) = render(is_settings)?;
     let (brute_full, brute_ind) = render(brute_settings)?;
 
@@ -152,6 +157,7 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<IlsEval> {
         indirect_rmse_vs_brute: vs_brute_ind.rmse,
         errors,
         brute_force,
+        progressive,
     };
     if let Some(dir) = &s.report {
         write_report(

@@ -24,6 +24,7 @@ pub mod ao;
 pub mod bzb;
 pub mod gi;
 pub mod ils;
+pub mod ils_progressive;
 pub mod oit;
 
 /// What every evaluation takes.

@@ -78,7 +78,8 @@ pub struct AbaAoSettings {
     pub steps: u32,
     /// Also write the colour with AO applied inside the OIT blend and the
     /// separate product (targets `hdr-aba-inside`, `hdr-aba-separate`; ABA §III's
-    /// comparison). Needs uncompressed lists (the nodes hold no colour).
+    /// comparison). The compressed nodes hold no colour, so with it the AO walks
+    /// the lists even when the A-buffer compresses.
     pub inside: bool,
     /// Bilateral reconstruction after the blend (ABA: possible because the AO is separate).
     pub blur: BilateralSettings,
@@ -182,7 +183,8 @@ impl AbaAoUniforms {
             seed: 0,
             rotate: s.rotate as u32,
             multilayer: s.multilayer as u32,
-            compressed: compressed as u32,
+            // the inside integration needs every fragment's colour: the lists
+            compressed: (compressed && !s.inside) as u32,
             kernel: s.kernel as u32,
             directions: s.directions,
             steps: s.steps,

@@ -214,11 +214,6 @@ impl ABufferSettings {
         }
         if let Some(a) = &self.ao {
             a.validate()?;
-            if a.inside && self.compress.is_some() {
-                return Err(
-                    "integration inside needs compress 0: the compressed nodes hold no colour (set compress=0)".into(),
-                );
-            }
         }
         Ok(())
     }
