@@ -466,10 +466,9 @@ fn bench_ao_splits_first_layer_and_increment() {
 #[test]
 fn bench_ao_deinterleaved_times_split_gather_and_resolve() {
     let args = |extra: &[&'static str]| {
-        let mut a = vec![
-            "bench", "ao", "--scene", "column-wall", "--width", "64", "--height", "48", "--layers", "2", "--frames",
-            "2", "--json",
-        ];
+        let mut a: Vec<&str> = "bench ao --scene column-wall --width 64 --height 48 --layers 2 --frames 2 --json"
+            .split(' ')
+            .collect();
         a.extend_from_slice(extra);
         a
     };
@@ -491,7 +490,8 @@ fn bench_ao_deinterleaved_times_split_gather_and_resolve() {
     );
     assert_eq!(v["deinterleave"], "2x2");
     assert_eq!(v["filter_obscurance"], true);
-    assert_one_line_error(&strata(&args(&["--deinterleave", "5x5"])), &["deinterleave", "5x5", "1..=4"]);
+    let bad = strata(&args(&["--deinterleave", "5x5"]));
+    assert_one_line_error(&bad, &["deinterleave", "5x5", "1..=4"]);
     assert_one_line_error(&strata(&args(&["--deinterleave", "2by2"])), &["deinterleave", "2by2"]);
 }
 

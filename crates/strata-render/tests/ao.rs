@@ -412,8 +412,16 @@ fn deinterleaved_1x1_equals_the_single_pass_ao() {
             ));
         }
         for (what, a, b) in [("ao-raw", &out[0].0, &out[1].0), ("ao", &out[0].1, &out[1].1)] {
-            let worst = a.data.iter().zip(&b.data).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max);
-            assert!(worst <= 1e-6, "{name} {what}: 1x1 differs from the single pass by {worst}");
+            let worst = a
+                .data
+                .iter()
+                .zip(&b.data)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0f32, f32::max);
+            assert!(
+                worst <= 1e-6,
+                "{name} {what}: 1x1 differs from the single pass by {worst}"
+            );
         }
         assert!(mean(&out[0].0.data) < 0.99, "{name}: test is weak, nothing occluded");
     }
@@ -455,7 +463,8 @@ fn deinterleaved_gpu_ao_equals_its_cpu_twin() {
                 close += (d < 1e-4) as usize;
                 occluded += (cpu < 0.99) as usize;
                 // the twin is not the single-pass AO (else the test could not tell them apart)
-                differs += ((cpu - ambient_visibility_cpu(&zmip, &normals, &f, &u, layers, x, y)).abs() > 1e-3) as usize;
+                differs +=
+                    ((cpu - ambient_visibility_cpu(&zmip, &normals, &f, &u, layers, x, y)).abs() > 1e-3) as usize;
             }
         }
         let n = (fw * fh) as usize;
@@ -467,8 +476,14 @@ fn deinterleaved_gpu_ao_equals_its_cpu_twin() {
         eprintln!(
             "{name} k={layers} {pattern:?} {fw}x{fh}: {close}/{n} within 1e-4, worst {worst}, {occluded} occluded, {differs} differ from the single pass"
         );
-        assert!(occluded > n / 20, "{name}: test is weak, only {occluded} occluded pixels");
-        assert!(differs > n / 20, "{name}: only {differs} pixels differ from the single pass");
+        assert!(
+            occluded > n / 20,
+            "{name}: test is weak, only {occluded} occluded pixels"
+        );
+        assert!(
+            differs > n / 20,
+            "{name}: only {differs} pixels differ from the single pass"
+        );
     }
 }
 
@@ -509,16 +524,27 @@ fn bad_deinterleave_settings_are_one_line_errors() {
             Ok(_) => panic!("{needle}: accepted"),
             Err(e) => e.to_string(),
         };
-        assert!(e.contains("deinterleave") && e.contains(needle) && !e.contains('\n'), "{e}");
+        assert!(
+            e.contains("deinterleave") && e.contains(needle) && !e.contains('\n'),
+            "{e}"
+        );
     }
     gpu.check_errors().expect("nothing invalid reached wgpu");
     let t = strata_render::technique::find("ao").unwrap();
     let mut s = t.settings(&RenderSettings::default(), None).unwrap();
-    let v = t.setting_list().find(|i| i.name == "deinterleave").unwrap().parse_value("4x4").unwrap();
+    let v = t
+        .setting_list()
+        .find(|i| i.name == "deinterleave")
+        .unwrap()
+        .parse_value("4x4")
+        .unwrap();
     t.set(&mut s, "deinterleave", v).unwrap();
     assert_eq!(s.ao.as_ref().unwrap().deinterleave, Some([4, 4]));
     let e = t.set(&mut s, "deinterleave", 4.0).unwrap_err().to_string();
-    assert!(e.contains("deinterleave") && e.contains("0..=3") && !e.contains('\n'), "{e}");
+    assert!(
+        e.contains("deinterleave") && e.contains("0..=3") && !e.contains('\n'),
+        "{e}"
+    );
 }
 
 /// `filter_obscurance`: `ao-raw` holds S = π/N_s·Σ (the twin's obscurance
@@ -570,8 +596,14 @@ fn filtered_obscurance_is_eq1_before_the_square_root_and_resolves_to_av() {
             }
         }
         let n = (w * h) as usize;
-        assert!(close as f32 >= 0.995 * n as f32, "{pattern:?}: {close}/{n} S within 1e-4");
-        assert!(positive > n / 10, "{pattern:?}: test is weak, {positive} pixels with S > 0.01");
+        assert!(
+            close as f32 >= 0.995 * n as f32,
+            "{pattern:?}: {close}/{n} S within 1e-4"
+        );
+        assert!(
+            positive > n / 10,
+            "{pattern:?}: test is weak, {positive} pixels with S > 0.01"
+        );
         let resolved = r.read_target(&gpu, "ao").unwrap();
         let plain = render_ao(&gpu, &scene, w, h, layers, unfiltered);
         // both through R16F (`ao-obscurance` / `ao`): S to ~5e-4 relative, then 1 − √S

@@ -345,7 +345,12 @@ pub fn ambient_visibility_cpu(
 /// whole radius range κ ∈ (0, 1) (a contiguous block of k would give one
 /// sub-buffer only the nearest taps), and the n·m pixels of a pattern cell
 /// together evaluate each of the N taps exactly once.
-pub fn sub_buffer_taps(samples: u32, [n, m]: [u32; 2], i: u32, j: u32) -> (std::iter::StepBy<std::ops::Range<u32>>, u32) {
+pub fn sub_buffer_taps(
+    samples: u32,
+    [n, m]: [u32; 2],
+    i: u32,
+    j: u32,
+) -> (std::iter::StepBy<std::ops::Range<u32>>, u32) {
     let count = n * m;
     let s = i + n * j;
     ((s..samples).step_by(count as usize), (samples - s).div_ceil(count))
@@ -378,7 +383,9 @@ pub fn deinterleaved_visibility_cpu(
     x: u32,
     y: u32,
 ) -> f32 {
-    visibility_from_obscurance(deinterleaved_obscurance_cpu(zmip, normals, frame, u, layers, pattern, x, y))
+    visibility_from_obscurance(deinterleaved_obscurance_cpu(
+        zmip, normals, frame, u, layers, pattern, x, y,
+    ))
 }
 
 /// Eq. 1's AV = max(0, 1 − √S) of an obscurance mean S (`ao-resolve`).
@@ -418,7 +425,10 @@ pub fn deinterleaved_obscurance_cpu(
     for i in taps {
         let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
         let dl = snap_tap(spiral::tap_texel(tap.offset), pattern);
-        let (qx, qy) = (x as i32 + dl[0] * pattern[0] as i32, y as i32 + dl[1] * pattern[1] as i32);
+        let (qx, qy) = (
+            x as i32 + dl[0] * pattern[0] as i32,
+            y as i32 + dl[1] * pattern[1] as i32,
+        );
         if qx < 0 || qy < 0 || qx >= w || qy >= h {
             continue;
         }

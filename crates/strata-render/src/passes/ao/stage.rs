@@ -9,9 +9,9 @@ use crate::gpu::GpuContext;
 use crate::passes::ao::{AoPass, AoSettings};
 use crate::passes::bilateral::BilateralPass;
 use crate::passes::deep_gbuffer::DeepGBufferSettings;
-use crate::passes::temporal::TemporalPass;
 use crate::passes::ils::InterleavePass;
 use crate::passes::interleave::{Interleave, SplitMethod};
+use crate::passes::temporal::TemporalPass;
 use crate::scene_gpu::GpuScene;
 use crate::RenderError;
 
@@ -180,8 +180,21 @@ fn deinterleaved(
     let gather = Interleave::new(gpu, DEINT_RAW_TILED.format, w, h, n, m, method)?;
     let tiled = split_z.tiled_size();
     let geometry = *split_z.geometry();
-    targets.create(gpu, TargetDesc { format: zformat, ..DEINT_Z });
-    targets.create_sized(gpu, TargetDesc { format: zformat, ..DEINT_Z_SPLIT }, tiled);
+    targets.create(
+        gpu,
+        TargetDesc {
+            format: zformat,
+            ..DEINT_Z
+        },
+    );
+    targets.create_sized(
+        gpu,
+        TargetDesc {
+            format: zformat,
+            ..DEINT_Z_SPLIT
+        },
+        tiled,
+    );
     targets.create_sized(gpu, DEINT_N_SPLIT, tiled);
     targets.create_sized(gpu, DEINT_RAW_TILED, tiled);
     let before: Vec<Box<dyn Pass>> = vec![
