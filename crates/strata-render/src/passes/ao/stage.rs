@@ -160,6 +160,9 @@ impl Pass for CopyLevel0 {
     }
 }
 
+/// `ao-deint`, the passes before it (copy, splits) and the gather.
+type DeinterleavedPasses = (AoPass, Vec<Box<dyn Pass>>, InterleavePass);
+
 /// The passes of the deinterleaved Eq. 1 (see the module docs): BS of zmip
 /// level 0 and of npack with the one-pass method (the fastest on lavapipe,
 /// `docs/ils-split.md`), the AO over the tiled buffer, BG into `ao-raw`.
@@ -170,7 +173,7 @@ fn deinterleaved(
     layers: u32,
     n: u32,
     m: u32,
-) -> Result<(AoPass, Vec<Box<dyn Pass>>, InterleavePass), RenderError> {
+) -> Result<DeinterleavedPasses, RenderError> {
     use crate::passes::ao::{DEINT_N_SPLIT, DEINT_RAW_TILED, DEINT_Z, DEINT_Z_SPLIT, OUTPUT};
     let (w, h) = (targets.width, targets.height);
     let zformat = targets.get("zmip").desc.format;
