@@ -323,7 +323,17 @@ pub struct AoArgs {
     /// Tap radius q in pixels at which the MIP level first increments, >= 1 (m = floor(log2(h/q))).
     #[arg(long, default_value_t = 8.0)]
     pub mip_q: f32,
+    /// Deinterleaved AO: "off" or an NxM pattern, N, M in 1..=4 (e.g. 2x2, 4x4; docs/ao.md).
+    #[arg(long, default_value = "off", value_parser = parse_pattern)]
+    pub deinterleave: Deinterleave,
+    /// Filter Eq. 1's obscurance mean before the square root, then AV = 1 − √ (not in the paper; docs/ao.md).
+    #[arg(long)]
+    pub filter_obscurance: bool,
 }
+
+/// `--deinterleave`: `None` = off.
+#[derive(Clone, Copy, Debug)]
+pub struct Deinterleave(pub Option<[u32; 2]>);
 
 impl AoArgs {
     pub fn settings(&self) -> AoSettings {
@@ -349,9 +359,23 @@ impl AoArgs {
                 alpha: self.alpha,
                 max_distance: self.temporal_distance,
             }),
+            deinterleave: self.deinterleave.0,
+            filter_obscurance: self.filter_obscurance,
             ..d
         }
     }
+}
+
+fn parse_pattern(s: &str) -> Result<Deinterleave, String> {
+    if s.eq_ignore_ascii_case("off") {
+        return Ok(Deinterleave(None));
+    }
+    let bad = || format!("'{s}' is not a deinterleave pattern: use \"off\" or NxM, e.g. 2x2");
+    let (n, m) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    Ok(Deinterleave(Some([
+        n.trim().parse().map_err(|_| bad())?,
+        m.trim().parse().map_err(|_| bad())?,
+    ])))
 }
 
 fn parse_turns(s: &str) -> Result<SpiralTurns, String> {

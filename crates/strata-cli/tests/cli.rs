@@ -460,6 +460,41 @@ fn bench_ao_splits_first_layer_and_increment() {
     assert!((first + inc - total).abs() < 1e-6, "{first} + {inc} != {total}");
 }
 
+/// `--deinterleave 2x2 --filter-obscurance`: the copy, both splits, `ao-deint`,
+/// the gather and `ao-resolve` replace `ao` in the timed passes; a bad pattern
+/// is a one-line error naming the flag or the setting and its range.
+#[test]
+fn bench_ao_deinterleaved_times_split_gather_and_resolve() {
+    let args = |extra: &[&'static str]| {
+        let mut a: Vec<&str> = "bench ao --scene column-wall --width 64 --height 48 --layers 2 --frames 2 --json"
+            .split(' ')
+            .collect();
+        a.extend_from_slice(extra);
+        a
+    };
+    let v = json_of(&strata(&args(&["--deinterleave", "2x2", "--filter-obscurance"])));
+    assert_eq!(
+        pass_names(&v),
+        [
+            "depth-mip",
+            "ao-deint-copy",
+            "ao-deint-split-z",
+            "ao-deint-split-n",
+            "ao-deint",
+            "ao-deint-gather",
+            "ao-temporal",
+            "ao-blur-h",
+            "ao-blur-v",
+            "ao-resolve"
+        ]
+    );
+    assert_eq!(v["deinterleave"], "2x2");
+    assert_eq!(v["filter_obscurance"], true);
+    let bad = strata(&args(&["--deinterleave", "5x5"]));
+    assert_one_line_error(&bad, &["deinterleave", "5x5", "1..=4"]);
+    assert_one_line_error(&strata(&args(&["--deinterleave", "2by2"])), &["deinterleave", "2by2"]);
+}
+
 #[test]
 fn render_full_is_brighter_than_direct_in_shadow_and_lists_its_passes() {
     let cache = scratch("probe-cache");

@@ -504,7 +504,7 @@ impl Renderer {
             );
         }
         let ao = match &settings.ao {
-            Some(a) => Some(AoStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, a)),
+            Some(a) => Some(AoStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, a)?),
             None => None,
         };
         let bzb = match &settings.bzb {

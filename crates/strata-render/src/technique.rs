@@ -165,7 +165,7 @@ static DIRECT_SETTINGS: [SettingInfo; 2] = [
     ),
 ];
 
-static AO_SETTINGS: [SettingInfo; 10] = [
+static AO_SETTINGS: [SettingInfo; 12] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
@@ -251,6 +251,25 @@ static AO_SETTINGS: [SettingInfo; 10] = [
         |s| Some(ao_of(s).q as f64),
         |s, v| ao_mut(s).q = v as f32
     ),
+    SettingInfo {
+        name: "deinterleave",
+        doc: "deinterleaved AO (issue 11 item 8): ILS split into n x n sub-buffers, sub-buffer s = i + n*j evaluates the spiral taps k with k mod n*n = s, then gather + the same temporal/bilateral (off = one full-resolution pass)",
+        range: Range::Closed(0.0, 3.0),
+        integer: true,
+        get: |s| Some(ao_of(s).deinterleave.map_or(0.0, |[n, _]| n as f64 - 1.0)),
+        // value v >= 1 is the (v+1)x(v+1) pattern
+        set: |s, v| ao_mut(s).deinterleave = (v >= 1.0).then(|| [v as u32 + 1; 2]),
+        values: &["off", "2x2", "3x3", "4x4"],
+    },
+    SettingInfo {
+        name: "filter-obscurance",
+        doc: "on: the temporal and bilateral filters average Eq. 1's obscurance mean before the square root, then AV = 1 - sqrt (not in the paper; removes the brightening of few-tap deinterleaved AO); off: DGB's order",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(ao_of(s).filter_obscurance as u32 as f64),
+        set: |s, v| ao_mut(s).filter_obscurance = v != 0.0,
+        values: &["off", "on"],
+    },
 ];
 
 static RADIOSITY_SETTINGS: [SettingInfo; 7] = [

@@ -7,7 +7,10 @@ mod common;
 use strata_reference::ao::{DiskSampling, ObscuranceSettings};
 use strata_reference::Reference;
 use strata_render::frame::FrameCameras;
-use strata_render::passes::ao::{ambient_visibility_cpu, AoSettings};
+use strata_render::passes::ao::{
+    ambient_visibility_cpu, deinterleaved_obscurance_cpu, deinterleaved_visibility_cpu, snap_tap, sub_buffer_taps,
+    AoSettings,
+};
 use strata_render::passes::bilateral::BilateralSettings;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::temporal::TemporalSettings;
@@ -335,4 +338,282 @@ fn temporal_filter_ignores_history_from_an_oracle_less_first_frame() {
         .filter(|((e, t), h)| (*t - (0.15 * *e + 0.85 * *h)).abs() < 1e-5 && (*e - *h).abs() > 1e-3)
         .count();
     assert!(blended > 100, "frame 2 did not blend ({blended} px)");
+}
+
+// ---- Deinterleaved AO (issue 11 item 8, docs/ao.md "Deinterleaved AO") ----
+
+fn deint(pattern: Option<[u32; 2]>) -> AoSettings {
+    AoSettings {
+        deinterleave: pattern,
+        ..AoSettings::default()
+    }
+}
+
+/// The tap assignment: the n·m sub-buffers of a pattern cell evaluate each of
+/// the N spiral taps exactly once, with N_s = ⌈(N − s)/(n·m)⌉ taps each; the
+/// snap moves a tap at most n/2 (m/2) pixels onto the sub-buffer's lattice
+/// and is the identity for 1×1.
+#[test]
+fn deinterleaved_taps_partition_the_spiral_and_snap_onto_the_lattice() {
+    for samples in [1u32, 4, 16, 19, 32, 57] {
+        for pattern @ [n, m] in [[1u32, 1], [2, 2], [3, 2], [4, 4], [2, 1]] {
+            if n * m > samples {
+                continue;
+            }
+            let mut seen = vec![0u32; samples as usize];
+            for j in 0..m {
+                for i in 0..n {
+                    let (taps, count) = sub_buffer_taps(samples, pattern, i, j);
+                    let taps: Vec<u32> = taps.collect();
+                    assert_eq!(taps.len() as u32, count, "N={samples} {n}x{m} ({i},{j})");
+                    assert!(count >= 1);
+                    for k in taps {
+                        assert_eq!(k % (n * m), i + n * j);
+                        seen[k as usize] += 1;
+                    }
+                }
+            }
+            assert!(seen.iter().all(|&c| c == 1), "N={samples} {n}x{m}: {seen:?}");
+        }
+    }
+    for dx in -40..=40 {
+        for dy in [-7, -1, 0, 1, 6] {
+            assert_eq!(snap_tap([dx, dy], [1, 1]), [dx, dy]);
+            for pattern @ [n, m] in [[2u32, 2], [3, 2], [4, 4]] {
+                let [lx, ly] = snap_tap([dx, dy], pattern);
+                let (ex, ey) = (lx * n as i32 - dx, ly * m as i32 - dy);
+                // ⌊d/n + ½⌋: within (−n/2, n/2] of the spiral's pixel
+                assert!(2 * ex > -(n as i32) && 2 * ex <= n as i32, "{dx} {n}: {lx}");
+                assert!(2 * ey > -(m as i32) && 2 * ey <= m as i32, "{dy} {m}: {ly}");
+            }
+        }
+    }
+}
+
+/// 1×1 runs the whole deinterleaved path (copy, splits, `ao-deint`, gather)
+/// and must reproduce today's single-pass AO: `ao-raw` and the filtered `ao`.
+#[test]
+fn deinterleaved_1x1_equals_the_single_pass_ao() {
+    let gpu = common::gpu();
+    for (name, layers) in [("atrium", 2u32), ("cornell", 1)] {
+        let scene = frozen(name);
+        let (w, h) = (96, 64);
+        let mut out = Vec::new();
+        for pattern in [None, Some([1, 1])] {
+            let mut r = ao_renderer(&gpu, &scene, w, h, layers, deint(pattern));
+            let passes: Vec<&str> = r.pass_infos().iter().map(|p| p.name).collect();
+            assert_eq!(passes.contains(&"ao-deint"), pattern.is_some(), "{passes:?}");
+            assert_eq!(passes.contains(&"ao"), pattern.is_none(), "{passes:?}");
+            r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+                .expect("frame renders without validation errors");
+            out.push((
+                r.read_target_full(&gpu, "ao-raw", 0).unwrap(),
+                r.read_target(&gpu, "ao").unwrap(),
+            ));
+        }
+        for (what, a, b) in [("ao-raw", &out[0].0, &out[1].0), ("ao", &out[0].1, &out[1].1)] {
+            let worst = a
+                .data
+                .iter()
+                .zip(&b.data)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0f32, f32::max);
+            assert!(
+                worst <= 1e-6,
+                "{name} {what}: 1x1 differs from the single pass by {worst}"
+            );
+        }
+        assert!(mean(&out[0].0.data) < 0.99, "{name}: test is weak, nothing occluded");
+    }
+}
+
+/// The deinterleaved shader against its CPU twin over the read-back buffers
+/// (sub-buffer taps, lattice snap, level-0 reads from the split, N_s), for
+/// patterns that divide the size and ones that leave padding.
+#[test]
+fn deinterleaved_gpu_ao_equals_its_cpu_twin() {
+    let gpu = common::gpu();
+    for (name, layers, pattern, (w, h)) in [
+        ("atrium", 2u32, [2u32, 2], (96, 64)),
+        // 4×4 leaves 1–2 taps per pixel and snaps taps nearer than 2 px onto
+        // the pixel itself: a larger image keeps enough pixels occluded
+        ("atrium", 2, [4, 4], (192, 128)),
+        ("cornell", 2, [3, 2], (97, 61)),
+        ("atrium", 3, [2, 2], (90, 61)),
+    ] {
+        let scene = frozen(name);
+        let mut r = ao_renderer(&gpu, &scene, w, h, layers, deint(Some(pattern)));
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let raw = r.read_target_full(&gpu, "ao-raw", 0).unwrap();
+        let u = r.ao_uniforms().unwrap();
+        let zmip: Vec<ImageBuf> = (0..=u.max_mip)
+            .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
+            .collect();
+        let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
+        let normals = common::npack_normals(&npack, 0);
+        let f = r.frame_uniforms();
+        let (mut close, mut occluded, mut worst, mut differs) = (0usize, 0usize, 0.0f32, 0usize);
+        let (fw, fh) = (raw.width, raw.height);
+        for y in 0..fh {
+            for x in 0..fw {
+                let cpu = deinterleaved_visibility_cpu(&zmip, &normals, &f, &u, layers, pattern, x, y);
+                let d = (cpu - raw.pixel(x, y)[0]).abs();
+                worst = worst.max(d);
+                close += (d < 1e-4) as usize;
+                occluded += (cpu < 0.99) as usize;
+                // the twin is not the single-pass AO (else the test could not tell them apart)
+                differs +=
+                    ((cpu - ambient_visibility_cpu(&zmip, &normals, &f, &u, layers, x, y)).abs() > 1e-3) as usize;
+            }
+        }
+        let n = (fw * fh) as usize;
+        // as for the single pass: a tap within ~1e-4 px of a texel edge may round differently
+        assert!(
+            close as f32 >= 0.995 * n as f32,
+            "{name} k={layers} {pattern:?}: only {close}/{n} pixels within 1e-4 (worst {worst})"
+        );
+        eprintln!(
+            "{name} k={layers} {pattern:?} {fw}x{fh}: {close}/{n} within 1e-4, worst {worst}, {occluded} occluded, {differs} differ from the single pass"
+        );
+        assert!(
+            occluded > n / 20,
+            "{name}: test is weak, only {occluded} occluded pixels"
+        );
+        assert!(
+            differs > n / 20,
+            "{name}: only {differs} pixels differ from the single pass"
+        );
+    }
+}
+
+#[test]
+fn deinterleaved_unoccluded_plane_is_one() {
+    let gpu = common::gpu();
+    let scene = frozen("plane");
+    for pattern in [[2, 2], [4, 4], [3, 2]] {
+        let av = render_ao(&gpu, &scene, 97, 64, 2, deint(Some(pattern)));
+        let min = av.data.iter().cloned().fold(f32::INFINITY, f32::min);
+        assert!(min >= 1.0 - 1e-3, "{pattern:?}: min AV {min}");
+    }
+}
+
+#[test]
+fn bad_deinterleave_settings_are_one_line_errors() {
+    let gpu = common::gpu();
+    let scene = frozen("plane");
+    for (ao, needle) in [
+        (deint(Some([5, 5])), "5x5"),
+        (deint(Some([0, 2])), "0x2"),
+        (
+            AoSettings {
+                samples: 8,
+                ..deint(Some([4, 4]))
+            },
+            "samples (8)",
+        ),
+    ] {
+        let settings = RenderSettings {
+            width: 32,
+            height: 32,
+            shade: false,
+            ao: Some(ao),
+            ..Default::default()
+        };
+        let e = match Renderer::new(&gpu, &scene, settings) {
+            Ok(_) => panic!("{needle}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("deinterleave") && e.contains(needle) && !e.contains('\n'),
+            "{e}"
+        );
+    }
+    gpu.check_errors().expect("nothing invalid reached wgpu");
+    let t = strata_render::technique::find("ao").unwrap();
+    let mut s = t.settings(&RenderSettings::default(), None).unwrap();
+    let v = t
+        .setting_list()
+        .find(|i| i.name == "deinterleave")
+        .unwrap()
+        .parse_value("4x4")
+        .unwrap();
+    t.set(&mut s, "deinterleave", v).unwrap();
+    assert_eq!(s.ao.as_ref().unwrap().deinterleave, Some([4, 4]));
+    let e = t.set(&mut s, "deinterleave", 4.0).unwrap_err().to_string();
+    assert!(
+        e.contains("deinterleave") && e.contains("0..=3") && !e.contains('\n'),
+        "{e}"
+    );
+}
+
+/// `filter_obscurance`: `ao-raw` holds S = π/N_s·Σ (the twin's obscurance
+/// mean, 0 where there is no surface), and with no temporal or spatial filter
+/// `ao-resolve` turns it into exactly the AV the default order writes.
+#[test]
+fn filtered_obscurance_is_eq1_before_the_square_root_and_resolves_to_av() {
+    let gpu = common::gpu();
+    let scene = frozen("atrium");
+    let (w, h, layers) = (96u32, 64u32, 2u32);
+    for pattern in [None, Some([2u32, 2])] {
+        let unfiltered = AoSettings {
+            temporal: None,
+            blur: BilateralSettings {
+                radius: 0,
+                ..AoSettings::default().blur
+            },
+            ..deint(pattern)
+        };
+        let mut r = ao_renderer(
+            &gpu,
+            &scene,
+            w,
+            h,
+            layers,
+            AoSettings {
+                filter_obscurance: true,
+                ..unfiltered.clone()
+            },
+        );
+        assert!(r.pass_infos().iter().any(|p| p.name == "ao-resolve"));
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let raw = r.read_target_full(&gpu, "ao-raw", 0).unwrap();
+        let u = r.ao_uniforms().unwrap();
+        assert_eq!(u.output_obscurance, 1);
+        let zmip: Vec<ImageBuf> = (0..=u.max_mip)
+            .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
+            .collect();
+        let normals = common::npack_normals(&r.read_target_full(&gpu, "npack", 0).unwrap(), 0);
+        let f = r.frame_uniforms();
+        let p = pattern.unwrap_or([1, 1]);
+        let (mut close, mut positive) = (0usize, 0usize);
+        for y in 0..h {
+            for x in 0..w {
+                let cpu = deinterleaved_obscurance_cpu(&zmip, &normals, &f, &u, layers, p, x, y);
+                close += ((cpu - raw.pixel(x, y)[0]).abs() <= 1e-4 * (1.0 + cpu)) as usize;
+                positive += (cpu > 0.01) as usize;
+            }
+        }
+        let n = (w * h) as usize;
+        assert!(
+            close as f32 >= 0.995 * n as f32,
+            "{pattern:?}: {close}/{n} S within 1e-4"
+        );
+        assert!(
+            positive > n / 10,
+            "{pattern:?}: test is weak, {positive} pixels with S > 0.01"
+        );
+        let resolved = r.read_target(&gpu, "ao").unwrap();
+        let plain = render_ao(&gpu, &scene, w, h, layers, unfiltered);
+        // both through R16F (`ao-obscurance` / `ao`): S to ~5e-4 relative, then 1 − √S
+        let worst = resolved
+            .data
+            .iter()
+            .zip(&plain.data)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 2e-3, "{pattern:?}: resolve differs from AV by {worst}");
+        eprintln!("{pattern:?}: {close}/{n} S within 1e-4, resolve vs AV worst {worst}");
+    }
 }

@@ -13,10 +13,18 @@ pub use strata_render::technique::AO_PASSES;
 
 pub fn run(stage: &StageSettings, ao: &AoSettings) -> Result<StageBench> {
     let extra = json!({"samples": ao.samples, "blur_taps": ao.blur.taps(),
-        "temporal_alpha": ao.temporal.map_or(0.0, |t| t.alpha), "variant": stage.variant.to_string()});
+        "temporal_alpha": ao.temporal.map_or(0.0, |t| t.alpha), "variant": stage.variant.to_string(),
+        "deinterleave": ao.deinterleave.map_or("off".to_string(), |[n, m]| format!("{n}x{m}")),
+        "filter_obscurance": ao.filter_obscurance});
+    // the deinterleaved frame replaces `ao` by its split, `ao-deint` and gather passes
+    let passes: Vec<&str> = AO_PASSES
+        .iter()
+        .chain(strata_render::passes::ao::DEINTERLEAVED_PASSES)
+        .copied()
+        .collect();
     stage::run(Stage {
         stage,
-        passes: AO_PASSES,
+        passes: &passes,
         settings: Box::new(move |layers| RenderSettings {
             shade: false,
             ao: Some(ao.clone()),

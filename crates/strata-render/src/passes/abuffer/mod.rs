@@ -834,7 +834,7 @@ impl ABufferStage {
         let mut blur = Vec::new();
         let ao = settings.ao.as_ref().map(|a| {
             targets.create(gpu, AO_RAW);
-            blur.extend(crate::passes::ao::stage::reconstruction(gpu, scene, targets, &a.blur, AO_RAW.name));
+            blur.extend(crate::passes::ao::stage::reconstruction(gpu, scene, targets, &a.blur, AO_RAW.name, "ao"));
             let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("aba-ao-lists"),
                 entries: &[

@@ -25,7 +25,8 @@ struct Ao {
     samples: u32,
     max_mip: u32,
     seed: u32,
-    _pad: u32,
+    // 1: return the obscurance mean S (Eq. 1 before the square root) instead of AV
+    output_obscurance: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -43,8 +44,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let p = vec2i(pos.xy);
     let z = textureLoad(zmip, p, 0).r;
     if (z <= 0.0) {
-        // no surface: unoccluded
-        return vec4f(1.0);
+        // no surface: unoccluded (AV 1, S 0)
+        return vec4f(f32(ao.output_obscurance == 0u));
     }
     let x = world_from_csz(frame, vec2f(p) + 0.5, z);
     let n = oct_decode(textureLoad(npack, p, 0).rg);
@@ -78,6 +79,10 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         }
         sum += a;
     }
-    let av = max(0.0, 1.0 - sqrt(ao.intensity * 3.14159265358979 / f32(ao.samples) * sum));
+    let s = ao.intensity * 3.14159265358979 / f32(ao.samples) * sum;
+    if (ao.output_obscurance != 0u) {
+        return vec4f(s);
+    }
+    let av = max(0.0, 1.0 - sqrt(s));
     return vec4f(av);
 }

@@ -18,6 +18,20 @@ use crate::spiral::{self, SpiralTurns};
 
 /// Largest accepted sample count N.
 pub const MAX_SAMPLES: u32 = 256;
+/// Largest side n, m of a deinterleaving pattern (4×4 already leaves about one
+/// of the default 19 taps per sub-buffer).
+pub const MAX_DEINTERLEAVE: u32 = 4;
+
+/// The passes the deinterleaved AO adds or substitutes, in frame order (the
+/// `ao` pass is replaced by `ao-deint`), and `filter_obscurance`'s last pass.
+pub const DEINTERLEAVED_PASSES: &[&str] = &[
+    "ao-deint-copy",
+    "ao-deint-split-z",
+    "ao-deint-split-n",
+    "ao-deint",
+    "ao-deint-gather",
+    "ao-resolve",
+];
 
 /// AO settings. Defaults: N = 19 taps (SAO's and the DGB demo's default; the
 /// paper does not state its AO N), τ from Listing 3, φ from a per-pixel hash, the
@@ -50,6 +64,18 @@ pub struct AoSettings {
     pub blur: BilateralSettings,
     /// `None` disables the temporal filter.
     pub temporal: Option<TemporalSettings>,
+    /// Deinterleaved evaluation (issue 11 item 8, `docs/ao.md`): the n×m
+    /// pattern of the ILS split/gather passes; sub-buffer s = i + n·j
+    /// evaluates the spiral taps k ≡ s (mod n·m) on its quarter-resolution
+    /// (for 2×2) depth layout. `None` = the single full-resolution pass.
+    pub deinterleave: Option<[u32; 2]>,
+    /// Not in the paper: `ao-raw` holds the obscurance mean S = π/N·Σ A_i
+    /// (Eq. 1 before the square root); the temporal and bilateral filters
+    /// average S and a last pass `ao-resolve` writes AV = max(0, 1 − √S).
+    /// Averaging after the square root is lighter than before it (Jensen),
+    /// which the deinterleaved AO's few taps per pixel make large
+    /// (`docs/ao.md`). Default false (DGB's order).
+    pub filter_obscurance: bool,
 }
 
 impl Default for AoSettings {
@@ -75,6 +101,8 @@ impl Default for AoSettings {
                 ..BilateralSettings::default()
             },
             temporal: Some(TemporalSettings::default()),
+            deinterleave: None,
+            filter_obscurance: false,
         }
     }
 }
@@ -109,6 +137,14 @@ impl AoSettings {
         if !(self.q >= 1.0 && self.q.is_finite()) {
             return Err(format!("MIP radius q {} is out of range: must be >= 1 pixel", self.q));
         }
+        if let Some([n, m]) = self.deinterleave {
+            if !(1..=MAX_DEINTERLEAVE).contains(&n) || !(1..=MAX_DEINTERLEAVE).contains(&m) || n * m > self.samples {
+                return Err(format!(
+                    "AO deinterleave pattern {n}x{m} is out of range: n and m must be in 1..={MAX_DEINTERLEAVE} and n·m <= samples ({})",
+                    self.samples
+                ));
+            }
+        }
         self.mips.validate()?;
         self.blur.validate()?;
         if let Some(t) = &self.temporal {
@@ -139,7 +175,9 @@ pub struct AoUniforms {
     pub samples: u32,
     pub max_mip: u32,
     pub seed: u32,
-    pub _pad: u32,
+    /// 1: write the obscurance mean S = π·intensity/N·Σ instead of AV = max(0, 1 − √S)
+    /// ([`AoSettings::filter_obscurance`]).
+    pub output_obscurance: u32,
 }
 
 impl AoUniforms {
@@ -158,7 +196,7 @@ impl AoUniforms {
             samples: s.samples,
             max_mip,
             seed: if s.temporal_noise { frame_index } else { 0 },
-            _pad: 0,
+            output_obscurance: s.filter_obscurance as u32,
         }
     }
 }
@@ -180,7 +218,44 @@ pub const OUTPUT: TargetDesc = TargetDesc::new(
 pub struct AoPass {
     pass: FullscreenPass,
     last: std::cell::Cell<AoUniforms>,
+    /// The split geometry of the deinterleaved pass (`ao-deint`); `None`: `ao`.
+    ils: Option<crate::passes::interleave::IlsUniforms>,
 }
+
+/// Mirrors `DeintAo` in `ao_deint.wgsl`: Eq. 1–2's uniforms and the split's geometry.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct DeintUniforms {
+    ao: AoUniforms,
+    ils: crate::passes::interleave::IlsUniforms,
+}
+
+/// The tiled targets of the deinterleaved AO (sub-buffer (i, j) at
+/// `InterleaveGeometry::tile_origin(i, j)`).
+pub const DEINT_Z: TargetDesc = TargetDesc::new(
+    "ao-deint-z",
+    wgpu::TextureFormat::Rg32Float,
+    1,
+    "zmip level 0 copied to a single-level texture (the split's source)",
+);
+pub const DEINT_Z_SPLIT: TargetDesc = TargetDesc::new(
+    "ao-deint-z-split",
+    wgpu::TextureFormat::Rg32Float,
+    1,
+    "ILS §3.2 split of zmip level 0: n×m tiled sub-buffers of camera-space z (channel j = layer j)",
+);
+pub const DEINT_N_SPLIT: TargetDesc = TargetDesc::new(
+    "ao-deint-n-split",
+    wgpu::TextureFormat::Rgba8Unorm,
+    1,
+    "ILS §3.2 split of npack (Oct16 normals) into n×m tiled sub-buffers",
+);
+pub const DEINT_RAW_TILED: TargetDesc = TargetDesc::new(
+    "ao-raw-tiled",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "deinterleaved DGB Eq. 1: each sub-buffer's AV from its subset of the spiral taps, tiled",
+);
 
 impl AoPass {
     pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32) -> Self {
@@ -197,11 +272,44 @@ impl AoPass {
         Self {
             pass,
             last: std::cell::Cell::new(zeroed),
+            ils: None,
+        }
+    }
+
+    /// The deinterleaved pass `ao-deint`: one full-screen pass over the tiled
+    /// buffer (every sub-buffer in its tile), reading the split depth and
+    /// normals, writing [`DEINT_RAW_TILED`].
+    pub(crate) fn new_deinterleaved(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        layers: u32,
+        geometry: &crate::passes::interleave::InterleaveGeometry,
+    ) -> Self {
+        let zeroed = AoUniforms::zeroed();
+        let ils = geometry.uniforms(crate::passes::interleave::PADDING_MARKER);
+        let pass = PassBuilder::new(gpu, targets, "ao-deint")
+            .shader("ao-deint", include_str!("ao_deint.wgsl"))
+            .constant("LAYERS", layers as f64)
+            .frame(scene)
+            .uniforms(&DeintUniforms { ao: zeroed, ils })
+            .read(DEINT_Z_SPLIT.name)
+            .read(DEINT_N_SPLIT.name)
+            .read("zmip")
+            .write(DEINT_RAW_TILED.name)
+            .build();
+        Self {
+            pass,
+            last: std::cell::Cell::new(zeroed),
+            ils: Some(ils),
         }
     }
 
     pub fn set_frame(&self, gpu: &GpuContext, u: AoUniforms) {
-        self.pass.set_uniforms(gpu, &u);
+        match self.ils {
+            Some(ils) => self.pass.set_uniforms(gpu, &DeintUniforms { ao: u, ils }),
+            None => self.pass.set_uniforms(gpu, &u),
+        }
         self.last.set(u);
     }
 
@@ -228,9 +336,79 @@ pub fn ambient_visibility_cpu(
     x: u32,
     y: u32,
 ) -> f32 {
+    deinterleaved_visibility_cpu(zmip, normals, frame, u, layers, [1, 1], x, y)
+}
+
+/// The taps of sub-buffer (i, j) of an n×m pattern: k ≡ s (mod n·m) with
+/// s = i + n·j, and how many there are, N_s = ⌈(N − s)/(n·m)⌉ (≥ 1 when
+/// n·m ≤ N). Striding through the spiral gives every sub-buffer taps over the
+/// whole radius range κ ∈ (0, 1) (a contiguous block of k would give one
+/// sub-buffer only the nearest taps), and the n·m pixels of a pattern cell
+/// together evaluate each of the N taps exactly once.
+pub fn sub_buffer_taps(
+    samples: u32,
+    [n, m]: [u32; 2],
+    i: u32,
+    j: u32,
+) -> (std::iter::StepBy<std::ops::Range<u32>>, u32) {
+    let count = n * m;
+    let s = i + n * j;
+    ((s..samples).step_by(count as usize), (samples - s).div_ceil(count))
+}
+
+/// A full-resolution tap offset d (px) snapped to the lattice of pixels of the
+/// same sub-buffer, in sub-buffer texels: ⌊(d + n/2)/n⌋ = ⌊d/n + ½⌋ per axis
+/// (integer maths, as in `ao_deint.wgsl`). The tap then lies at full-res pixel
+/// p + n·that, i.e. at most n/2 px from where the spiral put it.
+pub fn snap_tap(d: [i32; 2], [n, m]: [u32; 2]) -> [i32; 2] {
+    let f = |d: i32, n: u32| (2 * d + n as i32).div_euclid(2 * n as i32);
+    [f(d[0], n), f(d[1], m)]
+}
+
+/// CPU twin of the deinterleaved AO (`ao_deint.wgsl`) at full-resolution
+/// pixel (x, y) for the n×m `pattern`: Eq. 1–2 over the taps of the pixel's
+/// sub-buffer ([`sub_buffer_taps`]), each snapped to the sub-buffer's lattice
+/// ([`snap_tap`]) and normalised by N_s. Level-0 taps read the split depth,
+/// which holds exactly the full-resolution texel at the snapped pixel, so this
+/// reads `zmip[0]` there; taps at MIP level ≥ 1 (DGB §3.4) read the MIP chain
+/// at the snapped pixel as the single-pass AO does. 1×1 is the single-pass AO.
+#[allow(clippy::too_many_arguments)]
+pub fn deinterleaved_visibility_cpu(
+    zmip: &[ImageBuf],
+    normals: &ImageBuf,
+    frame: &FrameUniforms,
+    u: &AoUniforms,
+    layers: u32,
+    pattern: [u32; 2],
+    x: u32,
+    y: u32,
+) -> f32 {
+    visibility_from_obscurance(deinterleaved_obscurance_cpu(
+        zmip, normals, frame, u, layers, pattern, x, y,
+    ))
+}
+
+/// Eq. 1's AV = max(0, 1 − √S) of an obscurance mean S (`ao-resolve`).
+pub fn visibility_from_obscurance(s: f32) -> f32 {
+    (1.0 - s.sqrt()).max(0.0)
+}
+
+/// The obscurance mean S = π·intensity/N_s·Σ of [`deinterleaved_visibility_cpu`]
+/// (what `ao-raw` holds with [`AoSettings::filter_obscurance`]; 0 = no surface).
+#[allow(clippy::too_many_arguments)]
+pub fn deinterleaved_obscurance_cpu(
+    zmip: &[ImageBuf],
+    normals: &ImageBuf,
+    frame: &FrameUniforms,
+    u: &AoUniforms,
+    layers: u32,
+    pattern: [u32; 2],
+    x: u32,
+    y: u32,
+) -> f32 {
     let z = zmip[0].pixel(x, y)[0];
     if z <= 0.0 {
-        return 1.0;
+        return 0.0;
     }
     let px = normals.pixel(x, y);
     let n = Vec3::new(px[0], px[1], px[2]);
@@ -242,11 +420,15 @@ pub fn ambient_visibility_cpu(
         0.0
     };
     let (w, h) = (zmip[0].width as i32, zmip[0].height as i32);
+    let (taps, taps_here) = sub_buffer_taps(u.samples, pattern, x % pattern[0], y % pattern[1]);
     let mut sum = 0.0f32;
-    for i in 0..u.samples {
+    for i in taps {
         let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
-        let d = spiral::tap_texel(tap.offset);
-        let (qx, qy) = (x as i32 + d[0], y as i32 + d[1]);
+        let dl = snap_tap(spiral::tap_texel(tap.offset), pattern);
+        let (qx, qy) = (
+            x as i32 + dl[0] * pattern[0] as i32,
+            y as i32 + dl[1] * pattern[1] as i32,
+        );
         if qx < 0 || qy < 0 || qx >= w || qy >= h {
             continue;
         }
@@ -263,7 +445,7 @@ pub fn ambient_visibility_cpu(
         }
         sum += a;
     }
-    (1.0 - (u.intensity * std::f32::consts::PI / u.samples as f32 * sum).sqrt()).max(0.0)
+    u.intensity * std::f32::consts::PI / taps_here as f32 * sum
 }
 
 /// DGB Eq. 2.

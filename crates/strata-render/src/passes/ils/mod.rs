@@ -378,13 +378,14 @@ struct FilterUniforms {
     channel: u32,
 }
 
-/// BS or BG of one target into another, as a frame pass.
-struct InterleavePass {
-    name: &'static str,
-    interleave: Interleave,
-    src: &'static str,
-    dst: &'static str,
-    split: bool,
+/// BS or BG of one target into another, as a frame pass (also used by the
+/// deinterleaved AO, `passes::ao::stage`).
+pub(crate) struct InterleavePass {
+    pub(crate) name: &'static str,
+    pub(crate) interleave: Interleave,
+    pub(crate) src: &'static str,
+    pub(crate) dst: &'static str,
+    pub(crate) split: bool,
 }
 
 impl Pass for InterleavePass {
@@ -404,7 +405,7 @@ impl Pass for InterleavePass {
             self.interleave.gather(encoder, src, dst)
         };
         // the stage created both targets with the interleave's sizes and format
-        r.expect("ILS targets match their interleave geometry");
+        r.expect("interleave targets match their interleave geometry");
     }
 }
 
