@@ -207,29 +207,22 @@ fn xdotool(d: &str, args: &[&str]) -> String {
     text(&o.stdout)
 }
 
-#[test]
-fn real_x_key_and_mouse_events_move_the_camera() {
-    let Some(x) = xvfb("view::real_x_key_and_mouse_events_move_the_camera") else {
-        return;
-    };
+/// Starts `strata view` on cornell for `frames` frames (screenshot `shot`) under
+/// `x` and waits for its window: (child, window id). `None` (with the skip
+/// noted) when xdotool is missing.
+fn view_window(x: &XServer, test: &str, frames: &str, shot: &std::path::Path) -> Option<(std::process::Child, String)> {
     if find_on_path("xdotool").is_none() {
-        strata_scene::skip::note_skip(
-            "view::real_x_key_and_mouse_events_move_the_camera",
-            "xdotool not found on PATH (scripts/setup.sh installs it)",
-        );
-        return;
+        strata_scene::skip::note_skip(test, "xdotool not found on PATH (scripts/setup.sh installs it)");
+        return None;
     }
-    let dir = scratch("xevents");
-    let shot = dir.join("shot.png");
     let child = Command::new(env!("CARGO_BIN_EXE_strata"))
-        .args([&["view", "--scene", "cornell", "--frames", "300", "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
+        .args([&["view", "--scene", "cornell", "--frames", frames, "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
         .env("DISPLAY", &x.display)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // the window, then real X events through XTEST: hold W, right-drag to the right
     let t0 = Instant::now();
     let id = loop {
         let o = Command::new("xdotool").args(["search", "--name", "strata view"]).env("DISPLAY", &x.display).output().unwrap();
@@ -238,6 +231,20 @@ fn real_x_key_and_mouse_events_move_the_camera() {
         }
         assert!(t0.elapsed() < Duration::from_secs(60), "no viewer window");
         std::thread::sleep(Duration::from_millis(50));
+    };
+    Some((child, id))
+}
+
+#[test]
+fn real_x_key_and_mouse_events_move_the_camera() {
+    let Some(x) = xvfb("view::real_x_key_and_mouse_events_move_the_camera") else {
+        return;
+    };
+    let dir = scratch("xevents");
+    let shot = dir.join("shot.png");
+    // the window, then real X events through XTEST: hold W, right-drag to the right
+    let Some((child, id)) = view_window(&x, "view::real_x_key_and_mouse_events_move_the_camera", "300", &shot) else {
+        return;
     };
     xdotool(&x.display, &["windowfocus", "--sync", &id]);
     xdotool(&x.display, &["keydown", "w"]);
@@ -296,28 +303,10 @@ fn unmapped_window_keeps_running_and_finishes() {
     let Some(x) = xvfb("view::unmapped_window_keeps_running_and_finishes") else {
         return;
     };
-    if find_on_path("xdotool").is_none() {
-        strata_scene::skip::note_skip("view::unmapped_window_keeps_running_and_finishes", "xdotool not found on PATH (scripts/setup.sh installs it)");
-        return;
-    }
     let dir = scratch("unmap");
     let shot = dir.join("shot.png");
-    let child = Command::new(env!("CARGO_BIN_EXE_strata"))
-        .args([&["view", "--scene", "cornell", "--frames", "150", "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
-        .env("DISPLAY", &x.display)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = Instant::now();
-    let id = loop {
-        let o = Command::new("xdotool").args(["search", "--name", "strata view"]).env("DISPLAY", &x.display).output().unwrap();
-        if let Some(id) = text(&o.stdout).lines().next().map(String::from) {
-            break id;
-        }
-        assert!(t0.elapsed() < Duration::from_secs(60), "no viewer window");
-        std::thread::sleep(Duration::from_millis(50));
+    let Some((child, id)) = view_window(&x, "view::unmapped_window_keeps_running_and_finishes", "150", &shot) else {
+        return;
     };
     // hidden (what minimising does without a window manager), then shown again
     xdotool(&x.display, &["windowunmap", "--sync", &id]);

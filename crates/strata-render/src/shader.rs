@@ -16,6 +16,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
     ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),
     ("abuffer/lists.wgsl", include_str!("passes/abuffer/lists.wgsl")),
+    ("ao/uniforms.wgsl", include_str!("passes/ao/uniforms.wgsl")),
 ];
 
 /// Expands `#import "…"` lines recursively; panics only on a missing module,

@@ -9,25 +9,7 @@
 
 override LAYERS: u32 = 2u;
 
-// Matches `ao::AoUniforms`.
-struct Ao {
-    // r (world units), β, ε, intensity
-    radius: f32,
-    bias: f32,
-    epsilon: f32,
-    intensity: f32,
-    // pixels spanned by 1 world unit at depth 1; q; τ
-    proj_scale: f32,
-    q: f32,
-    tau: f32,
-    // 1 = rotate the spiral per pixel (φ from the hash), 0 = φ = 0
-    rotate: u32,
-    samples: u32,
-    max_mip: u32,
-    seed: u32,
-    // 1: return the obscurance mean S (Eq. 1 before the square root) instead of AV
-    output_obscurance: u32,
-}
+#import "ao/uniforms.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var<uniform> ao: Ao;

@@ -12,25 +12,11 @@
 #import "common/packing.wgsl"
 #import "common/spiral.wgsl"
 #import "common/interleave.wgsl"
+#import "common/obscurance.wgsl"
 
 override LAYERS: u32 = 2u;
 
-// Matches `ao::AoUniforms` (as in ao.wgsl).
-struct Ao {
-    radius: f32,
-    bias: f32,
-    epsilon: f32,
-    intensity: f32,
-    proj_scale: f32,
-    q: f32,
-    tau: f32,
-    rotate: u32,
-    samples: u32,
-    max_mip: u32,
-    seed: u32,
-    // 1: return the obscurance mean S (Eq. 1 before the square root) instead of AV
-    output_obscurance: u32,
-}
+#import "ao/uniforms.wgsl"
 
 // Matches `ao::DeintUniforms`.
 struct DeintAo {
@@ -48,12 +34,7 @@ struct DeintAo {
 
 // Eq. 2: obscurance at X (normal n) due to a surface point at v = Y − X.
 fn obscurance(v: vec3f, n: vec3f) -> f32 {
-    let vv = dot(v, v);
-    let r2 = u.ao.radius * u.ao.radius;
-    if (!(vv < r2)) {
-        return 0.0;
-    }
-    return (1.0 - vv / r2) * max((dot(v, n) - u.ao.bias) / sqrt(vv + u.ao.epsilon), 0.0);
+    return eq2_obscurance(v, n, u.ao.radius, u.ao.bias, u.ao.epsilon);
 }
 
 // ⌊a / b⌋ for b > 0 (WGSL's `/` truncates towards zero).
