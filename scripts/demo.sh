@@ -45,6 +45,13 @@ $S eval --scene warehouse --technique gi --layers 2 --width 320 --height 180 --r
 cat "$OUT/eval-gi.json"
 echo "[strata demo] interleaved deferred shading of 480 VPLs (ILS), 8x6 sub-buffers" >&2
 $S render --scene atrium --technique ils --width "$W" --height "$H" --out "$OUT/atrium-ils.png" --force
+echo "[strata demo] A-buffer (ABA): OIT and opacity-aware multilayer AO on glasshouse; aba-ao vs single-layer and DGB AO on atrium" >&2
+$S render --scene glasshouse --technique oit --width "$W" --height "$H" --out "$OUT/glasshouse-oit.png" --force
+$S render --scene glasshouse --technique aba-ao --width "$W" --height "$H" --out "$OUT/glasshouse-aba-ao.png" --force
+$S eval --scene atrium --technique aba-ao --width 320 --height 180 --json --quiet > "$OUT/eval-aba-ao.json"
+cat "$OUT/eval-aba-ao.json"
+echo "[strata demo] bounced z-buffer AO (BZB) on atrium" >&2
+$S render --scene atrium --technique bzb-ao --width "$W" --height "$H" --out "$OUT/atrium-bzb-ao.png" --force
 echo "[strata demo] GPU timings" >&2
 $S bench gbuffer --scene atrium --width "$W" --height "$H" --frames 5 --json > "$OUT/bench-gbuffer.json"
 cat "$OUT/bench-gbuffer.json"
@@ -55,6 +62,7 @@ cat "$OUT/bench-radiosity.json"
 echo "[strata demo] report: tables and plots of the JSON above, the images, links to the evaluation reports" >&2
 $S report --from "$OUT" --out "$OUT/report.html" --title "strata demo report" --force \
   --figures "Renders=atrium-full.png,mirror-full.png,atrium.png,atrium-ao.png,atrium-ils.png,cornell.png,warehouse.png" \
+  --figures "A-buffer and bounced z-buffer=glasshouse-oit.png,glasshouse-aba-ao.png,atrium-bzb-ao.png" \
   --figures "Fig. 9 views (atrium, full)=atrium-confidence.png,atrium-gbuffer-only.png,atrium-probe-only.png,atrium-blended.png" \
   --figures "atrium G-buffer and lighting targets=atrium-csz.png,atrium-normal.png,atrium-albedo.png,atrium-emission.png,atrium-direct-diffuse.png,atrium-shadow.png" \
   --figures "CPU reference (atrium AO with binary visibility; cornell path-traced GI)=atrium-ref-ao.png,cornell-ref-gi.png"
