@@ -400,7 +400,7 @@ pub struct EvalArgs {
     pub gpu: GpuArgs,
     /// Registered technique to compare (`strata techniques`): its eval kind picks the reference —
     /// `ao` against ray-traced obscurance and binary AO, `full` (alias `gi`) against the path tracer,
-    /// `ils` against the brute force of the same VPLs and the one-bounce path tracer (`--bounces` ignored: 1).
+    /// `ils` against the brute force of the same VPLs and the one-bounce path tracer (`--bounces` is read by `--progressive` only).
     #[arg(long, default_value = "ao", value_parser = parse_eval_technique)]
     pub technique: &'static strata_render::technique::Technique,
     #[command(flatten)]
@@ -417,7 +417,7 @@ pub struct EvalArgs {
     /// (0: integrate to the --ref-spp cap). Converged references are cached.
     #[arg(long, default_value_t = 0.02)]
     pub ref_noise: f64,
-    /// Indirect bounces of the path-traced reference (gi), 1..=64.
+    /// Indirect bounces of the path-traced reference (gi; ils --progressive: also the VPL bounces), 1..=64.
     #[arg(long, default_value_t = 4)]
     pub bounces: u32,
     /// ils: also run §6.3's physically-based mode — up to K frames with fresh VPL sets of
