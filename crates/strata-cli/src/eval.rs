@@ -19,7 +19,9 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         && !is_bzb
         && !is_aba
     {
-        anyhow::bail!("--set is only read by --technique ils, oit, bzb-ao and aba-ao in eval (ao and gi have their own flags)");
+        anyhow::bail!(
+            "--set is only read by --technique ils, oit, bzb-ao and aba-ao in eval (ao and gi have their own flags)"
+        );
     }
     if a.progressive.is_some() && a.technique.eval != EvalKind::VplRadiance {
         anyhow::bail!("--progressive is only read by --technique ils (ILS §6.3's physically-based mode)");

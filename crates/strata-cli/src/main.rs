@@ -26,7 +26,10 @@ fn main() {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
     tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG").unwrap_or_else(|_| "warn,winit=error,egui_wgpu=error".into()))
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_env("STRATA_LOG")
+                .unwrap_or_else(|_| "warn,winit=error,egui_wgpu=error".into()),
+        )
         .with_writer(std::io::stderr)
         .init();
     // Ctrl-C: outputs and cache entries are written to temporaries and renamed, so an

@@ -136,7 +136,10 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
     };
     // ambient visibility PNGs hold raw bytes 255·AV, as `render`'s AO PNGs do
     // (so the two compare directly); everything else is sRGB-encoded
-    let raw = matches!(a.kind, ReferenceKind::Ao | ReferenceKind::Obscurance | ReferenceKind::AoOpacity);
+    let raw = matches!(
+        a.kind,
+        ReferenceKind::Ao | ReferenceKind::Obscurance | ReferenceKind::AoOpacity
+    );
     for (p, img) in &outputs {
         save(img, p, !raw)?;
         eprintln!("wrote {}", p.display());

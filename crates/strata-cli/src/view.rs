@@ -87,7 +87,10 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     if !(0.1..=1.0).contains(&a.motion_scale) {
         bail!("--motion-scale {} is out of range: must be in 0.1..=1", a.motion_scale);
     }
-    for (flag, p) in [("--screenshot", &a.screenshot), ("--window-screenshot", &a.window_screenshot)] {
+    for (flag, p) in [
+        ("--screenshot", &a.screenshot),
+        ("--window-screenshot", &a.window_screenshot),
+    ] {
         if let Some(p) = p {
             if !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
                 bail!("{flag} {}: use a .png file name", p.display());
@@ -116,8 +119,9 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         extra,
     };
     let settings: strata_view::SettingsFn = Box::new(|scene, args| {
-        let flags = RenderFlags::try_parse_from(std::iter::once("strata render".to_string()).chain(args.iter().cloned()))
-            .map_err(clap_line)?;
+        let flags =
+            RenderFlags::try_parse_from(std::iter::once("strata render".to_string()).chain(args.iter().cloned()))
+                .map_err(clap_line)?;
         crate::render::settings_for(&flags.frame, scene).map_err(|e| format!("{e:#}").replace('\n', " "))
     });
     strata_view::run(strata_view::ViewOptions {

@@ -258,8 +258,21 @@ fn reference_ao_png_holds_raw_visibility_like_render_ao() {
         let (png, exr) = (scratch(&format!("raw-{kind}.png")), scratch(&format!("raw-{kind}.exr")));
         for out in [&png, &exr] {
             let o = strata(&[
-                "reference", "--scene", "cornell", "--kind", kind, "--spp", "8", "--width", "16", "--height", "16",
-                "--quiet", "--force", "--out", out.to_str().unwrap(),
+                "reference",
+                "--scene",
+                "cornell",
+                "--kind",
+                kind,
+                "--spp",
+                "8",
+                "--width",
+                "16",
+                "--height",
+                "16",
+                "--quiet",
+                "--force",
+                "--out",
+                out.to_str().unwrap(),
             ]);
             assert!(o.status.success(), "{}", stderr(&o));
         }
@@ -268,10 +281,17 @@ fn reference_ao_png_holds_raw_visibility_like_render_ao() {
         let mut mid = 0;
         for (b, a) in bytes.pixels().zip(av.pixels()) {
             let want = (a.0[0].clamp(0.0, 1.0) * 255.0).round();
-            assert!((b.0[0] as f32 - want).abs() <= 1.0, "{kind}: byte {} vs 255·AV {want}", b.0[0]);
+            assert!(
+                (b.0[0] as f32 - want).abs() <= 1.0,
+                "{kind}: byte {} vs 255·AV {want}",
+                b.0[0]
+            );
             mid += (want > 20.0 && want < 200.0) as u32;
         }
-        assert!(mid > 0, "{kind}: some pixels are partly occluded (sRGB would move them)");
+        assert!(
+            mid > 0,
+            "{kind}: some pixels are partly occluded (sRGB would move them)"
+        );
     }
 }
 
@@ -1605,16 +1625,43 @@ fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
     // distance to the path tracer falls with the frames down to the clamp bias
     let cache = scratch("ils-progressive-cache");
     let v = json_of(&strata(&[
-        "eval", "--scene", "cornell", "--technique", "ils", "--width", "48", "--height", "48", "--set", "vpls=24",
-        "--progressive", "16", "--bounces", "2", "--ref-noise", "0.03", "--cache", cache.to_str().unwrap(), "--json",
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        "ils",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--set",
+        "vpls=24",
+        "--progressive",
+        "16",
+        "--bounces",
+        "2",
+        "--ref-noise",
+        "0.03",
+        "--cache",
+        cache.to_str().unwrap(),
+        "--json",
     ]));
     let p = &v["progressive"];
     assert_eq!(p["bounces"].as_u64(), Some(2));
     let patterns = p["patterns"].as_array().expect("patterns");
     assert_eq!(patterns.len(), 2, "1x1 and 2x2");
     for q in patterns {
-        let curve: Vec<f64> = q["rms_curve"].as_array().unwrap().iter().map(|e| e[1].as_f64().unwrap()).collect();
-        assert!(curve.first().unwrap() > curve.last().unwrap(), "{}: {curve:?}", q["pattern"]);
+        let curve: Vec<f64> = q["rms_curve"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e[1].as_f64().unwrap())
+            .collect();
+        assert!(
+            curve.first().unwrap() > curve.last().unwrap(),
+            "{}: {curve:?}",
+            q["pattern"]
+        );
     }
     let one = &patterns[0];
     assert_eq!(one["pattern"], "1x1");

@@ -45,7 +45,10 @@ static NEXT_DISPLAY: AtomicU32 = AtomicU32::new(0);
 /// Starts Xvfb, or records why the test cannot run and returns None.
 fn xvfb(test: &str) -> Option<XServer> {
     let Some(bin) = find_xvfb() else {
-        strata_scene::skip::note_skip(test, "Xvfb not found on PATH (scripts/setup.sh installs the xvfb package)");
+        strata_scene::skip::note_skip(
+            test,
+            "Xvfb not found on PATH (scripts/setup.sh installs the xvfb package)",
+        );
         return None;
     };
     for _ in 0..50 {
@@ -54,7 +57,14 @@ fn xvfb(test: &str) -> Option<XServer> {
             continue;
         }
         let child = Command::new(&bin)
-            .args([format!(":{n}").as_str(), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"])
+            .args([
+                format!(":{n}").as_str(),
+                "-screen",
+                "0",
+                "1600x1000x24",
+                "-nolisten",
+                "tcp",
+            ])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()
@@ -101,7 +111,12 @@ fn text(b: &[u8]) -> String {
 }
 
 fn ok(o: &Output) -> &Output {
-    assert!(o.status.success(), "strata failed: {}\n{}", text(&o.stderr), text(&o.stdout));
+    assert!(
+        o.status.success(),
+        "strata failed: {}\n{}",
+        text(&o.stderr),
+        text(&o.stdout)
+    );
     o
 }
 
@@ -130,7 +145,9 @@ fn view(x: &XServer, dir: &Path, name: &str, frames: u32, script: Option<&str>, 
 
 /// RGB8 pixels of a PNG.
 fn rgb(path: &Path) -> (u32, u32, Vec<u8>) {
-    let img = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8();
+    let img = image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgb8();
     let (w, h) = img.dimensions();
     (w, h, img.into_raw())
 }
@@ -151,13 +168,21 @@ fn flip(a: &Path, b: &Path) -> f32 {
 /// Not a flat image: luma spread and many distinct colours.
 fn assert_not_flat(path: &Path) {
     let (_, _, p) = rgb(path);
-    let luma: Vec<f64> = p.chunks_exact(3).map(|c| 0.3 * c[0] as f64 + 0.59 * c[1] as f64 + 0.11 * c[2] as f64).collect();
+    let luma: Vec<f64> = p
+        .chunks_exact(3)
+        .map(|c| 0.3 * c[0] as f64 + 0.59 * c[1] as f64 + 0.11 * c[2] as f64)
+        .collect();
     let mean = luma.iter().sum::<f64>() / luma.len() as f64;
     let sd = (luma.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / luma.len() as f64).sqrt();
     let mut colours: Vec<[u8; 3]> = p.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     colours.sort();
     colours.dedup();
-    assert!(sd > 10.0 && colours.len() > 50, "{} is nearly flat: luma sd {sd:.1}, {} colours", path.display(), colours.len());
+    assert!(
+        sd > 10.0 && colours.len() > 50,
+        "{} is nearly flat: luma sd {sd:.1}, {} colours",
+        path.display(),
+        colours.len()
+    );
 }
 
 /// Runs the `strata render …` command a screenshot's `.cmd.txt` holds, writing `out`.
@@ -182,14 +207,28 @@ fn viewport_matches_render_and_is_not_flat() {
         return;
     };
     let dir = scratch("viewport");
-    let (o, shot) = view(&x, &dir, "shot", 6, None, &[&["--scene", "cornell"][..], &SIZE].concat());
+    let (o, shot) = view(
+        &x,
+        &dir,
+        "shot",
+        6,
+        None,
+        &[&["--scene", "cornell"][..], &SIZE].concat(),
+    );
     ok(&o);
     let err = text(&o.stderr);
     assert!(err.contains("strata view: adapter "), "the adapter is named: {err}");
     assert_not_flat(&shot);
     // an independent render of the scene's own camera, no camera flags
     let r = dir.join("render.png");
-    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
+    ok(&strata(
+        None,
+        &[
+            &["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..],
+            &SIZE,
+        ]
+        .concat(),
+    ));
     let f = flip(&shot, &r);
     eprintln!("FLIP(viewer, render) = {f}");
     assert!(f < FLIP_BOUND, "viewer vs render FLIP {f} >= {FLIP_BOUND}");
@@ -202,7 +241,11 @@ fn viewport_matches_render_and_is_not_flat() {
 
 /// `xdotool ARGS` on display `d`; panics when it fails.
 fn xdotool(d: &str, args: &[&str]) -> String {
-    let o = Command::new("xdotool").args(args).env("DISPLAY", d).output().expect("xdotool runs");
+    let o = Command::new("xdotool")
+        .args(args)
+        .env("DISPLAY", d)
+        .output()
+        .expect("xdotool runs");
     assert!(o.status.success(), "xdotool {args:?}: {}", text(&o.stderr));
     text(&o.stdout)
 }
@@ -216,7 +259,21 @@ fn view_window(x: &XServer, test: &str, frames: &str, shot: &std::path::Path) ->
         return None;
     }
     let child = Command::new(env!("CARGO_BIN_EXE_strata"))
-        .args([&["view", "--scene", "cornell", "--frames", frames, "--screenshot", shot.to_str().unwrap()][..], &SIZE].concat())
+        .args(
+            [
+                &[
+                    "view",
+                    "--scene",
+                    "cornell",
+                    "--frames",
+                    frames,
+                    "--screenshot",
+                    shot.to_str().unwrap(),
+                ][..],
+                &SIZE,
+            ]
+            .concat(),
+        )
         .env("DISPLAY", &x.display)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .stdout(Stdio::piped())
@@ -225,7 +282,11 @@ fn view_window(x: &XServer, test: &str, frames: &str, shot: &std::path::Path) ->
         .unwrap();
     let t0 = Instant::now();
     let id = loop {
-        let o = Command::new("xdotool").args(["search", "--name", "strata view"]).env("DISPLAY", &x.display).output().unwrap();
+        let o = Command::new("xdotool")
+            .args(["search", "--name", "strata view"])
+            .env("DISPLAY", &x.display)
+            .output()
+            .unwrap();
         if let Some(id) = text(&o.stdout).lines().next().map(String::from) {
             break id;
         }
@@ -250,18 +311,46 @@ fn real_x_key_and_mouse_events_move_the_camera() {
     xdotool(&x.display, &["keydown", "w"]);
     std::thread::sleep(Duration::from_millis(500));
     xdotool(&x.display, &["keyup", "w"]);
-    xdotool(&x.display, &["mousemove", "--window", &id, "60", "60", "mousedown", "3", "mousemove_relative", "--sync", "50", "0", "mouseup", "3"]);
+    xdotool(
+        &x.display,
+        &[
+            "mousemove",
+            "--window",
+            &id,
+            "60",
+            "60",
+            "mousedown",
+            "3",
+            "mousemove_relative",
+            "--sync",
+            "50",
+            "0",
+            "mouseup",
+            "3",
+        ],
+    );
     let o = child.wait_with_output().unwrap();
     ok(&o);
     let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
     let flag = |f: &str| -> Vec<f32> {
-        cmd.split(&format!(" {f} ")).nth(1).unwrap().split(' ').next().unwrap().split(',').map(|v| v.parse().unwrap()).collect()
+        cmd.split(&format!(" {f} "))
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect()
     };
     let (eye, target) = (flag("--eye"), flag("--target"));
     // cornell's camera: eye (0.278, 0.273, -0.8) looking down +z; the distance depends on
     // how many frames ran while W was down (the fly speed is per frame in --frames runs)
     assert!(eye[2] > -0.8 + 1e-4, "W moved the camera forward: {cmd}");
-    assert!((target[0] - eye[0]).abs() > 1e-5, "the right-drag turned the camera: {cmd}");
+    assert!(
+        (target[0] - eye[0]).abs() > 1e-5,
+        "the right-drag turned the camera: {cmd}"
+    );
     let r = dir.join("render.png");
     run_cmd_txt(&shot, &r);
     assert!(flip(&shot, &r) < FLIP_BOUND);
@@ -275,19 +364,40 @@ fn camera_path_playback_follows_the_scene_path() {
     let dir = scratch("playback");
     let small = ["--width", "64", "--height", "48"];
     let seek = dir.join("seek.png");
-    let script = format!("play\nwait 12\npause\nwait 2\nseek 30.5\nwait 1\nscreenshot {}\nwait 1\nplay\nwait 3\npause\nwait 1\n", seek.display());
-    let (o, shot) = view(&x, &dir, "played", 22, Some(&script), &[&["--scene", "atrium"][..], &small].concat());
+    let script = format!(
+        "play\nwait 12\npause\nwait 2\nseek 30.5\nwait 1\nscreenshot {}\nwait 1\nplay\nwait 3\npause\nwait 1\n",
+        seek.display()
+    );
+    let (o, shot) = view(
+        &x,
+        &dir,
+        "played",
+        22,
+        Some(&script),
+        &[&["--scene", "atrium"][..], &small].concat(),
+    );
     ok(&o);
     let atrium = strata_scene::load_scene("atrium").unwrap();
     assert!(atrium.camera_path.is_some(), "atrium has a camera path");
     let check = |png: &Path, lo: f32, hi: f32| {
         let cmd = std::fs::read_to_string(png.with_extension("cmd.txt")).unwrap();
-        let flag = |f: &str| cmd.split(&format!(" {f} ")).nth(1).unwrap().split(' ').next().unwrap().to_string();
+        let flag = |f: &str| {
+            cmd.split(&format!(" {f} "))
+                .nth(1)
+                .unwrap()
+                .split(' ')
+                .next()
+                .unwrap()
+                .to_string()
+        };
         let frame: f32 = flag("--frame").parse().unwrap();
         assert!((lo..=hi).contains(&frame), "frame {frame} not in {lo}..={hi}: {cmd}");
         let eye: Vec<f32> = flag("--eye").split(',').map(|v| v.parse().unwrap()).collect();
         let c = atrium.camera_at(frame);
-        assert!((glam::Vec3::new(eye[0], eye[1], eye[2]) - c.eye).length() < 1e-4, "the camera is the path's at frame {frame}: {cmd}");
+        assert!(
+            (glam::Vec3::new(eye[0], eye[1], eye[2]) - c.eye).length() < 1e-4,
+            "the camera is the path's at frame {frame}: {cmd}"
+        );
         frame
     };
     assert_eq!(check(&seek, 30.5, 30.5), 30.5);
@@ -315,7 +425,14 @@ fn unmapped_window_keeps_running_and_finishes() {
     let o = child.wait_with_output().unwrap();
     ok(&o);
     let r = dir.join("render.png");
-    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
+    ok(&strata(
+        None,
+        &[
+            &["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..],
+            &SIZE,
+        ]
+        .concat(),
+    ));
     assert!(flip(&shot, &r) < FLIP_BOUND);
 }
 
@@ -331,12 +448,18 @@ fn moving_renders_at_reduced_size_and_still_at_full() {
     let err = text(&o.stderr);
     // the run's summary: frames per kind
     let count = |prefix: &str| -> u32 {
-        let l = err.lines().find(|l| l.starts_with(prefix)).unwrap_or_else(|| panic!("no '{prefix}' line: {err}"));
+        let l = err
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no '{prefix}' line: {err}"));
         l[prefix.len()..].trim().split(' ').next().unwrap().parse().unwrap()
     };
     let moving = count("strata view: reduced ×0.5 while moving:");
     let still = count("strata view: 160x120:");
-    assert!((18..=20).contains(&moving), "the 20 moving frames (less the first) are reduced: {moving}");
+    assert!(
+        (18..=20).contains(&moving),
+        "the 20 moving frames (less the first) are reduced: {moving}"
+    );
     assert!(still >= 5, "still frames are full size: {still}");
     let (w, h, _) = rgb(&shot);
     assert_eq!((w, h), (160, 120), "the screenshot is full resolution");
@@ -354,7 +477,15 @@ fn hidpi_scale_factor_keeps_the_viewport_exact() {
     let shot = dir.join("shot.png");
     let win = dir.join("window.png");
     let args = [
-        &["view", "--scene", "cornell", "--frames", "4", "--screenshot", shot.to_str().unwrap()][..],
+        &[
+            "view",
+            "--scene",
+            "cornell",
+            "--frames",
+            "4",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ][..],
         &["--window-screenshot", win.to_str().unwrap()],
         &SIZE,
     ]
@@ -364,8 +495,18 @@ fn hidpi_scale_factor_keeps_the_viewport_exact() {
     let (ww, _, _) = rgb(&win);
     assert!(ww >= 2 * 160 + 600, "the window is laid out at scale 2 ({ww} px wide)");
     let r = dir.join("render.png");
-    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
-    assert!(flip(&shot, &r) < FLIP_BOUND, "the render size does not depend on the DPI");
+    ok(&strata(
+        None,
+        &[
+            &["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..],
+            &SIZE,
+        ]
+        .concat(),
+    ));
+    assert!(
+        flip(&shot, &r) < FLIP_BOUND,
+        "the render size does not depend on the DPI"
+    );
 }
 
 #[test]
@@ -377,14 +518,29 @@ fn scripted_keys_and_drag_move_the_camera_like_render_with_the_printed_command()
     let base = [&["--scene", "cornell"][..], &SIZE].concat();
     let (o0, still) = view(&x, &dir, "still", 3, None, &base);
     ok(&o0);
-    let (o, moved) = view(&x, &dir, "moved", 16, Some("wait 1\nkey W 6\nmouse-drag 80 -30\nkey D 3\nwait 2\n"), &base);
+    let (o, moved) = view(
+        &x,
+        &dir,
+        "moved",
+        16,
+        Some("wait 1\nkey W 6\nmouse-drag 80 -30\nkey D 3\nwait 2\n"),
+        &base,
+    );
     ok(&o);
     assert_not_flat(&moved);
     let d = flip(&still, &moved);
     assert!(d > 0.05, "moving the camera changes the frame (FLIP {d})");
     let cmd = std::fs::read_to_string(moved.with_extension("cmd.txt")).unwrap();
     let still_cmd = std::fs::read_to_string(still.with_extension("cmd.txt")).unwrap();
-    let eye = |c: &str| c.split(" --eye ").nth(1).unwrap().split(' ').next().unwrap().to_string();
+    let eye = |c: &str| {
+        c.split(" --eye ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .to_string()
+    };
     assert_ne!(eye(&cmd), eye(&still_cmd), "the command names the moved camera");
     let r = dir.join("render.png");
     run_cmd_txt(&moved, &r);
@@ -403,12 +559,18 @@ fn scripted_technique_and_debug_view_switch_match_render() {
     let (o0, direct) = view(&x, &dir, "direct", 3, None, &base);
     ok(&o0);
     let ao_shot = dir.join("ao.png");
-    let script = format!("technique ao\nwait 3\nscreenshot {}\nwait 1\ndebug-view layer0-normal\nwait 2\n", ao_shot.display());
+    let script = format!(
+        "technique ao\nwait 3\nscreenshot {}\nwait 1\ndebug-view layer0-normal\nwait 2\n",
+        ao_shot.display()
+    );
     let (o, normal) = view(&x, &dir, "normal", 8, Some(&script), &base);
     ok(&o);
     // AO shows ambient visibility as grey
     let (_, _, p) = rgb(&ao_shot);
-    assert!(p.chunks_exact(3).all(|c| c[0] == c[1] && c[1] == c[2]), "the ao frame is grey");
+    assert!(
+        p.chunks_exact(3).all(|c| c[0] == c[1] && c[1] == c[2]),
+        "the ao frame is grey"
+    );
     assert_not_flat(&ao_shot);
     assert!(flip(&direct, &ao_shot) > 0.05, "switching technique changes the frame");
     let line = run_cmd_txt(&ao_shot, &dir.join("ao-render.png"));
@@ -433,15 +595,31 @@ fn bad_settings_show_the_cli_error_and_keep_the_frame() {
     };
     let dir = scratch("badset");
     let base = [&["--scene", "cornell", "--technique", "ao"][..], &SIZE].concat();
-    let (o, shot) = view(&x, &dir, "shot", 5, Some("set samples 99999\nlayers 9\ntechnique nope\ndebug-view nope\n"), &base);
+    let (o, shot) = view(
+        &x,
+        &dir,
+        "shot",
+        5,
+        Some("set samples 99999\nlayers 9\ntechnique nope\ndebug-view nope\n"),
+        &base,
+    );
     ok(&o);
     let err = text(&o.stderr);
     // render's own messages, one line each
-    for needle in ["--set samples=99999", "out of range", "layers", "unknown technique 'nope'", "unknown debug view 'nope'"] {
+    for needle in [
+        "--set samples=99999",
+        "out of range",
+        "layers",
+        "unknown technique 'nope'",
+        "unknown debug view 'nope'",
+    ] {
         assert!(err.contains(needle), "stderr lacks '{needle}': {err}");
     }
     let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
-    assert!(!cmd.contains("99999") && cmd.contains("--layers 1"), "bad values are not applied: {cmd}");
+    assert!(
+        !cmd.contains("99999") && cmd.contains("--layers 1"),
+        "bad values are not applied: {cmd}"
+    );
     let r = dir.join("render.png");
     run_cmd_txt(&shot, &r);
     assert!(flip(&shot, &r) < FLIP_BOUND);
@@ -496,19 +674,46 @@ fn truncated_glb_shows_the_error_and_keeps_the_scene() {
     let bytes = quad_glb();
     std::fs::write(&good, &bytes).unwrap();
     std::fs::write(&bad, &bytes[..bytes.len() * 2 / 3]).unwrap();
-    assert!(strata_scene::load_scene(good.to_str().unwrap()).is_ok(), "the untruncated GLB loads");
+    assert!(
+        strata_scene::load_scene(good.to_str().unwrap()).is_ok(),
+        "the untruncated GLB loads"
+    );
     let base = [&["--scene", "cornell"][..], &SIZE].concat();
-    let (o, shot) = view(&x, &dir, "kept", 6, Some(&format!("wait 1\nopen {}\nwait 2\n", bad.display())), &base);
+    let (o, shot) = view(
+        &x,
+        &dir,
+        "kept",
+        6,
+        Some(&format!("wait 1\nopen {}\nwait 2\n", bad.display())),
+        &base,
+    );
     ok(&o);
     let err = text(&o.stderr);
-    let line = err.lines().find(|l| l.contains("open:")).unwrap_or_else(|| panic!("no open error: {err}"));
+    let line = err
+        .lines()
+        .find(|l| l.contains("open:"))
+        .unwrap_or_else(|| panic!("no open error: {err}"));
     assert!(line.contains("truncated.glb"), "the error names the file: {line}");
     // still cornell: equal to its render
     let r = dir.join("render.png");
-    ok(&strata(None, &[&["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..], &SIZE].concat()));
+    ok(&strata(
+        None,
+        &[
+            &["render", "--scene", "cornell", "--out", r.to_str().unwrap()][..],
+            &SIZE,
+        ]
+        .concat(),
+    ));
     assert!(flip(&shot, &r) < FLIP_BOUND, "the current scene is kept");
     // the good file opens through the same path, and the command names it
-    let (o2, shot2) = view(&x, &dir, "opened", 6, Some(&format!("wait 1\nopen {}\nwait 2\n", good.display())), &base);
+    let (o2, shot2) = view(
+        &x,
+        &dir,
+        "opened",
+        6,
+        Some(&format!("wait 1\nopen {}\nwait 2\n", good.display())),
+        &base,
+    );
     ok(&o2);
     assert!(text(&o2.stderr).contains("opened"), "{}", text(&o2.stderr));
     let cmd = std::fs::read_to_string(shot2.with_extension("cmd.txt")).unwrap();
@@ -529,12 +734,22 @@ fn recorded_path_loads_as_a_scene_and_resize_and_fit_survive() {
         "record-start\nkey D 25\nmouse-drag 50 0\nkey W 10\nrecord-stop {}\nresize 500 380\nwait 2\nfit on\nwait 2\nresize 900 700\nwait 3\n",
         path.display()
     );
-    let (o, shot) = view(&x, &dir, "shot", 45, Some(&script), &[&["--scene", "cornell"][..], &SIZE].concat());
+    let (o, shot) = view(
+        &x,
+        &dir,
+        "shot",
+        45,
+        Some(&script),
+        &[&["--scene", "cornell"][..], &SIZE].concat(),
+    );
     ok(&o);
     let scene = strata_scene::load_scene(path.to_str().unwrap()).unwrap_or_else(|e| panic!("{e}"));
     let p = scene.camera_path.clone().expect("a camera path");
     assert!(p.keyframes.len() >= 3, "{} keyframes", p.keyframes.len());
-    assert_eq!(scene.triangle_count(), strata_scene::load_scene("cornell").unwrap().triangle_count());
+    assert_eq!(
+        scene.triangle_count(),
+        strata_scene::load_scene("cornell").unwrap().triangle_count()
+    );
     let first = p.keyframes[0];
     let last = p.keyframes[p.keyframes.len() - 1];
     assert!((last.eye - first.eye).length() > 0.05, "the path moves");
@@ -546,7 +761,22 @@ fn recorded_path_loads_as_a_scene_and_resize_and_fit_survive() {
     assert!(flip(&shot, &r) < FLIP_BOUND);
     // the recorded file renders along its path
     let out = dir.join("along.png");
-    ok(&strata(None, &["render", "--scene", path.to_str().unwrap(), "--frame", "10", "--width", "64", "--height", "48", "--out", out.to_str().unwrap()]));
+    ok(&strata(
+        None,
+        &[
+            "render",
+            "--scene",
+            path.to_str().unwrap(),
+            "--frame",
+            "10",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    ));
 }
 
 #[test]
@@ -561,7 +791,25 @@ fn every_technique_and_debug_view_is_reachable() {
     let techniques: Vec<&str> = strata_render::technique::registry().iter().map(|t| t.name).collect();
     for t in &techniques {
         // every debug view of the technique's two-layer frame, as `render --list-passes` lists them
-        let lp = ok(&strata(None, &[&["render", "--scene", "cornell", "--technique", t, "--layers", "2", "--list-passes"][..], &small].concat())).stdout.clone();
+        let lp = ok(&strata(
+            None,
+            &[
+                &[
+                    "render",
+                    "--scene",
+                    "cornell",
+                    "--technique",
+                    t,
+                    "--layers",
+                    "2",
+                    "--list-passes",
+                ][..],
+                &small,
+            ]
+            .concat(),
+        ))
+        .stdout
+        .clone();
         let lp = text(&lp);
         let views: Vec<String> = lp
             .lines()
@@ -572,7 +820,10 @@ fn every_technique_and_debug_view_is_reachable() {
             .collect();
         assert!(views.len() > 20, "{t}: {views:?}");
         let final_shot = dir.join(format!("{t}.png"));
-        script += &format!("layers 1\ntechnique {t}\nlayers 2\nwait 1\nscreenshot {}\n", final_shot.display());
+        script += &format!(
+            "layers 1\ntechnique {t}\nlayers 2\nwait 1\nscreenshot {}\n",
+            final_shot.display()
+        );
         shots.push((t.to_string(), "final".to_string(), final_shot));
         for v in views {
             let shot = dir.join(format!("{t}--{v}.png"));
@@ -583,15 +834,28 @@ fn every_technique_and_debug_view_is_reachable() {
     }
     // a screenshot defers the actions after it to the next frame
     let frames = script_frames(&script) + shots.len() as u32 + 2;
-    let (o, _) = view(&x, &dir, "end", frames, Some(&script), &[&["--scene", "cornell"][..], &small].concat());
+    let (o, _) = view(
+        &x,
+        &dir,
+        "end",
+        frames,
+        Some(&script),
+        &[&["--scene", "cornell"][..], &small].concat(),
+    );
     ok(&o);
     let err = text(&o.stderr);
     assert!(!err.contains("strata view: error"), "{err}");
     for (t, v, shot) in &shots {
         assert!(shot.exists(), "technique {t}, view {v} not shown");
         let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
-        assert!(cmd.contains(&format!("--technique {t} ")) && cmd.contains("--layers 2"), "{cmd}");
-        assert!(cmd.contains("--width 64 --height 48"), "the frame's size, whatever the view's: {cmd}");
+        assert!(
+            cmd.contains(&format!("--technique {t} ")) && cmd.contains("--layers 2"),
+            "{cmd}"
+        );
+        assert!(
+            cmd.contains("--width 64 --height 48"),
+            "the frame's size, whatever the view's: {cmd}"
+        );
         if v != "final" {
             assert!(cmd.contains(&format!("--debug-view {v} ")), "{cmd}");
         }
@@ -615,5 +879,9 @@ fn every_technique_and_debug_view_is_reachable() {
 
 /// Frames a script spans (its `wait` commands).
 fn script_frames(script: &str) -> u32 {
-    script.lines().filter_map(|l| l.strip_prefix("wait ")).map(|n| n.trim().parse::<u32>().unwrap()).sum()
+    script
+        .lines()
+        .filter_map(|l| l.strip_prefix("wait "))
+        .map(|n| n.trim().parse::<u32>().unwrap())
+        .sum()
 }

@@ -26,7 +26,10 @@ fn main() {
     println!("scene {name} {w}x{h} {spp} spp radius {radius} epsilon {}", r.epsilon());
     for y in 0..h as i64 {
         for x in 0..w as i64 {
-            let mut win: Vec<f32> = (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))).map(|(dx, dy)| at(x + dx, y + dy)).collect();
+            let mut win: Vec<f32> = (-1..=1)
+                .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
+                .map(|(dx, dy)| at(x + dx, y + dy))
+                .collect();
             win.sort_by(f32::total_cmp);
             let v = at(x, y);
             if !(v < 0.15 && win[4] - v > 0.4) {
@@ -34,7 +37,9 @@ fn main() {
             }
             found += 1;
             let dir = cam.pixel_dir(x as u32, y as u32, w, h);
-            let hit = r.primary_hit(&cam, x as u32, y as u32, w, h).expect("dark pixels have a hit");
+            let hit = r
+                .primary_hit(&cam, x as u32, y as u32, w, h)
+                .expect("dark pixels have a hit");
             let (n, ng) = hit.facing_normals(dir);
             let obj = &scene.objects[hit.object as usize].name;
             let mat = &scene.materials[hit.material as usize].name;
@@ -48,7 +53,9 @@ fn main() {
                 if let Some(hh) = r.bvh().intersect(origin, d, 0.0, radius) {
                     dists.push(hh.t);
                     let s = r.bvh().surface(&hh, d);
-                    *hit_objects.entry(scene.objects[s.object as usize].name.clone()).or_default() += 1;
+                    *hit_objects
+                        .entry(scene.objects[s.object as usize].name.clone())
+                        .or_default() += 1;
                 }
             }
             dists.sort_by(f32::total_cmp);

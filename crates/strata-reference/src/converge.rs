@@ -146,7 +146,10 @@ impl Converged {
 
     /// Each half alone, finished (for noise measures).
     pub fn half_images(&self) -> [ImageBuf; 2] {
-        [self.estimator.finish(&self.halves[0]), self.estimator.finish(&self.halves[1])]
+        [
+            self.estimator.finish(&self.halves[0]),
+            self.estimator.finish(&self.halves[1]),
+        ]
     }
 }
 
@@ -248,7 +251,9 @@ impl Reference<'_> {
                 acc.data.iter_mut().zip(add).for_each(|(a, b)| *a += b);
                 acc.spp = next;
             }
-            let halves = sums.each_ref().map(|s| estimator.finish(&s.means(width, height, channels)));
+            let halves = sums
+                .each_ref()
+                .map(|s| estimator.finish(&s.means(width, height, channels)));
             let measured = noise(&halves[0], &halves[1]);
             rounds.push(Round {
                 spp: 2 * next,

@@ -123,9 +123,21 @@ pub fn spot_power(intensity: f32, inner_deg: f32, outer_deg: f32) -> f32 {
 
 /// One emitter as seen by the path allocation.
 enum Emitter {
-    Sun { dir: Vec3, centre: Vec3, radius: f32 },
-    Point { pos: Vec3 },
-    Spot { pos: Vec3, axis: Vec3, intensity: Vec3, cos_inner: f32, cos_outer: f32 },
+    Sun {
+        dir: Vec3,
+        centre: Vec3,
+        radius: f32,
+    },
+    Point {
+        pos: Vec3,
+    },
+    Spot {
+        pos: Vec3,
+        axis: Vec3,
+        intensity: Vec3,
+        cos_inner: f32,
+        cos_outer: f32,
+    },
     Emissive,
 }
 
@@ -157,7 +169,9 @@ fn allocate(n: u32, powers: &[f64]) -> Vec<u32> {
     }
     // anything still left goes to the most powerful light
     if left > 0 {
-        let imax = (0..powers.len()).max_by(|&a, &b| powers[a].total_cmp(&powers[b])).unwrap_or(0);
+        let imax = (0..powers.len())
+            .max_by(|&a, &b| powers[a].total_cmp(&powers[b]))
+            .unwrap_or(0);
         counts[imax] += left;
     }
     counts
@@ -231,11 +245,9 @@ impl Reference<'_> {
             }
         }
         if !self.lights.is_empty() {
-            let p = self
-                .lights
-                .tris
-                .iter()
-                .fold(Vec3::ZERO, |acc, (_, area, le)| acc + *le * (std::f32::consts::PI * area));
+            let p = self.lights.tris.iter().fold(Vec3::ZERO, |acc, (_, area, le)| {
+                acc + *le * (std::f32::consts::PI * area)
+            });
             out.push((Emitter::Emissive, p));
         }
         out

@@ -749,7 +749,10 @@ impl Renderer {
             a.set_frame(gpu, crate::passes::abuffer::far_depth(scene, &cams.current, frame));
             if let Some(s) = &a.settings().ao {
                 let compressed = a.settings().compress.is_some();
-                a.set_ao_frame(gpu, crate::passes::abuffer::ao::AbaAoUniforms::new(s, scene, &u, compressed));
+                a.set_ao_frame(
+                    gpu,
+                    crate::passes::abuffer::ao::AbaAoUniforms::new(s, scene, &u, compressed),
+                );
             }
         }
         if self.animated {
@@ -1022,7 +1025,9 @@ impl Renderer {
             if !exr_raw {
                 // the PNG shows it tonemapped like the frame
                 let e = self.settings.exposure.unwrap_or(1.0);
-                img.data.iter_mut().for_each(|v| *v = (*v * e / (1.0 + *v * e)).clamp(0.0, 1.0));
+                img.data
+                    .iter_mut()
+                    .for_each(|v| *v = (*v * e / (1.0 + *v * e)).clamp(0.0, 1.0));
             }
         } else if let Some((j, what)) = rest
             .strip_prefix("node")

@@ -190,7 +190,12 @@ impl GpuScene {
             .map(|m| {
                 let u = MaterialUniforms {
                     base_color: [m.base_color[0], m.base_color[1], m.base_color[2], m.opacity],
-                    emission: [m.emission[0], m.emission[1], m.emission[2], m.texture_alpha as u32 as f32],
+                    emission: [
+                        m.emission[0],
+                        m.emission[1],
+                        m.emission[2],
+                        m.texture_alpha as u32 as f32,
+                    ],
                     // the alpha rule of `Material::fragment_alpha` (`fragment_alpha` in scene.wgsl)
                     params: [
                         m.roughness,

@@ -247,7 +247,11 @@ fn hidden_occluder_darkens(multi: &ImageBuf, single: &ImageBuf, kernel: AoKernel
         assert_eq!(s, 1.0, "({x}, {y}): single-layer AO sees no occluder");
         darker += (m < s - 0.05) as u32;
     }
-    assert!(darker as usize > near.len() / 2, "{kernel:?}: {darker} of {} receivers darkened", near.len());
+    assert!(
+        darker as usize > near.len() / 2,
+        "{kernel:?}: {darker} of {} receivers darkened",
+        near.len()
+    );
     // far from the occluder (taps reach ≈ 12 px) both see one layer: equal
     for y in 0..H {
         for x in 0..W / 2 - 16 {
@@ -266,7 +270,10 @@ fn an_alpha_weighted_occluder_darkens_by_alpha_times_the_opaque_occlusion() {
                 Material::diffuse("plane", [0.6, 0.6, 0.6]),
                 glass("occluder", [0.5, 0.5, 0.5], alpha),
             ],
-            &[(0.0, [-20.0, 20.0], [-20.0, 20.0], 0), (0.3, [0.0, 2.0], [-2.0, 2.0], 1)],
+            &[
+                (0.0, [-20.0, 20.0], [-20.0, 20.0], 0),
+                (0.3, [0.0, 2.0], [-2.0, 2.0], 1),
+            ],
         );
         s.settings.ao_radius = 1.0;
         s
@@ -388,8 +395,16 @@ fn ao_inside_the_blend_and_separate_equal_their_cpu_twins_and_stay_close() {
             assert!((av.pixel(x, y)[0] - want.av).abs() < 2e-3, "({x}, {y}) AV");
             for c in 0..3 {
                 let (gi, gs) = (inside.pixel(x, y)[c], separate.pixel(x, y)[c]);
-                assert!((gi - want.inside[c]).abs() <= 2e-3 * want.inside[c].abs().max(1.0), "({x}, {y}) inside {gi} vs {}", want.inside[c]);
-                assert!((gs - want.separate[c]).abs() <= 2e-3 * want.separate[c].abs().max(1.0), "({x}, {y}) separate {gs} vs {}", want.separate[c]);
+                assert!(
+                    (gi - want.inside[c]).abs() <= 2e-3 * want.inside[c].abs().max(1.0),
+                    "({x}, {y}) inside {gi} vs {}",
+                    want.inside[c]
+                );
+                assert!(
+                    (gs - want.separate[c]).abs() <= 2e-3 * want.separate[c].abs().max(1.0),
+                    "({x}, {y}) separate {gs} vs {}",
+                    want.separate[c]
+                );
                 diff += (gi - gs).abs() as f64 / gi.abs().max(1e-3) as f64;
                 n += 1;
             }

@@ -555,16 +555,16 @@ fn mask_materials_cut_or_keep_opaque_by_material_fragment_alpha() {
         mask("kept", 0.7),
     ];
     let all = [-20.0, 20.0];
-    let scene = quads(materials.clone(), &[(1.0, all, all, 0), (0.0, all, all, 1), (-1.0, all, all, 2)]);
+    let scene = quads(
+        materials.clone(),
+        &[(1.0, all, all, 0), (0.0, all, all, 1), (-1.0, all, all, 2)],
+    );
     for method in ABufferMethod::ALL {
         let l = lists(&gpu, &render(&gpu, &scene, with(method)));
         for y in 0..H {
             for x in 0..W {
                 let got: Vec<f32> = l.at(x, y).iter().map(|f| f.alpha).collect();
-                let want: Vec<f32> = materials
-                    .iter()
-                    .filter_map(|m| m.fragment_alpha(1.0))
-                    .collect();
+                let want: Vec<f32> = materials.iter().filter_map(|m| m.fragment_alpha(1.0)).collect();
                 assert_eq!(got.len(), 2, "{method}: pixel ({x}, {y}) keeps blend + kept: {got:?}");
                 for (g, w) in got.iter().zip(&want) {
                     // α is stored as f16
@@ -581,7 +581,12 @@ fn layer_and_node_debug_views_show_the_read_back_lists() {
     let scene = layered();
     let r = render(&gpu, &scene, with(ABufferMethod::LinkedList));
     let names = r.debug_view_names();
-    for v in ["abuffer-layer0", "abuffer-layer3", "abuffer-node0-depth", "abuffer-node3-alpha"] {
+    for v in [
+        "abuffer-layer0",
+        "abuffer-layer3",
+        "abuffer-node0-depth",
+        "abuffer-node3-alpha",
+    ] {
         assert!(names.iter().any(|n| n == v), "{v} is listed: {names:?}");
     }
     let l = lists(&gpu, &r);

@@ -534,8 +534,17 @@ fn depth_tile_culling_leaves_the_image_unchanged() {
             let (on, off) = (render(&gpu, &scene, b(true)), render(&gpu, &scene, b(false)));
             for t in ["bzb-payload", "bzb-raw", "ao"] {
                 let (a, c) = (on.read_target(&gpu, t).unwrap(), off.read_target(&gpu, t).unwrap());
-                let differ = a.data.iter().zip(&c.data).filter(|(x, y)| x.to_bits() != y.to_bits()).count();
-                assert_eq!(differ, 0, "{} visibility={visibility} {t}: {differ} values differ", scene.name);
+                let differ = a
+                    .data
+                    .iter()
+                    .zip(&c.data)
+                    .filter(|(x, y)| x.to_bits() != y.to_bits())
+                    .count();
+                assert_eq!(
+                    differ, 0,
+                    "{} visibility={visibility} {t}: {differ} values differ",
+                    scene.name
+                );
             }
             let mean = on.read_target(&gpu, "ao").unwrap();
             let occluded = mean.data.iter().filter(|&&v| v < 0.9).count();

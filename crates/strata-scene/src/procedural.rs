@@ -792,8 +792,9 @@ pub fn still_life() -> Scene {
     b.geo(bone).cuboid(v(lo.x, hi.y - t, lo.z), hi); // top
     b.geo(bone).cuboid(v(lo.x, lo.y + t, lo.z), v(lo.x + t, hi.y - t, hi.z)); // left
     b.geo(bone).cuboid(v(hi.x - t, lo.y + t, lo.z), v(hi.x, hi.y - t, hi.z)); // right
-    b.geo(bone).cuboid(v(lo.x + t, lo.y + t, lo.z), v(hi.x - t, hi.y - t, lo.z + t)); // back
-    // glossy objects
+    b.geo(bone)
+        .cuboid(v(lo.x + t, lo.y + t, lo.z), v(hi.x - t, hi.y - t, lo.z + t)); // back
+                                                                               // glossy objects
     b.geo(gold).sphere(v(-0.55, 0.3, -0.3), 0.3, 48, 24);
     b.geo(vase).cylinder(v(1.25, 0.0, -0.6), 0.16, 0.7, 40, true);
     // pears
@@ -855,7 +856,12 @@ pub fn dominoes() -> Scene {
         let p = v(r * theta.cos(), half_h, r * theta.sin());
         // tangent of the spiral: d/dθ (r cos θ, r sin θ)
         let dr = pitch / std::f32::consts::TAU;
-        let tangent = v(dr * theta.cos() - r * theta.sin(), 0.0, dr * theta.sin() + r * theta.cos()).normalize();
+        let tangent = v(
+            dr * theta.cos() - r * theta.sin(),
+            0.0,
+            dr * theta.sin() + r * theta.cos(),
+        )
+        .normalize();
         let across = Vec3::Y.cross(tangent);
         b.geo(mats[i % mats.len()])
             .oriented_box(p, [across * half_w, Vec3::Y * half_h, tangent * half_t]);

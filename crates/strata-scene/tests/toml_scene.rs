@@ -292,7 +292,10 @@ fn material_override_sets_glossy_roughness_and_metallic_in_range() {
         std::path::Path::new("g.toml"),
     )
     .unwrap();
-    assert!(s.materials.iter().all(|m| m.glossy && m.roughness == 0.2 && m.metallic == 1.0));
+    assert!(s
+        .materials
+        .iter()
+        .all(|m| m.glossy && m.roughness == 0.2 && m.metallic == 1.0));
     let base = builtin("plane").unwrap();
     assert!(base.materials.iter().all(|m| !m.glossy), "the override is what set it");
     for f in ["roughness", "metallic"] {

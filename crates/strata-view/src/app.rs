@@ -256,7 +256,10 @@ impl App {
                     if !self.view_names.contains(v) {
                         let v = v.clone();
                         self.debug_view = None;
-                        self.say(format!("debug view '{v}' is not in this frame: showing the final image"), false);
+                        self.say(
+                            format!("debug view '{v}' is not in this frame: showing the final image"),
+                            false,
+                        );
                     }
                 }
                 true
@@ -314,7 +317,10 @@ impl App {
                 }
                 Action::DebugView(v) => match v {
                     Some(v) if !self.view_names.contains(&v) => self.say(
-                        format!("unknown debug view '{v}': valid views are {}", self.view_names.join(", ")),
+                        format!(
+                            "unknown debug view '{v}': valid views are {}",
+                            self.view_names.join(", ")
+                        ),
                         true,
                     ),
                     v => {
@@ -375,7 +381,10 @@ impl App {
     /// Loads a scene file; a bad one leaves the current scene and shows the loader's error.
     fn open(&mut self, path: &str) {
         if path.is_empty() {
-            self.say("open: give a .gltf, .glb, .obj or .toml file (or a built-in scene name)".into(), true);
+            self.say(
+                "open: give a .gltf, .glb, .obj or .toml file (or a built-in scene name)".into(),
+                true,
+            );
             return;
         }
         let scene = match strata_scene::load_scene(path) {
@@ -415,7 +424,12 @@ impl App {
         };
         match write_path_scene(path, &self.scene_spec, &keys, &self.cam.camera()) {
             Ok(()) => self.say(
-                format!("wrote camera path of {} keyframes to {} (strata render --scene {} --frame F)", keys.len(), path.display(), path.display()),
+                format!(
+                    "wrote camera path of {} keyframes to {} (strata render --scene {} --frame F)",
+                    keys.len(),
+                    path.display(),
+                    path.display()
+                ),
                 false,
             ),
             Err(e) => self.say(e, true),
@@ -446,7 +460,12 @@ impl App {
         }
         let use_reduced = reduced && self.reduced.is_some();
         let which = if use_reduced { 2 } else { 1 };
-        let r = if use_reduced { self.reduced.as_mut() } else { self.full.as_mut() }.expect("checked");
+        let r = if use_reduced {
+            self.reduced.as_mut()
+        } else {
+            self.full.as_mut()
+        }
+        .expect("checked");
         let continuing = self.used_last == which;
         if !continuing {
             // its history is from an older camera
@@ -622,7 +641,9 @@ impl App {
         if let Some(keys) = &mut self.recording {
             // a keyframe every 10 frames while the camera moves; frame = frames since the start
             let k = self.frames_done.saturating_sub(self.record_start) as f32;
-            let changed = keys.last().is_none_or(|l: &Keyframe| l.eye != cam.eye || l.target != cam.target);
+            let changed = keys
+                .last()
+                .is_none_or(|l: &Keyframe| l.eye != cam.eye || l.target != cam.target);
             if changed && (keys.is_empty() || k - keys.last().map_or(0.0, |l| l.frame) >= 10.0) {
                 keys.push(Keyframe {
                     frame: k,
@@ -680,9 +701,14 @@ impl App {
         };
         if let Some(s) = &self.shown {
             let bytes = self.display_bytes(s);
-            let img = egui::ColorImage::from_rgba_unmultiplied([s.image.width as usize, s.image.height as usize], &bytes);
+            let img =
+                egui::ColorImage::from_rgba_unmultiplied([s.image.width as usize, s.image.height as usize], &bytes);
             // full frames are shown 1:1 (nearest); reduced ones are upscaled (linear)
-            let filter = if s.full { egui::TextureOptions::NEAREST } else { egui::TextureOptions::LINEAR };
+            let filter = if s.full {
+                egui::TextureOptions::NEAREST
+            } else {
+                egui::TextureOptions::LINEAR
+            };
             match &mut self.texture {
                 Some(t) => t.set(img, filter),
                 None => self.texture = Some(gfx.egui_state.egui_ctx().load_texture("viewport", img, filter)),
@@ -698,7 +724,10 @@ impl App {
         // (a screenshot may take a few more frames; give up after 100)
         let over = scripted && self.frames_done >= frames + 100;
         if over && self.pending_shot.is_some() {
-            self.say("screenshot: the frame did not settle within 100 extra frames".into(), true);
+            self.say(
+                "screenshot: the frame did not settle within 100 extra frames".into(),
+                true,
+            );
             self.fatal = Some("screenshot not saved: the camera or settings kept changing".into());
         }
         let last = at_end && ((self.pending_shot.is_none() && self.actions.is_empty()) || over);
@@ -710,7 +739,8 @@ impl App {
         let prims = ctx.tessellate(out.shapes, out.pixels_per_point);
         for (id, deltas) in &out.textures_delta.set {
             for delta in deltas.iter() {
-                gfx.egui_rend.update_texture(&gfx.gpu.device, &gfx.gpu.queue, *id, delta);
+                gfx.egui_rend
+                    .update_texture(&gfx.gpu.device, &gfx.gpu.queue, *id, delta);
             }
         }
         let sd = egui_wgpu::ScreenDescriptor {
@@ -758,7 +788,10 @@ impl App {
                 } else {
                     format!("{w}x{h}")
                 };
-                eprintln!("strata view: {what}: {} frames, mean frame {frame:.1} ms, GPU passes {gpu:.1} ms", v.len());
+                eprintln!(
+                    "strata view: {what}: {} frames, mean frame {frame:.1} ms, GPU passes {gpu:.1} ms",
+                    v.len()
+                );
             }
             if let Some(s) = &self.script {
                 if s.end > self.frames_done {
@@ -780,7 +813,11 @@ fn one_line(s: &str) -> String {
 /// Heat map 0 → black … 1 → white (as `--debug-view abuffer-count`).
 fn heat(v: f32) -> [f32; 3] {
     let v = v.clamp(0.0, 1.0);
-    [(v * 3.0).min(1.0), (v * 3.0 - 1.0).clamp(0.0, 1.0), (v * 3.0 - 2.0).clamp(0.0, 1.0)]
+    [
+        (v * 3.0).min(1.0),
+        (v * 3.0 - 1.0).clamp(0.0, 1.0),
+        (v * 3.0 - 2.0).clamp(0.0, 1.0),
+    ]
 }
 
 /// A TOML scene the loader reads: the current scene as its base and the recorded path.
@@ -794,8 +831,16 @@ pub fn write_path_scene(path: &Path, scene_spec: &str, keys: &[Keyframe], cam: &
     }
     let mut doc = toml::Table::new();
     let spec = Path::new(scene_spec);
-    let ext = spec.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
-    let abs = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf()).display().to_string();
+    let ext = spec
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    let abs = |p: &Path| {
+        std::fs::canonicalize(p)
+            .unwrap_or_else(|_| p.to_path_buf())
+            .display()
+            .to_string()
+    };
     match ext.as_deref() {
         Some("toml") => {
             let text = std::fs::read_to_string(spec).map_err(|e| format!("{scene_spec}: cannot read: {e}"))?;
@@ -834,7 +879,10 @@ pub fn write_path_scene(path: &Path, scene_spec: &str, keys: &[Keyframe], cam: &
     let mut p = toml::Table::new();
     p.insert("keyframes".into(), toml::Value::Array(kf));
     doc.insert("camera_path".into(), toml::Value::Table(p));
-    let text = format!("# camera path recorded by strata view\n{}", toml::to_string(&doc).map_err(|e| e.to_string())?);
+    let text = format!(
+        "# camera path recorded by strata view\n{}",
+        toml::to_string(&doc).map_err(|e| e.to_string())?
+    );
     if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(d).map_err(|e| format!("{}: cannot create folder: {e}", d.display()))?;
     }
@@ -855,7 +903,12 @@ fn present(gfx: &mut Gfx, prims: &[egui::ClippedPrimitive], sd: &egui_wgpu::Scre
     gfx.gpu.queue.present(frame);
 }
 
-fn draw_egui(gfx: &mut Gfx, prims: &[egui::ClippedPrimitive], sd: &egui_wgpu::ScreenDescriptor, view: &wgpu::TextureView) {
+fn draw_egui(
+    gfx: &mut Gfx,
+    prims: &[egui::ClippedPrimitive],
+    sd: &egui_wgpu::ScreenDescriptor,
+    view: &wgpu::TextureView,
+) {
     let dev = &gfx.gpu.device;
     let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("egui") });
     let cmds = gfx.egui_rend.update_buffers(dev, &gfx.gpu.queue, &mut enc, prims, sd);
@@ -909,13 +962,17 @@ fn window_screenshot(
     let view = tex.create_view(&wgpu::TextureViewDescriptor::default());
     draw_egui(gfx, prims, sd, &view);
     let mut bytes = gfx.gpu.read_texture(&tex, 0).map_err(|e| e.to_string())?;
-    if matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb) {
+    if matches!(
+        format,
+        wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+    ) {
         bytes.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
     }
     bytes.chunks_exact_mut(4).for_each(|p| p[3] = 255);
     let img = image::RgbaImage::from_raw(gfx.config.width, gfx.config.height, bytes)
         .ok_or_else(|| "window screenshot: unexpected texture size".to_string())?;
-    img.save(path).map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
+    img.save(path)
+        .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
 }
 
 struct Handler {
@@ -982,14 +1039,19 @@ impl ApplicationHandler for Handler {
                 }
             }
             WindowEvent::Focused(false) => app.cam.release_all(),
-            WindowEvent::MouseInput { state, button: MouseButton::Right, .. } => {
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Right,
+                ..
+            } => {
                 // look / orbit drags start on the 3D viewport only
                 app.look_active = state == ElementState::Pressed && app.cursor_in_viewport();
             }
             WindowEvent::CursorMoved { position, .. } => {
                 if app.look_active {
                     if let Some((x, y)) = app.last_cursor {
-                        app.cam.apply(Input::Drag((position.x - x) as f32, (position.y - y) as f32));
+                        app.cam
+                            .apply(Input::Drag((position.x - x) as f32, (position.y - y) as f32));
                     }
                 }
                 app.last_cursor = Some((position.x, position.y));
@@ -1016,13 +1078,17 @@ impl ApplicationHandler for Handler {
 impl App {
     fn init(&mut self, el: &ActiveEventLoop) -> Result<(), String> {
         let (w, h) = self.render_size;
-        let attrs = Window::default_attributes()
-            .with_title("strata view")
-            .with_inner_size(winit::dpi::LogicalSize::new(
-                w as f64 + PANEL_WIDTH as f64 + 24.0,
-                (h as f64 + BOTTOM_HEIGHT as f64 + 40.0).max(720.0),
-            ));
-        let window = Arc::new(el.create_window(attrs).map_err(|e| format!("cannot open a window: {e} (is DISPLAY set? under no display use xvfb-run)"))?);
+        let attrs =
+            Window::default_attributes()
+                .with_title("strata view")
+                .with_inner_size(winit::dpi::LogicalSize::new(
+                    w as f64 + PANEL_WIDTH as f64 + 24.0,
+                    (h as f64 + BOTTOM_HEIGHT as f64 + 40.0).max(720.0),
+                ));
+        let window = Arc::new(
+            el.create_window(attrs)
+                .map_err(|e| format!("cannot open a window: {e} (is DISPLAY set? under no display use xvfb-run)"))?,
+        );
         let instance = GpuContext::instance();
         let surface = instance
             .create_surface(window.clone())
@@ -1052,7 +1118,11 @@ impl App {
             height: size.height.max(1),
             present_mode: wgpu::PresentMode::AutoVsync,
             desired_maximum_frame_latency: 2,
-            alpha_mode: caps.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
+            alpha_mode: caps
+                .alpha_modes
+                .first()
+                .copied()
+                .unwrap_or(wgpu::CompositeAlphaMode::Auto),
             view_formats: vec![],
         };
         if size.width > 0 && size.height > 0 {
@@ -1103,7 +1173,8 @@ impl App {
 }
 
 pub fn run(opts: ViewOptions) -> Result<(), String> {
-    let el = EventLoop::new().map_err(|e| format!("cannot open a window: {e} (is DISPLAY set? under no display use xvfb-run)"))?;
+    let el = EventLoop::new()
+        .map_err(|e| format!("cannot open a window: {e} (is DISPLAY set? under no display use xvfb-run)"))?;
     el.set_control_flow(ControlFlow::Poll);
     let mut h = Handler { app: App::new(opts) };
     el.run_app(&mut h).map_err(|e| format!("window event loop: {e}"))?;

@@ -44,7 +44,8 @@ pub struct Script {
 
 impl Script {
     pub fn load(path: &Path) -> Result<Script, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("--script {}: cannot read: {e}", path.display()))?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| format!("--script {}: cannot read: {e}", path.display()))?;
         Self::parse(&text).map_err(|e| format!("--script {}: {e}", path.display()))
     }
 
@@ -78,8 +79,8 @@ impl Script {
             let mut act = |a: Action| s.events.push((clock, Event::Action(a)));
             match cmd {
                 "key" => {
-                    let k = Key::parse(arg(0)?)
-                        .ok_or_else(|| err("unknown key: use W, A, S, D, Q, E or shift".into()))?;
+                    let k =
+                        Key::parse(arg(0)?).ok_or_else(|| err("unknown key: use W, A, S, D, Q, E or shift".into()))?;
                     let n = frames(1)?;
                     s.events.push((clock, Event::Input(Input::Key(k, true))));
                     clock += n;

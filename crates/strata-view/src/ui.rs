@@ -14,7 +14,9 @@ fn entered(ui: &egui::Ui, r: &egui::Response) -> bool {
 
 /// A stable colour per pass name.
 fn pass_colour(name: &str) -> Color32 {
-    let h = name.bytes().fold(2166136261u32, |h, b| (h ^ b as u32).wrapping_mul(16777619));
+    let h = name
+        .bytes()
+        .fold(2166136261u32, |h, b| (h ^ b as u32).wrapping_mul(16777619));
     let hue = (h % 360) as f32 / 360.0;
     let c = egui::ecolor::Hsva::new(hue, 0.65, 0.9, 1.0);
     c.into()
@@ -40,7 +42,10 @@ pub fn draw(app: &mut App, ui: &mut egui::Ui) {
 fn viewport(app: &mut App, ui: &mut egui::Ui) {
     let avail = ui.available_size();
     let ppp = ui.ctx().pixels_per_point();
-    app.viewport_px = ((avail.x * ppp).floor().max(0.0) as u32, (avail.y * ppp).floor().max(0.0) as u32);
+    app.viewport_px = (
+        (avail.x * ppp).floor().max(0.0) as u32,
+        (avail.y * ppp).floor().max(0.0) as u32,
+    );
     let r = ui.max_rect();
     app.viewport_rect = Some([r.min.x * ppp, r.min.y * ppp, r.max.x * ppp, r.max.y * ppp]);
     let Some(t) = &app.texture else {
@@ -70,9 +75,20 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
     ui.separator();
 
     // scene
-    ui.label(RichText::new(format!("scene: {} ({} triangles)", app.scene.name, app.scene.triangle_count())).strong());
+    ui.label(
+        RichText::new(format!(
+            "scene: {} ({} triangles)",
+            app.scene.name,
+            app.scene.triangle_count()
+        ))
+        .strong(),
+    );
     ui.horizontal(|ui| {
-        let r = ui.add(egui::TextEdit::singleline(&mut app.open_text).hint_text("file.glb / .gltf / .obj / .toml").desired_width(200.0));
+        let r = ui.add(
+            egui::TextEdit::singleline(&mut app.open_text)
+                .hint_text("file.glb / .gltf / .obj / .toml")
+                .desired_width(200.0),
+        );
         if ui.button("Open").clicked() || entered(ui, &r) {
             app.actions.push(Action::Open(app.open_text.clone()));
         }
@@ -138,7 +154,12 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
         .selected_text(tech.name)
         .show_ui(ui, |ui| {
             for t in registry() {
-                if ui.selectable_label(t.name == tech.name, t.name).on_hover_text(t.doc).clicked() && t.name != tech.name {
+                if ui
+                    .selectable_label(t.name == tech.name, t.name)
+                    .on_hover_text(t.doc)
+                    .clicked()
+                    && t.name != tech.name
+                {
                     app.actions.push(Action::Technique(t.name.to_string()));
                 }
             }
@@ -146,13 +167,15 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
     ui.label(RichText::new(tech.doc).small());
     if !tech.presets.is_empty() {
         let cur = app.spec.preset.clone().unwrap_or_else(|| tech.presets[0].to_string());
-        egui::ComboBox::from_label("preset").selected_text(&cur).show_ui(ui, |ui| {
-            for p in tech.presets {
-                if ui.selectable_label(*p == cur, *p).clicked() && *p != cur {
-                    app.actions.push(Action::Preset(p.to_string()));
+        egui::ComboBox::from_label("preset")
+            .selected_text(&cur)
+            .show_ui(ui, |ui| {
+                for p in tech.presets {
+                    if ui.selectable_label(*p == cur, *p).clicked() && *p != cur {
+                        app.actions.push(Action::Preset(p.to_string()));
+                    }
                 }
-            }
-        });
+            });
     }
     ui.horizontal(|ui| {
         let mut l = app.spec.layers;
@@ -161,13 +184,15 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
             app.actions.push(Action::Layers(l));
         }
         let cur = app.spec.variant.clone();
-        egui::ComboBox::from_id_salt("variant").selected_text(format!("variant {cur}")).show_ui(ui, |ui| {
-            for v in Variant::ALL {
-                if ui.selectable_label(v.name() == cur, v.name()).clicked() && v.name() != cur {
-                    app.actions.push(Action::Variant(v.name().to_string()));
+        egui::ComboBox::from_id_salt("variant")
+            .selected_text(format!("variant {cur}"))
+            .show_ui(ui, |ui| {
+                for v in Variant::ALL {
+                    if ui.selectable_label(v.name() == cur, v.name()).clicked() && v.name() != cur {
+                        app.actions.push(Action::Variant(v.name().to_string()));
+                    }
                 }
-            }
-        });
+            });
     });
     ui.horizontal(|ui| {
         ui.label("guard band");
@@ -181,54 +206,81 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
     });
 
     // every setting of the technique, applied through the CLI's validation
-    egui::CollapsingHeader::new("settings").default_open(true).show(ui, |ui| {
-        egui::Grid::new("settings-grid").num_columns(3).striped(true).show(ui, |ui| {
-            for info in tech.setting_list() {
-                let current = app.settings.as_ref().and_then(|s| (info.get)(s));
-                let shown = match current {
-                    Some(v) if !info.values.is_empty() => info.values.get(v as usize).map_or(v.to_string(), |n| n.to_string()),
-                    Some(v) => format!("{}", v as f32),
-                    None => "scene".into(),
-                };
-                ui.label(info.name).on_hover_text(format!("{} (range {})", info.doc, info.range));
-                if info.values.is_empty() {
-                    let text = app.setting_text.entry(info.name.to_string()).or_insert_with(|| shown.clone());
-                    let r = ui.add_sized([80.0, 18.0], egui::TextEdit::singleline(text));
-                    if entered(ui, &r) {
-                        app.actions.push(Action::Set(info.name.to_string(), text.trim().to_string()));
-                    }
-                } else {
-                    egui::ComboBox::from_id_salt(info.name).selected_text(&shown).show_ui(ui, |ui| {
-                        for v in info.values {
-                            if ui.selectable_label(*v == shown, *v).clicked() && *v != shown {
-                                app.actions.push(Action::Set(info.name.to_string(), v.to_string()));
+    egui::CollapsingHeader::new("settings")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::Grid::new("settings-grid")
+                .num_columns(3)
+                .striped(true)
+                .show(ui, |ui| {
+                    for info in tech.setting_list() {
+                        let current = app.settings.as_ref().and_then(|s| (info.get)(s));
+                        let shown = match current {
+                            Some(v) if !info.values.is_empty() => {
+                                info.values.get(v as usize).map_or(v.to_string(), |n| n.to_string())
                             }
+                            Some(v) => format!("{}", v as f32),
+                            None => "scene".into(),
+                        };
+                        ui.label(info.name)
+                            .on_hover_text(format!("{} (range {})", info.doc, info.range));
+                        if info.values.is_empty() {
+                            let text = app
+                                .setting_text
+                                .entry(info.name.to_string())
+                                .or_insert_with(|| shown.clone());
+                            let r = ui.add_sized([80.0, 18.0], egui::TextEdit::singleline(text));
+                            if entered(ui, &r) {
+                                app.actions
+                                    .push(Action::Set(info.name.to_string(), text.trim().to_string()));
+                            }
+                        } else {
+                            egui::ComboBox::from_id_salt(info.name)
+                                .selected_text(&shown)
+                                .show_ui(ui, |ui| {
+                                    for v in info.values {
+                                        if ui.selectable_label(*v == shown, *v).clicked() && *v != shown {
+                                            app.actions.push(Action::Set(info.name.to_string(), v.to_string()));
+                                        }
+                                    }
+                                });
                         }
-                    });
-                }
-                ui.label(RichText::new(info.range.to_string()).small());
-                ui.end_row();
-            }
+                        ui.label(RichText::new(info.range.to_string()).small());
+                        ui.end_row();
+                    }
+                });
         });
-    });
     ui.separator();
 
     // debug views: every target of the current frame
     let cur = app.debug_view.clone().unwrap_or_else(|| "final".into());
-    egui::ComboBox::from_label("debug view").selected_text(&cur).height(400.0).show_ui(ui, |ui| {
-        if ui.selectable_label(app.debug_view.is_none(), "final").clicked() {
-            app.actions.push(Action::DebugView(None));
-        }
-        for v in app.view_names.clone() {
-            if ui.selectable_label(app.debug_view.as_deref() == Some(v.as_str()), &v).clicked() {
-                app.actions.push(Action::DebugView(Some(v)));
+    egui::ComboBox::from_label("debug view")
+        .selected_text(&cur)
+        .height(400.0)
+        .show_ui(ui, |ui| {
+            if ui.selectable_label(app.debug_view.is_none(), "final").clicked() {
+                app.actions.push(Action::DebugView(None));
             }
-        }
-    });
+            for v in app.view_names.clone() {
+                if ui
+                    .selectable_label(app.debug_view.as_deref() == Some(v.as_str()), &v)
+                    .clicked()
+                {
+                    app.actions.push(Action::DebugView(Some(v)));
+                }
+            }
+        });
     ui.horizontal(|ui| {
-        ui.add(egui::Slider::new(&mut app.gain, 0.125..=16.0).logarithmic(true).text("display gain"));
+        ui.add(
+            egui::Slider::new(&mut app.gain, 0.125..=16.0)
+                .logarithmic(true)
+                .text("display gain"),
+        );
     });
-    ui.checkbox(&mut app.false_colour, "false colour (one-channel views: depth, counts, confidence)");
+    ui.checkbox(
+        &mut app.false_colour,
+        "false colour (one-channel views: depth, counts, confidence)",
+    );
     ui.separator();
 
     // resolution
@@ -253,7 +305,11 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
 
 fn timing_panel(app: &mut App, ui: &mut egui::Ui) {
     if let Some((msg, err)) = &app.status {
-        let c = if *err { Color32::from_rgb(255, 110, 100) } else { Color32::from_gray(200) };
+        let c = if *err {
+            Color32::from_rgb(255, 110, 100)
+        } else {
+            Color32::from_gray(200)
+        };
         ui.colored_label(c, msg);
     }
     let last = app.timings.back();
@@ -263,7 +319,11 @@ fn timing_panel(app: &mut App, ui: &mut egui::Ui) {
         app.last_frame_ms,
         1e3 / app.last_frame_ms.max(1e-3),
         gpu,
-        if last.is_some_and(|t| t.reduced) { " — reduced resolution while moving" } else { "" }
+        if last.is_some_and(|t| t.reduced) {
+            " — reduced resolution while moving"
+        } else {
+            ""
+        }
     ));
     let ch = (ui.available_height() - 6.0).max(80.0);
     ui.horizontal(|ui| {
@@ -293,23 +353,38 @@ fn timing_panel(app: &mut App, ui: &mut egui::Ui) {
                 y -= hgt;
             }
         }
-        p.text(rect.left_top() + egui::vec2(4.0, 2.0), egui::Align2::LEFT_TOP, format!("GPU per frame, last {HISTORY} frames; top = {max:.1} ms"), egui::FontId::monospace(11.0), Color32::GRAY);
+        p.text(
+            rect.left_top() + egui::vec2(4.0, 2.0),
+            egui::Align2::LEFT_TOP,
+            format!("GPU per frame, last {HISTORY} frames; top = {max:.1} ms"),
+            egui::FontId::monospace(11.0),
+            Color32::GRAY,
+        );
         // legend: pass, last and mean ms
-        egui::ScrollArea::vertical().id_salt("legend").max_height(ch).show(ui, |ui| {
-            egui::Grid::new("legend-grid").num_columns(3).show(ui, |ui| {
-                if let Some(t) = last {
-                    for (name, ms) in &t.passes {
-                        let n = app.timings.len().max(1) as f64;
-                        let mean = app.timings.iter().filter_map(|t| t.passes.iter().find(|p| &p.0 == name)).map(|p| p.1).sum::<f64>() / n;
-                        ui.colored_label(pass_colour(name), name.as_str());
-                        ui.label(RichText::new(format!("{ms:.2}")).monospace());
-                        ui.label(RichText::new(format!("avg {mean:.2} ms")).monospace().small());
-                        ui.end_row();
+        egui::ScrollArea::vertical()
+            .id_salt("legend")
+            .max_height(ch)
+            .show(ui, |ui| {
+                egui::Grid::new("legend-grid").num_columns(3).show(ui, |ui| {
+                    if let Some(t) = last {
+                        for (name, ms) in &t.passes {
+                            let n = app.timings.len().max(1) as f64;
+                            let mean = app
+                                .timings
+                                .iter()
+                                .filter_map(|t| t.passes.iter().find(|p| &p.0 == name))
+                                .map(|p| p.1)
+                                .sum::<f64>()
+                                / n;
+                            ui.colored_label(pass_colour(name), name.as_str());
+                            ui.label(RichText::new(format!("{ms:.2}")).monospace());
+                            ui.label(RichText::new(format!("avg {mean:.2} ms")).monospace().small());
+                            ui.end_row();
+                        }
+                    } else {
+                        ui.label("no GPU timings (the adapter lacks timestamp queries, or no frame yet)");
                     }
-                } else {
-                    ui.label("no GPU timings (the adapter lacks timestamp queries, or no frame yet)");
-                }
+                });
             });
-        });
     });
 }

@@ -11,8 +11,8 @@ use crate::scene::SceneSpec;
 use crate::stats::median_min;
 
 pub mod abuffer;
-pub mod bzb;
 pub mod ao;
+pub mod bzb;
 pub mod deep;
 pub mod gbuffer;
 pub mod ils;

@@ -76,7 +76,11 @@ pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Resu
     let refs = (&ref_obscurance, &ref_binary);
     // dropped fragments, if any: the lists were too small for the scene
     let dropped = |r: &strata_render::Renderer| -> Result<String> {
-        let overflow = r.abuffer().map(|a| a.read_lists(&gpu)).transpose()?.map_or(0, |l| l.overflow);
+        let overflow = r
+            .abuffer()
+            .map(|a| a.read_lists(&gpu))
+            .transpose()?
+            .map_or(0, |l| l.overflow);
         Ok(if overflow > 0 {
             format!(" ({overflow} fragments dropped: raise --set pool=N)")
         } else {

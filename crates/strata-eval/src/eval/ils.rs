@@ -105,7 +105,15 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u3
         Ok(out)
     };
     let progressive = match progressive {
-        Some((k, b)) => Some(super::ils_progressive::run(s, &is_settings, &scene, camera, &gpu, k, b)?),
+        Some((k, b)) => Some(super::ils_progressive::run(
+            s,
+            &is_settings,
+            &scene,
+            camera,
+            &gpu,
+            k,
+            b,
+        )?),
         None => None,
     };
     let (full, ind) = render(is_settings)?;

@@ -116,7 +116,9 @@ pub fn run(
     let converged_sets: Vec<VplSet> = (0..sets)
         .map(|k| vpl_set(&reference, paths, bounces, REFERENCE_SEED + k as u64))
         .collect();
-    let progressive_sets: Vec<VplSet> = (0..sets).map(|k| vpl_set(&reference, paths, bounces, k as u64)).collect();
+    let progressive_sets: Vec<VplSet> = (0..sets)
+        .map(|k| vpl_set(&reference, paths, bounces, k as u64))
+        .collect();
     let largest = converged_sets
         .iter()
         .chain(&progressive_sets)
@@ -125,7 +127,10 @@ pub fn run(
     // the renderer is built for the largest set (set_vpls takes up to that many)
     let mut initial = largest.vpls.clone();
     if initial.is_empty() {
-        bail!("scene '{}': the lights' paths hit no surface, so there are no VPLs", scene.name);
+        bail!(
+            "scene '{}': the lights' paths hit no surface, so there are no VPLs",
+            scene.name
+        );
     }
     // the path tracer with B indirect bounces (cached like `eval gi`)
     let rule = s.check(super::gi::DEFAULT_CAP, 8)?;
@@ -200,7 +205,10 @@ pub fn run(
             pattern[1],
             match reached {
                 Some((k, g, v)) => format!("< 1 % RMS after {k} frames, {g:.0} ms GPU + {v:.0} ms VPLs"),
-                None => format!("1 % not reached in {sets} frames (last {:.4})", curve.last().map_or(1.0, |c| c.1)),
+                None => format!(
+                    "1 % not reached in {sets} frames (last {:.4})",
+                    curve.last().map_or(1.0, |c| c.1)
+                ),
             }
         );
         patterns.push(IlsProgressivePattern {

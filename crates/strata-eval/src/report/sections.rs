@@ -355,7 +355,10 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
             }
         }
         BenchResult::Bzb(b) => {
-            for (what, s) in [("bounced z-buffer", &b.visibility), ("AOV baseline, no visibility", &b.no_visibility)] {
+            for (what, s) in [
+                ("bounced z-buffer", &b.visibility),
+                ("AOV baseline, no visibility", &b.no_visibility),
+            ] {
                 section = section.table(pass_table(
                     format!("BZB Table 1, {what}: splat ratio {:.2}x", b.splat_ratio),
                     &[("", &s.passes, (s.total_median_ms, s.total_min_ms))],

@@ -23,14 +23,20 @@ fn sample_ranges_add_up() {
     let cam = r.camera();
     let ao = Estimator::AoBinary(AoBinarySettings::new(0.5));
     let whole = r.sample_sums(&cam, 12, 10, &ao, 0..24);
-    let (a, b) = (r.sample_sums(&cam, 12, 10, &ao, 0..7), r.sample_sums(&cam, 12, 10, &ao, 7..24));
+    let (a, b) = (
+        r.sample_sums(&cam, 12, 10, &ao, 0..7),
+        r.sample_sums(&cam, 12, 10, &ao, 7..24),
+    );
     for ((w, x), y) in whole.iter().zip(&a).zip(&b) {
         assert_eq!(*w, x + y);
     }
     let gi = Estimator::Gi(GiSettings::default());
     let whole = r.sample_sums(&cam, 8, 6, &gi, 0..6);
     assert_eq!(whole.len(), 8 * 6 * 6);
-    let (a, b) = (r.sample_sums(&cam, 8, 6, &gi, 0..2), r.sample_sums(&cam, 8, 6, &gi, 2..6));
+    let (a, b) = (
+        r.sample_sums(&cam, 8, 6, &gi, 0..2),
+        r.sample_sums(&cam, 8, 6, &gi, 2..6),
+    );
     for ((w, x), y) in whole.iter().zip(&a).zip(&b) {
         assert!((w - (x + y)).abs() <= 1e-5 * w.abs().max(1.0), "{w} vs {x} + {y}");
     }
@@ -61,7 +67,11 @@ fn sample_sums_match_the_one_shot_estimators() {
         width: 10,
         height: 10,
         channels: 1,
-        data: r.sample_sums(&cam, 10, 10, &e, 0..16).iter().map(|s| (s / 16.0) as f32).collect(),
+        data: r
+            .sample_sums(&cam, 10, 10, &e, 0..16)
+            .iter()
+            .map(|s| (s / 16.0) as f32)
+            .collect(),
     };
     let finished = e.finish(&mean);
     for (a, b) in one_shot.data.iter().zip(&finished.data) {
@@ -103,7 +113,11 @@ fn converges_to_the_target_and_improves_on_each_half() {
     let c = r.converge(&cam, w, h, &est, &rule, rmse);
     assert!(c.converged, "rounds {:?}", c.rounds);
     assert!(c.noise <= rule.target);
-    assert!(c.rounds.len() >= 2, "4 spp per half cannot reach RMSE 0.01: {:?}", c.rounds);
+    assert!(
+        c.rounds.len() >= 2,
+        "4 spp per half cannot reach RMSE 0.01: {:?}",
+        c.rounds
+    );
     assert!(c.rounds[0].noise > rule.target);
     for pair in c.rounds.windows(2) {
         assert!(pair[1].spp >= 2 * pair[0].spp && pair[1].spp <= 8 * pair[0].spp);
@@ -123,7 +137,11 @@ fn converges_to_the_target_and_improves_on_each_half() {
     let combined = rmse(&c.image(), &truth);
     assert!(combined < rmse(&a, &truth) && combined < rmse(&b, &truth));
     // the halves' difference bounds the combined image's error (≈ half of it)
-    assert!(combined < c.noise, "combined error {combined} vs half-to-half {}", c.noise);
+    assert!(
+        combined < c.noise,
+        "combined error {combined} vs half-to-half {}",
+        c.noise
+    );
 }
 
 /// The cap wins over an unreachable target, and the result says so.
@@ -149,7 +167,7 @@ fn next_round_follows_the_measured_decay_within_bounds() {
     assert_eq!(next_round_spp(100, 0.04, 0.02, 0.5), 480);
     assert_eq!(next_round_spp(100, 0.021, 0.02, 0.5), 200); // at least 2×
     assert_eq!(next_round_spp(100, 1.0, 0.02, 0.5), 800); // at most 8×
-    // ꟻLIP-like decay (b = 0.35) asks for more than b = 0.5 would
+                                                          // ꟻLIP-like decay (b = 0.35) asks for more than b = 0.5 would
     assert!(next_round_spp(100, 0.024, 0.02, 0.35) > next_round_spp(100, 0.024, 0.02, 0.5));
     // target 0 (run to the cap), unusable noise: 8× per round
     assert_eq!(next_round_spp(10, f64::NAN, 0.02, 0.5), 80);

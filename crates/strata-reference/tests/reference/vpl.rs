@@ -8,7 +8,9 @@ use strata_scene::{Camera, Light, Material};
 use crate::scenes::*;
 
 fn total_flux(vpls: &[Vpl], bounce: u32) -> Vec3 {
-    vpls.iter().filter(|v| v.bounce == bounce).fold(Vec3::ZERO, |a, v| a + v.flux)
+    vpls.iter()
+        .filter(|v| v.bounce == bounce)
+        .fold(Vec3::ZERO, |a, v| a + v.flux)
 }
 
 /// A sun at 40° from the normal of a lone 10 × 10 m plane (albedo 0.5): the VPLs
@@ -30,7 +32,9 @@ fn sun_on_a_plane_reflected_power() {
     });
     let expected = Vec3::new(1.0, 0.9, 0.8) * (0.5 * 3.0 * 100.0 * theta.cos());
     let got = total_flux(&vpls, 1);
-    assert!(vpls.iter().all(|v| v.bounce == 1 && (v.normal - Vec3::Y).length() < 1e-5));
+    assert!(vpls
+        .iter()
+        .all(|v| v.bounce == 1 && (v.normal - Vec3::Y).length() < 1e-5));
     assert!(
         ((got - expected) / expected).abs().max_element() < 0.01,
         "flux {got} vs ρ E A cos θ = {expected}"
@@ -87,7 +91,10 @@ fn closed_room_keeps_energy_per_bounce() {
     for b in 1..=3u32 {
         let got = total_flux(&vpls, b).x;
         let expected = p * rho.powi(b as i32);
-        assert!((got - expected).abs() < 1e-4 * expected, "bounce {b}: {got} vs {expected}");
+        assert!(
+            (got - expected).abs() < 1e-4 * expected,
+            "bounce {b}: {got} vs {expected}"
+        );
         assert_eq!(vpls.iter().filter(|v| v.bounce == b).count(), 1000);
     }
 }
@@ -109,7 +116,10 @@ fn one_vpl_falls_off_as_cosines_over_distance_squared() {
         assert!((e - exact).abs() < 1e-6, "r = {r}: {e} vs {exact}");
     }
     // behind the VPL or facing away: nothing; the clamp bounds the geometry term
-    assert_eq!(v.irradiance_at(Vec3::new(0.0, 2.0, 0.0), -Vec3::Y, f32::INFINITY), Vec3::ZERO);
+    assert_eq!(
+        v.irradiance_at(Vec3::new(0.0, 2.0, 0.0), -Vec3::Y, f32::INFINITY),
+        Vec3::ZERO
+    );
     assert_eq!(v.irradiance_at(Vec3::ZERO, -Vec3::Y, f32::INFINITY), Vec3::ZERO);
     let close = v.irradiance_at(Vec3::new(0.0, 0.9, 0.0), Vec3::Y, 10.0).x;
     assert!((close - 10.0).abs() < 1e-5, "{close}");
@@ -123,7 +133,13 @@ fn vpls_are_reproducible_and_every_light_kind_emits() {
     let r = Reference::new(&cornell, 0.0);
     let a = r.vpls(&VplSettings::default());
     assert_eq!(a, r.vpls(&VplSettings::default()));
-    assert_ne!(a, r.vpls(&VplSettings { seed: 1, ..Default::default() }));
+    assert_ne!(
+        a,
+        r.vpls(&VplSettings {
+            seed: 1,
+            ..Default::default()
+        })
+    );
     // the box is open towards the camera: some paths leave it
     assert!(a.len() > 300 && a.len() < 480, "{} of 480 paths hit the box", a.len());
     let warehouse = strata_scene::procedural::builtin("warehouse").unwrap();

@@ -56,4 +56,3 @@ pub fn glass(name: &str, rgb: [f32; 3], alpha: f32) -> Material {
         ..Material::diffuse(name, rgb)
     }
 }
-

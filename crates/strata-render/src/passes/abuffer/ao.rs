@@ -127,7 +127,10 @@ impl AbaAoSettings {
             ));
         }
         if !(1..=MAX_STEPS).contains(&self.steps) {
-            return Err(format!("AO steps {} is out of range: must be in 1..={MAX_STEPS}", self.steps));
+            return Err(format!(
+                "AO steps {} is out of range: must be in 1..={MAX_STEPS}",
+                self.steps
+            ));
         }
         if !(1..=MAX_SAMPLES).contains(&self.samples) {
             return Err(format!(
@@ -362,7 +365,15 @@ pub fn integrate_cpu(
         Occluders::Lists => lists
             .at(x, y)
             .iter()
-            .map(|f| (f.alpha, f.depth, Vec3::from(f.normal), f.front_facing, Vec3::from(f.radiance)))
+            .map(|f| {
+                (
+                    f.alpha,
+                    f.depth,
+                    Vec3::from(f.normal),
+                    f.front_facing,
+                    Vec3::from(f.radiance),
+                )
+            })
             .collect(),
         Occluders::Compressed {
             nodes,

@@ -268,7 +268,10 @@ impl ABufferSettings {
     pub fn estimated_bytes(&self, w: u32, h: u32) -> u64 {
         let px = w as u64 * h as u64;
         // AO: ao-raw (4 bytes), ao-blur-h and ao (2 bytes each); inside: two RGBA32F
-        let ao = self.ao.as_ref().map_or(0, |a| px * 8 + if a.inside { px * 32 } else { 0 });
+        let ao = self
+            .ao
+            .as_ref()
+            .map_or(0, |a| px * 8 + if a.inside { px * 32 } else { 0 });
         self.memory_bytes(w, h) + self.compressed_bytes(w, h) + px * 16 + px * 4 + px + ao
     }
 }
@@ -834,7 +837,14 @@ impl ABufferStage {
         let mut blur = Vec::new();
         let ao = settings.ao.as_ref().map(|a| {
             targets.create(gpu, AO_RAW);
-            blur.extend(crate::passes::ao::stage::reconstruction(gpu, scene, targets, &a.blur, AO_RAW.name, "ao"));
+            blur.extend(crate::passes::ao::stage::reconstruction(
+                gpu,
+                scene,
+                targets,
+                &a.blur,
+                AO_RAW.name,
+                "ao",
+            ));
             let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("aba-ao-lists"),
                 entries: &[
@@ -901,7 +911,13 @@ impl ABufferStage {
                     &crate::passes::color_targets(&[AO_RAW, AO_INSIDE, AO_SEPARATE]),
                 )
             } else {
-                crate::passes::fullscreen_pipeline(device, "aba-ao", &pl, &module, &crate::passes::color_targets(&[AO_RAW]))
+                crate::passes::fullscreen_pipeline(
+                    device,
+                    "aba-ao",
+                    &pl,
+                    &module,
+                    &crate::passes::color_targets(&[AO_RAW]),
+                )
             };
             AoResources {
                 inside: a.inside,

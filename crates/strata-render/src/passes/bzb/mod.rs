@@ -371,7 +371,11 @@ pub const ZMINMAX_TILES: [u32; 3] = [8, 32, 128];
 
 /// Tiles of every level at `w`×`h` (the `bzb-zminmax` buffer holds one vec2 each).
 pub fn zminmax_tile_count(w: u32, h: u32) -> u32 {
-    ZMINMAX_TILES.iter().map(|t| w.div_ceil(*t) * h.div_ceil(*t)).sum::<u32>() + 1
+    ZMINMAX_TILES
+        .iter()
+        .map(|t| w.div_ceil(*t) * h.div_ceil(*t))
+        .sum::<u32>()
+        + 1
 }
 
 /// Min/max receiver depth per tile (compute), for the splat pass's culling.
