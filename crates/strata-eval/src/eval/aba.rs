@@ -13,9 +13,9 @@ use anyhow::{bail, Result};
 use strata_render::passes::abuffer::ao::AbaAoSettings;
 use strata_render::passes::abuffer::ABufferSettings;
 use strata_render::passes::ao::AoSettings;
-use strata_render::{GpuContext, GpuOptions, RenderSettings};
+use strata_render::RenderSettings;
 
-use super::ao::{evaluate_av, references, render_settings, DEFAULT_CAP};
+use super::ao::{av_setup, evaluate_av, render_settings, DEFAULT_CAP};
 use super::{noise_warnings, EvalSettings};
 use crate::results::AoEval;
 
@@ -66,13 +66,9 @@ pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Resu
         guard_band: s.guard_band.or_default(strata_render::renderer::AO_GUARD_BAND),
         ..s.render_settings(1)
     };
-    for rs in [aba_settings(aba.multilayer), render_settings(s, 2, &ao)] {
-        rs.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
-    }
-    let (ref_obscurance, ref_binary) = references(s, &scene, &camera, (radius, beta, epsilon), &rule)?;
-    let gpu = GpuContext::new(&GpuOptions {
-        adapter: s.adapter.clone(),
-    })?;
+    let configurations = [aba_settings(aba.multilayer), render_settings(s, 2, &ao)];
+    let (ref_obscurance, ref_binary, gpu) =
+        av_setup(s, &scene, &camera, &configurations, (radius, beta, epsilon), &rule)?;
     let refs = (&ref_obscurance, &ref_binary);
     // dropped fragments, if any: the lists were too small for the scene
     let dropped = |r: &strata_render::Renderer| -> Result<String> {

@@ -150,6 +150,26 @@ pub(crate) fn references(
     Ok((converge("obscurance", &obscurance)?, converge("binary-ao", &binary)?))
 }
 
+/// What the side-by-side AO evaluations (`bzb-ao`, `aba-ao`) share before any GPU
+/// work: every configuration validated, both references, the GPU.
+pub(crate) fn av_setup(
+    s: &EvalSettings,
+    scene: &Scene,
+    camera: &strata_scene::Camera,
+    configurations: &[RenderSettings],
+    rbe: (f32, f32, f32),
+    rule: &strata_reference::ConvergeRule,
+) -> Result<(RefImage, RefImage, GpuContext)> {
+    for rs in configurations {
+        rs.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    let (ref_obscurance, ref_binary) = references(s, scene, camera, rbe, rule)?;
+    let gpu = GpuContext::new(&GpuOptions {
+        adapter: s.adapter.clone(),
+    })?;
+    Ok((ref_obscurance, ref_binary, gpu))
+}
+
 /// One GPU configuration's AV (`rs`, frame of `s`) against both references, the
 /// frame's wall time and `note` (e.g. dropped fragments) printed under `what`.
 #[allow(clippy::too_many_arguments)]

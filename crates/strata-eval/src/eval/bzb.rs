@@ -7,9 +7,9 @@
 use anyhow::{bail, Result};
 use strata_render::passes::ao::AoSettings;
 use strata_render::passes::bzb::BzbSettings;
-use strata_render::{GpuContext, GpuOptions, RenderSettings};
+use strata_render::RenderSettings;
 
-use super::ao::{evaluate_av, references, render_settings, DEFAULT_CAP};
+use super::ao::{av_setup, evaluate_av, render_settings, DEFAULT_CAP};
 use super::{noise_warnings, EvalSettings};
 use crate::results::AoEval;
 
@@ -46,13 +46,9 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
         // BZB reads layer 0 only
         ..s.render_settings(1)
     };
-    for rs in [bzb_settings(bzb.visibility), render_settings(s, 2, &ao)] {
-        rs.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
-    }
-    let (ref_obscurance, ref_binary) = references(s, &scene, &camera, (radius, beta, epsilon), &rule)?;
-    let gpu = GpuContext::new(&GpuOptions {
-        adapter: s.adapter.clone(),
-    })?;
+    let configurations = [bzb_settings(bzb.visibility), render_settings(s, 2, &ao)];
+    let (ref_obscurance, ref_binary, gpu) =
+        av_setup(s, &scene, &camera, &configurations, (radius, beta, epsilon), &rule)?;
     let refs = (&ref_obscurance, &ref_binary);
     let evaluate = |rs: RenderSettings, what: &str| evaluate_av(&gpu, &scene, s, rs, what, refs, |_| Ok(String::new()));
     let main = evaluate(bzb_settings(bzb.visibility), "bzb-ao")?;

@@ -788,14 +788,22 @@ impl ABufferStage {
                 _pad1: [0.0; 3],
             },
         );
+        // lists.wgsl's group 1: parameters, nodes, links, counts, offsets
+        let lists_entries = [
+            layout_entry(0, frag, UNIFORM_TY),
+            layout_entry(1, frag, storage_ty(true)),
+            layout_entry(2, frag, storage_ty(true)),
+            layout_entry(3, frag, storage_ty(true)),
+            layout_entry(4, frag, storage_ty(true)),
+        ];
         let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("abuffer-resolve"),
             entries: &[
-                layout_entry(0, frag, UNIFORM_TY),
-                layout_entry(1, frag, storage_ty(true)),
-                layout_entry(2, frag, storage_ty(true)),
-                layout_entry(3, frag, storage_ty(true)),
-                layout_entry(4, frag, storage_ty(true)),
+                lists_entries[0],
+                lists_entries[1],
+                lists_entries[2],
+                lists_entries[3],
+                lists_entries[4],
                 layout_entry(
                     5,
                     frag,
@@ -847,13 +855,7 @@ impl ABufferStage {
             ));
             let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("aba-ao-lists"),
-                entries: &[
-                    layout_entry(0, frag, UNIFORM_TY),
-                    layout_entry(1, frag, storage_ty(true)),
-                    layout_entry(2, frag, storage_ty(true)),
-                    layout_entry(3, frag, storage_ty(true)),
-                    layout_entry(4, frag, storage_ty(true)),
-                ],
+                entries: &lists_entries,
             });
             let lists_group = crate::passes::bind_group(
                 device,
