@@ -137,13 +137,14 @@ def mitsuba_scene(mi, ply, cam, a, radius):
 
 
 def mitsuba_render(mi, dr, scene, a, seed):
-    t0 = time.perf_counter()
+    """Wall seconds, CPU seconds (all threads of this process) and mean AV of one render."""
+    t0, c0 = time.perf_counter(), time.process_time()
     img = mi.render(scene, spp=a.spp, seed=seed)
     dr.eval(img)
     dr.sync_thread()
-    dt = time.perf_counter() - t0
+    dt, cpu = time.perf_counter() - t0, time.process_time() - c0
     mean = float(sum(img.numpy().ravel()) / max(1, img.numpy().size))
-    return dt, mean
+    return dt, cpu, mean
 
 
 def main():
@@ -192,17 +193,20 @@ def main():
                 row[f"strata_{t}_mrays"] = r["mrays_per_s"]
                 row[f"strata_{t}_mean"] = r["mean_av"]
                 row[f"strata_{t}_build_s"] = r["build_s"]
-            dt, mean = mitsuba_render(mi, dr, ms, a, seed=rep)
+                row[f"strata_{t}_cpu_s"] = r["cpu_s"]
+            dt, cpu, mean = mitsuba_render(mi, dr, ms, a, seed=rep)
             if first is None:
                 first = dt
                 row["mitsuba_first_s"] = dt
-                dt, mean = mitsuba_render(mi, dr, ms, a, seed=rep + 1000)
+                dt, cpu, mean = mitsuba_render(mi, dr, ms, a, seed=rep + 1000)
             row["mitsuba_s"] = dt
+            row["mitsuba_cpu_s"] = cpu
             row["mitsuba_mean"] = mean
             rows.append(row)
             line = "  ".join(f"strata {t} {row[f'strata_{t}_s']:.2f} s" for t in tracers)
             extra = f" (first render {row['mitsuba_first_s']:.2f} s)" if "mitsuba_first_s" in row else ""
-            print(f"  repeat {rep}: {line}  mitsuba {dt:.2f} s{extra}")
+            print(f"  repeat {rep}: {line}  mitsuba {dt:.2f} s{extra}  (CPU s: {cpu:.2f} mitsuba, "
+                  + ", ".join(f"{row[f'strata_{t}_cpu_s']:.2f} {t}" for t in tracers) + ")")
         med = {k: statistics.median(r[k] for r in rows) for k in rows[0] if k not in ("repeat", "mitsuba_first_s")}
         mitsuba_ref = first if a.ratio_first else med["mitsuba_s"]
         # Rays: strata 1 primary + spp*ao per pixel; Mitsuba spp primary + spp*ao per pixel.
@@ -217,6 +221,7 @@ def main():
             print(
                 f"  medians: strata {t:<6} {s:.2f} s ({med[f'strata_{t}_mrays']:.1f} M rays/s), "
                 f"{s / mitsuba_ref:.2f}x Mitsuba's {'first' if a.ratio_first else 'warm'} time; "
+                f"CPU time {med[f'strata_{t}_cpu_s'] / med['mitsuba_cpu_s']:.2f}x Mitsuba's; "
                 f"mean AV {med[f'strata_{t}_mean']:.4f}"
             )
         results.append(

@@ -15,8 +15,16 @@
 use glam::Vec3;
 use strata_scene::{Camera, ImageBuf};
 
-use crate::sampling::{cosine_hemisphere, hash, pixel_offset, r2};
+use crate::bundle::BUNDLE;
+use crate::sampling::{basis, cosine_hemisphere, cosine_hemisphere_r2_8, hash, pixel_offset, r2};
 use crate::Reference;
+
+/// Fewest samples of one pixel that [`Reference::ao_binary_unoccluded`]
+/// traces in bundles: with fewer, a bundle's directions spread too far for its
+/// shared box tests to pay off.
+const BUNDLED_MIN: usize = 64;
+/// Samples sorted into bundles at a time.
+const BUNDLED_CHUNK: usize = 1024;
 
 /// Settings of the binary ambient-visibility oracle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,14 +177,98 @@ impl Reference<'_> {
     ) -> u32 {
         let origin = p + ng * self.epsilon;
         let offset = pixel_offset(key);
-        let mut free = 0u32;
-        for i in samples {
-            let d = cosine_hemisphere(n, r2(i, offset));
-            if !self.bvh.occluded(origin, d, 0.0, radius) {
-                free += 1;
+        if samples.len() < BUNDLED_MIN {
+            let mut free = 0u32;
+            for i in samples {
+                let d = cosine_hemisphere(n, r2(i, offset));
+                if !self.bvh.occluded(origin, d, 0.0, radius) {
+                    free += 1;
+                }
             }
+            return free;
+        }
+        let frame = basis(n);
+        let mut free = 0u32;
+        let mut start = samples.start;
+        while start < samples.end {
+            let end = samples.end.min(start.saturating_add(BUNDLED_CHUNK as u32));
+            free += self.unoccluded_bundled(origin, n, frame, offset, radius, start..end);
+            start = end;
         }
         free
+    }
+
+    /// [`Self::ao_binary_unoccluded`] for at most [`BUNDLED_CHUNK`] samples,
+    /// traced in bundles of 8 rays ([`crate::bundle`]): the directions are
+    /// counting-sorted by octant, then by a cell of the sample square (rings
+    /// of equal `u₀`, i.e. equal projected solid angle, serpentine sectors of
+    /// `u₁`), so the 8 rays of a bundle span a narrow cone. The count is the
+    /// same as ray by ray: every ray is still traced with its own exact
+    /// answer; only the order changes.
+    fn unoccluded_bundled(
+        &self,
+        origin: Vec3,
+        n: Vec3,
+        frame: (Vec3, Vec3),
+        offset: [f32; 2],
+        radius: f32,
+        samples: std::ops::Range<u32>,
+    ) -> u32 {
+        let count = samples.len();
+        debug_assert!(count <= BUNDLED_CHUNK);
+        let cells = (count / BUNDLE).max(1);
+        let rings = ((cells as f32 / 2.0).sqrt().round() as usize).max(1);
+        let sectors = (cells / rings).max(1);
+        let per_octant = rings * sectors;
+        // Keys: octant * per_octant + cell; the last key (8 * per_octant)
+        // holds directions with a zero component, traced one by one.
+        let irregular = 8 * per_octant;
+        let mut dirs = [Vec3::ZERO; BUNDLED_CHUNK];
+        let mut keys = [0u16; BUNDLED_CHUNK];
+        let mut starts = [0u16; 8 * BUNDLED_CHUNK / BUNDLE + 2];
+        for block in (0..count).step_by(8) {
+            let (d8, u8) = cosine_hemisphere_r2_8(n, frame, offset, samples.start + block as u32);
+            for (l, (d, u)) in d8.into_iter().zip(u8).take(count - block).enumerate() {
+                let j = block + l;
+                dirs[j] = d;
+                keys[j] = if d.cmpne(Vec3::ZERO).all() {
+                    let octant = d.cmplt(Vec3::ZERO).bitmask() as usize;
+                    let ring = ((u[0] * rings as f32) as usize).min(rings - 1);
+                    let mut sector = ((u[1] * sectors as f32) as usize).min(sectors - 1);
+                    if ring % 2 == 1 {
+                        sector = sectors - 1 - sector;
+                    }
+                    (octant * per_octant + ring * sectors + sector) as u16
+                } else {
+                    irregular as u16
+                };
+                starts[keys[j] as usize + 1] += 1;
+            }
+        }
+        for k in 1..=irregular + 1 {
+            starts[k] += starts[k - 1];
+        }
+        let mut sorted = [Vec3::ZERO; BUNDLED_CHUNK];
+        let mut fill = starts;
+        for j in 0..count {
+            let k = keys[j] as usize;
+            sorted[fill[k] as usize] = dirs[j];
+            fill[k] += 1;
+        }
+        let mut occluded = 0u32;
+        for octant in 0..8 {
+            let (a, b) = (
+                starts[octant * per_octant] as usize,
+                starts[(octant + 1) * per_octant] as usize,
+            );
+            for bundle in sorted[a..b].chunks(BUNDLE) {
+                occluded += self.bvh.occluded_bundle(origin, bundle, 0.0, radius).count_ones();
+            }
+        }
+        for &d in &sorted[starts[irregular] as usize..count] {
+            occluded += self.bvh.occluded(origin, d, 0.0, radius) as u32;
+        }
+        count as u32 - occluded
     }
 
     /// DGB obscurance ambient visibility (Eq. 1–2 over all layers) per pixel

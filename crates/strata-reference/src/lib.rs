@@ -48,6 +48,7 @@
 pub mod ao;
 pub mod bench;
 pub mod brdf;
+pub mod bundle;
 pub mod bvh;
 pub mod converge;
 pub mod gi;

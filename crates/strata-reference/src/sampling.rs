@@ -67,9 +67,18 @@ pub fn r2(i: u32, offset: [f32; 2]) -> [f32; 2] {
     const A1: f64 = 0.754_877_666_246_692_8; // 1/g, g = plastic number
     const A2: f64 = 0.569_840_290_998_053_3; // 1/g²
     let i = i as f64;
-    let u = (0.5 + A1 * i + offset[0] as f64).fract();
-    let v = (0.5 + A2 * i + offset[1] as f64).fract();
-    [u as f32, v as f32]
+    [
+        fract_nonneg(0.5 + A1 * i + offset[0] as f64) as f32,
+        fract_nonneg(0.5 + A2 * i + offset[1] as f64) as f32,
+    ]
+}
+
+/// `x.fract()` for `0 ≤ x < 2⁶³`, bit for bit (the truncation is exact there),
+/// without the `trunc` library call the x86-64 baseline makes for `fract`.
+#[inline(always)]
+fn fract_nonneg(x: f64) -> f64 {
+    debug_assert!((0.0..9.2e18).contains(&x));
+    x - (x as i64) as f64
 }
 
 /// Point `k` of the 4-D Kronecker low-discrepancy sequence α_j = φ₄^−(j+1)
@@ -109,12 +118,56 @@ pub fn basis(n: Vec3) -> (Vec3, Vec3) {
 /// by Malley's method: a uniform disk point lifted to the hemisphere.
 #[inline]
 pub fn cosine_hemisphere(n: Vec3, u: [f32; 2]) -> Vec3 {
+    cosine_hemisphere_in(n, basis(n), u)
+}
+
+/// [`cosine_hemisphere`] with the basis `(t, b) = basis(n)` computed once by
+/// the caller (the same bits).
+#[inline]
+pub fn cosine_hemisphere_in(n: Vec3, (t, b): (Vec3, Vec3), u: [f32; 2]) -> Vec3 {
     let r = u[0].sqrt();
     let phi = std::f32::consts::TAU * u[1];
     let (x, y) = (r * phi.cos(), r * phi.sin());
     let z = (1.0 - u[0]).max(0.0).sqrt();
-    let (t, b) = basis(n);
     (t * x + b * y + n * z).normalize()
+}
+
+/// Eight consecutive samples `first..first + 8` of [`r2`] (rotated by
+/// `offset`) mapped by [`cosine_hemisphere_in`]: the same bits lane by lane
+/// (the same IEEE operations in the same order; square roots, divisions and
+/// the arithmetic run over the 8 lanes at once, which the scalar form's
+/// serial `sqrt → div` chain per sample cannot). Returns the directions and
+/// the square samples.
+#[inline]
+pub fn cosine_hemisphere_r2_8(
+    n: Vec3,
+    (t, b): (Vec3, Vec3),
+    offset: [f32; 2],
+    first: u32,
+) -> ([Vec3; 8], [[f32; 2]; 8]) {
+    let mut u = [[0.0f32; 2]; 8];
+    let (mut u0, mut cos, mut sin) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
+    for l in 0..8 {
+        u[l] = r2(first.wrapping_add(l as u32), offset);
+        u0[l] = u[l][0];
+        let phi = std::f32::consts::TAU * u[l][1];
+        (cos[l], sin[l]) = (phi.cos(), phi.sin());
+    }
+    let (mut dx, mut dy, mut dz) = ([0.0f32; 8], [0.0f32; 8], [0.0f32; 8]);
+    for l in 0..8 {
+        let r = u0[l].sqrt();
+        let (x, y) = (r * cos[l], r * sin[l]);
+        let z = (1.0 - u0[l]).max(0.0).sqrt();
+        // (t·x + b·y) + n·z, then glam's normalize: v · (1 / √((vx² + vy²) + vz²)).
+        let v = [
+            t.x * x + b.x * y + n.x * z,
+            t.y * x + b.y * y + n.y * z,
+            t.z * x + b.z * y + n.z * z,
+        ];
+        let inv = 1.0 / (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        (dx[l], dy[l], dz[l]) = (v[0] * inv, v[1] * inv, v[2] * inv);
+    }
+    (std::array::from_fn(|l| Vec3::new(dx[l], dy[l], dz[l])), u)
 }
 
 /// A GGX (Trowbridge-Reitz) microfacet normal sampled from the distribution
@@ -158,6 +211,32 @@ mod tests {
         }
         // E[cos θ] under pdf cos θ / π is 2/3.
         assert!((mean_cos / 20_000.0 - 2.0 / 3.0).abs() < 0.01);
+    }
+
+    /// The 8-lane sampler is the scalar `r2` + `cosine_hemisphere` bit for bit
+    /// (and so is `fract_nonneg` inside `r2`, against `f64::fract`).
+    #[test]
+    fn eight_lane_cosine_sampler_equals_the_scalar_one_bitwise() {
+        let mut rng = Rng::new(3);
+        for k in 0..2000u32 {
+            let n = (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5).normalize_or(Vec3::Z);
+            let n = [n, Vec3::Z, -Vec3::Z, Vec3::X][(k % 4) as usize];
+            let offset = pixel_offset(k as u64 * 77);
+            let first = [0, 8 * k, u32::MAX - 20, 1_000_000 + k][(k / 4 % 4) as usize];
+            let (dirs, u) = cosine_hemisphere_r2_8(n, basis(n), offset, first);
+            for l in 0..8 {
+                let i = first.wrapping_add(l as u32);
+                assert_eq!(u[l], r2(i, offset));
+                let want = cosine_hemisphere(n, r2(i, offset));
+                assert_eq!(
+                    dirs[l].to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits),
+                    "n {n} i {i}"
+                );
+                let x = 0.5 + 0.754_877_666_246_692_8 * i as f64 + offset[0] as f64;
+                assert_eq!(fract_nonneg(x).to_bits(), x.fract().to_bits());
+            }
+        }
     }
 
     #[test]

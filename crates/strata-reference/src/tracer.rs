@@ -36,6 +36,16 @@ pub trait Tracer: Send + Sync {
     /// Any hit with `tmin < t < tmax` (shadow / visibility rays).
     fn occluded(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> bool;
 
+    /// Occlusion of up to [`crate::bundle::BUNDLE`] rays sharing `origin`: bit
+    /// `i` is set when `dirs[i]` has a hit with `tmin < t < tmax`. Always the
+    /// same answers as [`Tracer::occluded`] ray by ray; backends may trace the
+    /// rays together ([`crate::bundle`]).
+    fn occluded_bundle(&self, origin: Vec3, dirs: &[Vec3], tmin: f32, tmax: f32) -> u32 {
+        dirs.iter()
+            .enumerate()
+            .fold(0, |m, (i, &d)| m | (self.occluded(origin, d, tmin, tmax) as u32) << i)
+    }
+
     /// All hits with `tmin < t < tmax`, sorted by (t, triangle), into `out`
     /// (cleared first). A ray through an edge shared by two triangles may report both.
     fn intersect_all(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, out: &mut Vec<Hit>);
@@ -87,6 +97,9 @@ impl Tracer for WideBvh {
     }
     fn occluded(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> bool {
         WideBvh::occluded(self, origin, dir, tmin, tmax)
+    }
+    fn occluded_bundle(&self, origin: Vec3, dirs: &[Vec3], tmin: f32, tmax: f32) -> u32 {
+        WideBvh::occluded_bundle(self, origin, dirs, tmin, tmax)
     }
     fn intersect_all(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, out: &mut Vec<Hit>) {
         WideBvh::intersect_all(self, origin, dir, tmin, tmax, out)
@@ -183,6 +196,12 @@ impl AnyTracer {
         dispatch!(self, b => b.occluded(origin, dir, tmin, tmax))
     }
 
+    /// See [`Tracer::occluded_bundle`].
+    #[inline]
+    pub fn occluded_bundle(&self, origin: Vec3, dirs: &[Vec3], tmin: f32, tmax: f32) -> u32 {
+        dispatch!(self, b => Tracer::occluded_bundle(b, origin, dirs, tmin, tmax))
+    }
+
     /// See [`Tracer::intersect_all`].
     #[inline]
     pub fn intersect_all(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, out: &mut Vec<Hit>) {
@@ -223,6 +242,9 @@ impl Tracer for AnyTracer {
     }
     fn occluded(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> bool {
         AnyTracer::occluded(self, origin, dir, tmin, tmax)
+    }
+    fn occluded_bundle(&self, origin: Vec3, dirs: &[Vec3], tmin: f32, tmax: f32) -> u32 {
+        AnyTracer::occluded_bundle(self, origin, dirs, tmin, tmax)
     }
     fn intersect_all(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32, out: &mut Vec<Hit>) {
         AnyTracer::intersect_all(self, origin, dir, tmin, tmax, out)

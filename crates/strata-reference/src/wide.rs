@@ -38,26 +38,26 @@ use strata_scene::WorldTriangle;
 use crate::bvh::{box_range, next_up, scale_of, Bvh, ChildRef, Hit, LeafPolicy, Ray, BOX_SCALE, LEAF};
 
 /// Children per node.
-const WIDTH: usize = 8;
+pub(crate) const WIDTH: usize = 8;
 /// Traversal stack entries: a wide node pushes at most 7 children and the wide
 /// tree is no deeper than the binary tree (checked at build, see `max_depth`).
-const STACK: usize = 1024;
+pub(crate) const STACK: usize = 1024;
 
 /// A wide node: the boxes of its 8 children as `[axis][child]` (structure of
 /// arrays) and their references. Empty slots have an inverted box (lo = +∞,
 /// hi = −∞) that no ray enters.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node8 {
-    lo: [[f32; WIDTH]; 3],
-    hi: [[f32; WIDTH]; 3],
-    child: [ChildRef; WIDTH],
+pub(crate) struct Node8 {
+    pub(crate) lo: [[f32; WIDTH]; 3],
+    pub(crate) hi: [[f32; WIDTH]; 3],
+    pub(crate) child: [ChildRef; WIDTH],
 }
 
 /// The ≤ 4 triangles of one leaf: `p[vertex][axis][lane]`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
-struct Packet {
+pub(crate) struct Packet {
     p: [[[f32; 4]; 3]; 3],
 }
 
@@ -71,15 +71,15 @@ impl Packet {
 
 /// The 8-wide BVH. Built from (and answering exactly like) the binary [`Bvh`].
 pub struct WideBvh {
-    nodes: Vec<Node8>,
+    pub(crate) nodes: Vec<Node8>,
     /// Root reference (a node, or a leaf when the scene has ≤ 4 triangles) and bounds.
-    root: Option<(ChildRef, [f32; 3], [f32; 3])>,
-    packets: Vec<Packet>,
+    pub(crate) root: Option<(ChildRef, [f32; 3], [f32; 3])>,
+    pub(crate) packets: Vec<Packet>,
     /// Triangle index of each packet lane.
     ids: Vec<[u32; 4]>,
     triangles: Vec<WorldTriangle>,
     /// Use the AVX box test (runtime-detected).
-    avx: bool,
+    pub(crate) avx: bool,
 }
 
 impl Node8 {
@@ -593,7 +593,13 @@ unsafe fn box8_avx(node: &Node8, ray: &Ray, tmin: f32, tmax: f32, near_out: &mut
 /// The watertight test of [`Ray::hit_triangle`] on the `count` triangles of a
 /// packet: bit i of the mask is set when lane i hits at `tmin < t < tmax`.
 #[inline(always)]
-fn hit_packet(pk: &Packet, count: usize, ray: &Ray, tmin: f32, tmax: f32) -> (u32, [f32; 4], [f32; 4], [f32; 4]) {
+pub(crate) fn hit_packet(
+    pk: &Packet,
+    count: usize,
+    ray: &Ray,
+    tmin: f32,
+    tmax: f32,
+) -> (u32, [f32; 4], [f32; 4], [f32; 4]) {
     #[cfg(target_arch = "x86_64")]
     {
         // SAFETY: SSE is part of the x86-64 baseline.
