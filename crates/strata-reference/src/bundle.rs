@@ -82,7 +82,10 @@ impl WideBvh {
         let n = dirs.len();
         let valid = (1u32 << n) - 1;
         // Lanes past `n` repeat the last ray (their bits are never reported).
-        let rays: [Ray; BUNDLE] = std::array::from_fn(|i| Ray::new(origin, dirs[i.min(n - 1)]));
+        let mut rays = [Ray::new(origin, dirs[n - 1]); BUNDLE];
+        for (ray, &d) in rays.iter_mut().zip(&dirs[..n - 1]) {
+            *ray = Ray::new(origin, d);
+        }
         let scale = scale_of(&root_min, &root_max);
         let mut lanes = Lanes {
             org: [origin.x, origin.y, origin.z],

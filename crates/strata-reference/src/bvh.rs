@@ -133,6 +133,7 @@ pub(crate) struct Node {
 }
 
 /// Precomputed per-ray data for the slab and watertight tests.
+#[derive(Clone, Copy)]
 pub(crate) struct Ray {
     pub(crate) org: Vec3,
     pub(crate) inv: [f32; 3],
@@ -146,7 +147,7 @@ pub(crate) struct Ray {
 }
 
 impl Ray {
-    #[inline]
+    #[inline(always)]
     pub(crate) fn new(org: Vec3, dir: Vec3) -> Self {
         let a = dir.abs();
         let kz = if a.x >= a.y && a.x >= a.z {
