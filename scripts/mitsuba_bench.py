@@ -26,6 +26,8 @@ Example:
   python3 scripts/mitsuba_bench.py                       # Sponza, 256x256, 64x16 rays, radius 1.5, 3 repeats
   python3 scripts/mitsuba_bench.py --scene dragon --scene dense --radius-from-scene
   python3 scripts/mitsuba_bench.py --json out/bench/mitsuba_ao.json
+  python3 scripts/mitsuba_bench.py --kind primary --spp 256    # camera rays only
+  python3 scripts/mitsuba_bench.py --kind diffuse               # 64x16 cosine bounce rays per pixel, closest hit
 """
 
 import argparse
@@ -68,8 +70,9 @@ def export(scene, workdir):
 
 
 def strata_job(scene, a, radius, tracer):
+    rays = a.spp if a.kind == "primary" else a.spp * a.ao_samples
     out = run(
-        [example("ao_job"), scene, str(a.width), str(a.height), str(a.spp * a.ao_samples), str(radius), tracer, "1"],
+        [example("ao_job"), scene, str(a.width), str(a.height), str(rays), str(radius), tracer, "1", a.kind],
         env={**os.environ, **({"RAYON_NUM_THREADS": str(a.threads)} if a.threads else {})},
     )
     rows = [json.loads(l) for l in out.stdout.splitlines() if l.startswith("{")]
@@ -105,7 +108,42 @@ def make_mitsuba(a):
             av = dr.select(valid, 1.0 - hits / self.n, 1.0)
             return mi.Spectrum(av), valid, []
 
+    class StrataPrimary(mi.SamplingIntegrator):
+        """Camera rays only (closest hit): returns the hit distance."""
+
+        def __init__(self, props):
+            super().__init__(props)
+            props.get("shading_samples", 16)  # shared scene dict: mark as read
+            props.get("distance", 1.0)
+
+        def sample(self, scene, sampler, ray, medium=None, active=True):
+            si = scene.ray_intersect(ray, active)
+            return mi.Spectrum(dr.select(si.is_valid(), si.t, 0.0)), si.is_valid(), []
+
+    class StrataDiffuse(mi.SamplingIntegrator):
+        """Per sample one camera ray and `shading_samples` cosine bounce rays (closest hit, unbounded)."""
+
+        def __init__(self, props):
+            super().__init__(props)
+            self.n = props.get("shading_samples", 16)
+            props.get("distance", 1.0)  # shared scene dict: mark as read
+
+        def sample(self, scene, sampler, ray, medium=None, active=True):
+            si = scene.ray_intersect(ray, active)
+            valid = si.is_valid()
+            n = si.sh_frame.n
+            n = dr.select(dr.dot(n, ray.d) > 0, -n, n)
+            frame = mi.Frame3f(n)
+            acc = mi.Float(0.0)
+            for _ in range(self.n):
+                d = frame.to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d(valid)))
+                s2 = scene.ray_intersect(si.spawn_ray(d), valid)
+                acc += dr.select(s2.is_valid(), 1.0, 0.0)
+            return mi.Spectrum(acc / self.n), valid, []
+
     mi.register_integrator("strata_ao", lambda props: StrataAO(props))
+    mi.register_integrator("strata_primary", lambda props: StrataPrimary(props))
+    mi.register_integrator("strata_diffuse", lambda props: StrataDiffuse(props))
     return mi, dr
 
 
@@ -114,7 +152,7 @@ def mitsuba_scene(mi, ply, cam, a, radius):
     scene = mi.load_dict(
         {
             "type": "scene",
-            "integrator": {"type": "strata_ao", "shading_samples": a.ao_samples, "distance": radius},
+            "integrator": {"type": f"strata_{a.kind}", "shading_samples": a.ao_samples, "distance": radius},
             "sensor": {
                 "type": "perspective",
                 "fov": cam["fov_y_deg"],
@@ -163,6 +201,13 @@ def main():
     p.add_argument("--no-build", action="store_true")
     p.add_argument("--workdir", default=os.path.join(ROOT, "target", "mitsuba_bench"))
     p.add_argument("--json", help="write all timings here")
+    p.add_argument(
+        "--kind",
+        choices=["ao", "primary", "diffuse"],
+        default="ao",
+        help="ao: the AO job; primary: SPP camera rays per pixel; diffuse: SPP x AO_SAMPLES cosine bounce rays "
+        "(closest hit, unbounded) per pixel",
+    )
     a = p.parse_args()
     if a.width <= 0 or a.height <= 0 or a.spp <= 0 or a.ao_samples <= 0 or a.repeats <= 0 or not a.radius > 0:
         p.error("width, height, spp, ao-samples, repeats and radius must be positive")
@@ -179,9 +224,10 @@ def main():
         radius = cam["ao_radius"] if a.radius_from_scene else a.radius
         ms, load_s = mitsuba_scene(mi, ply, cam, a, radius)
         print(
-            f"\n{cam['scene']}: {cam['triangles']} triangles, {a.width}x{a.height}, "
-            f"{a.spp}x{a.ao_samples} = {a.spp * a.ao_samples} AO rays/pixel, radius {radius}; "
-            f"Mitsuba load + BVH {load_s:.2f} s"
+            f"\n{cam['scene']}: {cam['triangles']} triangles, {a.width}x{a.height}, {a.kind} job: "
+            + (f"{a.spp} camera rays/pixel; " if a.kind == "primary" else
+               f"{a.spp}x{a.ao_samples} = {a.spp * a.ao_samples} {a.kind} rays/pixel, radius {radius}; ")
+            + f"Mitsuba load + BVH {load_s:.2f} s"
         )
         rows = []
         first = None
@@ -209,9 +255,10 @@ def main():
                   + ", ".join(f"{row[f'strata_{t}_cpu_s']:.2f} {t}" for t in tracers) + ")")
         med = {k: statistics.median(r[k] for r in rows) for k in rows[0] if k not in ("repeat", "mitsuba_first_s")}
         mitsuba_ref = first if a.ratio_first else med["mitsuba_s"]
-        # Rays: strata 1 primary + spp*ao per pixel; Mitsuba spp primary + spp*ao per pixel.
+        # Rays: strata 1 primary + spp*ao per pixel; Mitsuba spp primary + spp*ao per pixel
+        # (primary job: spp camera rays per pixel on both sides).
         px = a.width * a.height
-        mitsuba_rays = px * a.spp * (1 + a.ao_samples)
+        mitsuba_rays = px * a.spp * (1 if a.kind == "primary" else 1 + a.ao_samples)
         print(
             f"  medians: mitsuba {med['mitsuba_s']:.2f} s warm, {first:.2f} s first "
             f"({mitsuba_rays / med['mitsuba_s'] / 1e6:.1f} M rays/s warm); mean AV {med['mitsuba_mean']:.4f}"
@@ -233,6 +280,7 @@ def main():
                 "spp": a.spp,
                 "ao_samples": a.ao_samples,
                 "radius": radius,
+                "kind": a.kind,
                 "mitsuba_load_s": load_s,
                 "mitsuba_first_s": first,
                 "repeats": rows,

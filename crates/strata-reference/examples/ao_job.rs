@@ -1,13 +1,20 @@
-//! Times one binary-AO job of the CPU reference (the job `scripts/mitsuba_bench.py`
+//! Times one job of the CPU reference (the jobs `scripts/mitsuba_bench.py`
 //! compares with Mitsuba 3).
 //!
-//! `cargo run --release -p strata-reference --example ao_job -- SCENE WIDTH HEIGHT SPP RADIUS [all|wide|binary] [REPEATS]`
+//! `cargo run --release -p strata-reference --example ao_job -- SCENE WIDTH HEIGHT SPP RADIUS [all|wide|binary] [REPEATS] [ao|primary|diffuse]`
+//!
+//! - `ao` (default): `Reference::ao_binary`, one primary ray per pixel + SPP AO rays;
+//! - `primary`: SPP camera rays per pixel (pixel centres, closest hit);
+//! - `diffuse`: SPP cosine bounce rays (closest hit, unbounded) per hit pixel, from
+//!   primary hits found untimed (`Reference::measure_rays`, 16 rays per pass).
 //!
 //! Prints one JSON object per repeat: build and render seconds, rays, M rays/s.
 
 use std::time::Instant;
 
-use strata_reference::{AoBinarySettings, Reference, TracerKind};
+use std::time::Duration;
+
+use strata_reference::{AoBinarySettings, RayKind, Reference, TracerKind};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -37,6 +44,15 @@ fn main() {
         },
     };
     let repeats = (arg(6, 1.0) as usize).max(1);
+    let job = match args.get(7).map(String::as_str) {
+        None | Some("ao") => None,
+        Some("primary") => Some(RayKind::Primary),
+        Some("diffuse") => Some(RayKind::Diffuse),
+        Some(k) => {
+            eprintln!("kind {k:?}: expected ao, primary or diffuse");
+            std::process::exit(2);
+        }
+    };
     let settings = AoBinarySettings {
         spp,
         ..AoBinarySettings::new(radius)
@@ -49,19 +65,30 @@ fn main() {
             let cam = r.camera();
             let start = Instant::now();
             let cpu0 = cpu_seconds();
-            let img = r.ao_binary(&cam, width, height, &settings);
+            let (rays, mean) = match job {
+                None => {
+                    let img = r.ao_binary(&cam, width, height, &settings);
+                    let mean = img.data.iter().map(|&v| v as f64).sum::<f64>() / img.data.len().max(1) as f64;
+                    (r.stats().rays, mean)
+                }
+                Some(k) => {
+                    // Passes of one primary ray (or 16 secondary rays) per pixel until SPP per pixel.
+                    let per_pass = if k == RayKind::Primary { 1 } else { 16 };
+                    let max_rays = width as u64 * height as u64 * spp as u64 / per_pass * per_pass;
+                    let t = r.measure_rays(&cam, width, height, k, radius, max_rays, Duration::from_secs(3600));
+                    (t.rays, 0.0)
+                }
+            };
             let secs = start.elapsed().as_secs_f64();
             let cpu = cpu_seconds() - cpu0;
-            let mean = img.data.iter().map(|&v| v as f64).sum::<f64>() / img.data.len().max(1) as f64;
-            let s = r.stats();
             println!(
                 "{{\"scene\": \"{}\", \"tracer\": \"{}\", \"triangles\": {}, \"width\": {width}, \"height\": {height}, \"spp\": {spp}, \"radius\": {radius}, \"threads\": {}, \"build_s\": {build:.4}, \"seconds\": {secs:.4}, \"cpu_s\": {cpu:.4}, \"rays\": {}, \"mrays_per_s\": {:.3}, \"mean_av\": {mean:.6}}}",
                 scene.name.replace('"', "'"),
                 kind.name(),
                 r.bvh().triangles().len(),
                 rayon::current_num_threads(),
-                s.rays,
-                s.rays as f64 / secs / 1e6
+                rays,
+                rays as f64 / secs / 1e6
             );
         }
     }

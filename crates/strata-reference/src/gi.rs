@@ -213,10 +213,23 @@ impl Reference<'_> {
             let mut r = Rng::new(hash(&[settings.seed, pixel, 0x0b0c]));
             [0; 4].map(|_: u8| r.next_f32() as f64)
         };
+        // Every sample of the pixel starts with the same camera ray (pixel
+        // centre) and so the same first vertex: its hit and its (noise-free)
+        // direct light from the scene's sun/point/spot lights are found once.
+        let mut memo = FirstVertex::default();
         for s in samples {
             let mut rng = Rng::new(hash(&[settings.seed, pixel, s as u64]));
             let first = Some(crate::sampling::kronecker4(s, &offset));
-            let (d, i) = self.trace_path(camera.eye, camera.near, dir, settings, first, &mut rng, rays);
+            let (d, i) = self.trace_path(
+                camera.eye,
+                camera.near,
+                dir,
+                settings,
+                first,
+                Some(&mut memo),
+                &mut rng,
+                rays,
+            );
             direct += d;
             indirect += i;
         }
@@ -227,12 +240,15 @@ impl Reference<'_> {
     /// emission and direct light of the first surface along `dir`, plus what it
     /// reflects of further bounces, or the sky. Used to bake light probes.
     pub fn radiance(&self, origin: Vec3, dir: Vec3, settings: &GiSettings, rng: &mut Rng, rays: &mut u64) -> Vec3 {
-        let (d, i) = self.trace_path(origin, 0.0, dir, settings, None, rng, rays);
+        let (d, i) = self.trace_path(origin, 0.0, dir, settings, None, None, rng, rays);
         d + i
     }
 
     /// One path from `origin` (hits beyond `t_min`) along `dir`: (direct, indirect).
     /// `first_bounces`: uniform samples of the first two bounce directions (random when `None`).
+    /// `memo`: the first vertex's deterministic parts, shared by paths that all
+    /// start with this same ray (filled by the first of them); the results are
+    /// the same bits with or without it.
     #[allow(clippy::too_many_arguments)]
     fn trace_path(
         &self,
@@ -241,13 +257,24 @@ impl Reference<'_> {
         dir: Vec3,
         settings: &GiSettings,
         first_bounces: Option<[f32; 4]>,
+        mut memo: Option<&mut FirstVertex>,
         rng: &mut Rng,
         rays: &mut u64,
     ) -> (Vec3, Vec3) {
         let sky = Vec3::from(self.scene.settings.sky);
         let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
-        *rays += 1;
-        let Some(h) = self.bvh.intersect(origin, dir, t_min, f32::INFINITY) else {
+        let first_hit = match memo.as_deref_mut() {
+            Some(FirstVertex { hit: Some(h), .. }) => *h,
+            _ => {
+                *rays += 1;
+                let h = self.bvh.intersect(origin, dir, t_min, f32::INFINITY);
+                if let Some(m) = memo.as_deref_mut() {
+                    m.hit = Some(h);
+                }
+                h
+            }
+        };
+        let Some(h) = first_hit else {
             return (sky, indirect);
         };
         let mut hit = self.bvh.surface(&h, dir);
@@ -269,12 +296,15 @@ impl Reference<'_> {
             };
             let m = self.material(hit.material);
             let ggx = m.glossy.then(|| Ggx::new(n, -wo, albedo, m.roughness, m.metallic));
+            let lights = match (depth, memo.as_deref_mut()) {
+                (0, Some(FirstVertex { lights: Some(e), .. })) => *e,
+                (0, Some(mv)) => *mv.lights.insert(self.lights_irradiance(&sp, ggx.as_ref(), rays)),
+                _ => self.lights_irradiance(&sp, ggx.as_ref(), rays),
+            };
+            let e = self.add_emissive(lights, &sp, ggx.as_ref(), rng, rays);
             match &ggx {
-                None => {
-                    *sink +=
-                        throughput * albedo * self.direct_irradiance(&sp, None, rng, rays) * std::f32::consts::FRAC_1_PI
-                }
-                Some(g) => *sink += throughput * self.direct_irradiance(&sp, Some(g), rng, rays),
+                None => *sink += throughput * albedo * e * std::f32::consts::FRAC_1_PI,
+                Some(_) => *sink += throughput * e,
             }
             // MIS: a glossy vertex also collects emitters its bounce ray hits.
             let mis = ggx.is_some() && !self.lights.is_empty();
@@ -346,6 +376,13 @@ impl Reference<'_> {
     /// With a GGX BRDF `brdf`, each term is also multiplied by f(v, l) (the
     /// sum is then outgoing radiance) and the emissive sample by its MIS weight.
     fn direct_irradiance(&self, sp: &ShadingPoint, brdf: Option<&Ggx>, rng: &mut Rng, rays: &mut u64) -> Vec3 {
+        let e = self.lights_irradiance(sp, brdf, rays);
+        self.add_emissive(e, sp, brdf, rng, rays)
+    }
+
+    /// [`Self::direct_irradiance`]'s sum over the scene's sun, point and spot
+    /// lights (no random numbers: the same for every path through `sp`).
+    fn lights_irradiance(&self, sp: &ShadingPoint, brdf: Option<&Ggx>, rays: &mut u64) -> Vec3 {
         let weigh = |l: Vec3, e: Vec3| match brdf {
             None => e,
             Some(g) => g.eval(l) * e,
@@ -393,6 +430,11 @@ impl Reference<'_> {
                 Light::Rect { .. } => {}
             }
         }
+        e
+    }
+
+    /// `e` plus one next-event sample of the emissive triangles (when there are any).
+    fn add_emissive(&self, mut e: Vec3, sp: &ShadingPoint, brdf: Option<&Ggx>, rng: &mut Rng, rays: &mut u64) -> Vec3 {
         if !self.lights.is_empty() {
             e += self.sample_emissive(sp, brdf, rng, rays);
         }
@@ -647,4 +689,13 @@ mod one_bounce_tests {
         assert!((a - b).abs() < 0.05 * b, "area-sampled {a} vs path-traced {b}");
         assert!(c > a * 1.02, "assuming visibility should add light: {c} vs {a}");
     }
+}
+
+/// The deterministic parts of a pixel's first path vertex (see
+/// [`Reference::gi_pixel_sum`]): the camera ray's hit and the first vertex's
+/// direct light from the sun, point and spot lights.
+#[derive(Default)]
+pub(crate) struct FirstVertex {
+    hit: Option<Option<crate::bvh::Hit>>,
+    lights: Option<Vec3>,
 }
