@@ -5,9 +5,10 @@
 // `ao_common.wgsl` with the four axis directions +x, +y, −x, −y (the existing
 // HBAO with D = 4 and φ = 0; S steps each, the paper's "8 samples along x and
 // y"), taking at each step the strongest horizon over every staged layer
-// (Algorithm 1). Taps beyond the apron (r_p larger than it) read the node
-// texture in global memory: the result does not depend on the tile, only the
-// speed does. Receivers are the pixel's compressed nodes (Eq. 3–4 blend, so
+// (Algorithm 1). The apron is what the tile's taps reach (its nearest
+// receivers' farthest step), capped by what fits in workgroup memory
+// (`ao.apron`); taps beyond the cap read the node texture in global memory:
+// the result does not depend on the tile, only the speed does. Receivers are the pixel's compressed nodes (Eq. 3–4 blend, so
 // transparent nodes work too; ABA uses it for opaque scenes). The CPU twin is
 // `passes::abuffer::ao::ambient_visibility_cpu` with kernel 2.
 #import "abuffer/ao_common.wgsl"
@@ -21,6 +22,10 @@ const SHARED_WORDS: u32 = 4096u;
 // The staged tile: (TILE + 2·apron)² pixels × `words` node words, row-major;
 // a word is a compressed node (z16 << 16 | α16), 0 = empty.
 var<workgroup> staged: array<u32, SHARED_WORDS>;
+// The farthest step (pixels along an axis) of the tile's receivers, and the
+// apron staged: min(that, `ao.apron`, what fits).
+var<workgroup> tile_reach: atomic<u32>;
+var<workgroup> tile_apron: u32;
 // Top-left pixel of the staged region and its side, set per invocation.
 var<private> stage_origin: vec2i;
 var<private> stage_side: i32;
@@ -89,10 +94,30 @@ fn cs_main(
     @builtin(local_invocation_index) li: u32,
     @builtin(local_invocation_id) lid: vec3u,
 ) {
-    let apron = i32(ao.apron);
+    let size = vec2i(i32(params.width), i32(params.height));
+    let p = vec2i(wg.xy * TILE + lid.xy);
+    // the apron this tile needs: the farthest step r_p (S − ½)/S of its
+    // nearest receivers (deeper nodes have smaller r_p), capped by what fits
+    if (li == 0u) {
+        atomicStore(&tile_reach, 0u);
+    }
+    workgroupBarrier();
+    if (all(p < size)) {
+        let w0 = nearest_node(p);
+        if ((w0 & 0xffffu) != 0u) {
+            let z = (f32(w0 >> 16u) + 0.5) / params.depth_scale;
+            let r_p = ao.proj_scale * ao.radius / z;
+            let h = r_p * (f32(ao.steps) - 0.5) / f32(ao.steps);
+            atomicMax(&tile_reach, u32(min(floor(h + 0.5), 65535.0)));
+        }
+    }
+    workgroupBarrier();
+    if (li == 0u) {
+        tile_apron = min(atomicLoad(&tile_reach), ao.apron);
+    }
+    let apron = i32(workgroupUniformLoad(&tile_apron));
     stage_side = i32(TILE) + 2 * apron;
     stage_origin = vec2i(wg.xy * TILE) - vec2i(apron);
-    let size = vec2i(i32(params.width), i32(params.height));
     let words = staged_words();
     // stage the tile + apron (the host keeps side² · words ≤ SHARED_WORDS)
     let count = u32(stage_side * stage_side);
@@ -116,7 +141,6 @@ fn cs_main(
         }
     }
     workgroupBarrier();
-    let p = vec2i(wg.xy * TILE + lid.xy);
     if (any(p >= size)) {
         return;
     }
