@@ -436,7 +436,7 @@ fn hbao_compute(multilayer: bool, compress: u32) -> ABufferSettings {
 /// Pixel (x, y) lies on the border of its 8×8 workgroup tile.
 fn tile_border(x: u32, y: u32) -> bool {
     let t = strata_render::passes::abuffer::ao::TILE;
-    x % t == 0 || x % t == t - 1 || y % t == 0 || y % t == t - 1
+    x.is_multiple_of(t) || x % t == t - 1 || y.is_multiple_of(t) || y % t == t - 1
 }
 
 /// Renders `a` and compares `ao-raw` with the CPU twin over the read-back
