@@ -53,18 +53,19 @@ pub enum AoKernel {
 
 /// Compute HBAO: pixels per side of a workgroup's tile.
 pub const TILE: u32 = 8;
-/// Compute HBAO: u32 words of workgroup memory for the staged nodes (16 KiB,
-/// WebGPU's guaranteed `maxComputeWorkgroupStorageSize`).
-pub const SHARED_WORDS: u32 = 4096;
+/// Compute HBAO: RGBA32Uint texels (4 node words each) of workgroup memory
+/// for the staged nodes (16 KiB, WebGPU's guaranteed
+/// `maxComputeWorkgroupStorageSize`).
+pub const SHARED_TEXELS: u32 = 1024;
 
-/// Compute HBAO: the apron (pixels on each side of the tile) whose nodes fit
-/// in workgroup memory with `words` node words per pixel: the largest side s
-/// with s² · words ≤ [`SHARED_WORDS`], apron = ⌊(s − [`TILE`]) / 2⌋. M = 6
-/// (Algorithm 1) gives 9 px, one word (single layer) 28 px. Taps farther out
-/// read global memory.
-pub fn apron(words: u32) -> u32 {
+/// Compute HBAO: the largest apron (pixels on each side of the tile) whose
+/// nodes fit in workgroup memory with `texels` texels per pixel (⌈M/4⌉ with
+/// Algorithm 1, 1 for the single layer): the largest side s with s² · texels
+/// ≤ [`SHARED_TEXELS`], apron = ⌊(s − [`TILE`]) / 2⌋. M = 5..8 gives 7 px,
+/// M ≤ 4 and the single layer 12 px. Taps farther out read global memory.
+pub fn apron(texels: u32) -> u32 {
     let mut s = TILE;
-    while (s + 1) * (s + 1) * words.max(1) <= SHARED_WORDS {
+    while (s + 1) * (s + 1) * texels.max(1) <= SHARED_TEXELS {
         s += 1;
     }
     (s - TILE) / 2
@@ -225,7 +226,7 @@ impl AbaAoUniforms {
             directions: if compute { 4 } else { s.directions },
             steps: s.steps,
             apron: if compute {
-                apron(if s.multilayer { nodes } else { 1 })
+                apron(if s.multilayer { nodes.div_ceil(4) } else { 1 })
             } else {
                 0
             },

@@ -16,12 +16,13 @@
 @group(2) @binding(2) var av_out: texture_storage_2d<r32float, write>;
 
 const TILE: u32 = 8u;
-// 16 KiB, WebGPU's guaranteed maxComputeWorkgroupStorageSize.
-const SHARED_WORDS: u32 = 4096u;
+// 16 KiB of RGBA32Uint texels, WebGPU's guaranteed maxComputeWorkgroupStorageSize.
+const SHARED_TEXELS: u32 = 1024u;
 
-// The staged tile: (TILE + 2·apron)² pixels × `words` node words, row-major;
-// a word is a compressed node (z16 << 16 | α16), 0 = empty.
-var<workgroup> staged: array<u32, SHARED_WORDS>;
+// The staged tile: (TILE + 2·apron)² pixels × `staged_texels()` texels,
+// row-major, each texel four compressed node words (z16 << 16 | α16, 0 =
+// empty) as in the node texture, so a tap reads 4 nodes per load.
+var<workgroup> staged: array<vec4u, SHARED_TEXELS>;
 // The farthest step (pixels along an axis) of the tile's receivers, and the
 // apron staged: min(that, `ao.apron`, what fits).
 var<workgroup> tile_reach: atomic<u32>;
@@ -30,28 +31,39 @@ var<workgroup> tile_apron: u32;
 var<private> stage_origin: vec2i;
 var<private> stage_side: i32;
 
-// Node words staged per pixel: all M with Algorithm 1, the nearest otherwise.
-fn staged_words() -> u32 {
+// Node words per pixel that occlude: all M with Algorithm 1, the nearest otherwise.
+fn occluder_words() -> u32 {
     if (ao.multilayer == 1u) {
         return params.compress;
     }
     return 1u;
 }
 
-// Node j of pixel q from the node texture (global memory).
-fn global_node(q: vec2i, j: u32) -> u32 {
-    return textureLoad(nodes_m, q, i32(j / 4u), 0)[j % 4u];
+// Texels staged per pixel: ⌈M/4⌉, or one holding the nearest node.
+fn staged_texels() -> u32 {
+    return (occluder_words() + 3u) / 4u;
 }
 
 // The nearest node with α > 0 of pixel q (single layer), 0 if none.
 fn nearest_node(q: vec2i) -> u32 {
-    for (var j = 0u; j < params.compress; j++) {
-        let w = global_node(q, j);
-        if ((w & 0xffffu) != 0u) {
-            return w;
+    for (var l = 0u; l < (params.compress + 3u) / 4u; l++) {
+        let v = textureLoad(nodes_m, q, i32(l), 0);
+        for (var e = 0u; e < 4u; e++) {
+            if (4u * l + e < params.compress && (v[e] & 0xffffu) != 0u) {
+                return v[e];
+            }
         }
     }
     return 0u;
+}
+
+// Texel l of pixel q as the taps see it: the node texture's, or (single
+// layer) the nearest node alone.
+fn tap_texel_nodes(q: vec2i, l: u32) -> vec4u {
+    if (ao.multilayer == 1u) {
+        return textureLoad(nodes_m, q, i32(l), 0);
+    }
+    return vec4u(nearest_node(q), 0u, 0u, 0u);
 }
 
 // Algorithm 1's inner loop at tap pixel q: max over its (staged) node words
@@ -59,30 +71,22 @@ fn nearest_node(q: vec2i) -> u32 {
 fn tap_occlusion(q: vec2i, x: vec3f, n: vec3f) -> f32 {
     let centre = vec2f(q) + 0.5;
     let t = q - stage_origin;
-    let words = staged_words();
+    let texels = staged_texels();
+    let words = occluder_words();
+    let inside = all(t >= vec2i(0)) && all(t < vec2i(stage_side));
     var a = 0.0;
-    if (all(t >= vec2i(0)) && all(t < vec2i(stage_side))) {
-        let base = u32(t.y * stage_side + t.x) * words;
-        for (var j = 0u; j < words; j++) {
-            let w = staged[base + j];
-            if ((w & 0xffffu) != 0u) {
-                a = max(a, node_occlusion(w, centre, x, n));
+    for (var l = 0u; l < texels; l++) {
+        var v: vec4u;
+        if (inside) {
+            v = staged[u32(t.y * stage_side + t.x) * texels + l];
+        } else {
+            // the apron is exceeded (r_p > apron): global reads
+            v = tap_texel_nodes(q, l);
+        }
+        for (var e = 0u; e < 4u; e++) {
+            if (4u * l + e < words && (v[e] & 0xffffu) != 0u) {
+                a = max(a, node_occlusion(v[e], centre, x, n));
             }
-        }
-        return a;
-    }
-    // the apron is exceeded (r_p > apron): global reads
-    if (ao.multilayer == 0u) {
-        let w = nearest_node(q);
-        if ((w & 0xffffu) != 0u) {
-            a = node_occlusion(w, centre, x, n);
-        }
-        return max(a, 0.0);
-    }
-    for (var j = 0u; j < params.compress; j++) {
-        let w = global_node(q, j);
-        if ((w & 0xffffu) != 0u) {
-            a = max(a, node_occlusion(w, centre, x, n));
         }
     }
     return a;
@@ -118,26 +122,18 @@ fn cs_main(
     let apron = i32(workgroupUniformLoad(&tile_apron));
     stage_side = i32(TILE) + 2 * apron;
     stage_origin = vec2i(wg.xy * TILE) - vec2i(apron);
-    let words = staged_words();
-    // stage the tile + apron (the host keeps side² · words ≤ SHARED_WORDS)
+    let texels = staged_texels();
+    // stage the tile + apron (the host keeps side² · texels ≤ SHARED_TEXELS)
     let count = u32(stage_side * stage_side);
     for (var i = li; i < count; i += TILE * TILE) {
         let q = stage_origin + vec2i(i32(i % u32(stage_side)), i32(i / u32(stage_side)));
         let inside = all(q >= vec2i(0)) && all(q < size);
-        if (ao.multilayer == 1u) {
-            for (var j = 0u; j < words; j++) {
-                var w = 0u;
-                if (inside) {
-                    w = global_node(q, j);
-                }
-                staged[i * words + j] = w;
-            }
-        } else {
-            var w = 0u;
+        for (var l = 0u; l < texels; l++) {
+            var v = vec4u(0u);
             if (inside) {
-                w = nearest_node(q);
+                v = tap_texel_nodes(q, l);
             }
-            staged[i] = w;
+            staged[i * texels + l] = v;
         }
     }
     workgroupBarrier();
