@@ -602,7 +602,7 @@ static ABA_AO_SETTINGS: [SettingInfo; 11] = [
     },
     setting!(
         "directions",
-        "HBAO screen directions D per hemisphere (rotated per pixel)",
+        "HBAO screen directions D per hemisphere (rotated per pixel; hbao-compute always uses the 4 axis directions, unrotated)",
         Range::Closed(1.0, crate::passes::abuffer::ao::MAX_DIRECTIONS as f64),
         true,
         |s| Some(aba_ao_of(s).directions as f64),
@@ -610,7 +610,7 @@ static ABA_AO_SETTINGS: [SettingInfo; 11] = [
     ),
     setting!(
         "steps",
-        "HBAO steps S along each direction (ABA Table III: 8)",
+        "HBAO steps S along each direction (ABA Table III: 8; also hbao-compute's samples along +-x and +-y)",
         Range::Closed(1.0, crate::passes::abuffer::ao::MAX_STEPS as f64),
         true,
         |s| Some(aba_ao_of(s).steps as f64),
