@@ -663,7 +663,9 @@ pub struct BenchAbufferArgs {
     #[command(flatten)]
     pub stage: BenchStageArgs,
     /// Settings of technique `aba-ao` (e.g. --set pool=8000000 --set max-layers=16 --set compress=6
-    /// --set kernel=hbao); `abuffer` and `compress` are the bench's own per column.
+    /// --set kernel=hbao); `abuffer` and `compress` are the bench's own per column. With
+    /// --set kernel=hbao-compute: ABA Table III (list columns walk lists with the compute
+    /// kernel's axis taps; adds `compressed-fragment` and `single-layer`).
     #[command(flatten)]
     pub set: SetArgs,
 }

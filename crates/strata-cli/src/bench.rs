@@ -71,7 +71,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         BenchResult::Abuffer(b) => {
             let ms = |v: Option<f64>| v.map_or("–".to_string(), |x| format!("{x:.3}"));
             println!(
-                "{:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>8}",
+                "{:<19} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10} {:>10} {:>8}",
                 "ABA Table I",
                 "clear",
                 "count",
@@ -85,10 +85,10 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 "fragments",
                 "dropped"
             );
-            for key in abuffer::KEYS {
-                let Some(m) = b.methods.get(key) else { continue };
+            for key in abuffer::KEYS.iter().chain(&abuffer::TABLE3_KEYS) {
+                let Some(m) = b.methods.get(*key) else { continue };
                 println!(
-                    "{key:<12} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9.3} {:>10.1} {:>10} {:>8}",
+                    "{key:<19} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9.3} {:>10.1} {:>10} {:>8}",
                     ms(m.clear_ms),
                     ms(m.count_ms),
                     ms(m.prefix_sum_ms),

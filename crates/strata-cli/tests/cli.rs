@@ -1618,6 +1618,67 @@ fn bench_abuffer_reports_table_one_per_method() {
     }
 }
 
+/// Issue 12 item 6: `--set kernel=hbao-compute` turns `bench abuffer` into ABA Table
+/// III: the list columns run the fragment HBAO with the compute kernel's axis taps, the
+/// compressed column the compute HBAO (§V-B), plus `compressed-fragment` and
+/// `single-layer` rows; the compute kernel without compression is a one-line error.
+#[test]
+fn bench_abuffer_table_three_with_the_compute_hbao() {
+    let v = json_of(&strata(&[
+        "bench",
+        "abuffer",
+        "--scene",
+        "atrium",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--frames",
+        "1",
+        "--set",
+        "kernel=hbao-compute",
+        "--json",
+    ]));
+    let m = &v["methods"];
+    for (key, kernel, multilayer) in [
+        ("linked-list", "Hbao", true),
+        ("dual-peel", "Hbao", true),
+        ("compressed", "HbaoCompute", true),
+        ("compressed-fragment", "Hbao", true),
+        ("single-layer", "HbaoCompute", false),
+    ] {
+        let x = &m[key];
+        assert!(x["ao_ms"].as_f64().unwrap() > 0.0, "{key}: {x}");
+        let st = &x["stage"];
+        assert_eq!(st["kernel"].as_str(), Some(kernel), "{key}: {st}");
+        assert_eq!(st["multilayer"].as_bool(), Some(multilayer), "{key}: {st}");
+    }
+    // the same axis taps over lists and over M = 6 nodes of an opaque scene
+    let flip = v["ao_flip_compressed_vs_brute"].as_f64().unwrap();
+    assert!(flip < 0.02, "FLIP {flip}");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "atrium",
+        "--technique",
+        "aba-ao",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--set",
+        "kernel=hbao-compute",
+        "--set",
+        "compress=0",
+        "--out",
+        scratch("hbao-compute-nocompress.png").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("hbao-compute") && e.contains("compress"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "one line: {e}");
+}
+
 #[test]
 fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
     // ILS §6.3: fresh VPL sets per frame (2 bounces, VPL shadow maps); the running

@@ -748,10 +748,10 @@ impl Renderer {
         if let Some(a) = &self.abuffer {
             a.set_frame(gpu, crate::passes::abuffer::far_depth(scene, &cams.current, frame));
             if let Some(s) = &a.settings().ao {
-                let compressed = a.settings().compress.is_some();
+                let m = a.settings().compress;
                 a.set_ao_frame(
                     gpu,
-                    crate::passes::abuffer::ao::AbaAoUniforms::new(s, scene, &u, compressed),
+                    crate::passes::abuffer::ao::AbaAoUniforms::with_nodes(s, scene, &u, m.is_some(), m.unwrap_or(0)),
                 );
             }
         }

@@ -1,4 +1,4 @@
-//! WGSL composition: `#import "common/NAME.wgsl"` (and `"abuffer/lists.wgsl"`) lines are replaced by the shared
+//! WGSL composition: `#import "common/NAME.wgsl"` (and `"abuffer/lists.wgsl"`, `"abuffer/ao_common.wgsl"`) lines are replaced by the shared
 //! module's text (each module once per shader), so shared code lives once.
 
 /// Shared WGSL modules, by import path.
@@ -16,6 +16,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
     ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),
     ("abuffer/lists.wgsl", include_str!("passes/abuffer/lists.wgsl")),
+    ("abuffer/ao_common.wgsl", include_str!("passes/abuffer/ao_common.wgsl")),
     ("ao/uniforms.wgsl", include_str!("passes/ao/uniforms.wgsl")),
 ];
 

@@ -577,18 +577,19 @@ static ABA_AO_SETTINGS: [SettingInfo; 11] = [
     },
     SettingInfo {
         name: "kernel",
-        doc: "getAO kernel extended by Algorithm 1: ssao (Poisson-disk: DGB Eq. 1 over `samples` spiral taps) or hbao (horizon-based: `directions` x `steps`)",
-        range: Range::Closed(0.0, 1.0),
+        doc: "getAO kernel extended by Algorithm 1: ssao (Poisson-disk: DGB Eq. 1 over `samples` spiral taps), hbao (horizon-based: `directions` x `steps`, fragment shader) or hbao-compute (ABA §V-B: `steps` along +-x and +-y, 8x8 tiles of compressed nodes staged in workgroup memory; needs compress >= 1)",
+        range: Range::Closed(0.0, 2.0),
         integer: true,
         get: |s| Some(aba_ao_of(s).kernel as u32 as f64),
         set: |s, v| {
-            aba_ao_mut(s).kernel = if v == 0.0 {
-                crate::passes::abuffer::ao::AoKernel::Ssao
-            } else {
-                crate::passes::abuffer::ao::AoKernel::Hbao
+            use crate::passes::abuffer::ao::AoKernel;
+            aba_ao_mut(s).kernel = match v as u32 {
+                0 => AoKernel::Ssao,
+                1 => AoKernel::Hbao,
+                _ => AoKernel::HbaoCompute,
             }
         },
-        values: &["ssao", "hbao"],
+        values: &["ssao", "hbao", "hbao-compute"],
     },
     SettingInfo {
         name: "integration",
@@ -601,7 +602,7 @@ static ABA_AO_SETTINGS: [SettingInfo; 11] = [
     },
     setting!(
         "directions",
-        "HBAO screen directions D per hemisphere (rotated per pixel)",
+        "HBAO screen directions D per hemisphere (rotated per pixel; hbao-compute always uses the 4 axis directions, unrotated)",
         Range::Closed(1.0, crate::passes::abuffer::ao::MAX_DIRECTIONS as f64),
         true,
         |s| Some(aba_ao_of(s).directions as f64),
@@ -609,7 +610,7 @@ static ABA_AO_SETTINGS: [SettingInfo; 11] = [
     ),
     setting!(
         "steps",
-        "HBAO steps S along each direction (ABA Table III: 8)",
+        "HBAO steps S along each direction (ABA Table III: 8; also hbao-compute's samples along +-x and +-y)",
         Range::Closed(1.0, crate::passes::abuffer::ao::MAX_STEPS as f64),
         true,
         |s| Some(aba_ao_of(s).steps as f64),

@@ -45,10 +45,14 @@ fn hbao(a: ABufferSettings) -> ABufferSettings {
 }
 
 fn render(gpu: &GpuContext, scene: &Scene, a: ABufferSettings) -> Renderer {
+    render_sized(gpu, scene, a, W, H)
+}
+
+fn render_sized(gpu: &GpuContext, scene: &Scene, a: ABufferSettings, width: u32, height: u32) -> Renderer {
     let t = strata_render::technique::find("aba-ao").unwrap();
     let base = RenderSettings {
-        width: W,
-        height: H,
+        width,
+        height,
         guard_band: GuardBand::Pixels(0),
         ..Default::default()
     };
@@ -284,6 +288,7 @@ fn an_alpha_weighted_occluder_darkens_by_alpha_times_the_opaque_occlusion() {
         (AoKernel::Ssao, Some(6)),
         (AoKernel::Hbao, None),
         (AoKernel::Hbao, Some(6)),
+        (AoKernel::HbaoCompute, Some(6)),
     ] {
         let settings = || {
             let mut a = aba(true, compress);
@@ -297,7 +302,7 @@ fn an_alpha_weighted_occluder_darkens_by_alpha_times_the_opaque_occlusion() {
         // Eq. 1's S = (1 − AV)²·N/π, HBAO's 1 − AV
         let sum = |av: f32| match kernel {
             AoKernel::Ssao => (1.0 - av).powi(2),
-            AoKernel::Hbao => 1.0 - av,
+            AoKernel::Hbao | AoKernel::HbaoCompute => 1.0 - av,
         };
         let mut checked = 0;
         // receivers on the plane left of the occluder (they see no pane)
@@ -422,4 +427,211 @@ fn ao_inside_the_blend_and_separate_equal_their_cpu_twins_and_stay_close() {
     let rc = render(&gpu, &scene, c);
     assert_eq!(rc.abuffer().unwrap().ao_uniforms().unwrap().compressed, 0);
     assert_eq!(rc.read_target(&gpu, "hdr-aba-inside").unwrap().data, inside.data);
+}
+
+// --- compute-shader multilayer HBAO (ABA §V-B)
+
+fn hbao_compute(multilayer: bool, compress: u32) -> ABufferSettings {
+    let mut a = aba(multilayer, Some(compress));
+    a.ao.as_mut().unwrap().kernel = AoKernel::HbaoCompute;
+    a
+}
+
+/// Pixel (x, y) lies on the border of its 8×8 workgroup tile.
+fn tile_border(x: u32, y: u32) -> bool {
+    let t = strata_render::passes::abuffer::ao::TILE;
+    x.is_multiple_of(t) || x % t == t - 1 || y.is_multiple_of(t) || y % t == t - 1
+}
+
+/// Renders `a` and compares `ao-raw` with the CPU twin over the read-back
+/// compressed nodes at every pixel; returns the image, the uniforms, the
+/// worst difference overall and on tile borders, the border pixels below 0.98
+/// and the pixels whose HBAO steps reach past the staged apron.
+fn compute_vs_twin(gpu: &GpuContext, scene: &Scene, a: ABufferSettings) -> (ImageBuf, f32, f32, u32, u32) {
+    compute_vs_twin_sized(gpu, scene, a, W, H)
+}
+
+fn compute_vs_twin_sized(
+    gpu: &GpuContext,
+    scene: &Scene,
+    a: ABufferSettings,
+    w: u32,
+    h: u32,
+) -> (ImageBuf, f32, f32, u32, u32) {
+    let r = render_sized(gpu, scene, a, w, h);
+    let ab = r.abuffer().unwrap();
+    let lists = ab.read_lists(gpu).unwrap();
+    assert_eq!(lists.overflow, 0);
+    let nodes = ab.read_compressed(gpu).unwrap().expect("hbao-compute compresses");
+    let normals = ab.read_compressed_normals(gpu).unwrap().unwrap();
+    let occ = Occluders::Compressed {
+        nodes: &nodes,
+        normals: &normals,
+        depth_scale: ab.depth_scale(),
+    };
+    let u = ab.ao_uniforms().unwrap();
+    assert_eq!(u.kernel, AoKernel::HbaoCompute as u32);
+    assert_eq!((u.directions, u.rotate), (4, 0), "compute HBAO: the axis directions");
+    assert!(u.apron > 0);
+    let frame = r.frame_uniforms();
+    let got = raw(gpu, &r);
+    let (mut worst, mut worst_border, mut border_dark, mut beyond) = (0.0f32, 0.0f32, 0, 0);
+    assert_eq!((got.width, got.height), (w, h));
+    for y in 0..h {
+        for x in 0..w {
+            let want = ambient_visibility_cpu(&lists, &occ, &frame, &u, x, y);
+            let have = got.pixel(x, y)[0];
+            let d = (have - want).abs();
+            // the same f32 operations in the same order: bit for bit on lavapipe
+            assert_eq!(
+                have.to_bits(),
+                want.to_bits(),
+                "({x}, {y}): GPU {have} vs CPU twin {want}"
+            );
+            worst = worst.max(d);
+            if tile_border(x, y) {
+                worst_border = worst_border.max(d);
+                border_dark += (want < 0.98) as u32;
+            }
+            // the farthest step r_p (S − ½)/S of the nearest receiver, against the apron
+            if let Some(f) = lists.at(x, y).first() {
+                let r_p = u.proj_scale * u.radius / f.depth;
+                let reach = (r_p * (u.steps as f32 - 0.5) / u.steps as f32 + 0.5).floor() as u32;
+                beyond += (reach > u.apron) as u32;
+            }
+        }
+    }
+    (got, worst, worst_border, border_dark, beyond)
+}
+
+#[test]
+fn compute_hbao_equals_its_cpu_twin_also_on_tile_borders_and_past_the_apron() {
+    let gpu = common::gpu();
+    let mixed = mixed();
+    let mut big = hidden_occluder();
+    // r_p ≈ 3× the scene's: steps reach past the staged apron (global reads)
+    big.settings.ao_radius = 3.0;
+    for (name, scene, multilayer, m) in [
+        ("mixed", &mixed, true, 6),
+        ("mixed", &mixed, false, 6),
+        ("mixed", &mixed, true, 3),
+        ("hidden", &hidden_occluder(), true, 6),
+        ("hidden r=3", &big, true, 6),
+        ("hidden r=3", &big, false, 6),
+    ] {
+        let (img, worst, worst_border, border_dark, beyond) = compute_vs_twin(&gpu, scene, hbao_compute(multilayer, m));
+        let dark = img.data.iter().filter(|&&a| a < 0.98).count();
+        eprintln!(
+            "{name} multilayer={multilayer} M={m}: |GPU − twin| max {worst:.2e} (tile borders {worst_border:.2e}), \
+             {dark} pixels < 0.98 ({border_dark} tile-border pixels < 0.98), {beyond} receivers reach past the apron"
+        );
+        assert!(dark > 50, "{name}: the scene occludes ({dark} pixels below 0.98)");
+        // border pixels take occluders from the neighbouring tiles' apron
+        assert!(border_dark > 20, "{name}: {border_dark} occluded tile-border pixels");
+        if name.ends_with("r=3") {
+            assert!(
+                beyond > 100,
+                "{name}: only {beyond} receivers exercise the global fallback"
+            );
+        }
+        if m == 3 {
+            // every tap inside the staged tile + apron: workgroup memory alone
+            assert_eq!(beyond, 0, "{name} M=3: the apron covers every step");
+        }
+    }
+}
+
+#[test]
+fn compute_hbao_equals_its_twin_on_partial_tiles_of_an_odd_sized_image() {
+    // 61×45: the last tile column and row are partial (5 of 8 pixels); their
+    // invocations outside the image stage but write nothing, and the apron of
+    // the edge tiles is cut by the image border
+    let gpu = common::gpu();
+    let mut scene = hidden_occluder();
+    scene.settings.ao_radius = 3.0;
+    for multilayer in [true, false] {
+        let (img, worst, _, _, _) = compute_vs_twin_sized(&gpu, &scene, hbao_compute(multilayer, 6), 61, 45);
+        // pixels of the partial tiles: x ≥ 56 or y ≥ 40
+        let partial = (0..45u32)
+            .flat_map(|y| (0..61u32).map(move |x| (x, y)))
+            .filter(|&(x, y)| x >= 56 || y >= 40);
+        let dark = partial.filter(|&(x, y)| img.pixel(x, y)[0] < 0.98).count();
+        eprintln!(
+            "61×45 multilayer={multilayer}: max |GPU − twin| {worst:.1e}, {dark} occluded pixels in the partial tiles"
+        );
+        assert!(dark > 5, "the partial tiles hold occluded pixels: {dark}");
+    }
+}
+
+#[test]
+fn compute_hbao_of_an_unoccluded_plane_is_one() {
+    let gpu = common::gpu();
+    let scene = quads(
+        vec![Material::diffuse("plane", [0.6, 0.6, 0.6])],
+        &[(0.0, [-20.0, 20.0], [-20.0, 20.0], 0)],
+    );
+    for multilayer in [true, false] {
+        let av = raw(&gpu, &render(&gpu, &scene, hbao_compute(multilayer, 6)));
+        assert!(
+            av.data.iter().all(|&a| a == 1.0),
+            "multilayer={multilayer}: min AV {}",
+            av.data.iter().cloned().fold(1.0, f32::min)
+        );
+    }
+}
+
+#[test]
+fn compute_hbao_with_one_layer_equals_single_layer_compute_hbao() {
+    // M = 1 without the back-half search keeps each pixel's nearest node
+    // (opaque: Eq. 5 evicts the farthest), so Algorithm 1 over one layer is
+    // the single-layer kernel over M = 6 bit for bit; M = 6 differs (hidden occluder)
+    let gpu = common::gpu();
+    let mut scene = hidden_occluder();
+    // r = 3 reaches from the plane to the visible pane's edge (single-layer occlusion)
+    scene.settings.ao_radius = 3.0;
+    let mut one = hbao_compute(true, 1);
+    one.compress_back_half = false;
+    let one = raw(&gpu, &render(&gpu, &scene, one));
+    let single = raw(&gpu, &render(&gpu, &scene, hbao_compute(false, 6)));
+    let multi = raw(&gpu, &render(&gpu, &scene, hbao_compute(true, 6)));
+    assert_eq!(one.data, single.data, "one stored layer = single-layer compute HBAO");
+    let occluded = single.data.iter().filter(|&&a| a < 0.99).count();
+    assert!(
+        occluded > 50,
+        "{occluded} occluded pixels (the pane's edge over the plane)"
+    );
+    assert_ne!(multi.data, single.data, "six layers see the hidden occluder");
+}
+
+#[test]
+fn compute_hbao_an_occluder_hidden_behind_the_first_layer_darkens_only_multilayer() {
+    let gpu = common::gpu();
+    let scene = hidden_occluder();
+    let multi = raw(&gpu, &render(&gpu, &scene, hbao_compute(true, 6)));
+    let single = raw(&gpu, &render(&gpu, &scene, hbao_compute(false, 6)));
+    hidden_occluder_darkens(&multi, &single, AoKernel::HbaoCompute);
+}
+
+#[test]
+fn compute_hbao_settings_are_range_checked_with_one_line_errors() {
+    let t = strata_render::technique::find("aba-ao").unwrap();
+    let mut s = t.settings(&RenderSettings::default(), None).unwrap();
+    t.set(&mut s, "kernel", 2.0).unwrap();
+    assert_eq!(
+        s.abuffer.as_ref().unwrap().ao.as_ref().unwrap().kernel,
+        AoKernel::HbaoCompute
+    );
+    s.validate().expect("hbao-compute with the default compress = 6");
+    let e = t.set(&mut s, "kernel", 3.0).unwrap_err().to_string();
+    assert!(e.contains("kernel") && !e.contains('\n'), "{e}");
+    s.abuffer.as_mut().unwrap().compress = None;
+    let e = s.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("hbao-compute") && e.contains("compress") && !e.contains('\n'),
+        "{e}"
+    );
+    s.abuffer.as_mut().unwrap().compress = Some(6);
+    s.abuffer.as_mut().unwrap().ao.as_mut().unwrap().inside = true;
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("hbao-compute") && !e.contains('\n'), "{e}");
 }

@@ -6,12 +6,22 @@
 //! dropped (overflow). The frame is the `aba-ao` technique's (OIT + multilayer
 //! AO); the AO speed-up of compression and the ꟻLIP between the two AO images
 //! come last (ABA §V's heavy-workload comparison).
+//!
+//! With `--set kernel=hbao-compute` the bench is ABA Table III (opaque
+//! multilayer HBAO, §V-B): the list columns run the fragment-shader HBAO with
+//! the compute kernel's taps (D = 4 axis directions, φ = 0: brute-force list
+//! walk per tap), `compressed` the compute HBAO over the M nodes staged in
+//! workgroup memory, plus [`TABLE3_KEYS`]: `compressed-fragment` (the same
+//! taps over the compressed nodes in the fragment shader, one texel fetch per
+//! tap: what the staging alone buys) and `single-layer` (compute HBAO over
+//! each pixel's nearest node: Table III's "default").
 
 use std::collections::BTreeMap;
 
 use anyhow::Result;
 use serde_json::json;
 use strata_render::frame::FrameCameras;
+use strata_render::passes::abuffer::ao::AoKernel;
 use strata_render::passes::abuffer::{ABufferMethod, ABufferSettings};
 use strata_render::technique;
 use strata_render::{RenderSettings, Renderer};
@@ -22,6 +32,9 @@ use crate::results::{AbufferBench, AbufferMethodBench};
 
 /// The bench keys in Table I's column order.
 pub const KEYS: [&str; 5] = ["dual-peel", "linked-list", "linear", "fixed-array", "compressed"];
+
+/// The columns Table III (`kernel=hbao-compute`) adds after [`KEYS`].
+pub const TABLE3_KEYS: [&str; 2] = ["compressed-fragment", "single-layer"];
 
 /// `set`: the `oit` technique's settings (`pool`, `max-layers`, `compress`, …), applied
 /// last and range-checked; `abuffer` and (for the compressed run) `compress` are the bench's.
@@ -39,12 +52,25 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
                 .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
         }
         let a = s.abuffer.get_or_insert_with(ABufferSettings::default);
-        if key == "compressed" {
+        let table3 = a.ao.as_ref().is_some_and(|o| o.kernel == AoKernel::HbaoCompute);
+        if key == "compressed" || TABLE3_KEYS.contains(&key) {
             a.method = ABufferMethod::LinkedList;
             a.compress = a.compress.or(ABufferSettings::default().compress).or(Some(6));
         } else {
             a.method = key.parse().map_err(|e: String| anyhow::anyhow!(e))?;
             a.compress = None;
+        }
+        if let (true, Some(o)) = (table3, a.ao.as_mut()) {
+            match key {
+                "compressed" => {}
+                "single-layer" => o.multilayer = false,
+                // the compute kernel's taps (D = 4, φ = 0) in the fragment shader
+                _ => {
+                    o.kernel = AoKernel::Hbao;
+                    o.directions = 4;
+                    o.rotate = false;
+                }
+            }
         }
         s.validate()?;
         Ok(s)
@@ -53,7 +79,16 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
     let (w, h) = (stage.scene.width, stage.scene.height);
     let mut methods = BTreeMap::new();
     let mut ao_images = BTreeMap::new();
-    for key in KEYS {
+    let table3 = configure("compressed")?
+        .abuffer
+        .and_then(|a| a.ao)
+        .is_some_and(|o| o.kernel == AoKernel::HbaoCompute);
+    let keys: Vec<&str> = if table3 {
+        KEYS.iter().chain(&TABLE3_KEYS).copied().collect()
+    } else {
+        KEYS.to_vec()
+    };
+    for key in keys {
         let settings = configure(key)?;
         let a = settings.abuffer.clone().expect("oit has an A-buffer");
         // fragments stored and dropped, from one frame's lists
@@ -76,6 +111,8 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
             "max_layers": a.max_layers,
             "compress": a.compress,
             "compress_back_half": a.compress_back_half,
+            "kernel": a.ao.as_ref().map(|o| format!("{:?}", o.kernel)),
+            "multilayer": a.ao.as_ref().map(|o| o.multilayer),
         });
         let s2 = settings.clone();
         let bench = stage::run(Stage {

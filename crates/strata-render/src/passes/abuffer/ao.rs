@@ -44,6 +44,31 @@ pub enum AoKernel {
     /// horizon per direction; AV = 1 − mean over directions (ABA Table III: 8
     /// samples along x and y; here D = 4 directions rotated per pixel, S = 8).
     Hbao = 1,
+    /// Compute-shader HBAO (ABA §V-B): [`AoKernel::Hbao`] with D = 4 and φ = 0,
+    /// i.e. S steps along +x, +y, −x, −y, over the compressed nodes (Eq. 5),
+    /// which each 8×8 workgroup stages with an apron in workgroup memory
+    /// (`hbao_compute.wgsl`). Needs compression; separate integration only.
+    HbaoCompute = 2,
+}
+
+/// Compute HBAO: pixels per side of a workgroup's tile.
+pub const TILE: u32 = 8;
+/// Compute HBAO: RGBA32Uint texels (4 node words each) of workgroup memory
+/// for the staged nodes (16 KiB, WebGPU's guaranteed
+/// `maxComputeWorkgroupStorageSize`).
+pub const SHARED_TEXELS: u32 = 1024;
+
+/// Compute HBAO: the largest apron (pixels on each side of the tile) whose
+/// nodes fit in workgroup memory with `texels` texels per pixel (⌈M/4⌉ with
+/// Algorithm 1, 1 for the single layer): the largest side s with s² · texels
+/// ≤ [`SHARED_TEXELS`], apron = ⌊(s − [`TILE`]) / 2⌋. M = 5..8 gives 7 px,
+/// M ≤ 4 and the single layer 12 px. Taps farther out read global memory.
+pub fn apron(texels: u32) -> u32 {
+    let mut s = TILE;
+    while (s + 1) * (s + 1) * texels.max(1) <= SHARED_TEXELS {
+        s += 1;
+    }
+    (s - TILE) / 2
 }
 
 /// Largest HBAO directions D and steps S.
@@ -167,14 +192,22 @@ pub struct AbaAoUniforms {
     pub kernel: u32,
     pub directions: u32,
     pub steps: u32,
-    pub _pad: u32,
+    /// Compute HBAO: the staged apron in pixels ([`apron`]); 0 otherwise.
+    pub apron: u32,
 }
 
 impl AbaAoUniforms {
     /// The uniforms of one frame (`frame`: the guard-banded frame's uniforms);
     /// `compressed`: the A-buffer keeps compressed lists.
     pub fn new(s: &AbaAoSettings, scene: &Scene, frame: &FrameUniforms, compressed: bool) -> Self {
+        Self::with_nodes(s, scene, frame, compressed, 0)
+    }
+
+    /// As [`Self::new`]; `nodes` = M of the compressed lists (the compute
+    /// HBAO's staged words per pixel with Algorithm 1).
+    pub fn with_nodes(s: &AbaAoSettings, scene: &Scene, frame: &FrameUniforms, compressed: bool, nodes: u32) -> Self {
         let (radius, bias, epsilon) = s.resolve(scene);
+        let compute = s.kernel == AoKernel::HbaoCompute;
         Self {
             radius,
             bias,
@@ -184,14 +217,19 @@ impl AbaAoUniforms {
             tau: s.turns.tau(s.samples),
             samples: s.samples,
             seed: 0,
-            rotate: s.rotate as u32,
+            // compute HBAO: the axis directions, φ = 0
+            rotate: (s.rotate && !compute) as u32,
             multilayer: s.multilayer as u32,
             // the inside integration needs every fragment's colour: the lists
             compressed: (compressed && !s.inside) as u32,
             kernel: s.kernel as u32,
-            directions: s.directions,
+            directions: if compute { 4 } else { s.directions },
             steps: s.steps,
-            _pad: 0,
+            apron: if compute {
+                apron(if s.multilayer { nodes.div_ceil(4) } else { 1 })
+            } else {
+                0
+            },
         }
     }
 
@@ -313,8 +351,10 @@ impl Twin<'_> {
     }
 
     /// The receiver hemisphere's AV with the uniforms' kernel.
+    /// (Compute HBAO is [`Self::hbao`] with the uniforms' D = 4, φ = 0: its
+    /// tile staging changes where nodes are read, not what is computed.)
     fn hemisphere(&self, r: &Receiver) -> f32 {
-        if self.u.kernel == AoKernel::Hbao as u32 {
+        if self.u.kernel != AoKernel::Ssao as u32 {
             self.hbao(r)
         } else {
             self.ssao(r)

@@ -214,6 +214,18 @@ impl ABufferSettings {
         }
         if let Some(a) = &self.ao {
             a.validate()?;
+            if a.kernel == ao::AoKernel::HbaoCompute {
+                // §V-B stages the compressed nodes (Eq. 5) in workgroup memory
+                if self.compress.is_none() {
+                    return Err(format!(
+                        "kernel hbao-compute needs compress in 1..={} (it stages the compressed nodes)",
+                        compress::MAX_NODES
+                    ));
+                }
+                if a.inside {
+                    return Err("kernel hbao-compute supports integration=separate only".into());
+                }
+            }
         }
         Ok(())
     }
@@ -443,6 +455,17 @@ struct AoResources {
     lists_group: wgpu::BindGroup,
     group: wgpu::BindGroup,
     uniforms: wgpu::Buffer,
+    /// kernel `hbao-compute` (§V-B): runs instead of the fragment pass
+    compute: Option<ComputeAo>,
+}
+
+/// The compute-shader HBAO's pipeline, groups 2 and its storage output.
+struct ComputeAo {
+    pipeline: wgpu::ComputePipeline,
+    /// AO uniforms, compressed nodes, `out`
+    group: wgpu::BindGroup,
+    /// R32Float storage texture, copied into `ao-raw` (frame targets are not storage-bindable)
+    out: wgpu::Texture,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -789,12 +812,14 @@ impl ABufferStage {
             },
         );
         // lists.wgsl's group 1: parameters, nodes, links, counts, offsets
+        // fragment (resolve, AO) and compute (§V-B HBAO) passes read them
+        let frag_comp = frag | wgpu::ShaderStages::COMPUTE;
         let lists_entries = [
-            layout_entry(0, frag, UNIFORM_TY),
-            layout_entry(1, frag, storage_ty(true)),
-            layout_entry(2, frag, storage_ty(true)),
-            layout_entry(3, frag, storage_ty(true)),
-            layout_entry(4, frag, storage_ty(true)),
+            layout_entry(0, frag_comp, UNIFORM_TY),
+            layout_entry(1, frag_comp, storage_ty(true)),
+            layout_entry(2, frag_comp, storage_ty(true)),
+            layout_entry(3, frag_comp, storage_ty(true)),
+            layout_entry(4, frag_comp, storage_ty(true)),
         ];
         let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("abuffer-resolve"),
@@ -869,20 +894,21 @@ impl ABufferStage {
                     offsets.as_entire_binding(),
                 ],
             );
+            let ao_entries = [
+                layout_entry(0, frag_comp, UNIFORM_TY),
+                layout_entry(
+                    1,
+                    frag_comp,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                ),
+            ];
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("aba-ao"),
-                entries: &[
-                    layout_entry(0, frag, UNIFORM_TY),
-                    layout_entry(
-                        1,
-                        frag,
-                        wgpu::BindingType::Texture {
-                            sample_type: wgpu::TextureSampleType::Uint,
-                            view_dimension: wgpu::TextureViewDimension::D2Array,
-                            multisampled: false,
-                        },
-                    ),
-                ],
+                entries: &ao_entries,
             });
             let uniforms = uniform_buffer(gpu, "aba-ao", &<ao::AbaAoUniforms as bytemuck::Zeroable>::zeroed());
             let group = crate::passes::bind_group(
@@ -921,12 +947,72 @@ impl ABufferStage {
                     &crate::passes::color_targets(&[AO_RAW]),
                 )
             };
+            // §V-B compute HBAO: writes a storage texture, copied into `ao-raw`
+            let compute = (a.kernel == ao::AoKernel::HbaoCompute).then(|| {
+                let out = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("aba-ao-compute"),
+                    size: wgpu::Extent3d {
+                        width: w,
+                        height: h,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: AO_RAW.format,
+                    usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                });
+                let out_view = out.create_view(&Default::default());
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("aba-ao-compute"),
+                    entries: &[
+                        ao_entries[0],
+                        ao_entries[1],
+                        layout_entry(
+                            2,
+                            wgpu::ShaderStages::COMPUTE,
+                            wgpu::BindingType::StorageTexture {
+                                access: wgpu::StorageTextureAccess::WriteOnly,
+                                format: AO_RAW.format,
+                                view_dimension: wgpu::TextureViewDimension::D2,
+                            },
+                        ),
+                    ],
+                });
+                let group = crate::passes::bind_group(
+                    device,
+                    "aba-ao-compute",
+                    &layout,
+                    &[
+                        uniforms.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&compressed_view),
+                        wgpu::BindingResource::TextureView(&out_view),
+                    ],
+                );
+                let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("aba-ao-compute"),
+                    bind_group_layouts: &[Some(&scene.frame_layout), Some(&lists_layout), Some(&layout)],
+                    immediate_size: 0,
+                });
+                let module = crate::shader::module(device, "aba-ao-compute", include_str!("hbao_compute.wgsl"));
+                let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("aba-ao-compute"),
+                    layout: Some(&pl),
+                    module: &module,
+                    entry_point: Some("cs_main"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+                ComputeAo { pipeline, group, out }
+            });
             AoResources {
                 inside: a.inside,
                 pipeline,
                 lists_group,
                 group,
                 uniforms,
+                compute,
             }
         });
         let shared = Arc::new(Shared {
@@ -1326,6 +1412,29 @@ impl Pass for ABufferPass {
             }
             Kind::Ao => {
                 let a = s.ao.as_ref().expect("the stage has AO");
+                if let Some(c) = &a.compute {
+                    {
+                        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                            label: Some("aba-ao"),
+                            timestamp_writes: None,
+                        });
+                        pass.set_pipeline(&c.pipeline);
+                        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+                        pass.set_bind_group(1, &a.lists_group, &[]);
+                        pass.set_bind_group(2, &c.group, &[]);
+                        pass.dispatch_workgroups(s.width.div_ceil(ao::TILE), s.height.div_ceil(ao::TILE), 1);
+                    }
+                    encoder.copy_texture_to_texture(
+                        c.out.as_image_copy(),
+                        targets.get(AO_RAW.name).texture.as_image_copy(),
+                        wgpu::Extent3d {
+                            width: s.width,
+                            height: s.height,
+                            depth_or_array_layers: 1,
+                        },
+                    );
+                    return;
+                }
                 let mut views = vec![&targets.get(AO_RAW.name).view];
                 if a.inside {
                     views.extend([&targets.get(AO_INSIDE.name).view, &targets.get(AO_SEPARATE.name).view]);
