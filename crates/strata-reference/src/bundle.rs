@@ -152,6 +152,7 @@ impl WideBvh {
                     if next.is_none() {
                         next = Some((child, m));
                     } else {
+                        self.prefetch(child);
                         stack[sp].write((child, m));
                         sp += 1;
                     }

@@ -244,6 +244,35 @@ impl WideBvh {
         index as ChildRef
     }
 
+    /// Starts loading child `c` (a node's 256 bytes, or a leaf's packets)
+    /// into the cache: incoherent rays in large scenes wait mostly on these
+    /// loads (perf on the dragon's diffuse rays), and a pushed child is
+    /// visited only after its siblings.
+    #[inline(always)]
+    pub(crate) fn prefetch(&self, c: ChildRef) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let (base, bytes) = if c & LEAF != 0 {
+                let first = ((c & !LEAF) >> 4) as usize;
+                let packets = ((c & 15) as usize).div_ceil(4);
+                (
+                    &self.packets[first] as *const Packet as *const i8,
+                    packets * size_of::<Packet>(),
+                )
+            } else {
+                (&self.nodes[c as usize] as *const Node8 as *const i8, size_of::<Node8>())
+            };
+            for offset in (0..bytes).step_by(64) {
+                // SAFETY: `offset` stays inside the leaf's packets / the node
+                // (contiguous in their vectors); prefetching never faults.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(base.add(offset)) };
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = c;
+    }
+
     /// Closest hit with `tmin < t < tmax`; ties at equal `t` go to the lowest triangle index.
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
         let mut best: Option<Hit> = None;
@@ -324,7 +353,9 @@ impl WideBvh {
                     cur = node.child[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
                     while mask != 0 {
-                        stack[sp].write(node.child[mask.trailing_zeros() as usize]);
+                        let c = node.child[mask.trailing_zeros() as usize];
+                        self.prefetch(c);
+                        stack[sp].write(c);
                         sp += 1;
                         mask &= mask - 1;
                     }
@@ -472,6 +503,7 @@ impl WideBvh {
                                 let i = mask.trailing_zeros() as usize;
                                 mask &= mask - 1;
                                 let item = (node.child[i], near[i]);
+                                self.prefetch(item.0);
                                 let mut j = k;
                                 while j > 0 && items[j - 1].1 > item.1 {
                                     items[j] = items[j - 1];
@@ -492,6 +524,7 @@ impl WideBvh {
                             while mask != 0 {
                                 let i = mask.trailing_zeros() as usize;
                                 mask &= mask - 1;
+                                self.prefetch(node.child[i]);
                                 stack[sp].write((node.child[i], near[i]));
                                 sp += 1;
                             }
