@@ -85,6 +85,16 @@ def make_mitsuba(a):
 
     mi.set_variant("llvm_ad_rgb")
 
+    def first_hit(scene, ray, active):
+        """The camera ray's hit, its validity and a frame around its shading normal facing the camera."""
+        si = scene.ray_intersect(ray, active)
+        n = si.sh_frame.n
+        return si, si.is_valid(), mi.Frame3f(dr.select(dr.dot(n, ray.d) > 0, -n, n))
+
+    def cosine_dir(frame, sampler, valid):
+        """A cosine-weighted direction around the frame's normal."""
+        return frame.to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d(valid)))
+
     class StrataAO(mi.SamplingIntegrator):
         """Binary AO: 1 - (occluded rays / n) around the facing shading normal."""
 
@@ -94,15 +104,10 @@ def make_mitsuba(a):
             self.n = props.get("shading_samples", 16)
 
         def sample(self, scene, sampler, ray, medium=None, active=True):
-            si = scene.ray_intersect(ray, active)
-            valid = si.is_valid()
-            n = si.sh_frame.n
-            n = dr.select(dr.dot(n, ray.d) > 0, -n, n)
-            frame = mi.Frame3f(n)
+            si, valid, frame = first_hit(scene, ray, active)
             hits = mi.Float(0.0)
             for _ in range(self.n):
-                d = frame.to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d(valid)))
-                r = si.spawn_ray(d)
+                r = si.spawn_ray(cosine_dir(frame, sampler, valid))
                 r.maxt = self.radius
                 hits += dr.select(scene.ray_test(r, valid), 1.0, 0.0)
             av = dr.select(valid, 1.0 - hits / self.n, 1.0)
@@ -129,15 +134,10 @@ def make_mitsuba(a):
             props.get("distance", 1.0)  # shared scene dict: mark as read
 
         def sample(self, scene, sampler, ray, medium=None, active=True):
-            si = scene.ray_intersect(ray, active)
-            valid = si.is_valid()
-            n = si.sh_frame.n
-            n = dr.select(dr.dot(n, ray.d) > 0, -n, n)
-            frame = mi.Frame3f(n)
+            si, valid, frame = first_hit(scene, ray, active)
             acc = mi.Float(0.0)
             for _ in range(self.n):
-                d = frame.to_world(mi.warp.square_to_cosine_hemisphere(sampler.next_2d(valid)))
-                s2 = scene.ray_intersect(si.spawn_ray(d), valid)
+                s2 = scene.ray_intersect(si.spawn_ray(cosine_dir(frame, sampler, valid)), valid)
                 acc += dr.select(s2.is_valid(), 1.0, 0.0)
             return mi.Spectrum(acc / self.n), valid, []
 
