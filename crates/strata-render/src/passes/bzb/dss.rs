@@ -219,6 +219,54 @@ pub fn shell(level: u32, d_max: f32) -> (f32, f32) {
     (if level == 0 { 0.0 } else { 0.5 * outer }, outer)
 }
 
+/// `dss_surfel_subimage` (dss_splat.wgsl, §4.1): the sub-image of level
+/// `level` that receives the surfel at `c` for direction `s`.
+pub fn surfel_subimage(c: Vec3, level: u32, s: u32, seed: u32) -> u32 {
+    let mask = (1u32 << (2 * level)) - 1;
+    pcg_hash(hash3(c, seed ^ 0x2545_f491) ^ pcg_hash(level + 16 * s)) & mask
+}
+
+/// The DSS bounced z-buffer on the CPU for one receiver (pixel `p`, direction
+/// `s`, origin `o`, direction `d`): the finest level l with a hit among the
+/// surfels that level l's shell splatting brings to p (those in p's sub-image,
+/// centre in the shell, disk enlarged to r·2^l, t > t_min), as
+/// `Some((level, t))`, or `None`. What dss-shuffle, dss-splat, dss-unshuffle
+/// and dss-reduce compute together.
+#[allow(clippy::too_many_arguments)]
+pub fn dss_hit(
+    p: [u32; 2],
+    s: u32,
+    o: Vec3,
+    d: Vec3,
+    surfels: &[Surfel],
+    levels: u32,
+    d_max: f32,
+    t_min: f32,
+    seed: u32,
+) -> Option<(u32, f32)> {
+    for l in 0..levels {
+        let (k, _) = unshuffle(l, s, p, seed);
+        let (inner, outer) = shell(l, d_max);
+        let scale = (1u32 << l) as f32;
+        let mut best: Option<f32> = None;
+        for sf in surfels {
+            let dist = (o - sf.position).length();
+            if !(dist > inner && dist <= outer) || surfel_subimage(sf.position, l, s, seed) != k {
+                continue;
+            }
+            if let Some(t) = ray_disk(o, d, sf.position, sf.normal, sf.radius * scale) {
+                if t > t_min && best.is_none_or(|b| t < b) {
+                    best = Some(t);
+                }
+            }
+        }
+        if let Some(t) = best {
+            return Some((l, t));
+        }
+    }
+    None
+}
+
 /// A surfel: a world-space disk.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Surfel {
