@@ -275,14 +275,14 @@ fn shuffle_then_unshuffle_is_the_identity() {
     // `dss_bounced_zbuffer_equals_the_cpu_twin`
     let gpu = common::gpu();
     let scene = corner_scene(0.6);
-    let (w, h) = (40, 28); // not multiples of 2^(l_max−1): padding
+    let (w, h) = (42, 30); // not multiples of 2^(l_max−1) = 4: padded to 44 × 32
     let b = dss_settings(2, 3, 4.0, true);
     let r = render(&gpu, &scene, b.clone(), w, h);
     let origins = r.read_target(&gpu, "bzb-origins").unwrap();
     let shuffled = r.read_target(&gpu, "dss-origins").unwrap();
     let (cols, rows) = b.grid();
     let plane = b.dss.plane(w, h);
-    assert_eq!(plane, [40, 28]);
+    assert_eq!(plane, [44, 32]);
     let (mut checked, mut padding) = (0, 0);
     for level in 0..3 {
         let bl = 1u32 << level;
@@ -299,7 +299,14 @@ fn shuffle_then_unshuffle_is_the_identity() {
                             continue;
                         }
                         let want = origins.pixel((s % cols) * w + p[0], (s / cols) * h + p[1]);
-                        assert_eq!(got, want, "level {level} s {s} k {k} nb ({nx}, {ny})");
+                        assert_eq!(got[..3], want[..3], "level {level} s {s} k {k} nb ({nx}, {ny})");
+                        // w = 1 + the pixel's index where there is a surface
+                        let index = if want[3] > 0.0 {
+                            (1 + p[1] * w + p[0]) as f32
+                        } else {
+                            0.0
+                        };
+                        assert_eq!(got[3], index);
                         checked += 1;
                     }
                 }
@@ -307,6 +314,7 @@ fn shuffle_then_unshuffle_is_the_identity() {
         }
     }
     assert_eq!(checked, 3 * 2 * w * h);
+    assert_eq!(padding, 3 * 2 * (44 * 32 - w * h));
     eprintln!("shuffle: {checked} texels equal the CPU twin's pixel, {padding} padding texels empty");
 }
 
@@ -450,6 +458,7 @@ fn dss_bounced_zbuffer_equals_the_cpu_twin() {
     let dirs = r.read_target(&gpu, "bzb-directions").unwrap();
     let payload = r.read_target(&gpu, "bzb-payload").unwrap();
     let unshuffled = r.read_target(&gpu, "dss-unshuffled").unwrap();
+    let normals = common::npack_normals(&r.read_target(&gpu, "npack").unwrap(), 0);
     let (radius, t_min) = b.resolve(&scene);
     let d_max = b.dss.d_max(radius);
     let (cols, _) = b.grid();
@@ -458,7 +467,8 @@ fn dss_bounced_zbuffer_equals_the_cpu_twin() {
     for (sd, p, t) in samples(&dirs, w, h, 2, cols) {
         let o = v3(origins.pixel(t[0], t[1]));
         let d = v3(dirs.pixel(t[0], t[1]));
-        let cpu = dss::dss_hit(p, sd, o, d, &s, 3, d_max, t_min, b.seed);
+        let n = v3(normals.pixel(p[0], p[1]));
+        let cpu = dss::dss_hit(p, sd, o, n, d, &s, 3, d_max, t_min, b.seed);
         let gpu_hit = payload.pixel(t[0], t[1])[0] > 0.5;
         total += 1;
         if cpu.is_some() != gpu_hit {
@@ -513,7 +523,7 @@ fn dss_converges_to_the_ray_traced_ao_of_the_same_surfel_cloud() {
                     // independent of the GPU's hash: another seed
                     let u = bzb::sample_uniforms(p, k, 0xfeed);
                     let (d, _) = bzb::direction(n, u, bzb::Hemisphere::Cosine);
-                    if dss::ray_occluded(o, d, &s, radius, t_min) {
+                    if dss::ray_occluded(o, n, d, &s, radius, t_min) {
                         occ += 1;
                     }
                 }

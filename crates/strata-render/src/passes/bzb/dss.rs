@@ -237,6 +237,7 @@ pub fn dss_hit(
     p: [u32; 2],
     s: u32,
     o: Vec3,
+    n: Vec3,
     d: Vec3,
     surfels: &[Surfel],
     levels: u32,
@@ -251,7 +252,10 @@ pub fn dss_hit(
         let mut best: Option<f32> = None;
         for sf in surfels {
             let dist = (o - sf.position).length();
-            if !(dist > inner && dist <= outer) || surfel_subimage(sf.position, l, s, seed) != k {
+            if !(dist > inner && dist <= outer)
+                || surfel_subimage(sf.position, l, s, seed) != k
+                || !above_tangent_plane(o, n, sf.position)
+            {
                 continue;
             }
             if let Some(t) = ray_disk(o, d, sf.position, sf.normal, sf.radius * scale) {
@@ -421,14 +425,23 @@ pub fn surfelize(
     (surfels, counts)
 }
 
+/// dss_splat.wgsl's receiver test: only disks centred above the receiver's
+/// tangent plane (normal `n` at `o`) occlude.
+pub fn above_tangent_plane(o: Vec3, n: Vec3, c: Vec3) -> bool {
+    n.dot(c - o) > 0.0
+}
+
 /// Binary AO within the shells of the surfel cloud along one ray, as DSS with
-/// l_max = 1 estimates it: 1 when the ray from `o` along `d` hits (t > t_min) a
-/// disk whose centre is within `outer` of `o`, else 0 (the CPU ray tracer of
-/// the same cloud, brute force).
-pub fn ray_occluded(o: Vec3, d: Vec3, surfels: &[Surfel], outer: f32, t_min: f32) -> bool {
+/// l_max = 1 estimates it: 1 when the ray from `o` (normal `n`) along `d` hits
+/// (t > t_min) a disk centred above the tangent plane within `outer` of `o`,
+/// else 0 (the CPU ray tracer of the same cloud, brute force).
+pub fn ray_occluded(o: Vec3, n: Vec3, d: Vec3, surfels: &[Surfel], outer: f32, t_min: f32) -> bool {
     surfels.iter().any(|sf| {
         let dist = (sf.position - o).length();
-        dist > 0.0 && dist <= outer && ray_disk(o, d, sf.position, sf.normal, sf.radius).is_some_and(|t| t > t_min)
+        dist > 0.0
+            && dist <= outer
+            && above_tangent_plane(o, n, sf.position)
+            && ray_disk(o, d, sf.position, sf.normal, sf.radius).is_some_and(|t| t > t_min)
     })
 }
 
@@ -793,6 +806,7 @@ impl DssStage {
                 buf(1, wgpu::BufferBindingType::Storage { read_only: true }),
                 tex(2),
                 tex(3),
+                tex(4),
             ],
         });
         let group = crate::passes::bind_group(
@@ -804,6 +818,7 @@ impl DssStage {
                 buffers.surfels.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
                 wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
+                wgpu::BindingResource::TextureView(&targets.get("npack").view),
             ],
         );
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -3,7 +3,8 @@
 // the receiver of pixel nb·2^l + offset(σ(k)) of the frame: its ray origin x_p
 // and (visibility on) its direction ω_p with pdf α, or (visibility off, the
 // additive baseline) its normal n_p. Texels whose pixel lies in the padding or
-// shows no surface get w = 0 (no sample).
+// shows no surface get w = 0 (no sample); else the origin's w = 1 + the pixel's
+// index (exact in f32 up to 2^24 pixels).
 #import "common/fullscreen.wgsl"
 #import "common/packing.wgsl"
 #import "common/dss.wgsl"
@@ -44,6 +45,10 @@ fn fs_main(@builtin(position) pos: vec4f) -> ShuffleOut {
     }
     let src = vec2i(vec2u(s % dss.cols, s / dss.cols) * dss.size + p);
     out.origin = textureLoad(origins, src, 0);
+    if (out.origin.w > 0.0) {
+        // w = 1 + the pixel's index: the splat reads the receiver's normal from npack
+        out.origin.w = f32(1u + p.y * dss.size.x + p.x);
+    }
     if (dss.visibility == 1u) {
         out.direction = textureLoad(directions, src, 0);
     } else if (out.origin.w > 0.0) {

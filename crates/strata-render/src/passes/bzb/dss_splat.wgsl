@@ -7,17 +7,26 @@
 // (shuffled there by dss-shuffle) and keeps only receivers in the shell
 // (inner, outer]; the surfel stands for 4^l surfels on level l (one of 4^l
 // sub-images receives it), so it is enlarged to radius r·2^l.
-//   fs_visibility: ray–disk hit at t > t_min → depth t²/(outer + r·2^l)², payload 1
+//   fs_visibility: disks centred above the receiver's tangent plane only;
+//                  ray–disk hit at t > t_min → depth t²/(outer + r·2^l)², payload 1
 //                  (depth test Less per level band, no blending); miss → discard.
 //   fs_additive:   the disk's form-factor occlusion, summed by additive blending
 //                  (the original shell splatting, no visibility).
 #import "common/dss.wgsl"
+#import "common/packing.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var<uniform> dss: Dss;
 @group(1) @binding(1) var<storage, read> surfels: array<vec4f>;
 @group(1) @binding(2) var origins: texture_2d<f32>;
 @group(1) @binding(3) var directions: texture_2d<f32>;
+@group(1) @binding(4) var npack: texture_2d<f32>;
+
+// The receiver's normal: origins.w = 1 + its pixel index (dss-shuffle).
+fn receiver_normal(w: f32) -> vec3f {
+    let i = u32(w) - 1u;
+    return oct_decode(textureLoad(npack, vec2i(vec2u(i % dss.size.x, i / dss.size.x)), 0).rg);
+}
 
 struct SplatVertex {
     @builtin(position) position: vec4f,
@@ -112,6 +121,12 @@ fn fs_visibility(in: SplatVertex) -> VisibilityOut {
     let shell = dss_shell(in.level, dss.d_max);
     let dist = distance(o.xyz, cr.xyz);
     if (!(dist > shell.x && dist <= shell.y)) {
+        discard;
+    }
+    // only disks centred above the receiver's tangent plane occlude: a disk
+    // centred below it (a neighbour on the same convex or curved surface) reaches
+    // into the hemisphere only by its size (BZB Fig. 9's protruding surfels)
+    if (!(dot(receiver_normal(o.w), cr.xyz - o.xyz) > 0.0)) {
         discard;
     }
     let r = cr.w * f32(1u << in.level);
