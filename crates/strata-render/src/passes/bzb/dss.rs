@@ -281,7 +281,7 @@ pub struct Surfel {
 
 /// Table 2's counts: triangles after frustum culling, sub-triangles after
 /// pre-tessellation, fine surfels, surfels after filtering.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct SurfelCounts {
     pub triangles_in: u32,
     pub triangles_culled: u32,
@@ -939,23 +939,23 @@ impl DssStage {
             })
             .collect())
     }
+}
 
-    /// GPU bytes of the DSS buffers and targets (Table 3's rows).
-    pub fn memory(u: &DssUniforms) -> DssMemory {
-        let big = (u.cols * u.plane[0]) as u64 * (u.levels * u.rows * u.plane[1]) as u64;
-        let out = (u.cols * u.size[0]) as u64 * (u.levels * u.rows * u.size[1]) as u64;
-        DssMemory {
-            shuffled_positions: big * 16,
-            shuffled_directions: big * 16,
-            layered_framebuffer: big * (2 + if u.visibility == 1 { 4 } else { 0 }) + out * 2,
-            framebuffer_layout: 0,
-            surfels: u.tri_capacity as u64 * 48 + u.fine_capacity as u64 * 32 + u.surfel_capacity as u64 * 32,
-        }
+/// GPU bytes of the DSS buffers and targets (Table 3's rows).
+pub fn memory(u: &DssUniforms) -> DssMemory {
+    let big = (u.cols * u.plane[0]) as u64 * (u.levels * u.rows * u.plane[1]) as u64;
+    let out = (u.cols * u.size[0]) as u64 * (u.levels * u.rows * u.size[1]) as u64;
+    DssMemory {
+        shuffled_positions: big * 16,
+        shuffled_directions: big * 16,
+        layered_framebuffer: big * (2 + if u.visibility == 1 { 4 } else { 0 }) + out * 2,
+        framebuffer_layout: 0,
+        surfels: u.tri_capacity as u64 * 48 + u.fine_capacity as u64 * 32 + u.surfel_capacity as u64 * 32,
     }
 }
 
 /// Table 3's rows for DSS (bytes).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct DssMemory {
     pub shuffled_positions: u64,
     pub shuffled_directions: u64,

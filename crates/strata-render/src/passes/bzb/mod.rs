@@ -176,6 +176,33 @@ impl BzbSettings {
         }
     }
 
+    /// The frame's BZB passes (profiler names) for this splatting algorithm.
+    pub fn pass_names(&self) -> &'static [&'static str] {
+        match self.splat {
+            Splat::Aov => &[
+                "bzb-directions",
+                "bzb-zminmax",
+                "bzb-splat",
+                "bzb-reconstruct",
+                "bzb-blur-h",
+                "bzb-blur-v",
+            ],
+            Splat::Dss => &[
+                "bzb-directions",
+                "dss-tessellate",
+                "dss-fine",
+                "dss-filter",
+                "dss-shuffle",
+                "dss-splat",
+                "dss-unshuffle",
+                "dss-reduce",
+                "bzb-reconstruct",
+                "bzb-blur-h",
+                "bzb-blur-v",
+            ],
+        }
+    }
+
     /// Sub-image grid (cols, rows) holding S sub-images: cols = ⌈√S⌉.
     pub fn grid(&self) -> (u32, u32) {
         let cols = (self.directions as f32).sqrt().ceil() as u32;
@@ -188,7 +215,7 @@ impl BzbSettings {
         let (c, r) = self.grid();
         let px = w as u64 * h as u64;
         if self.splat == Splat::Dss {
-            let m = dss::DssStage::memory(&self.dss_uniforms(w, h, 0.0, 0.0, triangles as u32));
+            let m = dss::memory(&self.dss_uniforms(w, h, 0.0, 0.0, triangles as u32));
             return px * (c * r) as u64 * (16 + 16 + 2)
                 + px * (4 + 2 + 2)
                 + triangles * 48
