@@ -632,11 +632,13 @@ fn dss_settings_errors_name_the_setting_and_range() {
 }
 
 #[test]
-fn additive_shell_splatting_matches_the_cloud_ao_where_occluders_do_not_overlap() {
-    // the baseline sums each disk's form factor A cos θ_r |cos θ_s| / (π d² + A);
-    // in the corner scene the occluders seen from a receiver (block faces) do
-    // not overlap each other much, so the sum's mean over the image is close to
-    // the surfel cloud's ray-traced AO (the visibility run's, S = 16, l_max = 1)
+fn hierarchy_matches_one_level_and_summing_over_occludes() {
+    // With surfels much smaller than d_max (1 px here: r ≈ 0.04 against
+    // d_max = 0.15 for l_max = 3), the subsampled levels with enlarged disks
+    // (one of 4^l sub-images, radius r·2^l) estimate the same AO as one full
+    // level (mean over the image within 15 %), with and without visibility; and
+    // the additive shell splatting (Σ of disk form factors) over-occludes
+    // against the nearest hit (BZB Fig. 2: occluders behind each other summed).
     let gpu = common::gpu();
     let scene = corner_scene(0.6);
     let (w, h) = (96, 64);
@@ -657,4 +659,8 @@ fn additive_shell_splatting_matches_the_cloud_ao_where_occluders_do_not_overlap(
     };
     let (vis1, add1, vis3, add3) = (mean(true, 1), mean(false, 1), mean(true, 3), mean(false, 3));
     eprintln!("mean AO: visibility {vis1:.4} / additive {add1:.4} (l_max = 1), {vis3:.4} / {add3:.4} (l_max = 3)");
+    assert!(vis1 > 0.01, "the scene has occlusion: {vis1}");
+    assert!((vis3 - vis1).abs() < 0.15 * vis1, "visibility: l_max 3 {vis3} vs 1 {vis1}");
+    assert!((add3 - add1).abs() < 0.15 * add1, "additive: l_max 3 {add3} vs 1 {add1}");
+    assert!(add1 > vis1 && add3 > vis3, "summing over-occludes: {add1} {vis1} {add3} {vis3}");
 }
