@@ -660,7 +660,16 @@ fn hierarchy_matches_one_level_and_summing_over_occludes() {
     let (vis1, add1, vis3, add3) = (mean(true, 1), mean(false, 1), mean(true, 3), mean(false, 3));
     eprintln!("mean AO: visibility {vis1:.4} / additive {add1:.4} (l_max = 1), {vis3:.4} / {add3:.4} (l_max = 3)");
     assert!(vis1 > 0.01, "the scene has occlusion: {vis1}");
-    assert!((vis3 - vis1).abs() < 0.15 * vis1, "visibility: l_max 3 {vis3} vs 1 {vis1}");
-    assert!((add3 - add1).abs() < 0.15 * add1, "additive: l_max 3 {add3} vs 1 {add1}");
-    assert!(add1 > vis1 && add3 > vis3, "summing over-occludes: {add1} {vis1} {add3} {vis3}");
+    assert!(
+        (vis3 - vis1).abs() < 0.15 * vis1,
+        "visibility: l_max 3 {vis3} vs 1 {vis1}"
+    );
+    assert!(
+        (add3 - add1).abs() < 0.15 * add1,
+        "additive: l_max 3 {add3} vs 1 {add1}"
+    );
+    assert!(
+        add1 > vis1 && add3 > vis3,
+        "summing over-occludes: {add1} {vis1} {add3} {vis3}"
+    );
 }
