@@ -653,7 +653,7 @@ static BZB_SETTINGS: [SettingInfo; 12] = [
     },
     SettingInfo {
         name: "culling",
-        doc: "cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        doc: "AOV: cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
         range: Range::Closed(0.0, 1.0),
         integer: true,
         get: |s| Some(bzb_of(s).culling as u32 as f64),
@@ -1080,7 +1080,7 @@ static REGISTRY: [Technique; 7] = [
     },
     Technique {
         name: "bzb-ao",
-        doc: "ambient occlusion volumes splatted into a bounced z-buffer (BZB §3: S directions per pixel, nearest occluder wins; visibility=off: the additive AOV baseline)",
+        doc: "ambient occlusion volumes (splat=aov) or deep-screen-space surfels (splat=dss, BZB §4) splatted into a bounced z-buffer (BZB §3: S directions per pixel, nearest occluder wins; visibility=off: the additive baseline)",
         output: "ao",
         display: ("ao", false),
         eval: EvalKind::AmbientVisibility,
