@@ -108,7 +108,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         }
         BenchResult::Bzb(b) => {
             print_stage("bzb-ao (bounced z-buffer)", &b.visibility);
-            print_stage("bzb-ao visibility=off (AOV baseline)", &b.no_visibility);
+            let baseline = if b.dss.is_some() {
+                "bzb-ao visibility=off (additive shell splatting)"
+            } else {
+                "bzb-ao visibility=off (AOV baseline)"
+            };
+            print_stage(baseline, &b.no_visibility);
             println!(
                 "visibility step: splat {:.2}x, whole technique {:.2}x the baseline; {} triangles, S = {}, {:.1} MiB",
                 b.splat_ratio,
@@ -117,6 +122,28 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 b.directions,
                 b.memory_bytes as f64 / (1024.0 * 1024.0)
             );
+            if let Some(d) = &b.dss {
+                let mib = |x: u64| x as f64 / (1024.0 * 1024.0);
+                for (name, t) in [
+                    ("bounced z-buffer", &d.stages),
+                    ("additive (no visibility)", &d.stages_no_visibility),
+                ] {
+                    println!(
+                        "DSS Table 1, {name}: surfelization {:.1} ms (tessellate {:.1}, fine {:.1}, filter {:.1}), shuffling {:.1}, splatting {:.1}, unshuffling {:.1}, reduction {:.1}, blurring {:.1}, total {:.1} ms",
+                        t.surfelization_ms, t.tessellate_ms, t.fine_ms, t.filter_ms, t.shuffling_ms, t.splatting_ms, t.unshuffling_ms, t.reduction_ms, t.blurring_ms, t.total_ms
+                    );
+                }
+                let c = &d.counts;
+                println!(
+                    "DSS Table 2: {} triangles, {} after frustum culling, {} after pre-tessellation, {} fine surfels, {} surfels (l_max = {}, surfel {} px, d_max {:.4})",
+                    c.triangles_in, c.triangles_culled, c.subtriangles, c.fine_surfels, c.surfels, d.levels, d.surfel_px, d.d_max
+                );
+                let m = &d.memory;
+                println!(
+                    "DSS Table 3: shuffled positions {:.1} MiB, shuffled directions {:.1} MiB, layered framebuffer {:.1} MiB, layout {:.1} MiB, surfel buffers {:.1} MiB",
+                    mib(m.shuffled_positions), mib(m.shuffled_directions), mib(m.layered_framebuffer), mib(m.framebuffer_layout), mib(m.surfels)
+                );
+            }
         }
         BenchResult::Ils(b) => {
             print_stage("ils (IS)", &b.interleaved);

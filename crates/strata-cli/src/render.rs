@@ -134,6 +134,14 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         for (n, ms) in &t.passes {
             eprintln!("{n:<12} {ms:8.3} ms");
         }
+        // BZB Table 2: DSS surfelization counts
+        if let Some(c) = r.dss_counts(&gpu) {
+            let c = c?;
+            eprintln!(
+                "dss surfelization: {} triangles, {} after frustum culling, {} after pre-tessellation, {} fine surfels, {} surfels",
+                c.triangles_in, c.triangles_culled, c.subtriangles, c.fine_surfels, c.surfels
+            );
+        }
     }
     eprintln!(
         "wrote {} ({}x{}, {} triangles)",

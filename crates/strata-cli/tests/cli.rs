@@ -1494,6 +1494,63 @@ fn bzb_ao_renders_with_and_without_visibility() {
     assert_eq!(e.trim().lines().count(), 1, "{e}");
 }
 
+/// Issue 13 (DSS): `--set splat=dss` renders in both modes with the surfel
+/// counts printed by `--timings`, and bad DSS settings are one-line errors naming the setting.
+#[test]
+fn bzb_ao_dss_renders_and_range_checks_its_settings() {
+    for (set, name) in [("visibility=on", "dss-on.png"), ("visibility=off", "dss-off.png")] {
+        let out = scratch(name);
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "bzb-ao",
+            "--set",
+            "splat=dss",
+            "--set",
+            set,
+            "--set",
+            "levels=2",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--timings",
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ]);
+        assert!(o.status.success(), "{set}: {}", stderr(&o));
+        assert!(out.exists());
+        assert!(stderr(&o).contains("dss surfelization:"), "{}", stderr(&o));
+        assert!(stderr(&o).contains("dss-splat"), "{}", stderr(&o));
+    }
+    for (set, needle) in [("levels=7", "1..=6"), ("surfel-size=0.1", "16"), ("splat=gpu", "splat")] {
+        let out = scratch("dss-bad.png");
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "bzb-ao",
+            "--set",
+            set,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "{set}");
+        let e = stderr(&o);
+        let name = set.split('=').next().unwrap();
+        assert!(e.contains(name) && e.contains(needle), "{set}: {e}");
+        assert_eq!(e.trim().lines().count(), 1, "{e}");
+    }
+}
+
 /// Issue 12: `strata eval --technique oit` compares the A-buffer's composite with the CPU
 /// compositing of every crossing (glasshouse: ≤ 0.02 ꟻLIP, the issue's bound) for every
 /// construction; a pool too small for the fragments drops some, says how many in the JSON and

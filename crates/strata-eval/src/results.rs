@@ -191,6 +191,43 @@ pub struct BzbBench {
     pub memory_bytes: u64,
     pub visibility: StageBench,
     pub no_visibility: StageBench,
+    /// `splat = dss`: BZB Tables 1–3 (stage groups, surfel counts, memory).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dss: Option<DssBench>,
+}
+
+/// BZB Table 1's DSS stages (median ms, sums of the passes' medians), Table
+/// 2's surfel counts and Table 3's memory.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DssBench {
+    /// Table 1 with the bounced z-buffer.
+    pub stages: DssStages,
+    /// Table 1 for the additive shell splatting (no visibility).
+    pub stages_no_visibility: DssStages,
+    /// Table 2: triangles in, after frustum culling, sub-triangles, fine surfels, surfels.
+    pub counts: strata_render::passes::bzb::dss::SurfelCounts,
+    /// Table 3 (bytes).
+    pub memory: strata_render::passes::bzb::dss::DssMemory,
+    pub levels: u32,
+    pub surfel_px: f32,
+    pub d_max: f32,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DssStages {
+    /// dss-tessellate + dss-fine + dss-filter (Table 1's "tessellation").
+    pub surfelization_ms: f64,
+    pub tessellate_ms: f64,
+    pub fine_ms: f64,
+    pub filter_ms: f64,
+    /// bzb-directions + dss-shuffle (direction setup and shuffling).
+    pub shuffling_ms: f64,
+    pub splatting_ms: f64,
+    pub unshuffling_ms: f64,
+    /// dss-reduce + bzb-reconstruct (levels combined, weighting).
+    pub reduction_ms: f64,
+    pub blurring_ms: f64,
+    pub total_ms: f64,
 }
 
 /// `strata bench abuffer`: ABA Table I's stages per construction, keyed `dual-peel`,

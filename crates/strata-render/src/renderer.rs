@@ -815,6 +815,25 @@ impl Renderer {
         self.bzb.as_ref().map(|b| b.uniforms())
     }
 
+    /// BZB §4.3 / Table 2: the DSS surfel counts of the last frame (`bzb-ao` with `splat = dss`).
+    pub fn dss_counts(&self, gpu: &GpuContext) -> Option<Result<crate::passes::bzb::dss::SurfelCounts, RenderError>> {
+        let b = self.bzb.as_ref()?;
+        Some(b.dss()?.read_counts(gpu, b.triangle_count()))
+    }
+
+    /// The DSS surfels of the last frame (GPU append order).
+    pub fn dss_surfels(&self, gpu: &GpuContext) -> Option<Result<Vec<crate::passes::bzb::dss::Surfel>, RenderError>> {
+        let b = self.bzb.as_ref()?;
+        let d = b.dss()?;
+        Some(d.read_counts(gpu, b.triangle_count()).and_then(|c| {
+            d.read_surfels(
+                gpu,
+                c.surfels
+                    .min(crate::passes::bzb::dss::capacities(b.triangle_count())[2]),
+            )
+        }))
+    }
+
     /// MIP level `mip` of target `name` (layer 0, whole texture incl. guard band).
     pub fn read_target_mip(&self, gpu: &GpuContext, name: &str, mip: u32) -> Result<ImageBuf, RenderError> {
         let t = self

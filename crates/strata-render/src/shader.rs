@@ -15,6 +15,11 @@ const COMMON: &[(&str, &str)] = &[
     ("common/vpl.wgsl", include_str!("shaders/common/vpl.wgsl")),
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
     ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),
+    (
+        "common/bzb_geometry.wgsl",
+        include_str!("shaders/common/bzb_geometry.wgsl"),
+    ),
+    ("common/dss.wgsl", include_str!("shaders/common/dss.wgsl")),
     ("abuffer/lists.wgsl", include_str!("passes/abuffer/lists.wgsl")),
     ("abuffer/ao_common.wgsl", include_str!("passes/abuffer/ao_common.wgsl")),
     ("ao/uniforms.wgsl", include_str!("passes/ao/uniforms.wgsl")),

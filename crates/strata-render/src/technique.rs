@@ -642,7 +642,7 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
     s.bzb.clone().unwrap_or_default()
 }
 
-static BZB_SETTINGS: [SettingInfo; 8] = [
+static BZB_SETTINGS: [SettingInfo; 12] = [
     SettingInfo {
         name: "visibility",
         doc: "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
@@ -654,7 +654,7 @@ static BZB_SETTINGS: [SettingInfo; 8] = [
     },
     SettingInfo {
         name: "culling",
-        doc: "cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        doc: "AOV: cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
         range: Range::Closed(0.0, 1.0),
         integer: true,
         get: |s| Some(bzb_of(s).culling as u32 as f64),
@@ -700,6 +700,46 @@ static BZB_SETTINGS: [SettingInfo; 8] = [
         |s| bzb_of(s).bias.map(f64::from),
         |s, v| bzb_mut(s).bias = Some(v as f32)
     ),
+    SettingInfo {
+        name: "splat",
+        doc: "splatting algorithm: aov (one occlusion volume per triangle, McGuire 2010) or dss (surfels shell-splatted into an interleaved hierarchical framebuffer, BZB §4)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_of(s).splat as u32 as f64),
+        set: |s, v| {
+            bzb_mut(s).splat = if v == 0.0 {
+                crate::passes::bzb::Splat::Aov
+            } else {
+                crate::passes::bzb::Splat::Dss
+            }
+        },
+        values: &["aov", "dss"],
+    },
+    setting!(
+        "levels",
+        "DSS levels l_max of the hierarchical framebuffer (BZB §4.1; 4, Table 3); d_max = r / 2^(l_max-1)",
+        Range::Closed(1.0, crate::passes::bzb::dss::MAX_LEVELS as f64),
+        true,
+        |s| Some(bzb_of(s).dss.levels as f64),
+        |s, v| bzb_mut(s).dss.levels = v as u32
+    ),
+    setting!(
+        "surfel-size",
+        "DSS ideal surfel radius in pixels (BZB §4.3: constant projected size)",
+        Range::Closed(0.5, 16.0),
+        false,
+        |s| Some(bzb_of(s).dss.surfel_px as f64),
+        |s, v| bzb_mut(s).dss.surfel_px = v as f32
+    ),
+    SettingInfo {
+        name: "surfel-culling",
+        doc: "DSS view-frustum culling of triangles before surfelization, margin = the outermost shell radius (BZB §5)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_of(s).dss.culling as u32 as f64),
+        set: |s, v| bzb_mut(s).dss.culling = v != 0.0,
+        values: &["off", "on"],
+    },
     setting!(
         "filter-radius",
         "cross-bilateral taps on each side (BZB §3.3; 0 = none)",
@@ -1041,7 +1081,7 @@ static REGISTRY: [Technique; 7] = [
     },
     Technique {
         name: "bzb-ao",
-        doc: "ambient occlusion volumes splatted into a bounced z-buffer (BZB §3: S directions per pixel, nearest occluder wins; visibility=off: the additive AOV baseline)",
+        doc: "ambient occlusion volumes (splat=aov) or deep-screen-space surfels (splat=dss, BZB §4) splatted into a bounced z-buffer (BZB §3: S directions per pixel, nearest occluder wins; visibility=off: the additive baseline)",
         output: "ao",
         display: ("ao", false),
         eval: EvalKind::AmbientVisibility,

@@ -10,7 +10,7 @@ use strata_render::technique;
 
 use super::stage::StageSettings;
 use super::technique as technique_bench;
-use crate::results::BzbBench;
+use crate::results::{BzbBench, DssBench, DssStages};
 
 /// `set`: the `bzb-ao` technique's settings (`directions`, `ao-radius`, …) applied
 /// last; `visibility` is the bench's own.
@@ -31,7 +31,7 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<BzbBench> {
     let splat = |b: &crate::results::StageBench| {
         b.passes
             .iter()
-            .find(|p| p.name == "bzb-splat")
+            .find(|p| p.name == "bzb-splat" || p.name == "dss-splat")
             .map_or(f64::NAN, |p| p.median_ms)
     };
     // the settings as the frame used them (for the memory)
@@ -42,6 +42,11 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<BzbBench> {
     }
     let b = rs.bzb.clone().unwrap_or_default();
     let (w, h) = (stage.scene.width, stage.scene.height);
+    let dss = if b.splat == strata_render::passes::bzb::Splat::Dss {
+        Some(dss_tables(stage, &scene, &rs, &on, &off)?)
+    } else {
+        None
+    };
     Ok(BzbBench {
         triangles: scene.triangle_count() as u64,
         directions: b.directions,
@@ -50,5 +55,62 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<BzbBench> {
         memory_bytes: b.estimated_bytes(w, h, scene.triangle_count() as u64),
         visibility: on,
         no_visibility: off,
+        dss,
+    })
+}
+
+/// BZB Table 1's DSS stage groups from the per-pass medians.
+fn dss_stages(b: &crate::results::StageBench) -> DssStages {
+    let ms = |names: &[&str]| -> f64 {
+        b.passes
+            .iter()
+            .filter(|p| names.contains(&p.name.as_str()))
+            .map(|p| p.median_ms)
+            .sum()
+    };
+    DssStages {
+        surfelization_ms: ms(&["dss-tessellate", "dss-fine", "dss-filter"]),
+        tessellate_ms: ms(&["dss-tessellate"]),
+        fine_ms: ms(&["dss-fine"]),
+        filter_ms: ms(&["dss-filter"]),
+        shuffling_ms: ms(&["bzb-directions", "dss-shuffle"]),
+        splatting_ms: ms(&["dss-splat"]),
+        unshuffling_ms: ms(&["dss-unshuffle"]),
+        reduction_ms: ms(&["dss-reduce", "bzb-reconstruct"]),
+        blurring_ms: ms(&["bzb-blur-h", "bzb-blur-v"]),
+        total_ms: b.total_median_ms,
+    }
+}
+
+/// Tables 1–3 for `splat = dss`: the stage groups of both runs, the surfel
+/// counts of one frame rendered with the bench's settings, and the memory.
+fn dss_tables(
+    stage: &StageSettings,
+    scene: &strata_scene::Scene,
+    rs: &strata_render::RenderSettings,
+    on: &crate::results::StageBench,
+    off: &crate::results::StageBench,
+) -> Result<DssBench> {
+    let gpu = strata_render::GpuContext::new(&strata_render::GpuOptions {
+        adapter: stage.adapter.clone(),
+    })?;
+    let b = rs.bzb.clone().unwrap_or_default();
+    let mut r = strata_render::Renderer::new(&gpu, scene, rs.clone())?;
+    let cams = strata_render::frame::FrameCameras::along_path(scene, stage.scene.frame);
+    r.render(&gpu, scene, &cams, stage.scene.frame)?;
+    let counts = r
+        .dss_counts(&gpu)
+        .ok_or_else(|| anyhow::anyhow!("bench bzb: the frame has no DSS stage"))??;
+    let (radius, t_min) = b.resolve(scene);
+    let (w, h) = (stage.scene.width, stage.scene.height);
+    let u = b.dss_uniforms(w, h, radius, t_min, scene.triangle_count() as u32);
+    Ok(DssBench {
+        stages: dss_stages(on),
+        stages_no_visibility: dss_stages(off),
+        counts,
+        memory: strata_render::passes::bzb::dss::memory(&u),
+        levels: b.dss.levels,
+        surfel_px: b.dss.surfel_px,
+        d_max: b.dss.d_max(radius),
     })
 }

@@ -48,7 +48,11 @@ pub fn run(
             let before = technique.passes.iter().copied().take_while(|p| !p.starts_with("ils-"));
             before.chain(i.passes()).chain(["tonemap"]).collect()
         }
-        None => technique.passes.to_vec(),
+        // BZB: the splatting algorithm's own passes (AOV or DSS)
+        None => match &checked.bzb {
+            Some(b) => b.pass_names().to_vec(),
+            None => technique.passes.to_vec(),
+        },
     };
     let extra = json!({
         "technique": technique.name,

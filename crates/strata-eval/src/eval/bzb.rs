@@ -1,8 +1,9 @@
-//! Bounced-z-buffer AO (`bzb-ao`, BZB §3 with AOV splats) against the CPU ground truth
-//! of the same camera — ray-traced binary AO within r, the quantity its estimator
-//! targets, and DGB's obscurance — with, in the same result, the errors of the
-//! no-visibility AOV baseline and of 2-layer deep-G-buffer AO, so one run says
-//! which is closest.
+//! Bounced-z-buffer AO (`bzb-ao`, BZB §3 with AOV splats, or §4 with DSS surfels
+//! for `splat = dss`) against the CPU ground truth of the same camera — ray-traced
+//! binary AO within r, the quantity its estimator targets, and DGB's obscurance —
+//! with, in the same result, the errors of the same splatting without visibility
+//! (additive AOV, or additive shell splatting) and of 2-layer deep-G-buffer AO, so
+//! one run says which is closest.
 
 use anyhow::{bail, Result};
 use strata_render::passes::ao::AoSettings;

@@ -30,6 +30,8 @@
 //!    of [`crate::passes::bilateral`] (position and normal weights) into `ao`,
 //!    the target DGB AO writes, so compose and `eval` treat both alike.
 
+pub mod dss;
+
 use bytemuck::Zeroable;
 use glam::Vec3;
 use strata_scene::Scene;
@@ -53,6 +55,17 @@ pub enum Hemisphere {
     Cosine,
     /// pdf 1/(2π): the paper's choice for AO (§3.1); §3.3 weights by 2 cos θ.
     Uniform,
+}
+
+/// The splatting algorithm whose splats the bounced z-buffer tests (BZB §3.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Splat {
+    /// Ambient occlusion volumes: one splat per triangle (McGuire 2010; default).
+    #[default]
+    Aov,
+    /// Deep screen space: surfels shell-splatted into an interleaved
+    /// hierarchical framebuffer (BZB §4, [`dss`]).
+    Dss,
 }
 
 /// Bounced-z-buffer AO settings. Defaults: S = 4 directions per pixel (the
@@ -80,6 +93,10 @@ pub struct BzbSettings {
     /// from min/max depth tiles (issue 13 item 4, BZB Table 3's "MIP map"); the
     /// image is the same either way.
     pub culling: bool,
+    /// The splatting algorithm (AOV or DSS).
+    pub splat: Splat,
+    /// DSS's levels, surfel size and frustum culling (used with `Splat::Dss`).
+    pub dss: dss::DssSettings,
 }
 
 impl Default for BzbSettings {
@@ -97,6 +114,8 @@ impl Default for BzbSettings {
                 ..BilateralSettings::default()
             },
             culling: true,
+            splat: Splat::Aov,
+            dss: dss::DssSettings::default(),
         }
     }
 }
@@ -119,6 +138,7 @@ impl BzbSettings {
                 return Err(format!("bzb AO bias {b} is out of range: must be >= 0"));
             }
         }
+        self.dss.validate()?;
         self.filter.validate()
     }
 
@@ -126,6 +146,61 @@ impl BzbSettings {
     pub fn resolve(&self, scene: &Scene) -> (f32, f32) {
         let r = self.radius.unwrap_or(scene.settings.ao_radius);
         (r, self.bias.unwrap_or(0.01 * r))
+    }
+
+    /// DSS uniforms for a `w`×`h` frame, AO radius `r`, bias `t_min`.
+    pub fn dss_uniforms(&self, w: u32, h: u32, r: f32, t_min: f32, triangles: u32) -> dss::DssUniforms {
+        let (cols, rows) = self.grid();
+        let [tri_capacity, fine_capacity, surfel_capacity] = dss::capacities(triangles);
+        dss::DssUniforms {
+            levels: self.dss.levels,
+            directions: self.directions,
+            cols,
+            rows,
+            size: [w, h],
+            plane: self.dss.plane(w, h),
+            d_max: self.dss.d_max(r),
+            t_min,
+            surfel_px: self.dss.surfel_px,
+            fine_ratio: dss::FINE_RATIO,
+            max_fine: dss::MAX_FINE,
+            tri_capacity,
+            fine_capacity,
+            surfel_capacity,
+            seed: self.seed,
+            visibility: self.visibility as u32,
+            culling: self.dss.culling as u32,
+            triangles,
+            max_split: dss::MAX_SPLIT,
+            _pad: [0; 3],
+        }
+    }
+
+    /// The frame's BZB passes (profiler names) for this splatting algorithm.
+    pub fn pass_names(&self) -> &'static [&'static str] {
+        match self.splat {
+            Splat::Aov => &[
+                "bzb-directions",
+                "bzb-zminmax",
+                "bzb-splat",
+                "bzb-reconstruct",
+                "bzb-blur-h",
+                "bzb-blur-v",
+            ],
+            Splat::Dss => &[
+                "bzb-directions",
+                "dss-tessellate",
+                "dss-fine",
+                "dss-filter",
+                "dss-shuffle",
+                "dss-splat",
+                "dss-unshuffle",
+                "dss-reduce",
+                "bzb-reconstruct",
+                "bzb-blur-h",
+                "bzb-blur-v",
+            ],
+        }
     }
 
     /// Sub-image grid (cols, rows) holding S sub-images: cols = ⌈√S⌉.
@@ -139,6 +214,16 @@ impl BzbSettings {
     pub fn estimated_bytes(&self, w: u32, h: u32, triangles: u64) -> u64 {
         let (c, r) = self.grid();
         let px = w as u64 * h as u64;
+        if self.splat == Splat::Dss {
+            let m = dss::memory(&self.dss_uniforms(w, h, 0.0, 0.0, triangles as u32));
+            return px * (c * r) as u64 * (16 + 16 + 2)
+                + px * (4 + 2 + 2)
+                + triangles * 48
+                + m.shuffled_positions
+                + m.shuffled_directions
+                + m.layered_framebuffer
+                + m.surfels;
+        }
         px * (c * r) as u64 * (16 + 16 + 2 + 4)
             + px * (4 + 2 + 2)
             + triangles * 48
@@ -470,8 +555,10 @@ macro_rules! bzb_shader {
 /// The BZB AO passes of a frame, into target `ao`.
 pub(crate) struct BzbStage {
     pub(crate) directions: FullscreenPass,
-    pub(crate) zminmax: ZMinMaxPass,
-    pub(crate) splat: SplatPass,
+    /// AOV splatting (with its depth tiles), or DSS.
+    pub(crate) zminmax: Option<ZMinMaxPass>,
+    pub(crate) splat: Option<SplatPass>,
+    pub(crate) dss: Option<dss::DssStage>,
     pub(crate) reconstruct: FullscreenPass,
     pub(crate) blur_h: BilateralPass,
     pub(crate) blur_v: BilateralPass,
@@ -505,7 +592,7 @@ impl BzbStage {
         for d in [ORIGINS, DIRECTIONS, PAYLOAD] {
             targets.create_sized(gpu, d, big);
         }
-        if s.visibility {
+        if s.visibility && s.splat == Splat::Aov {
             targets.create_sized(gpu, DEPTH, big);
         }
         for d in [
@@ -579,8 +666,23 @@ impl BzbStage {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let zminmax = Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count);
-        let splat = Self::splat_pass(gpu, scene_gpu, targets, s, &uniforms, &buffer, &tiles, count);
+        let (zminmax, splat, dss) = match s.splat {
+            Splat::Aov => (
+                Some(Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count)),
+                Some(Self::splat_pass(
+                    gpu, scene_gpu, targets, s, &uniforms, &buffer, &tiles, count,
+                )),
+                None,
+            ),
+            Splat::Dss => {
+                let du = s.dss_uniforms(w, h, u.radius, u.t_min, count);
+                (
+                    None,
+                    None,
+                    Some(dss::DssStage::new(gpu, scene_gpu, targets, &du, &buffer, PAYLOAD.name)?),
+                )
+            }
+        };
         let blur_h = BilateralPass::new(
             gpu,
             scene_gpu,
@@ -605,6 +707,7 @@ impl BzbStage {
             directions,
             zminmax,
             splat,
+            dss,
             reconstruct,
             blur_h,
             blur_v,
@@ -821,6 +924,15 @@ impl BzbStage {
         self.directions.set_uniforms(gpu, &u);
         self.reconstruct.set_uniforms(gpu, &u);
         gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        if let Some(d) = &self.dss {
+            let [w, h] = d.size;
+            d.set_uniforms(
+                gpu,
+                &self
+                    .settings
+                    .dss_uniforms(w, h, u.radius, u.t_min, self.triangles.count),
+            );
+        }
         if animated && self.triangles.count > 0 {
             let data = triangle_data(scene, frame);
             gpu.queue
@@ -835,14 +947,26 @@ impl BzbStage {
     }
 
     pub fn passes(&self) -> Vec<&dyn Pass> {
-        vec![
-            &self.directions,
-            &self.zminmax,
-            &self.splat,
-            &self.reconstruct,
-            &self.blur_h,
-            &self.blur_v,
-        ]
+        let mut v: Vec<&dyn Pass> = vec![&self.directions];
+        if let (Some(z), Some(s)) = (&self.zminmax, &self.splat) {
+            v.push(z);
+            v.push(s);
+        }
+        if let Some(d) = &self.dss {
+            v.extend(d.passes());
+        }
+        v.extend([&self.reconstruct as &dyn Pass, &self.blur_h, &self.blur_v]);
+        v
+    }
+
+    /// The DSS stage (`splat = dss`).
+    pub fn dss(&self) -> Option<&dss::DssStage> {
+        self.dss.as_ref()
+    }
+
+    /// Scene triangles in the splat buffer.
+    pub fn triangle_count(&self) -> u32 {
+        self.triangles.count
     }
 }
 

@@ -1,0 +1,983 @@
+//! Deep screen space (DSS, Nalbach, Ritschel, Seidel 2014) with the bounced
+//! z-buffer: BZB §4. `--set splat=dss` of `bzb-ao`.
+//!
+//! Passes (profiler names), after `bzb-directions` (§3.1, shared with the AOV path):
+//!
+//! 1. `dss-tessellate`, `dss-fine`, `dss-filter` (§4.3, Fig. 6; compute, since
+//!    wgpu has no tessellation or geometry shaders): frustum culling with a
+//!    safety margin and pre-tessellation of large triangles; fine surfels placed
+//!    uniformly at random on each (sub-)triangle from a hash of a world
+//!    position; each discarded with probability max(1 − A/A*, 0), survivors
+//!    given the ideal radius (a constant projected size). Counters give Table 2.
+//! 2. `dss-shuffle` (§4.1, Fig. 5): x_p and ω_p into the interleaved
+//!    hierarchical framebuffer (l_max levels stacked in one texture; level l has
+//!    4^l sub-images, each holding one random pixel of every 2^l × 2^l
+//!    neighbourhood).
+//! 3. `dss-splat` (§4.1–4.2): one indirect instanced draw, one instance per
+//!    (surfel, level, direction), into a random sub-image per level; shells
+//!    (0, d_max] and (d_max·2^(l−1), d_max·2^l]; with visibility a ray–disk test
+//!    and depth t² normalised per level (the bounced z-buffer, z kept per
+//!    level); without, the original additive shell splatting.
+//! 4. `dss-unshuffle`, `dss-reduce` (§4.2): back to pixel order; per (pixel,
+//!    direction) the finest level with a hit (or the sum without visibility)
+//!    into `bzb-payload`, then the AOV path's `bzb-reconstruct` and bilateral.
+
+use glam::Vec3;
+use strata_scene::Camera;
+
+use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::scene_gpu::GpuScene;
+use crate::spiral::pcg_hash;
+
+/// Largest l_max.
+pub const MAX_LEVELS: u32 = 6;
+/// Fine surfels per (sub-)triangle at most (the tessellator's amplification
+/// limit, which pre-tessellation works around).
+pub const MAX_FINE: u32 = 64;
+/// Largest pre-tessellation factor m (m² sub-triangles).
+pub const MAX_SPLIT: u32 = 64;
+/// Fine surfels' area as a fraction of the ideal area A* at the triangle's
+/// nearest point: fine surfels must be smaller than ideal ones for the
+/// filter's keep probability A_P/A* ≤ 1 to preserve the area.
+pub const FINE_RATIO: f32 = 0.25;
+
+/// DSS settings. Defaults: l_max = 4 (Table 3's memory is 4 levels' worth of
+/// shuffled positions: 18 MB at 768×512 = 4 × 12 B per pixel), surfels of 2
+/// pixels' radius, frustum culling on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DssSettings {
+    /// l_max: levels of the hierarchical framebuffer (1..=6).
+    pub levels: u32,
+    /// Ideal surfel radius in pixels (0.5..=16): A* = π (surfel_px · z · pixel size at depth 1)².
+    pub surfel_px: f32,
+    /// View-frustum culling of triangles before surfelization, with the largest
+    /// shell radius as the safety margin.
+    pub culling: bool,
+}
+
+impl Default for DssSettings {
+    fn default() -> Self {
+        Self {
+            levels: 4,
+            surfel_px: 2.0,
+            culling: true,
+        }
+    }
+}
+
+impl DssSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=MAX_LEVELS).contains(&self.levels) {
+            return Err(format!(
+                "bzb levels {} is out of range: must be in 1..={MAX_LEVELS}",
+                self.levels
+            ));
+        }
+        if !(0.5..=16.0).contains(&self.surfel_px) {
+            return Err(format!(
+                "bzb surfel-size {} is out of range: must be in 0.5..=16",
+                self.surfel_px
+            ));
+        }
+        Ok(())
+    }
+
+    /// d_max for AO radius r: the outermost shell d_max·2^(l_max−1) reaches r.
+    pub fn d_max(&self, r: f32) -> f32 {
+        r / (1u32 << (self.levels - 1)) as f32
+    }
+
+    /// The padded plane Wp × Hp of one direction on each level (multiples of 2^(l_max−1)).
+    pub fn plane(&self, w: u32, h: u32) -> [u32; 2] {
+        let b = 1u32 << (self.levels - 1);
+        [w.div_ceil(b) * b, h.div_ceil(b) * b]
+    }
+}
+
+/// Mirrors `Dss` in `common/dss.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct DssUniforms {
+    pub levels: u32,
+    pub directions: u32,
+    pub cols: u32,
+    pub rows: u32,
+    pub size: [u32; 2],
+    pub plane: [u32; 2],
+    pub d_max: f32,
+    pub t_min: f32,
+    pub surfel_px: f32,
+    pub fine_ratio: f32,
+    pub max_fine: u32,
+    pub tri_capacity: u32,
+    pub fine_capacity: u32,
+    pub surfel_capacity: u32,
+    pub seed: u32,
+    pub visibility: u32,
+    pub culling: u32,
+    pub triangles: u32,
+    pub max_split: u32,
+    pub _pad: [u32; 3],
+}
+
+/// Buffer capacities (entries) for `triangles` scene triangles.
+pub fn capacities(triangles: u32) -> [u32; 3] {
+    let tris = (triangles.saturating_mul(8)).clamp(1 << 16, 1 << 20);
+    [tris, 1 << 21, 1 << 20]
+}
+
+// ---- CPU twins of common/dss.wgsl and dss_surfelize.wgsl ----
+
+/// `dss_hash3`: hash of a world position's bit patterns.
+pub fn hash3(q: Vec3, seed: u32) -> u32 {
+    pcg_hash(q.x.to_bits() ^ pcg_hash(q.y.to_bits() ^ pcg_hash(q.z.to_bits() ^ pcg_hash(seed))))
+}
+
+/// `dss_unit`: 24-bit uniform in [0, 1).
+pub fn unit(h: u32) -> f32 {
+    (h >> 8) as f32 / 16_777_216.0
+}
+
+/// `dss_triangle_point`: uniform point on a triangle from two uniforms.
+pub fn triangle_point(v: [Vec3; 3], u: [f32; 2]) -> Vec3 {
+    let su = u[0].sqrt();
+    v[0] * (1.0 - su) + v[1] * (su * (1.0 - u[1])) + v[2] * (su * u[1])
+}
+
+fn layout_keys(nb: [u32; 2], level: u32, s: u32, seed: u32) -> [u32; 3] {
+    let h = pcg_hash(nb[0] ^ pcg_hash(nb[1] ^ pcg_hash(level ^ pcg_hash(s ^ pcg_hash(seed ^ 0x5bd1_e995)))));
+    let h2 = pcg_hash(h);
+    [h | 1, h2, pcg_hash(h2)]
+}
+
+/// `dss_sigma` (§4.1, Fig. 5): the neighbourhood pixel (0..4^l, row-major in the
+/// 2^l × 2^l block) that sub-image `k` of level `level` receives.
+pub fn sigma(k: u32, nb: [u32; 2], level: u32, s: u32, seed: u32) -> u32 {
+    let mask = (1u32 << (2 * level)) - 1;
+    let [a, b, c] = layout_keys(nb, level, s, seed);
+    (a.wrapping_mul((k ^ c) & mask).wrapping_add(b)) & mask
+}
+
+/// `dss_sigma_inverse`: the sub-image holding neighbourhood pixel `j`.
+pub fn sigma_inverse(j: u32, nb: [u32; 2], level: u32, s: u32, seed: u32) -> u32 {
+    let mask = (1u32 << (2 * level)) - 1;
+    let [a, b, c] = layout_keys(nb, level, s, seed);
+    let mut inv = a;
+    for _ in 0..5 {
+        inv = inv.wrapping_mul(2u32.wrapping_sub(a.wrapping_mul(inv)));
+    }
+    (inv.wrapping_mul(j.wrapping_sub(b)) & mask) ^ (c & mask)
+}
+
+/// `dss_texel`: texel of the stacked framebuffer for (level, direction s,
+/// sub-image k, neighbourhood nb).
+pub fn texel(level: u32, s: u32, k: u32, nb: [u32; 2], cols: u32, rows: u32, plane: [u32; 2]) -> [u32; 2] {
+    let b = 1u32 << level;
+    let sub = [plane[0] / b, plane[1] / b];
+    [
+        (s % cols) * plane[0] + (k % b) * sub[0] + nb[0],
+        level * rows * plane[1] + (s / cols) * plane[1] + (k / b) * sub[1] + nb[1],
+    ]
+}
+
+/// The shuffle of `dss_shuffle.wgsl`: the frame pixel a texel (level, s, k, nb)
+/// receives (may lie in the padding, ≥ the frame size).
+pub fn shuffle(level: u32, s: u32, k: u32, nb: [u32; 2], seed: u32) -> [u32; 2] {
+    let b = 1u32 << level;
+    let j = sigma(k, nb, level, s, seed);
+    [nb[0] * b + j % b, nb[1] * b + j / b]
+}
+
+/// The unshuffle of `dss_unshuffle.wgsl`: (sub-image k, neighbourhood nb) of pixel `p` on `level`.
+pub fn unshuffle(level: u32, s: u32, p: [u32; 2], seed: u32) -> (u32, [u32; 2]) {
+    let b = 1u32 << level;
+    let nb = [p[0] / b, p[1] / b];
+    let off = [p[0] % b, p[1] % b];
+    (sigma_inverse(off[1] * b + off[0], nb, level, s, seed), nb)
+}
+
+/// `dss_ray_disk` (§4.2): t of o + t·d on the disk (centre c, unit normal n,
+/// radius r), both faces; `None` on a miss.
+pub fn ray_disk(o: Vec3, d: Vec3, c: Vec3, n: Vec3, r: f32) -> Option<f32> {
+    let dn = d.dot(n);
+    if dn.abs() < 1e-8 {
+        return None;
+    }
+    let t = (c - o).dot(n) / dn;
+    let q = o + t * d - c;
+    if q.dot(q) > r * r {
+        return None;
+    }
+    Some(t)
+}
+
+/// `dss_shell`: (inner, outer] of level `level`'s shell.
+pub fn shell(level: u32, d_max: f32) -> (f32, f32) {
+    let outer = d_max * (1u32 << level) as f32;
+    (if level == 0 { 0.0 } else { 0.5 * outer }, outer)
+}
+
+/// `dss_surfel_subimage` (dss_splat.wgsl, §4.1): the sub-image of level
+/// `level` that receives the surfel at `c` for direction `s`.
+pub fn surfel_subimage(c: Vec3, level: u32, s: u32, seed: u32) -> u32 {
+    let mask = (1u32 << (2 * level)) - 1;
+    pcg_hash(hash3(c, seed ^ 0x2545_f491) ^ pcg_hash(level + 16 * s)) & mask
+}
+
+/// The DSS bounced z-buffer on the CPU for one receiver (pixel `p`, direction
+/// `s`, origin `o`, direction `d`): the finest level l with a hit among the
+/// surfels that level l's shell splatting brings to p (those in p's sub-image,
+/// centre in the shell, disk enlarged to r·2^l, t > t_min), as
+/// `Some((level, t))`, or `None`. What dss-shuffle, dss-splat, dss-unshuffle
+/// and dss-reduce compute together.
+#[allow(clippy::too_many_arguments)]
+pub fn dss_hit(
+    p: [u32; 2],
+    s: u32,
+    o: Vec3,
+    n: Vec3,
+    d: Vec3,
+    surfels: &[Surfel],
+    levels: u32,
+    d_max: f32,
+    t_min: f32,
+    seed: u32,
+) -> Option<(u32, f32)> {
+    for l in 0..levels {
+        let (k, _) = unshuffle(l, s, p, seed);
+        let (inner, outer) = shell(l, d_max);
+        let scale = (1u32 << l) as f32;
+        let mut best: Option<f32> = None;
+        for sf in surfels {
+            let dist = (o - sf.position).length();
+            if !(dist > inner && dist <= outer)
+                || surfel_subimage(sf.position, l, s, seed) != k
+                || !above_tangent_plane(o, n, sf.position)
+            {
+                continue;
+            }
+            if let Some(t) = ray_disk(o, d, sf.position, sf.normal, sf.radius * scale) {
+                if t > t_min && best.is_none_or(|b| t < b) {
+                    best = Some(t);
+                }
+            }
+        }
+        if let Some(t) = best {
+            return Some((l, t));
+        }
+    }
+    None
+}
+
+/// A surfel: a world-space disk.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surfel {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub radius: f32,
+}
+
+/// Table 2's counts: triangles after frustum culling, sub-triangles after
+/// pre-tessellation, fine surfels, surfels after filtering.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SurfelCounts {
+    pub triangles_in: u32,
+    pub triangles_culled: u32,
+    pub subtriangles: u32,
+    pub fine_surfels: u32,
+    pub surfels: u32,
+}
+
+/// The camera quantities surfelization needs (from `FrameUniforms`).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfelCamera {
+    pub eye: Vec3,
+    pub forward: Vec3,
+    pub near: f32,
+    /// Unit right and up, and tan of the half-angles (x: · aspect).
+    pub right: Vec3,
+    pub up: Vec3,
+    pub tan_x: f32,
+    pub tan_y: f32,
+    /// World radius of a pixel at depth 1: 2 tan(fov_y/2) / H.
+    pub pixel_scale: f32,
+}
+
+impl SurfelCamera {
+    pub fn new(c: &Camera, w: u32, h: u32) -> Self {
+        let forward = (c.target - c.eye).normalize();
+        let right = forward.cross(c.up).normalize();
+        let up = right.cross(forward);
+        let tan_y = (0.5 * c.fov_y_deg.to_radians()).tan();
+        Self {
+            eye: c.eye,
+            forward,
+            near: c.near,
+            right,
+            up,
+            tan_x: tan_y * w as f32 / h as f32,
+            tan_y,
+            pixel_scale: 2.0 * tan_y / h as f32,
+        }
+    }
+
+    /// `depth_of`: the eye distance (at least the near plane's).
+    fn depth(&self, q: Vec3) -> f32 {
+        (q - self.eye).length().max(self.near)
+    }
+
+    /// `min_depth`: the smallest eye distance over a triangle (at least the near plane's).
+    fn min_depth(&self, v: [Vec3; 3]) -> f32 {
+        super::triangle_dist2(self.eye, v).sqrt().max(self.near)
+    }
+
+    fn in_frustum(&self, v: [Vec3; 3], margin: f32) -> bool {
+        let m = (v[0] + v[1] + v[2]) / 3.0;
+        let rad = v
+            .iter()
+            .map(|p| (*p - m).length_squared())
+            .fold(0.0f32, f32::max)
+            .sqrt()
+            + margin;
+        let d = m - self.eye;
+        let z = d.dot(self.forward);
+        if z < self.near - rad {
+            return false;
+        }
+        let (x, y) = (d.dot(self.right), d.dot(self.up));
+        let kx = 1.0 / (1.0 + self.tan_x * self.tan_x).sqrt();
+        let ky = 1.0 / (1.0 + self.tan_y * self.tan_y).sqrt();
+        (x - self.tan_x * z) * kx <= rad
+            && (-x - self.tan_x * z) * kx <= rad
+            && (y - self.tan_y * z) * ky <= rad
+            && (-y - self.tan_y * z) * ky <= rad
+    }
+}
+
+fn tri_area(v: [Vec3; 3]) -> f32 {
+    0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length()
+}
+
+/// `dss_surfelize.wgsl` on the CPU: the surfel cloud and Table 2's counts for
+/// world triangles `tris` (same hashes; the GPU appends in another order, and
+/// float rounding can differ in the last bit, so a few decisions may too).
+pub fn surfelize(
+    tris: &[[Vec3; 3]],
+    cam: &SurfelCamera,
+    s: &DssSettings,
+    r: f32,
+    seed: u32,
+) -> (Vec<Surfel>, SurfelCounts) {
+    let ideal_area = |z: f32| {
+        let rr = s.surfel_px * z * cam.pixel_scale;
+        std::f32::consts::PI * rr * rr
+    };
+    let fine_count = |v: [Vec3; 3]| (tri_area(v) / (FINE_RATIO * ideal_area(cam.min_depth(v)))).ceil();
+    let margin = s.d_max(r) * (1u32 << (s.levels - 1)) as f32;
+    let mut counts = SurfelCounts {
+        triangles_in: tris.len() as u32,
+        ..Default::default()
+    };
+    let mut subtris = Vec::new();
+    for &v in tris {
+        if tri_area(v) <= 0.0 || (s.culling && !cam.in_frustum(v, margin)) {
+            continue;
+        }
+        counts.triangles_culled += 1;
+        let n = fine_count(v);
+        let m = ((n / MAX_FINE as f32).sqrt().ceil() as u32).clamp(1, MAX_SPLIT);
+        let (e1, e2) = ((v[1] - v[0]) / m as f32, (v[2] - v[0]) / m as f32);
+        for i in 0..m {
+            for j in 0..m - i {
+                let p = v[0] + i as f32 * e1 + j as f32 * e2;
+                subtris.push([p, p + e1, p + e2]);
+                if i + j + 1 < m {
+                    subtris.push([p + e1, p + e1 + e2, p + e2]);
+                }
+            }
+        }
+    }
+    counts.subtriangles = subtris.len() as u32;
+    let mut surfels = Vec::new();
+    for v in subtris {
+        let n = fine_count(v).clamp(1.0, MAX_FINE as f32) as u32;
+        let area = tri_area(v) / n as f32;
+        let nor = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+        for k in 0..n {
+            let g = [(k as f32 + 0.5) / n as f32, ((k as f32 + 0.5) * 0.618034).fract()];
+            let h = hash3(triangle_point(v, g), seed);
+            let x = triangle_point(v, [unit(h), unit(pcg_hash(h))]);
+            counts.fine_surfels += 1;
+            let a_ideal = ideal_area(cam.depth(x));
+            // keep with probability A/A* (discard max(1 − A/A*, 0); see dss_surfelize.wgsl)
+            if unit(pcg_hash(hash3(x, seed ^ 0x68e3_1da4))) < area / a_ideal {
+                surfels.push(Surfel {
+                    position: x,
+                    normal: nor,
+                    radius: (a_ideal / std::f32::consts::PI).sqrt(),
+                });
+            }
+        }
+    }
+    counts.surfels = surfels.len() as u32;
+    (surfels, counts)
+}
+
+/// dss_splat.wgsl's receiver test: only disks centred above the receiver's
+/// tangent plane (normal `n` at `o`) occlude.
+pub fn above_tangent_plane(o: Vec3, n: Vec3, c: Vec3) -> bool {
+    n.dot(c - o) > 0.0
+}
+
+/// Binary AO within the shells of the surfel cloud along one ray, as DSS with
+/// l_max = 1 estimates it: 1 when the ray from `o` (normal `n`) along `d` hits
+/// (t > t_min) a disk centred above the tangent plane within `outer` of `o`,
+/// else 0 (the CPU ray tracer of the same cloud, brute force).
+pub fn ray_occluded(o: Vec3, n: Vec3, d: Vec3, surfels: &[Surfel], outer: f32, t_min: f32) -> bool {
+    surfels.iter().any(|sf| {
+        let dist = (sf.position - o).length();
+        dist > 0.0
+            && dist <= outer
+            && above_tangent_plane(o, n, sf.position)
+            && ray_disk(o, d, sf.position, sf.normal, sf.radius).is_some_and(|t| t > t_min)
+    })
+}
+
+// ---- passes ----
+
+pub const ORIGINS: TargetDesc = TargetDesc::new(
+    "dss-origins",
+    wgpu::TextureFormat::Rgba32Float,
+    1,
+    "DSS §4.1 shuffled ray origins x_p: l_max levels stacked, 4^l sub-images per level (w = 1: has a sample)",
+);
+pub const DIRECTIONS: TargetDesc = TargetDesc::new(
+    "dss-directions",
+    wgpu::TextureFormat::Rgba32Float,
+    1,
+    "DSS §4.1 shuffled ω_p and α (visibility on) or receiver normals (off), stacked like dss-origins",
+);
+pub const PAYLOAD: TargetDesc = TargetDesc::new(
+    "dss-payload",
+    wgpu::TextureFormat::R16Float,
+    1,
+    "DSS §4.2 per-level payload in the shuffled layout (occlusion of the nearest hit, or the summed shells)",
+);
+pub const DEPTH: TargetDesc = TargetDesc::new(
+    "dss-depth",
+    wgpu::TextureFormat::Depth32Float,
+    1,
+    "DSS §4.2 bounced z per level: t² / (d_max·2^l + r_l)² (1 = none)",
+);
+pub const UNSHUFFLED: TargetDesc = TargetDesc::new(
+    "dss-unshuffled",
+    wgpu::TextureFormat::R16Float,
+    1,
+    "DSS per-level payload back in pixel order: levels stacked, directions tiled as bzb-payload",
+);
+
+/// Buffers of the surfelization.
+struct SurfelBuffers {
+    subtris: wgpu::Buffer,
+    fine: wgpu::Buffer,
+    surfels: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    args: wgpu::Buffer,
+    readback: wgpu::Buffer,
+}
+
+/// One surfelization compute pass (`dss-tessellate`, `dss-fine`, `dss-filter`).
+pub struct SurfelizePass {
+    name: &'static str,
+    pipelines: Vec<wgpu::ComputePipeline>,
+    group: wgpu::BindGroup,
+    /// Threads of each pipeline.
+    threads: Vec<u32>,
+    counters: Option<wgpu::Buffer>,
+}
+
+impl Pass for SurfelizePass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: self.name,
+            inputs: vec![],
+            outputs: vec![],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(c) = &self.counters {
+            encoder.clear_buffer(c, 0, None);
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(self.name),
+            timestamp_writes: None,
+        });
+        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        for (p, n) in self.pipelines.iter().zip(&self.threads) {
+            pass.set_pipeline(p);
+            // capacities keep this within one dimension's 65535 workgroups
+            pass.dispatch_workgroups(n.div_ceil(64).clamp(1, 65535), 1, 1);
+        }
+    }
+}
+
+/// `dss-splat`: the indirect instanced draw of shells.
+pub struct DssSplatPass {
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    args: wgpu::Buffer,
+    visibility: bool,
+}
+
+impl Pass for DssSplatPass {
+    fn info(&self) -> PassInfo {
+        PassInfo {
+            name: "dss-splat",
+            inputs: vec![ORIGINS.name, DIRECTIONS.name],
+            outputs: vec![PAYLOAD.name],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let depth = self.visibility.then(|| wgpu::RenderPassDepthStencilAttachment {
+            view: &targets.get(DEPTH.name).view,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("dss-splat"),
+            color_attachments: &[crate::passes::clear_attachment(&targets.get(PAYLOAD.name).view)],
+            depth_stencil_attachment: depth,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.draw_indirect(&self.args, 0);
+    }
+}
+
+/// The DSS passes between `bzb-directions` and `bzb-reconstruct`.
+pub(crate) struct DssStage {
+    pub(crate) tessellate: SurfelizePass,
+    pub(crate) fine: SurfelizePass,
+    pub(crate) filter: SurfelizePass,
+    pub(crate) shuffle: FullscreenPass,
+    pub(crate) splat: DssSplatPass,
+    pub(crate) unshuffle: FullscreenPass,
+    pub(crate) reduce: FullscreenPass,
+    uniforms: wgpu::Buffer,
+    buffers: SurfelBuffers,
+    /// The frame's W × H.
+    pub(crate) size: [u32; 2],
+}
+
+macro_rules! dss_shader {
+    ($file:literal) => {
+        include_str!($file)
+    };
+}
+
+impl DssStage {
+    /// `u`: the uniforms; `triangles`: the scene's triangle buffer (3 vec4 each);
+    /// `payload`: the bounced z-buffer's payload target the reduction writes.
+    pub fn new(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &mut Targets,
+        u: &DssUniforms,
+        triangles: &wgpu::Buffer,
+        payload: &'static str,
+    ) -> Result<Self, crate::RenderError> {
+        use wgpu::util::DeviceExt;
+        let device = &gpu.device;
+        let big = [u.cols * u.plane[0], u.levels * u.rows * u.plane[1]];
+        let out = [u.cols * u.size[0], u.levels * u.rows * u.size[1]];
+        let max = device.limits().max_texture_dimension_2d;
+        if big.iter().chain(out.iter()).any(|d| *d > max) {
+            return Err(crate::RenderError::Parameter(format!(
+                "bzb levels {} × directions {}: the DSS framebuffer of {}x{} exceeds the adapter's largest texture {max}x{max} (lower levels, directions or the size)",
+                u.levels, u.directions, big[0], big[1]
+            )));
+        }
+        for d in [ORIGINS, DIRECTIONS, PAYLOAD] {
+            targets.create_sized(gpu, d, big);
+        }
+        if u.visibility == 1 {
+            targets.create_sized(gpu, DEPTH, big);
+        }
+        targets.create_sized(gpu, UNSHUFFLED, out);
+        let limit = device.limits().max_storage_buffer_binding_size;
+        let storage =
+            |label: &str, bytes: u64, extra: wgpu::BufferUsages| -> Result<wgpu::Buffer, crate::RenderError> {
+                if bytes > limit {
+                    return Err(crate::RenderError::Parameter(format!(
+                        "DSS {label}: {bytes} bytes exceed the adapter's storage buffer binding size {limit}"
+                    )));
+                }
+                Ok(device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | extra,
+                    mapped_at_creation: false,
+                }))
+            };
+        let none = wgpu::BufferUsages::empty();
+        let buffers = SurfelBuffers {
+            subtris: storage("dss-subtriangles", u.tri_capacity as u64 * 48, none)?,
+            fine: storage("dss-fine-surfels", u.fine_capacity as u64 * 32, none)?,
+            surfels: storage("dss-surfels", u.surfel_capacity as u64 * 32, none)?,
+            counters: storage("dss-counters", 32, wgpu::BufferUsages::COPY_DST)?,
+            args: storage("dss-args", 16, wgpu::BufferUsages::INDIRECT)?,
+            readback: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("dss-counters-readback"),
+                size: 32,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        };
+        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dss"),
+            contents: bytemuck::bytes_of(u),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+
+        // surfelization: one layout for the four entry points
+        let comp = wgpu::ShaderStages::COMPUTE;
+        let buf = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: comp,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let rw = wgpu::BufferBindingType::Storage { read_only: false };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dss-surfelize"),
+            entries: &[
+                buf(0, wgpu::BufferBindingType::Uniform),
+                buf(1, wgpu::BufferBindingType::Storage { read_only: true }),
+                buf(2, rw),
+                buf(3, rw),
+                buf(4, rw),
+                buf(5, rw),
+                buf(6, rw),
+            ],
+        });
+        let group = |label| {
+            crate::passes::bind_group(
+                device,
+                label,
+                &layout,
+                &[
+                    uniforms.as_entire_binding(),
+                    triangles.as_entire_binding(),
+                    buffers.subtris.as_entire_binding(),
+                    buffers.fine.as_entire_binding(),
+                    buffers.surfels.as_entire_binding(),
+                    buffers.counters.as_entire_binding(),
+                    buffers.args.as_entire_binding(),
+                ],
+            )
+        };
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dss-surfelize"),
+            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(device, "dss-surfelize", dss_shader!("dss_surfelize.wgsl"));
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pl),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let tessellate = SurfelizePass {
+            name: "dss-tessellate",
+            pipelines: vec![pipeline("cs_tessellate")],
+            group: group("dss-tessellate"),
+            threads: vec![u.triangles],
+            counters: Some(buffers.counters.clone()),
+        };
+        let fine = SurfelizePass {
+            name: "dss-fine",
+            pipelines: vec![pipeline("cs_fine")],
+            group: group("dss-fine"),
+            threads: vec![u.tri_capacity],
+            counters: None,
+        };
+        let filter = SurfelizePass {
+            name: "dss-filter",
+            pipelines: vec![pipeline("cs_filter"), pipeline("cs_args")],
+            group: group("dss-filter"),
+            threads: vec![u.fine_capacity, 1],
+            counters: None,
+        };
+
+        let shuffle = PassBuilder::new(gpu, targets, "dss-shuffle")
+            .shader("dss-shuffle", dss_shader!("dss_shuffle.wgsl"))
+            .frame(scene_gpu)
+            .uniforms(u)
+            .read(super::ORIGINS.name)
+            .read(super::DIRECTIONS.name)
+            .read("npack")
+            .write(ORIGINS.name)
+            .write(DIRECTIONS.name)
+            .build();
+        let unshuffle = PassBuilder::new(gpu, targets, "dss-unshuffle")
+            .shader("dss-unshuffle", dss_shader!("dss_unshuffle.wgsl"))
+            .frame(scene_gpu)
+            .uniforms(u)
+            .read(PAYLOAD.name)
+            .write(UNSHUFFLED.name)
+            .build();
+        let reduce = PassBuilder::new(gpu, targets, "dss-reduce")
+            .shader("dss-reduce", dss_shader!("dss_reduce.wgsl"))
+            .frame(scene_gpu)
+            .uniforms(u)
+            .read(UNSHUFFLED.name)
+            .write(payload)
+            .build();
+        let splat = Self::splat_pass(gpu, scene_gpu, targets, u, &uniforms, &buffers);
+        Ok(Self {
+            tessellate,
+            fine,
+            filter,
+            shuffle,
+            splat,
+            unshuffle,
+            reduce,
+            uniforms,
+            buffers,
+            size: u.size,
+        })
+    }
+
+    fn splat_pass(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &Targets,
+        u: &DssUniforms,
+        uniforms: &wgpu::Buffer,
+        buffers: &SurfelBuffers,
+    ) -> DssSplatPass {
+        let device = &gpu.device;
+        let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let tex = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let buf = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: vf,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dss-splat"),
+            entries: &[
+                buf(0, wgpu::BufferBindingType::Uniform),
+                buf(1, wgpu::BufferBindingType::Storage { read_only: true }),
+                tex(2),
+                tex(3),
+                tex(4),
+            ],
+        });
+        let group = crate::passes::bind_group(
+            device,
+            "dss-splat",
+            &layout,
+            &[
+                uniforms.as_entire_binding(),
+                buffers.surfels.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+                wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
+                wgpu::BindingResource::TextureView(&targets.get("npack").view),
+            ],
+        );
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dss-splat"),
+            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(device, "dss-splat", dss_shader!("dss_splat.wgsl"));
+        let visibility = u.visibility == 1;
+        let (entry, blend, depth_stencil) = if visibility {
+            (
+                "fs_visibility",
+                None,
+                Some(wgpu::DepthStencilState {
+                    format: DEPTH.format,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+            )
+        } else {
+            let add = wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            };
+            ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
+        };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("dss-splat"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_splat"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: PAYLOAD.format,
+                    blend,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        DssSplatPass {
+            pipeline,
+            group,
+            args: buffers.args.clone(),
+            visibility,
+        }
+    }
+
+    pub fn set_uniforms(&self, gpu: &GpuContext, u: &DssUniforms) {
+        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(u));
+        self.shuffle.set_uniforms(gpu, u);
+        self.unshuffle.set_uniforms(gpu, u);
+        self.reduce.set_uniforms(gpu, u);
+    }
+
+    pub fn passes(&self) -> Vec<&dyn Pass> {
+        vec![
+            &self.tessellate,
+            &self.fine,
+            &self.filter,
+            &self.shuffle,
+            &self.splat,
+            &self.unshuffle,
+            &self.reduce,
+        ]
+    }
+
+    /// Table 2's counts of the last frame (`triangles_in` = `triangles`); counts
+    /// beyond a buffer's capacity are reported (and were dropped).
+    pub fn read_counts(&self, gpu: &GpuContext, triangles: u32) -> Result<SurfelCounts, crate::RenderError> {
+        let c = read_buffer(gpu, &self.buffers.counters, &self.buffers.readback, 32)?;
+        let c: &[u32] = bytemuck::cast_slice(&c);
+        Ok(SurfelCounts {
+            triangles_in: triangles,
+            triangles_culled: c[3],
+            subtriangles: c[0],
+            fine_surfels: c[1],
+            surfels: c[2],
+        })
+    }
+
+    /// The surfels of the last frame (in the GPU's append order).
+    pub fn read_surfels(&self, gpu: &GpuContext, count: u32) -> Result<Vec<Surfel>, crate::RenderError> {
+        let bytes = count as u64 * 32;
+        if bytes == 0 {
+            return Ok(Vec::new());
+        }
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dss-surfels-readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let data = read_buffer(gpu, &self.buffers.surfels, &staging, bytes)?;
+        let f: &[f32] = bytemuck::cast_slice(&data);
+        Ok(f.chunks_exact(8)
+            .map(|v| Surfel {
+                position: Vec3::new(v[0], v[1], v[2]),
+                radius: v[3],
+                normal: Vec3::new(v[4], v[5], v[6]),
+            })
+            .collect())
+    }
+}
+
+/// GPU bytes of the DSS buffers and targets (Table 3's rows).
+pub fn memory(u: &DssUniforms) -> DssMemory {
+    let big = (u.cols * u.plane[0]) as u64 * (u.levels * u.rows * u.plane[1]) as u64;
+    let out = (u.cols * u.size[0]) as u64 * (u.levels * u.rows * u.size[1]) as u64;
+    DssMemory {
+        shuffled_positions: big * 16,
+        shuffled_directions: big * 16,
+        layered_framebuffer: big * (2 + if u.visibility == 1 { 4 } else { 0 }) + out * 2,
+        framebuffer_layout: 0,
+        surfels: u.tri_capacity as u64 * 48 + u.fine_capacity as u64 * 32 + u.surfel_capacity as u64 * 32,
+    }
+}
+
+/// Table 3's rows for DSS (bytes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct DssMemory {
+    pub shuffled_positions: u64,
+    pub shuffled_directions: u64,
+    /// Per-level payload and bounced z, and the unshuffled levels.
+    pub layered_framebuffer: u64,
+    /// 0: the layout is a hashed affine permutation computed in the shaders, not lookup textures.
+    pub framebuffer_layout: u64,
+    /// Sub-triangle, fine-surfel and surfel buffers at capacity.
+    pub surfels: u64,
+}
+
+fn read_buffer(
+    gpu: &GpuContext,
+    src: &wgpu::Buffer,
+    staging: &wgpu::Buffer,
+    bytes: u64,
+) -> Result<Vec<u8>, crate::RenderError> {
+    let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("dss-readback"),
+    });
+    enc.copy_buffer_to_buffer(src, 0, staging, 0, bytes);
+    gpu.queue.submit([enc.finish()]);
+    let data = gpu.read_buffer(staging)?;
+    Ok(data)
+}
