@@ -2,10 +2,15 @@
 """Times the same ambient-occlusion job in the strata CPU reference and in Mitsuba 3.
 
 A benchmark tool only (strata never depends on Mitsuba). Needs `pip install mitsuba`
-(variant llvm_ad_rgb, which traces with Embree) and a Rust toolchain.
+numpy (variant llvm_ad_rgb, which traces with Embree), an LLVM that Dr.Jit can JIT
+with (on Debian 12: `apt-get install libllvm19`; with the default LLVM 14/15 the
+kernel fails to compile: "Cannot select ... fmaximum") and a Rust toolchain.
 
-The job (issue 10): binary AO at WIDTH x HEIGHT with SPP x AO_SAMPLES hemisphere rays
-per pixel within RADIUS, from the scene's camera.
+The job (issue 10, `--kind ao`): binary AO at WIDTH x HEIGHT with SPP x AO_SAMPLES
+hemisphere rays per pixel within RADIUS, from the scene's camera. `--kind primary`: SPP
+camera rays per pixel (closest hit); `--kind diffuse`: SPP x AO_SAMPLES cosine bounce
+rays per pixel (closest hit, unbounded). Both sides report wall and CPU seconds (CPU
+time, over all threads of each process, is steadier on a shared machine).
 
 - strata: `examples/ao_job` (Reference::ao_binary: one primary ray through each pixel
   centre + SPP*AO_SAMPLES cosine-weighted occlusion rays), once per tracer backend.
