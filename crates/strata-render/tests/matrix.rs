@@ -153,3 +153,49 @@ fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
     assert_eq!(runs, 2 * techniques * configs.len());
     eprintln!("validation matrix: {runs} configurations × 3 frames, {images} images checked, 0 validation errors, 0 non-finite values");
 }
+
+/// Settings that switch a technique to another algorithm rather than another
+/// preset (they add or replace passes): each must render cleanly too — no
+/// validation error, finite targets and debug views — at one and two layers,
+/// on both scenes.
+#[test]
+fn algorithm_switching_settings_render_cleanly() {
+    const VARIANTS: &[(&str, &[(&str, &str)])] = &[
+        ("bzb-ao", &[("splat", "dss")]),
+        ("bzb-ao", &[("splat", "dss"), ("visibility", "off")]),
+        ("aba-ao", &[("kernel", "hbao-compute")]),
+        ("aba-ao", &[("kernel", "hbao-compute"), ("multilayer", "off")]),
+    ];
+    let gpu = common::gpu();
+    let mut images = 0;
+    for scene_name in ["cornell", "atrium"] {
+        let scene = procedural::builtin(scene_name).expect("built-in scene");
+        for &(technique, sets) in VARIANTS {
+            let t = strata_render::technique::find(technique).expect("registered technique");
+            for layers in [1, 2] {
+                let base = RenderSettings {
+                    width: 64,
+                    height: 64,
+                    deep: DeepGBufferSettings {
+                        layers,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let mut s = t.settings(&base, None).expect("default settings");
+                for &(name, text) in sets {
+                    let info = t.setting_list().find(|i| i.name == name).expect("registered setting");
+                    let value = info.parse_value(text).expect("valid value");
+                    t.set(&mut s, name, value).expect("in range");
+                }
+                let what = format!("{scene_name} {technique} {sets:?} k={layers}");
+                images += check(&gpu, &scene, s, &[], &what);
+            }
+        }
+    }
+    assert!(images > 4 * VARIANTS.len(), "only {images} images checked");
+    eprintln!(
+        "algorithm settings: {} configurations, {images} images checked",
+        2 * 2 * VARIANTS.len()
+    );
+}
