@@ -130,6 +130,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             );
         }
     }
+    if let Some(overflow) = r.dss_overflow(&gpu) {
+        if let Some(message) = overflow? {
+            eprintln!("warning: {message}");
+        }
+    }
     if a.timings {
         for (n, ms) in &t.passes {
             eprintln!("{n:<12} {ms:8.3} ms");

@@ -821,6 +821,14 @@ impl Renderer {
         Some(b.dss()?.read_counts(gpu, b.triangle_count()))
     }
 
+    /// With DSS splatting: a one-line message when the last frame's
+    /// surfelization overflowed a buffer ([`crate::passes::bzb::dss::SurfelCounts::overflow`]).
+    pub fn dss_overflow(&self, gpu: &GpuContext) -> Option<Result<Option<String>, RenderError>> {
+        let b = self.bzb.as_ref()?;
+        let d = b.dss()?;
+        Some(d.read_counts(gpu, b.triangle_count()).map(|c| c.overflow(d.capacity())))
+    }
+
     /// The DSS surfels of the last frame (GPU append order).
     pub fn dss_surfels(&self, gpu: &GpuContext) -> Option<Result<Vec<crate::passes::bzb::dss::Surfel>, RenderError>> {
         let b = self.bzb.as_ref()?;

@@ -290,6 +290,31 @@ pub struct SurfelCounts {
     pub surfels: u32,
 }
 
+impl SurfelCounts {
+    /// One line naming what the frame dropped because a surfel buffer was full
+    /// (`capacity`: sub-triangles, fine surfels, surfels), and what to change;
+    /// `None` when everything fitted.
+    pub fn overflow(&self, capacity: [u32; 3]) -> Option<String> {
+        let stages = [
+            ("sub-triangles", self.subtriangles, capacity[0]),
+            ("fine surfels", self.fine_surfels, capacity[1]),
+            ("surfels", self.surfels, capacity[2]),
+        ];
+        let full: Vec<String> = stages
+            .iter()
+            .filter(|(_, n, cap)| n > cap)
+            .map(|(what, n, cap)| format!("{n} {what} for a buffer of {cap}"))
+            .collect();
+        (!full.is_empty()).then(|| {
+            format!(
+                "dss surfelization overflowed ({}; the excess was dropped, so the AO misses occluders): \
+                 raise surfel-size (0.5..=16 px) or lower the resolution",
+                full.join(", ")
+            )
+        })
+    }
+}
+
 /// The camera quantities surfelization needs (from `FrameUniforms`).
 #[derive(Clone, Copy, Debug)]
 pub struct SurfelCamera {
@@ -579,6 +604,8 @@ pub(crate) struct DssStage {
     buffers: SurfelBuffers,
     /// The frame's W × H.
     pub(crate) size: [u32; 2],
+    /// Capacities of the sub-triangle, fine-surfel and surfel buffers.
+    capacity: [u32; 3],
 }
 
 macro_rules! dss_shader {
@@ -766,6 +793,7 @@ impl DssStage {
             uniforms,
             buffers,
             size: u.size,
+            capacity: [u.tri_capacity, u.fine_capacity, u.surfel_capacity],
         })
     }
 
@@ -903,6 +931,12 @@ impl DssStage {
         ]
     }
 
+    /// Capacities of the sub-triangle, fine-surfel and surfel buffers
+    /// ([`SurfelCounts::overflow`]).
+    pub fn capacity(&self) -> [u32; 3] {
+        self.capacity
+    }
+
     /// Table 2's counts of the last frame (`triangles_in` = `triangles`); counts
     /// beyond a buffer's capacity are reported (and were dropped).
     pub fn read_counts(&self, gpu: &GpuContext, triangles: u32) -> Result<SurfelCounts, crate::RenderError> {
@@ -980,4 +1014,30 @@ fn read_buffer(
     gpu.queue.submit([enc.finish()]);
     let data = gpu.read_buffer(staging)?;
     Ok(data)
+}
+
+#[cfg(test)]
+mod overflow_tests {
+    use super::SurfelCounts;
+
+    /// A full buffer is named with its count and capacity and the setting to
+    /// change; counts at capacity are not an overflow.
+    #[test]
+    fn overflow_names_the_full_buffer_and_the_setting() {
+        let c = SurfelCounts {
+            triangles_in: 10,
+            triangles_culled: 10,
+            subtriangles: 100,
+            fine_surfels: 5000,
+            surfels: 300,
+        };
+        assert_eq!(c.overflow([100, 5000, 300]), None);
+        let m = c.overflow([100, 4096, 300]).expect("fine surfels overflowed");
+        assert!(m.contains("5000 fine surfels for a buffer of 4096"), "{m}");
+        assert!(m.contains("surfel-size (0.5..=16 px)") && !m.contains('\n'), "{m}");
+        assert!(
+            !m.contains("sub-triangles") && !m.contains(" surfels for a buffer of 300"),
+            "{m}"
+        );
+    }
 }
