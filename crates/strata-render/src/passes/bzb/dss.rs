@@ -856,54 +856,7 @@ impl DssStage {
         });
         let module = crate::shader::module(device, "dss-splat", dss_shader!("dss_splat.wgsl"));
         let visibility = u.visibility == 1;
-        let (entry, blend, depth_stencil) = if visibility {
-            (
-                "fs_visibility",
-                None,
-                Some(wgpu::DepthStencilState {
-                    format: DEPTH.format,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-            )
-        } else {
-            let add = wgpu::BlendComponent {
-                src_factor: wgpu::BlendFactor::One,
-                dst_factor: wgpu::BlendFactor::One,
-                operation: wgpu::BlendOperation::Add,
-            };
-            ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
-        };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dss-splat"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_splat"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: PAYLOAD.format,
-                    blend,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = super::splat_pipeline(device, "dss-splat", &pipeline_layout, &module, visibility);
         DssSplatPass {
             pipeline,
             group,

@@ -862,54 +862,7 @@ impl BzbStage {
             immediate_size: 0,
         });
         let module = crate::shader::module(device, "bzb-splat", bzb_shader!("bzb_splat.wgsl"));
-        let (entry, blend, depth_stencil) = if s.visibility {
-            (
-                "fs_visibility",
-                None,
-                Some(wgpu::DepthStencilState {
-                    format: DEPTH.format,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-            )
-        } else {
-            let add = wgpu::BlendComponent {
-                src_factor: wgpu::BlendFactor::One,
-                dst_factor: wgpu::BlendFactor::One,
-                operation: wgpu::BlendOperation::Add,
-            };
-            ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
-        };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("bzb-splat"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_splat"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: PAYLOAD.format,
-                    blend,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = splat_pipeline(device, "bzb-splat", &pipeline_layout, &module, s.visibility);
         SplatPass {
             pipeline,
             group,
@@ -974,4 +927,66 @@ impl Default for BzbUniforms {
     fn default() -> Self {
         Self::zeroed()
     }
+}
+
+/// The splat pipeline of §3.2, shared by the AOV and DSS splats. With
+/// visibility: depth test `Less` with depth writes and no blending, so the
+/// bounced z-buffer keeps the nearest hit per texel (`fs_visibility`);
+/// without: additive blending and no depth test, the baseline that sums every
+/// splat (`fs_additive`). Vertex pulling: no vertex buffers (`vs_splat`).
+pub(crate) fn splat_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    visibility: bool,
+) -> wgpu::RenderPipeline {
+    let (entry, blend, depth_stencil) = if visibility {
+        (
+            "fs_visibility",
+            None,
+            Some(wgpu::DepthStencilState {
+                format: DEPTH.format,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+        )
+    } else {
+        let add = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
+    };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_splat"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: PAYLOAD.format,
+                blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
