@@ -11,7 +11,7 @@ use strata_reference::Reference;
 use strata_render::frame::FrameCameras;
 use strata_render::passes::bzb::{self, BzbSettings, Hemisphere};
 use strata_render::{GpuContext, RenderSettings, Renderer};
-use strata_scene::model::{Material, Mesh, Object, SceneSettings};
+use strata_scene::model::Object;
 use strata_scene::{procedural, Camera, ImageBuf, Scene};
 
 const W: u32 = 64;
@@ -19,38 +19,9 @@ const H: u32 = 48;
 
 /// A scene of quads (corner, edge u, edge v; front face = u × v), one grey material.
 fn quads_scene(name: &str, quads: &[(Vec3, Vec3, Vec3)], camera: Camera, ao_radius: f32) -> Scene {
-    let mut meshes = Vec::new();
-    let mut objects = Vec::new();
-    for (i, &(c, u, v)) in quads.iter().enumerate() {
-        let n = u.cross(v).normalize();
-        let p = [c, c + u, c + u + v, c + v];
-        meshes.push(Mesh {
-            name: format!("{name}-{i}"),
-            positions: p.iter().map(|q| q.to_array()).collect(),
-            normals: vec![n.to_array(); 4],
-            uvs: vec![[0.0; 2]; 4],
-            indices: vec![0, 1, 2, 0, 2, 3],
-            material: 0,
-        });
-        objects.push(Object {
-            name: format!("{name}-{i}"),
-            mesh: i,
-            transform: Mat4::IDENTITY,
-            animation: None,
-        });
-    }
-    Scene {
-        name: name.into(),
-        meshes,
-        objects,
-        materials: vec![Material::diffuse("grey", [0.5; 3])],
-        camera,
-        settings: SceneSettings {
-            ao_radius,
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+    let corners: Vec<[Vec3; 4]> = quads.iter().map(|&(c, u, v)| [c, c + u, c + u + v, c + v]).collect();
+    let polygons: Vec<&[Vec3]> = corners.iter().map(|p| p.as_slice()).collect();
+    common::polygons_scene(name, &polygons, camera, ao_radius)
 }
 
 /// A floor (y = 0) with a stack of `plates` parallel vertical plates standing on

@@ -7,47 +7,17 @@
 
 mod common;
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use strata_render::frame::FrameCameras;
 use strata_render::passes::bzb::dss::{self, DssSettings, Surfel, SurfelCamera};
 use strata_render::passes::bzb::{self, BzbSettings, Splat};
 use strata_render::{GpuContext, RenderSettings, Renderer};
-use strata_scene::model::{Material, Mesh, Object, SceneSettings};
 use strata_scene::{Camera, ImageBuf, Scene};
 
 /// A scene of triangles (one mesh each), one grey material.
 fn tris_scene(name: &str, tris: &[[Vec3; 3]], camera: Camera, ao_radius: f32) -> Scene {
-    let mut meshes = Vec::new();
-    let mut objects = Vec::new();
-    for (i, t) in tris.iter().enumerate() {
-        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
-        meshes.push(Mesh {
-            name: format!("{name}-{i}"),
-            positions: t.iter().map(|q| q.to_array()).collect(),
-            normals: vec![n.to_array(); 3],
-            uvs: vec![[0.0; 2]; 3],
-            indices: vec![0, 1, 2],
-            material: 0,
-        });
-        objects.push(Object {
-            name: format!("{name}-{i}"),
-            mesh: i,
-            transform: Mat4::IDENTITY,
-            animation: None,
-        });
-    }
-    Scene {
-        name: name.into(),
-        meshes,
-        objects,
-        materials: vec![Material::diffuse("grey", [0.5; 3])],
-        camera,
-        settings: SceneSettings {
-            ao_radius,
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+    let polygons: Vec<&[Vec3]> = tris.iter().map(|t| t.as_slice()).collect();
+    common::polygons_scene(name, &polygons, camera, ao_radius)
 }
 
 /// Quad (corner, u, v) as two triangles, front face u × v.

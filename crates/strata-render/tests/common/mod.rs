@@ -3,6 +3,44 @@
 
 pub mod quads;
 
+/// A scene of flat convex polygons (one mesh each, fan-triangulated, front face by
+/// the winding of the first three corners), one grey material, the given camera
+/// and AO radius.
+pub fn polygons_scene(name: &str, polygons: &[&[glam::Vec3]], camera: Camera, ao_radius: f32) -> Scene {
+    use strata_scene::model::{Material, Mesh, Object, SceneSettings};
+    let mut meshes = Vec::new();
+    let mut objects = Vec::new();
+    for (i, p) in polygons.iter().enumerate() {
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        meshes.push(Mesh {
+            name: format!("{name}-{i}"),
+            positions: p.iter().map(|q| q.to_array()).collect(),
+            normals: vec![n.to_array(); p.len()],
+            uvs: vec![[0.0; 2]; p.len()],
+            indices: (1..p.len() as u32 - 1).flat_map(|k| [0, k, k + 1]).collect(),
+            material: 0,
+        });
+        objects.push(Object {
+            name: format!("{name}-{i}"),
+            mesh: i,
+            transform: glam::Mat4::IDENTITY,
+            animation: None,
+        });
+    }
+    Scene {
+        name: name.into(),
+        meshes,
+        objects,
+        materials: vec![Material::diffuse("grey", [0.5; 3])],
+        camera,
+        settings: SceneSettings {
+            ao_radius,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
 use strata_render::frame::FrameCameras;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, Scene};
