@@ -53,19 +53,6 @@ struct SplatVertex {
     @location(0) @interpolate(flat) triangle: u32,
 }
 
-// Pixel position of world point q, and whether q lies beyond the near plane.
-fn project(q: vec3f) -> vec3f {
-    let v = q - frame.eye.xyz;
-    let z = dot(v, frame.cam_forward.xyz);
-    if (z <= frame.eye.w) {
-        return vec3f(0.0, 0.0, 0.0);
-    }
-    let right = frame.cam_right.xyz;
-    let up = frame.cam_up.xyz;
-    let ndc = vec2f(dot(v, right) / dot(right, right), dot(v, up) / dot(up, up)) / z;
-    return vec3f((ndc.x * 0.5 + 0.5) * frame.size.x, (0.5 - ndc.y * 0.5) * frame.size.y, 1.0);
-}
-
 @vertex
 fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> SplatVertex {
     var out: SplatVertex;
@@ -94,7 +81,7 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
         let zq = dot(q - frame.eye.xyz, frame.cam_forward.xyz);
         zlo = min(zlo, zq);
         zhi = max(zhi, zq);
-        let p = project(q);
+        let p = pixel_of_world(frame, q);
         if (p.z > 0.0) {
             in_front++;
             rmin = min(rmin, p.xy);

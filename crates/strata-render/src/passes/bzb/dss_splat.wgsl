@@ -12,6 +12,7 @@
 //                  (depth test Less per level band, no blending); miss → discard.
 //   fs_additive:   the disk's form-factor occlusion, summed by additive blending
 //                  (the original shell splatting, no visibility).
+#import "common/camera.wgsl"
 #import "common/dss.wgsl"
 #import "common/packing.wgsl"
 
@@ -32,19 +33,6 @@ struct SplatVertex {
     @builtin(position) position: vec4f,
     @location(0) @interpolate(flat) surfel: u32,
     @location(1) @interpolate(flat) level: u32,
-}
-
-// Pixel position of world point q, and whether q lies beyond the near plane.
-fn project(q: vec3f) -> vec3f {
-    let v = q - frame.eye.xyz;
-    let z = dot(v, frame.cam_forward.xyz);
-    if (z <= frame.eye.w) {
-        return vec3f(0.0, 0.0, 0.0);
-    }
-    let right = frame.cam_right.xyz;
-    let up = frame.cam_up.xyz;
-    let ndc = vec2f(dot(v, right) / dot(right, right), dot(v, up) / dot(up, up)) / z;
-    return vec3f((ndc.x * 0.5 + 0.5) * frame.size.x, (0.5 - ndc.y * 0.5) * frame.size.y, 1.0);
 }
 
 // §4.1: the sub-image of level l receiving surfel (position c) for direction s.
@@ -72,7 +60,7 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     var in_front = 0u;
     for (var k = 0u; k < 8u; k++) {
         let q = select(lo, hi, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
-        let p = project(q);
+        let p = pixel_of_world(frame, q);
         if (p.z > 0.0) {
             in_front++;
             rmin = min(rmin, p.xy);

@@ -17,3 +17,17 @@ fn world_from_csz(f: Frame, pix: vec2f, z: f32) -> vec3f {
 fn csz_of(f: Frame, p: vec3f) -> f32 {
     return dot(p - f.eye.xyz, f.cam_forward.xyz);
 }
+
+// Pixel position (x, y) of world point q, z = 1 when q lies beyond the near
+// plane (else all 0): the inverse of world_from_csz, for vertex pulling.
+fn pixel_of_world(f: Frame, q: vec3f) -> vec3f {
+    let v = q - f.eye.xyz;
+    let z = dot(v, f.cam_forward.xyz);
+    if (z <= f.eye.w) {
+        return vec3f(0.0, 0.0, 0.0);
+    }
+    let right = f.cam_right.xyz;
+    let up = f.cam_up.xyz;
+    let ndc = vec2f(dot(v, right) / dot(right, right), dot(v, up) / dot(up, up)) / z;
+    return vec3f((ndc.x * 0.5 + 0.5) * f.size.x, (0.5 - ndc.y * 0.5) * f.size.y, 1.0);
+}
