@@ -21,6 +21,12 @@
 //! of walking the lists (ABA §III-B: one texel fetch per sample). Fragments
 //! Eq. 5 evicted neither receive nor occlude; their share of the blend goes
 //! to the background (visibility 1).
+//!
+//! Multi-resolution (ABA Table II, after Hoang & Low's MSSAO; `multires=L`,
+//! [`AbaAoSettings::levels`]): each receiver hemisphere is evaluated on L
+//! levels of point-sampled nodes (coarse texel (X, Y) of level k = pixel
+//! (2^k X, 2^k Y)) with [`level_radius`] and combined as
+//! 1 − (1 − max O_k)(1 − mean O_k); L = 1 is the single resolution.
 
 use glam::Vec3;
 
