@@ -1675,6 +1675,53 @@ fn bench_abuffer_reports_table_one_per_method() {
     }
 }
 
+/// Issue 12, Table II: `--set multires=4` runs every construction's AO on 4
+/// resolution levels (the rows say so); `multires=5` is a one-line range error.
+#[test]
+fn bench_abuffer_table_two_with_multires() {
+    let v = json_of(&strata(&[
+        "bench",
+        "abuffer",
+        "--scene",
+        "glasshouse",
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--frames",
+        "1",
+        "--set",
+        "multires=4",
+        "--json",
+    ]));
+    let m = &v["methods"];
+    for key in ["linked-list", "linear", "fixed-array", "dual-peel", "compressed"] {
+        let x = &m[key];
+        assert!(
+            x["ao_ms"].as_f64().unwrap() > 0.0 && x["total_ms"].as_f64().unwrap() > 0.0,
+            "{key}: {x}"
+        );
+        assert_eq!(x["stage"]["multires"].as_u64(), Some(4), "{key}: {x}");
+    }
+    let o = strata(&[
+        "bench",
+        "abuffer",
+        "--scene",
+        "glasshouse",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--frames",
+        "1",
+        "--set",
+        "multires=5",
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("multires") && err.trim().lines().count() == 1, "{err}");
+}
+
 /// Issue 12 item 6: `--set kernel=hbao-compute` turns `bench abuffer` into ABA Table
 /// III: the list columns run the fragment HBAO with the compute kernel's axis taps, the
 /// compressed column the compute HBAO (§V-B), plus `compressed-fragment` and

@@ -533,7 +533,7 @@ fn aba_ao_of(s: &RenderSettings) -> AbaAoSettings {
 }
 
 /// ABA multilayer AO (Algorithm 1); the names mean what DGB AO's mean.
-static ABA_AO_SETTINGS: [SettingInfo; 11] = [
+static ABA_AO_SETTINGS: [SettingInfo; 12] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1-2, as for ao; default: the scene's ao_radius)",
@@ -600,6 +600,14 @@ static ABA_AO_SETTINGS: [SettingInfo; 11] = [
         set: |s, v| aba_ao_mut(s).inside = v != 0.0,
         values: &["separate", "inside"],
     },
+    setting!(
+        "multires",
+        "multi-resolution AO levels L (ABA Table II after MSSAO; default 1 = off): level k reads the nodes of pixel (2^k X, 2^k Y) per coarse texel, taps capped at 5 texels except on the coarsest level, combined as O = 1-(1-max O_k)(1-mean O_k); not with hbao-compute",
+        Range::Closed(1.0, crate::passes::abuffer::ao::MAX_LEVELS as f64),
+        true,
+        |s| Some(aba_ao_of(s).levels as f64),
+        |s, v| aba_ao_mut(s).levels = v as u32
+    ),
     setting!(
         "directions",
         "HBAO screen directions D per hemisphere (rotated per pixel; hbao-compute always uses the 4 axis directions, unrotated)",

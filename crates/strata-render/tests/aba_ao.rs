@@ -635,3 +635,131 @@ fn compute_hbao_settings_are_range_checked_with_one_line_errors() {
     let e = s.validate().unwrap_err().to_string();
     assert!(e.contains("hbao-compute") && !e.contains('\n'), "{e}");
 }
+
+/// `a` with the multi-resolution AO on `levels` levels (ABA Table II).
+fn multires(a: ABufferSettings, levels: u32) -> ABufferSettings {
+    let mut a = a;
+    a.ao.as_mut().unwrap().levels = levels;
+    a
+}
+
+/// Multi-resolution AO (4 levels): the GPU equals the CPU twin over the
+/// read-back lists / compressed nodes, for list walks and compressed nodes,
+/// Poisson (spiral) and HBAO kernels.
+#[test]
+fn gpu_multires_ao_equals_the_cpu_twin() {
+    let gpu = common::gpu();
+    let scene = mixed();
+    let cases = [
+        (aba_with(ABufferMethod::LinkedList, true, None), "linked-list"),
+        (aba_with(ABufferMethod::FixedArray, true, None), "fixed-array"),
+        (aba_with(ABufferMethod::Linear, true, Some(6)), "linear compress=6"),
+        (
+            hbao(aba_with(ABufferMethod::LinkedList, true, None)),
+            "linked-list hbao",
+        ),
+    ];
+    for (settings, name) in cases {
+        let r = render(&gpu, &scene, multires(settings, 4));
+        let ab = r.abuffer().unwrap();
+        let lists = ab.read_lists(&gpu).unwrap();
+        assert_eq!(lists.overflow, 0);
+        let nodes = ab.read_compressed(&gpu).unwrap();
+        let normals = ab.read_compressed_normals(&gpu).unwrap();
+        let occ = match (&nodes, &normals) {
+            (Some(n), Some(nf)) => Occluders::Compressed {
+                nodes: n,
+                normals: nf,
+                depth_scale: ab.depth_scale(),
+            },
+            _ => Occluders::Lists,
+        };
+        let u = ab.ao_uniforms().expect("AO uniforms were set");
+        assert_eq!(u.levels, 4, "{name}: the uniforms carry the levels");
+        let frame = r.frame_uniforms();
+        let gpu_av = raw(&gpu, &r);
+        let (mut worst, mut sum, mut dark) = (0.0f32, 0.0f64, 0);
+        for y in 0..H {
+            for x in 0..W {
+                let want = ambient_visibility_cpu(&lists, &occ, &frame, &u, x, y);
+                let got = gpu_av.pixel(x, y)[0];
+                let d = (got - want).abs();
+                worst = worst.max(d);
+                sum += d as f64;
+                dark += (want < 0.9) as u32;
+                assert!(d < 2e-3, "{name} multires=4: pixel ({x}, {y}) GPU {got} vs CPU {want}");
+            }
+        }
+        let mean = sum / (W * H) as f64;
+        eprintln!("{name} multires=4: |GPU − CPU| max {worst:.2e}, mean {mean:.2e}, {dark} pixels below 0.9");
+        assert!(mean < 1e-4, "mean difference {mean}");
+        assert!(dark > 50, "the scene occludes: {dark} pixels below 0.9");
+    }
+}
+
+/// With 4 levels an unoccluded plane still has AV exactly 1 (every level's
+/// taps read nodes on the plane itself: Eq. 2's bias keeps them at 0).
+#[test]
+fn multires_keeps_an_unoccluded_plane_at_one() {
+    let gpu = common::gpu();
+    let scene = quads(
+        vec![Material::diffuse("plane", [0.6, 0.6, 0.6])],
+        &[(0.0, [-20.0, 20.0], [-20.0, 20.0], 0)],
+    );
+    for a in [aba(true, None), aba(true, Some(6)), hbao(aba(true, None))] {
+        let av = raw(&gpu, &render(&gpu, &scene, multires(a, 4)));
+        assert!(
+            av.data.iter().all(|&a| a == 1.0),
+            "min AV {}",
+            av.data.iter().cloned().fold(1.0, f32::min)
+        );
+    }
+}
+
+/// One level (level 0 only) is today's single-resolution AO bit for bit, and
+/// 4 levels change the image (the coarse levels reach farther, the fine are capped).
+#[test]
+fn multires_level_zero_only_is_the_single_resolution_ao() {
+    let gpu = common::gpu();
+    let scene = mixed();
+    for (a, compress) in [(aba(true, None), None), (aba(true, Some(6)), Some(6))] {
+        assert_eq!(AbaAoSettings::default().levels, 1, "off by default");
+        let today = raw(&gpu, &render(&gpu, &scene, a.clone()));
+        let one = raw(&gpu, &render(&gpu, &scene, multires(a.clone(), 1)));
+        assert_eq!(today.data, one.data, "compress={compress:?}: multires=1 is today's AO");
+        let four = raw(&gpu, &render(&gpu, &scene, multires(a, 4)));
+        let differ = today
+            .data
+            .iter()
+            .zip(&four.data)
+            .filter(|(a, b)| (*a - *b).abs() > 1e-3)
+            .count();
+        assert!(differ > 20, "compress={compress:?}: 4 levels change {differ} pixels");
+    }
+    assert_eq!(strata_render::passes::abuffer::ao::level_radius(37.5, 0, 1), 37.5);
+    assert_eq!(strata_render::passes::abuffer::ao::level_radius(37.5, 0, 4), 5.0);
+    assert_eq!(strata_render::passes::abuffer::ao::level_radius(37.5, 3, 4), 37.5 / 8.0);
+}
+
+/// `multires` is a registry setting with a one-line range error, and the
+/// compute HBAO (one staged resolution) refuses it.
+#[test]
+fn multires_setting_range_and_kernel_errors() {
+    let t = strata_render::technique::find("aba-ao").unwrap();
+    let mut s = t.settings(&RenderSettings::default(), None).unwrap();
+    t.set(&mut s, "multires", 4.0).unwrap();
+    assert_eq!(s.abuffer.as_ref().unwrap().ao.as_ref().unwrap().levels, 4);
+    for bad in [0.0, 5.0] {
+        let e = t.set(&mut s, "multires", bad).unwrap_err().to_string();
+        assert!(e.contains("multires") && !e.contains('\n'), "{e}");
+    }
+    let mut a = multires(aba(true, Some(4)), 4);
+    a.ao.as_mut().unwrap().kernel = AoKernel::HbaoCompute;
+    let e = a.validate().unwrap_err();
+    assert!(e.contains("multires") && !e.contains('\n'), "{e}");
+    let mut a = multires(aba(true, None), 5);
+    let e = a.validate().unwrap_err();
+    assert!(e.contains("multires") && !e.contains('\n'), "{e}");
+    a.ao.as_mut().unwrap().levels = 2;
+    a.validate().unwrap();
+}

@@ -15,6 +15,9 @@
 //! taps over the compressed nodes in the fragment shader, one texel fetch per
 //! tap: what the staging alone buys) and `single-layer` (compute HBAO over
 //! each pixel's nearest node: Table III's "default").
+//!
+//! With `--set multires=4` every column's AO is the multi-resolution AO over
+//! 4 levels (ABA Table II; each row's `stage.multires` says so).
 
 use std::collections::BTreeMap;
 
@@ -113,6 +116,7 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
             "compress_back_half": a.compress_back_half,
             "kernel": a.ao.as_ref().map(|o| format!("{:?}", o.kernel)),
             "multilayer": a.ao.as_ref().map(|o| o.multilayer),
+            "multires": a.ao.as_ref().map(|o| o.levels),
         });
         let s2 = settings.clone();
         let bench = stage::run(Stage {

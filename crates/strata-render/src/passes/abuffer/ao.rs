@@ -21,6 +21,12 @@
 //! of walking the lists (ABA §III-B: one texel fetch per sample). Fragments
 //! Eq. 5 evicted neither receive nor occlude; their share of the blend goes
 //! to the background (visibility 1).
+//!
+//! Multi-resolution (ABA Table II, after Hoang & Low's MSSAO; `multires=L`,
+//! [`AbaAoSettings::levels`]): each receiver hemisphere is evaluated on L
+//! levels of point-sampled nodes (coarse texel (X, Y) of level k = pixel
+//! (2^k X, 2^k Y)) with [`level_radius`] and combined as
+//! 1 − (1 − max O_k)(1 − mean O_k); L = 1 is the single resolution.
 
 use glam::Vec3;
 
@@ -71,6 +77,12 @@ pub fn apron(texels: u32) -> u32 {
     (s - TILE) / 2
 }
 
+/// Largest number of resolution levels of the multi-resolution AO (`multires`).
+pub const MAX_LEVELS: u32 = 4;
+/// Multi-resolution AO: the screen radius, in the level's texels, at which
+/// every level but the coarsest is capped (MSSAO's typical cap, Hoang & Low).
+pub const LEVEL_CAP: f32 = 5.0;
+
 /// Largest HBAO directions D and steps S.
 pub const MAX_DIRECTIONS: u32 = 16;
 pub const MAX_STEPS: u32 = 32;
@@ -108,6 +120,26 @@ pub struct AbaAoSettings {
     pub inside: bool,
     /// Bilateral reconstruction after the blend (ABA: possible because the AO is separate).
     pub blur: BilateralSettings,
+    /// Multi-resolution AO (ABA Table II, after Hoang & Low's MSSAO): the
+    /// number L of resolution levels (1 = off, today's single resolution).
+    /// Level k reads the nodes at 1/2^k resolution, where a coarse texel
+    /// (X, Y) holds exactly the nodes (or list) of full-resolution pixel
+    /// (2^k X, 2^k Y) (point-sampled downsample); the levels combine as
+    /// MSSAO: O = 1 − (1 − max_k O_k)(1 − mean_k O_k). See [`level_radius`].
+    pub levels: u32,
+}
+
+/// Screen radius in level-`k` texels of the taps of level `k` out of
+/// `levels`, for the full-resolution projected radius `r_p`: the coarsest
+/// level covers the whole world radius (`r_p / 2^k`), the finer ones are
+/// capped at [`LEVEL_CAP`] texels (MSSAO). With one level it is `r_p`.
+pub fn level_radius(r_p: f32, k: u32, levels: u32) -> f32 {
+    let r = r_p / (1u32 << k) as f32;
+    if k + 1 >= levels {
+        r
+    } else {
+        r.min(LEVEL_CAP)
+    }
 }
 
 impl Default for AbaAoSettings {
@@ -127,6 +159,7 @@ impl Default for AbaAoSettings {
             steps: 8,
             inside: false,
             blur: dgb.blur,
+            levels: 1,
         }
     }
 }
@@ -163,6 +196,15 @@ impl AbaAoSettings {
                 self.samples
             ));
         }
+        if !(1..=MAX_LEVELS).contains(&self.levels) {
+            return Err(format!(
+                "AO multires {} is out of range: must be in 1..={MAX_LEVELS}",
+                self.levels
+            ));
+        }
+        if self.levels > 1 && self.kernel == AoKernel::HbaoCompute {
+            return Err("AO multires > 1 needs kernel ssao or hbao (hbao-compute stages one resolution)".into());
+        }
         Ok(())
     }
 
@@ -194,6 +236,8 @@ pub struct AbaAoUniforms {
     pub steps: u32,
     /// Compute HBAO: the staged apron in pixels ([`apron`]); 0 otherwise.
     pub apron: u32,
+    /// Multi-resolution levels L (1 = single resolution).
+    pub levels: u32,
 }
 
 impl AbaAoUniforms {
@@ -230,6 +274,7 @@ impl AbaAoUniforms {
             } else {
                 0
             },
+            levels: if compute { 1 } else { s.levels },
         }
     }
 
@@ -315,24 +360,32 @@ impl Twin<'_> {
         a
     }
 
-    /// DGB Eq. 1 over the receiver's hemisphere (`hemisphere_av` of `aba_ao.wgsl`).
-    fn ssao(&self, r: &Receiver) -> f32 {
+    /// The full-resolution pixel holding level `k`'s nodes at level-`k` offset
+    /// `d` from `p`'s level-`k` texel (the point-sampled downsample), if inside.
+    fn level_pixel(&self, p: (u32, u32), d: [i32; 2], k: u32) -> Option<(u32, u32)> {
+        let qx = ((p.0 >> k) as i32 + d[0]) << k;
+        let qy = ((p.1 >> k) as i32 + d[1]) << k;
+        self.tap_pixel((0, 0), [qx, qy])
+    }
+
+    /// DGB Eq. 1 over the receiver's hemisphere at level `k` (`hemisphere_av` of `aba_ao.wgsl`).
+    fn ssao(&self, r: &Receiver, k: u32) -> f32 {
         let u = self.u;
-        let r_p = u.proj_scale * u.radius / r.z;
+        let r_p = level_radius(u.proj_scale * u.radius / r.z, k, u.levels.max(1));
         let mut sum = 0.0f32;
         for i in 0..u.samples {
             let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, r.phi);
-            if let Some(q) = self.tap_pixel(r.p, spiral::tap_texel(tap.offset)) {
+            if let Some(q) = self.level_pixel(r.p, spiral::tap_texel(tap.offset), k) {
                 sum += self.tap_occlusion(q, r.x, r.n);
             }
         }
         (1.0 - (u.intensity * std::f32::consts::PI / u.samples as f32 * sum).sqrt()).max(0.0)
     }
 
-    /// `hemisphere_hbao` of `aba_ao.wgsl`.
-    fn hbao(&self, r: &Receiver) -> f32 {
+    /// `hemisphere_hbao` of `aba_ao.wgsl` at level `k`.
+    fn hbao(&self, r: &Receiver, k: u32) -> f32 {
         let u = self.u;
-        let r_p = u.proj_scale * u.radius / r.z;
+        let r_p = level_radius(u.proj_scale * u.radius / r.z, k, u.levels.max(1));
         let mut sum = 0.0f32;
         for d in 0..u.directions {
             let ang = r.phi + std::f32::consts::TAU * d as f32 / u.directions as f32;
@@ -340,7 +393,7 @@ impl Twin<'_> {
             let mut horizon = 0.0f32;
             for s in 0..u.steps {
                 let len = r_p * (s as f32 + 0.5) / u.steps as f32;
-                let Some(q) = self.tap_pixel(r.p, spiral::tap_texel([dir[0] * len, dir[1] * len])) else {
+                let Some(q) = self.level_pixel(r.p, spiral::tap_texel([dir[0] * len, dir[1] * len]), k) else {
                     break;
                 };
                 horizon = horizon.max(self.tap_occlusion(q, r.x, r.n));
@@ -353,12 +406,28 @@ impl Twin<'_> {
     /// The receiver hemisphere's AV with the uniforms' kernel.
     /// (Compute HBAO is [`Self::hbao`] with the uniforms' D = 4, φ = 0: its
     /// tile staging changes where nodes are read, not what is computed.)
-    fn hemisphere(&self, r: &Receiver) -> f32 {
+    fn level(&self, r: &Receiver, k: u32) -> f32 {
         if self.u.kernel != AoKernel::Ssao as u32 {
-            self.hbao(r)
+            self.hbao(r, k)
         } else {
-            self.ssao(r)
+            self.ssao(r, k)
         }
+    }
+
+    /// Multi-resolution: MSSAO's combination of the levels' occlusions
+    /// O_k = 1 − AV_k, O = 1 − (1 − max O_k)(1 − mean O_k); one level: AV_0.
+    fn hemisphere(&self, r: &Receiver) -> f32 {
+        let levels = self.u.levels.max(1);
+        if levels == 1 {
+            return self.level(r, 0);
+        }
+        let (mut max_o, mut sum_o) = (0.0f32, 0.0f32);
+        for k in 0..levels {
+            let o = 1.0 - self.level(r, k);
+            max_o = max_o.max(o);
+            sum_o += o;
+        }
+        (1.0 - max_o) * (1.0 - sum_o / levels as f32)
     }
 }
 

@@ -37,6 +37,8 @@ struct AbaAo {
     steps: u32,
     // compute HBAO: tile apron in pixels staged in workgroup memory
     apron: u32,
+    // multi-resolution levels L (1 = single resolution; ABA Table II, MSSAO)
+    levels: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -56,14 +58,31 @@ fn node_occlusion(word: u32, centre: vec2f, x: vec3f, n: vec3f) -> f32 {
     return alpha * obscurance(world_from_csz(frame, centre, z) - x, n);
 }
 
-// DGB Eq. 1 over the hemisphere around n at x (camera depth z) seen from pixel p.
-fn hemisphere_av(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
-    let r_p = ao.proj_scale * ao.radius / z;
+// Multi-resolution: the tap radius in level-k texels (`ao::level_radius`):
+// the coarsest level covers r_p / 2^k, finer ones are capped at 5 texels.
+fn level_radius(r_p: f32, k: u32) -> f32 {
+    let r = r_p / f32(1u << k);
+    if (k + 1u >= max(ao.levels, 1u)) {
+        return r;
+    }
+    return min(r, 5.0);
+}
+
+// The full-resolution pixel holding level k's nodes at level-k offset d from
+// p's level-k texel: coarse texel (X, Y) = pixel (2^k X, 2^k Y).
+fn level_pixel(p: vec2i, d: vec2i, k: u32) -> vec2i {
+    return ((p >> vec2u(k)) + d) << vec2u(k);
+}
+
+// DGB Eq. 1 over the hemisphere around n at x (camera depth z) seen from
+// pixel p, on resolution level k.
+fn hemisphere_av(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32, k: u32) -> f32 {
+    let r_p = level_radius(ao.proj_scale * ao.radius / z, k);
     let size = vec2i(i32(params.width), i32(params.height));
     var sum = 0.0;
     for (var i = 0u; i < ao.samples; i++) {
         let tap = spiral_tap(i, ao.samples, ao.tau, r_p, phi);
-        let q = p + tap_texel(tap.offset);
+        let q = level_pixel(p, tap_texel(tap.offset), k);
         if (any(q < vec2i(0)) || any(q >= size)) {
             continue;
         }
@@ -97,8 +116,8 @@ fn receiver_av(p: vec2i, alpha: f32, depth: f32, nf: u32, phi: f32) -> f32 {
 // every layer — Eq. 2's (v·n − β)/|v| is the sine of the sample's elevation
 // above the tangent plane, (1 − |v|²/r²) HBAO's attenuation W; AV = 1 −
 // intensity · mean over the directions.
-fn hemisphere_hbao(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
-    let r_p = ao.proj_scale * ao.radius / z;
+fn hemisphere_hbao(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32, k: u32) -> f32 {
+    let r_p = level_radius(ao.proj_scale * ao.radius / z, k);
     let size = vec2i(i32(params.width), i32(params.height));
     var sum = 0.0;
     for (var d = 0u; d < ao.directions; d++) {
@@ -107,7 +126,7 @@ fn hemisphere_hbao(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
         var horizon = 0.0;
         for (var s = 0u; s < ao.steps; s++) {
             let h = r_p * (f32(s) + 0.5) / f32(ao.steps);
-            let q = p + tap_texel(dir * h);
+            let q = level_pixel(p, tap_texel(dir * h), k);
             if (any(q < vec2i(0)) || any(q >= size)) {
                 break;
             }
@@ -118,11 +137,28 @@ fn hemisphere_hbao(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
     return max(0.0, 1.0 - ao.intensity * sum / f32(ao.directions));
 }
 
-fn hemisphere(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
+fn hemisphere_level(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32, k: u32) -> f32 {
     if (ao.kernel >= 1u) {
-        return hemisphere_hbao(p, x, n, z, phi);
+        return hemisphere_hbao(p, x, n, z, phi, k);
     }
-    return hemisphere_av(p, x, n, z, phi);
+    return hemisphere_av(p, x, n, z, phi, k);
+}
+
+// Multi-resolution (ABA Table II after MSSAO): the levels' occlusions
+// O_k = 1 - AV_k combine as O = 1 - (1 - max O_k)(1 - mean O_k).
+fn hemisphere(p: vec2i, x: vec3f, n: vec3f, z: f32, phi: f32) -> f32 {
+    let levels = max(ao.levels, 1u);
+    if (levels == 1u) {
+        return hemisphere_level(p, x, n, z, phi, 0u);
+    }
+    var max_o = 0.0;
+    var sum_o = 0.0;
+    for (var k = 0u; k < levels; k++) {
+        let o = 1.0 - hemisphere_level(p, x, n, z, phi, k);
+        max_o = max(max_o, o);
+        sum_o += o;
+    }
+    return (1.0 - max_o) * (1.0 - sum_o / f32(levels));
 }
 
 // The compressed receivers of pixel p (§III-B: the M nodes, sorted by depth,
