@@ -966,6 +966,7 @@ const ILS_PASSES: &[&str] = &[
     "ils-bs",
     "ils-snsm",
     "ils-bg",
+    "ils-bg-glossy",
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",

@@ -207,3 +207,153 @@ fn gpu_glossy_vpl_radiance_equals_the_cpu_twin() {
         cases.len()
     );
 }
+
+/// World position of pixel (x, y) at camera-space depth z (common/camera.wgsl's twin).
+fn world(u: &strata_render::frame::FrameUniforms, x: u32, y: u32, z: f32) -> Vec3 {
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let ndc_x = (x as f32 + 0.5) * u.size[2] * 2.0 - 1.0;
+    let ndc_y = 1.0 - (y as f32 + 0.5) * u.size[3] * 2.0;
+    v(u.eye) + z * (v(u.cam_forward) + v(u.cam_right) * ndc_x + v(u.cam_up) * ndc_y)
+}
+
+/// The frame on `still-life` (gold metal sphere, blue glossy vase, Lambert
+/// cloth and boxes), brute force and 8×6 SNSM without blur: glossy pixels
+/// (emission.a = 2) carry Σ_k `glossy_radiance_at` in `ils-glossy` and 0 in
+/// `ils-irradiance`; Lambert pixels carry Σ_k `irradiance_at` as before and 0
+/// in `ils-glossy`.
+#[test]
+fn ils_frame_shades_glossy_receivers_with_the_cpu_twin() {
+    use strata_reference::vpl::VplSettings;
+    use strata_reference::Reference;
+    use strata_render::frame::FrameCameras;
+    use strata_render::passes::ils::{GpuVpl, IlsSettings};
+    use strata_render::passes::interleave::{InterleaveGeometry, SplitMethod};
+    use strata_render::{RenderSettings, Renderer};
+    const W: u32 = 64;
+    const H: u32 = 48;
+    let gpu = common::gpu();
+    let scene = strata_scene::procedural::builtin("still-life").unwrap();
+    let v = Reference::new(&scene, 0.0).vpls(&VplSettings {
+        paths: 96,
+        ..Default::default()
+    });
+    assert!(!v.is_empty());
+    let ils = IlsSettings {
+        vpls: v
+            .iter()
+            .map(|v| GpuVpl::new(v.position.into(), v.normal.into(), v.flux.into()))
+            .collect(),
+        blur: 0.0,
+        ..Default::default()
+    };
+    let max_g = ils.max_geometry(&scene);
+    for brute_force in [true, false] {
+        let t = strata_render::technique::find("ils").unwrap();
+        let mut s = t
+            .settings(
+                &RenderSettings {
+                    width: W,
+                    height: H,
+                    ..Default::default()
+                },
+                None,
+            )
+            .unwrap();
+        s.ils = Some(IlsSettings {
+            brute_force,
+            ..ils.clone()
+        });
+        let mut r = Renderer::new(&gpu, &scene, s).expect("renderer builds without validation errors");
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let read = |name: &str| {
+            let img = r.read_target(&gpu, name).unwrap();
+            gpu.check_errors().unwrap();
+            img
+        };
+        let (irr, glossy, csz) = (read("ils-irradiance"), read("ils-glossy"), read("csz"));
+        let (nrm, albedo, emission) = (read("normal"), read("albedo"), read("emission"));
+        let normals = r.read_normals(&gpu).unwrap();
+        let u = r.frame_uniforms();
+        let eye = Vec3::new(u.eye[0], u.eye[1], u.eye[2]);
+        let geo = InterleaveGeometry::new(W, H, 8, 6, SplitMethod::Naive).unwrap();
+        let n_all = v.len() as u32;
+        let (mut n_glossy, mut n_lambert, mut worst) = (0, 0, 0.0f32);
+        let mut cpu = vec![Vec3::ZERO; (W * H) as usize];
+        let mut is_glossy = vec![false; (W * H) as usize];
+        for y in 0..H {
+            for x in 0..W {
+                let i = (y * W + x) as usize;
+                let z = csz.data[i];
+                if z <= 0.0 {
+                    continue;
+                }
+                let p = world(&u, x, y, z);
+                let n = Vec3::from_slice(&normals.data[i * 3..i * 3 + 3]);
+                let g = emission.data[i * 4 + 3] > 1.5;
+                is_glossy[i] = g;
+                let rho = Vec3::from_slice(&albedo.data[i * 4..i * 4 + 3]);
+                let (rough, metal) = (nrm.data[i * 4 + 2], nrm.data[i * 4 + 3]);
+                let view = (eye - p).normalize();
+                let [si, sj] = geo.sub_buffer(x, y);
+                let (first, step) = if brute_force { (0, 1) } else { (sj * 8 + si, 48) };
+                let mut e = Vec3::ZERO;
+                let mut count = 0;
+                for k in (first..n_all).step_by(step as usize) {
+                    e += if g {
+                        v[k as usize].glossy_radiance_at(p, n, view, rho, rough, metal, max_g)
+                    } else {
+                        v[k as usize].irradiance_at(p, n, max_g)
+                    };
+                    count += 1;
+                }
+                if count > 0 {
+                    e *= n_all as f32 / count as f32;
+                }
+                cpu[i] = e;
+                if g {
+                    n_glossy += 1;
+                } else {
+                    n_lambert += 1;
+                }
+            }
+        }
+        assert!(
+            n_glossy > 50 && n_lambert > 50,
+            "{n_glossy} glossy, {n_lambert} Lambert pixels"
+        );
+        let scale_g = (0..cpu.len())
+            .filter(|&i| is_glossy[i])
+            .map(|i| cpu[i].max_element())
+            .fold(0.0f32, f32::max);
+        let scale_l = (0..cpu.len())
+            .filter(|&i| !is_glossy[i])
+            .map(|i| cpu[i].max_element())
+            .fold(0.0f32, f32::max);
+        assert!(scale_g > 0.0 && scale_l > 0.0, "the VPLs light both kinds");
+        for i in 0..cpu.len() {
+            let (own, other, scale, rel) = if is_glossy[i] {
+                // glossy: f32 camera reconstruction and sRGB decode differ; narrow lobes amplify
+                (&glossy, &irr, scale_g, 0.01)
+            } else {
+                // Lambert: the bound of tests/ils.rs (0.2 % + 0.02 % of the max; f16 storage)
+                (&irr, &glossy, scale_l, 0.002)
+            };
+            let abs = if is_glossy[i] { 2e-3 } else { 2e-4 };
+            for c in 0..3 {
+                let (a, b) = (own.data[i * 4 + c], cpu[i][c]);
+                let err = (a - b).abs() / (rel * b.abs() + abs * scale);
+                worst = worst.max(err);
+                assert!(
+                    err <= 1.0,
+                    "brute force {brute_force}: pixel {i} (glossy {}) channel {c}: GPU {a} vs CPU {b} (scale {scale})",
+                    is_glossy[i]
+                );
+                assert_eq!(other.data[i * 4 + c], 0.0, "pixel {i}: the other target is 0");
+            }
+        }
+        eprintln!(
+            "brute force {brute_force}: {n_glossy} glossy, {n_lambert} Lambert pixels; worst {worst:.3} of the tolerance"
+        );
+    }
+}

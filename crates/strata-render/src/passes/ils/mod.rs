@@ -53,6 +53,7 @@ pub const PASSES: &[&str] = &[
     "ils-bs",
     "ils-snsm",
     "ils-bg",
+    "ils-bg-glossy",
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",
@@ -270,7 +271,7 @@ impl IlsSettings {
         if self.brute_force {
             v.push(BRUTE_FORCE_PASS);
         } else {
-            v.extend(["ils-bs", self.shading_pass(), "ils-bg"]);
+            v.extend(["ils-bs", self.shading_pass(), "ils-bg", "ils-bg-glossy"]);
         }
         if self.blurs() {
             v.extend(["ils-db", "ils-blur-h", "ils-blur-v"]);
@@ -303,9 +304,9 @@ impl IlsSettings {
         let [n, m] = self.pattern;
         let tiled = (w.div_ceil(n.max(1)) * n.max(1)) as u64 * (h.div_ceil(m.max(1)) * m.max(1)) as u64;
         let px = w as u64 * h as u64;
-        // gbuffer 16 + irradiance 8 + DB 8 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8;
+        // gbuffer 16 + irradiance 8 + glossy 8 + DB 8 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8 + 8;
         // the Blocks intermediates ≤ 2 more tiled-size buffers
-        px * 72 + tiled * (24 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
+        px * 80 + tiled * (32 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
     }
 }
 
@@ -333,6 +334,18 @@ pub const IRRADIANCE: TargetDesc = TargetDesc::new(
     wgpu::TextureFormat::Rgba16Float,
     1,
     "ILS §4.4 (Fig. 3 d): gathered interleaved irradiance (or the brute force's)",
+);
+pub const GLOSSY_TILED: TargetDesc = TargetDesc::new(
+    "ils-glossy-tiled",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "outgoing radiance of glossy (GGX) receivers from each sub-buffer's VPL subset, tiled (0 on Lambert ones)",
+);
+pub const GLOSSY: TargetDesc = TargetDesc::new(
+    "ils-glossy",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "outgoing radiance of glossy (GGX) receivers, gathered; compose adds it as is (0 on Lambert receivers)",
 );
 pub const DISCONTINUITY: TargetDesc = TargetDesc::new(
     "ils-discontinuity",
@@ -475,6 +488,8 @@ pub(crate) struct IlsStage {
     split: Option<InterleavePass>,
     shade: FullscreenPass,
     gather: Option<InterleavePass>,
+    /// BG of the glossy receivers' radiance (`ils-glossy`, not blurred: docs/ils.md)
+    gather_glossy: Option<InterleavePass>,
     discontinuity: Option<FullscreenPass>,
     blur_h: Option<FullscreenPass>,
     blur_v: Option<FullscreenPass>,
@@ -509,7 +524,7 @@ impl IlsStage {
         let (w, h) = (targets.width, targets.height);
         let [n, m] = s.pattern;
         let vpl_buffer = vpl_buffer(gpu, &s.vpls);
-        for t in [GBUFFER, IRRADIANCE, INDIRECT] {
+        for t in [GBUFFER, IRRADIANCE, INDIRECT, GLOSSY] {
             targets.create(gpu, t);
         }
         let gbuffer = PassBuilder::new(gpu, targets, "ils-gbuffer")
@@ -519,14 +534,16 @@ impl IlsStage {
             .write(GBUFFER.name)
             .build();
 
-        let (split, gather, geo) = if s.brute_force {
-            (None, None, None)
+        let (split, gather, gather_glossy, geo) = if s.brute_force {
+            (None, None, None, None)
         } else {
             let bs = Interleave::new(gpu, GBUFFER.format, w, h, n, m, s.method)?;
             let bg = Interleave::new(gpu, IRRADIANCE.format, w, h, n, m, s.method)?;
+            let bg_glossy = Interleave::new(gpu, GLOSSY.format, w, h, n, m, s.method)?;
             let tiled = bs.tiled_size();
             targets.create_sized(gpu, GBUFFER_SPLIT, tiled);
             targets.create_sized(gpu, IRRADIANCE_TILED, tiled);
+            targets.create_sized(gpu, GLOSSY_TILED, tiled);
             let geo = *bs.geometry();
             let split = InterleavePass {
                 name: "ils-bs",
@@ -542,7 +559,14 @@ impl IlsStage {
                 dst: IRRADIANCE.name,
                 split: false,
             };
-            (Some(split), Some(gather), Some(geo))
+            let gather_glossy = InterleavePass {
+                name: "ils-bg-glossy",
+                interleave: bg_glossy,
+                src: GLOSSY_TILED.name,
+                dst: GLOSSY.name,
+                split: false,
+            };
+            (Some(split), Some(gather), Some(gather_glossy), Some(geo))
         };
         let vpl_shadows = match s.shadows {
             VplShadows::None => None,
@@ -572,11 +596,35 @@ impl IlsStage {
         };
         let shade = {
             let traced = vpl_shadows.is_some();
-            let (name, entry, input, output) = match (s.brute_force, traced) {
-                (true, false) => (BRUTE_FORCE_PASS, "fs_brute_force", GBUFFER.name, IRRADIANCE.name),
-                (true, true) => (BRUTE_FORCE_PASS, "fs_brute_force_ssm", GBUFFER.name, IRRADIANCE.name),
-                (false, false) => ("ils-snsm", "fs_snsm", GBUFFER_SPLIT.name, IRRADIANCE_TILED.name),
-                (false, true) => ("ils-ssm", "fs_ssm", GBUFFER_SPLIT.name, IRRADIANCE_TILED.name),
+            let (name, entry, input, output, output_glossy) = match (s.brute_force, traced) {
+                (true, false) => (
+                    BRUTE_FORCE_PASS,
+                    "fs_brute_force",
+                    GBUFFER.name,
+                    IRRADIANCE.name,
+                    GLOSSY.name,
+                ),
+                (true, true) => (
+                    BRUTE_FORCE_PASS,
+                    "fs_brute_force_ssm",
+                    GBUFFER.name,
+                    IRRADIANCE.name,
+                    GLOSSY.name,
+                ),
+                (false, false) => (
+                    "ils-snsm",
+                    "fs_snsm",
+                    GBUFFER_SPLIT.name,
+                    IRRADIANCE_TILED.name,
+                    GLOSSY_TILED.name,
+                ),
+                (false, true) => (
+                    "ils-ssm",
+                    "fs_ssm",
+                    GBUFFER_SPLIT.name,
+                    IRRADIANCE_TILED.name,
+                    GLOSSY_TILED.name,
+                ),
             };
             let b = PassBuilder::new(gpu, targets, name)
                 .shader("ils-snsm", include_str!("ils_snsm.wgsl"))
@@ -584,7 +632,10 @@ impl IlsStage {
                 .frame(scene_gpu)
                 .uniforms(&shade_uniforms)
                 .read(input)
-                .storage(&vpl_buffer);
+                .storage(&vpl_buffer)
+                .read_layer("normal", 0)
+                .read_layer("albedo", 0)
+                .read_layer("emission", 0);
             let b = match &vpl_shadows {
                 Some(p) => b
                     .depth_view(
@@ -596,7 +647,7 @@ impl IlsStage {
                     .storage(&p.matrices),
                 None => b,
             };
-            b.write(output).build()
+            b.write(output).write(output_glossy).build()
         };
 
         let (mut discontinuity, mut blur_h, mut blur_v) = (None, None, None);
@@ -610,12 +661,14 @@ impl IlsStage {
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
         }
-        let compose = crate::passes::compose::ComposePass::new(gpu, scene_gpu, targets, false, None, shown);
+        let compose =
+            crate::passes::compose::ComposePass::new(gpu, scene_gpu, targets, false, None, shown, Some(GLOSSY.name));
         Ok(Self {
             gbuffer,
             split,
             shade,
             gather,
+            gather_glossy,
             discontinuity,
             blur_h,
             blur_v,
@@ -655,6 +708,9 @@ impl IlsStage {
         }
         v.push(&self.shade);
         if let Some(p) = &self.gather {
+            v.push(p);
+        }
+        if let Some(p) = &self.gather_glossy {
             v.push(p);
         }
         for p in [&self.discontinuity, &self.blur_h, &self.blur_v].into_iter().flatten() {
