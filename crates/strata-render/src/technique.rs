@@ -970,6 +970,8 @@ const ILS_PASSES: &[&str] = &[
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",
+    "ils-blur-glossy-h",
+    "ils-blur-glossy-v",
     "compose",
     "tonemap",
 ];

@@ -57,6 +57,8 @@ pub const PASSES: &[&str] = &[
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",
+    "ils-blur-glossy-h",
+    "ils-blur-glossy-v",
     "compose",
 ];
 
@@ -274,7 +276,13 @@ impl IlsSettings {
             v.extend(["ils-bs", self.shading_pass(), "ils-bg", "ils-bg-glossy"]);
         }
         if self.blurs() {
-            v.extend(["ils-db", "ils-blur-h", "ils-blur-v"]);
+            v.extend([
+                "ils-db",
+                "ils-blur-h",
+                "ils-blur-v",
+                "ils-blur-glossy-h",
+                "ils-blur-glossy-v",
+            ]);
         }
         v.push("compose");
         v
@@ -346,6 +354,12 @@ pub const GLOSSY: TargetDesc = TargetDesc::new(
     wgpu::TextureFormat::Rgba16Float,
     1,
     "outgoing radiance of glossy (GGX) receivers, gathered; compose adds it as is (0 on Lambert receivers)",
+);
+pub const GLOSSY_BLURRED: TargetDesc = TargetDesc::new(
+    "ils-glossy-blurred",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "ils-glossy after the same discontinuity-aware blur as the irradiance",
 );
 pub const DISCONTINUITY: TargetDesc = TargetDesc::new(
     "ils-discontinuity",
@@ -482,17 +496,72 @@ fn filter_passes(
     (discontinuity, h, v)
 }
 
+/// The same blur (kernel, DB) over the glossy receivers' radiance, `GLOSSY` →
+/// `GLOSSY_BLURRED` through `BLUR_H` (free again after `ils-blur-v`).
+fn glossy_blur_passes(
+    gpu: &GpuContext,
+    scene_gpu: &GpuScene,
+    targets: &mut Targets,
+    s: &IlsSettings,
+) -> (FullscreenPass, FullscreenPass) {
+    targets.create(gpu, GLOSSY_BLURRED);
+    let [rx, ry] = s.blur_radius();
+    let filter = |radius: u32, dir: [i32; 2]| FilterUniforms {
+        depth_threshold: s.depth_threshold,
+        normal_cos: s.normal_threshold_deg.to_radians().cos(),
+        radius,
+        sigma: radius.max(1) as f32,
+        dir,
+        bilinear: s.bilinear as u32,
+        channel: if s.per_axis_discontinuities {
+            (dir[1] != 0) as u32
+        } else {
+            3
+        },
+    };
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("ils glossy blur bilinear"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    let blur = |name: &'static str, src: &'static str, dst: &'static str, u: FilterUniforms| {
+        let src_t = targets.get(src);
+        let db = targets.get(DISCONTINUITY.name);
+        PassBuilder::new(gpu, targets, name)
+            .shader("ils-filter", include_str!("ils_filter.wgsl"))
+            .entry("fs_blur")
+            .frame(scene_gpu)
+            .uniforms(&u)
+            .view(src, &src_t.view, wgpu::TextureViewDimension::D2, true)
+            .view(DISCONTINUITY.name, &db.view, wgpu::TextureViewDimension::D2, true)
+            .sampler(&sampler, wgpu::SamplerBindingType::Filtering)
+            .write(dst)
+            .build()
+    };
+    let h = blur("ils-blur-glossy-h", GLOSSY.name, BLUR_H.name, filter(rx, [1, 0]));
+    let v = blur(
+        "ils-blur-glossy-v",
+        BLUR_H.name,
+        GLOSSY_BLURRED.name,
+        filter(ry, [0, 1]),
+    );
+    (h, v)
+}
+
 /// The ILS passes of a frame (see the module docs).
 pub(crate) struct IlsStage {
     gbuffer: FullscreenPass,
     split: Option<InterleavePass>,
     shade: FullscreenPass,
     gather: Option<InterleavePass>,
-    /// BG of the glossy receivers' radiance (`ils-glossy`, not blurred: docs/ils.md)
+    /// BG of the glossy receivers' radiance (`ils-glossy`; blurred like the irradiance: docs/ils.md)
     gather_glossy: Option<InterleavePass>,
     discontinuity: Option<FullscreenPass>,
     blur_h: Option<FullscreenPass>,
     blur_v: Option<FullscreenPass>,
+    glossy_h: Option<FullscreenPass>,
+    glossy_v: Option<FullscreenPass>,
     compose: crate::passes::compose::ComposePass,
     vpl_buffer: wgpu::Buffer,
     vpl_capacity: usize,
@@ -651,18 +720,21 @@ impl IlsStage {
         };
 
         let (mut discontinuity, mut blur_h, mut blur_v) = (None, None, None);
-        let shown = if s.blurs() {
+        let (mut glossy_h, mut glossy_v) = (None, None);
+        let (shown, glossy_shown) = if s.blurs() {
             let (db, h, v) = filter_passes(gpu, scene_gpu, targets, s, IRRADIANCE.name, INDIRECT.name);
             (discontinuity, blur_h, blur_v) = (Some(db), Some(h), Some(v));
-            INDIRECT.name
+            let (gh, gv) = glossy_blur_passes(gpu, scene_gpu, targets, s);
+            (glossy_h, glossy_v) = (Some(gh), Some(gv));
+            (INDIRECT.name, GLOSSY_BLURRED.name)
         } else {
-            IRRADIANCE.name
+            (IRRADIANCE.name, GLOSSY.name)
         };
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
         }
         let compose =
-            crate::passes::compose::ComposePass::new(gpu, scene_gpu, targets, false, None, shown, Some(GLOSSY.name));
+            crate::passes::compose::ComposePass::new(gpu, scene_gpu, targets, false, None, shown, Some(glossy_shown));
         Ok(Self {
             gbuffer,
             split,
@@ -672,6 +744,8 @@ impl IlsStage {
             discontinuity,
             blur_h,
             blur_v,
+            glossy_h,
+            glossy_v,
             compose,
             vpl_capacity: s.vpls.len().max(1),
             vpl_buffer,
@@ -713,7 +787,16 @@ impl IlsStage {
         if let Some(p) = &self.gather_glossy {
             v.push(p);
         }
-        for p in [&self.discontinuity, &self.blur_h, &self.blur_v].into_iter().flatten() {
+        for p in [
+            &self.discontinuity,
+            &self.blur_h,
+            &self.blur_v,
+            &self.glossy_h,
+            &self.glossy_v,
+        ]
+        .into_iter()
+        .flatten()
+        {
             v.push(p);
         }
         v.push(&self.compose);
