@@ -8,9 +8,11 @@
 //! | `ils-bs` | §4.2 BS | split into n×m sub-buffers ([`Interleave`], any [`SplitMethod`] but `Compute`) |
 //! | `ils-snsm` | §4.3 SNSM | sub-buffer (i, j) shaded with its own subset of the N VPLs |
 //! | `ils-bg` | §4.4 BG | the tiled irradiance gathered back to the image |
+//! | `ils-bg-glossy` | – | the same for the glossy receivers' GGX radiance (`ils-glossy`) |
 //! | `ils-db` | §4.5 DB | discontinuity buffer (depth and normal vs the three positive neighbours) |
 //! | `ils-blur-h`, `ils-blur-v` | §4.5 B | separable Gaussian blur stopping at discontinuities (Fig. 4 a or b) |
-//! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance (the shared compose pass) |
+//! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers") |
+//! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance + blurred glossy radiance (the shared compose pass) |
 //!
 //! With [`IlsSettings::brute_force`] the three middle passes are replaced by
 //! `ils-brute-force`: every pixel, all N VPLs (Table 4's "no IS"), with the
@@ -25,6 +27,9 @@
 //! geometry term clamped to 1/d_c² ([`IlsSettings::clamp_distance`]; default
 //! 2 % of the scene's bounding-box diagonal); Lambertian receivers, ρ/π applied
 //! in compose after the blur (§4.5: object colours are never filtered).
+//! Receivers of `Material::glossy` materials (emission.a = 2 in the G-buffer)
+//! get Σ_k f_GGX(v, l_k) Φ_k/π · (same clamped geometry term) instead, in a
+//! second target `ils-glossy` that compose adds as radiance.
 //!
 //! **VPLs come from the caller.** strata-render does not trace light paths:
 //! the caller generates the VPLs on the CPU (`strata_reference::Reference::vpls`,
