@@ -71,6 +71,39 @@ impl Vpl {
         let g = (cos_y * cos_x / d2).min(max_geometry);
         self.flux * (g * std::f32::consts::FRAC_1_PI)
     }
+
+    /// Glossy receivers: outgoing radiance toward `view` (unit, away from the
+    /// surface) of receiver `x` (unit normal `n`, GGX material `rho`,
+    /// `roughness`, `metallic`: [`crate::brdf::Ggx`]) lit by this VPL:
+    /// f(view, l) · Φ/π · min(cos θ_y cos θ_x / d², `max_geometry`), l toward
+    /// the VPL. With f = ρ/π it is ρ/π · [`Vpl::irradiance_at`]. GPU twin:
+    /// `vpl_glossy_radiance` in strata-render's `shaders/common/vpl.wgsl`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn glossy_radiance_at(
+        &self,
+        x: Vec3,
+        n: Vec3,
+        view: Vec3,
+        rho: Vec3,
+        roughness: f32,
+        metallic: f32,
+        max_geometry: f32,
+    ) -> Vec3 {
+        let v = x - self.position;
+        let d2 = v.length_squared();
+        if !(d2 > 0.0) {
+            return Vec3::ZERO;
+        }
+        let w = v / d2.sqrt();
+        let cos_y = self.normal.dot(w);
+        let cos_x = -n.dot(w);
+        if cos_y <= 0.0 || cos_x <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let g = (cos_y * cos_x / d2).min(max_geometry);
+        let f = crate::brdf::Ggx::new(n, view, rho, roughness, metallic).eval(-w);
+        f * self.flux * (g * std::f32::consts::FRAC_1_PI)
+    }
 }
 
 /// Settings of [`Reference::vpls`].
@@ -370,6 +403,52 @@ fn uniform_sphere(u: [f32; 2]) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A glossy receiver's highlight sits at the mirror point of the VPL and
+    /// moves with the view; the Lambert term does not depend on the view.
+    #[test]
+    fn glossy_highlight_follows_the_mirror_point() {
+        // VPL 1 above the plane y = 0, facing down; receiver: metal, roughness 0.1
+        let vpl = Vpl {
+            position: Vec3::new(0.0, 1.0, 0.0),
+            normal: -Vec3::Y,
+            flux: Vec3::ONE,
+            albedo: Vec3::ONE,
+            bounce: 1,
+        };
+        let rho = Vec3::new(0.9, 0.8, 0.5);
+        let peak = |eye: Vec3| {
+            // x along the line z = 0 from −2 to 2, step 0.001
+            (0..=4000)
+                .map(|i| -2.0 + i as f32 * 0.001)
+                .map(|x| {
+                    let p = Vec3::new(x, 0.0, 0.0);
+                    let l = vpl.glossy_radiance_at(p, Vec3::Y, (eye - p).normalize(), rho, 0.1, 1.0, f32::INFINITY);
+                    (x, l.y)
+                })
+                .fold((0.0, -1.0), |a, b| if b.1 > a.1 { b } else { a })
+                .0
+        };
+        for eye_x in [-3.0f32, 0.0, 2.0, 4.0] {
+            let eye = Vec3::new(eye_x, 2.0, 0.0);
+            // mirror point: the VPL at height 1 and the eye at height 2 → x = eye_x / 3
+            let mirror = eye_x / 3.0;
+            let x = peak(eye);
+            assert!(
+                (x - mirror).abs() < 0.05,
+                "eye x {eye_x}: peak at {x}, mirror point {mirror}"
+            );
+        }
+        let p = Vec3::new(0.3, 0.0, 0.0);
+        // a rough dielectric is dominated by its diffuse lobe: close to ρ/π · E(1 − F_d)²
+        let e = vpl.irradiance_at(p, Vec3::Y, f32::INFINITY);
+        let l = vpl.glossy_radiance_at(p, Vec3::Y, Vec3::Y, rho, 1.0, 0.0, f32::INFINITY);
+        let lambert = rho * std::f32::consts::FRAC_1_PI * e;
+        assert!(
+            (l - lambert).abs().max_element() < 0.15 * lambert.max_element(),
+            "{l} vs {lambert}"
+        );
+    }
 
     #[test]
     fn allocation_sums_to_n_and_gives_every_light_a_path() {

@@ -56,6 +56,8 @@ pub struct MaterialUniforms {
     pub emission: [f32; 4],
     /// roughness, metallic, has_texture (0/1), alpha cutoff (< 0: none)
     pub params: [f32; 4],
+    /// x = 1 for `Material::glossy` (the GGX receivers of ILS), yzw unused
+    pub flags: [f32; 4],
 }
 
 pub struct GpuMesh {
@@ -203,6 +205,7 @@ impl GpuScene {
                         m.base_color_texture.is_some() as u32 as f32,
                         m.alpha_cutoff.unwrap_or(-1.0),
                     ],
+                    flags: [m.glossy as u32 as f32, 0.0, 0.0, 0.0],
                 };
                 let buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(&m.name),

@@ -12,6 +12,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/spiral.wgsl", include_str!("shaders/common/spiral.wgsl")),
     ("common/reproject.wgsl", include_str!("shaders/common/reproject.wgsl")),
     ("common/interleave.wgsl", include_str!("shaders/common/interleave.wgsl")),
+    ("common/ggx.wgsl", include_str!("shaders/common/ggx.wgsl")),
     ("common/vpl.wgsl", include_str!("shaders/common/vpl.wgsl")),
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
     ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),

@@ -974,9 +974,12 @@ const ILS_PASSES: &[&str] = &[
     "ils-bs",
     "ils-snsm",
     "ils-bg",
+    "ils-bg-glossy",
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",
+    "ils-blur-glossy-h",
+    "ils-blur-glossy-v",
     "compose",
     "tonemap",
 ];

@@ -16,7 +16,8 @@ struct Compose {
     use_probes: u32,
     // 1 = modulate the probe term by AO
     use_ao: u32,
-    _pad: u32,
+    // 1 = add the glossy receivers' radiance (ILS `ils-glossy`) as is
+    use_glossy: u32,
     // probe grid: origin (xyz), spacing (xyz), probes per axis
     origin: vec4f,
     spacing: vec4f,
@@ -37,6 +38,8 @@ struct Probe {
 @group(1) @binding(5) var csz: texture_2d<f32>;
 @group(1) @binding(6) var ao: texture_2d<f32>;
 @group(1) @binding(7) var<storage, read> probes: array<Probe>;
+// outgoing radiance of glossy receivers (rgb; use_glossy), else any target
+@group(1) @binding(8) var glossy: texture_2d<f32>;
 
 struct Out {
     @location(0) hdr: vec4f,
@@ -132,5 +135,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     }
     o.blended = vec4f(e, c);
     o.hdr = vec4f(direct.rgb + rho / 3.14159265358979 * e * k, direct.a);
+    if (compose.use_glossy != 0u) {
+        o.hdr = vec4f(o.hdr.rgb + textureLoad(glossy, p, 0).rgb, o.hdr.a);
+    }
     return o;
 }

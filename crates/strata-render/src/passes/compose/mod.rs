@@ -39,7 +39,7 @@ struct ComposeUniforms {
     boost: u32,
     use_probes: u32,
     use_ao: u32,
-    _pad: u32,
+    use_glossy: u32,
     origin: [f32; 4],
     spacing: [f32; 4],
     dims: [u32; 4],
@@ -52,6 +52,7 @@ pub struct ComposePass {
 impl ComposePass {
     /// `probes`: the static fallback (Fig. 9); AO modulates it when target `ao` exists.
     /// `indirect`: the target holding E (rgb) and the confidence (a), e.g. `indirect`.
+    /// `glossy`: a target of outgoing radiance added as is (ILS's `ils-glossy`).
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -59,13 +60,14 @@ impl ComposePass {
         boost: bool,
         probes: Option<&IrradianceProbes>,
         indirect: &'static str,
+        glossy: Option<&'static str>,
     ) -> Self {
         let use_ao = probes.is_some() && targets.try_get("ao").is_some();
         let u = ComposeUniforms {
             boost: boost as u32,
             use_probes: probes.is_some() as u32,
             use_ao: use_ao as u32,
-            _pad: 0,
+            use_glossy: glossy.is_some() as u32,
             origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
             spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(0.0).to_array()),
             dims: probes.map_or([1, 1, 1, 0], |p| [p.dims[0], p.dims[1], p.dims[2], 0]),
@@ -102,7 +104,9 @@ impl ComposePass {
             .read_layer("csz", 0)
             // without AO the binding is filled by a target that is read anyway
             .read_layer(if use_ao { "ao" } else { indirect }, 0)
-            .storage(&probe_buf);
+            .storage(&probe_buf)
+            // without glossy receivers the binding is filled by a target that is read anyway
+            .read_layer(glossy.unwrap_or(indirect), 0);
         for t in &OUTPUTS {
             b = b.write(t.name);
         }

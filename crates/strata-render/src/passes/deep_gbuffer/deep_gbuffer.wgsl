@@ -143,7 +143,7 @@ struct GBufferOut {
     @location(1) normal: vec4f,
     // rgb = albedo (sRGB target), a = opacity
     @location(2) albedo: vec4f,
-    // rgb = emitted radiance
+    // rgb = emitted radiance, a = 1 (2: glossy material)
     @location(3) emission: vec4f,
 }
 
@@ -169,7 +169,8 @@ fn shade(in: VsOut, front: bool) -> GBufferOut {
     o.csz = in.cam_z;
     o.normal = vec4f(oct_encode(n), material.params.x, material.params.y);
     o.albedo = vec4f(base.rgb, base.a);
-    o.emission = vec4f(material.emission.rgb, 1.0);
+    // a = 1, or 2 for a glossy material (ILS shades those with GGX)
+    o.emission = vec4f(material.emission.rgb, 1.0 + material.flags.x);
     return o;
 }
 

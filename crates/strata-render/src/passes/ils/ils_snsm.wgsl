@@ -35,10 +35,63 @@ struct Shade {
 // packed G-buffer: world normal (xyz), csz (w); split or not
 @group(1) @binding(1) var gbuffer: texture_2d<f32>;
 @group(1) @binding(2) var<storage, read> vpls: array<Vpl>;
+// layer 0 in image space, read at the pixel's gather index: rg = normal, b =
+// roughness, a = metallic; base colour; emission (a = 2: glossy material)
+@group(1) @binding(3) var normal_tex: texture_2d<f32>;
+@group(1) @binding(4) var albedo_tex: texture_2d<f32>;
+@group(1) @binding(5) var emission_tex: texture_2d<f32>;
 // SSM only: one layer per VPL, its six cube faces in a 3×2 atlas; 6 matrices per VPL
-@group(1) @binding(3) var vpl_shadow_maps: texture_depth_2d_array;
-@group(1) @binding(4) var vpl_shadow_sampler: sampler_comparison;
-@group(1) @binding(5) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
+@group(1) @binding(6) var vpl_shadow_maps: texture_depth_2d_array;
+@group(1) @binding(7) var vpl_shadow_sampler: sampler_comparison;
+@group(1) @binding(8) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
+
+// Lambert receivers: (E, 1) in location 0 and (0, 0, 0, 1) in location 1; glossy
+// ones: (0, 0, 0, 1) and (L_o, 1) (Σ_k vpl_glossy_radiance, common/vpl.wgsl).
+struct ShadeOut {
+    @location(0) irradiance: vec4f,
+    @location(1) glossy: vec4f,
+}
+
+struct Receiver {
+    glossy: bool,
+    view: vec3f,
+    rho: vec3f,
+    roughness: f32,
+    metallic: f32,
+}
+
+fn receiver(pix: vec2u, x: vec3f) -> Receiver {
+    var r: Receiver;
+    let p = vec2i(pix);
+    r.glossy = textureLoad(emission_tex, p, 0).a > 1.5;
+    if (r.glossy) {
+        let nrm = textureLoad(normal_tex, p, 0);
+        r.roughness = nrm.z;
+        r.metallic = nrm.w;
+        r.rho = textureLoad(albedo_tex, p, 0).rgb;
+        r.view = normalize(frame.eye.xyz - x);
+    }
+    return r;
+}
+
+fn vpl_term(k: u32, x: vec3f, n: vec3f, r: Receiver) -> vec3f {
+    if (r.glossy) {
+        return vpl_glossy_radiance(vpls[k], x, n, r.view, r.rho, r.roughness, r.metallic, shade.max_geometry);
+    }
+    return vpl_irradiance(vpls[k], x, n, shade.max_geometry);
+}
+
+fn shade_out(e: vec3f, r: Receiver) -> ShadeOut {
+    var o: ShadeOut;
+    if (r.glossy) {
+        o.irradiance = vec4f(0.0, 0.0, 0.0, 1.0);
+        o.glossy = vec4f(e, 1.0);
+    } else {
+        o.irradiance = vec4f(e, 1.0);
+        o.glossy = vec4f(0.0, 0.0, 0.0, 1.0);
+    }
+    return o;
+}
 
 // §4.3 SSM: visibility of surface point x (normal n) from VPL k, from its cube
 // shadow map (face by the major axis of the direction from the VPL, as a point
@@ -69,100 +122,115 @@ fn vpl_visibility(k: u32, v: Vpl, x: vec3f, n: vec3f) -> f32 {
 }
 
 // vpl_sum with each VPL's term times its visibility (SSM).
-fn vpl_sum_ssm(g: vec4f, pix: vec2u, first: u32, step: u32) -> vec3f {
+fn vpl_sum_ssm(g: vec4f, pix: vec2u, first: u32, step: u32) -> ShadeOut {
     let x = world_from_csz(frame, vec2f(pix) + 0.5, g.w);
+    let r = receiver(pix, x);
     var e = vec3f(0.0);
     for (var k = first; k < shade.vpl_count; k += step) {
-        let term = vpl_irradiance(vpls[k], x, g.xyz, shade.max_geometry);
+        let term = vpl_term(k, x, g.xyz, r);
         if (any(term > vec3f(0.0))) {
             e += term * vpl_visibility(k, vpls[k], x, g.xyz);
         }
     }
-    return e;
+    return shade_out(e, r);
 }
 
-// Σ over VPLs first, first + step, … < N of Φ/π cos θ_y cos θ_x / d² at the
-// surface of image pixel `pix` with packed G-buffer texel `g`.
-fn vpl_sum(g: vec4f, pix: vec2u, first: u32, step: u32) -> vec3f {
+// Σ over VPLs first, first + step, … < N of Φ/π cos θ_y cos θ_x / d² (Lambert
+// receivers; glossy ones: of f(v, l)·Φ/π cos θ_y cos θ_x / d²) at the surface
+// of image pixel `pix` with packed G-buffer texel `g`.
+fn vpl_sum(g: vec4f, pix: vec2u, first: u32, step: u32) -> ShadeOut {
     let x = world_from_csz(frame, vec2f(pix) + 0.5, g.w);
+    let r = receiver(pix, x);
     var e = vec3f(0.0);
     for (var k = first; k < shade.vpl_count; k += step) {
-        e += vpl_irradiance(vpls[k], x, g.xyz, shade.max_geometry);
+        e += vpl_term(k, x, g.xyz, r);
     }
-    return e;
+    return shade_out(e, r);
+}
+
+fn scaled(o: ShadeOut, s: f32) -> ShadeOut {
+    var r = o;
+    r.irradiance = vec4f(o.irradiance.rgb * s, 1.0);
+    r.glossy = vec4f(o.glossy.rgb * s, 1.0);
+    return r;
+}
+
+fn empty(a: f32) -> ShadeOut {
+    var o: ShadeOut;
+    o.irradiance = vec4f(0.0, 0.0, 0.0, a);
+    o.glossy = vec4f(0.0, 0.0, 0.0, a);
+    return o;
 }
 
 // SNSM on the tiled sub-buffers (writes the tiled irradiance buffer, Fig. 3 c).
 @fragment
-fn fs_snsm(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+fn fs_snsm(@builtin(position) pos: vec4f) -> ShadeOut {
     let t = vec2u(pos.xy);
     if (ils_is_padding(t, shade.geo)) {
-        return vec4f(0.0);
+        return empty(0.0);
     }
     let g = textureLoad(gbuffer, vec2i(t), 0);
     if (g.w <= 0.0) {
-        return vec4f(0.0);
+        return empty(0.0);
     }
     let pix = ils_gather_index(t, shade.geo);
     if (shade.all_vpls != 0u) {
-        return vec4f(vpl_sum(g, pix, 0u, 1u), 1.0);
+        return vpl_sum(g, pix, 0u, 1u);
     }
     let ij = ils_sub_buffer(t, shade.geo);
     let s = ij.y * shade.geo.pattern.x + ij.x;
     let big_s = shade.sub_buffers;
     if (s >= shade.vpl_count) {
         // fewer VPLs than sub-buffers: this one has none
-        return vec4f(0.0, 0.0, 0.0, 1.0);
+        return empty(1.0);
     }
     let n_s = (shade.vpl_count - s + big_s - 1u) / big_s;
-    let e = vpl_sum(g, pix, s, big_s) * (f32(shade.vpl_count) / f32(n_s));
-    return vec4f(e, 1.0);
+    return scaled(vpl_sum(g, pix, s, big_s), f32(shade.vpl_count) / f32(n_s));
 }
 
 // Brute force ("no IS", Table 4): every pixel, all N VPLs.
 @fragment
-fn fs_brute_force(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+fn fs_brute_force(@builtin(position) pos: vec4f) -> ShadeOut {
     let p = vec2u(pos.xy);
     let g = textureLoad(gbuffer, vec2i(p), 0);
     if (g.w <= 0.0) {
-        return vec4f(0.0);
+        return empty(0.0);
     }
-    return vec4f(vpl_sum(g, p, 0u, 1u), 1.0);
+    return vpl_sum(g, p, 0u, 1u);
 }
 
 // SSM on the tiled sub-buffers (same assignment and scaling as fs_snsm).
 @fragment
-fn fs_ssm(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+fn fs_ssm(@builtin(position) pos: vec4f) -> ShadeOut {
     let t = vec2u(pos.xy);
     if (ils_is_padding(t, shade.geo)) {
-        return vec4f(0.0);
+        return empty(0.0);
     }
     let g = textureLoad(gbuffer, vec2i(t), 0);
     if (g.w <= 0.0) {
-        return vec4f(0.0);
+        return empty(0.0);
     }
     let pix = ils_gather_index(t, shade.geo);
     if (shade.all_vpls != 0u) {
-        return vec4f(vpl_sum_ssm(g, pix, 0u, 1u), 1.0);
+        return vpl_sum_ssm(g, pix, 0u, 1u);
     }
     let ij = ils_sub_buffer(t, shade.geo);
     let s = ij.y * shade.geo.pattern.x + ij.x;
     let big_s = shade.sub_buffers;
     if (s >= shade.vpl_count) {
-        return vec4f(0.0, 0.0, 0.0, 1.0);
+        return empty(1.0);
     }
     let n_s = (shade.vpl_count - s + big_s - 1u) / big_s;
-    let e = vpl_sum_ssm(g, pix, s, big_s) * (f32(shade.vpl_count) / f32(n_s));
-    return vec4f(e, 1.0);
+    return scaled(vpl_sum_ssm(g, pix, s, big_s), f32(shade.vpl_count) / f32(n_s));
 }
 
 // Brute force with VPL shadows: every pixel, all N VPLs, each with its visibility.
 @fragment
-fn fs_brute_force_ssm(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+fn fs_brute_force_ssm(@builtin(position) pos: vec4f) -> ShadeOut {
     let p = vec2u(pos.xy);
     let g = textureLoad(gbuffer, vec2i(p), 0);
     if (g.w <= 0.0) {
-        return vec4f(0.0);
+        return empty(0.0);
     }
-    return vec4f(vpl_sum_ssm(g, p, 0u, 1u), 1.0);
+    return vpl_sum_ssm(g, p, 0u, 1u);
 }

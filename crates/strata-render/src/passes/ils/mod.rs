@@ -8,9 +8,11 @@
 //! | `ils-bs` | §4.2 BS | split into n×m sub-buffers ([`Interleave`], any [`SplitMethod`] but `Compute`) |
 //! | `ils-snsm` | §4.3 SNSM | sub-buffer (i, j) shaded with its own subset of the N VPLs |
 //! | `ils-bg` | §4.4 BG | the tiled irradiance gathered back to the image |
+//! | `ils-bg-glossy` | – | the same for the glossy receivers' GGX radiance (`ils-glossy`) |
 //! | `ils-db` | §4.5 DB | discontinuity buffer (depth and normal vs the three positive neighbours) |
 //! | `ils-blur-h`, `ils-blur-v` | §4.5 B | separable Gaussian blur stopping at discontinuities (Fig. 4 a or b) |
-//! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance (the shared compose pass) |
+//! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers") |
+//! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance + blurred glossy radiance (the shared compose pass) |
 //!
 //! With [`IlsSettings::brute_force`] the three middle passes are replaced by
 //! `ils-brute-force`: every pixel, all N VPLs (Table 4's "no IS"), with the
@@ -25,6 +27,9 @@
 //! geometry term clamped to 1/d_c² ([`IlsSettings::clamp_distance`]; default
 //! 2 % of the scene's bounding-box diagonal); Lambertian receivers, ρ/π applied
 //! in compose after the blur (§4.5: object colours are never filtered).
+//! Receivers of `Material::glossy` materials (emission.a = 2 in the G-buffer)
+//! get Σ_k f_GGX(v, l_k) Φ_k/π · (same clamped geometry term) instead, in a
+//! second target `ils-glossy` that compose adds as radiance.
 //!
 //! **VPLs come from the caller.** strata-render does not trace light paths:
 //! the caller generates the VPLs on the CPU (`strata_reference::Reference::vpls`,
@@ -53,9 +58,12 @@ pub const PASSES: &[&str] = &[
     "ils-bs",
     "ils-snsm",
     "ils-bg",
+    "ils-bg-glossy",
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",
+    "ils-blur-glossy-h",
+    "ils-blur-glossy-v",
     "compose",
 ];
 
@@ -270,10 +278,16 @@ impl IlsSettings {
         if self.brute_force {
             v.push(BRUTE_FORCE_PASS);
         } else {
-            v.extend(["ils-bs", self.shading_pass(), "ils-bg"]);
+            v.extend(["ils-bs", self.shading_pass(), "ils-bg", "ils-bg-glossy"]);
         }
         if self.blurs() {
-            v.extend(["ils-db", "ils-blur-h", "ils-blur-v"]);
+            v.extend([
+                "ils-db",
+                "ils-blur-h",
+                "ils-blur-v",
+                "ils-blur-glossy-h",
+                "ils-blur-glossy-v",
+            ]);
         }
         v.push("compose");
         v
@@ -303,9 +317,9 @@ impl IlsSettings {
         let [n, m] = self.pattern;
         let tiled = (w.div_ceil(n.max(1)) * n.max(1)) as u64 * (h.div_ceil(m.max(1)) * m.max(1)) as u64;
         let px = w as u64 * h as u64;
-        // gbuffer 16 + irradiance 8 + DB 8 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8;
+        // gbuffer 16 + irradiance 8 + glossy 8 + DB 8 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8 + 8;
         // the Blocks intermediates ≤ 2 more tiled-size buffers
-        px * 72 + tiled * (24 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
+        px * 80 + tiled * (32 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
     }
 }
 
@@ -333,6 +347,24 @@ pub const IRRADIANCE: TargetDesc = TargetDesc::new(
     wgpu::TextureFormat::Rgba16Float,
     1,
     "ILS §4.4 (Fig. 3 d): gathered interleaved irradiance (or the brute force's)",
+);
+pub const GLOSSY_TILED: TargetDesc = TargetDesc::new(
+    "ils-glossy-tiled",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "outgoing radiance of glossy (GGX) receivers from each sub-buffer's VPL subset, tiled (0 on Lambert ones)",
+);
+pub const GLOSSY: TargetDesc = TargetDesc::new(
+    "ils-glossy",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "outgoing radiance of glossy (GGX) receivers, gathered; compose adds it as is (0 on Lambert receivers)",
+);
+pub const GLOSSY_BLURRED: TargetDesc = TargetDesc::new(
+    "ils-glossy-blurred",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "ils-glossy after the same discontinuity-aware blur as the irradiance",
 );
 pub const DISCONTINUITY: TargetDesc = TargetDesc::new(
     "ils-discontinuity",
@@ -469,15 +501,72 @@ fn filter_passes(
     (discontinuity, h, v)
 }
 
+/// The same blur (kernel, DB) over the glossy receivers' radiance, `GLOSSY` →
+/// `GLOSSY_BLURRED` through `BLUR_H` (free again after `ils-blur-v`).
+fn glossy_blur_passes(
+    gpu: &GpuContext,
+    scene_gpu: &GpuScene,
+    targets: &mut Targets,
+    s: &IlsSettings,
+) -> (FullscreenPass, FullscreenPass) {
+    targets.create(gpu, GLOSSY_BLURRED);
+    let [rx, ry] = s.blur_radius();
+    let filter = |radius: u32, dir: [i32; 2]| FilterUniforms {
+        depth_threshold: s.depth_threshold,
+        normal_cos: s.normal_threshold_deg.to_radians().cos(),
+        radius,
+        sigma: radius.max(1) as f32,
+        dir,
+        bilinear: s.bilinear as u32,
+        channel: if s.per_axis_discontinuities {
+            (dir[1] != 0) as u32
+        } else {
+            3
+        },
+    };
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("ils glossy blur bilinear"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    let blur = |name: &'static str, src: &'static str, dst: &'static str, u: FilterUniforms| {
+        let src_t = targets.get(src);
+        let db = targets.get(DISCONTINUITY.name);
+        PassBuilder::new(gpu, targets, name)
+            .shader("ils-filter", include_str!("ils_filter.wgsl"))
+            .entry("fs_blur")
+            .frame(scene_gpu)
+            .uniforms(&u)
+            .view(src, &src_t.view, wgpu::TextureViewDimension::D2, true)
+            .view(DISCONTINUITY.name, &db.view, wgpu::TextureViewDimension::D2, true)
+            .sampler(&sampler, wgpu::SamplerBindingType::Filtering)
+            .write(dst)
+            .build()
+    };
+    let h = blur("ils-blur-glossy-h", GLOSSY.name, BLUR_H.name, filter(rx, [1, 0]));
+    let v = blur(
+        "ils-blur-glossy-v",
+        BLUR_H.name,
+        GLOSSY_BLURRED.name,
+        filter(ry, [0, 1]),
+    );
+    (h, v)
+}
+
 /// The ILS passes of a frame (see the module docs).
 pub(crate) struct IlsStage {
     gbuffer: FullscreenPass,
     split: Option<InterleavePass>,
     shade: FullscreenPass,
     gather: Option<InterleavePass>,
+    /// BG of the glossy receivers' radiance (`ils-glossy`; blurred like the irradiance: docs/ils.md)
+    gather_glossy: Option<InterleavePass>,
     discontinuity: Option<FullscreenPass>,
     blur_h: Option<FullscreenPass>,
     blur_v: Option<FullscreenPass>,
+    glossy_h: Option<FullscreenPass>,
+    glossy_v: Option<FullscreenPass>,
     compose: crate::passes::compose::ComposePass,
     vpl_buffer: wgpu::Buffer,
     vpl_capacity: usize,
@@ -509,7 +598,7 @@ impl IlsStage {
         let (w, h) = (targets.width, targets.height);
         let [n, m] = s.pattern;
         let vpl_buffer = vpl_buffer(gpu, &s.vpls);
-        for t in [GBUFFER, IRRADIANCE, INDIRECT] {
+        for t in [GBUFFER, IRRADIANCE, INDIRECT, GLOSSY] {
             targets.create(gpu, t);
         }
         let gbuffer = PassBuilder::new(gpu, targets, "ils-gbuffer")
@@ -519,14 +608,16 @@ impl IlsStage {
             .write(GBUFFER.name)
             .build();
 
-        let (split, gather, geo) = if s.brute_force {
-            (None, None, None)
+        let (split, gather, gather_glossy, geo) = if s.brute_force {
+            (None, None, None, None)
         } else {
             let bs = Interleave::new(gpu, GBUFFER.format, w, h, n, m, s.method)?;
             let bg = Interleave::new(gpu, IRRADIANCE.format, w, h, n, m, s.method)?;
+            let bg_glossy = Interleave::new(gpu, GLOSSY.format, w, h, n, m, s.method)?;
             let tiled = bs.tiled_size();
             targets.create_sized(gpu, GBUFFER_SPLIT, tiled);
             targets.create_sized(gpu, IRRADIANCE_TILED, tiled);
+            targets.create_sized(gpu, GLOSSY_TILED, tiled);
             let geo = *bs.geometry();
             let split = InterleavePass {
                 name: "ils-bs",
@@ -542,7 +633,14 @@ impl IlsStage {
                 dst: IRRADIANCE.name,
                 split: false,
             };
-            (Some(split), Some(gather), Some(geo))
+            let gather_glossy = InterleavePass {
+                name: "ils-bg-glossy",
+                interleave: bg_glossy,
+                src: GLOSSY_TILED.name,
+                dst: GLOSSY.name,
+                split: false,
+            };
+            (Some(split), Some(gather), Some(gather_glossy), Some(geo))
         };
         let vpl_shadows = match s.shadows {
             VplShadows::None => None,
@@ -572,11 +670,35 @@ impl IlsStage {
         };
         let shade = {
             let traced = vpl_shadows.is_some();
-            let (name, entry, input, output) = match (s.brute_force, traced) {
-                (true, false) => (BRUTE_FORCE_PASS, "fs_brute_force", GBUFFER.name, IRRADIANCE.name),
-                (true, true) => (BRUTE_FORCE_PASS, "fs_brute_force_ssm", GBUFFER.name, IRRADIANCE.name),
-                (false, false) => ("ils-snsm", "fs_snsm", GBUFFER_SPLIT.name, IRRADIANCE_TILED.name),
-                (false, true) => ("ils-ssm", "fs_ssm", GBUFFER_SPLIT.name, IRRADIANCE_TILED.name),
+            let (name, entry, input, output, output_glossy) = match (s.brute_force, traced) {
+                (true, false) => (
+                    BRUTE_FORCE_PASS,
+                    "fs_brute_force",
+                    GBUFFER.name,
+                    IRRADIANCE.name,
+                    GLOSSY.name,
+                ),
+                (true, true) => (
+                    BRUTE_FORCE_PASS,
+                    "fs_brute_force_ssm",
+                    GBUFFER.name,
+                    IRRADIANCE.name,
+                    GLOSSY.name,
+                ),
+                (false, false) => (
+                    "ils-snsm",
+                    "fs_snsm",
+                    GBUFFER_SPLIT.name,
+                    IRRADIANCE_TILED.name,
+                    GLOSSY_TILED.name,
+                ),
+                (false, true) => (
+                    "ils-ssm",
+                    "fs_ssm",
+                    GBUFFER_SPLIT.name,
+                    IRRADIANCE_TILED.name,
+                    GLOSSY_TILED.name,
+                ),
             };
             let b = PassBuilder::new(gpu, targets, name)
                 .shader("ils-snsm", include_str!("ils_snsm.wgsl"))
@@ -584,7 +706,10 @@ impl IlsStage {
                 .frame(scene_gpu)
                 .uniforms(&shade_uniforms)
                 .read(input)
-                .storage(&vpl_buffer);
+                .storage(&vpl_buffer)
+                .read_layer("normal", 0)
+                .read_layer("albedo", 0)
+                .read_layer("emission", 0);
             let b = match &vpl_shadows {
                 Some(p) => b
                     .depth_view(
@@ -596,29 +721,36 @@ impl IlsStage {
                     .storage(&p.matrices),
                 None => b,
             };
-            b.write(output).build()
+            b.write(output).write(output_glossy).build()
         };
 
         let (mut discontinuity, mut blur_h, mut blur_v) = (None, None, None);
-        let shown = if s.blurs() {
+        let (mut glossy_h, mut glossy_v) = (None, None);
+        let (shown, glossy_shown) = if s.blurs() {
             let (db, h, v) = filter_passes(gpu, scene_gpu, targets, s, IRRADIANCE.name, INDIRECT.name);
             (discontinuity, blur_h, blur_v) = (Some(db), Some(h), Some(v));
-            INDIRECT.name
+            let (gh, gv) = glossy_blur_passes(gpu, scene_gpu, targets, s);
+            (glossy_h, glossy_v) = (Some(gh), Some(gv));
+            (INDIRECT.name, GLOSSY_BLURRED.name)
         } else {
-            IRRADIANCE.name
+            (IRRADIANCE.name, GLOSSY.name)
         };
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
         }
-        let compose = crate::passes::compose::ComposePass::new(gpu, scene_gpu, targets, false, None, shown);
+        let compose =
+            crate::passes::compose::ComposePass::new(gpu, scene_gpu, targets, false, None, shown, Some(glossy_shown));
         Ok(Self {
             gbuffer,
             split,
             shade,
             gather,
+            gather_glossy,
             discontinuity,
             blur_h,
             blur_v,
+            glossy_h,
+            glossy_v,
             compose,
             vpl_capacity: s.vpls.len().max(1),
             vpl_buffer,
@@ -657,7 +789,19 @@ impl IlsStage {
         if let Some(p) = &self.gather {
             v.push(p);
         }
-        for p in [&self.discontinuity, &self.blur_h, &self.blur_v].into_iter().flatten() {
+        if let Some(p) = &self.gather_glossy {
+            v.push(p);
+        }
+        for p in [
+            &self.discontinuity,
+            &self.blur_h,
+            &self.blur_v,
+            &self.glossy_h,
+            &self.glossy_v,
+        ]
+        .into_iter()
+        .flatten()
+        {
             v.push(p);
         }
         v.push(&self.compose);

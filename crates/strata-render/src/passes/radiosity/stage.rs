@@ -118,7 +118,7 @@ impl RadiosityStage {
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
         }
-        let compose = crate::passes::compose::ComposePass::new(gpu, scene, targets, s.boost, probes, "indirect");
+        let compose = crate::passes::compose::ComposePass::new(gpu, scene, targets, s.boost, probes, "indirect", None);
         Self {
             propagate,
             gather,

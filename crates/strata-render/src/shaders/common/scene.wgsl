@@ -18,6 +18,8 @@ struct MaterialUniforms {
     emission: vec4f,
     // roughness, metallic, has_texture (0/1), alpha cutoff (< 0: none, not MASK)
     params: vec4f,
+    // x = 1 for a glossy material (`Material::glossy`: ILS's GGX receivers)
+    flags: vec4f,
 }
 
 // A fragment's alpha from the material and its texture sample `tex`, the rule

@@ -6,6 +6,7 @@
 // usual bound on the 1/d² singularity near a VPL). Multiply by ρ_x/π for the
 // reflected radiance. CPU twin: `strata_reference::Vpl::irradiance_at`.
 // Layout mirrors `passes::ils::GpuVpl` (w components unused).
+#import "common/ggx.wgsl"
 
 struct Vpl {
     position: vec4f,
@@ -27,4 +28,24 @@ fn vpl_irradiance(v: Vpl, x: vec3f, n: vec3f, max_geometry: f32) -> vec3f {
     }
     let g = min(cos_y * cos_x / d2, max_geometry);
     return v.flux.rgb * (g * 0.31830988618379067);
+}
+
+// Glossy receivers: outgoing radiance toward the unit view direction `view`
+//   f(view, l) · Φ/π · min(cos θ_y cos θ_x / d², max_geometry),  l = −w
+// with f the GGX BRDF (common/ggx.wgsl) — with f = ρ/π it is ρ/π times
+// `vpl_irradiance`. CPU twin: `strata_reference::Vpl::glossy_radiance_at`.
+fn vpl_glossy_radiance(v: Vpl, x: vec3f, n: vec3f, view: vec3f, rho: vec3f, roughness: f32, metallic: f32, max_geometry: f32) -> vec3f {
+    let d = x - v.position.xyz;
+    let d2 = dot(d, d);
+    if (!(d2 > 0.0)) {
+        return vec3f(0.0);
+    }
+    let w = d / sqrt(d2);
+    let cos_y = dot(v.normal.xyz, w);
+    let cos_x = -dot(n, w);
+    if (cos_y <= 0.0 || cos_x <= 0.0) {
+        return vec3f(0.0);
+    }
+    let g = min(cos_y * cos_x / d2, max_geometry);
+    return ggx_eval(n, view, -w, rho, roughness, metallic) * v.flux.rgb * (g * 0.31830988618379067);
 }
