@@ -57,19 +57,28 @@ impl Vpl {
     /// ρ_x/π for outgoing radiance. `max_geometry` clamps cos θ_y cos θ_x / d²
     /// (the usual bound that tames the 1/d² singularity near the VPL; ∞: none).
     pub fn irradiance_at(&self, x: Vec3, n: Vec3, max_geometry: f32) -> Vec3 {
+        match self.geometry(x, n, max_geometry) {
+            Some((_, g)) => self.flux * (g * std::f32::consts::FRAC_1_PI),
+            None => Vec3::ZERO,
+        }
+    }
+
+    /// The unit direction w from the VPL to receiver `x` (unit normal `n`) and
+    /// the clamped geometry term min(cos θ_y cos θ_x / d², `max_geometry`), or
+    /// `None` when either side faces away (or x is at the VPL).
+    fn geometry(&self, x: Vec3, n: Vec3, max_geometry: f32) -> Option<(Vec3, f32)> {
         let v = x - self.position;
         let d2 = v.length_squared();
         if !(d2 > 0.0) {
-            return Vec3::ZERO;
+            return None;
         }
         let w = v / d2.sqrt();
         let cos_y = self.normal.dot(w);
         let cos_x = -n.dot(w);
         if cos_y <= 0.0 || cos_x <= 0.0 {
-            return Vec3::ZERO;
+            return None;
         }
-        let g = (cos_y * cos_x / d2).min(max_geometry);
-        self.flux * (g * std::f32::consts::FRAC_1_PI)
+        Some((w, (cos_y * cos_x / d2).min(max_geometry)))
     }
 
     /// Glossy receivers: outgoing radiance toward `view` (unit, away from the
@@ -89,18 +98,9 @@ impl Vpl {
         metallic: f32,
         max_geometry: f32,
     ) -> Vec3 {
-        let v = x - self.position;
-        let d2 = v.length_squared();
-        if !(d2 > 0.0) {
+        let Some((w, g)) = self.geometry(x, n, max_geometry) else {
             return Vec3::ZERO;
-        }
-        let w = v / d2.sqrt();
-        let cos_y = self.normal.dot(w);
-        let cos_x = -n.dot(w);
-        if cos_y <= 0.0 || cos_x <= 0.0 {
-            return Vec3::ZERO;
-        }
-        let g = (cos_y * cos_x / d2).min(max_geometry);
+        };
         let f = crate::brdf::Ggx::new(n, view, rho, roughness, metallic).eval(-w);
         f * self.flux * (g * std::f32::consts::FRAC_1_PI)
     }
