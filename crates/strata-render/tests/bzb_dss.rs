@@ -133,61 +133,16 @@ fn main(@builtin(global_invocation_id) gid: vec3u) {
     let nr = cases[4u * i + 3u];
     out[i] = dss_ray_disk(cases[4u * i].xyz, cases[4u * i + 1u].xyz, cases[4u * i + 2u].xyz, nr.xyz, nr.w);
 }";
-    use wgpu::util::DeviceExt;
-    let device = &gpu.device;
     let flat: Vec<[f32; 4]> = cases.iter().flat_map(|c| c.map(|v| v.to_array())).collect();
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("cases"),
-        contents: bytemuck::cast_slice(&flat),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let bytes = n as u64 * 4;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("out"),
-        size: bytes,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("staging"),
-        size: bytes,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let module = strata_render::shader::module(device, "ray-disk-test", src);
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("ray-disk-test"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ray-disk-test"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: output.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(n.div_ceil(64), 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&output, 0, &staging, 0, bytes);
-    gpu.queue.submit([enc.finish()]);
-    gpu.check_errors().expect("no validation errors");
-    let data = gpu.read_buffer(&staging).expect("read back");
+    let data = common::run_compute(
+        &gpu,
+        "ray-disk-test",
+        src,
+        "main",
+        bytemuck::cast_slice(&flat),
+        n as u64 * 4,
+        n,
+    );
     let got: &[f32] = bytemuck::cast_slice(&data);
     let (mut hits, mut differ) = (0, 0);
     for (c, g) in cases.iter().zip(got) {

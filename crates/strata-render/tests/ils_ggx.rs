@@ -8,7 +8,6 @@ mod common;
 
 use glam::Vec3;
 use strata_reference::vpl::Vpl;
-use wgpu::util::DeviceExt;
 
 /// One configuration as the shader reads it (7 vec4).
 #[repr(C)]
@@ -122,59 +121,16 @@ fn gpu_glossy_vpl_radiance_equals_the_cpu_twin() {
             params: [metallic, max_g, 0.0, 0.0],
         });
     }
-    let d = &gpu.device;
-    let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("cases"),
-        contents: bytemuck::cast_slice(&cases),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
     let size = (cases.len() * 16) as u64;
-    let output = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("out"),
+    let bytes = common::run_compute(
+        &gpu,
+        "ggx-twin",
+        SHADER,
+        "cs_main",
+        bytemuck::cast_slice(&cases),
         size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let staging = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("staging"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let module = strata_render::shader::module(d, "ggx-twin", SHADER);
-    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("ggx-twin"),
-        layout: None,
-        module: &module,
-        entry_point: Some("cs_main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("ggx-twin"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: output.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
-    gpu.queue.submit([enc.finish()]);
-    gpu.check_errors().expect("no wgpu validation error");
-    let bytes = gpu.read_buffer(&staging).expect("read back");
+        cases.len() as u32,
+    );
     let got: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
     // per value: |GPU − CPU| ≤ (1e-3 + 1e-6/α²) relative + 1e-6 of the case's largest
     // channel. f32 on both sides, but sqrt, division and the pow5 product round

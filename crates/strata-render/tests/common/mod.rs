@@ -92,3 +92,72 @@ pub fn npack_normals(npack: &strata_scene::ImageBuf, layer: usize) -> strata_sce
     }
     out
 }
+
+/// Runs compute shader `src` (entry `entry`, workgroup size 64, one invocation per
+/// output element) with `input` bound as a read-only storage buffer at binding 0
+/// and an `output_bytes` read-write storage buffer at binding 1, over `threads`
+/// invocations; returns the output buffer's bytes. A wgpu validation error fails
+/// the test. The harness of the GPU-equals-CPU-twin tests of shader functions.
+pub fn run_compute(
+    gpu: &GpuContext,
+    label: &str,
+    src: &str,
+    entry: &str,
+    input: &[u8],
+    output_bytes: u64,
+    threads: u32,
+) -> Vec<u8> {
+    use wgpu::util::DeviceExt;
+    let d = &gpu.device;
+    let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: input,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let buffer = |usage| {
+        d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: output_bytes,
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    let output = buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+    let staging = buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+    let module = strata_render::shader::module(d, label, src);
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: None,
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: input.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: output.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(threads.div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&output, 0, &staging, 0, output_bytes);
+    gpu.queue.submit([enc.finish()]);
+    gpu.check_errors()
+        .unwrap_or_else(|e| panic!("{label}: wgpu validation error: {e}"));
+    gpu.read_buffer(&staging)
+        .unwrap_or_else(|e| panic!("{label}: read back: {e}"))
+}
