@@ -1830,6 +1830,21 @@ fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
     }
     let one = &patterns[0];
     assert_eq!(one["pattern"], "1x1");
+    // the per-set deviation σ₁ predicts when the running mean crosses 1 % of the K-set
+    // converged image: ‖mean_N − converged_K‖ ≈ σ₁·√(1/N + 1/K) (independent sets)
+    let (sigma, k) = (one["per_set_rel_rms"].as_f64().unwrap(), p["sets"].as_f64().unwrap());
+    let slack = (0.01 / sigma).powi(2) - 1.0 / k;
+    assert!(slack > 0.0, "σ₁ {sigma}: 1 % unreachable against {k} sets");
+    let predicted = (1.0 / slack).ceil();
+    let measured = one["frames_to_target"].as_f64().expect("cornell reaches 1 %");
+    assert!(
+        measured >= predicted / 2.0 && measured <= predicted * 2.0,
+        "crossing after {measured} frames, σ₁ {sigma} predicts {predicted}"
+    );
+    assert_eq!(
+        one["predicted_frames_to_target"].as_f64().unwrap(),
+        (sigma / 0.01).powi(2).ceil().max(1.0)
+    );
     let pt: Vec<(u64, f64)> = one["rms_vs_path_tracer"]
         .as_array()
         .unwrap()

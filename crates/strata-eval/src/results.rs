@@ -509,6 +509,16 @@ pub struct IlsProgressivePattern {
     pub gpu_ms_to_target: Option<f64>,
     pub vpl_ms_to_target: Option<f64>,
     pub gpu_ms_per_frame: f64,
+    /// σ₁: relative RMS of one VPL set about the estimator's expectation, from the
+    /// sample variance of every set the pattern rendered (the converged image's K and
+    /// the accumulated frames).
+    pub per_set_rel_rms: f64,
+    /// ⌈(σ₁ / target)²⌉: frames until the running mean is within the target of the
+    /// expectation, and their GPU / VPL-generation milliseconds at the measured per-frame
+    /// cost — Table 5's time where K frames do not reach it (a prediction, not a run).
+    pub predicted_frames_to_target: u64,
+    pub predicted_gpu_ms_to_target: f64,
+    pub predicted_vpl_ms_to_target: f64,
     /// (frames accumulated, relative RMS against the converged image).
     pub rms_curve: Vec<(u32, f64)>,
     /// (frames accumulated = 1, 2, 4, …, relative RMS of the running mean against the path

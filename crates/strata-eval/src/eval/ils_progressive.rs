@@ -86,6 +86,51 @@ fn accumulate(sum: &mut ImageBuf, img: &ImageBuf) {
     }
 }
 
+/// Σ and Σ² over K independent frames of one estimator, per pixel and channel, in f64
+/// (the per-set variance is a small difference of large sums).
+pub struct SetMoments {
+    k: u32,
+    sum: Vec<f64>,
+    sum_sq: Vec<f64>,
+}
+
+impl SetMoments {
+    pub fn new(len: usize) -> Self {
+        Self { k: 0, sum: vec![0.0; len], sum_sq: vec![0.0; len] }
+    }
+
+    pub fn add(&mut self, img: &ImageBuf) {
+        self.k += 1;
+        for ((s, q), v) in self.sum.iter_mut().zip(&mut self.sum_sq).zip(&img.data) {
+            let v = *v as f64;
+            *s += v;
+            *q += v * v;
+        }
+    }
+
+    /// σ₁: the relative RMS of ONE set about the estimator's expectation,
+    /// √(Σ_px s²) / ‖mean‖ with s² the unbiased sample variance over the K sets.
+    /// The running mean of N fresh sets is then σ₁/√N from the expectation, and
+    /// σ₁·√(1/N + 1/K) from a converged image of K other sets.
+    pub fn per_set_rel_rms(&self) -> f64 {
+        let k = self.k as f64;
+        assert!(self.k >= 2, "the sample variance needs two sets");
+        let (mut var, mut norm) = (0.0f64, 0.0f64);
+        for (s, q) in self.sum.iter().zip(&self.sum_sq) {
+            let mean = s / k;
+            var += ((q - k * mean * mean) / (k - 1.0)).max(0.0);
+            norm += mean * mean;
+        }
+        (var / norm.max(1e-30)).sqrt()
+    }
+}
+
+/// Frames N until σ₁/√N < `target`: Table 5's criterion against the estimator's
+/// expectation (the converged image without the K-set reference's own noise).
+pub fn predicted_frames(per_set_rel_rms: f64, target: f64) -> u64 {
+    ((per_set_rel_rms / target).powi(2).ceil() as u64).max(1)
+}
+
 fn scaled(sum: &ImageBuf, k: u32) -> ImageBuf {
     let mut m = sum.clone();
     m.data.iter_mut().for_each(|v| *v /= k as f32);
@@ -170,9 +215,11 @@ pub fn run(
         let mut r = Renderer::new(gpu, scene, rs)?;
         // the converged image of this estimator: K independent sets
         let mut sum = ImageBuf::new(s.scene.width, s.scene.height, 3);
+        let mut moments = SetMoments::new(sum.data.len());
         for set in &converged_sets {
             let (img, _) = frame(&mut r, gpu, scene, camera, set, at)?;
             accumulate(&mut sum, &img);
+            moments.add(&img);
         }
         let converged = scaled(&sum, sets);
         // the progressive run
@@ -184,6 +231,7 @@ pub fn run(
         for (k, set) in (1..=sets).zip(&progressive_sets) {
             let (img, g) = frame(&mut r, gpu, scene, camera, set, at)?;
             accumulate(&mut acc, &img);
+            moments.add(&img);
             gpu_ms += g;
             vpl_ms += set.ms;
             let mean = scaled(&acc, k);
@@ -199,10 +247,18 @@ pub fn run(
                 break;
             }
         }
+        // σ₁ from every set this pattern rendered: the K of the converged image and the
+        // accumulated ones (independent seeds; VPL noise is heavy-tailed, so the more sets
+        // the steadier the estimate)
+        let sigma = moments.per_set_rel_rms();
+        let predicted = predicted_frames(sigma, TARGET_RMS);
+        let per_frame = gpu_ms / curve.len() as f64;
+        let vpl_per_frame = vpl_ms / curve.len() as f64;
         eprintln!(
-            "ils §6.3 {}x{}: {}",
+            "ils §6.3 {}x{}: one set {sigma:.4} relative RMS → {predicted} frames to 1 % ≈ {:.1} s GPU; {}",
             pattern[0],
             pattern[1],
+            predicted as f64 * per_frame / 1e3,
             match reached {
                 Some((k, g, v)) => format!("< 1 % RMS after {k} frames, {g:.0} ms GPU + {v:.0} ms VPLs"),
                 None => format!(
@@ -216,7 +272,11 @@ pub fn run(
             frames_to_target: reached.map(|r| r.0),
             gpu_ms_to_target: reached.map(|r| r.1),
             vpl_ms_to_target: reached.map(|r| r.2),
-            gpu_ms_per_frame: gpu_ms / curve.len() as f64,
+            gpu_ms_per_frame: per_frame,
+            per_set_rel_rms: sigma,
+            predicted_frames_to_target: predicted,
+            predicted_gpu_ms_to_target: predicted as f64 * per_frame,
+            predicted_vpl_ms_to_target: predicted as f64 * vpl_per_frame,
             rms_curve: curve,
             rms_vs_path_tracer: pt_curve,
         });
@@ -235,4 +295,69 @@ pub fn run(
         converged_vs_path_tracer: ref_total.annotate(d, &display(&conv, exposure)),
         ref_spp: traced.spp(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(values: &[f32]) -> ImageBuf {
+        let mut img = ImageBuf::new(values.len() as u32, 1, 3);
+        for (px, v) in img.data.chunks_mut(3).zip(values) {
+            px.fill(*v);
+        }
+        img
+    }
+
+    #[test]
+    fn per_set_rms_is_the_sample_deviation_over_the_mean() {
+        // sets alternate μ ± σ per pixel: sample variance σ²·K/(K − 1), so
+        // σ₁ = (σ/μ)·√(K/(K − 1)) exactly
+        let (mu, sigma, k) = (2.0f32, 0.5f32, 8u32);
+        let mut m = SetMoments::new(4 * 3);
+        for i in 0..k {
+            let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+            m.add(&image(&[mu + sign * sigma; 4]));
+        }
+        let expect = (sigma / mu) as f64 * (k as f64 / (k as f64 - 1.0)).sqrt();
+        assert!((m.per_set_rel_rms() - expect).abs() < 1e-9, "{}", m.per_set_rel_rms());
+        // identical sets have no variance
+        let mut still = SetMoments::new(4 * 3);
+        (0..3).for_each(|_| still.add(&image(&[1.0, 2.0, 3.0, 4.0])));
+        assert_eq!(still.per_set_rel_rms(), 0.0);
+    }
+
+    #[test]
+    fn per_set_rms_predicts_the_running_mean_error() {
+        // Gaussian-ish noise (sum of 12 uniforms − 6) of relative deviation 0.3 on a
+        // 256-pixel image: the running mean of N fresh sets is σ₁/√N from the expectation
+        let (n_px, mu, rel) = (256usize, 1.5f64, 0.3f64);
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut normal = || {
+            let mut s = 0.0;
+            for _ in 0..12 {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                s += (state >> 11) as f64 / (1u64 << 53) as f64;
+            }
+            s - 6.0
+        };
+        let mut draw = || image(&(0..n_px).map(|_| (mu * (1.0 + rel * normal())) as f32).collect::<Vec<_>>());
+        let mut m = SetMoments::new(n_px * 3);
+        (0..64).for_each(|_| m.add(&draw()));
+        let sigma = m.per_set_rel_rms();
+        assert!((sigma / rel - 1.0).abs() < 0.1, "σ₁ {sigma} vs {rel}");
+        let truth = image(&vec![mu as f32; n_px]);
+        for n in [1u32, 4, 16] {
+            let mut sum = ImageBuf::new(n_px as u32, 1, 3);
+            (0..n).for_each(|_| accumulate(&mut sum, &draw()));
+            let e = relative_rms(&scaled(&sum, n), &truth);
+            let want = sigma / (n as f64).sqrt();
+            assert!((e / want - 1.0).abs() < 0.25, "N {n}: {e} vs {want}");
+        }
+        assert_eq!(predicted_frames(0.025, 0.01), 7);
+        assert_eq!(predicted_frames(0.01, 0.01), 1);
+        assert_eq!(predicted_frames(0.0, 0.01), 1);
+    }
 }
