@@ -197,10 +197,16 @@ pub fn parse_set(kv: &str) -> Result<(String, f64), String> {
         .ok()
         .or_else(|| strata_render::technique::named_value(name.trim(), value))
         .ok_or_else(|| {
-            format!(
-                "--set {kv}: '{value}' is not a number (nor a named value of '{}')",
-                name.trim()
-            )
+            let named = strata_render::technique::named_values(name.trim());
+            if named.is_empty() {
+                format!("--set {kv}: '{value}' is not a number")
+            } else {
+                format!(
+                    "--set {kv}: '{value}' is not a number nor a value of '{}' ({})",
+                    name.trim(),
+                    named.join(", ")
+                )
+            }
         })?;
     Ok((name.trim().to_string(), v))
 }

@@ -191,7 +191,19 @@ impl Targets {
     /// A target of its own size (e.g. the tiled sub-buffers of interleaved
     /// shading, which can be a few texels larger than the frame); read-back and
     /// debug views show it whole (no guard-band crop).
-    pub fn create_sized(&mut self, gpu: &GpuContext, desc: TargetDesc, [width, height]: [u32; 2]) {
+    pub fn create_sized(&mut self, gpu: &GpuContext, desc: TargetDesc, size: [u32; 2]) {
+        self.create_with_usage(gpu, desc, size, wgpu::TextureUsages::empty());
+    }
+
+    /// [`Targets::create_sized`] with `extra` usages, e.g. `STORAGE_BINDING` for a
+    /// target a compute pass writes (the compute split/gather of interleaved shading).
+    pub fn create_with_usage(
+        &mut self,
+        gpu: &GpuContext,
+        desc: TargetDesc,
+        [width, height]: [u32; 2],
+        extra: wgpu::TextureUsages,
+    ) {
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(desc.name),
             size: wgpu::Extent3d {
@@ -206,7 +218,8 @@ impl Targets {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::COPY_DST,
+                | wgpu::TextureUsages::COPY_DST
+                | extra,
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor {

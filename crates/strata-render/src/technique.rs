@@ -108,6 +108,23 @@ pub fn named_value(name: &str, text: &str) -> Option<f64> {
         .find_map(|i| i.parse_value(text))
 }
 
+/// The named values of setting `name` over every technique (e.g. `split`:
+/// naive, blocks, compute), deduplicated, in registry order; empty when it has none.
+pub fn named_values(name: &str) -> Vec<&'static str> {
+    let mut out: Vec<&'static str> = Vec::new();
+    for v in registry()
+        .iter()
+        .flat_map(|t| t.setting_list())
+        .filter(|i| i.name == name)
+        .flat_map(|i| i.values.iter().copied())
+    {
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
 macro_rules! setting {
     ($name:literal, $doc:literal, $range:expr, $int:literal, |$s:ident| $get:expr, |$t:ident, $v:ident| $set:expr) => {
         SettingInfo {
@@ -342,7 +359,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 14] = [
+static ILS_SETTINGS: [SettingInfo; 15] = [
     SettingInfo {
         name: "shadows",
         doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
@@ -405,6 +422,29 @@ static ILS_SETTINGS: [SettingInfo; 14] = [
             SplitMethod::Blocks { block: v as u32 }
         }
     ),
+    SettingInfo {
+        name: "split",
+        doc: "BS/BG method (ILS §3): naive (one pass through an index, Table 1's baseline), blocks (§3.3's block splitting + translation, block size `split-block`, 16 unless set) or compute (one compute pass, tiles read coherently; the modern form); all give the same bits",
+        range: Range::Closed(0.0, 2.0),
+        integer: true,
+        get: |s| {
+            Some(match ils_of(s).method {
+                SplitMethod::Naive => 0.0,
+                SplitMethod::Blocks { .. } => 1.0,
+                SplitMethod::Compute => 2.0,
+            })
+        },
+        set: |s, v| {
+            let i = ils_mut(s);
+            i.method = match (v as u32, i.method) {
+                (0, _) => SplitMethod::Naive,
+                (1, SplitMethod::Blocks { block }) => SplitMethod::Blocks { block },
+                (1, _) => SplitMethod::Blocks { block: 16 },
+                _ => SplitMethod::Compute,
+            }
+        },
+        values: &["naive", "blocks", "compute"],
+    },
     setting!(
         "clamp-distance",
         "geometry term clamped to 1/d^2 below this distance (default: 2% of the scene diagonal)",

@@ -5,7 +5,7 @@
 //! | pass | ILS | what |
 //! |---|---|---|
 //! | `ils-gbuffer` | §4.1 BC | layer 0's normal and csz packed into one RGBA32F buffer |
-//! | `ils-bs` | §4.2 BS | split into n×m sub-buffers ([`Interleave`], any [`SplitMethod`] but `Compute`) |
+//! | `ils-bs` | §4.2 BS | split into n×m sub-buffers ([`Interleave`], any [`SplitMethod`]) |
 //! | `ils-snsm` | §4.3 SNSM | sub-buffer (i, j) shaded with its own subset of the N VPLs |
 //! | `ils-bg` | §4.4 BG | the tiled irradiance gathered back to the image |
 //! | `ils-bg-glossy` | – | the same for the glossy receivers' GGX radiance (`ils-glossy`) |
@@ -132,7 +132,7 @@ pub struct IlsSettings {
     /// The interleaving pattern n×m, each 1..=16.
     pub pattern: [u32; 2],
     /// BS/BG method: `Naive` (one pass; the fastest on lavapipe, docs/ils-split.md)
-    /// or `Blocks` (§3.3); `Compute` needs storage targets and is refused here.
+    /// or `Blocks` (§3.3), or `Compute` (one compute pass; its destinations get storage usage).
     pub method: SplitMethod,
     /// d_c: the geometry term is clamped to 1/d_c² (scene units; `None`: 2 % of
     /// the scene's bounding-box diagonal).
@@ -202,12 +202,6 @@ impl IlsSettings {
         }
         let [n, m] = self.pattern;
         crate::passes::interleave::InterleaveGeometry::new(64, 64, n, m, self.method)?;
-        if self.method == SplitMethod::Compute {
-            return Err(
-                "interleave method compute is not available in the frame: use naive or blocks (split-block = 0 or a power of two)"
-                    .into(),
-            );
-        }
         if let Some(d) = self.clamp_distance {
             if !(d > 0.0 && d.is_finite()) {
                 return Err(format!("clamp-distance {d} is out of range: must be > 0"));
@@ -598,8 +592,17 @@ impl IlsStage {
         let (w, h) = (targets.width, targets.height);
         let [n, m] = s.pattern;
         let vpl_buffer = vpl_buffer(gpu, &s.vpls);
-        for t in [GBUFFER, IRRADIANCE, INDIRECT, GLOSSY] {
+        // the compute BS/BG writes its destinations as storage textures: the split
+        // G-buffer, and the gathered irradiance and glossy radiance
+        let storage = match s.method {
+            SplitMethod::Compute if !s.brute_force => wgpu::TextureUsages::STORAGE_BINDING,
+            _ => wgpu::TextureUsages::empty(),
+        };
+        for t in [GBUFFER, INDIRECT] {
             targets.create(gpu, t);
+        }
+        for t in [IRRADIANCE, GLOSSY] {
+            targets.create_with_usage(gpu, t, [w, h], storage);
         }
         let gbuffer = PassBuilder::new(gpu, targets, "ils-gbuffer")
             .shader("ils-gbuffer", include_str!("ils_gbuffer.wgsl"))
@@ -615,7 +618,7 @@ impl IlsStage {
             let bg = Interleave::new(gpu, IRRADIANCE.format, w, h, n, m, s.method)?;
             let bg_glossy = Interleave::new(gpu, GLOSSY.format, w, h, n, m, s.method)?;
             let tiled = bs.tiled_size();
-            targets.create_sized(gpu, GBUFFER_SPLIT, tiled);
+            targets.create_with_usage(gpu, GBUFFER_SPLIT, tiled, storage);
             targets.create_sized(gpu, IRRADIANCE_TILED, tiled);
             targets.create_sized(gpu, GLOSSY_TILED, tiled);
             let geo = *bs.geometry();
@@ -987,13 +990,6 @@ mod tests {
                     ..ok.clone()
                 },
                 "block size",
-            ),
-            (
-                IlsSettings {
-                    method: SplitMethod::Compute,
-                    ..ok.clone()
-                },
-                "compute",
             ),
             (
                 IlsSettings {
