@@ -185,12 +185,13 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                         ),
                     }
                     println!(
-                        "  §6.3 {}: one set {:.4} relative RMS → {} frames to < {:.0} % of the expectation ≈ {:.1} s GPU + {:.1} s VPL generation (predicted)",
+                        "  §6.3 {}: one set {:.4} relative RMS → {} frames to < {:.0} % of the expectation ≈ {:.1} s GPU ({:.1} s with a static view) + {:.1} s VPL generation (predicted)",
                         q.pattern,
                         q.per_set_rel_rms,
                         q.predicted_frames_to_target,
                         100.0 * p.target_rms,
                         q.predicted_gpu_ms_to_target / 1e3,
+                        q.predicted_static_view_gpu_ms_to_target / 1e3,
                         q.predicted_vpl_ms_to_target / 1e3
                     );
                 }

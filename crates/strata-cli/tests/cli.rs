@@ -1845,6 +1845,18 @@ fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
         one["predicted_frames_to_target"].as_f64().unwrap(),
         (sigma / 0.01).powi(2).ceil().max(1.0)
     );
+    // the VPL-dependent passes (shadow maps, SSM) are part of every frame, and a static
+    // view pays the rest once
+    for q in patterns {
+        let (dep, all) = (
+            q["vpl_dependent_ms_per_frame"].as_f64().unwrap(),
+            q["gpu_ms_per_frame"].as_f64().unwrap(),
+        );
+        assert!(dep > 0.0 && dep < all, "{}: {dep} of {all} ms", q["pattern"]);
+        let frames = q["predicted_frames_to_target"].as_f64().unwrap();
+        let fixed = q["predicted_static_view_gpu_ms_to_target"].as_f64().unwrap();
+        assert!((fixed - (all - dep + frames * dep)).abs() < 1e-6 * all.max(1.0), "{fixed}");
+    }
     let pt: Vec<(u64, f64)> = one["rms_vs_path_tracer"]
         .as_array()
         .unwrap()

@@ -519,6 +519,13 @@ pub struct IlsProgressivePattern {
     pub predicted_frames_to_target: u64,
     pub predicted_gpu_ms_to_target: f64,
     pub predicted_vpl_ms_to_target: f64,
+    /// GPU ms per frame of the passes that depend on the VPL set (VPL shadow maps,
+    /// SSM/SNSM or brute-force shading).
+    pub vpl_dependent_ms_per_frame: f64,
+    /// §6.3's accounting for a static view: one frame's fixed passes (G-buffer,
+    /// direct light, BS, DB; BG and the blur are linear with fixed weights, so once on
+    /// the accumulated sub-buffers) + the predicted frames × the VPL-dependent passes.
+    pub predicted_static_view_gpu_ms_to_target: f64,
     /// (frames accumulated, relative RMS against the converged image).
     pub rms_curve: Vec<(u32, f64)>,
     /// (frames accumulated = 1, 2, 4, …, relative RMS of the running mean against the path

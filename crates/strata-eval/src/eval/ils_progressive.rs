@@ -64,6 +64,17 @@ fn vpl_set(reference: &Reference, paths: u32, bounces: u32, seed: u64) -> VplSet
     }
 }
 
+/// GPU milliseconds of a frame: all passes, and those that depend on the VPL set
+/// (the VPL shadow maps and the shading pass). With a fixed view the rest (G-buffer,
+/// direct light, BS, DB) is the same every frame, and BG and the blur are linear
+/// with weights fixed by the view, so they could run once on the accumulated
+/// sub-buffers: §6.3's "the G-buffer creation, the manipulation passes and the
+/// filters become free".
+struct FrameMs {
+    total: f64,
+    vpl_dependent: f64,
+}
+
 /// One frame with `set`: (full image, GPU ms).
 fn frame(
     r: &mut Renderer,
@@ -72,12 +83,27 @@ fn frame(
     camera: Camera,
     set: &VplSet,
     at: f32,
-) -> Result<(ImageBuf, f64)> {
+) -> Result<(ImageBuf, FrameMs)> {
     r.set_vpls(gpu, &set.vpls)?;
     let t = r.render(gpu, scene, &FrameCameras::fixed(camera), at)?;
     let full = super::gi::rgb(&r.read_target(gpu, "hdr-full")?);
     gpu.check_errors()?;
-    Ok((full, t.total()))
+    let vpl_dependent = [
+        strata_render::passes::ils::VPL_SHADOW_PASS,
+        "ils-ssm",
+        "ils-snsm",
+        strata_render::passes::ils::BRUTE_FORCE_PASS,
+    ]
+    .iter()
+    .filter_map(|p| t.get(p))
+    .sum();
+    Ok((
+        full,
+        FrameMs {
+            total: t.total(),
+            vpl_dependent,
+        },
+    ))
 }
 
 fn accumulate(sum: &mut ImageBuf, img: &ImageBuf) {
@@ -224,7 +250,7 @@ pub fn run(
         let converged = scaled(&sum, sets);
         // the progressive run
         let mut acc = ImageBuf::new(s.scene.width, s.scene.height, 3);
-        let (mut gpu_ms, mut vpl_ms) = (0.0, 0.0);
+        let (mut gpu_ms, mut vpl_ms, mut dependent_ms) = (0.0, 0.0, 0.0);
         let mut curve = Vec::new();
         let mut pt_curve = Vec::new();
         let mut reached = None;
@@ -232,7 +258,8 @@ pub fn run(
             let (img, g) = frame(&mut r, gpu, scene, camera, set, at)?;
             accumulate(&mut acc, &img);
             moments.add(&img);
-            gpu_ms += g;
+            gpu_ms += g.total;
+            dependent_ms += g.vpl_dependent;
             vpl_ms += set.ms;
             let mean = scaled(&acc, k);
             let e = relative_rms(&mean, &converged);
@@ -253,6 +280,9 @@ pub fn run(
         let sigma = moments.per_set_rel_rms();
         let predicted = predicted_frames(sigma, TARGET_RMS);
         let per_frame = gpu_ms / curve.len() as f64;
+        let dependent_per_frame = dependent_ms / curve.len() as f64;
+        // a static view: one frame's fixed passes, then only the VPL-dependent ones
+        let static_view_ms = per_frame - dependent_per_frame + predicted as f64 * dependent_per_frame;
         let vpl_per_frame = vpl_ms / curve.len() as f64;
         eprintln!(
             "ils §6.3 {}x{}: one set {sigma:.4} relative RMS → {predicted} frames to 1 % ≈ {:.1} s GPU; {}",
@@ -277,6 +307,8 @@ pub fn run(
             predicted_frames_to_target: predicted,
             predicted_gpu_ms_to_target: predicted as f64 * per_frame,
             predicted_vpl_ms_to_target: predicted as f64 * vpl_per_frame,
+            vpl_dependent_ms_per_frame: dependent_per_frame,
+            predicted_static_view_gpu_ms_to_target: static_view_ms,
             rms_curve: curve,
             rms_vs_path_tracer: pt_curve,
         });
