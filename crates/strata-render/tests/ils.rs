@@ -11,7 +11,7 @@ use strata_reference::vpl::{Vpl, VplSettings};
 use strata_reference::Reference;
 use strata_render::frame::FrameCameras;
 use strata_render::passes::ils::{GpuVpl, IlsSettings};
-use strata_render::passes::interleave::{InterleaveGeometry, SplitMethod};
+use strata_render::passes::interleave::SplitMethod;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{procedural, ImageBuf, Scene};
 
@@ -156,14 +156,6 @@ fn split_methods_give_identical_frames() {
     }
 }
 
-/// World position of pixel (x, y) at camera-space depth z (common/camera.wgsl's twin).
-fn world(u: &strata_render::frame::FrameUniforms, x: u32, y: u32, z: f32) -> Vec3 {
-    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-    let ndc_x = (x as f32 + 0.5) * u.size[2] * 2.0 - 1.0;
-    let ndc_y = 1.0 - (y as f32 + 0.5) * u.size[3] * 2.0;
-    v(u.eye) + z * (v(u.cam_forward) + v(u.cam_right) * ndc_x + v(u.cam_up) * ndc_y)
-}
-
 /// The GPU's irradiance against the CPU sum over the same surface points and
 /// normals: the brute force against Σ_k, the interleaved 8×6 (no blur)
 /// against (N/N_s) Σ_{k ≡ s mod 48} for each pixel's sub-buffer s.
@@ -185,35 +177,12 @@ fn gpu_vpl_shading_equals_the_cpu_sum() {
                 },
             );
             let gpu_e = irradiance(&gpu, &r);
-            let csz = r.read_target(&gpu, "csz").unwrap();
-            let normals = r.read_normals(&gpu).unwrap();
-            let u = r.frame_uniforms();
-            let geo = InterleaveGeometry::new(W, H, 8, 6, SplitMethod::Naive).unwrap();
-            let n_all = v.len() as u32;
             let mut cpu = ImageBuf::new(W, H, 3);
-            for y in 0..H {
-                for x in 0..W {
-                    let i = (y * W + x) as usize;
-                    let z = csz.data[i];
-                    if z <= 0.0 {
-                        continue;
-                    }
-                    let p = world(&u, x, y, z);
-                    let n = Vec3::from_slice(&normals.data[i * 3..i * 3 + 3]);
-                    let [si, sj] = geo.sub_buffer(x, y);
-                    let s = sj * 8 + si;
-                    let (first, step) = if brute_force { (0, 1) } else { (s, 48) };
-                    let mut e = Vec3::ZERO;
-                    let mut count = 0;
-                    for k in (first..n_all).step_by(step as usize) {
-                        e += v[k as usize].irradiance_at(p, n, max_g);
-                        count += 1;
-                    }
-                    if count > 0 {
-                        e *= n_all as f32 / count as f32;
-                    }
-                    cpu.data[i * 3..i * 3 + 3].copy_from_slice(&e.to_array());
-                }
+            for q in common::surface_points(&gpu, &r) {
+                let e = common::ils_vpl_sum([8, 6], v.len(), brute_force, (q.x, q.y), |k| {
+                    v[k].irradiance_at(q.p, q.n, max_g)
+                });
+                cpu.data[q.i * 3..q.i * 3 + 3].copy_from_slice(&e.to_array());
             }
             // per pixel: |GPU − CPU| ≤ 0.2 % of the pixel's value + 0.02 % of the image's largest
             // (the GPU stores f16: 0.05 % rounding)
@@ -350,43 +319,20 @@ fn vpl_shadow_maps_match_traced_visibility() {
             },
         );
         let (gpu_e, snsm_e) = (irradiance(&gpu, &ssm), irradiance(&gpu, &snsm));
-        let csz = ssm.read_target(&gpu, "csz").unwrap();
-        let normals = ssm.read_normals(&gpu).unwrap();
-        let u = ssm.frame_uniforms();
-        let geo = InterleaveGeometry::new(W, H, 8, 6, SplitMethod::Naive).unwrap();
-        let n_all = v.len() as u32;
         let mut cpu = ImageBuf::new(W, H, 3);
-        for y in 0..H {
-            for x in 0..W {
-                let i = (y * W + x) as usize;
-                let z = csz.data[i];
-                if z <= 0.0 {
-                    continue;
+        for q in common::surface_points(&gpu, &ssm) {
+            let e = common::ils_vpl_sum([8, 6], v.len(), brute_force, (q.x, q.y), |k| {
+                let term = v[k].irradiance_at(q.p, q.n, max_g);
+                let origin = q.p + q.n * eps;
+                let to = v[k].position - origin;
+                let d = to.length();
+                if term == Vec3::ZERO || reference.bvh().occluded(origin, to / d, 0.0, d - eps) {
+                    Vec3::ZERO
+                } else {
+                    term
                 }
-                let p = world(&u, x, y, z);
-                let n = Vec3::from_slice(&normals.data[i * 3..i * 3 + 3]);
-                let [si, sj] = geo.sub_buffer(x, y);
-                let s = sj * 8 + si;
-                let (first, step) = if brute_force { (0, 1) } else { (s, 48) };
-                let (mut e, mut count) = (Vec3::ZERO, 0);
-                for k in (first..n_all).step_by(step as usize) {
-                    count += 1;
-                    let term = v[k as usize].irradiance_at(p, n, max_g);
-                    if term == Vec3::ZERO {
-                        continue;
-                    }
-                    let origin = p + n * eps;
-                    let to = v[k as usize].position - origin;
-                    let d = to.length();
-                    if !reference.bvh().occluded(origin, to / d, 0.0, d - eps) {
-                        e += term;
-                    }
-                }
-                if count > 0 {
-                    e *= n_all as f32 / count as f32;
-                }
-                cpu.data[i * 3..i * 3 + 3].copy_from_slice(&e.to_array());
-            }
+            });
+            cpu.data[q.i * 3..q.i * 3 + 3].copy_from_slice(&e.to_array());
         }
         let scale = cpu.data.iter().cloned().fold(0.0f32, f32::max);
         assert!(scale > 0.0);

@@ -164,14 +164,6 @@ fn gpu_glossy_vpl_radiance_equals_the_cpu_twin() {
     );
 }
 
-/// World position of pixel (x, y) at camera-space depth z (common/camera.wgsl's twin).
-fn world(u: &strata_render::frame::FrameUniforms, x: u32, y: u32, z: f32) -> Vec3 {
-    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-    let ndc_x = (x as f32 + 0.5) * u.size[2] * 2.0 - 1.0;
-    let ndc_y = 1.0 - (y as f32 + 0.5) * u.size[3] * 2.0;
-    v(u.eye) + z * (v(u.cam_forward) + v(u.cam_right) * ndc_x + v(u.cam_up) * ndc_y)
-}
-
 /// One ILS frame of `scene` (in the first test `still-life`: gold metal sphere,
 /// blue glossy vase, Lambert cloth and boxes) and, per pixel, the CPU twin of what it must hold: from the
 /// frame's own csz, decoded normal, roughness, metallic, albedo and glossy flag
@@ -197,7 +189,6 @@ fn glossy_frame(
     visible: &dyn Fn(Vec3, Vec3, &Vpl) -> bool,
 ) -> GlossyFrame {
     use strata_render::frame::FrameCameras;
-    use strata_render::passes::interleave::{InterleaveGeometry, SplitMethod};
     use strata_render::{RenderSettings, Renderer};
     let max_g = ils.max_geometry(scene);
     let brute_force = ils.brute_force;
@@ -221,50 +212,32 @@ fn glossy_frame(
         gpu.check_errors().unwrap();
         img
     };
-    let (irradiance, glossy, csz) = (read("ils-irradiance"), read("ils-glossy"), read("csz"));
+    let (irradiance, glossy) = (read("ils-irradiance"), read("ils-glossy"));
     let (nrm, albedo, emission) = (read("normal"), read("albedo"), read("emission"));
-    let normals = r.read_normals(gpu).unwrap();
     let u = r.frame_uniforms();
     let eye = Vec3::new(u.eye[0], u.eye[1], u.eye[2]);
-    let geo = InterleaveGeometry::new(W, H, 8, 6, SplitMethod::Naive).unwrap();
-    let n_all = v.len() as u32;
     let mut cpu = vec![Vec3::ZERO; (W * H) as usize];
     let mut is_glossy = vec![false; (W * H) as usize];
-    for y in 0..H {
-        for x in 0..W {
-            let i = (y * W + x) as usize;
-            let z = csz.data[i];
-            if z <= 0.0 {
-                continue;
+    for q in common::surface_points(gpu, &r) {
+        let (i, p, n) = (q.i, q.p, q.n);
+        let g = emission.data[i * 4 + 3] > 1.5;
+        is_glossy[i] = g;
+        let rho = Vec3::from_slice(&albedo.data[i * 4..i * 4 + 3]);
+        let (rough, metal) = (nrm.data[i * 4 + 2], nrm.data[i * 4 + 3]);
+        let view = (eye - p).normalize();
+        cpu[i] = common::ils_vpl_sum([8, 6], v.len(), brute_force, (q.x, q.y), |k| {
+            let vpl = &v[k];
+            let term = if g {
+                vpl.glossy_radiance_at(p, n, view, rho, rough, metal, max_g)
+            } else {
+                vpl.irradiance_at(p, n, max_g)
+            };
+            if term != Vec3::ZERO && visible(p, n, vpl) {
+                term
+            } else {
+                Vec3::ZERO
             }
-            let p = world(&u, x, y, z);
-            let n = Vec3::from_slice(&normals.data[i * 3..i * 3 + 3]);
-            let g = emission.data[i * 4 + 3] > 1.5;
-            is_glossy[i] = g;
-            let rho = Vec3::from_slice(&albedo.data[i * 4..i * 4 + 3]);
-            let (rough, metal) = (nrm.data[i * 4 + 2], nrm.data[i * 4 + 3]);
-            let view = (eye - p).normalize();
-            let [si, sj] = geo.sub_buffer(x, y);
-            let (first, step) = if brute_force { (0, 1) } else { (sj * 8 + si, 48) };
-            let mut e = Vec3::ZERO;
-            let mut count = 0;
-            for k in (first..n_all).step_by(step as usize) {
-                count += 1;
-                let vpl = &v[k as usize];
-                let term = if g {
-                    vpl.glossy_radiance_at(p, n, view, rho, rough, metal, max_g)
-                } else {
-                    vpl.irradiance_at(p, n, max_g)
-                };
-                if term != Vec3::ZERO && visible(p, n, vpl) {
-                    e += term;
-                }
-            }
-            if count > 0 {
-                e *= n_all as f32 / count as f32;
-            }
-            cpu[i] = e;
-        }
+        });
     }
     GlossyFrame {
         irradiance,

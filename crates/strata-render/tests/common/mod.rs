@@ -161,3 +161,68 @@ pub fn run_compute(
     gpu.read_buffer(&staging)
         .unwrap_or_else(|e| panic!("{label}: read back: {e}"))
 }
+
+/// Layer 0's surface under one pixel of a rendered frame.
+pub struct SurfacePoint {
+    /// Pixel index y·W + x.
+    pub i: usize,
+    pub x: u32,
+    pub y: u32,
+    /// World position from csz through the pixel centre (common/camera.wgsl's twin).
+    pub p: glam::Vec3,
+    /// Decoded world normal.
+    pub n: glam::Vec3,
+}
+
+/// Every covered pixel (csz > 0) of `r`'s last frame, row by row; panics on a
+/// wgpu validation error.
+pub fn surface_points(gpu: &GpuContext, r: &Renderer) -> Vec<SurfacePoint> {
+    use glam::Vec3;
+    let csz = r.read_target(gpu, "csz").unwrap();
+    let normals = r.read_normals(gpu).unwrap();
+    gpu.check_errors().unwrap();
+    let u = r.frame_uniforms();
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let mut out = Vec::new();
+    for y in 0..csz.height {
+        for x in 0..csz.width {
+            let i = (y * csz.width + x) as usize;
+            let z = csz.data[i];
+            if z <= 0.0 {
+                continue;
+            }
+            let ndc_x = (x as f32 + 0.5) * u.size[2] * 2.0 - 1.0;
+            let ndc_y = 1.0 - (y as f32 + 0.5) * u.size[3] * 2.0;
+            let p = v(u.eye) + z * (v(u.cam_forward) + v(u.cam_right) * ndc_x + v(u.cam_up) * ndc_y);
+            let n = Vec3::from_slice(&normals.data[i * 3..i * 3 + 3]);
+            out.push(SurfacePoint { i, x, y, p, n });
+        }
+    }
+    out
+}
+
+/// ILS §4.3's VPL sum at pixel (x, y): Σ_k `term(k)` over all `n_all` VPLs
+/// (`brute_force`) or over the pixel's sub-buffer subset of pattern n×m
+/// (k ≡ j·n + i mod n·m for sub-buffer (i, j) = (x mod n, y mod m)), scaled by N/N_s.
+pub fn ils_vpl_sum(
+    [n, m]: [u32; 2],
+    n_all: usize,
+    brute_force: bool,
+    (x, y): (u32, u32),
+    mut term: impl FnMut(usize) -> glam::Vec3,
+) -> glam::Vec3 {
+    let (first, step) = if brute_force {
+        (0, 1)
+    } else {
+        (((y % m) * n + x % n) as usize, (n * m) as usize)
+    };
+    let (mut e, mut count) = (glam::Vec3::ZERO, 0);
+    for k in (first..n_all).step_by(step) {
+        e += term(k);
+        count += 1;
+    }
+    if count > 0 {
+        e *= n_all as f32 / count as f32;
+    }
+    e
+}
