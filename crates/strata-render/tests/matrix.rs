@@ -102,6 +102,15 @@ fn check(gpu: &GpuContext, scene: &Scene, settings: RenderSettings, declared: &[
     checked
 }
 
+/// The caller's VPLs for ILS (instant radiosity, default settings, frame 0).
+fn scene_vpls(scene: &Scene) -> std::sync::Arc<[GpuVpl]> {
+    strata_reference::Reference::new(scene, 0.0)
+        .vpls(&Default::default())
+        .iter()
+        .map(|v| GpuVpl::new(v.position.into(), v.normal.into(), v.flux.into()))
+        .collect()
+}
+
 #[test]
 fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
     let gpu = common::gpu();
@@ -111,11 +120,7 @@ fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
     let (mut runs, mut images) = (0, 0);
     for scene_name in ["cornell", "atrium"] {
         let scene = procedural::builtin(scene_name).expect("built-in scene");
-        let vpls: std::sync::Arc<[GpuVpl]> = strata_reference::Reference::new(&scene, 0.0)
-            .vpls(&Default::default())
-            .iter()
-            .map(|v| GpuVpl::new(v.position.into(), v.normal.into(), v.flux.into()))
-            .collect();
+        let vpls = scene_vpls(&scene);
         for t in registry() {
             let presets: Vec<Option<&str>> = if t.presets.is_empty() {
                 vec![None]
@@ -165,6 +170,8 @@ fn algorithm_switching_settings_render_cleanly() {
         ("bzb-ao", &[("splat", "dss"), ("visibility", "off")]),
         ("aba-ao", &[("kernel", "hbao-compute")]),
         ("aba-ao", &[("kernel", "hbao-compute"), ("multilayer", "off")]),
+        ("ils", &[("split", "compute")]),
+        ("ils", &[("split", "blocks"), ("shadows", "vpl")]),
     ];
     let gpu = common::gpu();
     let mut images = 0;
@@ -187,6 +194,9 @@ fn algorithm_switching_settings_render_cleanly() {
                     let info = t.setting_list().find(|i| i.name == name).expect("registered setting");
                     let value = info.parse_value(text).expect("valid value");
                     t.set(&mut s, name, value).expect("in range");
+                }
+                if let Some(ils) = &mut s.ils {
+                    ils.vpls = scene_vpls(&scene);
                 }
                 let what = format!("{scene_name} {technique} {sets:?} k={layers}");
                 images += check(&gpu, &scene, s, &[], &what);
