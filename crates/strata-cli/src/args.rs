@@ -429,6 +429,12 @@ pub struct EvalArgs {
     /// without the n_Y test against single-bounce references with and without visibility.
     #[arg(long)]
     pub fig10: bool,
+    /// full: instead of the sky-off GI comparison, measure what `render --technique full`
+    /// shows (probes on): pixels clipped in the final image and the probe-only / blended /
+    /// gbuffer-only views, |blended − probe-only|, and the chroma of fixed regions against the
+    /// path-traced frame with sky (docs/image-quality.md).
+    #[arg(long)]
+    pub views: bool,
     /// Static frames rendered before the evaluated one (gi: progressive bounces and the
     /// temporal filter converge), 0..=1000.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=1000))]
