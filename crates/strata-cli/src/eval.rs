@@ -11,6 +11,9 @@ use crate::args::EvalArgs;
 
 pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
+    if a.views {
+        return views(a, &s);
+    }
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";
@@ -25,9 +28,6 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     }
     if a.progressive.is_some() && a.technique.eval != EvalKind::VplRadiance {
         anyhow::bail!("--progressive is only read by --technique ils (ILS §6.3's physically-based mode)");
-    }
-    if a.views {
-        return views(a, &s);
     }
     let result = match a.technique.eval {
         EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values, a.progressive.map(|k| (k, a.bounces)))?),
@@ -224,6 +224,11 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
         .settings(&base, Some(a.radiosity.preset.as_str()))
         .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
     settings.radiosity = Some(a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?);
+    for (name, value) in &a.set.values {
+        a.technique
+            .set(&mut settings, name, *value)
+            .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+    }
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
     settings.probes = Some(strata_eval::cache::probes::scene_probes(
         &scene,
@@ -241,6 +246,10 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
     println!(
         "|blended - probe-only| {:.2}/255, mean confidence {:.3}",
         e.blended_vs_probe_only, e.mean_confidence
+    );
+    println!(
+        "FLIP against the path-traced frame: blended {:.4}  probe-only {:.4}  gbuffer-only {:.4}",
+        e.flip_blended, e.flip_probe_only, e.flip_gbuffer_only
     );
     for r in &e.regions {
         println!(

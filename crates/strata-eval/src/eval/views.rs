@@ -25,24 +25,25 @@ use strata_scene::ImageBuf;
 use super::gi::{rgb, total};
 use super::{half_flip, EvalSettings};
 use crate::cache::{scene_fingerprint, RefCache};
-use crate::metrics::display;
+use crate::metrics::{compare, display};
 use crate::results::EvalRun;
 
 /// A named rectangle `[x0, y0, x1, y1]` in normalised image coordinates (0..1, y down).
 pub type Rect = (&'static str, [f32; 4]);
 
-/// The regions of atrium's default camera (frame 0) where the path-traced frame shows the
-/// banners' light on neutral surfaces: the upper gallery's columns, arches and back wall
-/// beside the green and red banners, and beside the yellow and blue ones. The gallery floor is
-/// hidden by its parapet from this camera. Other scenes or cameras: the same rectangles, read
-/// as "upper right of the frame" — documented, not meaningful.
+/// The regions of atrium's default camera (frame 0) where the light-probe composite's hue is
+/// furthest from the path-traced frame's (per-pixel (a*, b*) distance, 5×5 box, measured at
+/// 320×180): the upper gallery's columns and arch soffits around the banners, lit by them and by
+/// each other at a scale the 8×4×8 probe grid cannot resolve — where screen-space light should
+/// win. The gallery floor is hidden by its parapet from this camera. Other scenes or cameras:
+/// the same rectangles, not meaningful.
 pub const REGIONS: [Rect; 3] = [
-    // right of the green banner up to the red one: back wall and column faces
-    ("green-red", [0.70, 0.0, 0.84, 0.22]),
-    // between the yellow and the blue banner: columns and arch soffits
-    ("yellow-blue", [0.53, 0.17, 0.66, 0.36]),
-    // below the red banner: the column and arch under it
-    ("red", [0.80, 0.0, 0.95, 0.14]),
+    // the columns between the blue and the green banner
+    ("columns-blue-green", [0.60, 0.0, 0.72, 0.36]),
+    // the arch soffits and columns beside the yellow and blue banners
+    ("soffits-yellow-blue", [0.47, 0.10, 0.60, 0.36]),
+    // the columns and wall between the green and the red banner
+    ("columns-green-red", [0.72, 0.0, 0.84, 0.30]),
 ];
 
 /// Display-byte statistics of one view.
@@ -93,6 +94,11 @@ pub struct ViewsEval {
     /// Mean |blended − probe-only| of the debug views' display bytes, whole image.
     pub blended_vs_probe_only: f64,
     pub mean_confidence: f64,
+    /// ꟻLIP of the whole frame against the path-traced one: the final image (blend), and the
+    /// composites with the probes only and the deep G-buffer only.
+    pub flip_blended: f32,
+    pub flip_probe_only: f32,
+    pub flip_gbuffer_only: f32,
     pub regions: Vec<RegionChroma>,
 }
 
@@ -225,6 +231,7 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
     });
     let ref_display = display(&total(&converged.image()), exposure);
 
+    let flips = [0, 1, 2].map(|i| compare(&ref_display, &composites[i]).map_or(f32::NAN, |(st, _)| st.flip));
     let mean_abs = |a: &ImageBuf, b: &ImageBuf, pix: &mut dyn Iterator<Item = usize>| -> f64 {
         let (mut s, mut k) = (0.0, 0usize);
         for i in pix {
@@ -309,6 +316,9 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
         views: clips,
         blended_vs_probe_only,
         mean_confidence: mean_conf,
+        flip_blended: flips[1],
+        flip_probe_only: flips[0],
+        flip_gbuffer_only: flips[2],
         regions,
     })
 }
