@@ -1093,11 +1093,13 @@ impl Renderer {
                 }
             }
             if !exr_raw {
-                // the PNG shows it tonemapped like the frame
-                let e = self.settings.exposure.unwrap_or(1.0);
+                // the PNG shows it tonemapped like the frame: the last frame's exposure (the
+                // scene's unless overridden; was the override or 1) and the final ACES curve
+                // (was Reinhard)
+                let e = self.last_frame.sky[3];
                 img.data
                     .iter_mut()
-                    .for_each(|v| *v = (*v * e / (1.0 + *v * e)).clamp(0.0, 1.0));
+                    .for_each(|v| *v = crate::passes::tonemap::tonemap(*v, e));
             }
         } else if let Some((j, what)) = rest
             .strip_prefix("node")
