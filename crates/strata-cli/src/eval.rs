@@ -241,8 +241,15 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
         return Ok(());
     }
     for v in &e.views {
-        println!("{:<14} clipped {:6.2} %  mean {:6.1}/255", v.view, 100.0 * v.clip_fraction, v.mean);
+        println!(
+            "{:<14} clipped {:6.2} %  mean {:6.1}/255  outliers {}",
+            v.view,
+            100.0 * v.clip_fraction,
+            v.mean,
+            v.outliers
+        );
     }
+    println!("path-traced frame: outliers {}", e.reference_outliers);
     println!(
         "|blended - probe-only| {:.2}/255, mean confidence {:.3}",
         e.blended_vs_probe_only, e.mean_confidence

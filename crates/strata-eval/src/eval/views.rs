@@ -25,7 +25,7 @@ use strata_scene::ImageBuf;
 use super::gi::{rgb, total};
 use super::{half_flip, EvalSettings};
 use crate::cache::{scene_fingerprint, RefCache};
-use crate::metrics::{compare, display};
+use crate::metrics::{compare, display, outliers, OUTLIER_THRESHOLD};
 use crate::results::EvalRun;
 
 /// A named rectangle `[x0, y0, x1, y1]` in normalised image coordinates (0..1, y down).
@@ -54,6 +54,9 @@ pub struct ViewClip {
     pub clip_fraction: f64,
     /// Mean display value (bytes, 0..255) over all pixels and channels.
     pub mean: f64,
+    /// Pixels more than 0.25 from their 3×3 median in a channel of the sRGB display values
+    /// (`metrics::outliers`, as `eval` counts them).
+    pub outliers: u32,
 }
 
 /// One region's numbers.
@@ -91,6 +94,8 @@ pub struct ViewsEval {
     pub run: EvalRun,
     pub exposure: f32,
     pub views: Vec<ViewClip>,
+    /// Outliers of the path-traced frame's display values (compare with the final image's).
+    pub reference_outliers: u32,
     /// Mean |blended − probe-only| of the debug views' display bytes, whole image.
     pub blended_vs_probe_only: f64,
     pub mean_confidence: f64,
@@ -139,10 +144,17 @@ fn clip_of(view: &str, img: &ImageBuf) -> ViewClip {
         clipped += b.iter().any(|&v| v >= 255.0) as usize;
         sum += b.iter().sum::<f64>() / 3.0;
     }
+    let mut shown = ImageBuf::new(img.width, img.height, 3);
+    for (o, p) in shown.data.chunks_exact_mut(3).zip(img.data.chunks_exact(c)) {
+        for k in 0..3 {
+            o[k] = strata_scene::image_buf::linear_to_srgb(p[k].clamp(0.0, 1.0));
+        }
+    }
     ViewClip {
         view: view.into(),
         clip_fraction: clipped as f64 / n as f64,
         mean: sum / n as f64,
+        outliers: outliers(&shown, OUTLIER_THRESHOLD),
     }
 }
 
@@ -314,6 +326,7 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
         ),
         exposure,
         views: clips,
+        reference_outliers: outliers(&ref_display, OUTLIER_THRESHOLD),
         blended_vs_probe_only,
         mean_confidence: mean_conf,
         flip_blended: flips[1],
