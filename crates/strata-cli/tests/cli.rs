@@ -611,8 +611,25 @@ fn eval_full_views_reports_clipping_blend_and_region_chroma() {
     let cache = scratch("views-cache");
     let _ = std::fs::remove_dir_all(&cache);
     let o = strata(&[
-        "eval", "--scene", "mirror", "--technique", "full", "--views", "--layers", "2", "--width", "48",
-        "--height", "32", "--ref-spp", "4", "--warmup", "2", "--json", "--quiet", "--cache",
+        "eval",
+        "--scene",
+        "mirror",
+        "--technique",
+        "full",
+        "--views",
+        "--layers",
+        "2",
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--ref-spp",
+        "4",
+        "--warmup",
+        "2",
+        "--json",
+        "--quiet",
+        "--cache",
         cache.to_str().unwrap(),
     ]);
     let v = json_of(&o);
@@ -623,7 +640,13 @@ fn eval_full_views_reports_clipping_blend_and_region_chroma() {
         let c = x["clip_fraction"].as_f64().unwrap();
         assert!((0.0..=0.01).contains(&c), "{}: {c} of the pixels clipped", x["view"]);
     }
-    for key in ["flip_blended", "flip_probe_only", "flip_gbuffer_only", "blended_vs_probe_only", "mean_confidence"] {
+    for key in [
+        "flip_blended",
+        "flip_probe_only",
+        "flip_gbuffer_only",
+        "blended_vs_probe_only",
+        "mean_confidence",
+    ] {
         assert!(v[key].as_f64().is_some_and(|x| x >= 0.0), "{key}: {v}");
     }
     let regions = v["regions"].as_array().expect("regions");
@@ -634,7 +657,14 @@ fn eval_full_views_reports_clipping_blend_and_region_chroma() {
     let o = strata(&["eval", "--scene", "plane", "--technique", "ao", "--views"]);
     assert_one_line_error(&o, &["--views", "full"]);
     let o = strata(&[
-        "eval", "--scene", "plane", "--technique", "full", "--views", "--set", "coverage-confidence=2",
+        "eval",
+        "--scene",
+        "plane",
+        "--technique",
+        "full",
+        "--views",
+        "--set",
+        "coverage-confidence=2",
     ]);
     assert_one_line_error(&o, &["coverage-confidence", "0..=1"]);
 }

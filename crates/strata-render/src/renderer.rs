@@ -1060,7 +1060,11 @@ impl Renderer {
             }
             let m = 1.0 - normal.data[i * cn + 3];
             let rho = glam::Vec3::from_slice(&albedo.data[i * ca..i * ca + 3]) * m;
-            let k = if boost { crate::passes::radiosity::boost(rho) } else { 1.0 };
+            let k = if boost {
+                crate::passes::radiosity::boost(rho)
+            } else {
+                1.0
+            };
             for c in 0..3 {
                 let l = rho[c] / std::f32::consts::PI * e.data[i * ce + c] * k;
                 o[c] = crate::passes::tonemap::tonemap(l, exposure);

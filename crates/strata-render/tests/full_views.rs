@@ -33,7 +33,15 @@ fn constant_probes(e: [f32; 3]) -> IrradianceProbes {
     p
 }
 
-fn renderer(gpu: &GpuContext, scene: &Scene, w: u32, h: u32, rs: RadiositySettings, probes: Option<IrradianceProbes>, exposure: Option<f32>) -> Renderer {
+fn renderer(
+    gpu: &GpuContext,
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    rs: RadiositySettings,
+    probes: Option<IrradianceProbes>,
+    exposure: Option<f32>,
+) -> Renderer {
     Renderer::new(
         gpu,
         scene,
@@ -69,9 +77,21 @@ fn probe_lit_plane_reproduces_its_analytic_radiance_through_the_final_exposure()
     let gpu = common::gpu();
     let scene = frozen("plane");
     let (w, h) = (64, 48);
-    let e0 = [0.8 * std::f32::consts::PI, 0.5 * std::f32::consts::PI, 0.3 * std::f32::consts::PI];
+    let e0 = [
+        0.8 * std::f32::consts::PI,
+        0.5 * std::f32::consts::PI,
+        0.3 * std::f32::consts::PI,
+    ];
     for exposure in [0.5f32, 2.0] {
-        let mut r = renderer(&gpu, &scene, w, h, RadiositySettings::default(), Some(constant_probes(e0)), Some(exposure));
+        let mut r = renderer(
+            &gpu,
+            &scene,
+            w,
+            h,
+            RadiositySettings::default(),
+            Some(constant_probes(e0)),
+            Some(exposure),
+        );
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
             .expect("frame renders without validation errors");
         let full = r.read_target(&gpu, "hdr-full").unwrap();
@@ -90,7 +110,10 @@ fn probe_lit_plane_reproduces_its_analytic_radiance_through_the_final_exposure()
             for c in 0..3 {
                 let want = byte(tonemap(full.data[i * 4 + c], exposure));
                 let got = byte(ldr.data[i * 4 + c]);
-                assert!((want - got).abs() <= 1, "pixel {i}: ldr byte {got} vs CPU tonemap {want}");
+                assert!(
+                    (want - got).abs() <= 1,
+                    "pixel {i}: ldr byte {got} vs CPU tonemap {want}"
+                );
             }
             if rho[0] <= 0.0 {
                 continue;
@@ -98,10 +121,19 @@ fn probe_lit_plane_reproduces_its_analytic_radiance_through_the_final_exposure()
             surface += 1;
             for c in 0..3 {
                 // the probe view: raw E0 in EXR, tonemapped ρ/π·E0 in PNG
-                assert!((raw.data[i * 3 + c] - e0[c]).abs() <= 2e-3 * e0[c], "raw probe E {} vs {}", raw.data[i * 3 + c], e0[c]);
+                assert!(
+                    (raw.data[i * 3 + c] - e0[c]).abs() <= 2e-3 * e0[c],
+                    "raw probe E {} vs {}",
+                    raw.data[i * 3 + c],
+                    e0[c]
+                );
                 let l = rho[c] / std::f32::consts::PI * e0[c];
                 let want = tonemap(l, exposure);
-                assert!((view.data[i * 3 + c] - want).abs() <= 2e-3, "probe view {} vs {want}", view.data[i * 3 + c]);
+                assert!(
+                    (view.data[i * 3 + c] - want).abs() <= 2e-3,
+                    "probe view {} vs {want}",
+                    view.data[i * 3 + c]
+                );
             }
             if blended.data[i * 4 + 3] != 0.0 {
                 continue;
@@ -111,13 +143,19 @@ fn probe_lit_plane_reproduces_its_analytic_radiance_through_the_final_exposure()
             for c in 0..3 {
                 let l = rho[c] / std::f32::consts::PI * e0[c];
                 let added = full.data[i * 4 + c] - direct.data[i * 4 + c];
-                assert!((added - l).abs() <= 4e-3 * (l + direct.data[i * 4 + c]) + 1e-3, "added {added} vs ρE0/π {l}");
+                assert!(
+                    (added - l).abs() <= 4e-3 * (l + direct.data[i * 4 + c]) + 1e-3,
+                    "added {added} vs ρE0/π {l}"
+                );
                 assert!((blended_view.data[i * 3 + c] - tonemap(l, exposure)).abs() <= 2e-3);
             }
         }
         eprintln!("exposure {exposure}: {surface} surface pixels, {checked} at confidence 0");
         assert!(surface > (w * h) as usize / 4, "the plane covers the frame");
-        assert!(checked > surface / 2, "the open plane has confidence 0 almost everywhere");
+        assert!(
+            checked > surface / 2,
+            "the open plane has confidence 0 almost everywhere"
+        );
     }
 }
 
@@ -129,7 +167,15 @@ fn atrium_views_are_tonemapped_not_raw_irradiance() {
     let scene = frozen("atrium");
     let (w, h) = (80, 45);
     let e = [6.0, 5.0, 4.0];
-    let mut r = renderer(&gpu, &scene, w, h, RadiositySettings::default(), Some(constant_probes(e)), None);
+    let mut r = renderer(
+        &gpu,
+        &scene,
+        w,
+        h,
+        RadiositySettings::default(),
+        Some(constant_probes(e)),
+        None,
+    );
     for _ in 0..3 {
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
     }
@@ -138,14 +184,26 @@ fn atrium_views_are_tonemapped_not_raw_irradiance() {
         let raw = r.debug_view(&gpu, name, true).unwrap();
         let view = r.debug_view(&gpu, name, false).unwrap();
         let clipped = |img: &ImageBuf| img.data.chunks_exact(3).filter(|p| p.iter().any(|&v| v >= 1.0)).count();
-        eprintln!("{name}: raw E ≥ 1 at {} pixels, view clipped at {}", clipped(&raw), clipped(&view));
-        assert!(clipped(&view) * 100 <= (w * h) as usize, "{name}: more than 1 % clipped");
+        eprintln!(
+            "{name}: raw E ≥ 1 at {} pixels, view clipped at {}",
+            clipped(&raw),
+            clipped(&view)
+        );
+        assert!(
+            clipped(&view) * 100 <= (w * h) as usize,
+            "{name}: more than 1 % clipped"
+        );
         // every view value is at most the tone curve of the light E can add on a white surface
         for (v, e) in view.data.iter().zip(&raw.data) {
             assert!(*v <= tonemap(e / std::f32::consts::PI, exposure) + 1e-4);
         }
     }
-    assert!(r.debug_view(&gpu, "probe-only", true).unwrap().data.iter().any(|&v| v > 1.0));
+    assert!(r
+        .debug_view(&gpu, "probe-only", true)
+        .unwrap()
+        .data
+        .iter()
+        .any(|&v| v > 1.0));
 }
 
 /// The coverage confidence M/U equals its CPU twin over the read-back buffers, stays in [0, 1],
@@ -167,7 +225,9 @@ fn coverage_confidence_matches_cpu_and_bounds() {
             r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
                 .expect("frame renders without validation errors");
             let u = r.radiosity_uniforms().unwrap();
-            let zmip: Vec<ImageBuf> = (0..=u.max_mip).map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap()).collect();
+            let zmip: Vec<ImageBuf> = (0..=u.max_mip)
+                .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
+                .collect();
             let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
             let (n0, n1) = (common::npack_normals(&npack, 0), common::npack_normals(&npack, 1));
             let b0 = r.read_target_full(&gpu, "radiosity0", 0).unwrap();
@@ -194,16 +254,30 @@ fn coverage_confidence_matches_cpu_and_bounds() {
                 }
             }
             let n = (fw * fh) as usize;
-            assert!(close as f32 >= 0.995 * n as f32, "{name} coverage={coverage}: {close}/{n} match the CPU");
-            assert!(conf.iter().all(|c| (0.0..=1.0).contains(c)), "confidence outside [0, 1]");
+            assert!(
+                close as f32 >= 0.995 * n as f32,
+                "{name} coverage={coverage}: {close}/{n} match the CPU"
+            );
+            assert!(
+                conf.iter().all(|c| (0.0..=1.0).contains(c)),
+                "confidence outside [0, 1]"
+            );
             conf
         };
         let (paper, coverage) = (confidence(false), confidence(true));
         let mean = |v: &[f32]| v.iter().map(|&c| c as f64).sum::<f64>() / v.len() as f64;
-        eprintln!("{name}: mean confidence M/N {:.3}, M/U {:.3}", mean(&paper), mean(&coverage));
+        eprintln!(
+            "{name}: mean confidence M/N {:.3}, M/U {:.3}",
+            mean(&paper),
+            mean(&coverage)
+        );
         assert!(paper.iter().zip(&coverage).all(|(p, c)| *c >= *p - 1e-3), "M/U ≥ M/N");
         if name == "plane" {
-            assert!(mean(&coverage) < 0.01, "open plane: coverage confidence {}", mean(&coverage));
+            assert!(
+                mean(&coverage) < 0.01,
+                "open plane: coverage confidence {}",
+                mean(&coverage)
+            );
         } else {
             assert!(mean(&coverage) > 2.0 * mean(&paper), "atrium: M/U well above M/N");
         }

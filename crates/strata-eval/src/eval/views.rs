@@ -195,7 +195,11 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
     let conf = r.read_target(&gpu, "indirect-blended")?.channel(3);
     let boost = r.settings.radiosity.as_ref().is_some_and(|x| x.boost);
     let n = (w * h) as usize;
-    let (ca, cn, cz) = (albedo.channels as usize, normal.channels as usize, csz.channels as usize);
+    let (ca, cn, cz) = (
+        albedo.channels as usize,
+        normal.channels as usize,
+        csz.channels as usize,
+    );
     let rho: Vec<[f32; 3]> = (0..n)
         .map(|i| {
             let m = 1.0 - normal.data[i * cn + 3];
@@ -304,9 +308,8 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
     if let Some(dir) = &s.report {
         std::fs::create_dir_all(dir)?;
         // linear display values are sRGB-encoded on writing; `display` values already are
-        let save = |img: &ImageBuf, name: &str, srgb: bool| {
-            img.save(&dir.join(name), srgb).map_err(|e| anyhow::anyhow!(e))
-        };
+        let save =
+            |img: &ImageBuf, name: &str, srgb: bool| img.save(&dir.join(name), srgb).map_err(|e| anyhow::anyhow!(e));
         save(&final_img, "final.png", true)?;
         for (n, v) in names.iter().zip(&views) {
             save(v, &format!("{n}.png"), true)?;
