@@ -216,10 +216,11 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
         .iter()
         .map(|e| {
             let mut o = direct.clone();
-            for i in 0..n {
+            let pixels = o.data.chunks_exact_mut(3).zip(e.data.chunks_exact(3)).zip(&rho);
+            for (i, ((o, e), rho)) in pixels.enumerate() {
                 if csz.data[i * cz] > 0.0 {
-                    for c in 0..3 {
-                        o.data[i * 3 + c] += rho[i][c] * e.data[i * 3 + c];
+                    for ((o, e), r) in o.iter_mut().zip(e).zip(rho) {
+                        *o += r * e;
                     }
                 }
             }
@@ -277,8 +278,8 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
             let c = img.channels as usize;
             let mut m = [0.0f64; 3];
             for &i in &pix {
-                for k in 0..3 {
-                    m[k] += img.data[i * c + k] as f64;
+                for (m, v) in m.iter_mut().zip(&img.data[i * c..i * c + 3]) {
+                    *m += *v as f64;
                 }
             }
             lab_ab(m.map(|v| v / pix.len().max(1) as f64))
