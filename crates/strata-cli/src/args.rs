@@ -308,9 +308,14 @@ pub struct AoArgs {
     /// Do not rotate each pixel's spiral (φ = 0; DGB Fig. 7 left).
     #[arg(long)]
     pub no_rotate: bool,
-    /// Hash the frame index into the spiral rotation (temporal accumulation of different patterns).
-    #[arg(long)]
+    /// Hash the frame index into the spiral rotation (temporal accumulation of different
+    /// patterns). The default since issue 14; the flag is kept for scripts.
+    #[arg(long, conflicts_with = "fixed_rotation")]
     pub temporal_noise: bool,
+    /// The paper's rotation: φ = hash(x, y) only, the same tap pattern every frame (off by
+    /// default: the frame index is hashed in too, docs/ao.md "Temporal rotation").
+    #[arg(long)]
+    pub fixed_rotation: bool,
     /// Temporal filter weight α in [0, 1) of the reprojected history (DGB §3.3; 0 disables the filter).
     #[arg(long, default_value_t = 0.85)]
     pub alpha: f32,
@@ -351,7 +356,7 @@ impl AoArgs {
             samples: self.samples,
             turns: self.spiral_turns,
             rotate: !self.no_rotate,
-            temporal_noise: self.temporal_noise,
+            temporal_noise: !self.fixed_rotation,
             q: self.mip_q,
             mips: DepthMipSettings {
                 levels: self.mip_levels,
@@ -435,6 +440,12 @@ pub struct EvalArgs {
     /// without the n_Y test against single-bounce references with and without visibility.
     #[arg(long)]
     pub fig10: bool,
+    /// full: instead of the sky-off GI comparison, measure what `render --technique full`
+    /// shows (probes on): pixels clipped in the final image and the probe-only / blended /
+    /// gbuffer-only views, |blended − probe-only|, and the chroma of fixed regions against the
+    /// path-traced frame with sky (docs/image-quality.md).
+    #[arg(long)]
+    pub views: bool,
     /// Static frames rendered before the evaluated one (gi: progressive bounces and the
     /// temporal filter converge), 0..=1000.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=1000))]

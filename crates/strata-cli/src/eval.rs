@@ -2,7 +2,7 @@
 //! one JSON object or a line of numbers.
 
 use anyhow::Result;
-use strata_eval::eval::{aba, ao, bzb, gi, ils, oit, EvalSettings};
+use strata_eval::eval::{aba, ao, bzb, gi, ils, oit, views, EvalSettings};
 use strata_eval::results::{to_json_string, EvalResult};
 
 use strata_render::technique::EvalKind;
@@ -11,6 +11,9 @@ use crate::args::EvalArgs;
 
 pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
+    if a.views {
+        return views(a, &s);
+    }
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";
@@ -209,4 +212,68 @@ pub fn run(a: &EvalArgs) -> Result<()> {
 /// The reference noise (ꟻLIP between its halves) beside an error.
 fn noise(e: &strata_eval::metrics::ErrorStats) -> f32 {
     e.ref_noise.map_or(f32::NAN, |n| n.flip)
+}
+
+/// `--views`: `render --technique full`'s settings (preset, radiosity flags, probes) at the
+/// evaluated camera, measured by [`views::run`].
+fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
+    if a.technique.eval != EvalKind::Radiance {
+        anyhow::bail!("--views is only read by --technique full (the probe/blended views)");
+    }
+    let (scene, _) = s.scene.load()?;
+    let base = strata_render::RenderSettings {
+        width: a.scene.width,
+        height: a.scene.height,
+        deep: a.deep.settings(),
+        guard_band: a.deep.guard_band,
+        ao: Some(a.ao.settings()),
+        ..Default::default()
+    };
+    let mut settings = a
+        .technique
+        .settings(&base, Some(a.radiosity.preset.as_str()))
+        .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
+    settings.radiosity = Some(a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?);
+    for (name, value) in &a.set.values {
+        a.technique
+            .set(&mut settings, name, *value)
+            .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+    }
+    settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    settings.probes = Some(strata_eval::cache::probes::scene_probes(
+        &scene,
+        &strata_eval::cache::RefCache::new(&s.cache),
+        !s.progress,
+    )?);
+    let e = views::run(s, settings)?;
+    if a.json {
+        println!("{}", to_json_string(&e)?);
+        return Ok(());
+    }
+    for v in &e.views {
+        println!(
+            "{:<14} clipped {:6.2} %  mean {:6.1}/255  outliers {}",
+            v.view,
+            100.0 * v.clip_fraction,
+            v.mean,
+            v.outliers
+        );
+    }
+    println!("path-traced frame: outliers {}", e.reference_outliers);
+    println!(
+        "|blended - probe-only| {:.2}/255, mean confidence {:.3}",
+        e.blended_vs_probe_only, e.mean_confidence
+    );
+    println!(
+        "FLIP against the path-traced frame: blended {:.4}  probe-only {:.4}  gbuffer-only {:.4}",
+        e.flip_blended, e.flip_probe_only, e.flip_gbuffer_only
+    );
+    for r in &e.regions {
+        println!(
+            "region {:<12} {:5} px  chroma reference {:5.2}  probe-only {:5.2}  blended {:5.2}  gbuffer-only {:5.2}; (a*,b*) error probe-only {:5.2}  blended {:5.2}  gbuffer-only {:5.2}; |blended - probe-only| {:5.2}/255  confidence {:.3}",
+            r.name, r.pixels, r.chroma_reference, r.chroma_probe_only, r.chroma_blended, r.chroma_gbuffer_only,
+            r.ab_error_probe_only, r.ab_error_blended, r.ab_error_gbuffer_only, r.blended_vs_probe_only, r.confidence
+        );
+    }
+    Ok(())
 }

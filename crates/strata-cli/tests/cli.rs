@@ -603,6 +603,72 @@ fn unknown_preset_lists_the_valid_ones() {
     assert_one_line_error(&o, &["--preset", "high-performance, balanced, high-quality"]);
 }
 
+/// `eval --technique full --views` (issue 14): what `render --technique full` shows, measured —
+/// the final image and the Fig. 9 views' clipping, |blended − probe-only|, the frame's ꟻLIP
+/// against the path tracer and the regions' chroma; and its settings' one-line errors.
+#[test]
+fn eval_full_views_reports_clipping_blend_and_region_chroma() {
+    let cache = scratch("views-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "mirror",
+        "--technique",
+        "full",
+        "--views",
+        "--layers",
+        "2",
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--ref-spp",
+        "4",
+        "--warmup",
+        "2",
+        "--json",
+        "--quiet",
+        "--cache",
+        cache.to_str().unwrap(),
+    ]);
+    let v = json_of(&o);
+    let views = v["views"].as_array().expect("views");
+    let names: Vec<&str> = views.iter().map(|x| x["view"].as_str().unwrap()).collect();
+    assert_eq!(names, ["final", "probe-only", "blended", "gbuffer-only"]);
+    for x in views {
+        let c = x["clip_fraction"].as_f64().unwrap();
+        assert!((0.0..=0.01).contains(&c), "{}: {c} of the pixels clipped", x["view"]);
+    }
+    for key in [
+        "flip_blended",
+        "flip_probe_only",
+        "flip_gbuffer_only",
+        "blended_vs_probe_only",
+        "mean_confidence",
+    ] {
+        assert!(v[key].as_f64().is_some_and(|x| x >= 0.0), "{key}: {v}");
+    }
+    let regions = v["regions"].as_array().expect("regions");
+    assert_eq!(regions.len(), 3);
+    for r in regions {
+        assert!(r["chroma_reference"].as_f64().is_some_and(|x| x >= 0.0), "{r}");
+    }
+    let o = strata(&["eval", "--scene", "plane", "--technique", "ao", "--views"]);
+    assert_one_line_error(&o, &["--views", "full"]);
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "plane",
+        "--technique",
+        "full",
+        "--views",
+        "--set",
+        "coverage-confidence=2",
+    ]);
+    assert_one_line_error(&o, &["coverage-confidence", "0..=1"]);
+}
+
 #[test]
 fn eval_gi_reports_indirect_and_full_errors() {
     let cache = scratch("gi-cache");

@@ -985,9 +985,20 @@ impl Renderer {
             "ils-irradiance" | "ils-irradiance-tiled" | "ils-blur-h" | "indirect" if self.ils.is_some() => {
                 Ok(pad_channels(&self.read_target(gpu, base)?, 3))
             }
-            "gbuffer-only" => Ok(pad_channels(&self.read_target(gpu, "indirect")?, 3)),
-            "probe-only" => Ok(pad_channels(&self.read_target(gpu, "probe-irradiance")?, 3)),
-            "blended" => Ok(pad_channels(&self.read_target(gpu, "indirect-blended")?, 3)),
+            // Fig. 9's irradiance views: raw E in EXR; in PNG the light each E adds to the frame,
+            // shown through the frame's exposure and tone curve (`indirect_display`)
+            "gbuffer-only" | "probe-only" | "blended" => {
+                let target = match base {
+                    "gbuffer-only" => "indirect",
+                    "probe-only" => "probe-irradiance",
+                    _ => "indirect-blended",
+                };
+                let e = pad_channels(&self.read_target(gpu, target)?, 3);
+                if exr_raw {
+                    return Ok(e);
+                }
+                self.indirect_display(gpu, &e)
+            }
             "normal" => {
                 let n = self.read_normals_layer(gpu, layer)?;
                 let mut img = ImageBuf::new(n.width, n.height, 3);
@@ -1026,6 +1037,42 @@ impl Renderer {
         }
     }
 
+    /// Irradiance `e` (RGB, layer 0's receivers) as the final image shows the light it adds:
+    /// ρ/π · boost(ρ) · E with ρ = albedo · (1 − metallic) as `compose.wgsl` reflects it, then the
+    /// last frame's exposure and the ACES curve of `tonemap.wgsl` (display values in [0, 1],
+    /// linear; PNG output encodes sRGB as for the final image). Background pixels are black.
+    pub fn indirect_display(&self, gpu: &GpuContext, e: &ImageBuf) -> Result<ImageBuf, RenderError> {
+        let albedo = self.read_target_layer(gpu, "albedo", 0)?;
+        let normal = self.read_target_layer(gpu, "normal", 0)?;
+        let csz = self.read_target(gpu, "csz")?;
+        let boost = self.settings.radiosity.as_ref().is_some_and(|r| r.boost);
+        let exposure = self.last_frame.sky[3];
+        let mut out = ImageBuf::new(e.width, e.height, 3);
+        let (ca, cn, ce, cz) = (
+            albedo.channels as usize,
+            normal.channels as usize,
+            e.channels as usize,
+            csz.channels as usize,
+        );
+        for (i, o) in out.data.chunks_exact_mut(3).enumerate() {
+            if csz.data[i * cz] <= 0.0 {
+                continue;
+            }
+            let m = 1.0 - normal.data[i * cn + 3];
+            let rho = glam::Vec3::from_slice(&albedo.data[i * ca..i * ca + 3]) * m;
+            let k = if boost {
+                crate::passes::radiosity::boost(rho)
+            } else {
+                1.0
+            };
+            for c in 0..3 {
+                let l = rho[c] / std::f32::consts::PI * e.data[i * ce + c] * k;
+                o[c] = crate::passes::tonemap::tonemap(l, exposure);
+            }
+        }
+        Ok(out)
+    }
+
     /// The A-buffer views read back on the CPU (`rest` = the name after
     /// `abuffer-`): `layer{k}` = the k-th nearest fragment's radiance × α (black
     /// where the list is shorter), `node{j}-depth` / `node{j}-alpha` = compressed
@@ -1050,11 +1097,13 @@ impl Renderer {
                 }
             }
             if !exr_raw {
-                // the PNG shows it tonemapped like the frame
-                let e = self.settings.exposure.unwrap_or(1.0);
+                // the PNG shows it tonemapped like the frame: the last frame's exposure (the
+                // scene's unless overridden; was the override or 1) and the final ACES curve
+                // (was Reinhard)
+                let e = self.last_frame.sky[3];
                 img.data
                     .iter_mut()
-                    .for_each(|v| *v = (*v * e / (1.0 + *v * e)).clamp(0.0, 1.0));
+                    .for_each(|v| *v = crate::passes::tonemap::tonemap(*v, e));
             }
         } else if let Some((j, what)) = rest
             .strip_prefix("node")

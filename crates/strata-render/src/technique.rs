@@ -289,7 +289,16 @@ static AO_SETTINGS: [SettingInfo; 12] = [
     },
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 7] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 8] = [
+    SettingInfo {
+        name: "coverage-confidence",
+        doc: "on: the probe blend's confidence is M/U, U = the taps in the receiver's hemisphere (taps on its own plane or behind it no longer count against screen space; not in the paper, docs/image-quality.md); off: DGB's M/N",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(radiosity_of(s).coverage_confidence as u32 as f64),
+        set: |s, v| radiosity_mut(s).coverage_confidence = v != 0.0,
+        values: &["off", "on"],
+    },
     setting!(
         "indirect-samples",
         "radiosity taps N per pixel (DGB Eq. 4-5; default: the preset's)",

@@ -592,12 +592,17 @@ fn layer_and_node_debug_views_show_the_read_back_lists() {
     let l = lists(&gpu, &r);
     let nodes = r.abuffer().unwrap().read_compressed(&gpu).unwrap().unwrap();
     let layer1 = r.debug_view(&gpu, "abuffer-layer1", true).unwrap();
+    let layer1_png = r.debug_view(&gpu, "abuffer-layer1", false).unwrap();
     let alpha0 = r.debug_view(&gpu, "abuffer-node0-alpha", true).unwrap();
     let mut second = 0;
     for y in 0..H {
         for x in 0..W {
             let want = l.at(x, y).get(1).map_or([0.0; 3], |f| f.radiance.map(|c| c * f.alpha));
             assert_eq!(layer1.pixel(x, y), &want[..], "({x}, {y})");
+            // the PNG view: the same radiance through the frame's exposure and tone curve
+            let e = r.frame_uniforms().sky[3];
+            let shown = want.map(|c| strata_render::passes::tonemap::tonemap(c, e));
+            assert_eq!(layer1_png.pixel(x, y), &shown[..], "({x}, {y}) PNG");
             second += l.at(x, y).len().min(2) / 2;
             let word = nodes[(y * W + x) as usize][0];
             assert_eq!(alpha0.pixel(x, y)[0], (word & 0xffff) as f32 / 65535.0, "({x}, {y})");

@@ -207,6 +207,17 @@ pub(crate) fn render_frame(
     s: &EvalSettings,
     f: f32,
 ) -> Result<ImageBuf> {
+    if r.settings.ao.as_ref().is_some_and(|a| a.temporal_noise) {
+        // per-frame spiral rotations: `warmup` static frames at the evaluated camera first, so
+        // the temporal filter averages different tap patterns as in `render --warmup N` (with the
+        // paper's fixed rotation every static frame is the same, so none are rendered)
+        let fixed = strata_render::frame::FrameCameras::fixed(s.scene.cameras_at(scene, f).current);
+        for _ in 0..s.warmup.max(r.settings.deep.uses_history() as u32) {
+            r.render(gpu, scene, &fixed, f)?;
+        }
+        r.render(gpu, scene, &fixed, f)?;
+        return Ok(r.read_target(gpu, "ao")?);
+    }
     if r.settings.deep.uses_history() {
         r.render(gpu, scene, &s.scene.cameras_at(scene, f - 1.0), f - 1.0)?;
     }

@@ -26,6 +26,7 @@ pub mod gi;
 pub mod ils;
 pub mod ils_progressive;
 pub mod oit;
+pub mod views;
 
 /// What every evaluation takes.
 #[derive(Clone, Debug)]

@@ -55,8 +55,9 @@ pub struct AoSettings {
     /// Rotate each pixel's spiral by φ = hash(x, y) (false: φ = 0, Fig. 7 left).
     pub rotate: bool,
     /// Also hash the renderer's frame count into φ, so the temporal filter
-    /// averages different patterns (off by default: the paper's φ depends on
-    /// (x, y) only).
+    /// averages different patterns. On by default (issue 14): the paper's φ
+    /// depends on (x, y) only, which leaves a static view's 19-tap noise as
+    /// fixed blotches after the bilateral filter (docs/ao.md "Temporal rotation").
     pub temporal_noise: bool,
     /// q: the tap radius in pixels at which the MIP level first increments.
     pub q: f32,
@@ -88,7 +89,7 @@ impl Default for AoSettings {
             samples: 19,
             turns: SpiralTurns::Optimal,
             rotate: true,
-            temporal_noise: false,
+            temporal_noise: true,
             q: 8.0,
             mips: DepthMipSettings::default(),
             // 5 taps per direction, 1 px apart (σ = 1.5 px): measured against

@@ -54,6 +54,11 @@ pub struct RadiositySettings {
     /// Fraction of the guard band (DGB §3.5) in which the gather runs, in
     /// [0, 1]; outside it E = 0 and confidence 0.
     pub guard_band_shaded: f32,
+    /// Confidence = M / U, U the taps whose direction lies in the receiver's hemisphere (by
+    /// more than cos 0.1; background taps by their camera ray), instead of the paper's M / N:
+    /// taps on the receiver's own plane or behind it say nothing about its light, so they no
+    /// longer hand the pixel to the light probes (docs/image-quality.md). Not in the paper.
+    pub coverage_confidence: bool,
 }
 
 /// DGB Table 2's parameter sets, read from `presets/*.toml` (embedded).
@@ -147,6 +152,7 @@ impl Default for RadiositySettings {
             },
             temporal: Some(TemporalSettings::default()),
             guard_band_shaded: 0.5,
+            coverage_confidence: false,
         }
     }
 }
@@ -219,7 +225,9 @@ pub struct RadiosityUniforms {
     pub normal_test: u32,
     pub seed: u32,
     pub rotate: u32,
-    pub _pad: [u32; 2],
+    /// 1 = confidence M/U (taps in the receiver's hemisphere), 0 = M/N.
+    pub coverage: u32,
+    pub _pad: u32,
 }
 
 impl RadiosityUniforms {
@@ -241,7 +249,8 @@ impl RadiosityUniforms {
             normal_test: s.normal_test as u32,
             seed: if s.temporal_noise { frame_index } else { 0 },
             rotate: s.rotate as u32,
-            _pad: [0; 2],
+            coverage: s.coverage_confidence as u32,
+            _pad: 0,
         }
     }
 }
@@ -425,6 +434,10 @@ pub struct GatherInputs<'a> {
 
 /// CPU evaluation of exactly what `radiosity.wgsl` computes for receiver layer
 /// `receiver` (0 or 1) at pixel (x, y): (E, confidence).
+/// The coverage confidence's tangent-plane margin (`COVERAGE_COS` in radiosity.wgsl): a tap
+/// counts as in the receiver's hemisphere when cos(ω̂, n̂_X) exceeds it.
+pub const COVERAGE_COS: f32 = 0.1;
+
 pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec3, f32) {
     let u = g.uniforms;
     let zx = g.zmip[0].pixel(x, y);
@@ -446,7 +459,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     };
     let (w, h) = (g.zmip[0].width as i32, g.zmip[0].height as i32);
     let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
-    let (mut sum, mut m_count) = (Vec3::ZERO, 0u32);
+    let (mut sum, mut m_count, mut u_count) = (Vec3::ZERO, 0u32, 0u32);
     for i in 0..u.samples {
         let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
         let d = spiral::tap_texel(tap.offset);
@@ -486,14 +499,20 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
             sum += b;
             m_count += 1;
         }
+        // coverage confidence: the tap's direction (layer 0's point, else its camera ray)
+        // lies in the receiver's hemisphere (as `hemisphere_tap` in radiosity.wgsl)
+        let y0 = world(sx as f32, sy as f32, if zs[0] > 0.0 { zs[0] } else { 1.0e4 });
+        u_count += (best.is_some() || (y0 - pos).normalize().dot(n) > COVERAGE_COS) as u32;
     }
     if m_count == 0 {
         return (Vec3::ZERO, 0.0);
     }
-    (
-        sum * (2.0 * std::f32::consts::PI / m_count as f32),
-        m_count as f32 / u.samples as f32,
-    )
+    let confidence = if u.coverage != 0 {
+        m_count as f32 / u_count.max(m_count) as f32
+    } else {
+        m_count as f32 / u.samples as f32
+    };
+    (sum * (2.0 * std::f32::consts::PI / m_count as f32), confidence)
 }
 
 /// The gather's scissor for a `w`×`h` target with `guard` pixels of guard band

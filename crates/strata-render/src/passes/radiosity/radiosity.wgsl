@@ -28,7 +28,9 @@ struct Radiosity {
     normal_test: u32,
     seed: u32,
     rotate: u32,
-    _pad0: u32,
+    // 1 = confidence M/U with U the taps that lie in the receiver's hemisphere
+    // (see `hemisphere_tap`), 0 = the paper's M/N
+    coverage: u32,
     _pad1: u32,
 }
 
@@ -89,12 +91,33 @@ fn union_term(a: vec4f, b: vec4f) -> vec4f {
     return a;
 }
 
-fn estimate(sum: vec4f) -> vec4f {
+// Whether the tap at pixel `src` with layer-0 depth `z0` (0: background) tells the
+// receiver X (normal n) anything about its hemisphere: its direction from X lies above
+// X's tangent plane by more than COVERAGE_COS (taps on X's own plane, or behind it,
+// carry no light to X whatever they hold). A background tap's direction is its
+// camera ray's: the sky or distant geometry, which screen space does not see.
+const COVERAGE_COS: f32 = 0.1;
+fn hemisphere_tap(x: vec3f, n: vec3f, src: vec2i, z0: f32) -> f32 {
+    var y: vec3f;
+    if (z0 > 0.0) {
+        y = world_from_csz(frame, vec2f(src) + 0.5, z0);
+    } else {
+        y = world_from_csz(frame, vec2f(src) + 0.5, 1.0e4);
+    }
+    return select(0.0, 1.0, dot(normalize(y - x), n) > COVERAGE_COS);
+}
+
+// `u`: the taps in the receiver's hemisphere (coverage confidence), ≥ M.
+fn estimate(sum: vec4f, u: f32) -> vec4f {
     if (sum.a == 0.0) {
         return vec4f(0.0);
     }
-    // Eq. 4: 2π/M Σ, confidence M/N
-    return vec4f(sum.rgb * (2.0 * 3.14159265358979 / sum.a), sum.a / f32(rad.samples));
+    // Eq. 4: 2π/M Σ, confidence M/N (paper) or M/U (coverage)
+    var c = sum.a / f32(rad.samples);
+    if (rad.coverage != 0u) {
+        c = sum.a / max(u, sum.a);
+    }
+    return vec4f(sum.rgb * (2.0 * 3.14159265358979 / sum.a), c);
 }
 
 @fragment
@@ -125,6 +148,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let size = vec2i(textureDimensions(zmip, 0));
     var sum0 = vec4f(0.0);
     var sum1 = vec4f(0.0);
+    var u0 = 0.0;
+    var u1 = 0.0;
     for (var i = 0u; i < rad.samples; i++) {
         let tap = spiral_tap(i, rad.samples, rad.tau, r_p, phi);
         let q = p + tap_texel(tap.offset);
@@ -149,8 +174,14 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         }
         sum0 += best0;
         sum1 += best1;
+        if (rad.coverage != 0u) {
+            u0 += max(best0.a, hemisphere_tap(x0, n0, src, zs.x));
+            if (has1) {
+                u1 += max(best1.a, hemisphere_tap(x1, n1, src, zs.x));
+            }
+        }
     }
-    o.e0 = estimate(sum0);
-    o.e1 = estimate(sum1);
+    o.e0 = estimate(sum0, u0);
+    o.e1 = estimate(sum1, u1);
     return o;
 }

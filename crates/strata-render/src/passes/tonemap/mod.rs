@@ -12,6 +12,14 @@ pub const OUTPUTS: &[TargetDesc] = &[TargetDesc::new(
     "tonemapped display image (sRGB)",
 )];
 
+/// The CPU twin of `tonemap.wgsl` for one linear channel: `exposure · x` through the ACES
+/// filmic fit of `color.wgsl`, clamped to [0, 1] (the sRGB encoding is the image writer's).
+/// Debug views of radiance use it so they show what the final image shows.
+pub fn tonemap(x: f32, exposure: f32) -> f32 {
+    let x = x * exposure;
+    ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
+}
+
 pub struct TonemapPass {
     pass: FullscreenPass,
 }
