@@ -31,6 +31,7 @@
 //!    the target DGB AO writes, so compose and `eval` treat both alike.
 
 pub mod dss;
+pub mod gi;
 
 use bytemuck::Zeroable;
 use glam::Vec3;
@@ -503,11 +504,15 @@ pub struct SplatPass {
     group: wgpu::BindGroup,
     visibility: bool,
     instances: u32,
+    /// The payload target (`bzb-payload`, or `bzb-gi-payload` for GI).
+    payload: &'static str,
+    /// bzb-gi's sender data (group 2: materials, lights, shadow maps).
+    extra: Option<wgpu::BindGroup>,
 }
 
 impl Pass for SplatPass {
     fn info(&self) -> PassInfo {
-        let mut outputs = vec![PAYLOAD.name];
+        let mut outputs = vec![self.payload];
         if self.visibility {
             outputs.push(DEPTH.name);
         }
@@ -529,7 +534,7 @@ impl Pass for SplatPass {
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("bzb-splat"),
-            color_attachments: &[crate::passes::clear_attachment(&targets.get(PAYLOAD.name).view)],
+            color_attachments: &[crate::passes::clear_attachment(&targets.get(self.payload).view)],
             depth_stencil_attachment: depth,
             timestamp_writes: None,
             occlusion_query_set: None,
@@ -541,6 +546,9 @@ impl Pass for SplatPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.frame_bind_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
+        if let Some(g) = &self.extra {
+            pass.set_bind_group(2, g, &[]);
+        }
         pass.draw(0..6, 0..self.instances);
     }
 }
@@ -718,7 +726,7 @@ impl BzbStage {
         })
     }
 
-    fn zminmax_pass(
+    pub(crate) fn zminmax_pass(
         gpu: &GpuContext,
         scene_gpu: &GpuScene,
         targets: &Targets,
@@ -793,6 +801,99 @@ impl BzbStage {
         tiles: &wgpu::Buffer,
         count: u32,
     ) -> SplatPass {
+        splat_pass_with(
+            gpu,
+            scene_gpu,
+            targets,
+            SplatSpec {
+                visibility: s.visibility,
+                instances: count.saturating_mul(s.directions),
+                source: bzb_shader!("bzb_splat.wgsl"),
+                entries: ("fs_visibility", "fs_additive"),
+                payload: PAYLOAD,
+                extra: None,
+            },
+            uniforms,
+            triangles,
+            tiles,
+        )
+    }
+
+    /// Uploads this frame's uniforms (and, for animated scenes, the triangles at `frame`).
+    pub fn set_frame(&self, gpu: &GpuContext, scene: &Scene, frame: f32, animated: bool) {
+        let u = BzbUniforms::new(&self.settings, scene, self.triangles.count);
+        self.directions.set_uniforms(gpu, &u);
+        self.reconstruct.set_uniforms(gpu, &u);
+        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        if let Some(d) = &self.dss {
+            let [w, h] = d.size;
+            d.set_uniforms(
+                gpu,
+                &self
+                    .settings
+                    .dss_uniforms(w, h, u.radius, u.t_min, self.triangles.count),
+            );
+        }
+        if animated && self.triangles.count > 0 {
+            let data = triangle_data(scene, frame);
+            gpu.queue
+                .write_buffer(&self.triangles.buffer, 0, bytemuck::cast_slice(&data));
+        }
+        self.last.set(u);
+    }
+
+    /// The uniforms of the last frame.
+    pub fn uniforms(&self) -> BzbUniforms {
+        self.last.get()
+    }
+
+    pub fn passes(&self) -> Vec<&dyn Pass> {
+        let mut v: Vec<&dyn Pass> = vec![&self.directions];
+        if let (Some(z), Some(s)) = (&self.zminmax, &self.splat) {
+            v.push(z);
+            v.push(s);
+        }
+        if let Some(d) = &self.dss {
+            v.extend(d.passes());
+        }
+        v.extend([&self.reconstruct as &dyn Pass, &self.blur_h, &self.blur_v]);
+        v
+    }
+
+    /// The DSS stage (`splat = dss`).
+    pub fn dss(&self) -> Option<&dss::DssStage> {
+        self.dss.as_ref()
+    }
+
+    /// Scene triangles in the splat buffer.
+    pub fn triangle_count(&self) -> u32 {
+        self.triangles.count
+    }
+}
+
+
+/// What distinguishes the AO and GI splat passes: the shader, its two fragment
+/// entries (visibility, additive), the payload target and GI's group 2.
+pub(crate) struct SplatSpec<'a> {
+    pub visibility: bool,
+    pub instances: u32,
+    pub source: &'static str,
+    pub entries: (&'static str, &'static str),
+    pub payload: TargetDesc,
+    pub extra: Option<(&'a wgpu::BindGroupLayout, wgpu::BindGroup)>,
+}
+
+/// §3.2's splat pass over the triangles in `triangles` (group 1: uniforms,
+/// triangles, origins, directions, npack, depth tiles).
+pub(crate) fn splat_pass_with(
+    gpu: &GpuContext,
+    scene_gpu: &GpuScene,
+    targets: &Targets,
+    spec: SplatSpec,
+    uniforms: &wgpu::Buffer,
+    triangles: &wgpu::Buffer,
+    tiles: &wgpu::Buffer,
+) -> SplatPass {
         let device = &gpu.device;
         let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let tex = |binding| wgpu::BindGroupLayoutEntry {
@@ -856,71 +957,37 @@ impl BzbStage {
                 tiles.as_entire_binding(),
             ],
         );
+        let (extra_layout, extra) = match spec.extra {
+            Some((l, g)) => (Some(l), Some(g)),
+            None => (None, None),
+        };
+        let mut layouts = vec![Some(&scene_gpu.frame_layout), Some(&layout)];
+        if let Some(l) = extra_layout {
+            layouts.push(Some(l));
+        }
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("bzb-splat"),
-            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
+            bind_group_layouts: &layouts,
             immediate_size: 0,
         });
-        let module = crate::shader::module(device, "bzb-splat", bzb_shader!("bzb_splat.wgsl"));
-        let pipeline = splat_pipeline(device, "bzb-splat", &pipeline_layout, &module, s.visibility);
+        let module = crate::shader::module(device, "bzb-splat", spec.source);
+        let pipeline = splat_pipeline_with(
+            device,
+            "bzb-splat",
+            &pipeline_layout,
+            &module,
+            spec.visibility,
+            spec.payload.format,
+            spec.entries,
+        );
         SplatPass {
             pipeline,
             group,
-            visibility: s.visibility,
-            instances: count.saturating_mul(s.directions),
+            visibility: spec.visibility,
+            instances: spec.instances,
+            payload: spec.payload.name,
+            extra,
         }
-    }
-
-    /// Uploads this frame's uniforms (and, for animated scenes, the triangles at `frame`).
-    pub fn set_frame(&self, gpu: &GpuContext, scene: &Scene, frame: f32, animated: bool) {
-        let u = BzbUniforms::new(&self.settings, scene, self.triangles.count);
-        self.directions.set_uniforms(gpu, &u);
-        self.reconstruct.set_uniforms(gpu, &u);
-        gpu.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        if let Some(d) = &self.dss {
-            let [w, h] = d.size;
-            d.set_uniforms(
-                gpu,
-                &self
-                    .settings
-                    .dss_uniforms(w, h, u.radius, u.t_min, self.triangles.count),
-            );
-        }
-        if animated && self.triangles.count > 0 {
-            let data = triangle_data(scene, frame);
-            gpu.queue
-                .write_buffer(&self.triangles.buffer, 0, bytemuck::cast_slice(&data));
-        }
-        self.last.set(u);
-    }
-
-    /// The uniforms of the last frame.
-    pub fn uniforms(&self) -> BzbUniforms {
-        self.last.get()
-    }
-
-    pub fn passes(&self) -> Vec<&dyn Pass> {
-        let mut v: Vec<&dyn Pass> = vec![&self.directions];
-        if let (Some(z), Some(s)) = (&self.zminmax, &self.splat) {
-            v.push(z);
-            v.push(s);
-        }
-        if let Some(d) = &self.dss {
-            v.extend(d.passes());
-        }
-        v.extend([&self.reconstruct as &dyn Pass, &self.blur_h, &self.blur_v]);
-        v
-    }
-
-    /// The DSS stage (`splat = dss`).
-    pub fn dss(&self) -> Option<&dss::DssStage> {
-        self.dss.as_ref()
-    }
-
-    /// Scene triangles in the splat buffer.
-    pub fn triangle_count(&self) -> u32 {
-        self.triangles.count
-    }
 }
 
 impl Default for BzbUniforms {
@@ -941,9 +1008,30 @@ pub(crate) fn splat_pipeline(
     module: &wgpu::ShaderModule,
     visibility: bool,
 ) -> wgpu::RenderPipeline {
+    splat_pipeline_with(
+        device,
+        label,
+        layout,
+        module,
+        visibility,
+        PAYLOAD.format,
+        ("fs_visibility", "fs_additive"),
+    )
+}
+
+/// [`splat_pipeline`] with the payload format and fragment entries (visibility, additive) given.
+pub(crate) fn splat_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    visibility: bool,
+    format: wgpu::TextureFormat,
+    entries: (&'static str, &'static str),
+) -> wgpu::RenderPipeline {
     let (entry, blend, depth_stencil) = if visibility {
         (
-            "fs_visibility",
+            entries.0,
             None,
             Some(wgpu::DepthStencilState {
                 format: DEPTH.format,
@@ -959,7 +1047,7 @@ pub(crate) fn splat_pipeline(
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
+        (entries.1, Some(wgpu::BlendState { color: add, alpha: add }), None)
     };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
@@ -981,7 +1069,7 @@ pub(crate) fn splat_pipeline(
             entry_point: Some(entry),
             compilation_options: Default::default(),
             targets: &[Some(wgpu::ColorTargetState {
-                format: PAYLOAD.format,
+                format,
                 blend,
                 write_mask: wgpu::ColorWrites::ALL,
             })],
