@@ -1065,6 +1065,7 @@ const BZB_GI_PASSES: &[&str] = &[
     "lighting",
     "bzb-directions",
     "bzb-zminmax",
+    "bzb-gi-senders",
     "bzb-splat",
     "bzb-gi-shade",
     "bzb-reconstruct",

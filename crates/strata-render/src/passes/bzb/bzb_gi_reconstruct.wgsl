@@ -3,8 +3,8 @@
 // write the irradiance E = mean L cos θ/α (compose multiplies by ρ/π after the
 // filter, as for DGB radiosity and ILS); glossy receivers write the outgoing
 // radiance mean f_GGX(v, ω) L cos θ/α into the glossy target. Without
-// visibility the payload is already the summed irradiance (Lambert) or glossy
-// radiance of every splat (bzb_gi_splat.wgsl) and is averaged over s.
+// visibility the payload of sub-image 0 is already the summed irradiance
+// (Lambert) or glossy radiance of every splat (bzb_gi_splat.wgsl).
 #import "common/fullscreen.wgsl"
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
@@ -45,7 +45,12 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let size = vec2u(frame.size.xy);
     var sum = vec3f(0.0);
     var count = 0.0;
-    for (var s = 0u; s < bzb.directions; s++) {
+    if (bzb.visibility == 0u) {
+        // the additive baseline's sum, splatted into sub-image 0 only
+        sum = textureLoad(payload, vec2i(p), 0).rgb;
+        count = 1.0;
+    }
+    for (var s = 0u; s < bzb.directions * bzb.visibility; s++) {
         let texel = vec2i(bzb_tile_origin(s, bzb.cols, size) + p);
         let d = textureLoad(directions, texel, 0);
         if (d.w <= 0.0) {
@@ -53,10 +58,6 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         }
         count += 1.0;
         let l = textureLoad(payload, texel, 0).rgb;
-        if (bzb.visibility == 0u) {
-            sum += l;
-            continue;
-        }
         let c = max(0.0, dot(n, d.xyz));
         if (glossy) {
             sum += ggx_eval(n, v, d.xyz, rho, nrm.z, nrm.w) * l * (c / d.w);

@@ -8,8 +8,9 @@
 //       winner's outgoing radiance L(y → x_p) once per texel (deferred: on a
 //       CPU rasteriser shading every hit fragment cost more than the test).
 //   fs_gi_additive: the baseline without visibility: every triangle within
-//       d_max adds π·F·L (F its point-to-polygon form factor at x_p, L its
-//       radiance at a hashed point), summed by additive blending.
+//       d_max adds π·F·L̄_T (F its point-to-polygon form factor at x_p, L̄_T
+//       its mean radiance, bzb_gi_senders.wgsl), summed by additive blending.
+//       The sum does not depend on ω, so it is splatted into sub-image 0 only.
 
 @group(2) @binding(0) var<uniform> gi: BzbGi;
 // 5 vec4 per triangle: (n0, ρ.r), (n1, ρ.g), (n2, ρ.b), (emission, glossy), (roughness, metallic, 0, 0)
@@ -22,6 +23,8 @@
 @group(2) @binding(6) var normal_tex: texture_2d<f32>;
 @group(2) @binding(7) var albedo_tex: texture_2d<f32>;
 @group(2) @binding(8) var emission_tex: texture_2d<f32>;
+// the baseline's per-triangle mean radiance L̄_T (bzb_gi_senders.wgsl)
+@group(2) @binding(9) var<storage, read> mean_radiance: array<vec4f>;
 
 struct GiVisibilityOut {
     // the hit triangle + 1 (bzb-gi-hit; the shade pass computes its radiance)
@@ -101,14 +104,10 @@ fn fs_gi_additive(in: SplatVertex) -> @location(0) vec4f {
     if (ff <= 0.0) {
         discard;
     }
-    // the sender's radiance at a uniform point of the triangle (hash of p, s, triangle)
-    let u = bzb_sample_uniforms(pu, s + 16u * in.triangle, gi.seed + 1u);
-    let su = sqrt(u.x);
-    let bary = vec2f(u.y * su, 1.0 - su);
-    let y = v[0] + bary.x * (v[1] - v[0]) + bary.y * (v[2] - v[0]);
-    let to_x = normalize(o.xyz - y);
-    // irradiance from the triangle if its radiance were uniform: π F L
-    let e = BZB_PI * ff * gi_sender(in.triangle, y, bary, to_x);
+    // towards the triangle's centre (the receiver's BRDF direction)
+    let to_x = normalize(o.xyz - (v[0] + v[1] + v[2]) / 3.0);
+    // irradiance from a sender of constant radiance L̄_T: π F L̄_T
+    let e = BZB_PI * ff * mean_radiance[in.triangle].rgb;
     if (textureLoad(emission_tex, p, 0).a > 1.5) {
         let nrm = textureLoad(normal_tex, p, 0);
         let rho = textureLoad(albedo_tex, p, 0).rgb;

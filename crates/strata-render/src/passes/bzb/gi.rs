@@ -117,8 +117,18 @@ impl BzbGiSettings {
         px * (c * r) as u64 * (16 + 16 + 8 + 4) + px * 8 * 7 + triangles * (48 + 80) + super::zminmax_tile_count(w, h) as u64 * 8
     }
 
-    /// The AOV splat uniforms with r = d_max.
+    /// The AOV splat uniforms with r = d_max (the additive baseline splats
+    /// into sub-image 0 only: its sum does not depend on ω).
     pub fn splat_uniforms(&self, scene: &Scene, triangles: u32) -> BzbUniforms {
+        let mut u = self.uniforms(scene, triangles);
+        if !self.visibility {
+            u.directions = 1;
+        }
+        u
+    }
+
+    /// The direction and reconstruction uniforms with r = d_max.
+    pub fn uniforms(&self, scene: &Scene, triangles: u32) -> BzbUniforms {
         let (d_max, t_min) = self.resolve(scene);
         let (cols, rows) = self.grid();
         BzbUniforms {
@@ -356,6 +366,7 @@ pub const GLOSSY: TargetDesc = TargetDesc::new(
 pub const PASSES: &[&str] = &[
     "bzb-directions",
     "bzb-zminmax",
+    "bzb-gi-senders",
     "bzb-splat",
     "bzb-gi-shade",
     "bzb-reconstruct",
@@ -390,6 +401,8 @@ pub(crate) struct BzbGiStage {
     directions: FullscreenPass,
     zminmax: ZMinMaxPass,
     splat: SplatPass,
+    /// Without visibility: the triangles' mean radiance L̄_T.
+    senders_pass: Option<SenderPass>,
     /// With visibility: the winners' radiance (deferred shading of the hits).
     shade: Option<FullscreenPass>,
     reconstruct: FullscreenPass,
@@ -472,7 +485,8 @@ impl BzbGiStage {
             light_data.push(Zeroable::zeroed());
         }
         let lights = buffer("bzb-gi-lights", bytemuck::cast_slice(&light_data).to_vec(), 0, storage);
-        let u = s.splat_uniforms(scene, count);
+        let u = s.uniforms(scene, count);
+        let splat_u = s.splat_uniforms(scene, count);
         let base = GiUniforms {
             light_count: light.lights.len() as u32,
             pcf_radius: light.pcf_radius.clamp(0, 4),
@@ -485,7 +499,13 @@ impl BzbGiStage {
             seed: s.seed,
         };
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
-        let splat_uniforms = buffer("bzb-splat", bytemuck::bytes_of(&u).to_vec(), 0, uniform);
+        let splat_uniforms = buffer("bzb-splat", bytemuck::bytes_of(&splat_u).to_vec(), 0, uniform);
+        let mean = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bzb-gi-mean-radiance"),
+            size: (count.max(1) as u64) * 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         let gi_uniforms = buffer("bzb-gi", bytemuck::bytes_of(&base).to_vec(), 0, uniform);
 
         let directions = PassBuilder::new(gpu, targets, "bzb-directions")
@@ -571,6 +591,7 @@ impl BzbGiStage {
                 tex(6),
                 tex(7),
                 tex(8),
+                storage_ro(9),
             ],
         });
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -595,8 +616,25 @@ impl BzbGiStage {
                 view("normal"),
                 view("albedo"),
                 view("emission"),
+                mean.as_entire_binding(),
             ],
         );
+        let senders_pass = (!s.visibility).then(|| {
+            SenderPass::new(
+                gpu,
+                [
+                    gi_uniforms.as_entire_binding(),
+                    triangles.as_entire_binding(),
+                    senders.as_entire_binding(),
+                    lights.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&light.shadow.array_view),
+                    wgpu::BindingResource::Sampler(&sampler),
+                    light.shadow.matrices.as_entire_binding(),
+                    mean.as_entire_binding(),
+                ],
+                count,
+            )
+        });
         let shade = s.visibility.then(|| {
             PassBuilder::new(gpu, targets, "bzb-gi-shade")
                 .shader(
@@ -619,7 +657,7 @@ impl BzbGiStage {
                 .storage(&triangles)
                 .storage(&senders)
                 .storage(&lights)
-                .depth_view("shadow", &light.shadow.array_view, wgpu::TextureViewDimension::D2Array)
+                .depth_view("shadow-maps", &light.shadow.array_view, wgpu::TextureViewDimension::D2Array)
                 .sampler(&sampler, wgpu::SamplerBindingType::Comparison)
                 .storage(&light.shadow.matrices)
                 .write(PAYLOAD.name)
@@ -673,6 +711,7 @@ impl BzbGiStage {
             directions,
             zminmax,
             splat,
+            senders_pass,
             shade,
             reconstruct,
             blur,
@@ -690,9 +729,10 @@ impl BzbGiStage {
 
     /// This frame's uniforms; animated scenes also get their triangles and lights at `frame`.
     pub fn set_frame(&self, gpu: &GpuContext, scene: &Scene, frame: f32, animated: bool, lights: &[GpuLight]) {
-        let u = self.settings.splat_uniforms(scene, self.count);
+        let u = self.settings.uniforms(scene, self.count);
         self.directions.set_uniforms(gpu, &u);
         self.reconstruct.set_uniforms(gpu, &u);
+        let u = self.settings.splat_uniforms(scene, self.count);
         if let Some(p) = &self.shade {
             p.set_uniforms(gpu, &self.base);
         }
@@ -710,7 +750,11 @@ impl BzbGiStage {
     }
 
     pub fn passes(&self) -> Vec<&dyn Pass> {
-        let mut v: Vec<&dyn Pass> = vec![&self.directions, &self.zminmax, &self.splat];
+        let mut v: Vec<&dyn Pass> = vec![&self.directions, &self.zminmax];
+        if let Some(p) = &self.senders_pass {
+            v.push(p);
+        }
+        v.push(&self.splat);
         if let Some(p) = &self.shade {
             v.push(p);
         }
@@ -723,5 +767,108 @@ impl BzbGiStage {
     /// The splat uniforms of the last frame (d_max in `radius`).
     pub fn uniforms(&self) -> GiUniforms {
         self.base
+    }
+}
+
+/// `bzb-gi-senders` (compute, baseline only): every triangle's mean radiance L̄_T.
+struct SenderPass {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    count: u32,
+}
+
+impl SenderPass {
+    fn new(gpu: &GpuContext, resources: [wgpu::BindingResource; 8], count: u32) -> Self {
+        let device = &gpu.device;
+        let comp = wgpu::ShaderStages::COMPUTE;
+        let buf = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: comp,
+            ty: wgpu::BindingType::Buffer {
+                ty: if binding == 0 {
+                    wgpu::BufferBindingType::Uniform
+                } else {
+                    wgpu::BufferBindingType::Storage { read_only }
+                },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bzb-gi-senders"),
+            entries: &[
+                buf(0, true),
+                buf(1, true),
+                buf(2, true),
+                buf(3, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                buf(6, true),
+                buf(7, false),
+            ],
+        });
+        let group = crate::passes::bind_group(device, "bzb-gi-senders", &layout, &resources);
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("bzb-gi-senders"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(
+            device,
+            "bzb-gi-senders",
+            concat!(
+                include_str!("bzb.wgsl"),
+                "\n",
+                include_str!("bzb_gi.wgsl"),
+                "\n",
+                include_str!("bzb_gi_sender.wgsl"),
+                "\n",
+                include_str!("bzb_gi_senders.wgsl")
+            ),
+        );
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("bzb-gi-senders"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("cs_main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self { pipeline, group, count }
+    }
+}
+
+impl Pass for SenderPass {
+    fn info(&self) -> crate::frame::PassInfo {
+        crate::frame::PassInfo {
+            name: "bzb-gi-senders",
+            inputs: vec!["shadow-maps"],
+            outputs: vec!["bzb-gi-mean-radiance"],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("bzb-gi-senders"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.dispatch_workgroups(self.count.div_ceil(64), 1, 1);
     }
 }
