@@ -1065,7 +1065,6 @@ const BZB_GI_PASSES: &[&str] = &[
     "lighting",
     "bzb-directions",
     "bzb-zminmax",
-    "bzb-gi-senders",
     "bzb-splat",
     "bzb-gi-shade",
     "bzb-reconstruct",
