@@ -766,7 +766,6 @@ static BZB_SETTINGS: [SettingInfo; 12] = [
     ),
 ];
 
-
 fn bzb_gi_mut(s: &mut RenderSettings) -> &mut crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.get_or_insert_with(Default::default)
 }
@@ -1042,7 +1041,6 @@ const BZB_AO_PASSES: &[&str] = &[
     "bzb-blur-h",
     "bzb-blur-v",
 ];
-
 
 /// BZB GI: direct light + one bounce gathered through the bounced z-buffer
 /// (AOV triangle splats with a radiance payload), composed like ILS.

@@ -82,12 +82,21 @@ fn gi_directions_equal_the_cpu_twin_on_lambert_and_glossy_receivers() {
             }
         }
     }
-    assert!(checked > (w * h * g.directions / 2) as usize, "{checked} samples checked");
-    assert!(glossy > 200 && specular > 50, "glossy receivers sampled: {glossy}, specular lobe {specular}");
+    assert!(
+        checked > (w * h * g.directions / 2) as usize,
+        "{checked} samples checked"
+    );
+    assert!(
+        glossy > 200 && specular > 50,
+        "glossy receivers sampled: {glossy}, specular lobe {specular}"
+    );
     // a lobe choice at u ≈ P_s may flip on f32 rounding, and narrow lobes
     // amplify the normal's rounding: at most 0.5 % may differ (13 of 6144 did
     // at 2e-3 relative pdf tolerance)
-    assert!(bad * 200 <= checked, "{bad} of {checked} GPU directions differ from the CPU twin");
+    assert!(
+        bad * 200 <= checked,
+        "{bad} of {checked} GPU directions differ from the CPU twin"
+    );
 }
 
 /// The path tracer's GGX sampler (strata_reference::brdf::Ggx), equal sample for
@@ -96,10 +105,34 @@ fn gi_directions_equal_the_cpu_twin_on_lambert_and_glossy_receivers() {
 fn ggx_mixture_matches_the_reference_sampler_and_its_pdf_integrates_to_one() {
     use strata_reference::brdf::Ggx;
     let cases = [
-        (Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.6, 0.8, 0.0), [1.0, 0.78, 0.34], 0.25, 1.0),
-        (Vec3::new(0.3, 0.9, -0.2), Vec3::new(-0.2, 0.5, 0.9), [0.08, 0.2, 0.65], 0.15, 0.0),
-        (Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.1, 0.2, -0.3), [0.62, 0.62, 0.64], 0.12, 1.0),
-        (Vec3::new(1.0, 0.2, 0.1), Vec3::new(0.3, 0.9, 0.1), [0.8, 0.08, 0.06], 0.4, 0.0),
+        (
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.6, 0.8, 0.0),
+            [1.0, 0.78, 0.34],
+            0.25,
+            1.0,
+        ),
+        (
+            Vec3::new(0.3, 0.9, -0.2),
+            Vec3::new(-0.2, 0.5, 0.9),
+            [0.08, 0.2, 0.65],
+            0.15,
+            0.0,
+        ),
+        (
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(0.1, 0.2, -0.3),
+            [0.62, 0.62, 0.64],
+            0.12,
+            1.0,
+        ),
+        (
+            Vec3::new(1.0, 0.2, 0.1),
+            Vec3::new(0.3, 0.9, 0.1),
+            [0.8, 0.08, 0.06],
+            0.4,
+            0.0,
+        ),
     ];
     for (n, v, rho, roughness, metallic) in cases {
         let (n, v) = (n.normalize(), v.normalize());
@@ -139,7 +172,10 @@ fn ggx_mixture_matches_the_reference_sampler_and_its_pdf_integrates_to_one() {
             let p = gi::ggx_pdf(n, v, s, rho, roughness, metallic) as f64;
             integral += p / (0.5 / (4.0 * std::f64::consts::PI) + 0.5 * p);
         }
-        assert!(differ * 2000 <= count, "{differ} of {count} samples differ from the reference sampler");
+        assert!(
+            differ * 2000 <= count,
+            "{differ} of {count} samples differ from the reference sampler"
+        );
         let integral = integral / count as f64;
         assert!((integral - 1.0).abs() < 0.01, "∫pdf = {integral} (α = {roughness}²)");
     }
@@ -242,7 +278,11 @@ fn irradiance_under_an_emissive_rectangle_is_pi_l_times_the_form_factor() {
             worst = worst.max((e - expected).abs() / expected);
         }
         let rel = (got - want).abs() / want;
-        eprintln!("visibility {visibility}: mean E {:.4} vs π L F {:.4} (rel {rel:.4}, worst pixel {worst:.3})", got / px.len() as f64, want / px.len() as f64);
+        eprintln!(
+            "visibility {visibility}: mean E {:.4} vs π L F {:.4} (rel {rel:.4}, worst pixel {worst:.3})",
+            got / px.len() as f64,
+            want / px.len() as f64
+        );
         if visibility {
             // 16 cosine samples per pixel, 17-tap bilateral: the mean within 2 %, every pixel within 15 %
             assert!(rel < 0.02 && worst < 0.15, "rel {rel}, worst {worst}");
@@ -288,16 +328,25 @@ fn hidden_sender_adds_light_without_visibility_and_none_with_it() {
         means.push((got / px.len() as f64, want / px.len() as f64));
     }
     let ((with, _), (without, through)) = (means[0], means[1]);
-    eprintln!("hidden sender: with visibility {with:.5}, without {without:.4} (π L F through the blocker {through:.4})");
+    eprintln!(
+        "hidden sender: with visibility {with:.5}, without {without:.4} (π L F through the blocker {through:.4})"
+    );
     assert!(with < 1e-4, "the bounced z-buffer lets {with} through the blocker");
-    assert!((without - through).abs() < 0.01 * through, "without visibility {without} vs π L F {through}");
+    assert!(
+        (without - through).abs() < 0.01 * through,
+        "without visibility {without} vs π L F {through}"
+    );
 }
 
 #[test]
 fn settings_errors_name_the_setting_and_range() {
     let t = strata_render::technique::find("bzb-gi").unwrap();
     let mut s = t.settings(&RenderSettings::default(), None).unwrap();
-    for (name, value, range) in [("dmax", 0.0, "> 0"), ("directions", 17.0, "1..=16"), ("bias", -1.0, ">= 0")] {
+    for (name, value, range) in [
+        ("dmax", 0.0, "> 0"),
+        ("directions", 17.0, "1..=16"),
+        ("bias", -1.0, ">= 0"),
+    ] {
         let e = t.set(&mut s, name, value).unwrap_err().to_string();
         assert!(e.contains(name) && e.contains(range), "{e}");
     }

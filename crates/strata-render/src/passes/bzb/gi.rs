@@ -114,7 +114,10 @@ impl BzbGiSettings {
     pub fn estimated_bytes(&self, w: u32, h: u32, triangles: u64) -> u64 {
         let (c, r) = self.grid();
         let px = w as u64 * h as u64;
-        px * (c * r) as u64 * (16 + 16 + 8 + 4) + px * 8 * 7 + triangles * (48 + 80) + super::zminmax_tile_count(w, h) as u64 * 8
+        px * (c * r) as u64 * (16 + 16 + 8 + 4)
+            + px * 8 * 7
+            + triangles * (48 + 80)
+            + super::zminmax_tile_count(w, h) as u64 * 8
     }
 
     /// The AOV splat uniforms with r = d_max (the additive baseline splats
@@ -448,7 +451,14 @@ impl BzbGiStage {
             targets.create_sized(gpu, DEPTH, big);
             targets.create_sized(gpu, HIT, big);
         }
-        for d in [RAW, GLOSSY_RAW, BLUR_H, GLOSSY_BLUR_H, GLOSSY, crate::passes::ils::INDIRECT] {
+        for d in [
+            RAW,
+            GLOSSY_RAW,
+            BLUR_H,
+            GLOSSY_BLUR_H,
+            GLOSSY,
+            crate::passes::ils::INDIRECT,
+        ] {
             if targets.try_get(d.name).is_none() {
                 targets.create(gpu, d);
             }
@@ -479,7 +489,12 @@ impl BzbGiStage {
         };
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let triangles = buffer("bzb-triangles", bytemuck::cast_slice(&data).to_vec(), 48, storage);
-        let senders = buffer("bzb-gi-senders", bytemuck::cast_slice(&senders_data).to_vec(), 80, storage);
+        let senders = buffer(
+            "bzb-gi-senders",
+            bytemuck::cast_slice(&senders_data).to_vec(),
+            80,
+            storage,
+        );
         let mut light_data = light.lights.to_vec();
         if light_data.is_empty() {
             light_data.push(Zeroable::zeroed());
@@ -657,7 +672,11 @@ impl BzbGiStage {
                 .storage(&triangles)
                 .storage(&senders)
                 .storage(&lights)
-                .depth_view("shadow-maps", &light.shadow.array_view, wgpu::TextureViewDimension::D2Array)
+                .depth_view(
+                    "shadow-maps",
+                    &light.shadow.array_view,
+                    wgpu::TextureViewDimension::D2Array,
+                )
                 .sampler(&sampler, wgpu::SamplerBindingType::Comparison)
                 .storage(&light.shadow.matrices)
                 .write(PAYLOAD.name)
@@ -737,7 +756,8 @@ impl BzbGiStage {
             p.set_uniforms(gpu, &self.base);
         }
         gpu.queue.write_buffer(&self.splat_uniforms, 0, bytemuck::bytes_of(&u));
-        gpu.queue.write_buffer(&self.gi_uniforms, 0, bytemuck::bytes_of(&self.base));
+        gpu.queue
+            .write_buffer(&self.gi_uniforms, 0, bytemuck::bytes_of(&self.base));
         if animated && self.count > 0 {
             let data = super::triangle_data(scene, frame);
             gpu.queue.write_buffer(&self.triangles, 0, bytemuck::cast_slice(&data));

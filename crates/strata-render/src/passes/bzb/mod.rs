@@ -871,7 +871,6 @@ impl BzbStage {
     }
 }
 
-
 /// What distinguishes the AO and GI splat passes: the shader, its two fragment
 /// entries (visibility, additive), the payload target and GI's group 2.
 pub(crate) struct SplatSpec<'a> {
@@ -894,100 +893,100 @@ pub(crate) fn splat_pass_with(
     triangles: &wgpu::Buffer,
     tiles: &wgpu::Buffer,
 ) -> SplatPass {
-        let device = &gpu.device;
-        let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-        let tex = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
+    let device = &gpu.device;
+    let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    let tex = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("bzb-splat"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: vf,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
             },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("bzb-splat"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: vf,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
                 },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
+                count: None,
+            },
+            tex(2),
+            tex(3),
+            tex(4),
+            wgpu::BindGroupLayoutEntry {
+                binding: 5,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
                 },
-                tex(2),
-                tex(3),
-                tex(4),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::VERTEX,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let group = crate::passes::bind_group(
-            device,
-            "bzb-splat",
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                triangles.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
-                wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
-                wgpu::BindingResource::TextureView(&targets.get("npack").view),
-                tiles.as_entire_binding(),
-            ],
-        );
-        let (extra_layout, extra) = match spec.extra {
-            Some((l, g)) => (Some(l), Some(g)),
-            None => (None, None),
-        };
-        let mut layouts = vec![Some(&scene_gpu.frame_layout), Some(&layout)];
-        if let Some(l) = extra_layout {
-            layouts.push(Some(l));
-        }
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("bzb-splat"),
-            bind_group_layouts: &layouts,
-            immediate_size: 0,
-        });
-        let module = crate::shader::module(device, "bzb-splat", spec.source);
-        let pipeline = splat_pipeline_with(
-            device,
-            "bzb-splat",
-            &pipeline_layout,
-            &module,
-            spec.visibility,
-            spec.payload.format,
-            spec.entries,
-        );
-        SplatPass {
-            pipeline,
-            group,
-            visibility: spec.visibility,
-            instances: spec.instances,
-            payload: spec.payload.name,
-            extra,
-        }
+                count: None,
+            },
+        ],
+    });
+    let group = crate::passes::bind_group(
+        device,
+        "bzb-splat",
+        &layout,
+        &[
+            uniforms.as_entire_binding(),
+            triangles.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+            wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
+            wgpu::BindingResource::TextureView(&targets.get("npack").view),
+            tiles.as_entire_binding(),
+        ],
+    );
+    let (extra_layout, extra) = match spec.extra {
+        Some((l, g)) => (Some(l), Some(g)),
+        None => (None, None),
+    };
+    let mut layouts = vec![Some(&scene_gpu.frame_layout), Some(&layout)];
+    if let Some(l) = extra_layout {
+        layouts.push(Some(l));
+    }
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("bzb-splat"),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    let module = crate::shader::module(device, "bzb-splat", spec.source);
+    let pipeline = splat_pipeline_with(
+        device,
+        "bzb-splat",
+        &pipeline_layout,
+        &module,
+        spec.visibility,
+        spec.payload.format,
+        spec.entries,
+    );
+    SplatPass {
+        pipeline,
+        group,
+        visibility: spec.visibility,
+        instances: spec.instances,
+        payload: spec.payload.name,
+        extra,
+    }
 }
 
 impl Default for BzbUniforms {
