@@ -774,7 +774,7 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.clone().unwrap_or_default()
 }
 
-static BZB_GI_SETTINGS: [SettingInfo; 7] = [
+static BZB_GI_SETTINGS: [SettingInfo; 8] = [
     SettingInfo {
         name: "visibility",
         doc: "on: bounced z-buffer (BZB §3.2, the nearest sender per direction); off: the additive baseline (every triangle within d_max adds π·form factor·radiance)",
@@ -807,6 +807,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 7] = [
         false,
         |s| bzb_gi_of(s).bias.map(f64::from),
         |s, v| bzb_gi_mut(s).bias = Some(v as f32)
+    ),
+    setting!(
+        "clamp",
+        "largest sender radiance (RGB component) a payload keeps; biased, removes caustic fireflies (default: off)",
+        Range::Above(0.0),
+        false,
+        |s| bzb_gi_of(s).clamp.map(f64::from),
+        |s, v| bzb_gi_mut(s).clamp = Some(v as f32)
     ),
     SettingInfo {
         name: "culling",

@@ -366,3 +366,41 @@ fn settings_errors_name_the_setting_and_range() {
     };
     assert!(no_shade.validate().unwrap_err().to_string().contains("shading"));
 }
+
+/// `clamp` caps the payload's largest component: under an emitter of radiance 2
+/// clamped to 0.5 the irradiance is π · 0.5 · F (with and without visibility).
+#[test]
+fn payload_clamp_caps_the_sender_radiance() {
+    let gpu = common::gpu();
+    let (h, a, b, l, c) = (1.0f32, 1.5f32, 1.0f32, 2.0f32, 0.5f32);
+    let scene = emitter_scene(h, a, b, l, None);
+    let (w, hh) = (48, 32);
+    for visibility in [true, false] {
+        let g = BzbGiSettings {
+            visibility,
+            directions: 16,
+            d_max: Some(10.0),
+            clamp: Some(c),
+            filter: strata_render::passes::bilateral::BilateralSettings {
+                radius: 8,
+                step: 1,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let r = render(&gpu, &scene, w, hh, g);
+        let px = floor_irradiance(&gpu, &r, w, hh);
+        let (mut got, mut want) = (0.0, 0.0);
+        for &(x, z, e) in &px {
+            got += e;
+            want += std::f64::consts::PI
+                * c as f64
+                * parallel_rect_form_factor([x, z], h as f64, (-a as f64, a as f64), (-b as f64, b as f64));
+        }
+        let rel = (got - want).abs() / want;
+        assert!(
+            rel < 0.02,
+            "visibility {visibility}: mean E {got} vs π·clamp·F {want} (rel {rel})"
+        );
+    }
+}

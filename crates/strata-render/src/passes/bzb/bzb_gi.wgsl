@@ -15,6 +15,21 @@ struct BzbGi {
     t_min: f32,
     visibility: u32,
     seed: u32,
+    // payload clamp: largest RGB component kept (0 = off; biased)
+    clamp: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// The optional firefly clamp of the payload: L scaled so that its largest
+// component is at most `gi.clamp` (off when 0).
+fn bzb_gi_clamp(l: vec3f, c: f32) -> vec3f {
+    let m = max(l.x, max(l.y, l.z));
+    if (c > 0.0 && m > c) {
+        return l * (c / m);
+    }
+    return l;
 }
 
 // The third uniform of sample (p, s): the lobe choice of a glossy receiver.

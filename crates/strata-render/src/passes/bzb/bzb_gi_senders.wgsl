@@ -36,7 +36,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3u) {
             let su = sqrt(u.x);
             let bary = vec2f(u.y * su, 1.0 - su);
             let y = v[0] + bary.x * (v[1] - v[0]) + bary.y * (v[2] - v[0]);
-            sum += gi_sender(tri, y, bary, ng);
+            sum += bzb_gi_clamp(gi_sender(tri, y, bary, ng), gi.clamp);
         }
     }
     mean_radiance[tri] = vec4f(sum / f32(GI_SENDER_GRID * GI_SENDER_GRID), 1.0);

@@ -28,5 +28,5 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let v = gi_triangle(tri);
     let t = bzb_ray_triangle(o, d, v[0], v[1], v[2]);
     let y = o + max(t, 0.0) * d;
-    return vec4f(gi_sender(tri, y, gi_barycentrics(y, v[0], v[1], v[2]), -d), 1.0);
+    return vec4f(bzb_gi_clamp(gi_sender(tri, y, gi_barycentrics(y, v[0], v[1], v[2]), -d), gi.clamp), 1.0);
 }

@@ -54,6 +54,9 @@ pub struct BzbGiSettings {
     pub filter: BilateralSettings,
     /// Depth-tile culling of splats (the AOV path's; the image is unchanged).
     pub culling: bool,
+    /// Largest sender radiance a payload keeps (its RGB scaled down to this
+    /// maximum component; biased, trades caustic fireflies for energy); `None` = off.
+    pub clamp: Option<f32>,
 }
 
 impl Default for BzbGiSettings {
@@ -70,6 +73,7 @@ impl Default for BzbGiSettings {
                 ..BilateralSettings::default()
             },
             culling: true,
+            clamp: None,
         }
     }
 }
@@ -90,6 +94,11 @@ impl BzbGiSettings {
         if let Some(b) = self.bias {
             if !(b >= 0.0 && b.is_finite()) {
                 return Err(format!("bzb-gi bias {b} is out of range: must be >= 0"));
+            }
+        }
+        if let Some(c) = self.clamp {
+            if !(c > 0.0 && c.is_finite()) {
+                return Err(format!("bzb-gi clamp {c} is out of range: must be > 0"));
             }
         }
         self.filter.validate()
@@ -163,6 +172,9 @@ pub struct GiUniforms {
     pub t_min: f32,
     pub visibility: u32,
     pub seed: u32,
+    /// Payload clamp (largest RGB component; 0 = off).
+    pub clamp: f32,
+    pub _pad: [u32; 3],
 }
 
 // ---- CPU twins of bzb_gi.wgsl ----
@@ -512,6 +524,8 @@ impl BzbGiStage {
             t_min: u.t_min,
             visibility: s.visibility as u32,
             seed: s.seed,
+            clamp: s.clamp.unwrap_or(0.0),
+            _pad: [0; 3],
         };
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let splat_uniforms = buffer("bzb-splat", bytemuck::bytes_of(&splat_u).to_vec(), 0, uniform);
