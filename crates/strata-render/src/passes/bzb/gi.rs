@@ -213,7 +213,7 @@ pub fn p_spec(nv: f32, rho: Vec3, metallic: f32) -> f32 {
     let ws = luminance(f0 + (Vec3::ONE - f0) * k);
     let wd = luminance(rho * (1.0 - m)) * (1.0 - schlick_dielectric(nv));
     let sum = ws + wd;
-    if !(sum > 0.0) {
+    if sum.is_nan() || sum <= 0.0 {
         return 0.5;
     }
     (ws / sum).clamp(0.0, 1.0)
@@ -265,7 +265,7 @@ fn vndf(v: Vec3, alpha: f32, u: [f32; 2]) -> Vec3 {
     let hs = Vec3::new(s * phi.cos(), s * phi.sin(), z) + vs;
     let h = Vec3::new(hs.x * alpha, hs.y * alpha, hs.z.max(0.0));
     let len = h.length();
-    if !(len > 0.0) {
+    if len.is_nan() || len <= 0.0 {
         return Vec3::Z;
     }
     h / len
@@ -322,8 +322,8 @@ pub fn sender_data(scene: &Scene, frame: f32) -> Vec<[f32; 4]> {
     for t in scene.world_triangles(frame) {
         let m = &scene.materials[t.material as usize];
         let rho = m.base_color;
-        for k in 0..3 {
-            out.push(t.n[k].extend(rho[k]).to_array());
+        for (n, r) in t.n.iter().zip(rho) {
+            out.push(n.extend(r).to_array());
         }
         let e = m.emission;
         out.push([e[0], e[1], e[2], m.glossy as u32 as f32]);
