@@ -17,13 +17,15 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";
+    let is_bzb_gi = a.technique.name == "bzb-gi";
     if !a.set.values.is_empty()
+        && !is_bzb_gi
         && !matches!(a.technique.eval, EvalKind::VplRadiance | EvalKind::Composite)
         && !is_bzb
         && !is_aba
     {
         anyhow::bail!(
-            "--set is only read by --technique ils, oit, bzb-ao and aba-ao in eval (ao and gi have their own flags)"
+            "--set is only read by --technique ils, oit, bzb-ao, bzb-gi and aba-ao in eval (ao and gi have their own flags)"
         );
     }
     if a.progressive.is_some() && a.technique.eval != EvalKind::VplRadiance {
@@ -59,6 +61,10 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         }
         EvalKind::AmbientVisibility => EvalResult::Ao(ao::run(&s, &a.ao.settings())?),
         EvalKind::None => unreachable!("the argument parser admits only comparable techniques"),
+        EvalKind::Radiance if is_bzb_gi => {
+            let rs = a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
+            EvalResult::BzbGi(bzb::run_gi(&s, &a.set.values, &rs)?)
+        }
         EvalKind::Radiance => {
             let rs = a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
             let g = gi::GiEvalSettings {
@@ -149,6 +155,27 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces, noise FLIP {:.4} indirect / {:.4} full)",
                 run.scene, i.flip, i.rmse, i.mae, f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
             );
+        }
+        EvalResult::BzbGi(e) => {
+            let line = |what: &str, x: &strata_eval::results::GiErrors| {
+                println!(
+                    "  {what:<28} indirect FLIP {:.4}  RMSE {:.4}  MAE {:.4}; full FLIP {:.4}  RMSE {:.4}",
+                    x.indirect.flip, x.indirect.rmse, x.indirect.mae, x.full.flip, x.full.rmse
+                )
+            };
+            println!(
+                "{} bzb-gi S={} d_max={:.3} {w}x{h} (reference {} spp, 1 bounce, noise FLIP {:.4}); bzb-splat {:.0} ms with visibility, {:.0} ms without:",
+                run.scene,
+                e.directions,
+                e.d_max,
+                run.ref_spp,
+                noise(&e.errors.indirect),
+                e.splat_ms,
+                e.splat_ms_no_visibility
+            );
+            line("bzb-gi (bounced z-buffer)", &e.errors);
+            line("no visibility (additive)", &e.no_visibility);
+            line("DGB radiosity, 2 layers", &e.dgb_2_layers);
         }
         EvalResult::Oit(e) => {
             println!(

@@ -974,7 +974,10 @@ fn techniques_json_lists_settings_defaults_and_ranges() {
     let v = json_of(&strata(&["techniques", "--json"]));
     let ts = v["techniques"].as_array().expect("techniques");
     let names: Vec<&str> = ts.iter().map(|t| t["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["direct", "ao", "full", "ils", "oit", "aba-ao", "bzb-ao"]);
+    assert_eq!(
+        names,
+        ["direct", "ao", "full", "ils", "oit", "aba-ao", "bzb-ao", "bzb-gi"]
+    );
     let full = &ts[2];
     assert_eq!(
         full["presets"],
@@ -1557,6 +1560,53 @@ fn bzb_ao_renders_with_and_without_visibility() {
     assert!(!o.status.success());
     let e = stderr(&o);
     assert!(e.contains("directions") && e.contains("1..=16"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "{e}");
+}
+
+/// Issue 13 (GI): `bzb-gi` renders through the registry in both modes, and a
+/// bad `dmax` is a one-line error naming the setting and its range.
+#[test]
+fn bzb_gi_renders_with_and_without_visibility() {
+    for (set, name) in [("visibility=on", "bzb-gi-on.png"), ("visibility=off", "bzb-gi-off.png")] {
+        let out = scratch(name);
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "bzb-gi",
+            "--set",
+            set,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ]);
+        assert!(o.status.success(), "{set}: {}", stderr(&o));
+        assert!(out.exists());
+    }
+    let out = scratch("bzb-gi-bad.png");
+    let o = strata(&[
+        "render",
+        "--scene",
+        "cornell",
+        "--technique",
+        "bzb-gi",
+        "--set",
+        "dmax=0",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("dmax") && e.contains("> 0"), "{e}");
     assert_eq!(e.trim().lines().count(), 1, "{e}");
 }
 

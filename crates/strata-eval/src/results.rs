@@ -429,6 +429,30 @@ pub struct GiEval {
     pub by_layers: Vec<ByLayers<GiErrors>>,
 }
 
+/// `strata eval --technique bzb-gi`: bounced-z-buffer GI against the one-bounce path tracer,
+/// with the additive baseline and 2-layer DGB radiosity of the same camera beside it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BzbGiEval {
+    #[serde(flatten)]
+    pub run: EvalRun,
+    pub directions: u32,
+    pub visibility: bool,
+    pub d_max: f32,
+    pub t_min: f32,
+    /// The indirect light (top level: flip, rmse, mae) and the full image (`full`).
+    #[serde(flatten)]
+    pub errors: GiErrors,
+    /// The same splats summed additively (form factor × radiance, no depth test).
+    pub no_visibility: GiErrors,
+    /// DGB radiosity with 2 layers, single bounce (δ = 0), for the same camera.
+    pub dgb_2_layers: GiErrors,
+    /// GPU milliseconds of `bzb-splat` in the evaluated frame, with and without visibility.
+    pub splat_ms: f64,
+    pub splat_ms_no_visibility: f64,
+    /// GPU milliseconds of the whole frame (bzb-gi with visibility).
+    pub frame_ms: f64,
+}
+
 /// A-buffer OIT (ABA §IV) against the CPU compositing of every crossing.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OitEval {
@@ -548,6 +572,9 @@ pub enum EvalResult {
     AbaAo(AoEval),
     Gi(GiEval),
     Ils(IlsEval),
+    /// Bounced-z-buffer GI (`bzb-gi`), with its baseline and DGB radiosity beside it.
+    #[serde(rename = "bzb-gi")]
+    BzbGi(BzbGiEval),
 }
 
 impl EvalResult {
@@ -556,6 +583,7 @@ impl EvalResult {
             EvalResult::Ao(e) | EvalResult::Bzb(e) | EvalResult::AbaAo(e) => &e.run,
             EvalResult::Gi(e) => &e.run,
             EvalResult::Ils(e) => &e.run,
+            EvalResult::BzbGi(e) => &e.run,
             EvalResult::Oit(e) => &e.run,
         }
     }

@@ -160,6 +160,10 @@ pub struct RenderSettings {
     /// Bounced-z-buffer AO (BZB §3, AOV splats) into target `ao`; `None` = off.
     /// Excludes `ao` (both write the `ao` target).
     pub bzb: Option<crate::passes::bzb::BzbSettings>,
+    /// Bounced-z-buffer GI (BZB §3 with a radiance payload, AOV triangle
+    /// splats) into `indirect` and `bzb-gi-glossy`, composed into `hdr-full`;
+    /// `None` = off. Needs `shade`; excludes `radiosity`, `ils` and `bzb`.
+    pub bzb_gi: Option<crate::passes::bzb::gi::BzbGiSettings>,
 }
 
 impl Default for RenderSettings {
@@ -180,6 +184,7 @@ impl Default for RenderSettings {
             ils: None,
             abuffer: None,
             bzb: None,
+            bzb_gi: None,
         }
     }
 }
@@ -228,6 +233,19 @@ impl RenderSettings {
             if self.ao.is_some() {
                 return Err(RenderError::Parameter(
                     "bzb and ao both write the ao target: turn one off".into(),
+                ));
+            }
+        }
+        if let Some(g) = &self.bzb_gi {
+            g.validate().map_err(RenderError::Parameter)?;
+            if !self.shade {
+                return Err(RenderError::Parameter(
+                    "bzb-gi needs shading on: its senders are lit by the lighting pass's lights and shadow maps".into(),
+                ));
+            }
+            if self.radiosity.is_some() || self.ils.is_some() || self.bzb.is_some() {
+                return Err(RenderError::Parameter(
+                    "bzb-gi and radiosity/ils/bzb-ao are exclusive (the same indirect and bounced z-buffer targets): turn the others off".into(),
                 ));
             }
         }
@@ -328,6 +346,9 @@ impl RenderSettings {
         if let Some(b) = &self.bzb {
             bytes += b.estimated_bytes(w, h, scene.triangle_count() as u64);
         }
+        if let Some(g) = &self.bzb_gi {
+            bytes += g.estimated_bytes(w, h, scene.triangle_count() as u64) + sum(&crate::passes::compose::OUTPUTS);
+        }
         let geometry: u64 = scene
             .meshes
             .iter()
@@ -420,6 +441,7 @@ pub struct Renderer {
     radiosity: Option<RadiosityStage>,
     ils: Option<crate::passes::ils::IlsStage>,
     bzb: Option<crate::passes::bzb::BzbStage>,
+    bzb_gi: Option<crate::passes::bzb::gi::BzbGiStage>,
     reflections: Option<crate::passes::reflections::ReflectionPass>,
     abuffer: Option<crate::passes::abuffer::ABufferStage>,
     history: Option<HistoryPass>,
@@ -539,7 +561,23 @@ impl Renderer {
             )?),
             None => None,
         };
-        let shaded = if radiosity.is_some() || ils.is_some() {
+        let bzb_gi = match (&settings.bzb_gi, &shadow) {
+            (Some(g), Some(sh)) => Some(crate::passes::bzb::gi::BzbGiStage::new(
+                gpu,
+                &scene_gpu,
+                &mut targets,
+                g,
+                scene,
+                &crate::passes::bzb::gi::LightInputs {
+                    shadow: sh,
+                    lights: &lights,
+                    shadow_resolution: settings.shadow.resolution,
+                    pcf_radius: settings.lighting.pcf_radius,
+                },
+            )?),
+            _ => None,
+        };
+        let shaded = if radiosity.is_some() || ils.is_some() || bzb_gi.is_some() {
             "hdr-full"
         } else {
             "hdr"
@@ -613,6 +651,7 @@ impl Renderer {
             radiosity,
             ils,
             bzb,
+            bzb_gi,
             reflections,
             abuffer,
             history,
@@ -653,6 +692,9 @@ impl Renderer {
             }
             if let Some(i) = &self.ils {
                 v.extend(i.passes());
+            }
+            if let Some(g) = &self.bzb_gi {
+                v.extend(g.passes());
             }
             if let Some(r) = &self.reflections {
                 v.push(r);
@@ -762,6 +804,9 @@ impl Renderer {
                 l.update_lights(gpu, &self.lights);
             }
         }
+        if let Some(g) = &self.bzb_gi {
+            g.set_frame(gpu, scene, frame, self.animated, &self.lights);
+        }
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
@@ -811,6 +856,11 @@ impl Renderer {
     }
 
     /// The bounced-z-buffer pass's uniforms of the last rendered frame.
+    pub fn bzb_gi_uniforms(&self) -> Option<crate::passes::bzb::gi::GiUniforms> {
+        self.bzb_gi.as_ref().map(|g| g.uniforms())
+    }
+
+    /// The BZB AO stage's uniforms of the last rendered frame.
     pub fn bzb_uniforms(&self) -> Option<crate::passes::bzb::BzbUniforms> {
         self.bzb.as_ref().map(|b| b.uniforms())
     }

@@ -15,6 +15,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/ggx.wgsl", include_str!("shaders/common/ggx.wgsl")),
     ("common/vpl.wgsl", include_str!("shaders/common/vpl.wgsl")),
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
+    ("common/shadow.wgsl", include_str!("shaders/common/shadow.wgsl")),
     ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),
     (
         "common/bzb_geometry.wgsl",

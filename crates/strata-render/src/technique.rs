@@ -815,6 +815,83 @@ static BZB_SETTINGS: [SettingInfo; 12] = [
     ),
 ];
 
+fn bzb_gi_mut(s: &mut RenderSettings) -> &mut crate::passes::bzb::gi::BzbGiSettings {
+    s.bzb_gi.get_or_insert_with(Default::default)
+}
+
+fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
+    s.bzb_gi.clone().unwrap_or_default()
+}
+
+static BZB_GI_SETTINGS: [SettingInfo; 8] = [
+    SettingInfo {
+        name: "visibility",
+        doc: "on: bounced z-buffer (BZB §3.2, the nearest sender per direction); off: the additive baseline (every triangle within d_max adds π·form factor·radiance)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_gi_of(s).visibility as u32 as f64),
+        set: |s, v| bzb_gi_mut(s).visibility = v != 0.0,
+        values: &["off", "on"],
+    },
+    setting!(
+        "directions",
+        "directions S per pixel, one interleaved sub-image each, importance-sampled by the receiver's BRDF × cos (BZB §3.1, §5: 4)",
+        Range::Closed(1.0, crate::passes::bzb::MAX_DIRECTIONS as f64),
+        true,
+        |s| Some(bzb_gi_of(s).directions as f64),
+        |s, v| bzb_gi_mut(s).directions = v as u32
+    ),
+    setting!(
+        "dmax",
+        "largest sender distance d_max in scene units (BZB §3.2; default: the scene's bounding-box diagonal)",
+        Range::Above(0.0),
+        false,
+        |s| bzb_gi_of(s).d_max.map(f64::from),
+        |s, v| bzb_gi_mut(s).d_max = Some(v as f32)
+    ),
+    setting!(
+        "bias",
+        "ray t_min in scene units: nearer hits are the receiver itself (default 0.01 × the scene's ao_radius)",
+        Range::AtLeast(0.0),
+        false,
+        |s| bzb_gi_of(s).bias.map(f64::from),
+        |s, v| bzb_gi_mut(s).bias = Some(v as f32)
+    ),
+    setting!(
+        "clamp",
+        "largest sender radiance (RGB component) a payload keeps; biased, removes caustic fireflies (default: off)",
+        Range::Above(0.0),
+        false,
+        |s| bzb_gi_of(s).clamp.map(f64::from),
+        |s, v| bzb_gi_mut(s).clamp = Some(v as f32)
+    ),
+    SettingInfo {
+        name: "culling",
+        doc: "cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_gi_of(s).culling as u32 as f64),
+        set: |s, v| bzb_gi_mut(s).culling = v != 0.0,
+        values: &["off", "on"],
+    },
+    setting!(
+        "filter-radius",
+        "cross-bilateral taps on each side (BZB §3.3; 0 = none)",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(bzb_gi_of(s).filter.radius as f64),
+        |s, v| bzb_gi_mut(s).filter.radius = v as u32
+    ),
+    setting!(
+        "filter-step",
+        "pixels between cross-bilateral taps",
+        Range::Closed(1.0, 8.0),
+        true,
+        |s| Some(bzb_gi_of(s).filter.step as f64),
+        |s, v| bzb_gi_mut(s).filter.step = v as u32
+    ),
+];
+
 /// One registered technique.
 pub struct Technique {
     pub name: &'static str,
@@ -893,6 +970,7 @@ fn configure_direct(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), 
     s.radiosity = None;
     s.reflections = None;
     s.bzb = None;
+    s.bzb_gi = None;
     Ok(())
 }
 
@@ -907,6 +985,7 @@ fn configure_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Rend
     s.reflections = None;
     s.guard_band = s.guard_band.or_default(crate::renderer::AO_GUARD_BAND);
     s.bzb = None;
+    s.bzb_gi = None;
     Ok(())
 }
 
@@ -921,6 +1000,7 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
     s.reflections = Some(s.reflections.unwrap_or_default());
     s.guard_band = s.guard_band.or_default(crate::renderer::AO_GUARD_BAND);
     s.bzb = None;
+    s.bzb_gi = None;
     Ok(())
 }
 
@@ -936,6 +1016,7 @@ fn configure_ils(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Ren
     s.probes = None;
     s.ils = Some(s.ils.clone().unwrap_or_default());
     s.bzb = None;
+    s.bzb_gi = None;
     Ok(())
 }
 
@@ -950,6 +1031,7 @@ fn configure_oit(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Ren
     s.probes = None;
     s.ils = None;
     s.bzb = None;
+    s.bzb_gi = None;
     let mut a = s.abuffer.clone().unwrap_or_default();
     a.ao = None;
     s.abuffer = Some(a);
@@ -998,6 +1080,7 @@ fn configure_bzb_ao(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), 
     s.ils = None;
     s.radiosity = None;
     s.reflections = None;
+    s.bzb_gi = None;
     let mut b = s.bzb.clone().unwrap_or_default();
     if let Some(ao) = s.ao.take() {
         b.radius = b.radius.or(ao.radius);
@@ -1014,6 +1097,38 @@ const BZB_AO_PASSES: &[&str] = &[
     "bzb-reconstruct",
     "bzb-blur-h",
     "bzb-blur-v",
+];
+
+/// BZB GI: direct light + one bounce gathered through the bounced z-buffer
+/// (AOV triangle splats with a radiance payload), composed like ILS.
+fn configure_bzb_gi(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), RenderError> {
+    no_preset("bzb-gi", preset)?;
+    s.shade = true;
+    s.abuffer = None;
+    s.ao = None;
+    s.radiosity = None;
+    s.reflections = None;
+    s.probes = None;
+    s.ils = None;
+    s.bzb = None;
+    s.bzb_gi = Some(s.bzb_gi.clone().unwrap_or_default());
+    Ok(())
+}
+
+const BZB_GI_PASSES: &[&str] = &[
+    "shadow",
+    "lighting",
+    "bzb-directions",
+    "bzb-zminmax",
+    "bzb-splat",
+    "bzb-gi-shade",
+    "bzb-reconstruct",
+    "bzb-gi-blur-h",
+    "bzb-gi-blur-v",
+    "bzb-gi-glossy-blur-h",
+    "bzb-gi-glossy-blur-v",
+    "compose",
+    "tonemap",
 ];
 
 const ILS_PASSES: &[&str] = &[
@@ -1070,7 +1185,7 @@ const FULL_PASSES: &[&str] = &[
 /// Preset names of the DGB radiosity (Table 2), default first.
 const FULL_PRESETS: &[&str] = &["balanced", "high-performance", "high-quality"];
 
-static REGISTRY: [Technique; 7] = [
+static REGISTRY: [Technique; 8] = [
     Technique {
         name: "direct",
         doc: "direct light (shadowed sun, point, spot, rect) and emission from G-buffer layer 0, tonemapped",
@@ -1149,6 +1264,17 @@ static REGISTRY: [Technique; 7] = [
         passes: BZB_AO_PASSES,
         settings: &[&BZB_SETTINGS],
         configure: configure_bzb_ao,
+    },
+    Technique {
+        name: "bzb-gi",
+        doc: "direct + one-bounce diffuse/glossy GI through a bounced z-buffer (BZB §3): S BRDF-sampled directions per pixel, triangle splats carrying the sender's shadow-mapped direct radiance, nearest sender wins; visibility=off: the additive form-factor baseline",
+        output: "hdr-full",
+        display: ("ldr", true),
+        eval: EvalKind::Radiance,
+        presets: &[],
+        passes: BZB_GI_PASSES,
+        settings: &[&DIRECT_SETTINGS, &BZB_GI_SETTINGS],
+        configure: configure_bzb_gi,
     },
 ];
 

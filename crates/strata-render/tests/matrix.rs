@@ -168,6 +168,7 @@ fn algorithm_switching_settings_render_cleanly() {
     const VARIANTS: &[(&str, &[(&str, &str)])] = &[
         ("bzb-ao", &[("splat", "dss")]),
         ("bzb-ao", &[("splat", "dss"), ("visibility", "off")]),
+        ("bzb-gi", &[("visibility", "off")]),
         ("aba-ao", &[("kernel", "hbao-compute")]),
         ("aba-ao", &[("kernel", "hbao-compute"), ("multilayer", "off")]),
         ("ils", &[("split", "compute")]),

@@ -78,3 +78,153 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
         dgb_2_layers: Some(dgb),
     })
 }
+
+/// `strata eval --technique bzb-gi`: the bounced-z-buffer GI (one bounce) against the
+/// path tracer with one indirect bounce (the cached reference of `eval gi --bounces 1`
+/// and `eval ils`), and in the same result the additive baseline (`visibility = off`)
+/// and DGB radiosity with 2 layers (single bounce, δ = 0) for the same camera.
+/// `set`: the technique's settings (`--set directions=8` …); `radiosity`: DGB's.
+pub fn run_gi(
+    s: &EvalSettings,
+    set: &[(String, f64)],
+    radiosity: &strata_render::passes::radiosity::RadiositySettings,
+) -> Result<crate::results::BzbGiEval> {
+    use strata_reference::gi::GiSettings;
+    use strata_reference::{Estimator, Reference};
+    use strata_render::frame::FrameCameras;
+    use strata_render::passes::lighting::LightingSettings;
+    use strata_render::{GpuContext, GpuOptions, Renderer};
+    use strata_scene::ImageBuf;
+
+    use super::gi::{indirect, rgb, total};
+    use super::{half_flip, RefImage};
+    use crate::cache::{scene_fingerprint, RefCache};
+    use crate::metrics::{compare_radiance, display};
+    use crate::results::GiErrors;
+
+    if s.report.is_some() {
+        bail!("--report is not available for --technique bzb-gi yet: drop --report (the JSON has every error)");
+    }
+    if s.frames.is_some() {
+        bail!("--frames is not available for --technique bzb-gi (it has no temporal filter): drop --frames");
+    }
+    let rule = s.check(super::gi::DEFAULT_CAP, 8)?;
+    let t = strata_render::technique::find("bzb-gi")?;
+    let base = RenderSettings {
+        // as eval gi / ils: the GPU's direct specular lobe is not the reference's model
+        lighting: LightingSettings {
+            specular: false,
+            ..Default::default()
+        },
+        ..s.render_settings(1)
+    };
+    let mut main = t.settings(&base, None)?;
+    for (name, value) in set {
+        t.set(&mut main, name, *value)
+            .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+    }
+    main.validate()?;
+    let gi = main.bzb_gi.clone().expect("bzb-gi turns its stage on");
+    let mut baseline = main.clone();
+    if let Some(g) = &mut baseline.bzb_gi {
+        g.visibility = !gi.visibility;
+    }
+    let dgb = super::gi::render_settings(
+        s,
+        2,
+        &strata_render::passes::radiosity::RadiositySettings {
+            delta: 0.0,
+            ..radiosity.clone()
+        },
+    );
+
+    let (mut scene, cams) = s.scene.load()?;
+    // as eval gi / ils: no ambient term, no sky light (neither method gathers it)
+    scene.settings.ambient = [0.0; 3];
+    scene.settings.sky = [0.0; 3];
+    let (w, h) = (s.scene.width, s.scene.height);
+    let camera = cams.current;
+    let exposure = scene.settings.exposure;
+    let estimator = Estimator::Gi(GiSettings {
+        bounces: 1,
+        russian_roulette: false,
+        ..Default::default()
+    });
+    let cache = RefCache::new(&s.cache);
+    let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
+    let description = format!(
+        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
+        scene_fingerprint(&scene, s.scene.frame)
+    );
+    let shown = |img: &ImageBuf| display(img, exposure);
+    let converged = cache.converged(s.no_cache, &description, &estimator, || {
+        reference.converge(&camera, w, h, &estimator, &rule, |a, b| {
+            half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown))
+        })
+    });
+    let ref_total = RefImage::of(&converged, total, shown)?;
+    let ref_indirect = RefImage::of(&converged, indirect, shown)?;
+
+    let gpu = GpuContext::new(&GpuOptions {
+        adapter: s.adapter.clone(),
+    })?;
+    let fixed = FrameCameras::fixed(camera);
+    // (errors, splat ms, frame ms) of one configuration after `renders` frames
+    let evaluate = |rs: RenderSettings, renders: u32| -> Result<(GiErrors, f64, f64)> {
+        let mut r = Renderer::new(&gpu, &scene, rs)?;
+        let mut timings = Default::default();
+        for _ in 0..renders {
+            timings = r.render(&gpu, &scene, &fixed, s.scene.frame)?;
+        }
+        let full = rgb(&r.read_target(&gpu, "hdr-full")?);
+        let direct = rgb(&r.read_target(&gpu, "hdr")?);
+        let mut ind = full.clone();
+        for (o, d) in ind.data.iter_mut().zip(&direct.data) {
+            *o = (*o - d).max(0.0);
+        }
+        gpu.check_errors()?;
+        let (f, _) = compare_radiance(&ref_total.image, &full, exposure)?;
+        let (i, _) = compare_radiance(&ref_indirect.image, &ind, exposure)?;
+        let errors = GiErrors {
+            full: ref_total.annotate(f, &display(&full, exposure)),
+            indirect: ref_indirect.annotate(i, &display(&ind, exposure)),
+        };
+        Ok((errors, timings.get("bzb-splat").unwrap_or(f64::NAN), timings.total()))
+    };
+    let (errors, splat_ms, frame_ms) = evaluate(main.clone(), 1)?;
+    let (no_visibility, splat_ms_no_visibility, _) = evaluate(baseline, 1)?;
+    let (dgb_2_layers, _, _) = evaluate(dgb, s.warmup.max(1) + 1)?;
+    let (errors, no_visibility) = if gi.visibility {
+        (errors, no_visibility)
+    } else {
+        (no_visibility, errors)
+    };
+    let (splat_ms, splat_ms_no_visibility) = if gi.visibility {
+        (splat_ms, splat_ms_no_visibility)
+    } else {
+        (splat_ms_no_visibility, splat_ms)
+    };
+    let (d_max, t_min) = gi.resolve(&scene);
+    let mut run = s.run_info(
+        converged.spp(),
+        "path-traced GI (GGX for glossy materials) with 1 indirect bounce, sky and ambient off; \
+         errors of the indirect light (composed − direct) at top level, the full image in `full`",
+        gpu.describe(),
+        None,
+        noise_warnings(&[("bzb-gi indirect", &errors.indirect), ("bzb-gi full", &errors.full)]),
+    );
+    run.layers = 1;
+    Ok(crate::results::BzbGiEval {
+        run,
+        directions: gi.directions,
+        visibility: true,
+        d_max,
+        t_min,
+        errors,
+        no_visibility,
+        dgb_2_layers,
+        splat_ms,
+        splat_ms_no_visibility,
+        frame_ms,
+    })
+}

@@ -162,7 +162,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     Ok(out)
 }
 
-fn render_settings(s: &EvalSettings, layers: u32, radiosity: &RadiositySettings) -> RenderSettings {
+pub(crate) fn render_settings(s: &EvalSettings, layers: u32, radiosity: &RadiositySettings) -> RenderSettings {
     RenderSettings {
         lighting: LightingSettings {
             // the reference is Lambertian

@@ -102,6 +102,16 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
                 e.fig10.as_ref(),
             )
         }
+        EvalResult::BzbGi(e) => (
+            "bounced-z-buffer GI against the one-bounce path tracer",
+            &GI_HEADER[..],
+            vec![ErrorRow {
+                layers: 1,
+                cells: [stats_cells(&e.errors.indirect), stats_cells(&e.errors.full)].concat(),
+                flip_mae: (e.errors.indirect.flip, e.errors.indirect.mae),
+            }],
+            None,
+        ),
         EvalResult::Oit(e) => (
             "A-buffer OIT against the CPU compositing",
             &OIT_HEADER[..],
@@ -205,6 +215,7 @@ fn reference_table(r: &EvalResult) -> Table {
         }
         EvalResult::Gi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
         EvalResult::Ils(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
+        EvalResult::BzbGi(e) => vec![("indirect", &e.errors.indirect), ("full", &e.errors.full)],
         EvalResult::Oit(e) => vec![("composite", &e.errors)],
     };
     for (name, e) in named {
@@ -230,6 +241,7 @@ fn technique(r: &EvalResult) -> &'static str {
         EvalResult::AbaAo(_) => "eval aba-ao",
         EvalResult::Gi(_) => "eval gi",
         EvalResult::Ils(_) => "eval ils",
+        EvalResult::BzbGi(_) => "eval bzb-gi",
         EvalResult::Oit(_) => "eval oit",
     }
 }

@@ -31,6 +31,7 @@
 //!    the target DGB AO writes, so compose and `eval` treat both alike.
 
 pub mod dss;
+pub mod gi;
 
 use bytemuck::Zeroable;
 use glam::Vec3;
@@ -503,11 +504,15 @@ pub struct SplatPass {
     group: wgpu::BindGroup,
     visibility: bool,
     instances: u32,
+    /// The payload target (`bzb-payload`, or `bzb-gi-payload` for GI).
+    payload: &'static str,
+    /// bzb-gi's sender data (group 2: materials, lights, shadow maps).
+    extra: Option<wgpu::BindGroup>,
 }
 
 impl Pass for SplatPass {
     fn info(&self) -> PassInfo {
-        let mut outputs = vec![PAYLOAD.name];
+        let mut outputs = vec![self.payload];
         if self.visibility {
             outputs.push(DEPTH.name);
         }
@@ -529,7 +534,7 @@ impl Pass for SplatPass {
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("bzb-splat"),
-            color_attachments: &[crate::passes::clear_attachment(&targets.get(PAYLOAD.name).view)],
+            color_attachments: &[crate::passes::clear_attachment(&targets.get(self.payload).view)],
             depth_stencil_attachment: depth,
             timestamp_writes: None,
             occlusion_query_set: None,
@@ -541,6 +546,9 @@ impl Pass for SplatPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.frame_bind_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
+        if let Some(g) = &self.extra {
+            pass.set_bind_group(2, g, &[]);
+        }
         pass.draw(0..6, 0..self.instances);
     }
 }
@@ -718,7 +726,7 @@ impl BzbStage {
         })
     }
 
-    fn zminmax_pass(
+    pub(crate) fn zminmax_pass(
         gpu: &GpuContext,
         scene_gpu: &GpuScene,
         targets: &Targets,
@@ -793,82 +801,22 @@ impl BzbStage {
         tiles: &wgpu::Buffer,
         count: u32,
     ) -> SplatPass {
-        let device = &gpu.device;
-        let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-        let tex = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
+        splat_pass_with(
+            gpu,
+            scene_gpu,
+            targets,
+            SplatSpec {
+                visibility: s.visibility,
+                instances: count.saturating_mul(s.directions),
+                source: bzb_shader!("bzb_splat.wgsl"),
+                entries: ("fs_visibility", "fs_additive"),
+                payload: PAYLOAD,
+                extra: None,
             },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("bzb-splat"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: vf,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                tex(2),
-                tex(3),
-                tex(4),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::VERTEX,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let group = crate::passes::bind_group(
-            device,
-            "bzb-splat",
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                triangles.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
-                wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
-                wgpu::BindingResource::TextureView(&targets.get("npack").view),
-                tiles.as_entire_binding(),
-            ],
-        );
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("bzb-splat"),
-            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
-            immediate_size: 0,
-        });
-        let module = crate::shader::module(device, "bzb-splat", bzb_shader!("bzb_splat.wgsl"));
-        let pipeline = splat_pipeline(device, "bzb-splat", &pipeline_layout, &module, s.visibility);
-        SplatPass {
-            pipeline,
-            group,
-            visibility: s.visibility,
-            instances: count.saturating_mul(s.directions),
-        }
+            uniforms,
+            triangles,
+            tiles,
+        )
     }
 
     /// Uploads this frame's uniforms (and, for animated scenes, the triangles at `frame`).
@@ -923,6 +871,124 @@ impl BzbStage {
     }
 }
 
+/// What distinguishes the AO and GI splat passes: the shader, its two fragment
+/// entries (visibility, additive), the payload target and GI's group 2.
+pub(crate) struct SplatSpec<'a> {
+    pub visibility: bool,
+    pub instances: u32,
+    pub source: &'static str,
+    pub entries: (&'static str, &'static str),
+    pub payload: TargetDesc,
+    pub extra: Option<(&'a wgpu::BindGroupLayout, wgpu::BindGroup)>,
+}
+
+/// §3.2's splat pass over the triangles in `triangles` (group 1: uniforms,
+/// triangles, origins, directions, npack, depth tiles).
+pub(crate) fn splat_pass_with(
+    gpu: &GpuContext,
+    scene_gpu: &GpuScene,
+    targets: &Targets,
+    spec: SplatSpec,
+    uniforms: &wgpu::Buffer,
+    triangles: &wgpu::Buffer,
+    tiles: &wgpu::Buffer,
+) -> SplatPass {
+    let device = &gpu.device;
+    let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    let tex = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("bzb-splat"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: vf,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: vf,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            tex(2),
+            tex(3),
+            tex(4),
+            wgpu::BindGroupLayoutEntry {
+                binding: 5,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ],
+    });
+    let group = crate::passes::bind_group(
+        device,
+        "bzb-splat",
+        &layout,
+        &[
+            uniforms.as_entire_binding(),
+            triangles.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+            wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
+            wgpu::BindingResource::TextureView(&targets.get("npack").view),
+            tiles.as_entire_binding(),
+        ],
+    );
+    let (extra_layout, extra) = match spec.extra {
+        Some((l, g)) => (Some(l), Some(g)),
+        None => (None, None),
+    };
+    let mut layouts = vec![Some(&scene_gpu.frame_layout), Some(&layout)];
+    if let Some(l) = extra_layout {
+        layouts.push(Some(l));
+    }
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("bzb-splat"),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    let module = crate::shader::module(device, "bzb-splat", spec.source);
+    let pipeline = splat_pipeline_with(
+        device,
+        "bzb-splat",
+        &pipeline_layout,
+        &module,
+        spec.visibility,
+        spec.payload.format,
+        spec.entries,
+    );
+    SplatPass {
+        pipeline,
+        group,
+        visibility: spec.visibility,
+        instances: spec.instances,
+        payload: spec.payload.name,
+        extra,
+    }
+}
+
 impl Default for BzbUniforms {
     fn default() -> Self {
         Self::zeroed()
@@ -941,9 +1007,30 @@ pub(crate) fn splat_pipeline(
     module: &wgpu::ShaderModule,
     visibility: bool,
 ) -> wgpu::RenderPipeline {
+    splat_pipeline_with(
+        device,
+        label,
+        layout,
+        module,
+        visibility,
+        PAYLOAD.format,
+        ("fs_visibility", "fs_additive"),
+    )
+}
+
+/// [`splat_pipeline`] with the payload format and fragment entries (visibility, additive) given.
+pub(crate) fn splat_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    visibility: bool,
+    format: wgpu::TextureFormat,
+    entries: (&'static str, &'static str),
+) -> wgpu::RenderPipeline {
     let (entry, blend, depth_stencil) = if visibility {
         (
-            "fs_visibility",
+            entries.0,
             None,
             Some(wgpu::DepthStencilState {
                 format: DEPTH.format,
@@ -959,7 +1046,7 @@ pub(crate) fn splat_pipeline(
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        ("fs_additive", Some(wgpu::BlendState { color: add, alpha: add }), None)
+        (entries.1, Some(wgpu::BlendState { color: add, alpha: add }), None)
     };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
@@ -981,7 +1068,7 @@ pub(crate) fn splat_pipeline(
             entry_point: Some(entry),
             compilation_options: Default::default(),
             targets: &[Some(wgpu::ColorTargetState {
-                format: PAYLOAD.format,
+                format,
                 blend,
                 write_mask: wgpu::ColorWrites::ALL,
             })],

@@ -1,0 +1,908 @@
+//! `bzb-gi`: one-bounce diffuse and glossy global illumination with the bounced
+//! z-buffer (Nalbach, Ritschel, Seidel 2016, §3 with a radiance payload), the
+//! GI half of issue 13. The splats are the AOV path's triangles (one instanced
+//! draw, vertex pulling: wgpu has no geometry shaders), the payload is the
+//! sender's outgoing radiance. Passes (profiler names), after the lighting pass:
+//!
+//! 1. `bzb-directions` (§3.1): per texel of the bounced z-buffer (S sub-images),
+//!    x_p from layer 0 and ω importance-sampled by the receiver's BRDF × cos:
+//!    cosine for Lambert receivers, the path tracer's GGX mixture (visible
+//!    normals with probability P_s, else cosine) for glossy ones; the pdf α is
+//!    stored ([`direction`], [`lobe_uniform`] are the CPU twins).
+//! 2. `bzb-zminmax`, `bzb-splat` (§3.2): the AOV splat rectangles grown by
+//!    d_max; each covered texel intersects its ray with the triangle and on a
+//!    hit at t ∈ (t_min, d_max) writes depth t²/d_max² and the payload
+//!    L(y → x_p): direct light at y (the analytic lights, shadow-mapped as the
+//!    lighting pass does) × ρ/π (or f_GGX for glossy senders), + emission when
+//!    no Rect light carries it. Nearest sender wins. Without visibility
+//!    (baseline) every triangle within d_max adds π·F·L (form factor F,
+//!    radiance at a hashed point of it) by additive blending.
+//! 3. `bzb-reconstruct` (§3.3): mean over s of L · f · cos θ / α; Lambert
+//!    receivers into `bzb-gi-raw` as irradiance (compose applies ρ/π), glossy
+//!    ones into `bzb-gi-glossy-raw` as radiance.
+//! 4. `bzb-gi-blur-h/-v`, `bzb-gi-glossy-blur-h/-v`: the cross-bilateral filter
+//!    of [`crate::passes::bilateral`] into `indirect` and `bzb-gi-glossy`.
+//! 5. `compose`: hdr + ρ/π · indirect + glossy (the pass DGB radiosity and ILS use).
+
+use bytemuck::Zeroable;
+use glam::Vec3;
+use strata_scene::Scene;
+
+use super::{BzbUniforms, SplatPass, SplatSpec, ZMinMaxPass, DEPTH, DIRECTIONS, MAX_DIRECTIONS, ORIGINS};
+use crate::frame::{Pass, TargetDesc, Targets};
+use crate::gpu::GpuContext;
+use crate::lights::GpuLight;
+use crate::passes::bilateral::{BilateralPass, BilateralSettings};
+use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::scene_gpu::GpuScene;
+use crate::spiral::pcg_hash;
+
+/// Bounced-z-buffer GI settings. Defaults: S = 4, visibility on, d_max = the
+/// scene's bounding-box diagonal, t_min = 0.01 × the scene's AO radius (the AO
+/// bias convention), seed 0, bilateral filter 4 taps each side, 1 px apart.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BzbGiSettings {
+    /// S: directions per pixel (1..=16).
+    pub directions: u32,
+    /// true: bounced z-buffer (nearest sender per direction); false: the additive baseline.
+    pub visibility: bool,
+    /// Largest sender distance d_max (world units); `None` = the scene's diagonal.
+    pub d_max: Option<f32>,
+    /// Ray t_min (world units); `None` = 0.01 × the scene's AO radius.
+    pub bias: Option<f32>,
+    pub seed: u32,
+    pub filter: BilateralSettings,
+    /// Depth-tile culling of splats (the AOV path's; the image is unchanged).
+    pub culling: bool,
+    /// Largest sender radiance a payload keeps (its RGB scaled down to this
+    /// maximum component; biased, trades caustic fireflies for energy); `None` = off.
+    pub clamp: Option<f32>,
+}
+
+impl Default for BzbGiSettings {
+    fn default() -> Self {
+        Self {
+            directions: 4,
+            visibility: true,
+            d_max: None,
+            bias: None,
+            seed: 0,
+            filter: BilateralSettings {
+                radius: 4,
+                step: 1,
+                ..BilateralSettings::default()
+            },
+            culling: true,
+            clamp: None,
+        }
+    }
+}
+
+impl BzbGiSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=MAX_DIRECTIONS).contains(&self.directions) {
+            return Err(format!(
+                "bzb-gi directions {} is out of range: must be in 1..={MAX_DIRECTIONS}",
+                self.directions
+            ));
+        }
+        if let Some(d) = self.d_max {
+            if !(d > 0.0 && d.is_finite()) {
+                return Err(format!("bzb-gi dmax {d} is out of range: must be > 0"));
+            }
+        }
+        if let Some(b) = self.bias {
+            if !(b >= 0.0 && b.is_finite()) {
+                return Err(format!("bzb-gi bias {b} is out of range: must be >= 0"));
+            }
+        }
+        if let Some(c) = self.clamp {
+            if !(c > 0.0 && c.is_finite()) {
+                return Err(format!("bzb-gi clamp {c} is out of range: must be > 0"));
+            }
+        }
+        self.filter.validate()
+    }
+
+    /// (d_max, t_min) for `scene`.
+    pub fn resolve(&self, scene: &Scene) -> (f32, f32) {
+        let d_max = self.d_max.unwrap_or_else(|| {
+            let (lo, hi) = scene.bounds(0.0);
+            (hi - lo).length().max(1e-3)
+        });
+        (d_max, self.bias.unwrap_or(0.01 * scene.settings.ao_radius))
+    }
+
+    /// Sub-image grid (cols, rows): cols = ⌈√S⌉.
+    pub fn grid(&self) -> (u32, u32) {
+        let cols = (self.directions as f32).sqrt().ceil() as u32;
+        (cols, self.directions.div_ceil(cols))
+    }
+
+    /// GPU bytes at `w`×`h` with `triangles` triangles.
+    pub fn estimated_bytes(&self, w: u32, h: u32, triangles: u64) -> u64 {
+        let (c, r) = self.grid();
+        let px = w as u64 * h as u64;
+        px * (c * r) as u64 * (16 + 16 + 8 + 4)
+            + px * 8 * 7
+            + triangles * (48 + 80)
+            + super::zminmax_tile_count(w, h) as u64 * 8
+    }
+
+    /// The AOV splat uniforms with r = d_max (the additive baseline splats
+    /// into sub-image 0 only: its sum does not depend on ω).
+    pub fn splat_uniforms(&self, scene: &Scene, triangles: u32) -> BzbUniforms {
+        let mut u = self.uniforms(scene, triangles);
+        if !self.visibility {
+            u.directions = 1;
+        }
+        u
+    }
+
+    /// The direction and reconstruction uniforms with r = d_max.
+    pub fn uniforms(&self, scene: &Scene, triangles: u32) -> BzbUniforms {
+        let (d_max, t_min) = self.resolve(scene);
+        let (cols, rows) = self.grid();
+        BzbUniforms {
+            radius: d_max,
+            t_min,
+            inv_r2: 1.0 / (d_max * d_max),
+            _pad0: 0.0,
+            directions: self.directions,
+            cols,
+            rows,
+            seed: self.seed,
+            hemisphere: 0,
+            visibility: self.visibility as u32,
+            triangles,
+            culling: self.culling as u32,
+        }
+    }
+}
+
+/// Mirrors `BzbGi` in `bzb_gi.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GiUniforms {
+    pub light_count: u32,
+    pub pcf_radius: i32,
+    pub shadow_size: f32,
+    pub emission_in: u32,
+    pub d_max: f32,
+    pub t_min: f32,
+    pub visibility: u32,
+    pub seed: u32,
+    /// Payload clamp (largest RGB component; 0 = off).
+    pub clamp: f32,
+    pub _pad: [u32; 3],
+}
+
+// ---- CPU twins of bzb_gi.wgsl ----
+
+/// `bzb_gi_lobe_uniform`: the lobe-choice uniform of sample (p, s) (the third
+/// hash after [`super::sample_uniforms`]' two).
+pub fn lobe_uniform(p: [u32; 2], s: u32, seed: u32) -> f32 {
+    let h1 = pcg_hash(p[0].wrapping_add(pcg_hash(p[1].wrapping_add(pcg_hash(s.wrapping_add(pcg_hash(seed)))))));
+    let h2 = pcg_hash(h1 ^ 0x9e37_79b9);
+    let h3 = pcg_hash(h2 ^ 0x85eb_ca6b);
+    (h3 >> 8) as f32 / 16_777_216.0
+}
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+fn schlick_dielectric(c: f32) -> f32 {
+    0.04 + 0.96 * (1.0 - c.clamp(0.0, 1.0)).powi(5)
+}
+
+/// The GGX α of `roughness` (clamped as the BRDF clamps it).
+pub fn alpha(roughness: f32) -> f32 {
+    let r = roughness.clamp(0.0, 1.0);
+    (r * r).max(0.002)
+}
+
+/// `bzb_gi_p_spec`: probability of the specular lobe (as `strata_reference::brdf::Ggx`).
+pub fn p_spec(nv: f32, rho: Vec3, metallic: f32) -> f32 {
+    if nv <= 1e-4 {
+        return 0.0;
+    }
+    let m = metallic.clamp(0.0, 1.0);
+    let f0 = Vec3::splat(0.04).lerp(rho, m);
+    let k = (1.0 - nv.clamp(0.0, 1.0)).powi(5);
+    let ws = luminance(f0 + (Vec3::ONE - f0) * k);
+    let wd = luminance(rho * (1.0 - m)) * (1.0 - schlick_dielectric(nv));
+    let sum = ws + wd;
+    if sum.is_nan() || sum <= 0.0 {
+        return 0.5;
+    }
+    (ws / sum).clamp(0.0, 1.0)
+}
+
+fn ggx_d(cos_h: f32, alpha: f32) -> f32 {
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let k = (1.0 - cos_h) * (1.0 + cos_h) + a2 * cos_h * cos_h;
+    a2 / (std::f32::consts::PI * k * k)
+}
+
+fn smith_lambda(c: f32, alpha: f32) -> f32 {
+    let c2 = (c * c).max(1e-12);
+    let tan2 = (1.0 - c2).max(0.0) / c2;
+    0.5 * ((1.0 + alpha * alpha * tan2).sqrt() - 1.0)
+}
+
+/// `bzb_gi_ggx_pdf`: solid-angle pdf of [`direction`] for a glossy receiver.
+pub fn ggx_pdf(n: Vec3, v: Vec3, l: Vec3, rho: Vec3, roughness: f32, metallic: f32) -> f32 {
+    let nv = n.dot(v);
+    let ps = p_spec(nv, rho, metallic);
+    let mut p = 0.0;
+    if ps < 1.0 {
+        p += (1.0 - ps) * n.dot(l).max(0.0) / std::f32::consts::PI;
+    }
+    if ps > 0.0 {
+        let hv = v + l;
+        let hl = hv.length();
+        if hl > 0.0 {
+            let h = hv / hl;
+            if v.dot(h) > 0.0 {
+                let a = alpha(roughness);
+                let g1 = 1.0 / (1.0 + smith_lambda(nv, a));
+                p += ps * g1 * ggx_d(n.dot(h), a) / (4.0 * nv);
+            }
+        }
+    }
+    p
+}
+
+fn vndf(v: Vec3, alpha: f32, u: [f32; 2]) -> Vec3 {
+    let vs = Vec3::new(v.x * alpha, v.y * alpha, v.z).normalize();
+    let phi = 2.0 * std::f32::consts::PI * u[0];
+    let z = (1.0 - u[1]) * (1.0 + vs.z) - vs.z;
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    let hs = Vec3::new(s * phi.cos(), s * phi.sin(), z) + vs;
+    let h = Vec3::new(hs.x * alpha, hs.y * alpha, hs.z.max(0.0));
+    let len = h.length();
+    if len.is_nan() || len <= 0.0 {
+        return Vec3::Z;
+    }
+    h / len
+}
+
+/// A glossy receiver's material for [`direction`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Glossy {
+    pub rho: Vec3,
+    pub roughness: f32,
+    pub metallic: f32,
+}
+
+/// `bzb_gi_direction` (§3.1 for GI): ω and its pdf α for a receiver with unit
+/// normal `n`, unit view direction `v`; `glossy` = `None` for Lambert
+/// (cosine-weighted), else the GGX mixture of the path tracer.
+pub fn direction(n: Vec3, v: Vec3, glossy: Option<Glossy>, u_lobe: f32, u: [f32; 2]) -> (Vec3, f32) {
+    use std::f32::consts::PI;
+    let sgn = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sgn + n.z);
+    let b = n.x * n.y * a;
+    let t = Vec3::new(1.0 + sgn * n.x * n.x * a, sgn * b, -sgn * n.x);
+    let bt = Vec3::new(b, sgn + n.y * n.y * a, -n.y);
+    let nv = n.dot(v);
+    let l = match glossy {
+        Some(g) if u_lobe < p_spec(nv, g.rho, g.metallic) => {
+            let hl = vndf(Vec3::new(v.dot(t), v.dot(bt), nv), alpha(g.roughness), u);
+            let h = t * hl.x + bt * hl.y + n * hl.z;
+            let rl = 2.0 * v.dot(h) * h - v;
+            let len = rl.length();
+            if len > 0.0 {
+                rl / len
+            } else {
+                n
+            }
+        }
+        _ => {
+            let r = u[0].sqrt();
+            let phi = 2.0 * PI * u[1];
+            (t * (r * phi.cos()) + bt * (r * phi.sin()) + n * (1.0 - u[0]).max(0.0).sqrt()).normalize()
+        }
+    };
+    match glossy {
+        Some(g) => (l, ggx_pdf(n, v, l, g.rho, g.roughness, g.metallic)),
+        None => (l, n.dot(l).max(0.0) / PI),
+    }
+}
+
+/// Per-triangle sender data as `bzb_gi_splat.wgsl` pulls it: 5 vec4 per
+/// triangle, (n0, ρ.r), (n1, ρ.g), (n2, ρ.b), (emission, glossy), (roughness,
+/// metallic, 0, 0). ρ is the material's base colour (textures are not read).
+pub fn sender_data(scene: &Scene, frame: f32) -> Vec<[f32; 4]> {
+    let mut out = Vec::new();
+    for t in scene.world_triangles(frame) {
+        let m = &scene.materials[t.material as usize];
+        let rho = m.base_color;
+        for (n, r) in t.n.iter().zip(rho) {
+            out.push(n.extend(r).to_array());
+        }
+        let e = m.emission;
+        out.push([e[0], e[1], e[2], m.glossy as u32 as f32]);
+        out.push([m.roughness, m.metallic, 0.0, 0.0]);
+    }
+    out
+}
+
+// ---- targets ----
+
+pub const PAYLOAD: TargetDesc = TargetDesc::new(
+    "bzb-gi-payload",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi §3.2 payload per sub-image texel: the nearest sender's radiance L(y → x) (without visibility: the summed irradiance or glossy radiance of every splat)",
+);
+pub const HIT: TargetDesc = TargetDesc::new(
+    "bzb-gi-hit",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "bzb-gi §3.2 the nearest sender per sub-image texel: triangle index + 1 (0 = no hit)",
+);
+pub const RAW: TargetDesc = TargetDesc::new(
+    "bzb-gi-raw",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi §3.3 Lambert receivers' indirect irradiance E before filtering",
+);
+pub const GLOSSY_RAW: TargetDesc = TargetDesc::new(
+    "bzb-gi-glossy-raw",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi §3.3 glossy receivers' indirect radiance before filtering",
+);
+pub const BLUR_H: TargetDesc = TargetDesc::new(
+    "bzb-gi-blur-h",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi irradiance after the horizontal bilateral pass",
+);
+pub const GLOSSY_BLUR_H: TargetDesc = TargetDesc::new(
+    "bzb-gi-glossy-blur-h",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi glossy radiance after the horizontal bilateral pass",
+);
+pub const GLOSSY: TargetDesc = TargetDesc::new(
+    "bzb-gi-glossy",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi glossy receivers' indirect radiance (filtered), added by compose",
+);
+
+/// The frame's bzb-gi passes (profiler names).
+pub const PASSES: &[&str] = &[
+    "bzb-directions",
+    "bzb-zminmax",
+    "bzb-gi-senders",
+    "bzb-splat",
+    "bzb-gi-shade",
+    "bzb-reconstruct",
+    "bzb-gi-blur-h",
+    "bzb-gi-blur-v",
+    "bzb-gi-glossy-blur-h",
+    "bzb-gi-glossy-blur-v",
+    "compose",
+];
+
+macro_rules! gi_shader {
+    ($file:literal) => {
+        concat!(
+            include_str!("bzb.wgsl"),
+            "\n",
+            include_str!("bzb_gi.wgsl"),
+            "\n",
+            include_str!($file)
+        )
+    };
+}
+
+/// What the GI stage needs of the lighting: the shadow maps and lights it was built with.
+pub struct LightInputs<'a> {
+    pub shadow: &'a crate::passes::shadow::ShadowPass,
+    pub lights: &'a [GpuLight],
+    pub shadow_resolution: u32,
+    pub pcf_radius: i32,
+}
+
+pub(crate) struct BzbGiStage {
+    directions: FullscreenPass,
+    zminmax: ZMinMaxPass,
+    splat: SplatPass,
+    /// Without visibility: the triangles' mean radiance L̄_T.
+    senders_pass: Option<SenderPass>,
+    /// With visibility: the winners' radiance (deferred shading of the hits).
+    shade: Option<FullscreenPass>,
+    reconstruct: FullscreenPass,
+    blur: [BilateralPass; 4],
+    compose: crate::passes::compose::ComposePass,
+    splat_uniforms: wgpu::Buffer,
+    gi_uniforms: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    senders: wgpu::Buffer,
+    count: u32,
+    settings: BzbGiSettings,
+    base: GiUniforms,
+}
+
+impl BzbGiStage {
+    pub fn new(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &mut Targets,
+        s: &BzbGiSettings,
+        scene: &Scene,
+        light: &LightInputs,
+    ) -> Result<Self, crate::RenderError> {
+        use wgpu::util::DeviceExt;
+        let device = &gpu.device;
+        let (w, h) = (targets.width, targets.height);
+        let (cols, rows) = s.grid();
+        let max = device.limits().max_texture_dimension_2d;
+        if w * cols > max || h * rows > max {
+            return Err(crate::RenderError::Parameter(format!(
+                "bzb-gi directions {}: the bounced z-buffer of {cols}x{rows} sub-images is {}x{}, over the adapter's largest texture {max}x{max} (lower the directions or the size)",
+                s.directions,
+                w * cols,
+                h * rows
+            )));
+        }
+        let big = [w * cols, h * rows];
+        for d in [ORIGINS, DIRECTIONS, PAYLOAD] {
+            targets.create_sized(gpu, d, big);
+        }
+        if s.visibility {
+            targets.create_sized(gpu, DEPTH, big);
+            targets.create_sized(gpu, HIT, big);
+        }
+        for d in [
+            RAW,
+            GLOSSY_RAW,
+            BLUR_H,
+            GLOSSY_BLUR_H,
+            GLOSSY,
+            crate::passes::ils::INDIRECT,
+        ] {
+            if targets.try_get(d.name).is_none() {
+                targets.create(gpu, d);
+            }
+        }
+        for t in crate::passes::compose::OUTPUTS {
+            if targets.try_get(t.name).is_none() {
+                targets.create(gpu, t);
+            }
+        }
+        let data = super::triangle_data(scene, 0.0);
+        let count = (data.len() / 3) as u32;
+        let senders_data = sender_data(scene, 0.0);
+        let limit = device.limits().max_storage_buffer_binding_size;
+        let sender_bytes = (senders_data.len() * 16).max(80) as u64;
+        if sender_bytes > limit {
+            return Err(crate::RenderError::Parameter(format!(
+                "scene '{}' has {count} triangles: {sender_bytes} bytes of bzb-gi sender data exceed the adapter's storage buffer binding size {limit}",
+                scene.name
+            )));
+        }
+        let buffer = |label: &str, mut bytes: Vec<u8>, min: usize, usage: wgpu::BufferUsages| {
+            bytes.resize(bytes.len().max(min), 0);
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &bytes,
+                usage,
+            })
+        };
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let triangles = buffer("bzb-triangles", bytemuck::cast_slice(&data).to_vec(), 48, storage);
+        let senders = buffer(
+            "bzb-gi-senders",
+            bytemuck::cast_slice(&senders_data).to_vec(),
+            80,
+            storage,
+        );
+        let mut light_data = light.lights.to_vec();
+        if light_data.is_empty() {
+            light_data.push(Zeroable::zeroed());
+        }
+        let lights = buffer("bzb-gi-lights", bytemuck::cast_slice(&light_data).to_vec(), 0, storage);
+        let u = s.uniforms(scene, count);
+        let splat_u = s.splat_uniforms(scene, count);
+        let base = GiUniforms {
+            light_count: light.lights.len() as u32,
+            pcf_radius: light.pcf_radius.clamp(0, 4),
+            shadow_size: light.shadow_resolution as f32,
+            // the lighting pass's convention: Rect lights carry their emitters' light
+            emission_in: !light.lights.iter().any(|l| l.kind[0] == crate::lights::KIND_RECT) as u32,
+            d_max: u.radius,
+            t_min: u.t_min,
+            visibility: s.visibility as u32,
+            seed: s.seed,
+            clamp: s.clamp.unwrap_or(0.0),
+            _pad: [0; 3],
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let splat_uniforms = buffer("bzb-splat", bytemuck::bytes_of(&splat_u).to_vec(), 0, uniform);
+        let mean = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bzb-gi-mean-radiance"),
+            size: (count.max(1) as u64) * 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let gi_uniforms = buffer("bzb-gi", bytemuck::bytes_of(&base).to_vec(), 0, uniform);
+
+        let directions = PassBuilder::new(gpu, targets, "bzb-directions")
+            .shader("bzb-gi-directions", gi_shader!("bzb_gi_directions.wgsl"))
+            .frame(scene_gpu)
+            .uniforms(&u)
+            .read("zpack")
+            .read("npack")
+            .read_layer("normal", 0)
+            .read_layer("albedo", 0)
+            .read_layer("emission", 0)
+            .write(ORIGINS.name)
+            .write(DIRECTIONS.name)
+            .build();
+        let reconstruct = PassBuilder::new(gpu, targets, "bzb-reconstruct")
+            .shader("bzb-gi-reconstruct", gi_shader!("bzb_gi_reconstruct.wgsl"))
+            .frame(scene_gpu)
+            .uniforms(&u)
+            .read(PAYLOAD.name)
+            .read(DIRECTIONS.name)
+            .read("zpack")
+            .read("npack")
+            .read_layer("normal", 0)
+            .read_layer("albedo", 0)
+            .read_layer("emission", 0)
+            .write(RAW.name)
+            .write(GLOSSY_RAW.name)
+            .build();
+        let tile_count = super::zminmax_tile_count(w, h);
+        let tiles = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bzb-zminmax"),
+            size: tile_count as u64 * 8,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let zminmax = super::BzbStage::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count);
+
+        // group 2 of the splat: sender data, lights, shadow maps, receiver material
+        let frag = wgpu::ShaderStages::FRAGMENT;
+        let tex = |binding| crate::passes::texture_entry(binding, wgpu::TextureViewDimension::D2, false);
+        let storage_ro = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: frag,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bzb-gi-senders"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                storage_ro(1),
+                storage_ro(2),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                storage_ro(5),
+                tex(6),
+                tex(7),
+                tex(8),
+                storage_ro(9),
+            ],
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("bzb-gi shadow"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let view = |n: &str| wgpu::BindingResource::TextureView(targets.get(n).layer(0));
+        let group = crate::passes::bind_group(
+            device,
+            "bzb-gi-senders",
+            &layout,
+            &[
+                gi_uniforms.as_entire_binding(),
+                senders.as_entire_binding(),
+                lights.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&light.shadow.array_view),
+                wgpu::BindingResource::Sampler(&sampler),
+                light.shadow.matrices.as_entire_binding(),
+                view("normal"),
+                view("albedo"),
+                view("emission"),
+                mean.as_entire_binding(),
+            ],
+        );
+        let senders_pass = (!s.visibility).then(|| {
+            SenderPass::new(
+                gpu,
+                [
+                    gi_uniforms.as_entire_binding(),
+                    triangles.as_entire_binding(),
+                    senders.as_entire_binding(),
+                    lights.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&light.shadow.array_view),
+                    wgpu::BindingResource::Sampler(&sampler),
+                    light.shadow.matrices.as_entire_binding(),
+                    mean.as_entire_binding(),
+                ],
+                count,
+            )
+        });
+        let shade = s.visibility.then(|| {
+            PassBuilder::new(gpu, targets, "bzb-gi-shade")
+                .shader(
+                    "bzb-gi-shade",
+                    concat!(
+                        include_str!("bzb.wgsl"),
+                        "\n",
+                        include_str!("bzb_gi.wgsl"),
+                        "\n",
+                        include_str!("bzb_gi_sender.wgsl"),
+                        "\n",
+                        include_str!("bzb_gi_shade.wgsl")
+                    ),
+                )
+                .frame(scene_gpu)
+                .uniforms(&base)
+                .read(ORIGINS.name)
+                .read(DIRECTIONS.name)
+                .read(HIT.name)
+                .storage(&triangles)
+                .storage(&senders)
+                .storage(&lights)
+                .depth_view(
+                    "shadow-maps",
+                    &light.shadow.array_view,
+                    wgpu::TextureViewDimension::D2Array,
+                )
+                .sampler(&sampler, wgpu::SamplerBindingType::Comparison)
+                .storage(&light.shadow.matrices)
+                .write(PAYLOAD.name)
+                .build()
+        });
+        let splat = super::splat_pass_with(
+            gpu,
+            scene_gpu,
+            targets,
+            SplatSpec {
+                visibility: s.visibility,
+                instances: count.saturating_mul(s.directions),
+                source: concat!(
+                    include_str!("bzb.wgsl"),
+                    "\n",
+                    include_str!("bzb_gi.wgsl"),
+                    "\n",
+                    include_str!("bzb_splat.wgsl"),
+                    "\n",
+                    include_str!("bzb_gi_sender.wgsl"),
+                    "\n",
+                    include_str!("bzb_gi_splat.wgsl")
+                ),
+                entries: ("fs_gi_visibility", "fs_gi_additive"),
+                payload: if s.visibility { HIT } else { PAYLOAD },
+                extra: Some((&layout, group)),
+            },
+            &splat_uniforms,
+            &triangles,
+            &tiles,
+        );
+        let blur = |name, input, output, vertical| {
+            BilateralPass::new(gpu, scene_gpu, targets, &s.filter, name, input, output, vertical)
+        };
+        let blur = [
+            blur("bzb-gi-blur-h", RAW.name, BLUR_H.name, false),
+            blur("bzb-gi-blur-v", BLUR_H.name, crate::passes::ils::INDIRECT.name, true),
+            blur("bzb-gi-glossy-blur-h", GLOSSY_RAW.name, GLOSSY_BLUR_H.name, false),
+            blur("bzb-gi-glossy-blur-v", GLOSSY_BLUR_H.name, GLOSSY.name, true),
+        ];
+        let compose = crate::passes::compose::ComposePass::new(
+            gpu,
+            scene_gpu,
+            targets,
+            false,
+            None,
+            crate::passes::ils::INDIRECT.name,
+            Some(GLOSSY.name),
+        );
+        Ok(Self {
+            directions,
+            zminmax,
+            splat,
+            senders_pass,
+            shade,
+            reconstruct,
+            blur,
+            compose,
+            splat_uniforms,
+            gi_uniforms,
+            lights,
+            triangles,
+            senders,
+            count,
+            settings: s.clone(),
+            base,
+        })
+    }
+
+    /// This frame's uniforms; animated scenes also get their triangles and lights at `frame`.
+    pub fn set_frame(&self, gpu: &GpuContext, scene: &Scene, frame: f32, animated: bool, lights: &[GpuLight]) {
+        let u = self.settings.uniforms(scene, self.count);
+        self.directions.set_uniforms(gpu, &u);
+        self.reconstruct.set_uniforms(gpu, &u);
+        let u = self.settings.splat_uniforms(scene, self.count);
+        if let Some(p) = &self.shade {
+            p.set_uniforms(gpu, &self.base);
+        }
+        gpu.queue.write_buffer(&self.splat_uniforms, 0, bytemuck::bytes_of(&u));
+        gpu.queue
+            .write_buffer(&self.gi_uniforms, 0, bytemuck::bytes_of(&self.base));
+        if animated && self.count > 0 {
+            let data = super::triangle_data(scene, frame);
+            gpu.queue.write_buffer(&self.triangles, 0, bytemuck::cast_slice(&data));
+            let senders = sender_data(scene, frame);
+            gpu.queue.write_buffer(&self.senders, 0, bytemuck::cast_slice(&senders));
+            if !lights.is_empty() {
+                gpu.queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));
+            }
+        }
+    }
+
+    pub fn passes(&self) -> Vec<&dyn Pass> {
+        let mut v: Vec<&dyn Pass> = vec![&self.directions, &self.zminmax];
+        if let Some(p) = &self.senders_pass {
+            v.push(p);
+        }
+        v.push(&self.splat);
+        if let Some(p) = &self.shade {
+            v.push(p);
+        }
+        v.push(&self.reconstruct);
+        v.extend(self.blur.iter().map(|b| b as &dyn Pass));
+        v.push(&self.compose);
+        v
+    }
+
+    /// The splat uniforms of the last frame (d_max in `radius`).
+    pub fn uniforms(&self) -> GiUniforms {
+        self.base
+    }
+}
+
+/// `bzb-gi-senders` (compute, baseline only): every triangle's mean radiance L̄_T.
+struct SenderPass {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    count: u32,
+}
+
+impl SenderPass {
+    fn new(gpu: &GpuContext, resources: [wgpu::BindingResource; 8], count: u32) -> Self {
+        let device = &gpu.device;
+        let comp = wgpu::ShaderStages::COMPUTE;
+        let buf = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: comp,
+            ty: wgpu::BindingType::Buffer {
+                ty: if binding == 0 {
+                    wgpu::BufferBindingType::Uniform
+                } else {
+                    wgpu::BufferBindingType::Storage { read_only }
+                },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bzb-gi-senders"),
+            entries: &[
+                buf(0, true),
+                buf(1, true),
+                buf(2, true),
+                buf(3, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                buf(6, true),
+                buf(7, false),
+            ],
+        });
+        let group = crate::passes::bind_group(device, "bzb-gi-senders", &layout, &resources);
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("bzb-gi-senders"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(
+            device,
+            "bzb-gi-senders",
+            concat!(
+                include_str!("bzb.wgsl"),
+                "\n",
+                include_str!("bzb_gi.wgsl"),
+                "\n",
+                include_str!("bzb_gi_sender.wgsl"),
+                "\n",
+                include_str!("bzb_gi_senders.wgsl")
+            ),
+        );
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("bzb-gi-senders"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("cs_main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self { pipeline, group, count }
+    }
+}
+
+impl Pass for SenderPass {
+    fn info(&self) -> crate::frame::PassInfo {
+        crate::frame::PassInfo {
+            name: "bzb-gi-senders",
+            inputs: vec!["shadow-maps"],
+            outputs: vec!["bzb-gi-mean-radiance"],
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("bzb-gi-senders"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.dispatch_workgroups(self.count.div_ceil(64), 1, 1);
+    }
+}
