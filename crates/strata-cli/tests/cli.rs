@@ -603,6 +603,18 @@ fn unknown_preset_lists_the_valid_ones() {
     assert_one_line_error(&o, &["--preset", "high-performance, balanced, high-quality"]);
 }
 
+/// Issue 14's radiosity switches reject unknown values with one line naming the flag and the choices.
+#[test]
+fn radiosity_estimator_switches_are_range_checked() {
+    for (flag, value, choices) in [
+        ("--indirect-weights", "uniform", "paper or solid-angle"),
+        ("--indirect-temporal-noise", "sometimes", "on or off"),
+    ] {
+        let o = strata(&["eval", "--scene", "cornell", "--technique", "gi", flag, value, "--json"]);
+        assert_one_line_error(&o, &[flag, choices]);
+    }
+}
+
 #[test]
 fn eval_gi_reports_indirect_and_full_errors() {
     let cache = scratch("gi-cache");
