@@ -285,13 +285,21 @@ impl RadiosityArgs {
             None => {}
             Some("on") => s.temporal_noise = true,
             Some("off") => s.temporal_noise = false,
-            Some(v) => return Err(format!("--indirect-temporal-noise '{v}' is out of range: must be on or off")),
+            Some(v) => {
+                return Err(format!(
+                    "--indirect-temporal-noise '{v}' is out of range: must be on or off"
+                ))
+            }
         }
         match self.indirect_weights.as_deref() {
             None => {}
             Some("paper") => s.solid_angle = false,
             Some("solid-angle") => s.solid_angle = true,
-            Some(w) => return Err(format!("--indirect-weights '{w}' is out of range: must be paper or solid-angle")),
+            Some(w) => {
+                return Err(format!(
+                    "--indirect-weights '{w}' is out of range: must be paper or solid-angle"
+                ))
+            }
         }
         Ok(s)
     }

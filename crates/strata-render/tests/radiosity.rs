@@ -303,7 +303,13 @@ fn multi_bounce_in_a_closed_box_converges_below_the_geometric_bound() {
 
 /// Mean and RMS deviation from the mean of channel 0 of `target` after `frames`
 /// static frames (64×64).
-fn indirect_mean_and_spread(gpu: &GpuContext, scene: &Scene, rs: RadiositySettings, frames: u32, target: &str) -> (f64, f64) {
+fn indirect_mean_and_spread(
+    gpu: &GpuContext,
+    scene: &Scene,
+    rs: RadiositySettings,
+    frames: u32,
+    target: &str,
+) -> (f64, f64) {
     let (w, h) = (64, 64);
     let mut r = renderer(gpu, scene, w, h, 2, rs);
     let cams = FrameCameras::fixed(scene.camera);
@@ -367,9 +373,14 @@ fn per_frame_rotation_lets_the_temporal_filter_remove_the_pattern_noise() {
     };
     let (m_fixed, s_fixed) = run(false);
     let (m_rot, s_rot) = run(true);
-    eprintln!("fixed pattern: mean {m_fixed:.4} spread {s_fixed:.4}; per-frame rotation: mean {m_rot:.4} spread {s_rot:.4}");
+    eprintln!(
+        "fixed pattern: mean {m_fixed:.4} spread {s_fixed:.4}; per-frame rotation: mean {m_rot:.4} spread {s_rot:.4}"
+    );
     assert!(s_rot * 1.5 < s_fixed, "rotation did not smooth: {s_rot} vs {s_fixed}");
-    assert!((m_rot / m_fixed - 1.0).abs() < 0.03, "means differ: {m_rot} vs {m_fixed}");
+    assert!(
+        (m_rot / m_fixed - 1.0).abs() < 0.03,
+        "means differ: {m_rot} vs {m_fixed}"
+    );
 }
 
 /// Table 2's "fraction of guard band shaded": outside it the gather leaves
