@@ -253,10 +253,15 @@ pub struct RadiosityArgs {
     /// Progressive multi-bounce damping δ in [0, 1] (DGB §3.3; 0 = single bounce).
     #[arg(long, default_value_t = 0.9)]
     pub delta: f32,
-    /// Hash the frame index into the gather's spiral rotation too, so the temporal filter
-    /// averages different tap patterns (the paper hashes the pixel only).
+    /// on (default): hash the frame index into the gather's spiral rotation too, so the temporal
+    /// filter averages different tap patterns; off: the paper's per-pixel hash only.
+    #[arg(long, num_args = 0..=1, default_missing_value = "on")]
+    pub indirect_temporal_noise: Option<String>,
+    /// Tap weights of the gather: "solid-angle" (default: each tap weighs the solid angle its
+    /// screen area covers at the receiver, self-normalised) or "paper" (DGB Eq. 4, equal weights;
+    /// docs/radiosity.md).
     #[arg(long)]
-    pub indirect_temporal_noise: bool,
+    pub indirect_weights: Option<String>,
 }
 
 impl RadiosityArgs {
@@ -282,7 +287,26 @@ impl RadiosityArgs {
             ..Default::default()
         });
         s.delta = self.delta;
-        s.temporal_noise = self.indirect_temporal_noise;
+        match self.indirect_temporal_noise.as_deref() {
+            None => {}
+            Some("on") => s.temporal_noise = true,
+            Some("off") => s.temporal_noise = false,
+            Some(v) => {
+                return Err(format!(
+                    "--indirect-temporal-noise '{v}' is out of range: must be on or off"
+                ))
+            }
+        }
+        match self.indirect_weights.as_deref() {
+            None => {}
+            Some("paper") => s.solid_angle = false,
+            Some("solid-angle") => s.solid_angle = true,
+            Some(w) => {
+                return Err(format!(
+                    "--indirect-weights '{w}' is out of range: must be paper or solid-angle"
+                ))
+            }
+        }
         Ok(s)
     }
 }

@@ -669,6 +669,18 @@ fn eval_full_views_reports_clipping_blend_and_region_chroma() {
     assert_one_line_error(&o, &["coverage-confidence", "0..=1"]);
 }
 
+/// Issue 14's radiosity switches reject unknown values with one line naming the flag and the choices.
+#[test]
+fn radiosity_estimator_switches_are_range_checked() {
+    for (flag, value, choices) in [
+        ("--indirect-weights", "uniform", "paper or solid-angle"),
+        ("--indirect-temporal-noise", "sometimes", "on or off"),
+    ] {
+        let o = strata(&["eval", "--scene", "cornell", "--technique", "gi", flag, value, "--json"]);
+        assert_one_line_error(&o, &[flag, choices]);
+    }
+}
+
 #[test]
 fn eval_gi_reports_indirect_and_full_errors() {
     let cache = scratch("gi-cache");

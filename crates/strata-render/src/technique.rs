@@ -289,7 +289,7 @@ static AO_SETTINGS: [SettingInfo; 12] = [
     },
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 8] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 10] = [
     SettingInfo {
         name: "coverage-confidence",
         doc: "on: the probe blend's confidence is M/U, U = the taps in the receiver's hemisphere (taps on its own plane or behind it no longer count against screen space; not in the paper, docs/image-quality.md); off: DGB's M/N",
@@ -297,6 +297,24 @@ static RADIOSITY_SETTINGS: [SettingInfo; 8] = [
         integer: true,
         get: |s| Some(radiosity_of(s).coverage_confidence as u32 as f64),
         set: |s, v| radiosity_mut(s).coverage_confidence = v != 0.0,
+        values: &["off", "on"],
+    },
+    SettingInfo {
+        name: "indirect-weights",
+        doc: "tap weights of the gather: paper (DGB Eq. 4, every tap weighs 1) or solid-angle (each tap weighs the solid angle its screen area covers at the receiver, self-normalised)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(radiosity_of(s).solid_angle as u32 as f64),
+        set: |s, v| radiosity_mut(s).solid_angle = v != 0.0,
+        values: &["paper", "solid-angle"],
+    },
+    SettingInfo {
+        name: "indirect-temporal-noise",
+        doc: "on: hash the frame index into the gather's spiral rotation, so the temporal filter averages different tap patterns (the paper hashes the pixel only)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(radiosity_of(s).temporal_noise as u32 as f64),
+        set: |s, v| radiosity_mut(s).temporal_noise = v != 0.0,
         values: &["off", "on"],
     },
     setting!(

@@ -29,6 +29,13 @@ use crate::spiral::{self, SpiralTurns};
 /// q = 8 px, boost off (energy-conserving, comparable with the path tracer),
 /// temporal α = 0.85, multi-bounce δ = 0.9 (the demo's "propagation damping"
 /// 0.1, documented as 1 − δ).
+///
+/// Two defaults deviate from the paper (issue 14, measured in
+/// docs/radiosity.md § "Issue 14"): `temporal_noise` (the spiral's rotation
+/// also hashes the frame index, so the temporal filter averages different tap
+/// patterns; the paper hashes the pixel only) and `solid_angle` (taps weighted
+/// by the solid angle they cover instead of Eq. 4's equal weights). The
+/// paper's estimator: [`RadiositySettings::paper`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
     /// Samples N per pixel.
@@ -43,6 +50,9 @@ pub struct RadiositySettings {
     pub turns: SpiralTurns,
     pub rotate: bool,
     pub temporal_noise: bool,
+    /// Weight each tap by the solid angle its screen area subtends at the receiver
+    /// (self-normalised: E = 2π Σ w·B·cos / Σ w) instead of Eq. 4's equal weights.
+    pub solid_angle: bool,
     /// Eq. 7's boost(ρ) on the reflected bounce (false: boost = 1).
     pub boost: bool,
     /// §3.3 progressive multi-bounce damping δ in [0, 1]: each frame feeds
@@ -141,7 +151,8 @@ impl Default for RadiositySettings {
             q: 8.0,
             turns: SpiralTurns::Optimal,
             rotate: true,
-            temporal_noise: false,
+            temporal_noise: true,
+            solid_angle: true,
             boost: false,
             delta: 0.9,
             mips: DepthMipSettings::default(),
@@ -158,6 +169,16 @@ impl Default for RadiositySettings {
 }
 
 impl RadiositySettings {
+    /// DGB's estimator exactly as published: per-pixel (not per-frame) spiral
+    /// rotation and Eq. 4's equal tap weights (the rest as [`Default`]).
+    pub fn paper() -> Self {
+        Self {
+            temporal_noise: false,
+            solid_angle: false,
+            ..Default::default()
+        }
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         if !(1..=crate::passes::ao::MAX_SAMPLES).contains(&self.samples) {
             return Err(format!(
@@ -227,7 +248,8 @@ pub struct RadiosityUniforms {
     pub rotate: u32,
     /// 1 = confidence M/U (taps in the receiver's hemisphere), 0 = M/N.
     pub coverage: u32,
-    pub _pad: u32,
+    /// 1 = solid-angle tap weights ([`RadiositySettings::solid_angle`]).
+    pub solid_angle: u32,
 }
 
 impl RadiosityUniforms {
@@ -250,7 +272,7 @@ impl RadiosityUniforms {
             seed: if s.temporal_noise { frame_index } else { 0 },
             rotate: s.rotate as u32,
             coverage: s.coverage_confidence as u32,
-            _pad: 0,
+            solid_angle: s.solid_angle as u32,
         }
     }
 }
@@ -459,7 +481,8 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     };
     let (w, h) = (g.zmip[0].width as i32, g.zmip[0].height as i32);
     let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
-    let (mut sum, mut m_count, mut u_count) = (Vec3::ZERO, 0u32, 0u32);
+    let eye = Vec3::from_slice(&g.frame.eye[..3]);
+    let (mut sum, mut wsum, mut m_count, mut u_count) = (Vec3::ZERO, 0.0f32, 0u32, 0u32);
     for i in 0..u.samples {
         let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
         let d = spiral::tap_texel(tap.offset);
@@ -471,7 +494,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         let (tx, ty) = ((qx >> m) as u32, (qy >> m) as u32);
         let zs = g.zmip[m as usize].pixel(tx, ty);
         let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
-        let mut best: Option<Vec3> = None;
+        let mut best: Option<(Vec3, f32)> = None;
         for (j, &zj) in zs.iter().enumerate().take(g.layers.min(2) as usize) {
             if zj <= 0.0 {
                 continue;
@@ -487,16 +510,23 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
             if cos_x <= 0.0 {
                 continue;
             }
-            if u.normal_test != 0 && wdir.dot(v3(g.normals[j], sx, sy)) >= 0.0 {
+            let ny = v3(g.normals[j], sx, sy);
+            if u.normal_test != 0 && wdir.dot(ny) >= 0.0 {
                 continue;
             }
-            let c = v3(g.radiosity[j], sx, sy) * cos_x;
-            if best.is_none_or(|b| luminance(c) > luminance(b)) {
-                best = Some(c);
+            let wt = if u.solid_angle != 0 {
+                solid_angle_weight(eye, yv, ny, wdir, vv, tap.radius, u.radius)
+            } else {
+                1.0
+            };
+            let c = v3(g.radiosity[j], sx, sy) * cos_x * wt;
+            if best.is_none_or(|(b, _)| luminance(c) > luminance(b)) {
+                best = Some((c, wt));
             }
         }
-        if let Some(b) = best {
+        if let Some((b, wt)) = best {
             sum += b;
+            wsum += wt;
             m_count += 1;
         }
         // coverage confidence: the tap's direction (layer 0's point, else its camera ray)
@@ -504,7 +534,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         let y0 = world(sx as f32, sy as f32, if zs[0] > 0.0 { zs[0] } else { 1.0e4 });
         u_count += (best.is_some() || (y0 - pos).normalize().dot(n) > COVERAGE_COS) as u32;
     }
-    if m_count == 0 {
+    if m_count == 0 || wsum <= 0.0 {
         return (Vec3::ZERO, 0.0);
     }
     let confidence = if u.coverage != 0 {
@@ -512,7 +542,23 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     } else {
         m_count as f32 / u.samples as f32
     };
-    (sum * (2.0 * std::f32::consts::PI / m_count as f32), confidence)
+    (sum * (2.0 * std::f32::consts::PI / wsum), confidence)
+}
+
+/// `radiosity.wgsl`'s `solid_angle_weight`: the solid angle (up to a constant
+/// factor, which the self-normalised estimate cancels) that a tap at screen
+/// radius `h` covers on the surface at `y` (normal `ny`) seen from the receiver
+/// (direction `w`, squared distance `vv`). The spiral spreads taps linearly in
+/// radius, so tap i stands for an annulus of screen area ∝ h; a pixel's
+/// footprint on Y is ∝ z²/cos_view; that area subtends cos θ_Y/d² per unit
+/// area at X. cos_view ≥ 0.25 and d ≥ 0.05 r keep one tap from dominating.
+pub fn solid_angle_weight(eye: Vec3, y: Vec3, ny: Vec3, w: Vec3, vv: f32, h: f32, radius: f32) -> f32 {
+    let to_eye = eye - y;
+    let z2 = to_eye.dot(to_eye);
+    let cos_view = ny.dot(to_eye / z2.sqrt()).abs().max(0.25);
+    let cos_y = w.dot(ny).abs();
+    let dmin = 0.05 * radius;
+    h * z2 * cos_y / (cos_view * vv.max(dmin * dmin))
 }
 
 /// The gather's scissor for a `w`×`h` target with `guard` pixels of guard band

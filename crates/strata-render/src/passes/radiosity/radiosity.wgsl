@@ -31,7 +31,8 @@ struct Radiosity {
     // 1 = confidence M/U with U the taps that lie in the receiver's hemisphere
     // (see `hemisphere_tap`), 0 = the paper's M/N
     coverage: u32,
-    _pad1: u32,
+    // 1 = solid-angle weights (self-normalised; see `term`), 0 = Eq. 4's equal weights
+    solid_angle: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -64,8 +65,10 @@ fn radiosity_of(p: vec2i, layer: u32) -> vec3f {
 }
 
 // Eq. 4–5 term of sample Y (layer j, pixel src) for receiver X (normal n):
-// rgb = B(Y) max(ω̂·n̂_X, 0), a = 1 when Y passes Eq. 5 (and lies within r).
-fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i) -> vec4f {
+// rgb = w · B(Y) max(ω̂·n̂_X, 0), a = w when Y passes Eq. 5 (and lies within r),
+// with w = 1 (Eq. 4) or, with `solid_angle`, w ∝ the solid angle the tap's
+// screen area subtends at X (`solid_angle_weight`). `h` = the tap's screen radius.
+fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> vec4f {
     let v = y - x;
     let vv = dot(v, v);
     if (!(vv < rad.radius * rad.radius) || vv <= 0.0) {
@@ -76,10 +79,32 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i) -> vec4f {
     if (cos_x <= 0.0) {
         return vec4f(0.0);
     }
-    if (rad.normal_test != 0u && dot(w, normal_of(src, j)) >= 0.0) {
-        return vec4f(0.0);
+    var wt = 1.0;
+    if (rad.normal_test != 0u || rad.solid_angle != 0u) {
+        let ny = normal_of(src, j);
+        if (rad.normal_test != 0u && dot(w, ny) >= 0.0) {
+            return vec4f(0.0);
+        }
+        if (rad.solid_angle != 0u) {
+            wt = solid_angle_weight(y, ny, w, vv, h);
+        }
     }
-    return vec4f(radiosity_of(src, j) * cos_x, 1.0);
+    return vec4f(radiosity_of(src, j) * cos_x * wt, wt);
+}
+
+// Solid angle (up to a constant) that the screen area represented by a tap at
+// screen radius h (the spiral's taps are spread linearly in radius, so tap i
+// stands for an annulus of area ∝ h) covers on the surface at Y (normal n_y)
+// as seen from X (ω̂ from X to Y, |Y − X|² = vv): pixel footprint z² / cos_view
+// times cos θ_Y / d². cos_view and d are clamped (grazing views, taps next
+// to X) so that one tap cannot dominate.
+fn solid_angle_weight(y: vec3f, ny: vec3f, w: vec3f, vv: f32, h: f32) -> f32 {
+    let to_eye = frame.eye.xyz - y;
+    let z2 = dot(to_eye, to_eye);
+    let cos_view = max(abs(dot(ny, to_eye * inverseSqrt(z2))), 0.25);
+    let cos_y = max(abs(dot(w, ny)), 0.0);
+    let dmin = 0.05 * rad.radius;
+    return h * z2 * cos_y / (cos_view * max(vv, dmin * dmin));
 }
 
 // Of two candidate terms, the one with the larger contribution (the union of
@@ -107,15 +132,16 @@ fn hemisphere_tap(x: vec3f, n: vec3f, src: vec2i, z0: f32) -> f32 {
     return select(0.0, 1.0, dot(normalize(y - x), n) > COVERAGE_COS);
 }
 
-// `u`: the taps in the receiver's hemisphere (coverage confidence), ≥ M.
-fn estimate(sum: vec4f, u: f32) -> vec4f {
+// `m`: the contributing taps M; `u`: the taps in the receiver's hemisphere
+// (coverage confidence), ≥ M.
+fn estimate(sum: vec4f, m: f32, u: f32) -> vec4f {
     if (sum.a == 0.0) {
         return vec4f(0.0);
     }
-    // Eq. 4: 2π/M Σ, confidence M/N (paper) or M/U (coverage)
-    var c = sum.a / f32(rad.samples);
+    // Eq. 4: 2π/M Σ (w = 1) or 2π Σ w·B·cos / Σ w; confidence M/N (paper) or M/U (coverage)
+    var c = m / f32(rad.samples);
     if (rad.coverage != 0u) {
-        c = sum.a / max(u, sum.a);
+        c = m / max(u, m);
     }
     return vec4f(sum.rgb * (2.0 * 3.14159265358979 / sum.a), c);
 }
@@ -148,6 +174,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let size = vec2i(textureDimensions(zmip, 0));
     var sum0 = vec4f(0.0);
     var sum1 = vec4f(0.0);
+    var m0 = 0.0;
+    var m1 = 0.0;
     var u0 = 0.0;
     var u1 = 0.0;
     for (var i = 0u; i < rad.samples; i++) {
@@ -167,21 +195,25 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
                 continue;
             }
             let y = world_from_csz(frame, vec2f(src) + 0.5, zs[j]);
-            best0 = union_term(best0, term(x0, n0, y, j, src));
+            best0 = union_term(best0, term(x0, n0, y, j, src, tap.radius));
             if (has1) {
-                best1 = union_term(best1, term(x1, n1, y, j, src));
+                best1 = union_term(best1, term(x1, n1, y, j, src, tap.radius));
             }
         }
         sum0 += best0;
         sum1 += best1;
+        let hit0 = select(0.0, 1.0, best0.a > 0.0);
+        let hit1 = select(0.0, 1.0, best1.a > 0.0);
+        m0 += hit0;
+        m1 += hit1;
         if (rad.coverage != 0u) {
-            u0 += max(best0.a, hemisphere_tap(x0, n0, src, zs.x));
+            u0 += max(hit0, hemisphere_tap(x0, n0, src, zs.x));
             if (has1) {
-                u1 += max(best1.a, hemisphere_tap(x1, n1, src, zs.x));
+                u1 += max(hit1, hemisphere_tap(x1, n1, src, zs.x));
             }
         }
     }
-    o.e0 = estimate(sum0, u0);
-    o.e1 = estimate(sum1, u1);
+    o.e0 = estimate(sum0, m0, u0);
+    o.e1 = estimate(sum1, m1, u1);
     return o;
 }
