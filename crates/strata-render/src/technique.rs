@@ -1316,7 +1316,7 @@ static REGISTRY: [Technique; 8] = [
     },
     Technique {
         name: "bzb-gi",
-        doc: "direct + one-bounce diffuse/glossy GI through a bounced z-buffer (BZB §3): S BRDF-sampled directions per pixel, triangle splats carrying the sender's shadow-mapped direct radiance, nearest sender wins; visibility=off: the additive form-factor baseline",
+        doc: "direct + one-bounce diffuse/glossy GI through a bounced z-buffer (BZB §3): S BRDF-sampled directions per pixel, triangle splats (splat=aov) or DSS surfels shaded at surfelization (splat=dss, BZB §4.3) carrying the sender's shadow-mapped direct radiance, nearest sender wins; visibility=off: the additive form-factor baseline (DSS's additive shell splatting with splat=dss)",
         output: "hdr-full",
         display: ("ldr", true),
         eval: EvalKind::Radiance,
