@@ -346,6 +346,9 @@ fn settings_errors_name_the_setting_and_range() {
         ("dmax", 0.0, "> 0"),
         ("directions", 17.0, "1..=16"),
         ("bias", -1.0, ">= 0"),
+        ("splat", 2.0, "splat"),
+        ("levels", 7.0, "1..=6"),
+        ("surfel-size", 0.1, "16"),
     ] {
         let e = t.set(&mut s, name, value).unwrap_err().to_string();
         assert!(e.contains(name) && e.contains(range), "{e}");
