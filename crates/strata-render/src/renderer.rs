@@ -892,6 +892,24 @@ impl Renderer {
         }))
     }
 
+    /// `bzb-gi` with `splat = dss`: the last frame's surfels (GPU append order)
+    /// with their shaded radiance towards +n (emission included) and −n.
+    #[allow(clippy::type_complexity)]
+    pub fn dss_gi_surfels(
+        &self,
+        gpu: &GpuContext,
+    ) -> Option<Result<Vec<(crate::passes::bzb::dss::Surfel, glam::Vec3, glam::Vec3)>, RenderError>> {
+        let g = self.bzb_gi.as_ref()?;
+        let d = g.dss()?;
+        Some((|| {
+            let c = d.read_counts(gpu, g.triangle_count())?;
+            let n = c.surfels.min(d.capacity()[2]);
+            let sf = d.read_surfels(gpu, n)?;
+            let l = d.read_radiance(gpu, n)?;
+            Ok(sf.into_iter().zip(l).map(|(s, (a, b))| (s, a, b)).collect())
+        })())
+    }
+
     /// MIP level `mip` of target `name` (layer 0, whole texture incl. guard band).
     pub fn read_target_mip(&self, gpu: &GpuContext, name: &str, mip: u32) -> Result<ImageBuf, RenderError> {
         let t = self

@@ -841,7 +841,38 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.clone().unwrap_or_default()
 }
 
-static BZB_GI_SETTINGS: [SettingInfo; 8] = [
+static BZB_GI_SETTINGS: [SettingInfo; 11] = [
+    SettingInfo {
+        name: "splat",
+        doc: "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(bzb_gi_of(s).splat as u32 as f64),
+        set: |s, v| {
+            bzb_gi_mut(s).splat = if v == 0.0 {
+                crate::passes::bzb::Splat::Aov
+            } else {
+                crate::passes::bzb::Splat::Dss
+            }
+        },
+        values: &["aov", "dss"],
+    },
+    setting!(
+        "levels",
+        "DSS levels l_max (splat=dss, BZB §4.1); the outermost shell reaches dmax",
+        Range::Closed(1.0, crate::passes::bzb::dss::MAX_LEVELS as f64),
+        true,
+        |s| Some(bzb_gi_of(s).dss.levels as f64),
+        |s, v| bzb_gi_mut(s).dss.levels = v as u32
+    ),
+    setting!(
+        "surfel-size",
+        "DSS ideal surfel radius in pixels (splat=dss, BZB §4.3: constant projected size)",
+        Range::Closed(0.5, 16.0),
+        false,
+        |s| Some(bzb_gi_of(s).dss.surfel_px as f64),
+        |s, v| bzb_gi_mut(s).dss.surfel_px = v as f32
+    ),
     SettingInfo {
         name: "visibility",
         doc: "on: bounced z-buffer (BZB §3.2, the nearest sender per direction); off: the additive baseline (every triangle within d_max adds π·form factor·radiance)",
@@ -1285,7 +1316,7 @@ static REGISTRY: [Technique; 8] = [
     },
     Technique {
         name: "bzb-gi",
-        doc: "direct + one-bounce diffuse/glossy GI through a bounced z-buffer (BZB §3): S BRDF-sampled directions per pixel, triangle splats carrying the sender's shadow-mapped direct radiance, nearest sender wins; visibility=off: the additive form-factor baseline",
+        doc: "direct + one-bounce diffuse/glossy GI through a bounced z-buffer (BZB §3): S BRDF-sampled directions per pixel, triangle splats (splat=aov) or DSS surfels shaded at surfelization (splat=dss, BZB §4.3) carrying the sender's shadow-mapped direct radiance, nearest sender wins; visibility=off: the additive form-factor baseline (DSS's additive shell splatting with splat=dss)",
         output: "hdr-full",
         display: ("ldr", true),
         eval: EvalKind::Radiance,

@@ -169,6 +169,8 @@ fn algorithm_switching_settings_render_cleanly() {
         ("bzb-ao", &[("splat", "dss")]),
         ("bzb-ao", &[("splat", "dss"), ("visibility", "off")]),
         ("bzb-gi", &[("visibility", "off")]),
+        ("bzb-gi", &[("splat", "dss")]),
+        ("bzb-gi", &[("splat", "dss"), ("visibility", "off")]),
         ("aba-ao", &[("kernel", "hbao-compute")]),
         ("aba-ao", &[("kernel", "hbao-compute"), ("multilayer", "off")]),
         ("ils", &[("split", "compute")]),

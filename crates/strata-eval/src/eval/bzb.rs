@@ -189,7 +189,9 @@ pub fn run_gi(
             full: ref_total.annotate(f, &display(&full, exposure)),
             indirect: ref_indirect.annotate(i, &display(&ind, exposure)),
         };
-        Ok((errors, timings.get("bzb-splat").unwrap_or(f64::NAN), timings.total()))
+        // AOV-style triangle splats: bzb-splat; DSS surfels: dss-splat
+        let splat = timings.get("bzb-splat").or_else(|| timings.get("dss-splat"));
+        Ok((errors, splat.unwrap_or(f64::NAN), timings.total()))
     };
     let (errors, splat_ms, frame_ms) = evaluate(main.clone(), 1)?;
     let (no_visibility, splat_ms_no_visibility, _) = evaluate(baseline, 1)?;

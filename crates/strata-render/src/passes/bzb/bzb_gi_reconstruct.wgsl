@@ -67,7 +67,9 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     }
     let mean = select(vec3f(0.0), sum / max(count, 1.0), count > 0.0);
     if (glossy) {
-        o.glossy = vec4f(mean, 1.0);
+        // DSS without visibility (hemisphere = 1) sums irradiance for every
+        // receiver: glossy ones reflect it as a Lambert surface of albedo ρ
+        o.glossy = vec4f(select(mean, mean * rho * (1.0 / BZB_PI), bzb.hemisphere == 1u), 1.0);
     } else {
         o.irradiance = vec4f(mean, 1.0);
     }

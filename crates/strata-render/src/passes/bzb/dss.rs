@@ -43,6 +43,12 @@ pub const MAX_SPLIT: u32 = 64;
 /// filter's keep probability A_P/A* ≤ 1 to preserve the area.
 pub const FINE_RATIO: f32 = 0.25;
 
+/// bzb-gi with visibility: ray–disk radius over the surfel radius
+/// (`DSS_GI_COVER` in dss_gi_splat.wgsl). Random surfels of total area = mesh
+/// area cover only 1 − e^−1 ≈ 63 % of a surface; the bounced z-buffer keeps
+/// the nearest hit only, so disks ×2 (coverage 1 − e^−4 ≈ 98 %) add no energy.
+pub const GI_COVER: f32 = 2.0;
+
 /// DSS settings. Defaults: l_max = 4 (Table 3's memory is 4 levels' worth of
 /// shuffled positions: 18 MB at 768×512 = 4 × 12 B per pixel), surfels of 2
 /// pixels' radius, frustum culling on.
@@ -119,7 +125,9 @@ pub struct DssUniforms {
     pub culling: u32,
     pub triangles: u32,
     pub max_split: u32,
-    pub _pad: [u32; 3],
+    /// 1 = bzb-gi (RGBA radiance payload, hit flag in alpha), 0 = bzb-ao.
+    pub gi: u32,
+    pub _pad: [u32; 2],
 }
 
 /// Buffer capacities (entries) for `triangles` scene triangles.
@@ -503,6 +511,30 @@ pub const UNSHUFFLED: TargetDesc = TargetDesc::new(
     "DSS per-level payload back in pixel order: levels stacked, directions tiled as bzb-payload",
 );
 
+pub const GI_PAYLOAD: TargetDesc = TargetDesc::new(
+    "dss-gi-payload",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi DSS per-level payload in the shuffled layout: the nearest surfel's radiance and a hit flag (alpha), or the summed π·F·L of the shells",
+);
+pub const GI_UNSHUFFLED: TargetDesc = TargetDesc::new(
+    "dss-gi-unshuffled",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "bzb-gi DSS per-level payload back in pixel order: levels stacked, directions tiled as bzb-gi-payload",
+);
+
+/// What `bzb-gi` adds to the DSS stage: the sender shading's inputs for the
+/// `dss-gi-shade` pass (the resources of `bzb-gi-shade`).
+pub(crate) struct DssGiInputs<'a> {
+    pub gi_uniforms: &'a wgpu::Buffer,
+    pub senders: &'a wgpu::Buffer,
+    pub lights: &'a wgpu::Buffer,
+    pub shadow_view: &'a wgpu::TextureView,
+    pub sampler: &'a wgpu::Sampler,
+    pub shadow_mats: &'a wgpu::Buffer,
+}
+
 /// Buffers of the surfelization.
 struct SurfelBuffers {
     subtris: wgpu::Buffer,
@@ -511,6 +543,8 @@ struct SurfelBuffers {
     counters: wgpu::Buffer,
     args: wgpu::Buffer,
     readback: wgpu::Buffer,
+    /// bzb-gi: two vec4 per surfel, the radiance of its +n and −n faces.
+    radiance: Option<wgpu::Buffer>,
 }
 
 /// One surfelization compute pass (`dss-tessellate`, `dss-fine`, `dss-filter`).
@@ -556,6 +590,7 @@ pub struct DssSplatPass {
     group: wgpu::BindGroup,
     args: wgpu::Buffer,
     visibility: bool,
+    payload: &'static str,
 }
 
 impl Pass for DssSplatPass {
@@ -563,7 +598,7 @@ impl Pass for DssSplatPass {
         PassInfo {
             name: "dss-splat",
             inputs: vec![ORIGINS.name, DIRECTIONS.name],
-            outputs: vec![PAYLOAD.name],
+            outputs: vec![self.payload],
         }
     }
 
@@ -578,7 +613,7 @@ impl Pass for DssSplatPass {
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("dss-splat"),
-            color_attachments: &[crate::passes::clear_attachment(&targets.get(PAYLOAD.name).view)],
+            color_attachments: &[crate::passes::clear_attachment(&targets.get(self.payload).view)],
             depth_stencil_attachment: depth,
             timestamp_writes: None,
             occlusion_query_set: None,
@@ -596,6 +631,8 @@ pub(crate) struct DssStage {
     pub(crate) tessellate: SurfelizePass,
     pub(crate) fine: SurfelizePass,
     pub(crate) filter: SurfelizePass,
+    /// bzb-gi: `dss-gi-shade`, the surfels' direct-light radiance.
+    pub(crate) shade: Option<SurfelizePass>,
     pub(crate) shuffle: FullscreenPass,
     pub(crate) splat: DssSplatPass,
     pub(crate) unshuffle: FullscreenPass,
@@ -624,8 +661,14 @@ impl DssStage {
         u: &DssUniforms,
         triangles: &wgpu::Buffer,
         payload: &'static str,
+        gi: Option<DssGiInputs>,
     ) -> Result<Self, crate::RenderError> {
         use wgpu::util::DeviceExt;
+        let (level_payload, unshuffled) = if gi.is_some() {
+            (GI_PAYLOAD, GI_UNSHUFFLED)
+        } else {
+            (PAYLOAD, UNSHUFFLED)
+        };
         let device = &gpu.device;
         let big = [u.cols * u.plane[0], u.levels * u.rows * u.plane[1]];
         let out = [u.cols * u.size[0], u.levels * u.rows * u.size[1]];
@@ -636,13 +679,13 @@ impl DssStage {
                 u.levels, u.directions, big[0], big[1]
             )));
         }
-        for d in [ORIGINS, DIRECTIONS, PAYLOAD] {
+        for d in [ORIGINS, DIRECTIONS, level_payload] {
             targets.create_sized(gpu, d, big);
         }
         if u.visibility == 1 {
             targets.create_sized(gpu, DEPTH, big);
         }
-        targets.create_sized(gpu, UNSHUFFLED, out);
+        targets.create_sized(gpu, unshuffled, out);
         let limit = device.limits().max_storage_buffer_binding_size;
         let storage =
             |label: &str, bytes: u64, extra: wgpu::BufferUsages| -> Result<wgpu::Buffer, crate::RenderError> {
@@ -671,6 +714,10 @@ impl DssStage {
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
+            radiance: match gi {
+                Some(_) => Some(storage("dss-surfel-radiance", u.surfel_capacity as u64 * 32, none)?),
+                None => None,
+            },
         };
         let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("dss"),
@@ -771,21 +818,23 @@ impl DssStage {
             .shader("dss-unshuffle", dss_shader!("dss_unshuffle.wgsl"))
             .frame(scene_gpu)
             .uniforms(u)
-            .read(PAYLOAD.name)
-            .write(UNSHUFFLED.name)
+            .read(level_payload.name)
+            .write(unshuffled.name)
             .build();
         let reduce = PassBuilder::new(gpu, targets, "dss-reduce")
             .shader("dss-reduce", dss_shader!("dss_reduce.wgsl"))
             .frame(scene_gpu)
             .uniforms(u)
-            .read(UNSHUFFLED.name)
+            .read(unshuffled.name)
             .write(payload)
             .build();
-        let splat = Self::splat_pass(gpu, scene_gpu, targets, u, &uniforms, &buffers);
+        let shade = gi.as_ref().map(|g| Self::shade_pass(gpu, scene_gpu, u, triangles, &buffers, g));
+        let splat = Self::splat_pass(gpu, scene_gpu, targets, u, &uniforms, &buffers, level_payload.name);
         Ok(Self {
             tessellate,
             fine,
             filter,
+            shade,
             shuffle,
             splat,
             unshuffle,
@@ -804,6 +853,7 @@ impl DssStage {
         u: &DssUniforms,
         uniforms: &wgpu::Buffer,
         buffers: &SurfelBuffers,
+        payload: &'static str,
     ) -> DssSplatPass {
         let device = &gpu.device;
         let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
@@ -827,41 +877,167 @@ impl DssStage {
             },
             count: None,
         };
+        let mut entries = vec![
+            buf(0, wgpu::BufferBindingType::Uniform),
+            buf(1, wgpu::BufferBindingType::Storage { read_only: true }),
+            tex(2),
+            tex(3),
+            tex(4),
+        ];
+        let mut resources = vec![
+            uniforms.as_entire_binding(),
+            buffers.surfels.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+            wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
+            wgpu::BindingResource::TextureView(&targets.get("npack").view),
+        ];
+        if let Some(r) = &buffers.radiance {
+            entries.push(wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ..buf(5, wgpu::BufferBindingType::Storage { read_only: true })
+            });
+            resources.push(r.as_entire_binding());
+        }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dss-splat"),
-            entries: &[
-                buf(0, wgpu::BufferBindingType::Uniform),
-                buf(1, wgpu::BufferBindingType::Storage { read_only: true }),
-                tex(2),
-                tex(3),
-                tex(4),
-            ],
+            entries: &entries,
         });
-        let group = crate::passes::bind_group(
-            device,
-            "dss-splat",
-            &layout,
-            &[
-                uniforms.as_entire_binding(),
-                buffers.surfels.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
-                wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
-                wgpu::BindingResource::TextureView(&targets.get("npack").view),
-            ],
-        );
+        let group = crate::passes::bind_group(device, "dss-splat", &layout, &resources);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("dss-splat"),
             bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
             immediate_size: 0,
         });
-        let module = crate::shader::module(device, "dss-splat", dss_shader!("dss_splat.wgsl"));
         let visibility = u.visibility == 1;
-        let pipeline = super::splat_pipeline(device, "dss-splat", &pipeline_layout, &module, visibility);
+        let pipeline = if buffers.radiance.is_some() {
+            let module = crate::shader::module(
+                device,
+                "dss-gi-splat",
+                concat!(include_str!("dss_splat.wgsl"), "\n", include_str!("dss_gi_splat.wgsl")),
+            );
+            super::splat_pipeline_with(
+                device,
+                "dss-splat",
+                &pipeline_layout,
+                &module,
+                visibility,
+                GI_PAYLOAD.format,
+                ("fs_gi_visibility", "fs_gi_additive"),
+            )
+        } else {
+            let module = crate::shader::module(device, "dss-splat", dss_shader!("dss_splat.wgsl"));
+            super::splat_pipeline(device, "dss-splat", &pipeline_layout, &module, visibility)
+        };
         DssSplatPass {
             pipeline,
             group,
             args: buffers.args.clone(),
             visibility,
+            payload,
+        }
+    }
+
+    /// `dss-gi-shade` (bzb-gi, §4.3): every surfel's direct-light radiance.
+    fn shade_pass(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        u: &DssUniforms,
+        triangles: &wgpu::Buffer,
+        buffers: &SurfelBuffers,
+        g: &DssGiInputs,
+    ) -> SurfelizePass {
+        let device = &gpu.device;
+        let comp = wgpu::ShaderStages::COMPUTE;
+        let buf = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: comp,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let ro = wgpu::BufferBindingType::Storage { read_only: true };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dss-gi-shade"),
+            entries: &[
+                buf(0, wgpu::BufferBindingType::Uniform),
+                buf(1, ro),
+                buf(2, ro),
+                buf(3, ro),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 4,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: comp,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+                buf(6, ro),
+                buf(7, ro),
+                buf(8, ro),
+                buf(9, wgpu::BufferBindingType::Storage { read_only: false }),
+            ],
+        });
+        let radiance = buffers.radiance.as_ref().expect("bzb-gi DSS has a radiance buffer");
+        let group = crate::passes::bind_group(
+            device,
+            "dss-gi-shade",
+            &layout,
+            &[
+                g.gi_uniforms.as_entire_binding(),
+                triangles.as_entire_binding(),
+                g.senders.as_entire_binding(),
+                g.lights.as_entire_binding(),
+                wgpu::BindingResource::TextureView(g.shadow_view),
+                wgpu::BindingResource::Sampler(g.sampler),
+                g.shadow_mats.as_entire_binding(),
+                buffers.surfels.as_entire_binding(),
+                buffers.counters.as_entire_binding(),
+                radiance.as_entire_binding(),
+            ],
+        );
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dss-gi-shade"),
+            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(
+            device,
+            "dss-gi-shade",
+            concat!(
+                include_str!("bzb.wgsl"),
+                "\n",
+                include_str!("bzb_gi.wgsl"),
+                "\n",
+                include_str!("bzb_gi_sender.wgsl"),
+                "\n",
+                include_str!("dss_gi_shade.wgsl")
+            ),
+        );
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("dss-gi-shade"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("cs_main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        SurfelizePass {
+            name: "dss-gi-shade",
+            pipelines: vec![pipeline],
+            group,
+            threads: vec![u.surfel_capacity],
+            counters: None,
         }
     }
 
@@ -873,15 +1049,21 @@ impl DssStage {
     }
 
     pub fn passes(&self) -> Vec<&dyn Pass> {
-        vec![
+        let mut v: Vec<&dyn Pass> = vec![
             &self.tessellate,
             &self.fine,
             &self.filter,
-            &self.shuffle,
+        ];
+        if let Some(p) = &self.shade {
+            v.push(p);
+        }
+        v.extend([
+            &self.shuffle as &dyn Pass,
             &self.splat,
             &self.unshuffle,
             &self.reduce,
-        ]
+        ]);
+        v
     }
 
     /// Capacities of the sub-triangle, fine-surfel and surfel buffers
@@ -902,6 +1084,29 @@ impl DssStage {
             fine_surfels: c[1],
             surfels: c[2],
         })
+    }
+
+    /// bzb-gi: the radiance of the last frame's first `count` surfels (same
+    /// order as [`Self::read_surfels`]): (towards +n incl. emission, towards −n).
+    pub fn read_radiance(&self, gpu: &GpuContext, count: u32) -> Result<Vec<(Vec3, Vec3)>, crate::RenderError> {
+        let Some(src) = &self.buffers.radiance else {
+            return Ok(Vec::new());
+        };
+        let bytes = count as u64 * 32;
+        if bytes == 0 {
+            return Ok(Vec::new());
+        }
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dss-radiance-readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let data = read_buffer(gpu, src, &staging, bytes)?;
+        let f: &[f32] = bytemuck::cast_slice(&data);
+        Ok(f.chunks_exact(8)
+            .map(|v| (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[4], v[5], v[6])))
+            .collect())
     }
 
     /// The surfels of the last frame (in the GPU's append order).

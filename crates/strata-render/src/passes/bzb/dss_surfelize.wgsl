@@ -117,11 +117,11 @@ fn cs_tessellate(@builtin(global_invocation_id) gid: vec3u) {
                 let idx = atomicAdd(&counters[0], 1u);
                 if (idx < dss.tri_capacity) {
                     if (q == 0u) {
-                        subtris[3u * idx] = vec4f(p, 0.0);
+                        subtris[3u * idx] = vec4f(p, f32(t));
                         subtris[3u * idx + 1u] = vec4f(p + e1, 0.0);
                         subtris[3u * idx + 2u] = vec4f(p + e2, 0.0);
                     } else {
-                        subtris[3u * idx] = vec4f(p + e1, 0.0);
+                        subtris[3u * idx] = vec4f(p + e1, f32(t));
                         subtris[3u * idx + 1u] = vec4f(p + e1 + e2, 0.0);
                         subtris[3u * idx + 2u] = vec4f(p + e2, 0.0);
                     }
@@ -155,7 +155,8 @@ fn cs_fine(@builtin(global_invocation_id) gid: vec3u) {
         let idx = atomicAdd(&counters[1], 1u);
         if (idx < dss.fine_capacity) {
             fine[2u * idx] = vec4f(x, area);
-            fine[2u * idx + 1u] = vec4f(nor, 0.0);
+            // w: the source scene triangle index (exact in f32 below 2^24), for bzb-gi's surfel shading
+            fine[2u * idx + 1u] = vec4f(nor, subtris[3u * t].w);
         }
     }
 }

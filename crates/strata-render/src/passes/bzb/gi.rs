@@ -57,6 +57,12 @@ pub struct BzbGiSettings {
     /// Largest sender radiance a payload keeps (its RGB scaled down to this
     /// maximum component; biased, trades caustic fireflies for energy); `None` = off.
     pub clamp: Option<f32>,
+    /// The splats: the scene's triangles (AOV-style, default) or DSS surfels
+    /// shaded with direct light at surfelization (BZB §4.3).
+    pub splat: super::Splat,
+    /// DSS's levels, surfel size and frustum culling (`splat = dss`); the
+    /// outermost shell reaches d_max.
+    pub dss: super::dss::DssSettings,
 }
 
 impl Default for BzbGiSettings {
@@ -74,6 +80,8 @@ impl Default for BzbGiSettings {
             },
             culling: true,
             clamp: None,
+            splat: super::Splat::Aov,
+            dss: super::dss::DssSettings::default(),
         }
     }
 }
@@ -101,7 +109,41 @@ impl BzbGiSettings {
                 return Err(format!("bzb-gi clamp {c} is out of range: must be > 0"));
             }
         }
+        self.dss.validate()?;
         self.filter.validate()
+    }
+
+    /// DSS uniforms (`splat = dss`) for a `w`×`h` frame: the outermost shell
+    /// d_max_dss·2^(l_max−1) reaches bzb-gi's d_max; without visibility one
+    /// direction (the additive sum does not depend on ω, reconstruction reads
+    /// sub-image 0).
+    pub fn dss_uniforms(&self, scene: &Scene, w: u32, h: u32, triangles: u32) -> super::dss::DssUniforms {
+        let (d_max, t_min) = self.resolve(scene);
+        let (cols, rows) = if self.visibility { self.grid() } else { (1, 1) };
+        let [tri_capacity, fine_capacity, surfel_capacity] = super::dss::capacities(triangles);
+        super::dss::DssUniforms {
+            levels: self.dss.levels,
+            directions: if self.visibility { self.directions } else { 1 },
+            cols,
+            rows,
+            size: [w, h],
+            plane: self.dss.plane(w, h),
+            d_max: self.dss.d_max(d_max),
+            t_min,
+            surfel_px: self.dss.surfel_px,
+            fine_ratio: super::dss::FINE_RATIO,
+            max_fine: super::dss::MAX_FINE,
+            tri_capacity,
+            fine_capacity,
+            surfel_capacity,
+            seed: self.seed,
+            visibility: self.visibility as u32,
+            culling: self.dss.culling as u32,
+            triangles,
+            max_split: super::dss::MAX_SPLIT,
+            gi: 1,
+            _pad: [0; 2],
+        }
     }
 
     /// (d_max, t_min) for `scene`.
@@ -152,7 +194,9 @@ impl BzbGiSettings {
             cols,
             rows,
             seed: self.seed,
-            hemisphere: 0,
+            // bzb-gi reuses `hemisphere` as "the additive payload is irradiance
+            // for glossy receivers too" (DSS without visibility: bzb_gi_reconstruct.wgsl)
+            hemisphere: (self.splat == super::Splat::Dss && !self.visibility) as u32,
             visibility: self.visibility as u32,
             triangles,
             culling: self.culling as u32,
@@ -414,8 +458,11 @@ pub struct LightInputs<'a> {
 
 pub(crate) struct BzbGiStage {
     directions: FullscreenPass,
-    zminmax: ZMinMaxPass,
-    splat: SplatPass,
+    /// AOV-style triangle splats (`splat = aov`).
+    zminmax: Option<ZMinMaxPass>,
+    splat: Option<SplatPass>,
+    /// DSS surfels (`splat = dss`).
+    dss: Option<super::dss::DssStage>,
     /// Without visibility: the triangles' mean radiance L̄_T.
     senders_pass: Option<SenderPass>,
     /// With visibility: the winners' radiance (deferred shading of the hits).
@@ -459,7 +506,8 @@ impl BzbGiStage {
         for d in [ORIGINS, DIRECTIONS, PAYLOAD] {
             targets.create_sized(gpu, d, big);
         }
-        if s.visibility {
+        let aov = s.splat == super::Splat::Aov;
+        if s.visibility && aov {
             targets.create_sized(gpu, DEPTH, big);
             targets.create_sized(gpu, HIT, big);
         }
@@ -570,7 +618,7 @@ impl BzbGiStage {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let zminmax = super::BzbStage::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count);
+        let zminmax = aov.then(|| super::BzbStage::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count));
 
         // group 2 of the splat: sender data, lights, shadow maps, receiver material
         let frag = wgpu::ShaderStages::FRAGMENT;
@@ -648,7 +696,7 @@ impl BzbGiStage {
                 mean.as_entire_binding(),
             ],
         );
-        let senders_pass = (!s.visibility).then(|| {
+        let senders_pass = (!s.visibility && aov).then(|| {
             SenderPass::new(
                 gpu,
                 [
@@ -664,7 +712,7 @@ impl BzbGiStage {
                 count,
             )
         });
-        let shade = s.visibility.then(|| {
+        let shade = (s.visibility && aov).then(|| {
             PassBuilder::new(gpu, targets, "bzb-gi-shade")
                 .shader(
                     "bzb-gi-shade",
@@ -696,7 +744,7 @@ impl BzbGiStage {
                 .write(PAYLOAD.name)
                 .build()
         });
-        let splat = super::splat_pass_with(
+        let splat = aov.then(|| super::splat_pass_with(
             gpu,
             scene_gpu,
             targets,
@@ -721,7 +769,26 @@ impl BzbGiStage {
             &splat_uniforms,
             &triangles,
             &tiles,
-        );
+        ));
+        let dss = match s.splat {
+            super::Splat::Aov => None,
+            super::Splat::Dss => Some(super::dss::DssStage::new(
+                gpu,
+                scene_gpu,
+                targets,
+                &s.dss_uniforms(scene, w, h, count),
+                &triangles,
+                PAYLOAD.name,
+                Some(super::dss::DssGiInputs {
+                    gi_uniforms: &gi_uniforms,
+                    senders: &senders,
+                    lights: &lights,
+                    shadow_view: &light.shadow.array_view,
+                    sampler: &sampler,
+                    shadow_mats: &light.shadow.matrices,
+                }),
+            )?),
+        };
         let blur = |name, input, output, vertical| {
             BilateralPass::new(gpu, scene_gpu, targets, &s.filter, name, input, output, vertical)
         };
@@ -744,6 +811,7 @@ impl BzbGiStage {
             directions,
             zminmax,
             splat,
+            dss,
             senders_pass,
             shade,
             reconstruct,
@@ -770,6 +838,10 @@ impl BzbGiStage {
             p.set_uniforms(gpu, &self.base);
         }
         gpu.queue.write_buffer(&self.splat_uniforms, 0, bytemuck::bytes_of(&u));
+        if let Some(d) = &self.dss {
+            let [w, h] = d.size;
+            d.set_uniforms(gpu, &self.settings.dss_uniforms(scene, w, h, self.count));
+        }
         gpu.queue
             .write_buffer(&self.gi_uniforms, 0, bytemuck::bytes_of(&self.base));
         if animated && self.count > 0 {
@@ -784,11 +856,19 @@ impl BzbGiStage {
     }
 
     pub fn passes(&self) -> Vec<&dyn Pass> {
-        let mut v: Vec<&dyn Pass> = vec![&self.directions, &self.zminmax];
+        let mut v: Vec<&dyn Pass> = vec![&self.directions];
+        if let Some(p) = &self.zminmax {
+            v.push(p);
+        }
         if let Some(p) = &self.senders_pass {
             v.push(p);
         }
-        v.push(&self.splat);
+        if let Some(p) = &self.splat {
+            v.push(p);
+        }
+        if let Some(d) = &self.dss {
+            v.extend(d.passes());
+        }
         if let Some(p) = &self.shade {
             v.push(p);
         }
@@ -796,6 +876,16 @@ impl BzbGiStage {
         v.extend(self.blur.iter().map(|b| b as &dyn Pass));
         v.push(&self.compose);
         v
+    }
+
+    /// The DSS stage (`splat = dss`).
+    pub fn dss(&self) -> Option<&super::dss::DssStage> {
+        self.dss.as_ref()
+    }
+
+    /// Scene triangles (splat buffer).
+    pub fn triangle_count(&self) -> u32 {
+        self.count
     }
 
     /// The splat uniforms of the last frame (d_max in `radius`).

@@ -173,7 +173,8 @@ impl BzbSettings {
             culling: self.dss.culling as u32,
             triangles,
             max_split: dss::MAX_SPLIT,
-            _pad: [0; 3],
+            gi: 0,
+            _pad: [0; 2],
         }
     }
 
@@ -687,7 +688,7 @@ impl BzbStage {
                 (
                     None,
                     None,
-                    Some(dss::DssStage::new(gpu, scene_gpu, targets, &du, &buffer, PAYLOAD.name)?),
+                    Some(dss::DssStage::new(gpu, scene_gpu, targets, &du, &buffer, PAYLOAD.name, None)?),
                 )
             }
         };

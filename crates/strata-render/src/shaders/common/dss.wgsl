@@ -37,7 +37,8 @@ struct Dss {
     triangles: u32,
     // largest pre-tessellation factor m (m² sub-triangles per triangle)
     max_split: u32,
-    _pad0: u32,
+    // 1 = bzb-gi: RGBA radiance payload, hit flag in alpha (0 = bzb-ao occlusion)
+    gi: u32,
     _pad1: u32,
     _pad2: u32,
 }
