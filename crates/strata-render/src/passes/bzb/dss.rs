@@ -1014,15 +1014,7 @@ impl DssStage {
         let module = crate::shader::module(
             device,
             "dss-gi-shade",
-            concat!(
-                include_str!("bzb.wgsl"),
-                "\n",
-                include_str!("bzb_gi.wgsl"),
-                "\n",
-                include_str!("bzb_gi_sender.wgsl"),
-                "\n",
-                include_str!("dss_gi_shade.wgsl")
-            ),
+            gi_sender_shader!("dss_gi_shade.wgsl"),
         );
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("dss-gi-shade"),

@@ -53,24 +53,9 @@ fn fs_gi_visibility(in: SplatVertex) -> VisibilityOut {
 
 @fragment
 fn fs_gi_additive(in: SplatVertex) -> @location(0) vec4f {
-    let texel = vec2i(in.position.xy);
-    let o = textureLoad(origins, texel, 0);
-    let nr = textureLoad(directions, texel, 0);
-    if (o.w <= 0.0) {
+    let a = dss_additive(in);
+    if (a.f <= 0.0) {
         discard;
     }
-    let cr = surfels[2u * in.surfel];
-    let ns = surfels[2u * in.surfel + 1u].xyz;
-    let shell = dss_shell(in.level, dss.d_max);
-    let v = cr.xyz - o.xyz;
-    let dist = length(v);
-    if (!(dist > shell.x && dist <= shell.y)) {
-        discard;
-    }
-    let r = cr.w * f32(1u << in.level);
-    let f = dss_disk_occlusion(v, nr.xyz, ns, DSS_PI * r * r, dss.t_min);
-    if (f <= 0.0) {
-        discard;
-    }
-    return vec4f(DSS_PI * f * dss_gi_radiance(in.surfel, cr.xyz, ns, o.xyz), 1.0);
+    return vec4f(DSS_PI * a.f * dss_gi_radiance(in.surfel, a.c, a.ns, a.o), 1.0);
 }

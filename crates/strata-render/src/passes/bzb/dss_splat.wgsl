@@ -130,27 +130,46 @@ fn fs_visibility(in: SplatVertex) -> VisibilityOut {
     return out;
 }
 
-@fragment
-fn fs_additive(in: SplatVertex) -> @location(0) vec4f {
+// DSS's additive shell splatting at one fragment (the baseline without
+// visibility): the form factor f of the fragment's surfel (centre c, normal
+// ns) at the receiver o, 0 where the texel has no receiver, the surfel lies
+// outside this level's shell or faces away.
+struct DssAdditive {
+    f: f32,
+    o: vec3f,
+    c: vec3f,
+    ns: vec3f,
+}
+
+fn dss_additive(in: SplatVertex) -> DssAdditive {
+    var a: DssAdditive;
     let texel = vec2i(in.position.xy);
     let o = textureLoad(origins, texel, 0);
     // without visibility the shuffle stores the receiver normal in `directions`
     let nr = textureLoad(directions, texel, 0);
-    if (o.w <= 0.0) {
-        discard;
-    }
     let cr = surfels[2u * in.surfel];
-    let ns = surfels[2u * in.surfel + 1u].xyz;
+    a.o = o.xyz;
+    a.c = cr.xyz;
+    a.ns = surfels[2u * in.surfel + 1u].xyz;
+    if (o.w <= 0.0) {
+        return a;
+    }
     let shell = dss_shell(in.level, dss.d_max);
     let v = cr.xyz - o.xyz;
     let dist = length(v);
     if (!(dist > shell.x && dist <= shell.y)) {
-        discard;
+        return a;
     }
     let r = cr.w * f32(1u << in.level);
-    let a = dss_disk_occlusion(v, nr.xyz, ns, DSS_PI * r * r, dss.t_min);
-    if (a <= 0.0) {
+    a.f = dss_disk_occlusion(v, nr.xyz, a.ns, DSS_PI * r * r, dss.t_min);
+    return a;
+}
+
+@fragment
+fn fs_additive(in: SplatVertex) -> @location(0) vec4f {
+    let a = dss_additive(in);
+    if (a.f <= 0.0) {
         discard;
     }
-    return vec4f(a);
+    return vec4f(a.f);
 }

@@ -716,15 +716,7 @@ impl BzbGiStage {
             PassBuilder::new(gpu, targets, "bzb-gi-shade")
                 .shader(
                     "bzb-gi-shade",
-                    concat!(
-                        include_str!("bzb.wgsl"),
-                        "\n",
-                        include_str!("bzb_gi.wgsl"),
-                        "\n",
-                        include_str!("bzb_gi_sender.wgsl"),
-                        "\n",
-                        include_str!("bzb_gi_shade.wgsl")
-                    ),
+                    gi_sender_shader!("bzb_gi_shade.wgsl"),
                 )
                 .frame(scene_gpu)
                 .uniforms(&base)
@@ -955,15 +947,7 @@ impl SenderPass {
         let module = crate::shader::module(
             device,
             "bzb-gi-senders",
-            concat!(
-                include_str!("bzb.wgsl"),
-                "\n",
-                include_str!("bzb_gi.wgsl"),
-                "\n",
-                include_str!("bzb_gi_sender.wgsl"),
-                "\n",
-                include_str!("bzb_gi_senders.wgsl")
-            ),
+            gi_sender_shader!("bzb_gi_senders.wgsl"),
         );
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("bzb-gi-senders"),

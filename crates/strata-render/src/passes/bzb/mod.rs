@@ -30,6 +30,22 @@
 //!    of [`crate::passes::bilateral`] (position and normal weights) into `ao`,
 //!    the target DGB AO writes, so compose and `eval` treat both alike.
 
+/// WGSL of a pass that shades bzb-gi senders: the shared bounced-z-buffer and GI
+/// uniforms, the sender shading (`bzb_gi_sender.wgsl`) and the pass's own `$file`.
+macro_rules! gi_sender_shader {
+    ($file:literal) => {
+        concat!(
+            include_str!("bzb.wgsl"),
+            "\n",
+            include_str!("bzb_gi.wgsl"),
+            "\n",
+            include_str!("bzb_gi_sender.wgsl"),
+            "\n",
+            include_str!($file)
+        )
+    };
+}
+
 pub mod dss;
 pub mod gi;
 
