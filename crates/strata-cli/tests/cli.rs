@@ -1983,7 +1983,10 @@ fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
         assert!(dep > 0.0 && dep < all, "{}: {dep} of {all} ms", q["pattern"]);
         let frames = q["predicted_frames_to_target"].as_f64().unwrap();
         let fixed = q["predicted_static_view_gpu_ms_to_target"].as_f64().unwrap();
-        assert!((fixed - (all - dep + frames * dep)).abs() < 1e-6 * all.max(1.0), "{fixed}");
+        assert!(
+            (fixed - (all - dep + frames * dep)).abs() < 1e-6 * all.max(1.0),
+            "{fixed}"
+        );
     }
     let pt: Vec<(u64, f64)> = one["rms_vs_path_tracer"]
         .as_array()

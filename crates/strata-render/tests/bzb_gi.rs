@@ -452,12 +452,21 @@ fn dss_surfel_radiance_equals_the_cpu_twin_on_a_sunlit_plane_and_an_emitter() {
     let want = Vec3::from(color) * (illuminance * 0.5 / std::f32::consts::PI * cos);
     let mut worst = 0.0f32;
     for (s, front, back) in &surfels {
-        assert!((s.normal - Vec3::Y).length() < 1e-4 && s.position.y.abs() < 1e-4, "{s:?}");
+        assert!(
+            (s.normal - Vec3::Y).length() < 1e-4 && s.position.y.abs() < 1e-4,
+            "{s:?}"
+        );
         worst = worst.max(((*front - want) / want).abs().max_element());
         assert_eq!(*back, Vec3::ZERO, "the unlit back face of {s:?}");
     }
-    eprintln!("{} sunlit surfels: worst relative error {worst:.5} (want {want})", surfels.len());
-    assert!(worst < 2e-3, "surfel radiance off by {worst} relative to ρ/π E cos θ = {want}");
+    eprintln!(
+        "{} sunlit surfels: worst relative error {worst:.5} (want {want})",
+        surfels.len()
+    );
+    assert!(
+        worst < 2e-3,
+        "surfel radiance off by {worst} relative to ρ/π E cos θ = {want}"
+    );
 
     let l = 2.0f32;
     let scene = emitter_scene(1.0, 1.5, 1.0, l, None);
@@ -512,8 +521,13 @@ fn dss_hidden_sender_adds_light_without_visibility_and_little_with_it() {
         means.push((got / px.len() as f64, want / px.len() as f64));
     }
     let ((with, _), (without, through)) = (means[0], means[1]);
-    eprintln!("dss hidden sender: with visibility {with:.5}, without {without:.4} (π L F through the blocker {through:.4})");
-    assert!(without > 0.5 * through, "without visibility {without} vs π L F {through}");
+    eprintln!(
+        "dss hidden sender: with visibility {with:.5}, without {without:.4} (π L F through the blocker {through:.4})"
+    );
+    assert!(
+        without > 0.5 * through,
+        "without visibility {without} vs π L F {through}"
+    );
     assert!(with < 0.06 * without, "with visibility {with}, without {without}");
 }
 
@@ -544,7 +558,12 @@ fn dss_irradiance_under_an_emissive_rectangle() {
                 * parallel_rect_form_factor([x, z], h as f64, (-a as f64, a as f64), (-b as f64, b as f64));
         }
         let rel = (got - want) / want;
-        eprintln!("dss emitter visibility {visibility}: mean E {} vs π L F {} (rel {rel:.4}, {} px)", got / px.len() as f64, want / px.len() as f64, px.len());
+        eprintln!(
+            "dss emitter visibility {visibility}: mean E {} vs π L F {} (rel {rel:.4}, {} px)",
+            got / px.len() as f64,
+            want / px.len() as f64,
+            px.len()
+        );
         assert!(px.len() > 300, "{} floor pixels", px.len());
         if visibility {
             assert!(rel.abs() < 0.1, "rel {rel}");

@@ -129,23 +129,27 @@ fn split_methods_give_identical_frames() {
     let scene = procedural::builtin("cornell").unwrap();
     let v = vpls(&scene, 240);
     let views = ["ils-gbuffer-split", "ils-irradiance", "indirect"];
-    let frames: Vec<Vec<ImageBuf>> = [SplitMethod::Naive, SplitMethod::Blocks { block: 16 }, SplitMethod::Compute]
-        .into_iter()
-        .map(|method| {
-            let r = render(
-                &gpu,
-                &scene,
-                IlsSettings {
-                    method,
-                    blur: 1.0,
-                    ..base(&scene, &v)
-                },
-            );
-            let out = views.iter().map(|t| r.read_target(&gpu, t).unwrap()).collect();
-            gpu.check_errors().unwrap();
-            out
-        })
-        .collect();
+    let frames: Vec<Vec<ImageBuf>> = [
+        SplitMethod::Naive,
+        SplitMethod::Blocks { block: 16 },
+        SplitMethod::Compute,
+    ]
+    .into_iter()
+    .map(|method| {
+        let r = render(
+            &gpu,
+            &scene,
+            IlsSettings {
+                method,
+                blur: 1.0,
+                ..base(&scene, &v)
+            },
+        );
+        let out = views.iter().map(|t| r.read_target(&gpu, t).unwrap()).collect();
+        gpu.check_errors().unwrap();
+        out
+    })
+    .collect();
     assert!(frames[0][1].data.iter().any(|&x| x > 0.0), "the VPLs light the box");
     for (k, f) in frames.iter().enumerate().skip(1) {
         for (view, (a, b)) in views.iter().zip(f.iter().zip(&frames[0])) {

@@ -393,7 +393,11 @@ fn ssm_glossy_receivers_match_traced_visibility() {
             100.0 * ssm_off,
             100.0 * snsm_off
         );
-        assert!(ssm_off <= 0.05, "brute force {brute_force}: SSM off on {:.2} %", 100.0 * ssm_off);
+        assert!(
+            ssm_off <= 0.05,
+            "brute force {brute_force}: SSM off on {:.2} %",
+            100.0 * ssm_off
+        );
         assert!(
             snsm_off >= 2.0 * ssm_off.max(0.01),
             "brute force {brute_force}: SNSM ({:.2} %) not clearly further from the traced sum than SSM",

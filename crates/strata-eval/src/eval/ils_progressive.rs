@@ -122,7 +122,11 @@ pub struct SetMoments {
 
 impl SetMoments {
     pub fn new(len: usize) -> Self {
-        Self { k: 0, sum: vec![0.0; len], sum_sq: vec![0.0; len] }
+        Self {
+            k: 0,
+            sum: vec![0.0; len],
+            sum_sq: vec![0.0; len],
+        }
     }
 
     pub fn add(&mut self, img: &ImageBuf) {
@@ -375,7 +379,13 @@ mod tests {
             }
             s - 6.0
         };
-        let mut draw = || image(&(0..n_px).map(|_| (mu * (1.0 + rel * normal())) as f32).collect::<Vec<_>>());
+        let mut draw = || {
+            image(
+                &(0..n_px)
+                    .map(|_| (mu * (1.0 + rel * normal())) as f32)
+                    .collect::<Vec<_>>(),
+            )
+        };
         let mut m = SetMoments::new(n_px * 3);
         (0..64).for_each(|_| m.add(&draw()));
         let sigma = m.per_set_rel_rms();

@@ -828,7 +828,9 @@ impl DssStage {
             .read(unshuffled.name)
             .write(payload)
             .build();
-        let shade = gi.as_ref().map(|g| Self::shade_pass(gpu, scene_gpu, u, triangles, &buffers, g));
+        let shade = gi
+            .as_ref()
+            .map(|g| Self::shade_pass(gpu, scene_gpu, u, triangles, &buffers, g));
         let splat = Self::splat_pass(gpu, scene_gpu, targets, u, &uniforms, &buffers, level_payload.name);
         Ok(Self {
             tessellate,
@@ -1011,11 +1013,7 @@ impl DssStage {
             bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
             immediate_size: 0,
         });
-        let module = crate::shader::module(
-            device,
-            "dss-gi-shade",
-            gi_sender_shader!("dss_gi_shade.wgsl"),
-        );
+        let module = crate::shader::module(device, "dss-gi-shade", gi_sender_shader!("dss_gi_shade.wgsl"));
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("dss-gi-shade"),
             layout: Some(&pl),
@@ -1041,20 +1039,11 @@ impl DssStage {
     }
 
     pub fn passes(&self) -> Vec<&dyn Pass> {
-        let mut v: Vec<&dyn Pass> = vec![
-            &self.tessellate,
-            &self.fine,
-            &self.filter,
-        ];
+        let mut v: Vec<&dyn Pass> = vec![&self.tessellate, &self.fine, &self.filter];
         if let Some(p) = &self.shade {
             v.push(p);
         }
-        v.extend([
-            &self.shuffle as &dyn Pass,
-            &self.splat,
-            &self.unshuffle,
-            &self.reduce,
-        ]);
+        v.extend([&self.shuffle as &dyn Pass, &self.splat, &self.unshuffle, &self.reduce]);
         v
     }
 

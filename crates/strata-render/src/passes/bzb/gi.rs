@@ -714,10 +714,7 @@ impl BzbGiStage {
         });
         let shade = (s.visibility && aov).then(|| {
             PassBuilder::new(gpu, targets, "bzb-gi-shade")
-                .shader(
-                    "bzb-gi-shade",
-                    gi_sender_shader!("bzb_gi_shade.wgsl"),
-                )
+                .shader("bzb-gi-shade", gi_sender_shader!("bzb_gi_shade.wgsl"))
                 .frame(scene_gpu)
                 .uniforms(&base)
                 .read(ORIGINS.name)
@@ -736,32 +733,34 @@ impl BzbGiStage {
                 .write(PAYLOAD.name)
                 .build()
         });
-        let splat = aov.then(|| super::splat_pass_with(
-            gpu,
-            scene_gpu,
-            targets,
-            SplatSpec {
-                visibility: s.visibility,
-                instances: count.saturating_mul(s.directions),
-                source: concat!(
-                    include_str!("bzb.wgsl"),
-                    "\n",
-                    include_str!("bzb_gi.wgsl"),
-                    "\n",
-                    include_str!("bzb_splat.wgsl"),
-                    "\n",
-                    include_str!("bzb_gi_sender.wgsl"),
-                    "\n",
-                    include_str!("bzb_gi_splat.wgsl")
-                ),
-                entries: ("fs_gi_visibility", "fs_gi_additive"),
-                payload: if s.visibility { HIT } else { PAYLOAD },
-                extra: Some((&layout, group)),
-            },
-            &splat_uniforms,
-            &triangles,
-            &tiles,
-        ));
+        let splat = aov.then(|| {
+            super::splat_pass_with(
+                gpu,
+                scene_gpu,
+                targets,
+                SplatSpec {
+                    visibility: s.visibility,
+                    instances: count.saturating_mul(s.directions),
+                    source: concat!(
+                        include_str!("bzb.wgsl"),
+                        "\n",
+                        include_str!("bzb_gi.wgsl"),
+                        "\n",
+                        include_str!("bzb_splat.wgsl"),
+                        "\n",
+                        include_str!("bzb_gi_sender.wgsl"),
+                        "\n",
+                        include_str!("bzb_gi_splat.wgsl")
+                    ),
+                    entries: ("fs_gi_visibility", "fs_gi_additive"),
+                    payload: if s.visibility { HIT } else { PAYLOAD },
+                    extra: Some((&layout, group)),
+                },
+                &splat_uniforms,
+                &triangles,
+                &tiles,
+            )
+        });
         let dss = match s.splat {
             super::Splat::Aov => None,
             super::Splat::Dss => Some(super::dss::DssStage::new(
@@ -944,11 +943,7 @@ impl SenderPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = crate::shader::module(
-            device,
-            "bzb-gi-senders",
-            gi_sender_shader!("bzb_gi_senders.wgsl"),
-        );
+        let module = crate::shader::module(device, "bzb-gi-senders", gi_sender_shader!("bzb_gi_senders.wgsl"));
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("bzb-gi-senders"),
             layout: Some(&pl),

@@ -704,7 +704,15 @@ impl BzbStage {
                 (
                     None,
                     None,
-                    Some(dss::DssStage::new(gpu, scene_gpu, targets, &du, &buffer, PAYLOAD.name, None)?),
+                    Some(dss::DssStage::new(
+                        gpu,
+                        scene_gpu,
+                        targets,
+                        &du,
+                        &buffer,
+                        PAYLOAD.name,
+                        None,
+                    )?),
                 )
             }
         };
