@@ -1085,6 +1085,38 @@ fn bench_technique_times_the_registered_passes() {
         ["depth-mip", "ao", "ao-temporal", "ao-blur-h", "ao-blur-v"]
     );
     assert!(v["increment_spread"]["frames"].as_u64() == Some(2), "{v}");
+    // bzb-gi with DSS surfels: its surfelization, surfel shading and splat passes are timed
+    let v = json_of(&strata(&[
+        "bench",
+        "technique",
+        "--technique",
+        "bzb-gi",
+        "--scene",
+        "still-life",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--frames",
+        "1",
+        "--layers",
+        "1",
+        "--set",
+        "splat=dss",
+        "--json",
+    ]));
+    let names = pass_names(&v);
+    for p in [
+        "bzb-directions",
+        "dss-fine",
+        "dss-gi-shade",
+        "dss-splat",
+        "dss-reduce",
+        "bzb-reconstruct",
+    ] {
+        assert!(names.contains(&p), "{p} in {names:?}");
+    }
+    assert!(!names.contains(&"bzb-splat"), "{names:?}");
     let o = strata(&[
         "bench",
         "technique",

@@ -49,9 +49,16 @@ pub fn run(
             before.chain(i.passes()).chain(["tonemap"]).collect()
         }
         // BZB: the splatting algorithm's own passes (AOV or DSS)
-        None => match &checked.bzb {
-            Some(b) => b.pass_names().to_vec(),
-            None => technique.passes.to_vec(),
+        None => match (&checked.bzb, &checked.bzb_gi) {
+            (Some(b), _) => b.pass_names().to_vec(),
+            // bzb-gi: the registry's (AOV) passes and DSS's; the frame times those it has
+            (None, Some(_)) => technique
+                .passes
+                .iter()
+                .copied()
+                .chain(strata_render::passes::bzb::gi::DSS_PASSES)
+                .collect(),
+            (None, None) => technique.passes.to_vec(),
         },
     };
     let extra = json!({

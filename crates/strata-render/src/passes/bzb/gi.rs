@@ -86,6 +86,20 @@ impl Default for BzbGiSettings {
     }
 }
 
+/// The passes `splat=dss` adds to bzb-gi's frame (profiler names; the registry's
+/// `passes` list the AOV path's): surfelization, the surfels' direct light, DSS's
+/// shuffle, splat, unshuffle and reduction.
+pub const DSS_PASSES: [&str; 8] = [
+    "dss-tessellate",
+    "dss-fine",
+    "dss-filter",
+    "dss-gi-shade",
+    "dss-shuffle",
+    "dss-splat",
+    "dss-unshuffle",
+    "dss-reduce",
+];
+
 impl BzbGiSettings {
     pub fn validate(&self) -> Result<(), String> {
         if !(1..=MAX_DIRECTIONS).contains(&self.directions) {
