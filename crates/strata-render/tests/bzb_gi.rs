@@ -297,27 +297,26 @@ fn irradiance_under_an_emissive_rectangle_is_pi_l_times_the_form_factor() {
 /// BZB Fig. 1: a sender hidden behind a blocker. Without visibility it adds its
 /// light (π L F through the blocker); with the bounced z-buffer the blocker is
 /// the nearest sender along every ray towards it, so the floor stays black.
-#[test]
-fn hidden_sender_adds_light_without_visibility_and_none_with_it() {
-    let gpu = common::gpu();
-    let (h, a, l) = (2.0f32, 1.0f32, 2.0f32);
-    let scene = emitter_scene(h, a, a, l, Some((1.0, 5.0)));
-    let (w, hh) = (48, 32);
+/// Fig. 1's hidden sender: with visibility on and then off (`settings`), the mean GPU
+/// irradiance and the mean π L F of the emitter (half-size `a`, height `h`,
+/// radiance `l`) over the floor pixels with |x|, |z| < 1, where every segment to
+/// the emitter crosses the blocker (at least `min_px` of them).
+fn hidden_sender_means(
+    gpu: &strata_render::GpuContext,
+    scene: &strata_scene::Scene,
+    (w, hh): (u32, u32),
+    (h, a, l): (f32, f32, f32),
+    min_px: usize,
+    settings: impl Fn(bool) -> BzbGiSettings,
+) -> ((f64, f64), (f64, f64)) {
     let mut means = Vec::new();
     for visibility in [true, false] {
-        let g = BzbGiSettings {
-            visibility,
-            directions: 8,
-            d_max: Some(10.0),
-            ..Default::default()
-        };
-        let r = render(&gpu, &scene, w, hh, g);
-        // floor points with |x|, |z| < 1: every segment to the emitter crosses the blocker
-        let px: Vec<_> = floor_irradiance(&gpu, &r, w, hh)
+        let r = render(gpu, scene, w, hh, settings(visibility));
+        let px: Vec<_> = floor_irradiance(gpu, &r, w, hh)
             .into_iter()
             .filter(|p| p.0.abs() < 1.0 && p.1.abs() < 1.0)
             .collect();
-        assert!(px.len() > 100, "{} floor pixels under the emitter", px.len());
+        assert!(px.len() > min_px, "{} floor pixels under the emitter", px.len());
         let (mut got, mut want) = (0.0, 0.0);
         for &(x, z, e) in &px {
             got += e;
@@ -327,7 +326,22 @@ fn hidden_sender_adds_light_without_visibility_and_none_with_it() {
         }
         means.push((got / px.len() as f64, want / px.len() as f64));
     }
-    let ((with, _), (without, through)) = (means[0], means[1]);
+    (means[0], means[1])
+}
+
+#[test]
+fn hidden_sender_adds_light_without_visibility_and_none_with_it() {
+    let gpu = common::gpu();
+    let (h, a, l) = (2.0f32, 1.0f32, 2.0f32);
+    let scene = emitter_scene(h, a, a, l, Some((1.0, 5.0)));
+    let (w, hh) = (48, 32);
+    let ((with, _), (without, through)) =
+        hidden_sender_means(&gpu, &scene, (w, hh), (h, a, l), 100, |visibility| BzbGiSettings {
+            visibility,
+            directions: 8,
+            d_max: Some(10.0),
+            ..Default::default()
+        });
     eprintln!(
         "hidden sender: with visibility {with:.5}, without {without:.4} (π L F through the blocker {through:.4})"
     );
@@ -497,30 +511,14 @@ fn dss_hidden_sender_adds_light_without_visibility_and_little_with_it() {
     let (h, a, l) = (2.0f32, 1.0f32, 2.0f32);
     let scene = emitter_scene(h, a, a, l, Some((1.0, 5.0)));
     let (w, hh) = (32, 24);
-    let mut means = Vec::new();
-    for visibility in [true, false] {
-        let g = dss(BzbGiSettings {
+    let ((with, _), (without, through)) = hidden_sender_means(&gpu, &scene, (w, hh), (h, a, l), 50, |visibility| {
+        dss(BzbGiSettings {
             visibility,
             directions: 4,
             d_max: Some(10.0),
             ..Default::default()
-        });
-        let r = render(&gpu, &scene, w, hh, g);
-        let px: Vec<_> = floor_irradiance(&gpu, &r, w, hh)
-            .into_iter()
-            .filter(|p| p.0.abs() < 1.0 && p.1.abs() < 1.0)
-            .collect();
-        assert!(px.len() > 50, "{} floor pixels under the emitter", px.len());
-        let (mut got, mut want) = (0.0, 0.0);
-        for &(x, z, e) in &px {
-            got += e;
-            want += std::f64::consts::PI
-                * l as f64
-                * parallel_rect_form_factor([x, z], h as f64, (-a as f64, a as f64), (-a as f64, a as f64));
-        }
-        means.push((got / px.len() as f64, want / px.len() as f64));
-    }
-    let ((with, _), (without, through)) = (means[0], means[1]);
+        })
+    });
     eprintln!(
         "dss hidden sender: with visibility {with:.5}, without {without:.4} (π L F through the blocker {through:.4})"
     );

@@ -89,16 +89,14 @@ pub fn run_gi(
     set: &[(String, f64)],
     radiosity: &strata_render::passes::radiosity::RadiositySettings,
 ) -> Result<crate::results::BzbGiEval> {
-    use strata_reference::gi::GiSettings;
-    use strata_reference::{Estimator, Reference};
     use strata_render::frame::FrameCameras;
     use strata_render::passes::lighting::LightingSettings;
     use strata_render::{GpuContext, GpuOptions, Renderer};
     use strata_scene::ImageBuf;
 
     use super::gi::{indirect, rgb, total};
-    use super::{half_flip, RefImage};
-    use crate::cache::{scene_fingerprint, RefCache};
+    use super::RefImage;
+
     use crate::metrics::{compare_radiance, display};
     use crate::results::GiErrors;
 
@@ -142,26 +140,11 @@ pub fn run_gi(
     // as eval gi / ils: no ambient term, no sky light (neither method gathers it)
     scene.settings.ambient = [0.0; 3];
     scene.settings.sky = [0.0; 3];
-    let (w, h) = (s.scene.width, s.scene.height);
+    let (_w, _h) = (s.scene.width, s.scene.height);
     let camera = cams.current;
     let exposure = scene.settings.exposure;
-    let estimator = Estimator::Gi(GiSettings {
-        bounces: 1,
-        russian_roulette: false,
-        ..Default::default()
-    });
-    let cache = RefCache::new(&s.cache);
-    let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
-    let description = format!(
-        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
-        scene_fingerprint(&scene, s.scene.frame)
-    );
     let shown = |img: &ImageBuf| display(img, exposure);
-    let converged = cache.converged(s.no_cache, &description, &estimator, || {
-        reference.converge(&camera, w, h, &estimator, &rule, |a, b| {
-            half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown))
-        })
-    });
+    let converged = super::gi::converged_gi(s, &scene, camera, 1, &rule);
     let ref_total = RefImage::of(&converged, total, shown)?;
     let ref_indirect = RefImage::of(&converged, indirect, shown)?;
 

@@ -43,6 +43,43 @@ struct GiResult {
     indirect_map: ImageBuf,
 }
 
+/// The path tracer's GI of `camera` with `bounces` indirect bounces, converged under
+/// `rule` until both the full image and the indirect light of its two halves are within
+/// the noise target (ꟻLIP on the tonemapped images), and cached by scene, camera, size,
+/// estimator and rule — `eval gi`, `ils` (one bounce), `bzb-gi` and ILS §6.3 share
+/// entries. No Russian roulette: the path length is bounded by `bounces` anyway, and
+/// roulette's reweighted survivors were most of the noise of the deeper bounces.
+pub(crate) fn converged_gi(
+    s: &EvalSettings,
+    scene: &Scene,
+    camera: Camera,
+    bounces: u32,
+    rule: &strata_reference::ConvergeRule,
+) -> strata_reference::Converged {
+    let (w, h) = (s.scene.width, s.scene.height);
+    let estimator = Estimator::Gi(GiSettings {
+        bounces,
+        russian_roulette: false,
+        ..Default::default()
+    });
+    let description = format!(
+        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
+        scene_fingerprint(scene, s.scene.frame)
+    );
+    let exposure = scene.settings.exposure;
+    let shown = |img: &ImageBuf| display(img, exposure);
+    RefCache::new(&s.cache).converged(s.no_cache, &description, &estimator, || {
+        Reference::new(scene, s.scene.frame).with_progress(s.progress).converge(
+            &camera,
+            w,
+            h,
+            &estimator,
+            rule,
+            |a, b| half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown)),
+        )
+    })
+}
+
 pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Result<GiEval> {
     let rule = s.check(DEFAULT_CAP, 8)?;
     if !(1..=64).contains(&g.bounces) {
@@ -54,34 +91,16 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     // does not see (the light-probe fallback's job): both are removed.
     scene.settings.ambient = [0.0; 3];
     scene.settings.sky = [0.0; 3];
-    let (w, h) = (s.scene.width, s.scene.height);
+    let (_w, _h) = (s.scene.width, s.scene.height);
     let camera = cams.current;
     render_settings(s, s.deep.layers, rs)
         .validate()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
 
-    // The path tracer converged until both the full image and the indirect light of its two
-    // halves are within the noise target (ꟻLIP on the tonemapped images); cached.
     let cache = RefCache::new(&s.cache);
     let exposure = scene.settings.exposure;
-    // No Russian roulette: the path length is bounded by `bounces` anyway, and roulette's
-    // reweighted survivors were most of the noise of the deeper bounces.
-    let estimator = Estimator::Gi(GiSettings {
-        bounces: g.bounces,
-        russian_roulette: false,
-        ..Default::default()
-    });
-    let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
-    let description = format!(
-        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
-        scene_fingerprint(&scene, s.scene.frame)
-    );
     let shown = |img: &ImageBuf| display(img, exposure);
-    let converged = cache.converged(s.no_cache, &description, &estimator, || {
-        reference.converge(&camera, w, h, &estimator, &rule, |a, b| {
-            half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown))
-        })
-    });
+    let converged = converged_gi(s, &scene, camera, g.bounces, &rule);
     let ref_total = RefImage::of(&converged, total, shown)?;
     let ref_indirect = RefImage::of(&converged, indirect, shown)?;
 

@@ -10,16 +10,13 @@
 //!   (SSM, §4.3) removes most of it.
 
 use anyhow::{bail, Result};
-use strata_reference::gi::GiSettings;
-use strata_reference::{Estimator, Reference};
 use strata_render::passes::lighting::LightingSettings;
 use strata_render::technique;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::ImageBuf;
 
 use super::gi::{indirect, render_indirect, total, DEFAULT_CAP};
-use super::{half_flip, noise_warnings, write_report, EvalSettings, RefImage};
-use crate::cache::{scene_fingerprint, RefCache};
+use super::{noise_warnings, write_report, EvalSettings, RefImage};
 use crate::metrics::{compare, compare_radiance, display};
 use crate::results::{EvalResult, GiErrors, IlsEval};
 
@@ -65,28 +62,13 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u3
     // as `eval gi`: the reference has no ambient term and the VPLs carry no sky light
     scene.settings.ambient = [0.0; 3];
     scene.settings.sky = [0.0; 3];
-    let (w, h) = (s.scene.width, s.scene.height);
+    let (_w, _h) = (s.scene.width, s.scene.height);
     let camera = cams.current;
     let exposure = scene.settings.exposure;
 
     // One indirect bounce = one VPL bounce (§6.2); the same cache entry as `eval gi --bounces 1`.
-    let estimator = Estimator::Gi(GiSettings {
-        bounces: 1,
-        russian_roulette: false,
-        ..Default::default()
-    });
-    let cache = RefCache::new(&s.cache);
-    let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
-    let description = format!(
-        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
-        scene_fingerprint(&scene, s.scene.frame)
-    );
     let shown = |img: &ImageBuf| display(img, exposure);
-    let converged = cache.converged(s.no_cache, &description, &estimator, || {
-        reference.converge(&camera, w, h, &estimator, &rule, |a, b| {
-            half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown))
-        })
-    });
+    let converged = super::gi::converged_gi(s, &scene, camera, 1, &rule);
     let ref_total = RefImage::of(&converged, total, shown)?;
     let ref_indirect = RefImage::of(&converged, indirect, shown)?;
 

@@ -11,17 +11,15 @@
 //! plus the CPU time that generated their VPLs, reported apart.
 
 use anyhow::{bail, Result};
-use strata_reference::gi::GiSettings;
 use strata_reference::vpl::VplSettings;
-use strata_reference::{Estimator, Reference};
+use strata_reference::Reference;
 use strata_render::frame::FrameCameras;
 use strata_render::passes::ils::{GpuVpl, VplShadows};
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{Camera, ImageBuf, Scene};
 
-use super::gi::{indirect, total};
-use super::{half_flip, EvalSettings, RefImage};
-use crate::cache::{scene_fingerprint, RefCache};
+use super::gi::total;
+use super::{EvalSettings, RefImage};
 use crate::metrics::{compare_radiance, display};
 use crate::results::{IlsProgressive, IlsProgressivePattern};
 
@@ -209,28 +207,9 @@ pub fn run(
     }
     // the path tracer with B indirect bounces (cached like `eval gi`)
     let rule = s.check(super::gi::DEFAULT_CAP, 8)?;
-    let estimator = Estimator::Gi(GiSettings {
-        bounces,
-        russian_roulette: false,
-        ..Default::default()
-    });
-    let (w, h) = (s.scene.width, s.scene.height);
     let exposure = scene.settings.exposure;
     let shown = |img: &ImageBuf| display(img, exposure);
-    let description = format!(
-        "v2 converged gi {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
-        scene_fingerprint(scene, s.scene.frame)
-    );
-    let traced = RefCache::new(&s.cache).converged(s.no_cache, &description, &estimator, || {
-        Reference::new(scene, s.scene.frame).with_progress(s.progress).converge(
-            &camera,
-            w,
-            h,
-            &estimator,
-            &rule,
-            |a, b| half_flip(&total(a), &total(b), shown).max(half_flip(&indirect(a), &indirect(b), shown)),
-        )
-    });
+    let traced = super::gi::converged_gi(s, scene, camera, bounces, &rule);
     let ref_total = RefImage::of(&traced, total, shown)?;
     let mut patterns = Vec::new();
     let mut converged_1x1 = None;
