@@ -20,12 +20,15 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     let is_bzb_gi = a.technique.name == "bzb-gi";
     if !a.set.values.is_empty()
         && !is_bzb_gi
-        && !matches!(a.technique.eval, EvalKind::VplRadiance | EvalKind::Composite)
+        && !matches!(
+            a.technique.eval,
+            EvalKind::VplRadiance | EvalKind::Composite | EvalKind::Radiance
+        )
         && !is_bzb
         && !is_aba
     {
         anyhow::bail!(
-            "--set is only read by --technique ils, oit, bzb-ao, bzb-gi and aba-ao in eval (ao and gi have their own flags)"
+            "--set is only read by --technique full, ils, oit, bzb-ao, bzb-gi and aba-ao in eval (ao has its own flags)"
         );
     }
     if a.progressive.is_some() && a.technique.eval != EvalKind::VplRadiance {
@@ -66,10 +69,21 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             EvalResult::BzbGi(bzb::run_gi(&s, &a.set.values, &rs)?)
         }
         EvalKind::Radiance => {
-            let rs = a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
+            // the radiosity flags, then the registry's `--set` names (e.g. open-sky)
+            let mut render = strata_render::RenderSettings {
+                radiosity: Some(a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?),
+                ..Default::default()
+            };
+            for (name, value) in &a.set.values {
+                a.technique
+                    .set(&mut render, name, *value)
+                    .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+            }
+            let rs = render.radiosity.expect("set above");
             let g = gi::GiEvalSettings {
                 bounces: a.bounces,
                 fig10: a.fig10,
+                probes: a.probes,
             };
             EvalResult::Gi(gi::run(&s, &rs, &g)?)
         }

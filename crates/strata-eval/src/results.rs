@@ -418,6 +418,9 @@ pub struct GiEval {
     pub boost: bool,
     pub warmup: u32,
     pub ref_bounces: u32,
+    /// Blended with light probes baked from the evaluated scene (`--probes`).
+    #[serde(default)]
+    pub probes: bool,
     #[serde(flatten)]
     pub errors: GiErrors,
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -289,7 +289,25 @@ static AO_SETTINGS: [SettingInfo; 12] = [
     },
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 10] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 12] = [
+    SettingInfo {
+        name: "open-sky",
+        doc: "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(radiosity_of(s).open_sky as u32 as f64),
+        set: |s, v| radiosity_mut(s).open_sky = v != 0.0,
+        values: &["fill", "sky"],
+    },
+    SettingInfo {
+        name: "hidden-taps",
+        doc: "taps that fail Eq. 5's n_Y test: fill (skipped, the paper) or black (occluders: their weight, no light)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(radiosity_of(s).hidden_black as u32 as f64),
+        set: |s, v| radiosity_mut(s).hidden_black = v != 0.0,
+        values: &["fill", "black"],
+    },
     SettingInfo {
         name: "coverage-confidence",
         doc: "on: the probe blend's confidence is M/U, U = the taps in the receiver's hemisphere (taps on its own plane or behind it no longer count against screen space; not in the paper, docs/image-quality.md); off: DGB's M/N",

@@ -31,6 +31,8 @@ pub struct GiEvalSettings {
     pub bounces: u32,
     /// Also run DGB Fig. 10's error-source study.
     pub fig10: bool,
+    /// Blend with light probes baked from the evaluated scene (DGB's coarse-scale fallback).
+    pub probes: bool,
 }
 
 /// GPU images of one configuration and their errors.
@@ -107,8 +109,17 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
     })?;
+    // the probes see the scene as evaluated: sky and ambient off
+    let probes = match g.probes {
+        true => Some(crate::cache::probes::scene_probes(&scene, &cache, !s.progress)?),
+        false => None,
+    };
     let evaluate = |layers: u32| -> Result<GiResult> {
-        let mut r = Renderer::new(&gpu, &scene, render_settings(s, layers, rs))?;
+        let settings = RenderSettings {
+            probes: probes.clone(),
+            ..render_settings(s, layers, rs)
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings)?;
         // static warm-up at the evaluated camera: bounces and temporal history
         let renders = s.warmup.max(1) + 1;
         let (full, indirect) = render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, renders)?;
@@ -169,6 +180,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         boost: rs.boost,
         warmup: s.warmup,
         ref_bounces: g.bounces,
+        probes: g.probes,
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
         fig10,

@@ -69,6 +69,13 @@ pub struct RadiositySettings {
     /// taps on the receiver's own plane or behind it say nothing about its light, so they no
     /// longer hand the pixel to the light probes (docs/image-quality.md). Not in the paper.
     pub coverage_confidence: bool,
+    /// Background taps (no surface in any layer) count as the sky's radiance along their
+    /// camera ray, with the solid-angle weight of a surface at infinity, instead of being
+    /// skipped (which fills their part of the hemisphere with the other taps' light).
+    pub open_sky: bool,
+    /// Taps that fail Eq. 5's n̂_Y test count as black occluders (their weight, no light)
+    /// instead of being skipped.
+    pub hidden_black: bool,
 }
 
 /// DGB Table 2's parameter sets, read from `presets/*.toml` (embedded).
@@ -164,6 +171,8 @@ impl Default for RadiositySettings {
             temporal: Some(TemporalSettings::default()),
             guard_band_shaded: 0.5,
             coverage_confidence: false,
+            open_sky: false,
+            hidden_black: false,
         }
     }
 }
@@ -250,6 +259,10 @@ pub struct RadiosityUniforms {
     pub coverage: u32,
     /// 1 = solid-angle tap weights ([`RadiositySettings::solid_angle`]).
     pub solid_angle: u32,
+    /// 1 = background taps count as the sky ([`RadiositySettings::open_sky`]).
+    pub open_sky: u32,
+    /// 1 = back-facing taps count as black ([`RadiositySettings::hidden_black`]).
+    pub hidden_black: u32,
 }
 
 impl RadiosityUniforms {
@@ -273,6 +286,8 @@ impl RadiosityUniforms {
             rotate: s.rotate as u32,
             coverage: s.coverage_confidence as u32,
             solid_angle: s.solid_angle as u32,
+            open_sky: s.open_sky as u32,
+            hidden_black: s.hidden_black as u32,
         }
     }
 }

@@ -33,6 +33,12 @@ struct Radiosity {
     coverage: u32,
     // 1 = solid-angle weights (self-normalised; see `term`), 0 = Eq. 4's equal weights
     solid_angle: u32,
+    // 1 = background taps (layer 0 empty) count as the sky's radiance along their
+    // camera ray instead of being skipped (`sky_term`)
+    open_sky: u32,
+    // 1 = taps that fail Eq. 5's n̂_Y test count as black occluders instead of
+    // being skipped
+    hidden_black: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -83,6 +89,14 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> vec4f {
     if (rad.normal_test != 0u || rad.solid_angle != 0u) {
         let ny = normal_of(src, j);
         if (rad.normal_test != 0u && dot(w, ny) >= 0.0) {
+            if (rad.hidden_black != 0u) {
+                // a black occluder: weight, no light (a < 0 marks it)
+                var wo = 1.0;
+                if (rad.solid_angle != 0u) {
+                    wo = solid_angle_weight(y, ny, w, vv, h);
+                }
+                return vec4f(0.0, 0.0, 0.0, -wo);
+            }
             return vec4f(0.0);
         }
         if (rad.solid_angle != 0u) {
@@ -109,11 +123,32 @@ fn solid_angle_weight(y: vec3f, ny: vec3f, w: vec3f, vv: f32, h: f32) -> f32 {
 
 // Of two candidate terms, the one with the larger contribution (the union of
 // layers, as for AO's max in Eq. 1).
+// A light-carrying term (a > 0) wins over an occluder (a < 0), which wins over
+// nothing (a = 0).
 fn union_term(a: vec4f, b: vec4f) -> vec4f {
-    if (b.a > 0.0 && (a.a == 0.0 || luminance(b.rgb) > luminance(a.rgb))) {
+    if (b.a > 0.0 && (a.a <= 0.0 || luminance(b.rgb) > luminance(a.rgb))) {
+        return b;
+    }
+    if (b.a < 0.0 && a.a == 0.0) {
         return b;
     }
     return a;
+}
+
+// A background tap (nothing in any layer) as the sky seen along its camera ray
+// from X: radiance sky · cos, weight = the solid-angle weight's limit for a
+// surface at infinity (z²/d² → 1, cos_y/cos_view → 1), i.e. the tap's h.
+fn sky_term(x: vec3f, n: vec3f, src: vec2i, h: f32) -> vec4f {
+    let y = world_from_csz(frame, vec2f(src) + 0.5, 1.0e4);
+    let cos_x = dot(normalize(y - x), n);
+    if (cos_x <= 0.0) {
+        return vec4f(0.0);
+    }
+    var wt = 1.0;
+    if (rad.solid_angle != 0u) {
+        wt = h;
+    }
+    return vec4f(frame.sky.rgb * cos_x * wt, -wt);
 }
 
 // Whether the tap at pixel `src` with layer-0 depth `z0` (0: background) tells the
@@ -200,8 +235,15 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
                 best1 = union_term(best1, term(x1, n1, y, j, src, tap.radius));
             }
         }
-        sum0 += best0;
-        sum1 += best1;
+        if (rad.open_sky != 0u && zs.x <= 0.0) {
+            best0 = sky_term(x0, n0, src, tap.radius);
+            if (has1) {
+                best1 = sky_term(x1, n1, src, tap.radius);
+            }
+        }
+        // occluders and the sky add weight (and the sky its light) but do not count in M
+        sum0 += vec4f(best0.rgb, abs(best0.a));
+        sum1 += vec4f(best1.rgb, abs(best1.a));
         let hit0 = select(0.0, 1.0, best0.a > 0.0);
         let hit1 = select(0.0, 1.0, best1.a > 0.0);
         m0 += hit0;
