@@ -236,12 +236,36 @@ impl Reference<'_> {
         [direct, indirect]
     }
 
-    /// Radiance arriving at `origin` from direction −`dir` (one path sample):
-    /// emission and direct light of the first surface along `dir`, plus what it
-    /// reflects of further bounces, or the sky. Used to bake light probes.
+    /// Radiance arriving at `origin` from direction −`dir` (one path sample) that a
+    /// receiver there gets as *indirect* light: the emission, direct light and further
+    /// bounces of the first surface along `dir`, or the sky — less the emission of a
+    /// surface that lies on a [`Light::Rect`], whose light the GPU's direct lighting
+    /// already carries (counting it here too would add it twice). Used to bake light
+    /// probes.
     pub fn radiance(&self, origin: Vec3, dir: Vec3, settings: &GiSettings, rng: &mut Rng, rays: &mut u64) -> Vec3 {
         let (d, i) = self.trace_path(origin, 0.0, dir, settings, None, None, rng, rays);
-        d + i
+        let direct_light = self.bvh.intersect(origin, dir, 0.0, f32::INFINITY).and_then(|h| {
+            let hit = self.bvh.surface(&h, dir);
+            (hit.front_face && self.on_rect_light(hit.position))
+                .then(|| Vec3::from(self.material(hit.material).emission).max(Vec3::ZERO))
+        });
+        (d - direct_light.unwrap_or(Vec3::ZERO)).max(Vec3::ZERO) + i
+    }
+
+    /// Whether `p` lies on one of the scene's [`Light::Rect`] rectangles (within 1 mm of
+    /// its plane, inside its edges).
+    fn on_rect_light(&self, p: Vec3) -> bool {
+        self.scene.lights.iter().any(|l| match *l {
+            Light::Rect {
+                center, half_u, half_v, ..
+            } => {
+                let d = p - center;
+                let n = half_u.cross(half_v).normalize_or_zero();
+                let inside = |h: Vec3| d.dot(h).abs() <= h.length_squared() * (1.0 + 1e-3) + 1e-6;
+                d.dot(n).abs() < 1e-3 && inside(half_u) && inside(half_v)
+            }
+            _ => false,
+        })
     }
 
     /// One path from `origin` (hits beyond `t_min`) along `dir`: (direct, indirect).

@@ -79,7 +79,7 @@ mod tests {
     /// Inside a closed box whose walls emit L and reflect nothing, every probe
     /// sees radiance L in every direction: irradiance πL for every normal.
     #[test]
-    fn probes_in_a_glowing_box_see_pi_l() {
+    fn probes_in_a_glowing_box_see_pi_l_but_not_rect_lights() {
         let mut walls = MeshBuilder::new();
         walls.cuboid(Vec3::splat(-1.0), Vec3::splat(1.0));
         let l = 0.5;
@@ -131,6 +131,58 @@ mod tests {
                     "probe {i} normal {n}: {e}"
                 );
             }
+        }
+        // the ceiling and the floor declared as rect lights: the GPU lights the receivers
+        // with them directly, so the probes (indirect light only) must not see their
+        // emission — only the four side walls, which still glow.
+        let mut lit = scene.clone();
+        let rect = |c: Vec3, u: Vec3, v: Vec3| strata_scene::Light::Rect {
+            center: c,
+            half_u: u,
+            half_v: v,
+            radiance: [l; 3],
+        };
+        lit.lights = vec![rect(Vec3::Y, Vec3::X, Vec3::Z), rect(-Vec3::Y, Vec3::Z, Vec3::X)];
+        let probes = Reference::new(&lit, 0.0).bake_probes([2, 2, 2], 1024, &GiSettings::default());
+        // oracle: L × ∫ cos over the directions whose ray leaves the box through a side wall
+        let side_walls = |p: Vec3, n: Vec3| {
+            let k = 20_000;
+            let mut e = 0.0;
+            for i in 0..k {
+                let d = fibonacci_sphere(i, k);
+                let c = d.dot(n);
+                if c <= 0.0 {
+                    continue;
+                }
+                // exit axis: the smallest t = (±1 − p_i) / d_i
+                let t = |i: usize| (d[i].signum() - p[i]) / d[i];
+                if t(1) > t(0).min(t(2)) {
+                    e += c;
+                }
+            }
+            e * 4.0 * std::f32::consts::PI / k as f32 * l
+        };
+        for i in 0..probes.count() {
+            for n in [Vec3::Y, Vec3::X, Vec3::new(0.3, 0.4, -0.866).normalize()] {
+                let e = probes.probe_irradiance(i, n).x;
+                let want = side_walls(probes.position(i), n);
+                assert!(
+                    (e - want).abs() < 0.1 * std::f32::consts::PI * l,
+                    "probe {i} normal {n}: {e}, expected {want}"
+                );
+            }
+        }
+        // every wall a rect light: no indirect light at all
+        lit.lights.extend([
+            rect(Vec3::X, Vec3::Y, Vec3::Z),
+            rect(-Vec3::X, Vec3::Z, Vec3::Y),
+            rect(Vec3::Z, Vec3::X, Vec3::Y),
+            rect(-Vec3::Z, Vec3::Y, Vec3::X),
+        ]);
+        let dark = Reference::new(&lit, 0.0).bake_probes([2, 2, 2], 64, &GiSettings::default());
+        for i in 0..dark.count() {
+            let e = dark.probe_irradiance(i, Vec3::new(0.3, 0.4, -0.866).normalize());
+            assert!(e.max_element().abs() < 1e-4, "probe {i}: {e}");
         }
     }
 }

@@ -355,3 +355,52 @@ fn coverage_confidence_is_near_one_inside_a_closed_box() {
         }
     }
 }
+
+/// The composite's probe term (`probe-irradiance`, before AO's factor) is the CPU
+/// twin's `IrradianceProbes::irradiance` at every covered pixel — trilinear weights, the
+/// facing weight (probes behind the receiver's tangent plane barely count) and SH
+/// evaluation — for a 3×3×3 grid of distinct, direction-dependent probes, one of them
+/// invalid.
+#[test]
+fn probe_field_matches_cpu_twin() {
+    let gpu = common::gpu();
+    let scene = frozen("cornell");
+    let (w, h) = (64, 48);
+    let (lo, hi) = (glam::Vec3::new(-0.1, -0.1, -0.1), glam::Vec3::new(0.66, 0.66, 0.66));
+    let mut probes = IrradianceProbes::grid(lo, hi, [3, 3, 3]);
+    for (i, c) in probes.coeffs.iter_mut().enumerate() {
+        for (k, band) in c.iter_mut().enumerate() {
+            // a positive constant band and smaller, signed higher bands
+            let v = |ch: usize| ((i * 31 + k * 7 + ch * 13) % 17) as f32 / 17.0;
+            *band = match k {
+                0 => [1.0 + v(0), 1.0 + v(1), 1.0 + v(2)],
+                _ => [0.3 * (v(0) - 0.5), 0.3 * (v(1) - 0.5), 0.3 * (v(2) - 0.5)],
+            };
+        }
+    }
+    probes.valid[13] = false;
+    let mut r = renderer(&gpu, &scene, w, h, RadiositySettings::default(), Some(probes.clone()), None);
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+        .expect("frame renders without validation errors");
+    let field = r.read_target(&gpu, "probe-irradiance").unwrap();
+    let points = common::surface_points(&gpu, &r);
+    assert!(points.len() > w as usize * h as usize / 2, "the box fills the frame");
+    let mut worst = 0.0f32;
+    for s in &points {
+        let av = field.data[s.i * 4 + 3];
+        let want = probes.irradiance(s.p, s.n) * av;
+        for c in 0..3 {
+            let got = field.data[s.i * 4 + c];
+            let err = (got - want[c]).abs() / want[c].abs().max(0.05);
+            worst = worst.max(err);
+            assert!(
+                err < 5e-3,
+                "pixel ({}, {}) channel {c}: GPU {got} vs CPU {}",
+                s.x,
+                s.y,
+                want[c]
+            );
+        }
+    }
+    eprintln!("worst relative error {worst:.2e} over {} pixels", points.len());
+}

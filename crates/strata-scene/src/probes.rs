@@ -93,8 +93,8 @@ impl IrradianceProbes {
     }
 
     /// Irradiance at `p` for normal `n`: trilinear blend of the valid ones of
-    /// the 8 surrounding probes (positions clamped to the grid), weights
-    /// renormalised; all 8 when none is valid.
+    /// the 8 surrounding probes (positions clamped to the grid), each weight times
+    /// [`facing_weight`], renormalised; all 8 when none is valid.
     pub fn irradiance(&self, p: Vec3, n: Vec3) -> Vec3 {
         let g = ((p - self.origin) / self.spacing).max(Vec3::ZERO);
         let max = Vec3::new(
@@ -118,6 +118,7 @@ impl IrradianceProbes {
                 * (if o.y > 0.0 { t.y } else { 1.0 - t.y })
                 * (if o.z > 0.0 { t.z } else { 1.0 - t.z });
             let index = (c.x as u32 + self.dims[0] * (c.y as u32 + self.dims[1] * c.z as u32)) as usize;
+            let w = w * facing_weight(self.origin + c * self.spacing - p, n);
             let pe = self.probe_irradiance(index, n);
             e_all += pe * w;
             sum_all += w;
@@ -132,6 +133,21 @@ impl IrradianceProbes {
             e_all / sum_all.max(1e-6)
         }
     }
+}
+
+/// How much a probe at offset `to_probe` from a receiver with normal `n` counts:
+/// ((1 + cos)/2)² + 0.02, cos between `n` and the direction to the probe. A probe
+/// behind the receiver's tangent plane sees the other side of its surface (through a
+/// wall or a floor: light leaking) and gets almost no weight; one in front counts
+/// fully. (The wrap-shading weight of irradiance-field probes; a probe at the
+/// receiver itself counts as one in its plane.)
+pub fn facing_weight(to_probe: Vec3, n: Vec3) -> f32 {
+    let len = to_probe.length();
+    if len <= 1e-4 {
+        return 0.25 + 0.02;
+    }
+    let f = 0.5 * (to_probe.dot(n) / len + 1.0);
+    f * f + 0.02
 }
 
 #[cfg(test)]
@@ -163,5 +179,15 @@ mod tests {
         // an invalid probe gets no weight
         p.valid[1] = false;
         assert!((p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::Y).x - y0).abs() < 1e-5);
+        // a receiver facing probe 1 (normal +x, probe 0 behind it): weights
+        // 0.25 · 0.02 and 0.75 · 1.02 at x = 1.5
+        p.valid[1] = true;
+        let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::X).x / sh9(Vec3::X)[0];
+        let (w0, w1) = (0.25 * 0.02, 0.75 * 1.02);
+        assert!((e - (w0 * 1.0 + w1 * 3.0) / (w0 + w1)).abs() < 1e-4, "{e}");
+        // facing away from probe 1: probe 0 wins
+        let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), -Vec3::X).x / sh9(-Vec3::X)[0];
+        let (w0, w1) = (0.25 * 1.02, 0.75 * 0.02);
+        assert!((e - (w0 * 1.0 + w1 * 3.0) / (w0 + w1)).abs() < 1e-4, "{e}");
     }
 }

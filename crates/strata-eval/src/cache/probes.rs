@@ -12,7 +12,7 @@ use strata_scene::{ImageBuf, Scene};
 use super::{scene_fingerprint, RefCache};
 
 /// Probes per axis, rays per probe, path bounces.
-pub const GRID: [u32; 3] = [8, 4, 8];
+pub const GRID: [u32; 3] = [16, 8, 16];
 pub const RAYS: u32 = 512;
 pub const BOUNCES: u32 = 3;
 
@@ -20,7 +20,7 @@ pub const BOUNCES: u32 = 3;
 /// notice on stderr unless `quiet`).
 pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v2 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
+        "v3 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
         scene_fingerprint(scene, 0.0)
     );
     let key = RefCache::key(&description);

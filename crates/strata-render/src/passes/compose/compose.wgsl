@@ -72,8 +72,8 @@ fn probe_irradiance(index: u32, n: vec3f) -> vec3f {
     return max(e, vec3f(0.0));
 }
 
-// Trilinear blend of the valid ones of the 8 probes around p (as
-// `IrradianceProbes::irradiance`).
+// Trilinear blend of the valid ones of the 8 probes around p, weighted by how
+// much each faces the receiver (as `IrradianceProbes::irradiance`).
 fn probe_field(p: vec3f, n: vec3f) -> vec3f {
     let dims = compose.dims.xyz;
     let mx = vec3f(dims) - 1.0;
@@ -88,8 +88,17 @@ fn probe_field(p: vec3f, n: vec3f) -> vec3f {
         let o = vec3f(f32(corner & 1u), f32((corner >> 1u) & 1u), f32((corner >> 2u) & 1u));
         let c = vec3u(min(i0 + o, mx));
         let w3 = mix(1.0 - t, t, o);
-        let w = w3.x * w3.y * w3.z;
+        var w = w3.x * w3.y * w3.z;
         let index = c.x + dims.x * (c.y + dims.y * c.z);
+        // probes behind the receiver's tangent plane see the other side of its
+        // surface (as `probes::facing_weight`)
+        let to_probe = compose.origin.xyz + vec3f(c) * compose.spacing.xyz - p;
+        let len = length(to_probe);
+        var f = 0.5;
+        if (len > 1e-4) {
+            f = 0.5 * (dot(to_probe / len, n) + 1.0);
+        }
+        w *= f * f + 0.02;
         let pe = probe_irradiance(index, n);
         e_all += pe * w;
         sum_all += w;
