@@ -46,20 +46,25 @@ fn frozen(name: &str) -> Scene {
 #[test]
 fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     let gpu = common::gpu();
-    // (scene, n̂_Y test, solid-angle weights): the paper's Eq. 4 and the default weights
-    for (name, normal_test, solid_angle) in [
-        ("atrium", true, false),
-        ("cornell", false, false),
-        ("warehouse", true, false),
-        ("atrium", true, true),
-        ("cornell", false, true),
-        ("warehouse", true, true),
+    // (scene, n̂_Y test, solid-angle weights, open sky, hidden taps black): the paper's
+    // Eq. 4, the default weights, and the two non-paper tap rules (the atrium has a sky)
+    for (name, normal_test, solid_angle, open_sky, hidden_black) in [
+        ("atrium", true, false, false, false),
+        ("cornell", false, false, false, false),
+        ("warehouse", true, false, false, false),
+        ("atrium", true, true, false, false),
+        ("cornell", false, true, false, false),
+        ("warehouse", true, true, false, false),
+        ("atrium", true, true, true, true),
+        ("warehouse", true, false, true, true),
     ] {
         let scene = frozen(name);
         let (w, h) = (96, 64);
         let rs = RadiositySettings {
             normal_test,
             solid_angle,
+            open_sky,
+            hidden_black,
             radius: Some(4.0),
             ..Default::default()
         };

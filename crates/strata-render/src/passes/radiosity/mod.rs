@@ -509,7 +509,9 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         let (tx, ty) = ((qx >> m) as u32, (qy >> m) as u32);
         let zs = g.zmip[m as usize].pixel(tx, ty);
         let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
-        let mut best: Option<(Vec3, f32)> = None;
+        // (light · cos · w, w, carries light): a light-carrying term wins over a black
+        // occluder (`hidden_black`), which wins over nothing (as `union_term`)
+        let mut best: Option<(Vec3, f32, bool)> = None;
         for (j, &zj) in zs.iter().enumerate().take(g.layers.min(2) as usize) {
             if zj <= 0.0 {
                 continue;
@@ -526,30 +528,43 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
                 continue;
             }
             let ny = v3(g.normals[j], sx, sy);
-            if u.normal_test != 0 && wdir.dot(ny) >= 0.0 {
-                continue;
-            }
             let wt = if u.solid_angle != 0 {
                 solid_angle_weight(eye, yv, ny, wdir, vv, tap.radius, u.radius)
             } else {
                 1.0
             };
+            if u.normal_test != 0 && wdir.dot(ny) >= 0.0 {
+                if u.hidden_black != 0 && best.is_none() {
+                    best = Some((Vec3::ZERO, wt, false));
+                }
+                continue;
+            }
             let c = v3(g.radiosity[j], sx, sy) * cos_x * wt;
-            if best.is_none_or(|(b, _)| luminance(c) > luminance(b)) {
-                best = Some((c, wt));
+            if best.is_none_or(|(b, _, light)| !light || luminance(c) > luminance(b)) {
+                best = Some((c, wt, true));
             }
         }
-        if let Some((b, wt)) = best {
+        // a background tap: the sky along its camera ray, weight h (`sky_term`)
+        if u.open_sky != 0 && zs[0] <= 0.0 {
+            best = None;
+            let dir = (world(sx as f32, sy as f32, 1.0e4) - pos).normalize();
+            let cos_x = dir.dot(n);
+            if cos_x > 0.0 {
+                let wt = if u.solid_angle != 0 { tap.radius } else { 1.0 };
+                best = Some((Vec3::from_slice(&g.frame.sky[..3]) * cos_x * wt, wt, false));
+            }
+        }
+        if let Some((b, wt, light)) = best {
             sum += b;
             wsum += wt;
-            m_count += 1;
+            m_count += light as u32;
         }
         // coverage confidence: the tap's direction (layer 0's point, else its camera ray)
         // lies in the receiver's hemisphere (as `hemisphere_tap` in radiosity.wgsl)
         let y0 = world(sx as f32, sy as f32, if zs[0] > 0.0 { zs[0] } else { 1.0e4 });
-        u_count += (best.is_some() || (y0 - pos).normalize().dot(n) > COVERAGE_COS) as u32;
+        u_count += (best.is_some_and(|b| b.2) || (y0 - pos).normalize().dot(n) > COVERAGE_COS) as u32;
     }
-    if m_count == 0 || wsum <= 0.0 {
+    if wsum <= 0.0 {
         return (Vec3::ZERO, 0.0);
     }
     let confidence = if u.coverage != 0 {
