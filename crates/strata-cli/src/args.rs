@@ -464,12 +464,12 @@ pub struct EvalArgs {
     /// without the n_Y test against single-bounce references with and without visibility.
     #[arg(long)]
     pub fig10: bool,
-    /// gi: blend the screen-space radiosity with light probes baked from the evaluated (sky-off)
-    /// scene by the confidence, as `render --technique full` does (DGB §3.2: "all our results
-    /// use static radiance and irradiance probes for the coarse-scale fallback"); off: the
-    /// deep G-buffer's radiosity alone.
+    /// gi: evaluate the deep G-buffer's screen-space radiosity alone. By default it is blended
+    /// with light probes baked from the evaluated (sky-off) scene by its confidence, as
+    /// `render --technique full` shows it (DGB §3.2: "all our results use static radiance and
+    /// irradiance probes for the coarse-scale fallback").
     #[arg(long)]
-    pub probes: bool,
+    pub no_probes: bool,
     /// full: instead of the sky-off GI comparison, measure what `render --technique full`
     /// shows (probes on): pixels clipped in the final image and the probe-only / blended /
     /// gbuffer-only views, |blended − probe-only|, and the chroma of fixed regions against the

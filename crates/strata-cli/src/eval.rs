@@ -83,7 +83,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             let g = gi::GiEvalSettings {
                 bounces: a.bounces,
                 fig10: a.fig10,
-                probes: a.probes,
+                probes: !a.no_probes,
             };
             EvalResult::Gi(gi::run(&s, &rs, &g)?)
         }

@@ -681,40 +681,55 @@ fn radiosity_estimator_switches_are_range_checked() {
     }
 }
 
+/// `eval --technique gi` blends with light probes by default (what `render --technique full`
+/// shows) and evaluates the screen-space radiosity alone with `--no-probes`; both report the
+/// indirect and full errors; `--set` reaches the radiosity's registry settings.
 #[test]
 fn eval_gi_reports_indirect_and_full_errors() {
     let cache = scratch("gi-cache");
     let _ = std::fs::remove_dir_all(&cache);
-    let o = strata(&[
-        "eval",
-        "--scene",
-        "cornell",
-        "--technique",
-        "gi",
-        "--layers",
-        "2",
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--ref-spp",
-        "4",
-        "--bounces",
-        "2",
-        "--warmup",
-        "2",
-        "--json",
-        "--quiet",
-        "--cache",
-        cache.to_str().unwrap(),
-    ]);
-    let v = json_of(&o);
-    assert_eq!(v["technique"], "gi");
-    for key in ["flip", "rmse", "mae"] {
-        assert!(v[key].as_f64().is_some_and(|x| x >= 0.0), "{key}: {v}");
-        assert!(v["full"][key].as_f64().is_some_and(|x| x >= 0.0), "full.{key}: {v}");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "eval",
+            "--scene",
+            "cornell",
+            "--technique",
+            "gi",
+            "--layers",
+            "2",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--ref-spp",
+            "4",
+            "--bounces",
+            "2",
+            "--warmup",
+            "2",
+            "--json",
+            "--quiet",
+            "--cache",
+            cache.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        json_of(&strata(&args))
+    };
+    let blended = run(&[]);
+    let alone = run(&["--no-probes", "--set", "hidden-taps=black"]);
+    for v in [&blended, &alone] {
+        assert_eq!(v["technique"], "gi");
+        for key in ["flip", "rmse", "mae"] {
+            assert!(v[key].as_f64().is_some_and(|x| x >= 0.0), "{key}: {v}");
+            assert!(v["full"][key].as_f64().is_some_and(|x| x >= 0.0), "full.{key}: {v}");
+        }
+        assert_eq!(v["ref_spp"], 4);
     }
-    assert_eq!(v["ref_spp"], 4);
+    assert_eq!(blended["probes"], true);
+    assert_eq!(alone["probes"], false);
+    assert_ne!(blended["rmse"], alone["rmse"], "the probes change the indirect light");
+    let o = strata(&["eval", "--scene", "cornell", "--technique", "gi", "--set", "open-sky=cloud", "--json"]);
+    assert_one_line_error(&o, &["open-sky", "fill", "sky"]);
 }
 
 #[test]
