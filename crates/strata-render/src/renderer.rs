@@ -629,7 +629,15 @@ impl Renderer {
             copies.push(("indirect-temporal", "indirect-temporal-history"));
         }
         if radiosity.as_ref().is_some_and(|r| r.propagate.is_some()) {
-            copies.push(("indirect", "indirect-history"));
+            // the next bounce reflects the best estimate of E there is: with probes, the blend
+            copies.push((
+                if settings.probes.is_some() {
+                    "indirect-blended"
+                } else {
+                    "indirect"
+                },
+                "indirect-history",
+            ));
             if settings.deep.layers > 1 {
                 copies.push(("indirect1-raw", "indirect1-history"));
             }
