@@ -728,7 +728,16 @@ fn eval_gi_reports_indirect_and_full_errors() {
     assert_eq!(blended["probes"], true);
     assert_eq!(alone["probes"], false);
     assert_ne!(blended["rmse"], alone["rmse"], "the probes change the indirect light");
-    let o = strata(&["eval", "--scene", "cornell", "--technique", "gi", "--set", "open-sky=cloud", "--json"]);
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        "gi",
+        "--set",
+        "open-sky=cloud",
+        "--json",
+    ]);
     assert_one_line_error(&o, &["open-sky", "fill", "sky"]);
 }
 

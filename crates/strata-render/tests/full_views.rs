@@ -379,7 +379,15 @@ fn probe_field_matches_cpu_twin() {
         }
     }
     probes.valid[13] = false;
-    let mut r = renderer(&gpu, &scene, w, h, RadiositySettings::default(), Some(probes.clone()), None);
+    let mut r = renderer(
+        &gpu,
+        &scene,
+        w,
+        h,
+        RadiositySettings::default(),
+        Some(probes.clone()),
+        None,
+    );
     r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
         .expect("frame renders without validation errors");
     let field = r.read_target(&gpu, "probe-irradiance").unwrap();
