@@ -290,7 +290,8 @@ fn view_window(x: &XServer, test: &str, frames: &str, shot: &std::path::Path) ->
         if let Some(id) = text(&o.stdout).lines().next().map(String::from) {
             break id;
         }
-        assert!(t0.elapsed() < Duration::from_secs(60), "no viewer window");
+        // generous: under the full test run the 2 cores are shared with the other tests
+        assert!(t0.elapsed() < Duration::from_secs(180), "no viewer window after 180 s");
         std::thread::sleep(Duration::from_millis(50));
     };
     Some((child, id))
