@@ -139,6 +139,22 @@ macro_rules! setting {
     };
 }
 
+/// A two-valued radiosity setting stored as a `bool` field of [`RadiositySettings`]: value 0
+/// = `values[0]` (false), 1 = `values[1]` (true).
+macro_rules! radiosity_switch {
+    ($name:literal, $doc:literal, $field:ident, $values:expr) => {
+        SettingInfo {
+            name: $name,
+            doc: $doc,
+            range: Range::Closed(0.0, 1.0),
+            integer: true,
+            get: |s: &RenderSettings| Some(radiosity_of(s).$field as u32 as f64),
+            set: |s: &mut RenderSettings, v: f64| radiosity_mut(s).$field = v != 0.0,
+            values: &$values,
+        }
+    };
+}
+
 fn ao_mut(s: &mut RenderSettings) -> &mut AoSettings {
     s.ao.get_or_insert_with(AoSettings::default)
 }
@@ -290,51 +306,36 @@ static AO_SETTINGS: [SettingInfo; 12] = [
 ];
 
 static RADIOSITY_SETTINGS: [SettingInfo; 12] = [
-    SettingInfo {
-        name: "open-sky",
-        doc: "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(radiosity_of(s).open_sky as u32 as f64),
-        set: |s, v| radiosity_mut(s).open_sky = v != 0.0,
-        values: &["fill", "sky"],
-    },
-    SettingInfo {
-        name: "hidden-taps",
-        doc: "taps that fail Eq. 5's n_Y test: fill (skipped, the paper) or black (occluders: their weight, no light)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(radiosity_of(s).hidden_black as u32 as f64),
-        set: |s, v| radiosity_mut(s).hidden_black = v != 0.0,
-        values: &["fill", "black"],
-    },
-    SettingInfo {
-        name: "coverage-confidence",
-        doc: "on: the probe blend's confidence is M/U, U = the taps in the receiver's hemisphere (taps on its own plane or behind it no longer count against screen space; not in the paper, docs/image-quality.md); off: DGB's M/N",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(radiosity_of(s).coverage_confidence as u32 as f64),
-        set: |s, v| radiosity_mut(s).coverage_confidence = v != 0.0,
-        values: &["off", "on"],
-    },
-    SettingInfo {
-        name: "indirect-weights",
-        doc: "tap weights of the gather: paper (DGB Eq. 4, every tap weighs 1) or solid-angle (each tap weighs the solid angle its screen area covers at the receiver, self-normalised)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(radiosity_of(s).solid_angle as u32 as f64),
-        set: |s, v| radiosity_mut(s).solid_angle = v != 0.0,
-        values: &["paper", "solid-angle"],
-    },
-    SettingInfo {
-        name: "indirect-temporal-noise",
-        doc: "on: hash the frame index into the gather's spiral rotation, so the temporal filter averages different tap patterns (the paper hashes the pixel only)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(radiosity_of(s).temporal_noise as u32 as f64),
-        set: |s, v| radiosity_mut(s).temporal_noise = v != 0.0,
-        values: &["off", "on"],
-    },
+    radiosity_switch!(
+        "open-sky",
+        "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",
+        open_sky,
+        ["fill", "sky"]
+    ),
+    radiosity_switch!(
+        "hidden-taps",
+        "taps that fail Eq. 5's n_Y test: fill (skipped, the paper) or black (occluders: their weight, no light)",
+        hidden_black,
+        ["fill", "black"]
+    ),
+    radiosity_switch!(
+        "coverage-confidence",
+        "on: the probe blend's confidence is M/U, U = the taps in the receiver's hemisphere (taps on its own plane or behind it no longer count against screen space; not in the paper, docs/image-quality.md); off: DGB's M/N",
+        coverage_confidence,
+        ["off", "on"]
+    ),
+    radiosity_switch!(
+        "indirect-weights",
+        "tap weights of the gather: paper (DGB Eq. 4, every tap weighs 1) or solid-angle (each tap weighs the solid angle its screen area covers at the receiver, self-normalised)",
+        solid_angle,
+        ["paper", "solid-angle"]
+    ),
+    radiosity_switch!(
+        "indirect-temporal-noise",
+        "on: hash the frame index into the gather's spiral rotation, so the temporal filter averages different tap patterns (the paper hashes the pixel only)",
+        temporal_noise,
+        ["off", "on"]
+    ),
     setting!(
         "indirect-samples",
         "radiosity taps N per pixel (DGB Eq. 4-5; default: the preset's)",
