@@ -284,7 +284,8 @@ impl RadiosityArgs {
         }
         s.temporal = (self.indirect_alpha != 0.0).then_some(TemporalSettings {
             alpha: self.indirect_alpha,
-            ..Default::default()
+            ..s.temporal
+                .unwrap_or_else(strata_render::passes::radiosity::indirect_temporal)
         });
         s.delta = self.delta;
         match self.indirect_temporal_noise.as_deref() {
@@ -393,6 +394,7 @@ impl AoArgs {
             temporal: (self.alpha != 0.0).then_some(TemporalSettings {
                 alpha: self.alpha,
                 max_distance: self.temporal_distance,
+                ..Default::default()
             }),
             deinterleave: self.deinterleave.0,
             filter_obscurance: self.filter_obscurance,

@@ -18,19 +18,6 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";
     let is_bzb_gi = a.technique.name == "bzb-gi";
-    if !a.set.values.is_empty()
-        && !is_bzb_gi
-        && !matches!(
-            a.technique.eval,
-            EvalKind::VplRadiance | EvalKind::Composite | EvalKind::Radiance
-        )
-        && !is_bzb
-        && !is_aba
-    {
-        anyhow::bail!(
-            "--set is only read by --technique full, ils, oit, bzb-ao, bzb-gi and aba-ao in eval (ao has its own flags)"
-        );
-    }
     if a.progressive.is_some() && a.technique.eval != EvalKind::VplRadiance {
         anyhow::bail!("--progressive is only read by --technique ils (ILS §6.3's physically-based mode)");
     }
@@ -62,7 +49,19 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 EvalResult::Bzb(bzb::run(&s, &b, &a.ao.settings())?)
             }
         }
-        EvalKind::AmbientVisibility => EvalResult::Ao(ao::run(&s, &a.ao.settings())?),
+        EvalKind::AmbientVisibility => {
+            // the AO flags, then the registry's `--set` names (e.g. temporal-clamp)
+            let mut render = strata_render::RenderSettings {
+                ao: Some(a.ao.settings()),
+                ..Default::default()
+            };
+            for (name, value) in &a.set.values {
+                a.technique
+                    .set(&mut render, name, *value)
+                    .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+            }
+            EvalResult::Ao(ao::run(&s, &render.ao.expect("set above"))?)
+        }
         EvalKind::None => unreachable!("the argument parser admits only comparable techniques"),
         EvalKind::Radiance if is_bzb_gi => {
             let rs = a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;

@@ -163,11 +163,23 @@ fn ao_of(s: &RenderSettings) -> AoSettings {
     s.ao.clone().unwrap_or_default()
 }
 
-/// α of an optional temporal filter: 0 turns it off, any other value keeps its distance threshold.
-fn set_alpha(t: &mut Option<crate::passes::temporal::TemporalSettings>, v: f64) {
+/// The history clamp of an optional temporal filter (nothing to set when the filter is off).
+fn set_clamp(t: &mut Option<crate::passes::temporal::TemporalSettings>, v: f64) {
+    if let Some(t) = t {
+        t.clamp_history = v != 0.0;
+    }
+}
+
+/// α of an optional temporal filter: 0 turns it off, any other value keeps its distance threshold
+/// (`off`'s when the filter was off).
+fn set_alpha(
+    t: &mut Option<crate::passes::temporal::TemporalSettings>,
+    v: f64,
+    off: crate::passes::temporal::TemporalSettings,
+) {
     *t = (v != 0.0).then(|| crate::passes::temporal::TemporalSettings {
         alpha: v as f32,
-        ..t.unwrap_or_default()
+        ..t.unwrap_or(off)
     });
 }
 
@@ -198,7 +210,7 @@ static DIRECT_SETTINGS: [SettingInfo; 2] = [
     ),
 ];
 
-static AO_SETTINGS: [SettingInfo; 12] = [
+static AO_SETTINGS: [SettingInfo; 13] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
@@ -237,8 +249,17 @@ static AO_SETTINGS: [SettingInfo; 12] = [
         Range::HalfOpen(0.0, 1.0),
         false,
         |s| Some(ao_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
-        |s, v| set_alpha(&mut ao_mut(s).temporal, v)
+        |s, v| set_alpha(&mut ao_mut(s).temporal, v, Default::default())
     ),
+    SettingInfo {
+        name: "temporal-clamp",
+        doc: "on: clamp the reprojected history to the range of this frame's AO over the pixel's 3x3 neighbourhood before blending (no ghosts of moved occluders; not in the paper); off: DGB's filter as published",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(ao_of(s).temporal.is_some_and(|t| t.clamp_history) as u32 as f64),
+        set: |s, v| set_clamp(&mut ao_mut(s).temporal, v),
+        values: &["off", "on"],
+    },
     setting!(
         "temporal-distance",
         "reprojection accepted within this distance of either layer (scene units)",
@@ -305,7 +326,7 @@ static AO_SETTINGS: [SettingInfo; 12] = [
     },
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 12] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 13] = [
     radiosity_switch!(
         "open-sky",
         "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",
@@ -366,8 +387,21 @@ static RADIOSITY_SETTINGS: [SettingInfo; 12] = [
         Range::HalfOpen(0.0, 1.0),
         false,
         |s| Some(radiosity_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
-        |s, v| set_alpha(&mut radiosity_mut(s).temporal, v)
+        |s, v| set_alpha(
+            &mut radiosity_mut(s).temporal,
+            v,
+            crate::passes::radiosity::indirect_temporal()
+        )
     ),
+    SettingInfo {
+        name: "indirect-temporal-clamp",
+        doc: "on: clamp the reprojected indirect history to the range of this frame's over the pixel's 3x3 neighbourhood before blending (not in the paper); off: DGB's filter as published",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(radiosity_of(s).temporal.is_some_and(|t| t.clamp_history) as u32 as f64),
+        set: |s, v| set_clamp(&mut radiosity_mut(s).temporal, v),
+        values: &["off", "on"],
+    },
     setting!(
         "delta",
         "progressive multi-bounce damping δ (DGB §3.3; 0 = single bounce)",

@@ -244,8 +244,9 @@ fn temporal_filter_reduces_per_pixel_variance_on_a_static_view() {
     assert!(vf < 0.2 * vr, "filtered variance {vf} vs raw {vr}");
 }
 
-/// With the true previous camera every pixel blends (1 − α)·E + α·E_{t−1}; when
-/// the previous camera is far from where the history was rendered, every
+/// With the true previous camera every pixel blends (1 − α)·E + α·E_{t−1}, the history
+/// first clamped to the range of E's 3×3 neighbourhood when `clamp_history` is on (the
+/// default); when the previous camera is far from where the history was rendered, every
 /// reprojected point misses both layers and takes the current value.
 #[test]
 fn temporal_filter_blends_valid_and_rejects_failed_reprojections() {
@@ -258,40 +259,64 @@ fn temporal_filter_blends_valid_and_rejects_failed_reprojections() {
     let shift = (cam.target - cam.eye).normalize() * -2.0;
     moved.eye += shift;
     moved.target += shift;
-    for (previous, expect_blend) in [(cam, true), (moved, false)] {
-        let mut r = ao_renderer(&gpu, &scene, w, h, 2, temporal_settings(alpha));
-        r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
-        let e0 = r.read_target(&gpu, "ao-temporal").unwrap();
-        let cams = FrameCameras {
-            previous,
-            ..FrameCameras::fixed(cam)
-        };
-        r.render(&gpu, &scene, &cams, 1.0).unwrap();
-        let e1 = r.read_target(&gpu, "ao-raw").unwrap();
-        let out = r.read_target(&gpu, "ao-temporal").unwrap();
-        let csz = r.read_target(&gpu, "csz").unwrap();
-        let (mut checked, mut differs) = (0, 0);
-        for i in 0..(w * h) as usize {
-            if csz.data[i] <= 0.0 {
-                continue;
-            }
-            checked += 1;
-            let want = if expect_blend {
-                (1.0 - alpha) * e1.data[i] + alpha * e0.data[i]
-            } else {
-                e1.data[i]
+    for clamp_history in [false, true] {
+        for (previous, expect_blend) in [(cam, true), (moved, false)] {
+            let mut settings = temporal_settings(alpha);
+            settings.temporal.as_mut().unwrap().clamp_history = clamp_history;
+            let mut r = ao_renderer(&gpu, &scene, w, h, 2, settings);
+            r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
+            let e0 = r.read_target(&gpu, "ao-temporal").unwrap();
+            let cams = FrameCameras {
+                previous,
+                ..FrameCameras::fixed(cam)
             };
+            r.render(&gpu, &scene, &cams, 1.0).unwrap();
+            let e1 = r.read_target(&gpu, "ao-raw").unwrap();
+            let out = r.read_target(&gpu, "ao-temporal").unwrap();
+            let csz = r.read_target(&gpu, "csz").unwrap();
+            let (mut checked, mut differs, mut clamped) = (0, 0, 0);
+            for y in 0..h as i32 {
+                for x in 0..w as i32 {
+                    let i = (y * w as i32 + x) as usize;
+                    if csz.data[i] <= 0.0 {
+                        continue;
+                    }
+                    checked += 1;
+                    // the current estimate's range over the 3×3 neighbourhood (clamped edges)
+                    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+                    for (dx, dy) in (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))) {
+                        let (qx, qy) = ((x + dx).clamp(0, w as i32 - 1), (y + dy).clamp(0, h as i32 - 1));
+                        let v = e1.data[(qy * w as i32 + qx) as usize];
+                        lo = lo.min(v);
+                        hi = hi.max(v);
+                    }
+                    let history = if clamp_history {
+                        e0.data[i].clamp(lo, hi)
+                    } else {
+                        e0.data[i]
+                    };
+                    clamped += (history != e0.data[i]) as usize;
+                    let want = if expect_blend {
+                        (1.0 - alpha) * e1.data[i] + alpha * history
+                    } else {
+                        e1.data[i]
+                    };
+                    assert!(
+                        (out.data[i] - want).abs() < 1e-5,
+                        "pixel ({x}, {y}): got {} want {want} (blend {expect_blend}, clamp {clamp_history})",
+                        out.data[i]
+                    );
+                    differs += ((e1.data[i] - e0.data[i]).abs() > 1e-3) as usize;
+                }
+            }
             assert!(
-                (out.data[i] - want).abs() < 1e-5,
-                "pixel {i}: got {} want {want} (blend {expect_blend})",
-                out.data[i]
+                checked > 1000 && differs > 100,
+                "weak test: {checked} px, {differs} differ"
             );
-            differs += ((e1.data[i] - e0.data[i]).abs() > 1e-3) as usize;
+            if clamp_history {
+                assert!(clamped > 10, "weak test: the clamp moved only {clamped} histories");
+            }
         }
-        assert!(
-            checked > 1000 && differs > 100,
-            "weak test: {checked} px, {differs} differ"
-        );
     }
 }
 

@@ -168,7 +168,7 @@ impl Default for RadiositySettings {
                 step: 1,
                 ..Default::default()
             },
-            temporal: Some(TemporalSettings::default()),
+            temporal: Some(indirect_temporal()),
             guard_band_shaded: 0.5,
             coverage_confidence: false,
             open_sky: false,
@@ -228,6 +228,18 @@ impl RadiositySettings {
             t.validate()?;
         }
         Ok(())
+    }
+}
+
+/// The indirect light's temporal filter: DGB §3.3's, without the history clamp that AO
+/// uses. The gather's noise is correlated over 4×4-pixel blocks (minimum MIP 2), so a 3×3
+/// range is too narrow to hold the converged mean and the clamp undoes the accumulation:
+/// `--no-probes` Sponza 0.1204 → 0.1320 ꟻLIP (docs/radiosity.md; `--set
+/// indirect-temporal-clamp=on` turns it on).
+pub fn indirect_temporal() -> TemporalSettings {
+    TemporalSettings {
+        clamp_history: false,
+        ..Default::default()
     }
 }
 

@@ -10,7 +10,8 @@ use crate::scene_gpu::GpuScene;
 
 /// Defaults: α = 0.85 (the paper's recommendation); reprojection accepted when
 /// the point lies within 0.01 scene units of either layer (the paper's 1 cm, with
-/// scenes in metres).
+/// scenes in metres); the history clamp on (not in the paper: issue 14, measured
+/// in docs/ao.md "History clamp").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TemporalSettings {
     /// Weight of the reprojected history, in [0, 1).
@@ -18,6 +19,12 @@ pub struct TemporalSettings {
     /// Camera-space distance (scene units) within which the reprojected point
     /// must lie of a layer of last frame's deep G-buffer.
     pub max_distance: f32,
+    /// Clamp the reprojected history to the range of the current input's 3×3
+    /// neighbourhood before blending (per channel; not in the paper): history that no
+    /// nearby current value supports — an occluder that moved away or arrived, light
+    /// that changed — is pulled to what this frame sees instead of fading over
+    /// 1/(1 − α) frames.
+    pub clamp_history: bool,
 }
 
 impl Default for TemporalSettings {
@@ -25,6 +32,7 @@ impl Default for TemporalSettings {
         Self {
             alpha: 0.85,
             max_distance: 0.01,
+            clamp_history: true,
         }
     }
 }
@@ -55,6 +63,8 @@ pub struct TemporalUniforms {
     pub max_distance: f32,
     pub has_history: u32,
     pub layers: u32,
+    /// 1 = [`TemporalSettings::clamp_history`].
+    pub clamp: u32,
 }
 
 /// Filters target `input` with `history` (last frame's `output`) into `output`.
@@ -82,6 +92,7 @@ impl TemporalPass {
             max_distance: settings.max_distance,
             has_history: 0,
             layers,
+            clamp: settings.clamp_history as u32,
         };
         let pass = PassBuilder::new(gpu, targets, name)
             .shader("temporal", include_str!("temporal.wgsl"))
@@ -107,6 +118,7 @@ impl TemporalPass {
             max_distance: self.settings.max_distance,
             has_history: has_history as u32,
             layers: self.layers,
+            clamp: self.settings.clamp_history as u32,
         };
         self.pass.set_uniforms(gpu, &u);
     }

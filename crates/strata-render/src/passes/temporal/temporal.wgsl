@@ -14,6 +14,8 @@ struct Temporal {
     has_history: u32,
     // layers in csz-history
     layers: u32,
+    // 1 = clamp the history to the current input's 3×3 range
+    clamp_history: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -37,5 +39,21 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     if (matching_layer(csz_history, r, temporal.layers, temporal.max_distance) < 0) {
         return e;
     }
-    return mix(e, bilinear_at(history, r.c), temporal.alpha);
+    var h = bilinear_at(history, r.c);
+    if (temporal.clamp_history != 0u) {
+        // the range this frame's estimate spans around p (per channel)
+        let size = vec2i(textureDimensions(current, 0));
+        var lo = e;
+        var hi = e;
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let q = clamp(p + vec2i(dx, dy), vec2i(0), size - 1);
+                let c = textureLoad(current, q, 0);
+                lo = min(lo, c);
+                hi = max(hi, c);
+            }
+        }
+        h = clamp(h, lo, hi);
+    }
+    return mix(e, h, temporal.alpha);
 }
