@@ -1354,7 +1354,8 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
         "--set",
         "vpls=3",
     ]);
-    assert_one_line_error(&o, &["--set", "ils"]);
+    // an ILS setting given to AO: the error names it, the technique and AO's own settings
+    assert_one_line_error(&o, &["--set vpls=3", "'ao'", "temporal-clamp"]);
 }
 
 /// Issue 10: `export-scene` writes every world-space triangle (per material, unshared
