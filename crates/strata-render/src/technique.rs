@@ -155,6 +155,22 @@ macro_rules! radiosity_switch {
     };
 }
 
+/// The history clamp of the temporal filter of the settings `$of` reads and `$mut` writes
+/// (two-valued: off, on).
+macro_rules! temporal_clamp {
+    ($name:literal, $doc:literal, $of:ident, $mut:ident) => {
+        SettingInfo {
+            name: $name,
+            doc: $doc,
+            range: Range::Closed(0.0, 1.0),
+            integer: true,
+            get: |s: &RenderSettings| Some($of(s).temporal.is_some_and(|t| t.clamp_history) as u32 as f64),
+            set: |s: &mut RenderSettings, v: f64| set_clamp(&mut $mut(s).temporal, v),
+            values: &["off", "on"],
+        }
+    };
+}
+
 fn ao_mut(s: &mut RenderSettings) -> &mut AoSettings {
     s.ao.get_or_insert_with(AoSettings::default)
 }
@@ -251,15 +267,12 @@ static AO_SETTINGS: [SettingInfo; 13] = [
         |s| Some(ao_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
         |s, v| set_alpha(&mut ao_mut(s).temporal, v, Default::default())
     ),
-    SettingInfo {
-        name: "temporal-clamp",
-        doc: "on: clamp the reprojected history to the range of this frame's AO over the pixel's 3x3 neighbourhood before blending (no ghosts of moved occluders; not in the paper); off: DGB's filter as published",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(ao_of(s).temporal.is_some_and(|t| t.clamp_history) as u32 as f64),
-        set: |s, v| set_clamp(&mut ao_mut(s).temporal, v),
-        values: &["off", "on"],
-    },
+    temporal_clamp!(
+        "temporal-clamp",
+        "on: clamp the reprojected history to the range of this frame's AO over the pixel's 3x3 neighbourhood before blending (no ghosts of moved occluders; not in the paper); off: DGB's filter as published",
+        ao_of,
+        ao_mut
+    ),
     setting!(
         "temporal-distance",
         "reprojection accepted within this distance of either layer (scene units)",
@@ -393,15 +406,12 @@ static RADIOSITY_SETTINGS: [SettingInfo; 13] = [
             crate::passes::radiosity::indirect_temporal()
         )
     ),
-    SettingInfo {
-        name: "indirect-temporal-clamp",
-        doc: "on: clamp the reprojected indirect history to the range of this frame's over the pixel's 3x3 neighbourhood before blending (not in the paper); off: DGB's filter as published",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(radiosity_of(s).temporal.is_some_and(|t| t.clamp_history) as u32 as f64),
-        set: |s, v| set_clamp(&mut radiosity_mut(s).temporal, v),
-        values: &["off", "on"],
-    },
+    temporal_clamp!(
+        "indirect-temporal-clamp",
+        "on: clamp the reprojected indirect history to the range of this frame's over the pixel's 3x3 neighbourhood before blending (not in the paper); off: DGB's filter as published",
+        radiosity_of,
+        radiosity_mut
+    ),
     setting!(
         "delta",
         "progressive multi-bounce damping δ (DGB §3.3; 0 = single bounce)",
