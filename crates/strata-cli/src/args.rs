@@ -362,9 +362,10 @@ pub struct AoArgs {
     /// Deinterleaved AO: "off" or an NxM pattern, N, M in 1..=4 (e.g. 2x2, 4x4; docs/ao.md).
     #[arg(long, default_value = "off", value_parser = parse_pattern)]
     pub deinterleave: Deinterleave,
-    /// Filter Eq. 1's obscurance mean before the square root, then AV = 1 − √ (not in the paper; docs/ao.md).
-    #[arg(long)]
-    pub filter_obscurance: bool,
+    /// on (default): the temporal and bilateral filters average Eq. 1's obscurance mean S, then
+    /// AV = 1 − √S (not in the paper; docs/ao.md); off: DGB's order (filter AV).
+    #[arg(long, num_args = 0..=1, default_missing_value = "on", value_parser = ["on", "off"])]
+    pub filter_obscurance: Option<String>,
 }
 
 /// `--deinterleave`: `None` = off.
@@ -397,7 +398,7 @@ impl AoArgs {
                 ..Default::default()
             }),
             deinterleave: self.deinterleave.0,
-            filter_obscurance: self.filter_obscurance,
+            filter_obscurance: self.filter_obscurance.as_deref() != Some("off"),
             ..d
         }
     }

@@ -115,7 +115,13 @@ fn gpu_ao_equals_cpu_eq1_eq2_over_the_same_buffers() {
     for (name, layers) in [("atrium", 2u32), ("cornell", 2), ("column-wall", 1), ("atrium", 3)] {
         let scene = frozen(name);
         let (w, h) = (96, 64);
-        let mut r = ao_renderer(&gpu, &scene, w, h, layers, AoSettings::default());
+        // DGB's order: `ao-raw` holds Eq. 1's AV (with the default filter_obscurance it holds S,
+        // checked by `filtered_obscurance_is_eq1_before_the_square_root_and_resolves_to_av`)
+        let settings = AoSettings {
+            filter_obscurance: false,
+            ..AoSettings::default()
+        };
+        let mut r = ao_renderer(&gpu, &scene, w, h, layers, settings);
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
             .expect("frame renders without validation errors");
         let raw = r.read_target_full(&gpu, "ao-raw", 0).unwrap();
@@ -367,9 +373,11 @@ fn temporal_filter_ignores_history_from_an_oracle_less_first_frame() {
 
 // ---- Deinterleaved AO (issue 11 item 8, docs/ao.md "Deinterleaved AO") ----
 
+/// Deinterleaved AO in DGB's order (AV filtered, `ao-raw` = AV), which the twins compute.
 fn deint(pattern: Option<[u32; 2]>) -> AoSettings {
     AoSettings {
         deinterleave: pattern,
+        filter_obscurance: false,
         ..AoSettings::default()
     }
 }

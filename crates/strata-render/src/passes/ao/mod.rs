@@ -75,7 +75,8 @@ pub struct AoSettings {
     /// average S and a last pass `ao-resolve` writes AV = max(0, 1 − √S).
     /// Averaging after the square root is lighter than before it (Jensen),
     /// which the deinterleaved AO's few taps per pixel make large
-    /// (`docs/ao.md`). Default false (DGB's order).
+    /// (`docs/ao.md`), and so does the per-frame rotation's temporal
+    /// accumulation. Default true since issue 14 (false = DGB's order).
     pub filter_obscurance: bool,
 }
 
@@ -103,7 +104,7 @@ impl Default for AoSettings {
             },
             temporal: Some(TemporalSettings::default()),
             deinterleave: None,
-            filter_obscurance: false,
+            filter_obscurance: true,
         }
     }
 }
