@@ -258,7 +258,7 @@ fn view_window(x: &XServer, test: &str, frames: &str, shot: &std::path::Path) ->
         strata_scene::skip::note_skip(test, "xdotool not found on PATH (scripts/setup.sh installs it)");
         return None;
     }
-    let child = Command::new(env!("CARGO_BIN_EXE_strata"))
+    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
         .args(
             [
                 &[
@@ -289,6 +289,15 @@ fn view_window(x: &XServer, test: &str, frames: &str, shot: &std::path::Path) ->
             .unwrap();
         if let Some(id) = text(&o.stdout).lines().next().map(String::from) {
             break id;
+        }
+        // a viewer that exited never shows a window: say why instead of waiting
+        if child.try_wait().unwrap().is_some() {
+            let o = child.wait_with_output().unwrap();
+            panic!(
+                "the viewer exited ({}) before its window appeared: {}",
+                o.status,
+                text(&o.stderr)
+            );
         }
         // generous: under the full test run the 2 cores are shared with the other tests
         assert!(t0.elapsed() < Duration::from_secs(180), "no viewer window after 180 s");
