@@ -139,18 +139,46 @@ macro_rules! setting {
     };
 }
 
-/// A two-valued radiosity setting stored as a `bool` field of [`RadiositySettings`]: value 0
-/// = `values[0]` (false), 1 = `values[1]` (true).
-macro_rules! radiosity_switch {
-    ($name:literal, $doc:literal, $field:ident, $values:expr) => {
+/// A two-valued setting stored as a `bool` field (path `$field` of what `$of` reads and `$mut`
+/// writes): value 0 = `values[0]` (false), 1 = `values[1]` (true).
+macro_rules! bool_setting {
+    ($name:literal, $doc:literal, $of:ident, $mut:ident, $($field:ident).+, $values:expr) => {
         SettingInfo {
             name: $name,
             doc: $doc,
             range: Range::Closed(0.0, 1.0),
             integer: true,
-            get: |s: &RenderSettings| Some(radiosity_of(s).$field as u32 as f64),
-            set: |s: &mut RenderSettings, v: f64| radiosity_mut(s).$field = v != 0.0,
+            get: |s: &RenderSettings| Some($of(s).$($field).+ as u32 as f64),
+            set: |s: &mut RenderSettings, v: f64| $mut(s).$($field).+ = v != 0.0,
             values: &$values,
+        }
+    };
+}
+
+/// A two-valued radiosity setting ([`bool_setting!`] of [`RadiositySettings`]).
+macro_rules! radiosity_switch {
+    ($name:literal, $doc:literal, $field:ident, $values:expr) => {
+        bool_setting!($name, $doc, radiosity_of, radiosity_mut, $field, $values)
+    };
+}
+
+/// The splatting algorithm of a bounced-z-buffer technique (`$of`/`$mut` its settings).
+macro_rules! splat_setting {
+    ($doc:literal, $of:ident, $mut:ident) => {
+        SettingInfo {
+            name: "splat",
+            doc: $doc,
+            range: Range::Closed(0.0, 1.0),
+            integer: true,
+            get: |s: &RenderSettings| Some($of(s).splat as u32 as f64),
+            set: |s: &mut RenderSettings, v: f64| {
+                $mut(s).splat = if v == 0.0 {
+                    crate::passes::bzb::Splat::Aov
+                } else {
+                    crate::passes::bzb::Splat::Dss
+                }
+            },
+            values: &["aov", "dss"],
         }
     };
 }
@@ -328,15 +356,14 @@ static AO_SETTINGS: [SettingInfo; 13] = [
         set: |s, v| ao_mut(s).deinterleave = (v >= 1.0).then(|| [v as u32 + 1; 2]),
         values: &["off", "2x2", "3x3", "4x4"],
     },
-    SettingInfo {
-        name: "filter-obscurance",
-        doc: "on: the temporal and bilateral filters average Eq. 1's obscurance mean before the square root, then AV = 1 - sqrt (not in the paper; removes the brightening of few-tap deinterleaved AO); off: DGB's order",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(ao_of(s).filter_obscurance as u32 as f64),
-        set: |s, v| ao_mut(s).filter_obscurance = v != 0.0,
-        values: &["off", "on"],
-    },
+    bool_setting!(
+        "filter-obscurance",
+        "on: the temporal and bilateral filters average Eq. 1's obscurance mean before the square root, then AV = 1 - sqrt (not in the paper; removes the brightening of few-tap deinterleaved AO); off: DGB's order",
+        ao_of,
+        ao_mut,
+        filter_obscurance,
+        ["off", "on"]
+    ),
 ];
 
 static RADIOSITY_SETTINGS: [SettingInfo; 13] = [
@@ -696,15 +723,14 @@ static ABA_AO_SETTINGS: [SettingInfo; 12] = [
         |s| Some(aba_ao_of(s).samples as f64),
         |s, v| aba_ao_mut(s).samples = v as u32
     ),
-    SettingInfo {
-        name: "multilayer",
-        doc: "on: every fragment of a tap pixel occludes (ABA Algorithm 1); off: the nearest only (single-layer SSAO)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(aba_ao_of(s).multilayer as u32 as f64),
-        set: |s, v| aba_ao_mut(s).multilayer = v != 0.0,
-        values: &["off", "on"],
-    },
+    bool_setting!(
+        "multilayer",
+        "on: every fragment of a tap pixel occludes (ABA Algorithm 1); off: the nearest only (single-layer SSAO)",
+        aba_ao_of,
+        aba_ao_mut,
+        multilayer,
+        ["off", "on"]
+    ),
     SettingInfo {
         name: "kernel",
         doc: "getAO kernel extended by Algorithm 1: ssao (Poisson-disk: DGB Eq. 1 over `samples` spiral taps), hbao (horizon-based: `directions` x `steps`, fragment shader) or hbao-compute (ABA §V-B: `steps` along +-x and +-y, 8x8 tiles of compressed nodes staged in workgroup memory; needs compress >= 1)",
@@ -721,15 +747,14 @@ static ABA_AO_SETTINGS: [SettingInfo; 12] = [
         },
         values: &["ssao", "hbao", "hbao-compute"],
     },
-    SettingInfo {
-        name: "integration",
-        doc: "separate: AO blended apart from the colour (ABA's choice, then filtered); inside: also write the colour with AO inside the OIT blend and the separate product (hdr-aba-inside, hdr-aba-separate; needs compress=0)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(aba_ao_of(s).inside as u32 as f64),
-        set: |s, v| aba_ao_mut(s).inside = v != 0.0,
-        values: &["separate", "inside"],
-    },
+    bool_setting!(
+        "integration",
+        "separate: AO blended apart from the colour (ABA's choice, then filtered); inside: also write the colour with AO inside the OIT blend and the separate product (hdr-aba-inside, hdr-aba-separate; needs compress=0)",
+        aba_ao_of,
+        aba_ao_mut,
+        inside,
+        ["separate", "inside"]
+    ),
     setting!(
         "multires",
         "multi-resolution AO levels L (ABA Table II after MSSAO; default 1 = off): level k reads the nodes of pixel (2^k X, 2^k Y) per coarse texel, taps capped at 5 texels except on the coarsest level, combined as O = 1-(1-max O_k)(1-mean O_k); not with hbao-compute",
@@ -781,24 +806,22 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
 }
 
 static BZB_SETTINGS: [SettingInfo; 12] = [
-    SettingInfo {
-        name: "visibility",
-        doc: "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(bzb_of(s).visibility as u32 as f64),
-        set: |s, v| bzb_mut(s).visibility = v != 0.0,
-        values: &["off", "on"],
-    },
-    SettingInfo {
-        name: "culling",
-        doc: "AOV: cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(bzb_of(s).culling as u32 as f64),
-        set: |s, v| bzb_mut(s).culling = v != 0.0,
-        values: &["off", "on"],
-    },
+    bool_setting!(
+        "visibility",
+        "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
+        bzb_of,
+        bzb_mut,
+        visibility,
+        ["off", "on"]
+    ),
+    bool_setting!(
+        "culling",
+        "AOV: cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        bzb_of,
+        bzb_mut,
+        culling,
+        ["off", "on"]
+    ),
     setting!(
         "directions",
         "directions S per pixel, one interleaved sub-image each (BZB §3.1, §5: 4)",
@@ -838,21 +861,11 @@ static BZB_SETTINGS: [SettingInfo; 12] = [
         |s| bzb_of(s).bias.map(f64::from),
         |s, v| bzb_mut(s).bias = Some(v as f32)
     ),
-    SettingInfo {
-        name: "splat",
-        doc: "splatting algorithm: aov (one occlusion volume per triangle, McGuire 2010) or dss (surfels shell-splatted into an interleaved hierarchical framebuffer, BZB §4)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(bzb_of(s).splat as u32 as f64),
-        set: |s, v| {
-            bzb_mut(s).splat = if v == 0.0 {
-                crate::passes::bzb::Splat::Aov
-            } else {
-                crate::passes::bzb::Splat::Dss
-            }
-        },
-        values: &["aov", "dss"],
-    },
+    splat_setting!(
+        "splatting algorithm: aov (one occlusion volume per triangle, McGuire 2010) or dss (surfels shell-splatted into an interleaved hierarchical framebuffer, BZB §4)",
+        bzb_of,
+        bzb_mut
+    ),
     setting!(
         "levels",
         "DSS levels l_max of the hierarchical framebuffer (BZB §4.1; 4, Table 3); d_max = r / 2^(l_max-1)",
@@ -869,15 +882,14 @@ static BZB_SETTINGS: [SettingInfo; 12] = [
         |s| Some(bzb_of(s).dss.surfel_px as f64),
         |s, v| bzb_mut(s).dss.surfel_px = v as f32
     ),
-    SettingInfo {
-        name: "surfel-culling",
-        doc: "DSS view-frustum culling of triangles before surfelization, margin = the outermost shell radius (BZB §5)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(bzb_of(s).dss.culling as u32 as f64),
-        set: |s, v| bzb_mut(s).dss.culling = v != 0.0,
-        values: &["off", "on"],
-    },
+    bool_setting!(
+        "surfel-culling",
+        "DSS view-frustum culling of triangles before surfelization, margin = the outermost shell radius (BZB §5)",
+        bzb_of,
+        bzb_mut,
+        dss.culling,
+        ["off", "on"]
+    ),
     setting!(
         "filter-radius",
         "cross-bilateral taps on each side (BZB §3.3; 0 = none)",
@@ -905,21 +917,11 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
 }
 
 static BZB_GI_SETTINGS: [SettingInfo; 11] = [
-    SettingInfo {
-        name: "splat",
-        doc: "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(bzb_gi_of(s).splat as u32 as f64),
-        set: |s, v| {
-            bzb_gi_mut(s).splat = if v == 0.0 {
-                crate::passes::bzb::Splat::Aov
-            } else {
-                crate::passes::bzb::Splat::Dss
-            }
-        },
-        values: &["aov", "dss"],
-    },
+    splat_setting!(
+        "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
+        bzb_gi_of,
+        bzb_gi_mut
+    ),
     setting!(
         "levels",
         "DSS levels l_max (splat=dss, BZB §4.1); the outermost shell reaches dmax",
@@ -936,15 +938,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 11] = [
         |s| Some(bzb_gi_of(s).dss.surfel_px as f64),
         |s, v| bzb_gi_mut(s).dss.surfel_px = v as f32
     ),
-    SettingInfo {
-        name: "visibility",
-        doc: "on: bounced z-buffer (BZB §3.2, the nearest sender per direction); off: the additive baseline (every triangle within d_max adds π·form factor·radiance)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(bzb_gi_of(s).visibility as u32 as f64),
-        set: |s, v| bzb_gi_mut(s).visibility = v != 0.0,
-        values: &["off", "on"],
-    },
+    bool_setting!(
+        "visibility",
+        "on: bounced z-buffer (BZB §3.2, the nearest sender per direction); off: the additive baseline (every triangle within d_max adds π·form factor·radiance)",
+        bzb_gi_of,
+        bzb_gi_mut,
+        visibility,
+        ["off", "on"]
+    ),
     setting!(
         "directions",
         "directions S per pixel, one interleaved sub-image each, importance-sampled by the receiver's BRDF × cos (BZB §3.1, §5: 4)",
@@ -977,15 +978,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 11] = [
         |s| bzb_gi_of(s).clamp.map(f64::from),
         |s, v| bzb_gi_mut(s).clamp = Some(v as f32)
     ),
-    SettingInfo {
-        name: "culling",
-        doc: "cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(bzb_gi_of(s).culling as u32 as f64),
-        set: |s, v| bzb_gi_mut(s).culling = v != 0.0,
-        values: &["off", "on"],
-    },
+    bool_setting!(
+        "culling",
+        "cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        bzb_gi_of,
+        bzb_gi_mut,
+        culling,
+        ["off", "on"]
+    ),
     setting!(
         "filter-radius",
         "cross-bilateral taps on each side (BZB §3.3; 0 = none)",
