@@ -69,13 +69,31 @@ fn xvfb(test: &str) -> Option<XServer> {
             .stderr(Stdio::null())
             .spawn()
             .expect("Xvfb exists but does not start");
-        let server = XServer {
+        let mut server = XServer {
             child,
             display: format!(":{n}"),
         };
+        // ready = our server is alive and accepts a client (its socket alone can exist
+        // before it does, or belong to another server: the viewer then failed with
+        // "cannot open a window")
+        let xdotool = find_on_path("xdotool");
+        let accepts = |display: &str| match &xdotool {
+            Some(bin) => Command::new(bin)
+                .args(["getdisplaygeometry"])
+                .env("DISPLAY", display)
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+                .is_ok_and(|s| s.success()),
+            None => true,
+        };
         let t0 = Instant::now();
         while t0.elapsed() < Duration::from_secs(20) {
-            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
+            if server.child.try_wait().unwrap().is_some() {
+                // this display was taken after all: try the next one
+                break;
+            }
+            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && accepts(&server.display) {
                 return Some(server);
             }
             std::thread::sleep(Duration::from_millis(50));
