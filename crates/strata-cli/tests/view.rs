@@ -64,6 +64,10 @@ fn xvfb(test: &str) -> Option<XServer> {
                 "1600x1000x24",
                 "-nolisten",
                 "tcp",
+                // without it Xvfb resets whenever its last client disconnects: the
+                // readiness probe and the `xdotool search` polling below each did, and a
+                // viewer connecting during that reset failed with "cannot open a window"
+                "-noreset",
             ])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
