@@ -165,8 +165,8 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         EvalResult::Gi(e) => {
             let (i, f) = (&e.errors.indirect, &e.errors.full);
             println!(
-                "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces, noise FLIP {:.4} indirect / {:.4} full)",
-                run.scene, i.flip, i.rmse, i.mae, f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
+                "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4} mean ×{:.3}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces, noise FLIP {:.4} indirect / {:.4} full)",
+                run.scene, i.flip, i.rmse, i.mae, i.mean_ratio.unwrap_or(f32::NAN), f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
             );
         }
         EvalResult::BzbGi(e) => {

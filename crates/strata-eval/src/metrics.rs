@@ -49,6 +49,10 @@ pub struct ErrorStats {
     /// Pixels of the reference that are [`outliers`] (display values).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ref_outliers: Option<u32>,
+    /// Mean of the test's linear values over the reference's ([`mean_ratio`]): the
+    /// brightness bias (1 = none), filled where linear radiance is compared.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mean_ratio: Option<f32>,
 }
 
 impl ErrorStats {
@@ -168,11 +172,20 @@ pub fn linear_errors(reference: &ImageBuf, test: &ImageBuf) -> (f32, f32) {
     ((se / n).sqrt() as f32, (ae / n) as f32)
 }
 
+/// Sum of the test's values over the reference's (every channel of every pixel): > 1 when
+/// the test is brighter on average. `None` when the reference sums to zero.
+pub fn mean_ratio(reference: &ImageBuf, test: &ImageBuf) -> Option<f32> {
+    let sum = |img: &ImageBuf| img.data.iter().map(|v| *v as f64).sum::<f64>();
+    let r = sum(reference);
+    (r > 0.0).then(|| (sum(test) / r) as f32)
+}
+
 /// [`compare`] on display values (`display(·, exposure)`: FLIP and the map) with RMSE and MAE
-/// replaced by those of the linear radiance.
+/// replaced by those of the linear radiance, and its [`mean_ratio`].
 pub fn compare_radiance(reference: &ImageBuf, test: &ImageBuf, exposure: f32) -> Result<(ErrorStats, ImageBuf)> {
     let (mut stats, map) = compare(&display(reference, exposure), &display(test, exposure))?;
     (stats.rmse, stats.mae) = linear_errors(reference, test);
+    stats.mean_ratio = mean_ratio(reference, test);
     Ok((stats, map))
 }
 
@@ -365,6 +378,17 @@ mod tests {
         let b = offset(&a, 2.0);
         let (rmse, mae) = linear_errors(&a, &b);
         assert!((mae - 2.0).abs() < 1e-6 && (rmse - 2.0).abs() < 1e-6);
+        assert_eq!(mean_ratio(&a, &a), Some(1.0));
+        let twice = ImageBuf {
+            data: a.data.iter().map(|v| 2.0 * v).collect(),
+            ..a.clone()
+        };
+        assert!((mean_ratio(&a, &twice).unwrap() - 2.0).abs() < 1e-6);
+        assert_eq!(
+            mean_ratio(&ImageBuf::new(2, 2, 1), &a),
+            None,
+            "a black reference has no ratio"
+        );
         let d = display(&b, 1.0);
         assert!(d.data.iter().all(|v| *v > 0.9 && *v <= 1.0), "{:?}", d.data);
         assert_eq!(display(&ImageBuf::new(2, 2, 1), 1.0).data, vec![0.0; 4]);

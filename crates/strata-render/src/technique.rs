@@ -366,7 +366,23 @@ static AO_SETTINGS: [SettingInfo; 13] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 13] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 14] = [
+    SettingInfo {
+        name: "irradiance-normalisation",
+        doc: "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
+        range: Range::Closed(0.0, 2.0),
+        integer: true,
+        get: |s| Some(radiosity_of(s).normalisation as u32 as f64),
+        set: |s, v| {
+            use crate::passes::radiosity::Normalisation;
+            radiosity_mut(s).normalisation = match v as u32 {
+                0 => Normalisation::Hemisphere,
+                1 => Normalisation::Cosine,
+                _ => Normalisation::Bounded,
+            }
+        },
+        values: &["hemisphere", "cosine", "bounded"],
+    },
     radiosity_switch!(
         "open-sky",
         "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",

@@ -6,7 +6,7 @@ mod common;
 use glam::{Mat4, Vec3};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
-use strata_render::passes::radiosity::{irradiance_cpu, GatherInputs, RadiositySettings};
+use strata_render::passes::radiosity::{irradiance_cpu, GatherInputs, Normalisation, RadiositySettings};
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::shapes::MeshBuilder;
 use strata_scene::{procedural, Camera, ImageBuf, Material, Object, Scene, SceneSettings};
@@ -46,17 +46,20 @@ fn frozen(name: &str) -> Scene {
 #[test]
 fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     let gpu = common::gpu();
-    // (scene, n̂_Y test, solid-angle weights, open sky, hidden taps black): the paper's
-    // Eq. 4, the default weights, and the two non-paper tap rules (the atrium has a sky)
-    for (name, normal_test, solid_angle, open_sky, hidden_black) in [
-        ("atrium", true, false, false, false),
-        ("cornell", false, false, false, false),
-        ("warehouse", true, false, false, false),
-        ("atrium", true, true, false, false),
-        ("cornell", false, true, false, false),
-        ("warehouse", true, true, false, false),
-        ("atrium", true, true, true, true),
-        ("warehouse", true, false, true, true),
+    // (scene, n̂_Y test, solid-angle weights, open sky, hidden taps black, cosine
+    // normalisation): the paper's Eq. 4, the default weights and normaliser, and the two
+    // non-paper tap rules (the atrium has a sky)
+    use Normalisation::*;
+    for (name, normal_test, solid_angle, open_sky, hidden_black, normalisation) in [
+        ("atrium", true, false, false, false, Hemisphere),
+        ("cornell", false, false, false, false, Hemisphere),
+        ("warehouse", true, false, false, false, Hemisphere),
+        ("atrium", true, true, false, false, Hemisphere),
+        ("cornell", false, true, false, false, Bounded),
+        ("warehouse", true, true, false, false, Bounded),
+        ("atrium", true, true, true, true, Cosine),
+        ("warehouse", true, false, true, true, Hemisphere),
+        ("warehouse", true, false, false, true, Cosine),
     ] {
         let scene = frozen(name);
         let (w, h) = (96, 64);
@@ -65,6 +68,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             solid_angle,
             open_sky,
             hidden_black,
+            normalisation,
             radius: Some(4.0),
             ..Default::default()
         };
@@ -239,6 +243,7 @@ fn closed_box(rho: f32) -> Scene {
 fn box_settings(delta: f32) -> RadiositySettings {
     RadiositySettings {
         solid_angle: false,
+        normalisation: Normalisation::Hemisphere,
         temporal_noise: false,
         radius: Some(10.0),
         samples: 32,
@@ -354,6 +359,99 @@ fn solid_angle_weights_return_the_analytic_irradiance_of_a_uniform_enclosure() {
     eprintln!("E/(πL): Eq. 4 {g_paper:.4} (spread {s_paper:.4}), solid-angle {g_solid:.4} (spread {s_solid:.4})");
     assert!(g_paper > 1.1, "Eq. 4's known bias vanished: g = {g_paper}");
     assert!((g_solid - 1.0).abs() < 0.05, "solid-angle weights: E/(πL) = {g_solid}");
+}
+
+/// Cosine normalisation, E = π Σ w·B·cos / Σ w·cos, in the glowing box (every wall L = 1,
+/// E = πL exactly): πL at every pixel for both tap weightings (Eq. 4's equal weights
+/// over-estimate by > 10 %). The bounded form π / max(Σ w·cos, ½ Σ w), the default, is the
+/// smaller of cosine and Eq. 4: no pixel above πL, a mean within 15 % below it, and on a
+/// real scene never above Eq. 4's estimate from the same taps at any pixel.
+#[test]
+fn cosine_normalisation_returns_pi_l_in_a_uniform_enclosure_and_bounded_never_exceeds_eq4() {
+    let gpu = common::gpu();
+    let mut glowing = closed_box(0.0);
+    glowing.materials[0].emission = [1.0; 3];
+    glowing.lights.clear();
+    let pi = std::f32::consts::PI;
+    let raw = |scene: &Scene, rs: RadiositySettings| {
+        let mut r = renderer(&gpu, scene, 64, 64, 2, rs);
+        r.render(&gpu, scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
+        r.read_target(&gpu, "indirect-raw").unwrap()
+    };
+    let lit = |img: &ImageBuf| {
+        img.data
+            .chunks_exact(4)
+            .map(|p| p[0])
+            .filter(|e| *e > 0.0)
+            .collect::<Vec<f32>>()
+    };
+    let mean = |v: &[f32]| v.iter().map(|e| *e as f64).sum::<f64>() / v.len().max(1) as f64;
+    for solid_angle in [false, true] {
+        let settings = |normalisation| RadiositySettings {
+            solid_angle,
+            normalisation,
+            ..box_settings(0.0)
+        };
+        let eq4 = lit(&raw(&glowing, settings(Normalisation::Hemisphere)));
+        let cos = lit(&raw(&glowing, settings(Normalisation::Cosine)));
+        let bounded = lit(&raw(&glowing, settings(Normalisation::Bounded)));
+        let g = |v: &[f32]| mean(v) / pi as f64;
+        let max = |v: &[f32]| v.iter().copied().fold(0.0f32, f32::max);
+        let min = |v: &[f32]| v.iter().copied().fold(f32::MAX, f32::min);
+        eprintln!(
+            "solid angle {solid_angle}: E/(πL) Eq. 4 {:.4}, cosine {:.4} [{:.4}, {:.4}], bounded {:.4} (max {:.4})",
+            g(&eq4),
+            g(&cos),
+            min(&cos) / pi,
+            max(&cos) / pi,
+            g(&bounded),
+            max(&bounded) / pi
+        );
+        assert!(
+            cos.len() > 3000 && bounded.len() == cos.len(),
+            "weak test: {} lit",
+            cos.len()
+        );
+        // Rgba16Float: 2^-11 relative
+        assert!(
+            cos.iter().all(|e| (e / pi - 1.0).abs() < 2e-3),
+            "cosine normalisation not πL: [{}, {}]",
+            min(&cos) / pi,
+            max(&cos) / pi
+        );
+        assert!(max(&bounded) <= pi * 1.002, "bounded: a pixel above πL");
+        assert!(
+            (0.85..=1.002).contains(&g(&bounded)),
+            "bounded: E/(πL) = {}",
+            g(&bounded)
+        );
+        if !solid_angle {
+            assert!(g(&eq4) > 1.1, "Eq. 4's known bias vanished: g = {}", g(&eq4));
+        }
+    }
+    let scene = frozen("atrium");
+    let rs = |normalisation| RadiositySettings {
+        normalisation,
+        radius: Some(4.0),
+        ..Default::default()
+    };
+    let (eq4, bounded) = (
+        raw(&scene, rs(Normalisation::Hemisphere)),
+        raw(&scene, rs(Normalisation::Bounded)),
+    );
+    let (mut n_lit, mut lower) = (0usize, 0usize);
+    for (a, b) in eq4.data.chunks_exact(4).zip(bounded.data.chunks_exact(4)) {
+        for c in 0..3 {
+            assert!(b[c] <= a[c] * 1.002 + 1e-5, "bounded {} above Eq. 4 {}", b[c], a[c]);
+        }
+        n_lit += (a[0] > 1e-3) as usize;
+        lower += (b[0] < 0.95 * a[0]) as usize;
+    }
+    eprintln!("atrium: {lower} of {n_lit} lit pixels lowered by > 5 %");
+    assert!(
+        n_lit > 500 && lower > n_lit / 10,
+        "weak test: {lower} of {n_lit} lowered"
+    );
 }
 
 /// Issue 14, per-frame spiral rotation: with the paper's per-pixel hash a

@@ -30,11 +30,12 @@ use crate::spiral::{self, SpiralTurns};
 /// temporal α = 0.85, multi-bounce δ = 0.9 (the demo's "propagation damping"
 /// 0.1, documented as 1 − δ).
 ///
-/// Two defaults deviate from the paper (issue 14, measured in
-/// docs/radiosity.md § "Issue 14"): `temporal_noise` (the spiral's rotation
-/// also hashes the frame index, so the temporal filter averages different tap
-/// patterns; the paper hashes the pixel only) and `solid_angle` (taps weighted
-/// by the solid angle they cover instead of Eq. 4's equal weights). The
+/// Three defaults deviate from the paper (issue 14, measured in
+/// docs/radiosity.md § "Issue 14" and § "Cosine normalisation"): `temporal_noise`
+/// (the spiral's rotation also hashes the frame index, so the temporal filter
+/// averages different tap patterns; the paper hashes the pixel only), `solid_angle`
+/// (taps weighted by the solid angle they cover instead of Eq. 4's equal weights)
+/// and `normalisation` (Eq. 4's 2π/Σw becomes π/max(Σw·cos, ½Σw)). The
 /// paper's estimator: [`RadiositySettings::paper`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
@@ -76,6 +77,28 @@ pub struct RadiositySettings {
     /// Taps that fail Eq. 5's n̂_Y test count as black occluders (their weight, no light)
     /// instead of being skipped.
     pub hidden_black: bool,
+    /// The gather's normaliser ([`Normalisation`]; default `Bounded`, not in the paper).
+    pub normalisation: Normalisation,
+}
+
+/// How the gather turns Σ w·B·cos into irradiance E (docs/radiosity.md § "Cosine
+/// normalisation"). Uniform solid-angle samples have mean cos ½, so all three agree for
+/// them; screen-space taps are not uniform in direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Normalisation {
+    /// DGB Eq. 4: E = 2π Σ w·B·cos / Σ w. Where the taps cluster near n̂_X (a floor seeing
+    /// the walls above it) it over-estimates E, up to 2×, and the progressive bounces (§3.3)
+    /// compound that.
+    Hemisphere,
+    /// E = π Σ w·B·cos / Σ w·cos: π times the cosine-weighted mean radiance of the taps,
+    /// exact for a uniformly radiant surround whatever the taps' directions; where only
+    /// grazing taps find a surface it fills the whole hemisphere with their light.
+    Cosine,
+    /// E = π Σ w·B·cos / max(Σ w·cos, ½ Σ w) = min(Cosine, Hemisphere) per pixel: never
+    /// above Eq. 4. Biased low by up to ~11 % in a uniform enclosure with solid-angle
+    /// weights (test `cosine_normalisation_…`), which offsets the gather's over-estimate
+    /// from assumed mutual visibility; the steadiest of the three against the path tracer.
+    Bounded,
 }
 
 /// DGB Table 2's parameter sets, read from `presets/*.toml` (embedded).
@@ -173,6 +196,7 @@ impl Default for RadiositySettings {
             coverage_confidence: false,
             open_sky: false,
             hidden_black: false,
+            normalisation: Normalisation::Bounded,
         }
     }
 }
@@ -184,6 +208,7 @@ impl RadiositySettings {
         Self {
             temporal_noise: false,
             solid_angle: false,
+            normalisation: Normalisation::Hemisphere,
             ..Default::default()
         }
     }
@@ -275,6 +300,9 @@ pub struct RadiosityUniforms {
     pub open_sky: u32,
     /// 1 = back-facing taps count as black ([`RadiositySettings::hidden_black`]).
     pub hidden_black: u32,
+    /// [`Normalisation`]: 0 = Eq. 4, 1 = π/Σ w·cos, 2 = π/max(Σ w·cos, ½ Σ w).
+    pub cosine: u32,
+    pub _pad: [u32; 3],
 }
 
 impl RadiosityUniforms {
@@ -300,6 +328,8 @@ impl RadiosityUniforms {
             solid_angle: s.solid_angle as u32,
             open_sky: s.open_sky as u32,
             hidden_black: s.hidden_black as u32,
+            cosine: s.normalisation as u32,
+            _pad: [0; 3],
         }
     }
 }
@@ -509,7 +539,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     let (w, h) = (g.zmip[0].width as i32, g.zmip[0].height as i32);
     let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let eye = Vec3::from_slice(&g.frame.eye[..3]);
-    let (mut sum, mut wsum, mut m_count, mut u_count) = (Vec3::ZERO, 0.0f32, 0u32, 0u32);
+    let (mut sum, mut wsum, mut wcsum, mut m_count, mut u_count) = (Vec3::ZERO, 0.0f32, 0.0f32, 0u32, 0u32);
     for i in 0..u.samples {
         let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
         let d = spiral::tap_texel(tap.offset);
@@ -521,9 +551,9 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         let (tx, ty) = ((qx >> m) as u32, (qy >> m) as u32);
         let zs = g.zmip[m as usize].pixel(tx, ty);
         let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
-        // (light · cos · w, w, carries light): a light-carrying term wins over a black
+        // (light · cos · w, w, w · cos, carries light): a light-carrying term wins over a black
         // occluder (`hidden_black`), which wins over nothing (as `union_term`)
-        let mut best: Option<(Vec3, f32, bool)> = None;
+        let mut best: Option<(Vec3, f32, f32, bool)> = None;
         for (j, &zj) in zs.iter().enumerate().take(g.layers.min(2) as usize) {
             if zj <= 0.0 {
                 continue;
@@ -547,13 +577,13 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
             };
             if u.normal_test != 0 && wdir.dot(ny) >= 0.0 {
                 if u.hidden_black != 0 && best.is_none() {
-                    best = Some((Vec3::ZERO, wt, false));
+                    best = Some((Vec3::ZERO, wt, cos_x * wt, false));
                 }
                 continue;
             }
             let c = v3(g.radiosity[j], sx, sy) * cos_x * wt;
-            if best.is_none_or(|(b, _, light)| !light || luminance(c) > luminance(b)) {
-                best = Some((c, wt, true));
+            if best.is_none_or(|(b, _, _, light)| !light || luminance(c) > luminance(b)) {
+                best = Some((c, wt, cos_x * wt, true));
             }
         }
         // a background tap: the sky along its camera ray, weight h (`sky_term`)
@@ -563,18 +593,19 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
             let cos_x = dir.dot(n);
             if cos_x > 0.0 {
                 let wt = if u.solid_angle != 0 { tap.radius } else { 1.0 };
-                best = Some((Vec3::from_slice(&g.frame.sky[..3]) * cos_x * wt, wt, false));
+                best = Some((Vec3::from_slice(&g.frame.sky[..3]) * cos_x * wt, wt, cos_x * wt, false));
             }
         }
-        if let Some((b, wt, light)) = best {
+        if let Some((b, wt, wc, light)) = best {
             sum += b;
             wsum += wt;
+            wcsum += wc;
             m_count += light as u32;
         }
         // coverage confidence: the tap's direction (layer 0's point, else its camera ray)
         // lies in the receiver's hemisphere (as `hemisphere_tap` in radiosity.wgsl)
         let y0 = world(sx as f32, sy as f32, if zs[0] > 0.0 { zs[0] } else { 1.0e4 });
-        u_count += (best.is_some_and(|b| b.2) || (y0 - pos).normalize().dot(n) > COVERAGE_COS) as u32;
+        u_count += (best.is_some_and(|b| b.3) || (y0 - pos).normalize().dot(n) > COVERAGE_COS) as u32;
     }
     if wsum <= 0.0 {
         return (Vec3::ZERO, 0.0);
@@ -584,7 +615,13 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     } else {
         m_count as f32 / u.samples as f32
     };
-    (sum * (2.0 * std::f32::consts::PI / wsum), confidence)
+    // Eq. 4: π / (½ Σ w); cosine: π / Σ w·cos; bounded: π / max(Σ w·cos, ½ Σ w)
+    let denom = match u.cosine {
+        0 => 0.5 * wsum,
+        1 => wcsum,
+        _ => wcsum.max(0.5 * wsum),
+    };
+    (sum * (std::f32::consts::PI / denom), confidence)
 }
 
 /// `radiosity.wgsl`'s `solid_angle_weight`: the solid angle (up to a constant

@@ -39,6 +39,15 @@ struct Radiosity {
     // 1 = taps that fail Eq. 5's n̂_Y test count as black occluders instead of
     // being skipped
     hidden_black: u32,
+    // `estimate`'s normaliser: 0 = Eq. 4's 2π / Σ w, 1 = cosine, 2 = bounded cosine
+    cosine: u32,
+}
+
+// One tap's share of the sums: c.rgb = w · B(Y) max(ω̂·n̂_X, 0), c.a = w (< 0 for an
+// occluder or the sky, 0 for nothing), wc = w · max(ω̂·n̂_X, 0).
+struct Term {
+    c: vec4f,
+    wc: f32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -70,20 +79,21 @@ fn radiosity_of(p: vec2i, layer: u32) -> vec3f {
     return textureLoad(b1, p, 0).rgb;
 }
 
-// Eq. 4–5 term of sample Y (layer j, pixel src) for receiver X (normal n):
-// rgb = w · B(Y) max(ω̂·n̂_X, 0), a = w when Y passes Eq. 5 (and lies within r),
-// with w = 1 (Eq. 4) or, with `solid_angle`, w ∝ the solid angle the tap's
-// screen area subtends at X (`solid_angle_weight`). `h` = the tap's screen radius.
-fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> vec4f {
+// Eq. 4–5 term of sample Y (layer j, pixel src) for receiver X (normal n), with
+// w = 1 (Eq. 4) or, with `solid_angle`, w ∝ the solid angle the tap's screen area
+// subtends at X (`solid_angle_weight`); c.a = w when Y passes Eq. 5 (and lies
+// within r). `h` = the tap's screen radius.
+fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> Term {
+    var none: Term;
     let v = y - x;
     let vv = dot(v, v);
     if (!(vv < rad.radius * rad.radius) || vv <= 0.0) {
-        return vec4f(0.0);
+        return none;
     }
     let w = v * inverseSqrt(vv);
     let cos_x = dot(w, n);
     if (cos_x <= 0.0) {
-        return vec4f(0.0);
+        return none;
     }
     var wt = 1.0;
     if (rad.normal_test != 0u || rad.solid_angle != 0u) {
@@ -95,15 +105,15 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> vec4f {
                 if (rad.solid_angle != 0u) {
                     wo = solid_angle_weight(y, ny, w, vv, h);
                 }
-                return vec4f(0.0, 0.0, 0.0, -wo);
+                return Term(vec4f(0.0, 0.0, 0.0, -wo), wo * cos_x);
             }
-            return vec4f(0.0);
+            return none;
         }
         if (rad.solid_angle != 0u) {
             wt = solid_angle_weight(y, ny, w, vv, h);
         }
     }
-    return vec4f(radiosity_of(src, j) * cos_x * wt, wt);
+    return Term(vec4f(radiosity_of(src, j) * cos_x * wt, wt), wt * cos_x);
 }
 
 // Solid angle (up to a constant) that the screen area represented by a tap at
@@ -125,11 +135,11 @@ fn solid_angle_weight(y: vec3f, ny: vec3f, w: vec3f, vv: f32, h: f32) -> f32 {
 // layers, as for AO's max in Eq. 1).
 // A light-carrying term (a > 0) wins over an occluder (a < 0), which wins over
 // nothing (a = 0).
-fn union_term(a: vec4f, b: vec4f) -> vec4f {
-    if (b.a > 0.0 && (a.a <= 0.0 || luminance(b.rgb) > luminance(a.rgb))) {
+fn union_term(a: Term, b: Term) -> Term {
+    if (b.c.a > 0.0 && (a.c.a <= 0.0 || luminance(b.c.rgb) > luminance(a.c.rgb))) {
         return b;
     }
-    if (b.a < 0.0 && a.a == 0.0) {
+    if (b.c.a < 0.0 && a.c.a == 0.0) {
         return b;
     }
     return a;
@@ -138,17 +148,18 @@ fn union_term(a: vec4f, b: vec4f) -> vec4f {
 // A background tap (nothing in any layer) as the sky seen along its camera ray
 // from X: radiance sky · cos, weight = the solid-angle weight's limit for a
 // surface at infinity (z²/d² → 1, cos_y/cos_view → 1), i.e. the tap's h.
-fn sky_term(x: vec3f, n: vec3f, src: vec2i, h: f32) -> vec4f {
+fn sky_term(x: vec3f, n: vec3f, src: vec2i, h: f32) -> Term {
     let y = world_from_csz(frame, vec2f(src) + 0.5, 1.0e4);
     let cos_x = dot(normalize(y - x), n);
     if (cos_x <= 0.0) {
-        return vec4f(0.0);
+        var none: Term;
+        return none;
     }
     var wt = 1.0;
     if (rad.solid_angle != 0u) {
         wt = h;
     }
-    return vec4f(frame.sky.rgb * cos_x * wt, -wt);
+    return Term(vec4f(frame.sky.rgb * cos_x * wt, -wt), wt * cos_x);
 }
 
 // Whether the tap at pixel `src` with layer-0 depth `z0` (0: background) tells the
@@ -167,18 +178,28 @@ fn hemisphere_tap(x: vec3f, n: vec3f, src: vec2i, z0: f32) -> f32 {
     return select(0.0, 1.0, dot(normalize(y - x), n) > COVERAGE_COS);
 }
 
-// `m`: the contributing taps M; `u`: the taps in the receiver's hemisphere
-// (coverage confidence), ≥ M.
-fn estimate(sum: vec4f, m: f32, u: f32) -> vec4f {
+// `sum` = (Σ w·B·cos, Σ w), `wc` = Σ w·cos; `m`: the contributing taps M; `u`: the
+// taps in the receiver's hemisphere (coverage confidence), ≥ M.
+fn estimate(sum: vec4f, wc: f32, m: f32, u: f32) -> vec4f {
     if (sum.a == 0.0) {
         return vec4f(0.0);
     }
-    // Eq. 4: 2π/M Σ (w = 1) or 2π Σ w·B·cos / Σ w; confidence M/N (paper) or M/U (coverage)
+    // Eq. 4: 2π/M Σ (w = 1) or 2π Σ w·B·cos / Σ w = π Σ w·B·cos / (½ Σ w). Uniform
+    // solid-angle taps have mean cos ½, so Σ w·cos ≈ ½ Σ w; screen-space taps that
+    // cluster near n̂_X make Eq. 4 over-estimate E. Cosine: π / Σ w·cos (exact for a
+    // uniform surround); bounded: π / max(Σ w·cos, ½ Σ w), never above Eq. 4.
+    // Confidence M/N (paper) or M/U (coverage).
+    var denom = 0.5 * sum.a;
+    if (rad.cosine == 1u) {
+        denom = wc;
+    } else if (rad.cosine == 2u) {
+        denom = max(wc, denom);
+    }
     var c = m / f32(rad.samples);
     if (rad.coverage != 0u) {
         c = m / max(u, m);
     }
-    return vec4f(sum.rgb * (2.0 * 3.14159265358979 / sum.a), c);
+    return vec4f(sum.rgb * (3.14159265358979 / denom), c);
 }
 
 @fragment
@@ -209,6 +230,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let size = vec2i(textureDimensions(zmip, 0));
     var sum0 = vec4f(0.0);
     var sum1 = vec4f(0.0);
+    var wc0 = 0.0;
+    var wc1 = 0.0;
     var m0 = 0.0;
     var m1 = 0.0;
     var u0 = 0.0;
@@ -223,8 +246,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         let t = q >> vec2u(m);
         let zs = textureLoad(zmip, t, i32(m));
         let src = mip_source_pixel(zmip, t, m);
-        var best0 = vec4f(0.0);
-        var best1 = vec4f(0.0);
+        var best0: Term;
+        var best1: Term;
         for (var j = 0u; j < min(LAYERS, 2u); j++) {
             if (zs[j] <= 0.0) {
                 continue;
@@ -242,10 +265,12 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             }
         }
         // occluders and the sky add weight (and the sky its light) but do not count in M
-        sum0 += vec4f(best0.rgb, abs(best0.a));
-        sum1 += vec4f(best1.rgb, abs(best1.a));
-        let hit0 = select(0.0, 1.0, best0.a > 0.0);
-        let hit1 = select(0.0, 1.0, best1.a > 0.0);
+        sum0 += vec4f(best0.c.rgb, abs(best0.c.a));
+        sum1 += vec4f(best1.c.rgb, abs(best1.c.a));
+        wc0 += best0.wc;
+        wc1 += best1.wc;
+        let hit0 = select(0.0, 1.0, best0.c.a > 0.0);
+        let hit1 = select(0.0, 1.0, best1.c.a > 0.0);
         m0 += hit0;
         m1 += hit1;
         if (rad.coverage != 0u) {
@@ -255,7 +280,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             }
         }
     }
-    o.e0 = estimate(sum0, m0, u0);
-    o.e1 = estimate(sum1, m1, u1);
+    o.e0 = estimate(sum0, wc0, m0, u0);
+    o.e1 = estimate(sum1, wc1, m1, u1);
     return o;
 }
