@@ -162,6 +162,26 @@ macro_rules! radiosity_switch {
     };
 }
 
+/// A setting choosing one variant of a `Copy` enum field (`$of`/`$mut` its settings): the
+/// variants in discriminant order, each with the name `--set` takes.
+macro_rules! enum_setting {
+    ($name:literal, $doc:literal, $of:ident, $mut:ident, $field:ident, [$($variant:expr => $value:literal),+ $(,)?]) => {
+        SettingInfo {
+            name: $name,
+            doc: $doc,
+            range: Range::Closed(0.0, ([$($value),+].len() - 1) as f64),
+            integer: true,
+            get: |s: &RenderSettings| Some($of(s).$field as u32 as f64),
+            // values past the range clamp to the last variant (the range check reports them)
+            set: |s: &mut RenderSettings, v: f64| {
+                let variants = [$($variant),+];
+                $mut(s).$field = variants[(v as usize).min(variants.len() - 1)]
+            },
+            values: &[$($value),+],
+        }
+    };
+}
+
 /// The splatting algorithm of a bounced-z-buffer technique (`$of`/`$mut` its settings).
 macro_rules! splat_setting {
     ($doc:literal, $of:ident, $mut:ident) => {
@@ -367,22 +387,18 @@ static AO_SETTINGS: [SettingInfo; 13] = [
 ];
 
 static RADIOSITY_SETTINGS: [SettingInfo; 14] = [
-    SettingInfo {
-        name: "irradiance-normalisation",
-        doc: "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
-        range: Range::Closed(0.0, 2.0),
-        integer: true,
-        get: |s| Some(radiosity_of(s).normalisation as u32 as f64),
-        set: |s, v| {
-            use crate::passes::radiosity::Normalisation;
-            radiosity_mut(s).normalisation = match v as u32 {
-                0 => Normalisation::Hemisphere,
-                1 => Normalisation::Cosine,
-                _ => Normalisation::Bounded,
-            }
-        },
-        values: &["hemisphere", "cosine", "bounded"],
-    },
+    enum_setting!(
+        "irradiance-normalisation",
+        "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
+        radiosity_of,
+        radiosity_mut,
+        normalisation,
+        [
+            crate::passes::radiosity::Normalisation::Hemisphere => "hemisphere",
+            crate::passes::radiosity::Normalisation::Cosine => "cosine",
+            crate::passes::radiosity::Normalisation::Bounded => "bounded",
+        ]
+    ),
     radiosity_switch!(
         "open-sky",
         "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",
@@ -747,22 +763,18 @@ static ABA_AO_SETTINGS: [SettingInfo; 12] = [
         multilayer,
         ["off", "on"]
     ),
-    SettingInfo {
-        name: "kernel",
-        doc: "getAO kernel extended by Algorithm 1: ssao (Poisson-disk: DGB Eq. 1 over `samples` spiral taps), hbao (horizon-based: `directions` x `steps`, fragment shader) or hbao-compute (ABA §V-B: `steps` along +-x and +-y, 8x8 tiles of compressed nodes staged in workgroup memory; needs compress >= 1)",
-        range: Range::Closed(0.0, 2.0),
-        integer: true,
-        get: |s| Some(aba_ao_of(s).kernel as u32 as f64),
-        set: |s, v| {
-            use crate::passes::abuffer::ao::AoKernel;
-            aba_ao_mut(s).kernel = match v as u32 {
-                0 => AoKernel::Ssao,
-                1 => AoKernel::Hbao,
-                _ => AoKernel::HbaoCompute,
-            }
-        },
-        values: &["ssao", "hbao", "hbao-compute"],
-    },
+    enum_setting!(
+        "kernel",
+        "getAO kernel extended by Algorithm 1: ssao (Poisson-disk: DGB Eq. 1 over `samples` spiral taps), hbao (horizon-based: `directions` x `steps`, fragment shader) or hbao-compute (ABA §V-B: `steps` along +-x and +-y, 8x8 tiles of compressed nodes staged in workgroup memory; needs compress >= 1)",
+        aba_ao_of,
+        aba_ao_mut,
+        kernel,
+        [
+            crate::passes::abuffer::ao::AoKernel::Ssao => "ssao",
+            crate::passes::abuffer::ao::AoKernel::Hbao => "hbao",
+            crate::passes::abuffer::ao::AoKernel::HbaoCompute => "hbao-compute",
+        ]
+    ),
     bool_setting!(
         "integration",
         "separate: AO blended apart from the colour (ABA's choice, then filtered); inside: also write the colour with AO inside the OIT blend and the separate product (hdr-aba-inside, hdr-aba-separate; needs compress=0)",

@@ -238,6 +238,14 @@ fn closed_box(rho: f32) -> Scene {
     }
 }
 
+/// The closed box with every wall emitting L = 1 and no light: E = πL exactly everywhere.
+fn glowing_box() -> Scene {
+    let mut glowing = closed_box(0.0);
+    glowing.materials[0].emission = [1.0; 3];
+    glowing.lights.clear();
+    glowing
+}
+
 /// The paper's estimator (Eq. 4 weights, the same taps every frame: the bounce
 /// operator is then one fixed linear map).
 fn box_settings(delta: f32) -> RadiositySettings {
@@ -284,9 +292,7 @@ fn multi_bounce_in_a_closed_box_converges_below_the_geometric_bound() {
     let gpu = common::gpu();
     let rho = 0.6;
     // g: every wall emits L = 1, no light, one bounce
-    let mut glowing = closed_box(0.0);
-    glowing.materials[0].emission = [1.0; 3];
-    glowing.lights.clear();
+    let glowing = glowing_box();
     let g = mean_indirect_per_frame(&gpu, &glowing, box_settings(0.0), 1)[0] / std::f64::consts::PI;
     let s = mean_indirect_per_frame(&gpu, &closed_box(rho), box_settings(1.0), 12);
     let d: Vec<f64> = s.windows(2).map(|p| p[1] - p[0]).collect();
@@ -342,9 +348,7 @@ fn indirect_mean_and_spread(
 #[test]
 fn solid_angle_weights_return_the_analytic_irradiance_of_a_uniform_enclosure() {
     let gpu = common::gpu();
-    let mut glowing = closed_box(0.0);
-    glowing.materials[0].emission = [1.0; 3];
-    glowing.lights.clear();
+    let glowing = glowing_box();
     let pi = std::f64::consts::PI;
     let gain = |solid_angle: bool| {
         let rs = RadiositySettings {
@@ -369,9 +373,7 @@ fn solid_angle_weights_return_the_analytic_irradiance_of_a_uniform_enclosure() {
 #[test]
 fn cosine_normalisation_returns_pi_l_in_a_uniform_enclosure_and_bounded_never_exceeds_eq4() {
     let gpu = common::gpu();
-    let mut glowing = closed_box(0.0);
-    glowing.materials[0].emission = [1.0; 3];
-    glowing.lights.clear();
+    let glowing = glowing_box();
     let pi = std::f32::consts::PI;
     let raw = |scene: &Scene, rs: RadiositySettings| {
         let mut r = renderer(&gpu, scene, 64, 64, 2, rs);
@@ -462,9 +464,7 @@ fn cosine_normalisation_returns_pi_l_in_a_uniform_enclosure_and_bounded_never_ex
 #[test]
 fn per_frame_rotation_lets_the_temporal_filter_remove_the_pattern_noise() {
     let gpu = common::gpu();
-    let mut glowing = closed_box(0.0);
-    glowing.materials[0].emission = [1.0; 3];
-    glowing.lights.clear();
+    let glowing = glowing_box();
     let run = |temporal_noise: bool| {
         let rs = RadiositySettings {
             temporal_noise,
