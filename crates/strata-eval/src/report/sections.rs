@@ -39,11 +39,12 @@ const AO_HEADER: [&str; 7] = [
 
 const OIT_HEADER: [&str; 5] = ["layers k", "FLIP", "RMSE", "MAE", "flicker"];
 
-const GI_HEADER: [&str; 8] = [
+const GI_HEADER: [&str; 9] = [
     "layers k",
     "indirect FLIP",
     "indirect RMSE",
     "indirect MAE",
+    "indirect mean / reference's",
     "full FLIP",
     "full RMSE",
     "full MAE",
@@ -60,6 +61,17 @@ struct ErrorRow {
 
 fn stats_cells(s: &ErrorStats) -> Vec<Cell> {
     vec![s.flip.into(), s.rmse.into(), s.mae.into()]
+}
+
+/// The cells of a GI row: the indirect light's errors and brightness bias, then the
+/// full image's errors.
+fn gi_cells(x: &crate::results::GiErrors) -> Vec<Cell> {
+    [
+        stats_cells(&x.indirect),
+        vec![x.indirect.mean_ratio.into()],
+        stats_cells(&x.full),
+    ]
+    .concat()
 }
 
 /// Sections of an evaluation: its settings, the errors by layer count, DGB Fig. 10 when
@@ -87,7 +99,7 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         EvalResult::Gi(e) => {
             let row = |layers: u32, x: &crate::results::GiErrors| ErrorRow {
                 layers,
-                cells: [stats_cells(&x.indirect), stats_cells(&x.full)].concat(),
+                cells: gi_cells(x),
                 flip_mae: (x.indirect.flip, x.indirect.mae),
             };
             let mut rows: Vec<ErrorRow> = e.by_layers.iter().map(|b| row(b.layers, &b.errors)).collect();
@@ -107,7 +119,7 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
             &GI_HEADER[..],
             vec![ErrorRow {
                 layers: 1,
-                cells: [stats_cells(&e.errors.indirect), stats_cells(&e.errors.full)].concat(),
+                cells: gi_cells(&e.errors),
                 flip_mae: (e.errors.indirect.flip, e.errors.indirect.mae),
             }],
             None,
@@ -127,7 +139,7 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
             &GI_HEADER[..],
             vec![ErrorRow {
                 layers: 1,
-                cells: [stats_cells(&e.errors.indirect), stats_cells(&e.errors.full)].concat(),
+                cells: gi_cells(&e.errors),
                 flip_mae: (e.errors.indirect.flip, e.errors.indirect.mae),
             }],
             None,
