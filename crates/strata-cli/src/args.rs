@@ -479,8 +479,9 @@ pub struct EvalArgs {
     /// path-traced frame with sky (docs/image-quality.md).
     #[arg(long)]
     pub views: bool,
-    /// Static frames rendered before the evaluated one (gi: progressive bounces and the
-    /// temporal filter converge), 0..=1000.
+    /// Static frames rendered before the evaluated one (gi: the progressive bounces and the
+    /// temporal filter build up; 8 is a short history, a camera held still reaches its
+    /// steady state by about 32: docs/radiosity.md § "Cosine normalisation"), 0..=1000.
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=1000))]
     pub warmup: u32,
     /// Folder of cached reference images (default: $STRATA_CACHE, else $XDG_CACHE_HOME/strata/reference, else ~/.cache/strata/reference).

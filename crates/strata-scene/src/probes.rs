@@ -135,8 +135,13 @@ impl IrradianceProbes {
     }
 }
 
+/// The facing weight's floor: what a probe straight behind the receiver still counts
+/// (`FACING_FLOOR` in compose.wgsl; 0 would leave a receiver with every probe behind it
+/// with no weight).
+pub const FACING_FLOOR: f32 = 0.002;
+
 /// How much a probe at offset `to_probe` from a receiver with normal `n` counts:
-/// ((1 + cos)/2)² + 0.02, cos between `n` and the direction to the probe. A probe
+/// ((1 + cos)/2)² + [`FACING_FLOOR`], cos between `n` and the direction to the probe. A probe
 /// behind the receiver's tangent plane sees the other side of its surface (through a
 /// wall or a floor: light leaking) and gets almost no weight; one in front counts
 /// fully. (The wrap-shading weight of irradiance-field probes; a probe at the
@@ -144,10 +149,10 @@ impl IrradianceProbes {
 pub fn facing_weight(to_probe: Vec3, n: Vec3) -> f32 {
     let len = to_probe.length();
     if len <= 1e-4 {
-        return 0.25 + 0.02;
+        return 0.25 + FACING_FLOOR;
     }
     let f = 0.5 * (to_probe.dot(n) / len + 1.0);
-    f * f + 0.02
+    f * f + FACING_FLOOR
 }
 
 #[cfg(test)]
@@ -180,14 +185,14 @@ mod tests {
         p.valid[1] = false;
         assert!((p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::Y).x - y0).abs() < 1e-5);
         // a receiver facing probe 1 (normal +x, probe 0 behind it): weights
-        // 0.25 · 0.02 and 0.75 · 1.02 at x = 1.5
+        // 0.25 · floor and 0.75 · (1 + floor) at x = 1.5
         p.valid[1] = true;
         let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::X).x / sh9(Vec3::X)[0];
-        let (w0, w1) = (0.25 * 0.02, 0.75 * 1.02);
+        let (w0, w1) = (0.25 * FACING_FLOOR, 0.75 * (1.0 + FACING_FLOOR));
         assert!((e - (w0 * 1.0 + w1 * 3.0) / (w0 + w1)).abs() < 1e-4, "{e}");
         // facing away from probe 1: probe 0 wins
         let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), -Vec3::X).x / sh9(-Vec3::X)[0];
-        let (w0, w1) = (0.25 * 1.02, 0.75 * 0.02);
+        let (w0, w1) = (0.25 * (1.0 + FACING_FLOOR), 0.75 * FACING_FLOOR);
         assert!((e - (w0 * 1.0 + w1 * 3.0) / (w0 + w1)).abs() < 1e-4, "{e}");
     }
 }

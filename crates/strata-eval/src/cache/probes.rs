@@ -13,7 +13,7 @@ use super::{scene_fingerprint, RefCache};
 
 /// Probes per axis, rays per probe, path bounces.
 pub const GRID: [u32; 3] = [16, 8, 16];
-pub const RAYS: u32 = 512;
+pub const RAYS: u32 = 4096;
 pub const BOUNCES: u32 = 3;
 
 /// The scene's probes at animation frame 0 (static lighting), from the cache or baked (with a

@@ -72,6 +72,10 @@ fn probe_irradiance(index: u32, n: vec3f) -> vec3f {
     return max(e, vec3f(0.0));
 }
 
+// The facing weight's floor (as `probes::FACING_FLOOR`): a probe straight behind the
+// receiver still counts this much.
+const FACING_FLOOR: f32 = 0.002;
+
 // Trilinear blend of the valid ones of the 8 probes around p, weighted by how
 // much each faces the receiver (as `IrradianceProbes::irradiance`).
 fn probe_field(p: vec3f, n: vec3f) -> vec3f {
@@ -98,7 +102,7 @@ fn probe_field(p: vec3f, n: vec3f) -> vec3f {
         if (len > 1e-4) {
             f = 0.5 * (dot(to_probe / len, n) + 1.0);
         }
-        w *= f * f + 0.02;
+        w *= f * f + FACING_FLOOR;
         let pe = probe_irradiance(index, n);
         e_all += pe * w;
         sum_all += w;
