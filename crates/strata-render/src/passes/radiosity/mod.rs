@@ -83,22 +83,23 @@ pub struct RadiositySettings {
 
 /// How the gather turns Σ w·B·cos into irradiance E (docs/radiosity.md § "Cosine
 /// normalisation"). Uniform solid-angle samples have mean cos ½, so all three agree for
-/// them; screen-space taps are not uniform in direction.
+/// them; screen-space taps are not uniform in direction. The discriminants are the
+/// shader's `normalisation` values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Normalisation {
     /// DGB Eq. 4: E = 2π Σ w·B·cos / Σ w. Where the taps cluster near n̂_X (a floor seeing
     /// the walls above it) it over-estimates E, up to 2×, and the progressive bounces (§3.3)
     /// compound that.
-    Hemisphere,
+    Hemisphere = 0,
     /// E = π Σ w·B·cos / Σ w·cos: π times the cosine-weighted mean radiance of the taps,
     /// exact for a uniformly radiant surround whatever the taps' directions; where only
     /// grazing taps find a surface it fills the whole hemisphere with their light.
-    Cosine,
+    Cosine = 1,
     /// E = π Σ w·B·cos / max(Σ w·cos, ½ Σ w) = min(Cosine, Hemisphere) per pixel: never
     /// above Eq. 4. Biased low by up to ~11 % in a uniform enclosure with solid-angle
     /// weights (test `cosine_normalisation_…`), which offsets the gather's over-estimate
     /// from assumed mutual visibility; the steadiest of the three against the path tracer.
-    Bounded,
+    Bounded = 2,
 }
 
 /// DGB Table 2's parameter sets, read from `presets/*.toml` (embedded).
@@ -300,8 +301,8 @@ pub struct RadiosityUniforms {
     pub open_sky: u32,
     /// 1 = back-facing taps count as black ([`RadiositySettings::hidden_black`]).
     pub hidden_black: u32,
-    /// [`Normalisation`]: 0 = Eq. 4, 1 = π/Σ w·cos, 2 = π/max(Σ w·cos, ½ Σ w).
-    pub cosine: u32,
+    /// [`Normalisation`] as its discriminant: 0 = Eq. 4, 1 = π/Σ w·cos, 2 = π/max(Σ w·cos, ½ Σ w).
+    pub normalisation: u32,
     pub _pad: [u32; 3],
 }
 
@@ -328,7 +329,7 @@ impl RadiosityUniforms {
             solid_angle: s.solid_angle as u32,
             open_sky: s.open_sky as u32,
             hidden_black: s.hidden_black as u32,
-            cosine: s.normalisation as u32,
+            normalisation: s.normalisation as u32,
             _pad: [0; 3],
         }
     }
@@ -616,7 +617,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         m_count as f32 / u.samples as f32
     };
     // Eq. 4: π / (½ Σ w); cosine: π / Σ w·cos; bounded: π / max(Σ w·cos, ½ Σ w)
-    let denom = match u.cosine {
+    let denom = match u.normalisation {
         0 => 0.5 * wsum,
         1 => wcsum,
         _ => wcsum.max(0.5 * wsum),

@@ -40,7 +40,7 @@ struct Radiosity {
     // being skipped
     hidden_black: u32,
     // `estimate`'s normaliser: 0 = Eq. 4's 2π / Σ w, 1 = cosine, 2 = bounded cosine
-    cosine: u32,
+    normalisation: u32,
 }
 
 // One tap's share of the sums: c.rgb = w · B(Y) max(ω̂·n̂_X, 0), c.a = w (< 0 for an
@@ -190,9 +190,9 @@ fn estimate(sum: vec4f, wc: f32, m: f32, u: f32) -> vec4f {
     // uniform surround); bounded: π / max(Σ w·cos, ½ Σ w), never above Eq. 4.
     // Confidence M/N (paper) or M/U (coverage).
     var denom = 0.5 * sum.a;
-    if (rad.cosine == 1u) {
+    if (rad.normalisation == 1u) {
         denom = wc;
-    } else if (rad.cosine == 2u) {
+    } else if (rad.normalisation == 2u) {
         denom = max(wc, denom);
     }
     var c = m / f32(rad.samples);
