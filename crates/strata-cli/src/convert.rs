@@ -27,6 +27,13 @@ impl From<&SceneArgs> for SceneSpec {
 
 impl From<&EvalArgs> for EvalSettings {
     fn from(a: &EvalArgs) -> Self {
+        // the direct light's `--set` names (area-shadows, shadow-resolution); a name
+        // this technique does not have is reported by the comparison that reads the
+        // rest of `--set`
+        let mut direct = strata_render::RenderSettings::default();
+        for (name, value) in &a.set.values {
+            let _ = a.technique.set(&mut direct, name, *value);
+        }
         EvalSettings {
             scene: (&a.scene).into(),
             adapter: a.gpu.adapter.clone(),
@@ -41,6 +48,8 @@ impl From<&EvalArgs> for EvalSettings {
             report: a.report.clone(),
             force: a.force,
             progress: !a.quiet,
+            lighting: direct.lighting,
+            shadow: direct.shadow,
         }
     }
 }

@@ -7,9 +7,11 @@
 //! from the light). Other point lights are unshadowed.
 //! A `Rect` light is an area light: its Lambertian irradiance is the exact
 //! polygon integral (Lambert's formula over the rectangle clipped to the
-//! receiver's hemisphere), shadowed by one perspective map from its centre (hard
-//! shadows: the documented approximation); its GGX lobe uses the centre as a
-//! point light with the cosine emission lobe (intensity L·A·cos θ).
+//! receiver's hemisphere), times the share of the rectangle the receiver sees,
+//! estimated by percentage-closer soft shadows from one perspective map at its
+//! centre (`common/shadow.wgsl`; `LightingSettings::area_penumbrae`, hard
+//! shadows from the centre when off); its GGX lobe uses the centre as a point
+//! light with the cosine emission lobe (intensity L·A·cos θ).
 
 use glam::camera::rh::proj::directx;
 use glam::{Mat4, Vec3};
@@ -32,7 +34,9 @@ pub struct GpuLight {
     pub direction: [f32; 4],
     /// rgb intensity × colour (sun: irradiance; point/spot: W/sr; rect: radiance × area)
     pub color: [f32; 4],
-    /// cos(outer), cos(inner), shadow texel size in world units at distance 1 (or absolute for sun), 0
+    /// cos(outer), cos(inner), shadow texel size in world units at distance 1 (or absolute for sun),
+    /// and for a Rect light the shadow map's depth scale C (ndc z = F − C / d at distance d along
+    /// its axis: [`depth_scale`]), which its PCSS penumbra estimate needs; 0 otherwise
     pub cone: [f32; 4],
     /// Rect: the half-edge vectors (xyz); zero for other kinds.
     pub half_u: [f32; 4],
@@ -198,12 +202,13 @@ pub fn gpu_lights_for(scene: &Scene, frame: f32, shadow: &crate::passes::shadow:
                 let fov = 150f32.to_radians();
                 let pos = c + n * 1e-4 * radius;
                 let (view, proj) = perspective_shadow(pos, n, fov, radius, center);
+                let c_depth = depth_scale(proj * view, pos, n);
                 GpuLight {
                     kind: [KIND_RECT, next_layer(), 0, 0],
                     position: c.extend(1.0).to_array(),
                     direction: n.extend(0.0).to_array(),
                     color: [radiance[0], radiance[1], radiance[2], 0.0],
-                    cone: [0.0, 0.0, 2.0 * (fov * 0.5).tan() / res, 0.0],
+                    cone: [0.0, 0.0, 2.0 * (fov * 0.5).tan() / res, c_depth],
                     half_u: half_u.extend(0.0).to_array(),
                     half_v: half_v.extend(0.0).to_array(),
                     shadow_view_proj: (proj * view).to_cols_array_2d(),
@@ -242,6 +247,16 @@ fn perspective_shadow(pos: Vec3, dir: Vec3, fov: f32, scene_radius: f32, scene_c
     let far = (pos - scene_center).length() + scene_radius * 1.01;
     let near = (far * 1e-4).max(1e-4);
     (look_at(pos, pos + dir, dir), directx::perspective(fov, 1.0, near, far))
+}
+
+/// C of a perspective shadow map `view_proj` (eye `pos`, axis `dir`): its ndc
+/// depth at distance d along the axis is F − C / d, so 1/d₁ − 1/d₂ = (z₂ − z₁) / C
+/// (the PCSS blocker-to-receiver term of `common/shadow.wgsl`). Measured from the
+/// matrix at two distances, so it holds whatever the projection's convention.
+pub fn depth_scale(view_proj: Mat4, pos: Vec3, dir: Vec3) -> f32 {
+    let z = |d: f32| view_proj.project_point3(pos + dir * d).z;
+    let (d1, d2) = (1.0f32, 2.0f32);
+    (z(d2) - z(d1)) / (1.0 / d1 - 1.0 / d2)
 }
 
 /// View-projection of face `face` (of [`CUBE_FACES`]) of a point light's

@@ -573,6 +573,7 @@ impl Renderer {
                     lights: &lights,
                     shadow_resolution: settings.shadow.resolution,
                     pcf_radius: settings.lighting.pcf_radius,
+                    area_penumbrae: settings.lighting.area_penumbrae,
                 },
             )?),
             _ => None,

@@ -255,7 +255,7 @@ fn radiosity_of(s: &RenderSettings) -> radiosity::RadiositySettings {
     s.radiosity.clone().unwrap_or_default()
 }
 
-static DIRECT_SETTINGS: [SettingInfo; 2] = [
+static DIRECT_SETTINGS: [SettingInfo; 3] = [
     setting!(
         "shadow-resolution",
         "shadow map resolution per light",
@@ -272,6 +272,15 @@ static DIRECT_SETTINGS: [SettingInfo; 2] = [
         |s| s.exposure.map(f64::from),
         |s, v| s.exposure = Some(v as f32)
     ),
+    SettingInfo {
+        name: "area-shadows",
+        doc: "shadows of rect (area) lights: soft (PCSS: the light's image through the blockers is the filter, so penumbrae widen with the blocker-to-receiver distance) or hard (one shadow test from the light's centre)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(s.lighting.area_penumbrae as u32 as f64),
+        set: |s, v| s.lighting.area_penumbrae = v != 0.0,
+        values: &["hard", "soft"],
+    },
 ];
 
 static AO_SETTINGS: [SettingInfo; 13] = [

@@ -218,12 +218,29 @@ fn light_test_scene(light: Light) -> Scene {
 /// polygon integral on the GPU and next-event estimation over the emissive quad
 /// on the CPU. Returns the relative mean absolute error over lit surface pixels.
 fn direct_light_error(light: Light) -> f64 {
+    direct_error_of(&light_test_scene(light), Default::default(), 64, 48)
+}
+
+/// Relative mean absolute error of the GPU's direct light (`lighting`) against the
+/// path tracer's direct term over the non-emitting surface pixels of `scene`.
+fn direct_error_of(scene: &Scene, lighting: strata_render::passes::lighting::LightingSettings, w: u32, h: u32) -> f64 {
     use strata_reference::GiSettings;
-    let scene = light_test_scene(light);
-    let (w, h) = (64, 48);
+    let scene = scene.clone();
     let gpu = common::gpu();
     let cam = scene.camera;
-    let r = common::render(&gpu, &scene, &cam, w, h);
+    let mut r = strata_render::Renderer::new(
+        &gpu,
+        &scene,
+        strata_render::RenderSettings {
+            width: w,
+            height: h,
+            lighting,
+            ..Default::default()
+        },
+    )
+    .expect("renderer builds without validation errors");
+    r.render(&gpu, &scene, &strata_render::frame::FrameCameras::fixed(cam), 0.0)
+        .expect("frame renders without validation errors");
     let g = r.read_target(&gpu, "direct-diffuse").unwrap();
     let reference = Reference::new(&scene, 0.0).with_progress(false);
     let rd = reference
@@ -244,7 +261,7 @@ fn direct_light_error(light: Light) -> f64 {
             let Some(hit) = reference.primary_hit(&cam, x, y, w, h) else {
                 continue;
             };
-            if hit.material != 0 {
+            if scene.materials[hit.material as usize].emission != [0.0; 3] {
                 continue; // the lamp itself: emission, not reflected light
             }
             let i = (y * w + x) as usize;
@@ -309,6 +326,54 @@ fn direct_light_per_type_matches_the_reference() {
         eprintln!("{name}: relative MAE of the direct light {e:.4}");
         assert!(e < tolerance, "{name}: relative MAE {e:.4} >= {tolerance}");
     }
+}
+
+/// Issue 14: the rect light's penumbrae. A 0.5 m plate hangs halfway between a
+/// 1 × 0.6 m panel and the floor, so its shadow is all penumbra (no umbra across
+/// the panel's long side). PCSS (`area_penumbrae`, the default) must follow the
+/// path tracer's direct light, and do clearly better than the hard shadow from the
+/// panel's centre, which cuts a sharp, too dark shadow into the penumbra.
+#[test]
+fn rect_light_penumbrae_follow_the_path_tracer() {
+    use strata_render::passes::lighting::LightingSettings;
+    use strata_scene::shapes::MeshBuilder;
+    let mut scene = light_test_scene(Light::Rect {
+        center: Vec3::new(0.0, 1.2, -1.5),
+        half_u: Vec3::new(0.5, 0.0, 0.0),
+        half_v: Vec3::new(0.0, 0.0, 0.3),
+        radiance: [4.0, 4.0, 3.0],
+    });
+    let mut plate = MeshBuilder::new();
+    // a 0.5 × 0.5 m plate 0.6 m above the floor, its upper face towards the panel
+    plate.rect(
+        Vec3::new(0.1, 0.6, -1.4),
+        Vec3::new(0.0, 0.0, 0.25),
+        Vec3::new(0.25, 0.0, 0.0),
+    );
+    scene.meshes.push(plate.build("plate", 0));
+    scene.objects.push(strata_scene::Object {
+        name: "plate".into(),
+        mesh: scene.meshes.len() - 1,
+        transform: glam::Mat4::IDENTITY,
+        animation: None,
+    });
+    let (w, h) = (96, 72);
+    let soft = direct_error_of(&scene, LightingSettings::default(), w, h);
+    let hard = direct_error_of(
+        &scene,
+        LightingSettings {
+            area_penumbrae: false,
+            ..Default::default()
+        },
+        w,
+        h,
+    );
+    eprintln!("rect light over a plate: relative MAE of the direct light, PCSS {soft:.4}, hard {hard:.4}");
+    assert!(soft < 0.05, "PCSS: relative MAE {soft:.4} >= 0.05");
+    assert!(
+        soft < 0.6 * hard,
+        "PCSS {soft:.4} is not clearly below the hard shadow's {hard:.4}"
+    );
 }
 
 /// Issue 17's per-light switch: with `ShadowSettings::unshadowed = [0]` the

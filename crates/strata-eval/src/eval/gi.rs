@@ -198,7 +198,7 @@ pub(crate) fn render_settings(s: &EvalSettings, layers: u32, radiosity: &Radiosi
         lighting: LightingSettings {
             // the reference is Lambertian
             specular: false,
-            ..Default::default()
+            ..s.lighting.clone()
         },
         radiosity: Some(radiosity.clone()),
         // `--guard-band auto`: what `render --technique full` uses

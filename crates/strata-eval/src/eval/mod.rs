@@ -8,6 +8,8 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use strata_render::passes::deep_gbuffer::DeepGBufferSettings;
+use strata_render::passes::lighting::LightingSettings;
+use strata_render::passes::shadow::ShadowSettings;
 use strata_render::renderer::GuardBand;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{Camera, ImageBuf, Scene};
@@ -56,6 +58,10 @@ pub struct EvalSettings {
     pub force: bool,
     /// Progress bars of the CPU reference on stderr.
     pub progress: bool,
+    /// The direct light's settings (`--set area-shadows`, …) of every rendered configuration.
+    pub lighting: LightingSettings,
+    /// The shadow maps' (`--set shadow-resolution`).
+    pub shadow: ShadowSettings,
 }
 
 impl EvalSettings {
@@ -98,6 +104,8 @@ impl EvalSettings {
             height: self.scene.height,
             deep: DeepGBufferSettings { layers, ..self.deep },
             guard_band: self.guard_band,
+            lighting: self.lighting.clone(),
+            shadow: self.shadow.clone(),
             ..Default::default()
         }
     }

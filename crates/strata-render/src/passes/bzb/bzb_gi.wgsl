@@ -17,7 +17,8 @@ struct BzbGi {
     seed: u32,
     // payload clamp: largest RGB component kept (0 = off; biased)
     clamp: f32,
-    _pad0: u32,
+    // 1: Rect lights' shadows are PCSS penumbrae (the lighting pass's `area_penumbrae`)
+    area_penumbrae: u32,
     _pad1: u32,
     _pad2: u32,
 }

@@ -68,7 +68,7 @@ fn gi_sender(tri: u32, y: vec3f, bary: vec2f, to_x: vec3f) -> vec3f {
             dist = length(d);
             l = d / max(dist, 1e-12);
         }
-        let vis = shadow_visibility_pcf(li, y, ns, dist, gi.pcf_radius, gi.shadow_size);
+        let vis = light_visibility(li, y, ns, dist, gi.pcf_radius, gi.shadow_size, gi.area_penumbrae);
         if (vis <= 0.0) {
             continue;
         }

@@ -232,7 +232,9 @@ pub struct GiUniforms {
     pub seed: u32,
     /// Payload clamp (largest RGB component; 0 = off).
     pub clamp: f32,
-    pub _pad: [u32; 3],
+    /// 1: Rect lights' shadows are the lighting pass's PCSS penumbrae (`LightingSettings::area_penumbrae`).
+    pub area_penumbrae: u32,
+    pub _pad: [u32; 2],
 }
 
 // ---- CPU twins of bzb_gi.wgsl ----
@@ -468,6 +470,7 @@ pub struct LightInputs<'a> {
     pub lights: &'a [GpuLight],
     pub shadow_resolution: u32,
     pub pcf_radius: i32,
+    pub area_penumbrae: bool,
 }
 
 pub(crate) struct BzbGiStage {
@@ -587,7 +590,8 @@ impl BzbGiStage {
             visibility: s.visibility as u32,
             seed: s.seed,
             clamp: s.clamp.unwrap_or(0.0),
-            _pad: [0; 3],
+            area_penumbrae: light.area_penumbrae as u32,
+            _pad: [0; 2],
         };
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let splat_uniforms = buffer("bzb-splat", bytemuck::bytes_of(&splat_u).to_vec(), 0, uniform);

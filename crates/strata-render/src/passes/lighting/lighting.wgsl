@@ -16,7 +16,8 @@ struct LightingParams {
     shadow_size: f32,
     // 1 = emission enters the radiosity B (0 when emitters are Rect lights)
     emission_in_radiosity: u32,
-    _pad0: u32,
+    // 1 = Rect lights' shadows are PCSS penumbrae (`shadow_visibility_rect`), 0 = hard, from the centre
+    area_penumbrae: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -34,9 +35,9 @@ struct LightingParams {
 @group(1) @binding(8) var<storage, read> shadow_mats: array<mat4x4f>;
 
 const PI: f32 = 3.14159265358979;
-// shadow_layer, shadow_visibility: common/shadow.wgsl (shared with bzb-gi's senders)
+// light_visibility: common/shadow.wgsl (shared with bzb-gi's senders)
 fn shadow_visibility(l: GpuLight, p: vec3f, n: vec3f, dist: f32) -> f32 {
-    return shadow_visibility_pcf(l, p, n, dist, params.pcf_radius, params.shadow_size);
+    return light_visibility(l, p, n, dist, params.pcf_radius, params.shadow_size, params.area_penumbrae);
 }
 
 // GGX / Smith-correlated specular BRDF times cos, Schlick Fresnel.
@@ -118,7 +119,8 @@ fn direct_light(px: vec2i, frag: vec2f, z: f32) -> Direct {
             }
         }
         if (li.kind.x == 3u) {
-            // area light: exact unoccluded Lambertian irradiance, shadowed from the centre
+            // area light: exact unoccluded Lambertian irradiance times the light's
+            // visible share (PCSS), or shadowed from the centre
             let f = rect_irradiance(p, n, li.position.xyz, li.half_u.xyz, li.half_v.xyz, li.direction.xyz);
             var vis_r = 0.0;
             if (f > 0.0) {

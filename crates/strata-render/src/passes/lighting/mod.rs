@@ -1,5 +1,5 @@
 //! Deferred direct lighting over the G-buffer: Lambert + GGX specular, shadow
-//! maps with PCF, emission, constant ambient, sky.
+//! maps with PCF (PCSS penumbrae for area lights), emission, constant ambient, sky.
 
 use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
 use crate::gpu::GpuContext;
@@ -14,6 +14,11 @@ pub struct LightingSettings {
     pub specular: bool,
     /// PCF kernel radius in shadow texels (default 1 → 3×3 bilinear comparisons).
     pub pcf_radius: i32,
+    /// Soft shadows of `Rect` (area) lights: percentage-closer soft shadows
+    /// (PCSS) whose kernel is the light's image through the blockers, so the
+    /// penumbra widens with the blocker-to-receiver distance as the path
+    /// tracer's does (default true). False: hard shadows from the light's centre.
+    pub area_penumbrae: bool,
 }
 
 impl Default for LightingSettings {
@@ -21,6 +26,7 @@ impl Default for LightingSettings {
         Self {
             specular: true,
             pcf_radius: 1,
+            area_penumbrae: true,
         }
     }
 }
@@ -55,7 +61,8 @@ struct Params {
     pcf_radius: i32,
     shadow_size: f32,
     emission_in_radiosity: u32,
-    _pad: [u32; 3],
+    area_penumbrae: u32,
+    _pad: [u32; 2],
 }
 
 pub struct LightingPass {
@@ -135,7 +142,8 @@ impl LightingPass {
             // they are also analytic `Rect` lights: then the direct term
             // already carries their light (no double counting).
             emission_in_radiosity: !lights.iter().any(|l| l.kind[0] == crate::lights::KIND_RECT) as u32,
-            _pad: [0; 3],
+            area_penumbrae: settings.area_penumbrae as u32,
+            _pad: [0; 2],
         };
         let params_buf = wgpu::util::DeviceExt::create_buffer_init(
             device,
