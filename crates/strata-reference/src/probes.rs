@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use rayon::prelude::*;
-use strata_scene::probes::{sh9, sh_band, IrradianceProbes, COSINE_LOBE};
+use strata_scene::probes::{oct_decode, sh9, sh_band, IrradianceProbes, COSINE_LOBE, DEPTH_OCT, DEPTH_TEXELS};
 
 use crate::gi::GiSettings;
 use crate::sampling::{hash, Rng};
@@ -15,25 +15,53 @@ impl Reference<'_> {
     /// per axis), `rays` paths per probe (Fibonacci-sphere directions, each a
     /// path of `settings.bounces` bounces). Probes whose rays hit back faces
     /// more than [`INSIDE_BACKFACE_FRACTION`] of the time lie inside geometry
-    /// and are marked invalid.
+    /// and are marked invalid. Each probe's distance map ([`IrradianceProbes::depth`])
+    /// holds the moments of its rays' first-hit distances, weighted per texel by
+    /// cos^[`DEPTH_SHARPNESS`] between the ray and the texel's direction (misses
+    /// count as twice the scene's diagonal).
     pub fn bake_probes(&self, dims: [u32; 3], rays: u32, settings: &GiSettings) -> IrradianceProbes {
         let (lo, hi) = self.bvh().bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
         let inset = (hi - lo) * 0.05;
-        let mut probes = IrradianceProbes::grid(lo + inset, hi - inset, dims);
+        self.bake_grid(IrradianceProbes::grid(lo + inset, hi - inset, dims), rays, settings)
+    }
+
+    /// Bakes the probes of `probes`' grid as [`Self::bake_probes`] does (its
+    /// coefficients, validity and distance maps are replaced).
+    pub fn bake_grid(&self, mut probes: IrradianceProbes, rays: u32, settings: &GiSettings) -> IrradianceProbes {
+        let (lo, hi) = self.bvh().bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
         let positions: Vec<Vec3> = (0..probes.count()).map(|i| probes.position(i)).collect();
         let rays = rays.max(1);
-        let baked: Vec<([[f32; 3]; 9], bool)> = positions
+        let far = 2.0 * (hi - lo).length().max(1e-3);
+        let texel_dirs: Vec<Vec3> = (0..DEPTH_TEXELS)
+            .map(|t| {
+                let uv = glam::Vec2::new((t % DEPTH_OCT) as f32 + 0.5, (t / DEPTH_OCT) as f32 + 0.5) / DEPTH_OCT as f32;
+                oct_decode(uv)
+            })
+            .collect();
+        let baked: Vec<([[f32; 3]; 9], bool, [[f32; 2]; DEPTH_TEXELS])> = positions
             .par_iter()
             .enumerate()
             .map(|(index, &p)| {
                 let mut sum = [[0.0f32; 3]; 9];
                 let mut traced = 0u64;
                 let mut back = 0u32;
+                let mut moments = [[0.0f32; 3]; DEPTH_TEXELS];
                 for k in 0..rays {
                     let d = fibonacci_sphere(k, rays);
                     traced += 1;
+                    let mut dist = far;
                     if let Some(h) = self.bvh().intersect(p, d, 0.0, f32::INFINITY) {
                         back += !self.bvh().surface(&h, d).front_face as u32;
+                        dist = h.t.min(far);
+                    }
+                    for (m, t) in moments.iter_mut().zip(&texel_dirs) {
+                        let c = t.dot(d);
+                        if c > 0.0 {
+                            let w = c.powi(DEPTH_SHARPNESS);
+                            m[0] += w * dist;
+                            m[1] += w * dist * dist;
+                            m[2] += w;
+                        }
                     }
                     let mut rng = Rng::new(hash(&[settings.seed, index as u64, k as u64]));
                     let l = self.radiance(p, d, settings, &mut rng, &mut traced);
@@ -48,15 +76,21 @@ impl Reference<'_> {
                 // L_i = 4π/M Σ L Y_i; stored as irradiance E_i = Â_l L_i
                 let scale = 4.0 * std::f32::consts::PI / rays as f32;
                 let coeffs = std::array::from_fn(|i| sum[i].map(|v| v * scale * COSINE_LOBE[sh_band(i)]));
+                let depth = moments.map(|m| [m[0] / m[2].max(1e-12), m[1] / m[2].max(1e-12)]);
                 // inside geometry: most rays leave through back faces
-                (coeffs, (back as f32) < INSIDE_BACKFACE_FRACTION * rays as f32)
+                (coeffs, (back as f32) < INSIDE_BACKFACE_FRACTION * rays as f32, depth)
             })
             .collect();
         probes.coeffs = baked.iter().map(|b| b.0).collect();
         probes.valid = baked.iter().map(|b| b.1).collect();
+        probes.depth = baked.iter().map(|b| b.2).collect();
         probes
     }
 }
+
+/// Exponent of the cosine lobe that spreads a ray's distance over the distance
+/// map's texels (about a texel's width at 8 × 8).
+pub const DEPTH_SHARPNESS: i32 = 20;
 
 /// A probe whose rays hit back faces this often is inside geometry (invalid).
 pub const INSIDE_BACKFACE_FRACTION: f32 = 0.25;
@@ -75,6 +109,68 @@ mod tests {
     use super::*;
     use glam::Mat4;
     use strata_scene::{shapes::MeshBuilder, Material, Object, Scene, SceneSettings};
+
+    /// Two probes 1 m either side of a wall (x = 0, 10 cm thick) and a receiver
+    /// 0.5 m in front of it: the distance map of the probe behind the wall says the
+    /// wall is about 0.95 m away towards +x (the lobe's spread adds a little), so that probe fails the
+    /// visibility test and the receiver's light is the near probe's alone.
+    #[test]
+    fn distance_maps_hide_probes_behind_a_wall() {
+        let mut geo = MeshBuilder::new();
+        // a 10 cm thick slab (its faces outward: both probes see front faces)
+        geo.cuboid(Vec3::new(-0.05, -10.0, -10.0), Vec3::new(0.05, 10.0, 10.0));
+        let scene = Scene {
+            name: "wall".into(),
+            meshes: vec![geo.build("wall", 0)],
+            objects: vec![Object {
+                name: "wall".into(),
+                mesh: 0,
+                transform: Mat4::IDENTITY,
+                animation: None,
+            }],
+            materials: vec![Material::diffuse("grey", [0.5; 3])],
+            settings: SceneSettings::default(),
+            ..Default::default()
+        };
+        let grid = IrradianceProbes::grid(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), [2, 1, 1]);
+        let mut probes = Reference::new(&scene, 0.0).bake_grid(grid, 1024, &GiSettings::default());
+        let [mean, mean2] = probes.depth_moments(0, Vec3::X);
+        // the lobe averages slanted rays (0.95 / cos θ): at least the wall's distance, at most 15 % more
+        assert!(
+            (0.95..1.1).contains(&mean),
+            "probe 0 towards the wall: mean distance {mean}"
+        );
+        assert!(probes.valid.iter().all(|&v| v), "both probes are outside the slab");
+        assert!(mean2 >= mean * mean - 1e-4, "moments {mean}, {mean2}");
+        // open side: nothing within twice the scene's size
+        assert!(probes.depth_moments(0, -Vec3::X)[0] > 5.0);
+        // a floor-like receiver: both probes lie in its tangent plane (equal facing weights)
+        let (p, n) = (Vec3::new(0.5, 0.0, 0.0), Vec3::Y);
+        let far = probes.visibility(0, p, n);
+        let near = probes.visibility(1, p, n);
+        assert!(far < 0.01, "the probe behind the wall: visibility {far}");
+        assert_eq!(near, 1.0, "the probe in front of the receiver");
+        // the receiver's light: the near probe's, not a blend with the far one's
+        probes.coeffs[0] = [[0.0; 3]; 9];
+        probes.coeffs[0][0] = [10.0; 3];
+        probes.coeffs[1] = [[0.0; 3]; 9];
+        probes.coeffs[1][0] = [1.0; 3];
+        let e = probes.irradiance(p, n).x / strata_scene::probes::sh9(n)[0];
+        assert!(
+            (e - 1.0).abs() < 0.05,
+            "receiver in front of the wall: {e} (near probe 1, far probe 10)"
+        );
+        let blind = IrradianceProbes {
+            depth: Vec::new(),
+            ..probes.clone()
+        };
+        let e_blind = blind.irradiance(p, n).x / strata_scene::probes::sh9(n)[0];
+        // trilinear weights 1/4 and 3/4: 0.25 · 10 + 0.75 · 1
+        assert!(
+            (e_blind - 3.25).abs() < 0.05,
+            "without distance maps the far probe leaks in: {e_blind}"
+        );
+    }
 
     /// Inside a closed box whose walls emit L and reflect nothing, every probe
     /// sees radiance L in every direction: irradiance πL for every normal.

@@ -358,9 +358,10 @@ fn coverage_confidence_is_near_one_inside_a_closed_box() {
 
 /// The composite's probe term (`probe-irradiance`, before AO's factor) is the CPU
 /// twin's `IrradianceProbes::irradiance` at every covered pixel — trilinear weights, the
-/// facing weight (probes behind the receiver's tangent plane barely count) and SH
-/// evaluation — for a 3×3×3 grid of distinct, direction-dependent probes, one of them
-/// invalid.
+/// facing weight (probes behind the receiver's tangent plane barely count), the
+/// distance maps' visibility test and SH evaluation — for a 3×3×3 grid of distinct,
+/// direction-dependent probes, one of them invalid; without distance maps and with
+/// the path tracer's (the grid reaches outside the box, so walls hide probes).
 #[test]
 fn probe_field_matches_cpu_twin() {
     let gpu = common::gpu();
@@ -379,36 +380,63 @@ fn probe_field_matches_cpu_twin() {
         }
     }
     probes.valid[13] = false;
-    let mut r = renderer(
-        &gpu,
-        &scene,
-        w,
-        h,
-        RadiositySettings::default(),
-        Some(probes.clone()),
-        None,
-    );
-    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
-        .expect("frame renders without validation errors");
-    let field = r.read_target(&gpu, "probe-irradiance").unwrap();
-    let points = common::surface_points(&gpu, &r);
-    assert!(points.len() > w as usize * h as usize / 2, "the box fills the frame");
-    let mut worst = 0.0f32;
-    for s in &points {
-        let av = field.data[s.i * 4 + 3];
-        let want = probes.irradiance(s.p, s.n) * av;
-        for c in 0..3 {
-            let got = field.data[s.i * 4 + c];
-            let err = (got - want[c]).abs() / want[c].abs().max(0.05);
-            worst = worst.max(err);
+    // the distance maps of the same grid, traced
+    let baked = strata_reference::Reference::new(&scene, 0.0)
+        .with_progress(false)
+        .bake_grid(probes.clone(), 256, &Default::default());
+    for with_depth in [false, true] {
+        if with_depth {
+            probes.depth = baked.depth.clone();
+        }
+        let mut r = renderer(
+            &gpu,
+            &scene,
+            w,
+            h,
+            RadiositySettings::default(),
+            Some(probes.clone()),
+            None,
+        );
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let field = r.read_target(&gpu, "probe-irradiance").unwrap();
+        let points = common::surface_points(&gpu, &r);
+        assert!(points.len() > w as usize * h as usize / 2, "the box fills the frame");
+        let mut worst = 0.0f32;
+        // receivers whose probe term the visibility test changes by over 5 %
+        let mut hidden = 0usize;
+        let blind = IrradianceProbes {
+            depth: Vec::new(),
+            ..probes.clone()
+        };
+        for s in &points {
+            let av = field.data[s.i * 4 + 3];
+            let want = probes.irradiance(s.p, s.n) * av;
+            let free = blind.irradiance(s.p, s.n) * av;
+            hidden += ((want - free).abs().max_element() > 0.05 * free.max_element()) as usize;
+            for c in 0..3 {
+                let got = field.data[s.i * 4 + c];
+                let err = (got - want[c]).abs() / want[c].abs().max(0.05);
+                worst = worst.max(err);
+                assert!(
+                    err < 5e-3,
+                    "distance maps {with_depth}, pixel ({}, {}) channel {c}: GPU {got} vs CPU {}",
+                    s.x,
+                    s.y,
+                    want[c]
+                );
+            }
+        }
+        if with_depth {
             assert!(
-                err < 5e-3,
-                "pixel ({}, {}) channel {c}: GPU {got} vs CPU {}",
-                s.x,
-                s.y,
-                want[c]
+                hidden > points.len() / 20,
+                "the walls must hide probes from many receivers, changing their light ({hidden} of {})",
+                points.len()
             );
         }
+        eprintln!(
+            "distance maps {with_depth}: worst relative error {worst:.2e} over {} pixels, {hidden} changed by hidden probes",
+            points.len()
+        );
     }
-    eprintln!("worst relative error {worst:.2e} over {} pixels", points.len());
 }

@@ -17,6 +17,7 @@ pub mod image_buf;
 pub mod load;
 pub mod model;
 pub mod normals;
+pub mod oct;
 pub mod path;
 pub mod probes;
 pub mod procedural;

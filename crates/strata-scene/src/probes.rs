@@ -5,6 +5,8 @@
 
 use glam::Vec3;
 
+pub use crate::oct::{oct_decode, oct_encode};
+
 /// Cosine-lobe convolution of SH band l (Ramamoorthi & Hanrahan 2001): Â_0 = π,
 /// Â_1 = 2π/3, Â_2 = π/4.
 pub const COSINE_LOBE: [f32; 3] = [
@@ -53,7 +55,41 @@ pub struct IrradianceProbes {
     /// Per probe: false when it lies inside geometry (most of its rays hit back
     /// faces); invalid probes get no weight in the interpolation.
     pub valid: Vec<bool>,
+    /// Per probe (empty: no visibility test): the mean and mean square of the
+    /// distance to the first surface, over the directions of each texel of a
+    /// [`DEPTH_OCT`]² octahedral map ([`oct_encode`]). A receiver farther from the
+    /// probe than that surface is likely hidden from it ([`chebyshev_visibility`]).
+    pub depth: Vec<[[f32; 2]; DEPTH_TEXELS]>,
 }
+
+/// Texels per side of a probe's octahedral distance map.
+pub const DEPTH_OCT: usize = 8;
+/// Texels of a probe's distance map.
+pub const DEPTH_TEXELS: usize = DEPTH_OCT * DEPTH_OCT;
+
+/// Receivers are moved this fraction of the smallest probe spacing along their
+/// normal before the visibility test (`VISIBILITY_BIAS` in compose.wgsl), so a
+/// surface is not hidden from a probe by itself.
+pub const VISIBILITY_BIAS: f32 = 0.1;
+
+/// Chebyshev's bound on the chance that a receiver at distance `dist` from a probe
+/// is visible from it, given the mean `mean` and mean square `mean2` of the
+/// distance to the probe's first surface in that direction: 1 in front of the
+/// surface, var / (var + (dist − mean)²) behind it, cubed to sharpen the cut and
+/// floored at [`VISIBILITY_FLOOR`] (`chebyshev_visibility` in compose.wgsl).
+pub fn chebyshev_visibility(dist: f32, mean: f32, mean2: f32) -> f32 {
+    if dist <= mean {
+        return 1.0;
+    }
+    let var = (mean2 - mean * mean).max(1e-4 * mean * mean + 1e-8);
+    let t = dist - mean;
+    let p = var / (var + t * t);
+    (p * p * p).max(VISIBILITY_FLOOR)
+}
+
+/// What a probe behind a surface still counts (0 would leave a receiver that every
+/// probe's test rejects with no weight).
+pub const VISIBILITY_FLOOR: f32 = 0.002;
 
 impl IrradianceProbes {
     /// Probe positions of a grid spanning `lo`..`hi` with `dims` probes per axis.
@@ -66,6 +102,7 @@ impl IrradianceProbes {
             dims,
             coeffs: vec![[[0.0; 3]; 9]; (dims[0] * dims[1] * dims[2]) as usize],
             valid: vec![true; (dims[0] * dims[1] * dims[2]) as usize],
+            depth: Vec::new(),
         }
     }
 
@@ -92,9 +129,46 @@ impl IrradianceProbes {
         e.max(Vec3::ZERO)
     }
 
+    /// The distance map of probe `index` at direction `d`: (mean, mean square),
+    /// bilinear between texel centres (clamped at the map's border).
+    pub fn depth_moments(&self, index: usize, d: Vec3) -> [f32; 2] {
+        let map = &self.depth[index];
+        let st = oct_encode(d) * DEPTH_OCT as f32 - 0.5;
+        let base = st.floor();
+        let f = st - base;
+        let mut m = [0.0f32; 2];
+        for k in 0..4 {
+            let (ox, oy) = (k & 1, k >> 1);
+            let w = if ox == 1 { f.x } else { 1.0 - f.x } * if oy == 1 { f.y } else { 1.0 - f.y };
+            let x = (base.x as i32 + ox).clamp(0, DEPTH_OCT as i32 - 1) as usize;
+            let y = (base.y as i32 + oy).clamp(0, DEPTH_OCT as i32 - 1) as usize;
+            let t = map[y * DEPTH_OCT + x];
+            m[0] += w * t[0];
+            m[1] += w * t[1];
+        }
+        m
+    }
+
+    /// How visible a receiver at `p` (normal `n`) is from probe `index`: 1 without
+    /// distance maps, else [`chebyshev_visibility`] of the receiver moved by
+    /// [`VISIBILITY_BIAS`] × the smallest spacing along `n`.
+    pub fn visibility(&self, index: usize, p: Vec3, n: Vec3) -> f32 {
+        if self.depth.is_empty() {
+            return 1.0;
+        }
+        let x = p + n * (VISIBILITY_BIAS * self.spacing.min_element());
+        let d = x - self.position(index);
+        let dist = d.length();
+        if dist <= 1e-6 {
+            return 1.0;
+        }
+        let [mean, mean2] = self.depth_moments(index, d / dist);
+        chebyshev_visibility(dist, mean, mean2)
+    }
+
     /// Irradiance at `p` for normal `n`: trilinear blend of the valid ones of
     /// the 8 surrounding probes (positions clamped to the grid), each weight times
-    /// [`facing_weight`], renormalised; all 8 when none is valid.
+    /// [`facing_weight`] and [`Self::visibility`], renormalised; all 8 when none is valid.
     pub fn irradiance(&self, p: Vec3, n: Vec3) -> Vec3 {
         let g = ((p - self.origin) / self.spacing).max(Vec3::ZERO);
         let max = Vec3::new(
@@ -118,7 +192,7 @@ impl IrradianceProbes {
                 * (if o.y > 0.0 { t.y } else { 1.0 - t.y })
                 * (if o.z > 0.0 { t.z } else { 1.0 - t.z });
             let index = (c.x as u32 + self.dims[0] * (c.y as u32 + self.dims[1] * c.z as u32)) as usize;
-            let w = w * facing_weight(self.origin + c * self.spacing - p, n);
+            let w = w * facing_weight(self.origin + c * self.spacing - p, n) * self.visibility(index, p, n);
             let pe = self.probe_irradiance(index, n);
             e_all += pe * w;
             sum_all += w;

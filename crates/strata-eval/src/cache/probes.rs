@@ -6,7 +6,7 @@ use anyhow::Result;
 use glam::Vec3;
 use strata_reference::gi::GiSettings;
 use strata_reference::Reference;
-use strata_scene::probes::IrradianceProbes;
+use strata_scene::probes::{IrradianceProbes, DEPTH_TEXELS};
 use strata_scene::{ImageBuf, Scene};
 
 use super::{scene_fingerprint, RefCache};
@@ -20,7 +20,7 @@ pub const BOUNCES: u32 = 3;
 /// notice on stderr unless `quiet`).
 pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v3 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
+        "v4 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
         scene_fingerprint(scene, 0.0)
     );
     let key = RefCache::key(&description);
@@ -46,21 +46,28 @@ pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<Irra
     Ok(probes)
 }
 
-/// Row 0: origin, spacing, dims; row 1 + i: probe i's 27 coefficients and its validity.
+/// Floats per row: 27 coefficients, the validity, the distance map's moments.
+const ROW: usize = 28 + 2 * DEPTH_TEXELS;
+
+/// Row 0: origin, spacing, dims; row 1 + i: probe i's 27 coefficients, its validity
+/// and its distance map (mean, mean square per texel).
 fn encode(p: &IrradianceProbes) -> ImageBuf {
-    let mut img = ImageBuf::new(28, p.count() as u32 + 1, 1);
+    let mut img = ImageBuf::new(ROW as u32, p.count() as u32 + 1, 1);
     let head = [p.origin.to_array(), p.spacing.to_array(), p.dims.map(|d| d as f32)].concat();
     img.data[..9].copy_from_slice(&head);
     for (i, c) in p.coeffs.iter().enumerate() {
-        let row = 28 * (i + 1);
+        let row = ROW * (i + 1);
         img.data[row..row + 27].copy_from_slice(&c.concat());
         img.data[row + 27] = p.valid[i] as u32 as f32;
+        if let Some(d) = p.depth.get(i) {
+            img.data[row + 28..row + ROW].copy_from_slice(&d.concat());
+        }
     }
     img
 }
 
 fn decode(img: &ImageBuf) -> Option<IrradianceProbes> {
-    if img.width != 28 || img.channels != 1 || img.height < 2 {
+    if img.width as usize != ROW || img.channels != 1 || img.height < 2 {
         return None;
     }
     let d = &img.data;
@@ -70,15 +77,19 @@ fn decode(img: &ImageBuf) -> Option<IrradianceProbes> {
         return None;
     }
     let coeffs = (0..count)
-        .map(|i| std::array::from_fn(|k| std::array::from_fn(|c| d[28 * (i + 1) + 3 * k + c])))
+        .map(|i| std::array::from_fn(|k| std::array::from_fn(|c| d[ROW * (i + 1) + 3 * k + c])))
         .collect();
-    let valid = (0..count).map(|i| d[28 * (i + 1) + 27] > 0.5).collect();
+    let valid = (0..count).map(|i| d[ROW * (i + 1) + 27] > 0.5).collect();
+    let depth = (0..count)
+        .map(|i| std::array::from_fn(|t| std::array::from_fn(|c| d[ROW * (i + 1) + 28 + 2 * t + c])))
+        .collect();
     Some(IrradianceProbes {
         origin: Vec3::new(d[0], d[1], d[2]),
         spacing: Vec3::new(d[3], d[4], d[5]),
         dims,
         coeffs,
         valid,
+        depth,
     })
 }
 
@@ -95,6 +106,9 @@ mod tests {
             }
         }
         p.valid[3] = false;
+        p.depth = (0..p.count())
+            .map(|i| std::array::from_fn(|t| [i as f32 + t as f32, 0.25 * t as f32]))
+            .collect();
         assert_eq!(decode(&encode(&p)), Some(p));
     }
 }

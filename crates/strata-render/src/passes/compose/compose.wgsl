@@ -18,7 +18,8 @@ struct Compose {
     use_ao: u32,
     // 1 = add the glossy receivers' radiance (ILS `ils-glossy`) as is
     use_glossy: u32,
-    // probe grid: origin (xyz), spacing (xyz), probes per axis
+    // probe grid: origin (xyz), spacing (xyz; w: the visibility test's normal
+    // offset of the receiver), probes per axis (w: 1 = the probes have distance maps)
     origin: vec4f,
     spacing: vec4f,
     dims: vec4u,
@@ -40,6 +41,9 @@ struct Probe {
 @group(1) @binding(7) var<storage, read> probes: array<Probe>;
 // outgoing radiance of glossy receivers (rgb; use_glossy), else any target
 @group(1) @binding(8) var glossy: texture_2d<f32>;
+// per probe, PROBE_DEPTH_OCT² texels (row-major) of (mean, mean square) distance to
+// the first surface (`IrradianceProbes::depth`); one dummy texel without distance maps
+@group(1) @binding(9) var<storage, read> probe_depth: array<vec2f>;
 
 struct Out {
     @location(0) hdr: vec4f,
@@ -76,8 +80,51 @@ fn probe_irradiance(index: u32, n: vec3f) -> vec3f {
 // receiver still counts this much.
 const FACING_FLOOR: f32 = 0.002;
 
+// As `probes::DEPTH_OCT` and `probes::VISIBILITY_FLOOR`.
+const PROBE_DEPTH_OCT: i32 = 8;
+const VISIBILITY_FLOOR: f32 = 0.002;
+
+// Chebyshev's bound that a receiver at `dist` is visible from a probe whose
+// first surface in that direction has distance moments m (as
+// `probes::chebyshev_visibility`).
+fn chebyshev_visibility(dist: f32, m: vec2f) -> f32 {
+    if (dist <= m.x) {
+        return 1.0;
+    }
+    let v = max(m.y - m.x * m.x, 1e-4 * m.x * m.x + 1e-8);
+    let t = dist - m.x;
+    let pr = v / (v + t * t);
+    return max(pr * pr * pr, VISIBILITY_FLOOR);
+}
+
+// How visible the receiver p (normal n) is from probe `index` at `probe_pos`
+// (as `IrradianceProbes::visibility`): its distance map, bilinear between texel
+// centres, at the direction to p moved off its surface.
+fn probe_visibility(index: u32, probe_pos: vec3f, p: vec3f, n: vec3f) -> f32 {
+    if (compose.dims.w == 0u) {
+        return 1.0;
+    }
+    let d = p + n * compose.spacing.w - probe_pos;
+    let dist = length(d);
+    if (dist <= 1e-6) {
+        return 1.0;
+    }
+    let st = oct_encode(d / dist) * f32(PROBE_DEPTH_OCT) - 0.5;
+    let base = floor(st);
+    let f = st - base;
+    var m = vec2f(0.0);
+    for (var k = 0; k < 4; k++) {
+        let o = vec2i(k & 1, k >> 1);
+        let w = select(1.0 - f.x, f.x, o.x == 1) * select(1.0 - f.y, f.y, o.y == 1);
+        let t = clamp(vec2i(base) + o, vec2i(0), vec2i(PROBE_DEPTH_OCT - 1));
+        m += w * probe_depth[index * u32(PROBE_DEPTH_OCT * PROBE_DEPTH_OCT) + u32(t.y * PROBE_DEPTH_OCT + t.x)];
+    }
+    return chebyshev_visibility(dist, m);
+}
+
 // Trilinear blend of the valid ones of the 8 probes around p, weighted by how
-// much each faces the receiver (as `IrradianceProbes::irradiance`).
+// much each faces the receiver and how visible the receiver is from it (as
+// `IrradianceProbes::irradiance`).
 fn probe_field(p: vec3f, n: vec3f) -> vec3f {
     let dims = compose.dims.xyz;
     let mx = vec3f(dims) - 1.0;
@@ -96,13 +143,14 @@ fn probe_field(p: vec3f, n: vec3f) -> vec3f {
         let index = c.x + dims.x * (c.y + dims.y * c.z);
         // probes behind the receiver's tangent plane see the other side of its
         // surface (as `probes::facing_weight`)
-        let to_probe = compose.origin.xyz + vec3f(c) * compose.spacing.xyz - p;
+        let probe_pos = compose.origin.xyz + vec3f(c) * compose.spacing.xyz;
+        let to_probe = probe_pos - p;
         let len = length(to_probe);
         var f = 0.5;
         if (len > 1e-4) {
             f = 0.5 * (dot(to_probe / len, n) + 1.0);
         }
-        w *= f * f + FACING_FLOOR;
+        w *= (f * f + FACING_FLOOR) * probe_visibility(index, probe_pos, p, n);
         let pe = probe_irradiance(index, n);
         e_all += pe * w;
         sum_all += w;

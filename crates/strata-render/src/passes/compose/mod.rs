@@ -69,8 +69,16 @@ impl ComposePass {
             use_ao: use_ao as u32,
             use_glossy: glossy.is_some() as u32,
             origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
-            spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(0.0).to_array()),
-            dims: probes.map_or([1, 1, 1, 0], |p| [p.dims[0], p.dims[1], p.dims[2], 0]),
+            // w: the visibility test's normal offset (`probes::VISIBILITY_BIAS` × the smallest spacing)
+            spacing: probes.map_or([1.0; 4], |p| {
+                p.spacing
+                    .extend(strata_scene::probes::VISIBILITY_BIAS * p.spacing.min_element())
+                    .to_array()
+            }),
+            // w: 1 = distance maps (the visibility test)
+            dims: probes.map_or([1, 1, 1, 0], |p| {
+                [p.dims[0], p.dims[1], p.dims[2], !p.depth.is_empty() as u32]
+            }),
         };
         let data: Vec<[f32; 4]> = match probes {
             Some(p) => p
@@ -93,6 +101,18 @@ impl ComposePass {
                 usage: wgpu::BufferUsages::STORAGE,
             },
         );
+        let depth: Vec<[f32; 2]> = match probes {
+            Some(p) if !p.depth.is_empty() => p.depth.iter().flatten().copied().collect(),
+            _ => vec![[0.0; 2]],
+        };
+        let depth_buf = wgpu::util::DeviceExt::create_buffer_init(
+            &gpu.device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("light-probe distance maps"),
+                contents: bytemuck::cast_slice(&depth),
+                usage: wgpu::BufferUsages::STORAGE,
+            },
+        );
         let mut b = PassBuilder::new(gpu, targets, "compose")
             .shader("compose", include_str!("compose.wgsl"))
             .frame(scene)
@@ -106,7 +126,8 @@ impl ComposePass {
             .read_layer(if use_ao { "ao" } else { indirect }, 0)
             .storage(&probe_buf)
             // without glossy receivers the binding is filled by a target that is read anyway
-            .read_layer(glossy.unwrap_or(indirect), 0);
+            .read_layer(glossy.unwrap_or(indirect), 0)
+            .storage(&depth_buf);
         for t in &OUTPUTS {
             b = b.write(t.name);
         }
