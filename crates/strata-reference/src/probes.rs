@@ -38,7 +38,7 @@ impl Reference<'_> {
                 oct_decode(uv)
             })
             .collect();
-        let baked: Vec<([[f32; 3]; 9], bool, [[f32; 2]; DEPTH_TEXELS])> = positions
+        let baked: Vec<BakedProbe> = positions
             .par_iter()
             .enumerate()
             .map(|(index, &p)| {
@@ -87,6 +87,9 @@ impl Reference<'_> {
         probes
     }
 }
+
+/// One probe's irradiance coefficients, validity and distance map.
+type BakedProbe = ([[f32; 3]; 9], bool, [[f32; 2]; DEPTH_TEXELS]);
 
 /// Exponent of the cosine lobe that spreads a ray's distance over the distance
 /// map's texels (about a texel's width at 8 × 8).
