@@ -395,7 +395,7 @@ static AO_SETTINGS: [SettingInfo; 13] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 14] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 15] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -413,6 +413,12 @@ static RADIOSITY_SETTINGS: [SettingInfo; 14] = [
         "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",
         open_sky,
         ["fill", "sky"]
+    ),
+    radiosity_switch!(
+        "probe-visibility",
+        "on: a light probe that its distance map says is behind a surface from the receiver barely counts in the probe blend (Chebyshev test; no light through walls; not in the paper); off: probes weigh by distance and facing only",
+        probe_visibility,
+        ["off", "on"]
     ),
     radiosity_switch!(
         "hidden-taps",

@@ -77,6 +77,11 @@ pub struct RadiositySettings {
     /// Taps that fail Eq. 5's n̂_Y test count as black occluders (their weight, no light)
     /// instead of being skipped.
     pub hidden_black: bool,
+    /// The light probes' visibility test: a probe whose distance map says a surface lies
+    /// between it and the receiver barely counts in the probe blend (no light leaking
+    /// through walls; `IrradianceProbes::visibility`). Needs probes baked with distance
+    /// maps; not in the paper (default true).
+    pub probe_visibility: bool,
     /// The gather's normaliser ([`Normalisation`]; default `Bounded`, not in the paper).
     pub normalisation: Normalisation,
 }
@@ -197,6 +202,7 @@ impl Default for RadiositySettings {
             coverage_confidence: false,
             open_sky: false,
             hidden_black: false,
+            probe_visibility: true,
             normalisation: Normalisation::Bounded,
         }
     }
@@ -204,12 +210,14 @@ impl Default for RadiositySettings {
 
 impl RadiositySettings {
     /// DGB's estimator exactly as published: per-pixel (not per-frame) spiral
-    /// rotation and Eq. 4's equal tap weights (the rest as [`Default`]).
+    /// rotation, Eq. 4's equal tap weights and normaliser, probes blended without a
+    /// visibility test (the rest as [`Default`]).
     pub fn paper() -> Self {
         Self {
             temporal_noise: false,
             solid_angle: false,
             normalisation: Normalisation::Hemisphere,
+            probe_visibility: false,
             ..Default::default()
         }
     }

@@ -118,6 +118,18 @@ impl RadiosityStage {
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
         }
+        // without the visibility test the probes blend as if they had no distance maps
+        let blind;
+        let probes = match probes {
+            Some(p) if !s.probe_visibility && !p.depth.is_empty() => {
+                blind = strata_scene::probes::IrradianceProbes {
+                    depth: Vec::new(),
+                    ..p.clone()
+                };
+                Some(&blind)
+            }
+            other => other,
+        };
         let compose = crate::passes::compose::ComposePass::new(gpu, scene, targets, s.boost, probes, "indirect", None);
         Self {
             propagate,
