@@ -473,6 +473,11 @@ pub struct EvalArgs {
     /// irradiance probes for the coarse-scale fallback").
     #[arg(long)]
     pub no_probes: bool,
+    /// gi: bake the light probes from this scene (built-in name or file) instead of the
+    /// evaluated one: stale probes, as after a change the static bake has not seen (a moved
+    /// object, a recoloured surface), which only the screen-space radiosity can follow.
+    #[arg(long, value_name = "SCENE", conflicts_with = "no_probes")]
+    pub probes_from: Option<String>,
     /// full: instead of the sky-off GI comparison, measure what `render --technique full`
     /// shows (probes on): pixels clipped in the final image and the probe-only / blended /
     /// gbuffer-only views, |blended − probe-only|, and the chroma of fixed regions against the

@@ -83,6 +83,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 bounces: a.bounces,
                 fig10: a.fig10,
                 probes: !a.no_probes,
+                probes_from: a.probes_from.clone(),
             };
             EvalResult::Gi(gi::run(&s, &rs, &g)?)
         }

@@ -732,6 +732,32 @@ fn eval_gi_reports_indirect_and_full_errors() {
     assert_eq!(blended["probes"], true);
     assert_eq!(alone["probes"], false);
     assert_ne!(blended["rmse"], alone["rmse"], "the probes change the indirect light");
+    // probes baked from a named scene: the same scene gives the same (cached) probes and
+    // the same errors; an unknown scene is a one-line error naming the flag
+    let same = run(&["--probes-from", "cornell"]);
+    assert_eq!(same["probes_from"], "cornell");
+    assert_eq!(same["rmse"], blended["rmse"]);
+    assert!(blended.get("probes_from").is_none(), "{blended}");
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        "gi",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--ref-spp",
+        "4",
+        "--quiet",
+        "--cache",
+        cache.to_str().unwrap(),
+        "--probes-from",
+        "no-such-scene",
+        "--json",
+    ]);
+    assert_one_line_error(&o, &["--probes-from", "no-such-scene"]);
     let o = strata(&[
         "eval",
         "--scene",

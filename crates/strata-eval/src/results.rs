@@ -421,6 +421,9 @@ pub struct GiEval {
     /// Blended with light probes baked from the evaluated scene (`--probes`).
     #[serde(default)]
     pub probes: bool,
+    /// The scene the probes were baked from when not the evaluated one (`--probes-from`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probes_from: Option<String>,
     #[serde(flatten)]
     pub errors: GiErrors,
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -25,7 +25,7 @@ pub const DEFAULT_CAP: u32 = 32_768;
 const FIG10_SPP: u32 = 256;
 
 /// What only the GI evaluation takes.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct GiEvalSettings {
     /// Indirect bounces of the path-traced reference, 1..=64.
     pub bounces: u32,
@@ -33,6 +33,9 @@ pub struct GiEvalSettings {
     pub fig10: bool,
     /// Blend with light probes baked from the evaluated scene (DGB's coarse-scale fallback).
     pub probes: bool,
+    /// Bake the probes from this scene instead (stale probes; sky and ambient off as for
+    /// the evaluated scene).
+    pub probes_from: Option<String>,
 }
 
 /// GPU images of one configuration and their errors.
@@ -110,9 +113,15 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         adapter: s.adapter.clone(),
     })?;
     // the probes see the scene as evaluated: sky and ambient off
-    let probes = match g.probes {
-        true => Some(crate::cache::probes::scene_probes(&scene, &cache, !s.progress)?),
-        false => None,
+    let probes = match (g.probes, &g.probes_from) {
+        (false, _) => None,
+        (true, None) => Some(crate::cache::probes::scene_probes(&scene, &cache, !s.progress)?),
+        (true, Some(other)) => {
+            let mut source = strata_scene::load_scene(other).map_err(|e| anyhow::anyhow!("--probes-from: {e}"))?;
+            source.settings.ambient = [0.0; 3];
+            source.settings.sky = [0.0; 3];
+            Some(crate::cache::probes::scene_probes(&source, &cache, !s.progress)?)
+        }
     };
     let evaluate = |layers: u32| -> Result<GiResult> {
         let settings = RenderSettings {
@@ -181,6 +190,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         warmup: s.warmup,
         ref_bounces: g.bounces,
         probes: g.probes,
+        probes_from: g.probes_from.clone(),
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
         fig10,
