@@ -478,6 +478,11 @@ pub struct EvalArgs {
     /// object, a recoloured surface), which only the screen-space radiosity can follow.
     #[arg(long, value_name = "SCENE", conflicts_with = "no_probes")]
     pub probes_from: Option<String>,
+    /// gi: the warm-up frames follow the scene's camera path up to the evaluated --frame
+    /// (frames f − warmup … f) instead of holding its camera still: the GI error of a moving
+    /// camera, with the temporal filter and the progressive bounces reprojecting every frame.
+    #[arg(long)]
+    pub moving: bool,
     /// full: instead of the sky-off GI comparison, measure what `render --technique full`
     /// shows (probes on): pixels clipped in the final image and the probe-only / blended /
     /// gbuffer-only views, |blended − probe-only|, and the chroma of fixed regions against the

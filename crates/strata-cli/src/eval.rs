@@ -84,6 +84,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 fig10: a.fig10,
                 probes: !a.no_probes,
                 probes_from: a.probes_from.clone(),
+                moving: a.moving,
             };
             EvalResult::Gi(gi::run(&s, &rs, &g)?)
         }

@@ -738,6 +738,11 @@ fn eval_gi_reports_indirect_and_full_errors() {
     assert_eq!(same["probes_from"], "cornell");
     assert_eq!(same["rmse"], blended["rmse"]);
     assert!(blended.get("probes_from").is_none(), "{blended}");
+    // --moving warms up along the camera path; Cornell has none, so it is the still warm-up
+    let moving = run(&["--moving"]);
+    assert_eq!(moving["moving"], true);
+    assert_eq!(moving["rmse"], blended["rmse"]);
+    assert!(blended.get("moving").is_none(), "{blended}");
     let o = strata(&[
         "eval",
         "--scene",

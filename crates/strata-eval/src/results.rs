@@ -424,6 +424,9 @@ pub struct GiEval {
     /// The scene the probes were baked from when not the evaluated one (`--probes-from`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub probes_from: Option<String>,
+    /// The warm-up followed the camera path (`--moving`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub moving: bool,
     #[serde(flatten)]
     pub errors: GiErrors,
     #[serde(default, skip_serializing_if = "Option::is_none")]

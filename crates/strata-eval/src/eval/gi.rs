@@ -36,6 +36,8 @@ pub struct GiEvalSettings {
     /// Bake the probes from this scene instead (stale probes; sky and ambient off as for
     /// the evaluated scene).
     pub probes_from: Option<String>,
+    /// Warm up along the camera path (frames f − warmup … f) instead of at a still camera.
+    pub moving: bool,
 }
 
 /// GPU images of one configuration and their errors.
@@ -129,9 +131,19 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
             ..render_settings(s, layers, rs)
         };
         let mut r = Renderer::new(&gpu, &scene, settings)?;
-        // static warm-up at the evaluated camera: bounces and temporal history
+        // warm-up at the evaluated camera (bounces and temporal history), or along the
+        // camera path up to it (--moving)
         let renders = s.warmup.max(1) + 1;
-        let (full, indirect) = render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, renders)?;
+        let (full, indirect) = if g.moving {
+            let f = s.scene.frame;
+            for k in (0..renders).rev() {
+                let fk = (f - k as f32).max(0.0);
+                r.render(&gpu, &scene, &s.scene.cameras_at(&scene, fk), fk)?;
+            }
+            read_indirect(&r, &gpu)?
+        } else {
+            render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, renders)?
+        };
         // RMSE / MAE on linear radiance, FLIP on the tonemapped images
         let (full_stats, full_map) = compare_radiance(&ref_total.image, &full, exposure)?;
         let (indirect_stats, indirect_map) = compare_radiance(&ref_indirect.image, &indirect, exposure)?;
@@ -191,6 +203,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         ref_bounces: g.bounces,
         probes: g.probes,
         probes_from: g.probes_from.clone(),
+        moving: g.moving,
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
         fig10,
@@ -231,6 +244,11 @@ pub(crate) fn render_indirect(
     for _ in 0..renders {
         r.render(gpu, scene, &fixed, frame)?;
     }
+    read_indirect(r, gpu)
+}
+
+/// The last rendered frame's composed image and its indirect part (composed − direct), RGB.
+fn read_indirect(r: &Renderer, gpu: &GpuContext) -> Result<(ImageBuf, ImageBuf)> {
     let full = rgb(&r.read_target(gpu, "hdr-full")?);
     let direct = rgb(&r.read_target(gpu, "hdr")?);
     let mut indirect = full.clone();
