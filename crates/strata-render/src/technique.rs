@@ -395,7 +395,7 @@ static AO_SETTINGS: [SettingInfo; 13] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 15] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 16] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -413,6 +413,18 @@ static RADIOSITY_SETTINGS: [SettingInfo; 15] = [
         "background taps of the gather: fill (skipped, the paper: their part of the hemisphere takes the other taps' light) or sky (the sky's radiance along the tap's camera ray)",
         open_sky,
         ["fill", "sky"]
+    ),
+    enum_setting!(
+        "probe-ao",
+        "how AO darkens the light probes' irradiance: off, plain (x AV, DGB Fig. 9: occluders are black) or multibounce (x GTAO's multi-bounce G(AV, albedo): occluders reflect light too; not in the paper)",
+        radiosity_of,
+        radiosity_mut,
+        probe_ao,
+        [
+            crate::passes::radiosity::ProbeAo::Off => "off",
+            crate::passes::radiosity::ProbeAo::Plain => "plain",
+            crate::passes::radiosity::ProbeAo::MultiBounce => "multibounce",
+        ]
     ),
     radiosity_switch!(
         "probe-visibility",

@@ -440,3 +440,74 @@ fn probe_field_matches_cpu_twin() {
         );
     }
 }
+
+/// Issue 14: with AO running, the composite's probe term is E_probe × AV (`ProbeAo::Plain`,
+/// DGB Fig. 9) or E_probe × G(AV, ρ) per channel (`ProbeAo::MultiBounce`, GTAO's multi-bounce
+/// fit, the default): GPU = CPU twin (`ao_multibounce`) at every covered pixel of Cornell,
+/// whose corners give AO something to darken; and the multi-bounce factor lies in [AV, 1].
+#[test]
+fn probe_ao_modes_match_cpu_twin() {
+    use strata_render::passes::radiosity::{ao_multibounce, ProbeAo};
+    let gpu = common::gpu();
+    let scene = frozen("cornell");
+    let (w, h) = (64, 48);
+    let probes = constant_probes([1.0, 0.8, 0.6]);
+    for mode in [ProbeAo::Plain, ProbeAo::MultiBounce] {
+        let mut r = Renderer::new(
+            &gpu,
+            &scene,
+            RenderSettings {
+                width: w,
+                height: h,
+                deep: DeepGBufferSettings {
+                    layers: 2,
+                    variant: Variant::Peel,
+                    min_separation: Some(scene.settings.min_separation),
+                    ..Default::default()
+                },
+                radiosity: Some(RadiositySettings {
+                    probe_ao: mode,
+                    ..Default::default()
+                }),
+                probes: Some(probes.clone()),
+                ao: Some(Default::default()),
+                ..Default::default()
+            },
+        )
+        .expect("renderer builds without validation errors");
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let field = r.read_target(&gpu, "probe-irradiance").unwrap();
+        let albedo = r.read_target(&gpu, "albedo").unwrap();
+        let points = common::surface_points(&gpu, &r);
+        let mut occluded = 0usize;
+        for s in &points {
+            let av = field.data[s.i * 4 + 3];
+            occluded += (av < 0.9) as usize;
+            let e = probes.irradiance(s.p, s.n);
+            for c in 0..3 {
+                let rho = albedo.data[s.i * albedo.channels as usize + c];
+                let factor = match mode {
+                    ProbeAo::MultiBounce => ao_multibounce(av, rho),
+                    _ => av,
+                };
+                assert!(
+                    (av - 1e-6..=1.0 + 1e-6).contains(&factor),
+                    "G({av}, {rho}) = {factor} is outside [AV, 1]"
+                );
+                let (got, want) = (field.data[s.i * 4 + c], e[c] * factor);
+                assert!(
+                    (got - want).abs() <= 5e-3 * want.abs().max(0.05),
+                    "{mode:?}, pixel ({}, {}) channel {c}: GPU {got} vs CPU {want} (AV {av}, ρ {rho})",
+                    s.x,
+                    s.y
+                );
+            }
+        }
+        assert!(
+            occluded > points.len() / 20,
+            "{mode:?}: AO must darken a share of the box ({occluded} of {})",
+            points.len()
+        );
+    }
+}

@@ -14,7 +14,7 @@ struct Compose {
     boost: u32,
     // 1 = blend with the light probes
     use_probes: u32,
-    // 1 = modulate the probe term by AO
+    // the probe term × AV (1), × GTAO's multi-bounce G(AV, rho) (2), or not (0)
     use_ao: u32,
     // 1 = add the glossy receivers' radiance (ILS `ils-glossy`) as is
     use_glossy: u32,
@@ -165,6 +165,15 @@ fn probe_field(p: vec3f, n: vec3f) -> vec3f {
     return e_all / max(sum_all, 1e-6);
 }
 
+// GTAO's multi-bounce fit G(AV, rho) per channel (Jimenez et al. 2016; CPU twin
+// `radiosity::ao_multibounce`): occluders within the AO radius reflect light too.
+fn ao_multibounce(av: f32, rho: vec3f) -> vec3f {
+    let a = 2.0404 * rho - 0.3324;
+    let b = -4.7951 * rho + 0.6417;
+    let c = 2.7552 * rho + 0.6903;
+    return max(vec3f(av), ((av * a + b) * av + c) * av);
+}
+
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let p = vec2i(pos.xy);
@@ -186,11 +195,16 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let c = clamp(g.a, 0.0, 1.0);
     if (compose.use_probes != 0u) {
         var av = 1.0;
+        var occlusion = vec3f(1.0);
         if (compose.use_ao != 0u) {
             av = textureLoad(ao, p, 0).r;
+            occlusion = vec3f(av);
+            if (compose.use_ao == 2u) {
+                occlusion = ao_multibounce(av, rho);
+            }
         }
         let x = world_from_csz(frame, vec2f(p) + 0.5, z);
-        let ep = probe_field(x, oct_decode(nrm.rg)) * av;
+        let ep = probe_field(x, oct_decode(nrm.rg)) * occlusion;
         o.probe = vec4f(ep, av);
         e = c * g.rgb + (1.0 - c) * ep;
     }

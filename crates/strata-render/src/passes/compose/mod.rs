@@ -3,7 +3,7 @@
 //! where E blends the deep-G-buffer result with static irradiance probes by the
 //! gather's confidence c = M/N (the probe term modulated by AO when it runs):
 //! E = c · E_dgb + (1 − c) · AV · E_probe. Outputs `hdr-full`,
-//! `indirect-blended` (E, c) and `probe-irradiance` (AV · E_probe, AV).
+//! `indirect-blended` (E, c) and `probe-irradiance` (AO's factor · E_probe, AV).
 
 use crate::passes::builder::{FullscreenPass, PassBuilder};
 use strata_scene::probes::IrradianceProbes;
@@ -29,7 +29,7 @@ pub const OUTPUTS: [TargetDesc; 3] = [
         "probe-irradiance",
         wgpu::TextureFormat::Rgba16Float,
         1,
-        "light-probe irradiance × AV (rgb), AV (a)",
+        "light-probe irradiance × AO's factor (AV, or the multi-bounce G(AV, ρ)) (rgb), AV (a)",
     ),
 ];
 
@@ -58,15 +58,19 @@ impl ComposePass {
         scene: &GpuScene,
         targets: &Targets,
         boost: bool,
-        probes: Option<&IrradianceProbes>,
+        probes: Option<(&IrradianceProbes, crate::passes::radiosity::ProbeAo)>,
         indirect: &'static str,
         glossy: Option<&'static str>,
     ) -> Self {
-        let use_ao = probes.is_some() && targets.try_get("ao").is_some();
+        let probe_ao = probes.map_or(crate::passes::radiosity::ProbeAo::Off, |p| p.1);
+        let probes = probes.map(|p| p.0);
+        let use_ao =
+            probes.is_some() && targets.try_get("ao").is_some() && probe_ao != crate::passes::radiosity::ProbeAo::Off;
         let u = ComposeUniforms {
             boost: boost as u32,
             use_probes: probes.is_some() as u32,
-            use_ao: use_ao as u32,
+            // 0: no AO, 1: × AV, 2: × GTAO's multi-bounce G(AV, ρ) (`ProbeAo`)
+            use_ao: if use_ao { probe_ao as u32 } else { 0 },
             use_glossy: glossy.is_some() as u32,
             origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
             // w: the visibility test's normal offset (`probes::VISIBILITY_BIAS` × the smallest spacing)

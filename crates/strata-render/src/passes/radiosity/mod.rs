@@ -82,8 +82,35 @@ pub struct RadiositySettings {
     /// through walls; `IrradianceProbes::visibility`). Needs probes baked with distance
     /// maps; not in the paper (default true).
     pub probe_visibility: bool,
+    /// How AO modulates the probes' irradiance ([`ProbeAo`]; default `MultiBounce`).
+    pub probe_ao: ProbeAo,
     /// The gather's normaliser ([`Normalisation`]; default `Bounded`, not in the paper).
     pub normalisation: Normalisation,
+}
+
+/// How AO's visibility AV modulates the light probes' irradiance in the composite
+/// (DGB Fig. 9: E = c·E_dgb + (1 − c)·AV·E_probe). The discriminants are compose.wgsl's
+/// `use_ao` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProbeAo {
+    /// AV does not touch the probes.
+    Off = 0,
+    /// × AV, as the paper: treats the occluders within the AO radius as black.
+    Plain = 1,
+    /// × G(AV, ρ), the multi-bounce fit of Jimenez et al. 2016 (GTAO §5): occluders
+    /// reflect light too, the more the brighter the receiver's albedo ρ, so AV darkens
+    /// less than × AV does (G(AV, ρ) ≥ AV, G(1, ρ) = 1; not in the paper).
+    MultiBounce = 2,
+}
+
+/// GTAO's multi-bounce fit G(AV, ρ) per colour channel (CPU twin of `ao_multibounce` in
+/// compose.wgsl): max(AV, ((AV·a + b)·AV + c)·AV), a = 2.0404ρ − 0.3324,
+/// b = −4.7951ρ + 0.6417, c = 2.7552ρ + 0.6903.
+pub fn ao_multibounce(av: f32, rho: f32) -> f32 {
+    let a = 2.0404 * rho - 0.3324;
+    let b = -4.7951 * rho + 0.6417;
+    let c = 2.7552 * rho + 0.6903;
+    av.max(((av * a + b) * av + c) * av)
 }
 
 /// How the gather turns Σ w·B·cos into irradiance E (docs/radiosity.md § "Cosine
@@ -203,6 +230,7 @@ impl Default for RadiositySettings {
             open_sky: false,
             hidden_black: false,
             probe_visibility: true,
+            probe_ao: ProbeAo::MultiBounce,
             normalisation: Normalisation::Bounded,
         }
     }
@@ -211,13 +239,14 @@ impl Default for RadiositySettings {
 impl RadiositySettings {
     /// DGB's estimator exactly as published: per-pixel (not per-frame) spiral
     /// rotation, Eq. 4's equal tap weights and normaliser, probes blended without a
-    /// visibility test (the rest as [`Default`]).
+    /// visibility test and darkened by × AV (the rest as [`Default`]).
     pub fn paper() -> Self {
         Self {
             temporal_noise: false,
             solid_angle: false,
             normalisation: Normalisation::Hemisphere,
             probe_visibility: false,
+            probe_ao: ProbeAo::Plain,
             ..Default::default()
         }
     }
@@ -659,6 +688,27 @@ pub fn shaded_region(w: u32, h: u32, guard: u32, shaded: f32) -> Option<[u32; 4]
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// GTAO's multi-bounce fit: no occlusion stays none (G(1, ρ) = 1), it never darkens
+    /// more than × AV, the brighter the albedo the less it darkens, and black occluders
+    /// (ρ = 0) leave it close to × AV.
+    #[test]
+    fn ao_multibounce_lies_between_av_and_one() {
+        for rho in [0.0f32, 0.2, 0.5, 0.8, 1.0] {
+            assert!((ao_multibounce(1.0, rho) - 1.0).abs() < 1e-3, "G(1, {rho})");
+            for k in 0..=20 {
+                let av = k as f32 / 20.0;
+                let g = ao_multibounce(av, rho);
+                assert!(g >= av && g <= 1.0 + 1e-3, "G({av}, {rho}) = {g}");
+                assert!(
+                    ao_multibounce(av, (rho + 0.1).min(1.0)) >= g - 1e-6,
+                    "monotone in ρ at {av}"
+                );
+            }
+        }
+        assert!((ao_multibounce(0.5, 0.0) - 0.5).abs() < 0.05);
+        assert!(ao_multibounce(0.5, 0.8) > 0.6);
+    }
 
     /// The preset files reproduce DGB Table 2 and change the settings they name.
     #[test]

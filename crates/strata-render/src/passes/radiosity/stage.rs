@@ -130,7 +130,15 @@ impl RadiosityStage {
             }
             other => other,
         };
-        let compose = crate::passes::compose::ComposePass::new(gpu, scene, targets, s.boost, probes, "indirect", None);
+        let compose = crate::passes::compose::ComposePass::new(
+            gpu,
+            scene,
+            targets,
+            s.boost,
+            probes.map(|p| (p, s.probe_ao)),
+            "indirect",
+            None,
+        );
         Self {
             propagate,
             gather,
