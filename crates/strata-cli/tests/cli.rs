@@ -692,7 +692,7 @@ fn radiosity_estimator_switches_are_range_checked() {
 fn eval_gi_reports_indirect_and_full_errors() {
     let cache = scratch("gi-cache");
     let _ = std::fs::remove_dir_all(&cache);
-    let run = |extra: &[&str]| {
+    let gi = |extra: &[&str]| {
         let mut args = vec![
             "eval",
             "--scene",
@@ -717,8 +717,9 @@ fn eval_gi_reports_indirect_and_full_errors() {
             cache.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);
-        json_of(&strata(&args))
+        strata(&args)
     };
+    let run = |extra: &[&str]| json_of(&gi(extra));
     let blended = run(&[]);
     let alone = run(&["--no-probes", "--set", "hidden-taps=black"]);
     for v in [&blended, &alone] {
@@ -743,25 +744,7 @@ fn eval_gi_reports_indirect_and_full_errors() {
     assert_eq!(moving["moving"], true);
     assert_eq!(moving["rmse"], blended["rmse"]);
     assert!(blended.get("moving").is_none(), "{blended}");
-    let o = strata(&[
-        "eval",
-        "--scene",
-        "cornell",
-        "--technique",
-        "gi",
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--ref-spp",
-        "4",
-        "--quiet",
-        "--cache",
-        cache.to_str().unwrap(),
-        "--probes-from",
-        "no-such-scene",
-        "--json",
-    ]);
+    let o = gi(&["--probes-from", "no-such-scene"]);
     assert_one_line_error(&o, &["--probes-from", "no-such-scene"]);
     let o = strata(&[
         "eval",

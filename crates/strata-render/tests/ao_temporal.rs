@@ -6,7 +6,6 @@ mod common;
 
 use strata_render::frame::FrameCameras;
 use strata_render::passes::ao::AoSettings;
-use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::{RenderSettings, Renderer};
 use strata_scene::{procedural, ImageBuf};
 
@@ -28,16 +27,8 @@ fn per_frame_rotation_averages_tap_patterns_at_a_still_camera() {
             &gpu,
             &scene,
             RenderSettings {
-                width: w,
-                height: h,
-                deep: DeepGBufferSettings {
-                    layers: 2,
-                    variant: Variant::Peel,
-                    min_separation: Some(scene.settings.min_separation),
-                    ..Default::default()
-                },
                 ao: Some(ao),
-                ..Default::default()
+                ..common::two_peeled_layers(&scene, w, h)
             },
         )
         .unwrap();

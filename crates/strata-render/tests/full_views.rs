@@ -5,7 +5,6 @@
 mod common;
 
 use strata_render::frame::FrameCameras;
-use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::radiosity::{irradiance_cpu, GatherInputs, RadiositySettings};
 use strata_render::passes::tonemap::tonemap;
 use strata_render::{GpuContext, RenderSettings, Renderer};
@@ -42,25 +41,26 @@ fn renderer(
     probes: Option<IrradianceProbes>,
     exposure: Option<f32>,
 ) -> Renderer {
-    Renderer::new(
-        gpu,
-        scene,
-        RenderSettings {
-            width: w,
-            height: h,
-            deep: DeepGBufferSettings {
-                layers: 2,
-                variant: Variant::Peel,
-                min_separation: Some(scene.settings.min_separation),
-                ..Default::default()
-            },
-            radiosity: Some(rs),
-            probes,
-            exposure,
-            ..Default::default()
-        },
-    )
-    .unwrap_or_else(|e| panic!("{}: {e}", scene.name))
+    let settings = RenderSettings {
+        exposure,
+        ..full_settings(scene, w, h, rs, probes)
+    };
+    Renderer::new(gpu, scene, settings).unwrap_or_else(|e| panic!("{}: {e}", scene.name))
+}
+
+/// Two peeled layers, the radiosity `rs` and `probes`: what the views' tests render.
+fn full_settings(
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    rs: RadiositySettings,
+    probes: Option<IrradianceProbes>,
+) -> RenderSettings {
+    RenderSettings {
+        radiosity: Some(rs),
+        probes,
+        ..common::two_peeled_layers(scene, w, h)
+    }
 }
 
 /// The byte an sRGB PNG stores for a display value.
@@ -453,28 +453,15 @@ fn probe_ao_modes_match_cpu_twin() {
     let (w, h) = (64, 48);
     let probes = constant_probes([1.0, 0.8, 0.6]);
     for mode in [ProbeAo::Plain, ProbeAo::MultiBounce] {
-        let mut r = Renderer::new(
-            &gpu,
-            &scene,
-            RenderSettings {
-                width: w,
-                height: h,
-                deep: DeepGBufferSettings {
-                    layers: 2,
-                    variant: Variant::Peel,
-                    min_separation: Some(scene.settings.min_separation),
-                    ..Default::default()
-                },
-                radiosity: Some(RadiositySettings {
-                    probe_ao: mode,
-                    ..Default::default()
-                }),
-                probes: Some(probes.clone()),
-                ao: Some(Default::default()),
-                ..Default::default()
-            },
-        )
-        .expect("renderer builds without validation errors");
+        let rs = RadiositySettings {
+            probe_ao: mode,
+            ..Default::default()
+        };
+        let settings = RenderSettings {
+            ao: Some(Default::default()),
+            ..full_settings(&scene, w, h, rs, Some(probes.clone()))
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings).expect("renderer builds without validation errors");
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
             .expect("frame renders without validation errors");
         let field = r.read_target(&gpu, "probe-irradiance").unwrap();

@@ -67,6 +67,23 @@ pub fn render(gpu: &GpuContext, scene: &Scene, camera: &Camera, w: u32, h: u32) 
     r
 }
 
+/// `w`×`h` with two exactly peeled deep-G-buffer layers at the scene's minimum separation
+/// (the rest default).
+#[allow(dead_code)]
+pub fn two_peeled_layers(scene: &Scene, w: u32, h: u32) -> RenderSettings {
+    RenderSettings {
+        width: w,
+        height: h,
+        deep: strata_render::passes::deep_gbuffer::DeepGBufferSettings {
+            layers: 2,
+            variant: strata_render::passes::deep_gbuffer::Variant::Peel,
+            min_separation: Some(scene.settings.min_separation),
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
 /// `../shared/scenes/<rel>` next to the repository, if present.
 pub fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
     let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -97,26 +97,22 @@ impl ComposePass {
                 .collect(),
             None => vec![[0.0; 4]; 9],
         };
-        let probe_buf = wgpu::util::DeviceExt::create_buffer_init(
-            &gpu.device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("light probes"),
-                contents: bytemuck::cast_slice(&data),
-                usage: wgpu::BufferUsages::STORAGE,
-            },
-        );
+        let storage = |label: &str, contents: &[u8]| {
+            wgpu::util::DeviceExt::create_buffer_init(
+                &gpu.device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE,
+                },
+            )
+        };
+        let probe_buf = storage("light probes", bytemuck::cast_slice(&data));
         let depth: Vec<[f32; 2]> = match probes {
             Some(p) if !p.depth.is_empty() => p.depth.iter().flatten().copied().collect(),
             _ => vec![[0.0; 2]],
         };
-        let depth_buf = wgpu::util::DeviceExt::create_buffer_init(
-            &gpu.device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("light-probe distance maps"),
-                contents: bytemuck::cast_slice(&depth),
-                usage: wgpu::BufferUsages::STORAGE,
-            },
-        );
+        let depth_buf = storage("light-probe distance maps", bytemuck::cast_slice(&depth));
         let mut b = PassBuilder::new(gpu, targets, "compose")
             .shader("compose", include_str!("compose.wgsl"))
             .frame(scene)
