@@ -1,8 +1,9 @@
 // Final composition (DGB §3.2, Eq. 6, Fig. 9): direct light (+ emission, sky)
 // plus the Lambertian reflection ρ/π · E · boost(ρ) of the indirect
-// irradiance E. With light probes, E = c · E_dgb + (1 − c) · AV · E_probe: the
+// irradiance E. With light probes, E = c · E_dgb + (1 − c) · G · E_probe: the
 // deep-G-buffer result where its confidence c = M/N is high, the static
-// probes (modulated by AO when it runs) where it is not.
+// probes where it is not, darkened by AO when it runs (G = AV as in the paper,
+// or GTAO's multi-bounce G(AV, ρ): `radiosity::ProbeAo`).
 #import "common/fullscreen.wgsl"
 #import "common/color.wgsl"
 #import "common/frame.wgsl"
@@ -49,7 +50,7 @@ struct Out {
     @location(0) hdr: vec4f,
     // blended E (rgb), confidence (a)
     @location(1) blended: vec4f,
-    // probe irradiance × AV (rgb), AV (a)
+    // probe irradiance × AO's factor G (rgb), AV (a)
     @location(2) probe: vec4f,
 }
 

@@ -2,7 +2,8 @@
 //! plus the Lambertian reflection ρ/π · E · boost(ρ) of the indirect irradiance,
 //! where E blends the deep-G-buffer result with static irradiance probes by the
 //! gather's confidence c = M/N (the probe term modulated by AO when it runs):
-//! E = c · E_dgb + (1 − c) · AV · E_probe. Outputs `hdr-full`,
+//! E = c · E_dgb + (1 − c) · G · E_probe, G = AV or its multi-bounce form
+//! (`radiosity::ProbeAo`). Outputs `hdr-full`,
 //! `indirect-blended` (E, c) and `probe-irradiance` (AO's factor · E_probe, AV).
 
 use crate::passes::builder::{FullscreenPass, PassBuilder};
