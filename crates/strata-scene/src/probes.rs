@@ -68,7 +68,8 @@ pub const DEPTH_OCT: usize = 8;
 pub const DEPTH_TEXELS: usize = DEPTH_OCT * DEPTH_OCT;
 
 /// Receivers are moved this fraction of the smallest probe spacing along their
-/// normal before the visibility test (`VISIBILITY_BIAS` in compose.wgsl), so a
+/// normal before the visibility test ([`IrradianceProbes::visibility_bias`]; compose.wgsl
+/// receives it as `spacing.w`), so a
 /// surface is not hidden from a probe by itself.
 pub const VISIBILITY_BIAS: f32 = 0.1;
 
@@ -149,14 +150,29 @@ impl IrradianceProbes {
         m
     }
 
+    /// How far a receiver moves along its normal before the visibility test:
+    /// [`VISIBILITY_BIAS`] × the smallest spacing between probes (over the axes with more
+    /// than one probe; a single probe: 0).
+    pub fn visibility_bias(&self) -> f32 {
+        let spacing = (0..3)
+            .filter(|&i| self.dims[i] > 1)
+            .map(|i| self.spacing[i])
+            .fold(f32::INFINITY, f32::min);
+        if spacing.is_finite() {
+            VISIBILITY_BIAS * spacing
+        } else {
+            0.0
+        }
+    }
+
     /// How visible a receiver at `p` (normal `n`) is from probe `index`: 1 without
     /// distance maps, else [`chebyshev_visibility`] of the receiver moved by
-    /// [`VISIBILITY_BIAS`] × the smallest spacing along `n`.
+    /// [`Self::visibility_bias`] along `n`.
     pub fn visibility(&self, index: usize, p: Vec3, n: Vec3) -> f32 {
         if self.depth.is_empty() {
             return 1.0;
         }
-        let x = p + n * (VISIBILITY_BIAS * self.spacing.min_element());
+        let x = p + n * self.visibility_bias();
         let d = x - self.position(index);
         let dist = d.length();
         if dist <= 1e-6 {

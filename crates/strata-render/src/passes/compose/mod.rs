@@ -74,12 +74,8 @@ impl ComposePass {
             use_ao: if use_ao { probe_ao as u32 } else { 0 },
             use_glossy: glossy.is_some() as u32,
             origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
-            // w: the visibility test's normal offset (`probes::VISIBILITY_BIAS` × the smallest spacing)
-            spacing: probes.map_or([1.0; 4], |p| {
-                p.spacing
-                    .extend(strata_scene::probes::VISIBILITY_BIAS * p.spacing.min_element())
-                    .to_array()
-            }),
+            // w: the visibility test's normal offset
+            spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(p.visibility_bias()).to_array()),
             // w: 1 = distance maps (the visibility test)
             dims: probes.map_or([1, 1, 1, 0], |p| {
                 [p.dims[0], p.dims[1], p.dims[2], !p.depth.is_empty() as u32]
