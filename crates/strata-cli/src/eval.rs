@@ -11,13 +11,25 @@ use crate::args::EvalArgs;
 
 pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
-    if a.views {
-        return views(a, &s);
-    }
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";
     let is_bzb_gi = a.technique.name == "bzb-gi";
+    // flags that only the deep-G-buffer GI comparison reads: an error elsewhere, not ignored
+    if a.views || a.technique.eval != EvalKind::Radiance || is_bzb_gi {
+        let gi_only = [
+            ("--fig10", a.fig10),
+            ("--no-probes", a.no_probes),
+            ("--probes-from", a.probes_from.is_some()),
+            ("--moving", a.moving),
+        ];
+        if let Some((flag, _)) = gi_only.iter().find(|f| f.1) {
+            anyhow::bail!("{flag} is only read by eval --technique gi or full (the deep-G-buffer radiosity against the path tracer, without --views)");
+        }
+    }
+    if a.views {
+        return views(a, &s);
+    }
     if a.progressive.is_some() && a.technique.eval != EvalKind::VplRadiance {
         anyhow::bail!("--progressive is only read by --technique ils (ILS §6.3's physically-based mode)");
     }

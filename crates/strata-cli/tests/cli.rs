@@ -746,6 +746,9 @@ fn eval_gi_reports_indirect_and_full_errors() {
     assert!(blended.get("moving").is_none(), "{blended}");
     let o = gi(&["--probes-from", "no-such-scene"]);
     assert_one_line_error(&o, &["--probes-from", "no-such-scene"]);
+    // the GI comparison's own flags are errors where nothing reads them
+    let o = strata(&["eval", "--scene", "cornell", "--technique", "ao", "--moving", "--json"]);
+    assert_one_line_error(&o, &["--moving", "gi"]);
     let o = strata(&[
         "eval",
         "--scene",
