@@ -68,9 +68,8 @@ pub const DEPTH_OCT: usize = 8;
 pub const DEPTH_TEXELS: usize = DEPTH_OCT * DEPTH_OCT;
 
 /// Receivers are moved this fraction of the smallest probe spacing along their
-/// normal before the visibility test ([`IrradianceProbes::visibility_bias`]; compose.wgsl
-/// receives it as `spacing.w`), so a
-/// surface is not hidden from a probe by itself.
+/// normal before the visibility test, so that a surface is not hidden from a probe
+/// by itself ([`IrradianceProbes::visibility_bias`]; compose.wgsl gets it as `spacing.w`).
 pub const VISIBILITY_BIAS: f32 = 0.1;
 
 /// Chebyshev's bound on the chance that a receiver at distance `dist` from a probe

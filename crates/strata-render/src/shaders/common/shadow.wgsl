@@ -28,32 +28,55 @@ fn shadow_layer(l: GpuLight, p: vec3f) -> u32 {
     return l.kind.y + face;
 }
 
+// Where p (normal n, distance `dist` to a local light) falls in light `l`'s
+// shadow map, moved ~1.5 shadow texels along n (a texel grows with distance for
+// perspective maps): its layer, uv, ndc depth z, clip w (the distance along a
+// perspective map's axis) and the moved point q; `inside` is false off the map.
+struct ShadowCoords {
+    layer: u32,
+    uv: vec2f,
+    z: f32,
+    w: f32,
+    q: vec3f,
+    inside: bool,
+}
+
+fn shadow_coords(l: GpuLight, p: vec3f, n: vec3f, dist: f32) -> ShadowCoords {
+    var out: ShadowCoords;
+    out.layer = shadow_layer(l, p);
+    var texel = l.cone.z;
+    if (l.kind.x != 0u) {
+        texel = texel * dist;
+    }
+    out.q = p + n * texel * 1.5;
+    let c = shadow_mats[out.layer] * vec4f(out.q, 1.0);
+    let ndc = c.xyz / c.w;
+    out.inside = !(c.w <= 0.0 || any(abs(ndc.xy) > vec2f(1.0)) || ndc.z > 1.0);
+    out.uv = vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    out.z = ndc.z;
+    out.w = c.w;
+    return out;
+}
+
 // Visibility of light `l` at p (normal n, distance `dist` to a local light):
 // (2r+1)² bilinear comparisons, r = `pcf_radius`, of a `shadow_size`² map.
 fn shadow_visibility_pcf(l: GpuLight, p: vec3f, n: vec3f, dist: f32, pcf_radius: i32, shadow_size: f32) -> f32 {
     if (l.kind.y == NO_SHADOW) {
         return 1.0;
     }
-    let layer = shadow_layer(l, p);
-    // Normal offset of ~1.5 shadow texels (texel size grows with distance for perspective maps).
-    var texel = l.cone.z;
-    if (l.kind.x != 0u) {
-        texel = texel * dist;
-    }
-    let q = p + n * texel * 1.5;
-    let c = shadow_mats[layer] * vec4f(q, 1.0);
-    let ndc = c.xyz / c.w;
-    if (c.w <= 0.0 || any(abs(ndc.xy) > vec2f(1.0)) || ndc.z > 1.0) {
+    let sc = shadow_coords(l, p, n, dist);
+    if (!sc.inside) {
         return 1.0;
     }
-    let uv = vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    let layer = sc.layer;
+    let uv = sc.uv;
     let r = pcf_radius;
     var sum = 0.0;
     var count = 0.0;
     for (var y = -r; y <= r; y++) {
         for (var x = -r; x <= r; x++) {
             let o = vec2f(f32(x), f32(y)) / shadow_size;
-            sum += textureSampleCompareLevel(shadow_maps, shadow_sampler, uv + o, i32(layer), ndc.z);
+            sum += textureSampleCompareLevel(shadow_maps, shadow_sampler, uv + o, i32(layer), sc.z);
             count += 1.0;
         }
     }
@@ -84,36 +107,35 @@ fn shadow_visibility_rect(l: GpuLight, p: vec3f, n: vec3f, dist: f32, pcf_radius
     if (l.kind.y == NO_SHADOW || l.cone.w <= 0.0) {
         return shadow_visibility_pcf(l, p, n, dist, pcf_radius, shadow_size);
     }
-    let layer = l.kind.y;
-    let m = shadow_mats[layer];
-    let q = p + n * l.cone.z * dist * 1.5;
-    let c = m * vec4f(q, 1.0);
-    let ndc = c.xyz / c.w;
-    if (c.w <= 0.0 || any(abs(ndc.xy) > vec2f(1.0)) || ndc.z > 1.0) {
+    let sc = shadow_coords(l, p, n, dist);
+    if (!sc.inside) {
         return 1.0;
     }
-    let uv = vec2f(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    let layer = sc.layer;
+    let m = shadow_mats[layer];
+    let q = sc.q;
+    let uv = sc.uv;
     // the light's half-edges as map (uv) offsets per unit of k
     let au = (m * vec4f(l.half_u.xyz, 0.0)).xy * vec2f(0.5, -0.5);
     let av = (m * vec4f(l.half_v.xyz, 0.0)).xy * vec2f(0.5, -0.5);
     // receiver plane: the ray through c + (s·hu + t·hv)·k·d_r meets it at ndc depth
     // z_r + k·(s·gu + t·gv) (first order in the offset, exact for a plane)
-    let to_q = (q - l.position.xyz) / c.w;
+    let to_q = (q - l.position.xyz) / sc.w;
     let facing = min(dot(to_q, n), -0.05);
-    let gu = -l.cone.w * dot(l.half_u.xyz, n) / (c.w * facing);
-    let gv = -l.cone.w * dot(l.half_v.xyz, n) / (c.w * facing);
+    let gu = -l.cone.w * dot(l.half_u.xyz, n) / (sc.w * facing);
+    let gv = -l.cone.w * dot(l.half_v.xyz, n) / (sc.w * facing);
     let size = vec2i(textureDimensions(shadow_maps));
     // 1) blocker search: each tap weighs its four texels bilinearly, so the
     //    blockers' share and mean depth move smoothly with p (no blocks where a
     //    point load would flip)
-    let ks = PCSS_SEARCH / c.w;
+    let ks = PCSS_SEARCH / sc.w;
     var z_sum = 0.0;
     var blockers = 0.0;
     for (var j = 0; j < PCSS_SEARCH_TAPS; j++) {
         for (var i = 0; i < PCSS_SEARCH_TAPS; i++) {
             let s = (f32(2 * i + 1) / f32(PCSS_SEARCH_TAPS) - 1.0);
             let t = (f32(2 * j + 1) / f32(PCSS_SEARCH_TAPS) - 1.0);
-            let z_plane = ndc.z + ks * (s * gu + t * gv);
+            let z_plane = sc.z + ks * (s * gu + t * gv);
             let st = (uv + (s * au + t * av) * ks) * vec2f(size) - 0.5;
             let base = floor(st);
             let f = st - base;
@@ -134,7 +156,7 @@ fn shadow_visibility_rect(l: GpuLight, p: vec3f, n: vec3f, dist: f32, pcf_radius
     }
     // 2) filter: the light's image at the blockers' mean depth is the box
     //    [a_p ± k] × [b_p ± k] in the image coordinates (a, b)
-    let k = max(ndc.z - z_sum / blockers, 0.0) / l.cone.w;
+    let k = max(sc.z - z_sum / blockers, 0.0) / l.cone.w;
     let extent = max(length(au), length(av)) * k * shadow_size;
     let det = au.x * av.y - au.y * av.x;
     if (!(extent >= 1.0) || abs(det) < 1e-12) {
@@ -142,7 +164,7 @@ fn shadow_visibility_rect(l: GpuLight, p: vec3f, n: vec3f, dist: f32, pcf_radius
     }
     let ab = vec2f(av.y * uv.x - av.x * uv.y, au.x * uv.y - au.y * uv.x) / det;
     let cell = exp2(ceil(log2(2.0 * k / PCSS_CELLS)));
-    return pcss_lattice(layer, ab, k, cell, au, av, gu, gv, ndc.z);
+    return pcss_lattice(layer, ab, k, cell, au, av, gu, gv, sc.z);
 }
 
 // Visibility over the box [ab ± k] in the light's image coordinates (a, b)
