@@ -203,17 +203,23 @@ macro_rules! splat_setting {
     };
 }
 
-/// The history clamp of the temporal filter of the settings `$of` reads and `$mut` writes
-/// (two-valued: off, on).
-macro_rules! temporal_clamp {
-    ($name:literal, $doc:literal, $of:ident, $mut:ident) => {
+/// A two-valued switch (off, on) of the temporal filter of the settings `$of` reads and
+/// `$mut` writes: `$field` of [`TemporalSettings`](crate::passes::temporal::TemporalSettings)
+/// (the history clamp, the start-up ramp).
+macro_rules! temporal_flag {
+    ($name:literal, $doc:literal, $of:ident, $mut:ident, $field:ident) => {
         SettingInfo {
             name: $name,
             doc: $doc,
             range: Range::Closed(0.0, 1.0),
             integer: true,
-            get: |s: &RenderSettings| Some($of(s).temporal.is_some_and(|t| t.clamp_history) as u32 as f64),
-            set: |s: &mut RenderSettings, v: f64| set_clamp(&mut $mut(s).temporal, v),
+            get: |s: &RenderSettings| Some($of(s).temporal.is_some_and(|t| t.$field) as u32 as f64),
+            set: |s: &mut RenderSettings, v: f64| {
+                // nothing to set when the filter is off
+                if let Some(t) = &mut $mut(s).temporal {
+                    t.$field = v != 0.0;
+                }
+            },
             values: &["off", "on"],
         }
     };
@@ -225,13 +231,6 @@ fn ao_mut(s: &mut RenderSettings) -> &mut AoSettings {
 
 fn ao_of(s: &RenderSettings) -> AoSettings {
     s.ao.clone().unwrap_or_default()
-}
-
-/// The history clamp of an optional temporal filter (nothing to set when the filter is off).
-fn set_clamp(t: &mut Option<crate::passes::temporal::TemporalSettings>, v: f64) {
-    if let Some(t) = t {
-        t.clamp_history = v != 0.0;
-    }
 }
 
 /// α of an optional temporal filter: 0 turns it off, any other value keeps its distance threshold
@@ -283,7 +282,7 @@ static DIRECT_SETTINGS: [SettingInfo; 3] = [
     },
 ];
 
-static AO_SETTINGS: [SettingInfo; 13] = [
+static AO_SETTINGS: [SettingInfo; 14] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
@@ -324,11 +323,19 @@ static AO_SETTINGS: [SettingInfo; 13] = [
         |s| Some(ao_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
         |s, v| set_alpha(&mut ao_mut(s).temporal, v, Default::default())
     ),
-    temporal_clamp!(
+    temporal_flag!(
         "temporal-clamp",
         "on: clamp the reprojected history to the range of this frame's AO over the pixel's 3x3 neighbourhood before blending (no ghosts of moved occluders; not in the paper); off: DGB's filter as published",
         ao_of,
-        ao_mut
+        ao_mut,
+        clamp_history
+    ),
+    temporal_flag!(
+        "temporal-ramp",
+        "on: the AO's temporal filter averages the first frames after a cut equally (alpha_n = min(alpha, n/(n+1)); not in the paper); off: alpha from the first frame",
+        ao_of,
+        ao_mut,
+        ramp
     ),
     setting!(
         "temporal-distance",
@@ -395,7 +402,7 @@ static AO_SETTINGS: [SettingInfo; 13] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 16] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 17] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -492,11 +499,19 @@ static RADIOSITY_SETTINGS: [SettingInfo; 16] = [
             crate::passes::radiosity::indirect_temporal()
         )
     ),
-    temporal_clamp!(
+    temporal_flag!(
         "indirect-temporal-clamp",
         "on: clamp the reprojected indirect history to the range of this frame's over the pixel's 3x3 neighbourhood before blending (not in the paper); off: DGB's filter as published",
         radiosity_of,
-        radiosity_mut
+        radiosity_mut,
+        clamp_history
+    ),
+    temporal_flag!(
+        "indirect-temporal-ramp",
+        "on: the indirect light's temporal filter averages the first frames after a cut equally (alpha_n = min(alpha, n/(n+1)); not in the paper); off: alpha from the first frame",
+        radiosity_of,
+        radiosity_mut,
+        ramp
     ),
     setting!(
         "delta",

@@ -250,8 +250,9 @@ fn temporal_filter_reduces_per_pixel_variance_on_a_static_view() {
     assert!(vf < 0.2 * vr, "filtered variance {vf} vs raw {vr}");
 }
 
-/// With the true previous camera every pixel blends (1 − α)·E + α·E_{t−1}, the history
-/// first clamped to the range of E's 3×3 neighbourhood when `clamp_history` is on (the
+/// With the true previous camera every pixel blends (1 − α₁)·E + α₁·E_{t−1} — α₁ = α, or
+/// 1/2 with the start-up ramp (the mean of the first two frames) — the history first
+/// clamped to the range of E's 3×3 neighbourhood when `clamp_history` is on (the
 /// default); when the previous camera is far from where the history was rendered, every
 /// reprojected point misses both layers and takes the current value.
 #[test]
@@ -265,10 +266,14 @@ fn temporal_filter_blends_valid_and_rejects_failed_reprojections() {
     let shift = (cam.target - cam.eye).normalize() * -2.0;
     moved.eye += shift;
     moved.target += shift;
-    for clamp_history in [false, true] {
+    for (clamp_history, ramp) in [(false, false), (true, true)] {
+        let weight = if ramp { 0.5 } else { alpha };
         for (previous, expect_blend) in [(cam, true), (moved, false)] {
             let mut settings = temporal_settings(alpha);
-            settings.temporal.as_mut().unwrap().clamp_history = clamp_history;
+            let t = settings.temporal.as_mut().unwrap();
+            t.clamp_history = clamp_history;
+            t.ramp = ramp;
+            assert_eq!(t.history_weight(1), weight);
             let mut r = ao_renderer(&gpu, &scene, w, h, 2, settings);
             r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
             let e0 = r.read_target(&gpu, "ao-temporal").unwrap();
@@ -303,13 +308,13 @@ fn temporal_filter_blends_valid_and_rejects_failed_reprojections() {
                     };
                     clamped += (history != e0.data[i]) as usize;
                     let want = if expect_blend {
-                        (1.0 - alpha) * e1.data[i] + alpha * history
+                        (1.0 - weight) * e1.data[i] + weight * history
                     } else {
                         e1.data[i]
                     };
                     assert!(
                         (out.data[i] - want).abs() < 1e-5,
-                        "pixel ({x}, {y}): got {} want {want} (blend {expect_blend}, clamp {clamp_history})",
+                        "pixel ({x}, {y}): got {} want {want} (blend {expect_blend}, clamp {clamp_history}, ramp {ramp})",
                         out.data[i]
                     );
                     differs += ((e1.data[i] - e0.data[i]).abs() > 1e-3) as usize;
@@ -360,13 +365,16 @@ fn temporal_filter_ignores_history_from_an_oracle_less_first_frame() {
     }
     // frame 1: history (frame 0) came from oracle-less layers → current value only
     assert_eq!(outs[1].0, outs[1].1, "frame 1 averaged frame 0's oracle-less AO");
-    // frame 2: frame 1's layers were exact → blended
+    // frame 2: frame 1's layers were exact → blended, as the first frame with a history
+    // (the start-up ramp's weight 1/2: the count restarted after the rejected frame)
+    let a = TemporalSettings::default().history_weight(1);
+    assert_eq!(a, 0.5);
     let blended = outs[2]
         .0
         .iter()
         .zip(&outs[2].1)
         .zip(&outs[1].1)
-        .filter(|((e, t), h)| (*t - (0.15 * *e + 0.85 * *h)).abs() < 1e-5 && (*e - *h).abs() > 1e-3)
+        .filter(|((e, t), h)| (*t - ((1.0 - a) * *e + a * *h)).abs() < 1e-5 && (*e - *h).abs() > 1e-3)
         .count();
     assert!(blended > 100, "frame 2 did not blend ({blended} px)");
 }

@@ -239,10 +239,15 @@ impl Default for RadiositySettings {
 impl RadiositySettings {
     /// DGB's estimator exactly as published: per-pixel (not per-frame) spiral
     /// rotation, Eq. 4's equal tap weights and normaliser, probes blended without a
-    /// visibility test and darkened by × AV (the rest as [`Default`]).
+    /// visibility test and darkened by × AV, the temporal filter's α from the first
+    /// frame (the rest as [`Default`]).
     pub fn paper() -> Self {
         Self {
             temporal_noise: false,
+            temporal: Some(TemporalSettings {
+                ramp: false,
+                ..indirect_temporal()
+            }),
             solid_angle: false,
             normalisation: Normalisation::Hemisphere,
             probe_visibility: false,

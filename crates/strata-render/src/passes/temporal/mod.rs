@@ -11,7 +11,8 @@ use crate::scene_gpu::GpuScene;
 /// Defaults: α = 0.85 (the paper's recommendation); reprojection accepted when
 /// the point lies within 0.01 scene units of either layer (the paper's 1 cm, with
 /// scenes in metres); the history clamp on (not in the paper: issue 14, measured
-/// in docs/ao.md "History clamp").
+/// in docs/ao.md "History clamp"); the start-up ramp on (not in the paper: issue 14,
+/// docs/radiosity.md § "Start-up ramp").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TemporalSettings {
     /// Weight of the reprojected history, in [0, 1).
@@ -25,6 +26,11 @@ pub struct TemporalSettings {
     /// that changed — is pulled to what this frame sees instead of fading over
     /// 1/(1 − α) frames.
     pub clamp_history: bool,
+    /// Average the first frames after a cut (or after the start) with equal weights:
+    /// frame n of history blends with α_n = min(α, n/(n + 1)), the running mean, until
+    /// n/(n + 1) reaches α (n = 6 for α = 0.85) and the paper's EWMA takes over. Off:
+    /// α from the first frame, so the oldest frame keeps weight α^n (not in the paper).
+    pub ramp: bool,
 }
 
 impl Default for TemporalSettings {
@@ -33,11 +39,26 @@ impl Default for TemporalSettings {
             alpha: 0.85,
             max_distance: 0.01,
             clamp_history: true,
+            ramp: true,
         }
     }
 }
 
+
 impl TemporalSettings {
+    /// The history's weight on frame `history_frames` (0 = no history) after a cut:
+    /// α, or with [`ramp`](Self::ramp) min(α, n/(n + 1)). The CPU twin of `temporal.wgsl`'s.
+    pub fn history_weight(&self, history_frames: u32) -> f32 {
+        if history_frames == 0 {
+            0.0
+        } else if self.ramp {
+            let n = history_frames as f32;
+            self.alpha.min(n / (n + 1.0))
+        } else {
+            self.alpha
+        }
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         if !(0.0..1.0).contains(&self.alpha) {
             return Err(format!(
@@ -59,9 +80,10 @@ impl TemporalSettings {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TemporalUniforms {
+    /// The history's weight this frame ([`TemporalSettings::history_weight`]; 0 = no
+    /// history).
     pub alpha: f32,
     pub max_distance: f32,
-    pub has_history: u32,
     pub layers: u32,
     /// 1 = [`TemporalSettings::clamp_history`].
     pub clamp: u32,
@@ -88,9 +110,8 @@ impl TemporalPass {
         layers: u32,
     ) -> Self {
         let u = TemporalUniforms {
-            alpha: settings.alpha,
+            alpha: 0.0,
             max_distance: settings.max_distance,
-            has_history: 0,
             layers,
             clamp: settings.clamp_history as u32,
         };
@@ -111,12 +132,11 @@ impl TemporalPass {
         }
     }
 
-    /// Whether `history` holds last frame's output.
-    pub fn set_frame(&self, gpu: &GpuContext, has_history: bool) {
+    /// How many frames in a row `history` has been valid (0: it holds nothing).
+    pub fn set_frame(&self, gpu: &GpuContext, history_frames: u32) {
         let u = TemporalUniforms {
-            alpha: self.settings.alpha,
+            alpha: self.settings.history_weight(history_frames),
             max_distance: self.settings.max_distance,
-            has_history: has_history as u32,
             layers: self.layers,
             clamp: self.settings.clamp_history as u32,
         };
@@ -125,3 +145,32 @@ impl TemporalPass {
 }
 
 crate::passes::builder::delegate_pass!(TemporalPass);
+
+#[cfg(test)]
+mod tests {
+    use super::TemporalSettings;
+
+    /// With the ramp the filter is the running mean of the frames since the cut until
+    /// n/(n + 1) reaches α; then (and without the ramp throughout) the weight is α.
+    #[test]
+    fn ramp_averages_the_first_frames_equally_then_hands_over_to_alpha() {
+        let on = TemporalSettings::default();
+        let off = TemporalSettings { ramp: false, ..on };
+        let frames = [3.0f32, -1.0, 4.0, 1.0, -5.0, 9.0, 2.0, 6.0];
+        let (mut e_on, mut e_off) = (0.0f32, 0.0f32);
+        for (n, &x) in frames.iter().enumerate() {
+            let (a_on, a_off) = (on.history_weight(n as u32), off.history_weight(n as u32));
+            e_on = (1.0 - a_on) * x + a_on * e_on;
+            e_off = (1.0 - a_off) * x + a_off * e_off;
+            let mean = frames[..=n].iter().sum::<f32>() / (n + 1) as f32;
+            if (n as f32) / (n as f32 + 1.0) <= on.alpha {
+                assert!((e_on - mean).abs() < 1e-5, "frame {n}: {e_on} vs the mean {mean}");
+            } else {
+                assert_eq!(a_on, on.alpha, "frame {n}");
+            }
+            assert_eq!(a_off, if n == 0 { 0.0 } else { off.alpha }, "frame {n}");
+        }
+        // without the ramp the first frame keeps weight α^7 after 7 more frames
+        assert!((e_off - e_on).abs() > 0.1, "the ramp changed nothing ({e_on} vs {e_off})");
+    }
+}

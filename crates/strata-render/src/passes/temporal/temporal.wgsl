@@ -8,10 +8,10 @@
 
 // Matches `temporal::TemporalUniforms`.
 struct Temporal {
+    // the history's weight this frame: α, or min(α, n/(n + 1)) on the n-th frame
+    // after a cut with the start-up ramp; 0 before the first frame: no history
     alpha: f32,
     max_distance: f32,
-    // 0 before the first frame (or after a cut): no history
-    has_history: u32,
     // layers in csz-history
     layers: u32,
     // 1 = clamp the history to the current input's 3×3 range
@@ -30,7 +30,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let p = vec2i(pos.xy);
     let e = textureLoad(current, p, 0);
     let z = textureLoad(zpack, p, 0).r;
-    if (temporal.has_history == 0u || z <= 0.0) {
+    if (temporal.alpha == 0.0 || z <= 0.0) {
         return e;
     }
     // reverse reprojection of X = layer 0's surface into frame t − 1; accept
