@@ -767,7 +767,11 @@ impl Renderer {
         // frames (α^n): temporal filters start the average afresh instead
         let temporal_history = self.has_history && self.history_layers_valid;
         // frames in a row with a valid history (the temporal filters' start-up ramp)
-        self.history_frames = if temporal_history { self.history_frames.saturating_add(1) } else { 0 };
+        self.history_frames = if temporal_history {
+            self.history_frames.saturating_add(1)
+        } else {
+            0
+        };
         let max_mip = self.targets.try_get("zmip").map_or(0, |t| t.desc.mips - 1);
         if let (Some(stage), Some(s)) = (&self.ao, &self.settings.ao) {
             let au = AoUniforms::new(s, scene, &u, max_mip, self.frames_rendered);

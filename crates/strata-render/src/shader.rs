@@ -16,6 +16,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/vpl.wgsl", include_str!("shaders/common/vpl.wgsl")),
     ("common/lights.wgsl", include_str!("shaders/common/lights.wgsl")),
     ("common/shadow.wgsl", include_str!("shaders/common/shadow.wgsl")),
+    ("common/probes.wgsl", include_str!("shaders/common/probes.wgsl")),
     ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),
     (
         "common/bzb_geometry.wgsl",

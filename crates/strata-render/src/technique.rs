@@ -402,7 +402,7 @@ static AO_SETTINGS: [SettingInfo; 14] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 17] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 18] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -449,6 +449,12 @@ static RADIOSITY_SETTINGS: [SettingInfo; 17] = [
         "coverage-confidence",
         "on: the probe blend's confidence is M/U, U = the taps in the receiver's hemisphere (taps on its own plane or behind it no longer count against screen space; not in the paper, docs/image-quality.md); off: DGB's M/N",
         coverage_confidence,
+        ["off", "on"]
+    ),
+    radiosity_switch!(
+        "probe-detail",
+        "on: with probes, E = G*E_probe + c*(E_screen - E_probe along the same taps): the gather adds only what the probes miss in the directions it saw (not in the paper); off: DGB's blend c*E_screen + (1 - c)*G*E_probe",
+        probe_detail,
         ["off", "on"]
     ),
     radiosity_switch!(

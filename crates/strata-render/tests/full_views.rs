@@ -240,6 +240,7 @@ fn coverage_confidence_matches_cpu_and_bounds() {
                 frame: &f,
                 uniforms: &u,
                 layers: 2,
+                probes: None,
             };
             let gpu_e = r.read_target_full(&gpu, "indirect-raw", 0).unwrap();
             let (fw, fh) = (gpu_e.width, gpu_e.height);
@@ -356,18 +357,9 @@ fn coverage_confidence_is_near_one_inside_a_closed_box() {
     }
 }
 
-/// The composite's probe term (`probe-irradiance`, before AO's factor) is the CPU
-/// twin's `IrradianceProbes::irradiance` at every covered pixel — trilinear weights, the
-/// facing weight (probes behind the receiver's tangent plane barely count), the
-/// distance maps' visibility test and SH evaluation — for a 3×3×3 grid of distinct,
-/// direction-dependent probes, one of them invalid; without distance maps and with
-/// the path tracer's (the grid reaches outside the box, so walls hide probes).
-#[test]
-fn probe_field_matches_cpu_twin() {
-    let gpu = common::gpu();
-    let scene = frozen("cornell");
-    let (w, h) = (64, 48);
-    let (lo, hi) = (glam::Vec3::new(-0.1, -0.1, -0.1), glam::Vec3::new(0.66, 0.66, 0.66));
+/// A 3×3×3 grid of distinct, direction-dependent probes over `lo`..`hi` (a positive constant
+/// band, smaller signed higher bands), the centre one invalid.
+fn distinct_probes(lo: glam::Vec3, hi: glam::Vec3) -> IrradianceProbes {
     let mut probes = IrradianceProbes::grid(lo, hi, [3, 3, 3]);
     for (i, c) in probes.coeffs.iter_mut().enumerate() {
         for (k, band) in c.iter_mut().enumerate() {
@@ -380,6 +372,22 @@ fn probe_field_matches_cpu_twin() {
         }
     }
     probes.valid[13] = false;
+    probes
+}
+
+/// The composite's probe term (`probe-irradiance`, before AO's factor) is the CPU
+/// twin's `IrradianceProbes::irradiance` at every covered pixel — trilinear weights, the
+/// facing weight (probes behind the receiver's tangent plane barely count), the
+/// distance maps' visibility test and SH evaluation — for a 3×3×3 grid of distinct,
+/// direction-dependent probes, one of them invalid; without distance maps and with
+/// the path tracer's (the grid reaches outside the box, so walls hide probes).
+#[test]
+fn probe_field_matches_cpu_twin() {
+    let gpu = common::gpu();
+    let scene = frozen("cornell");
+    let (w, h) = (64, 48);
+    let (lo, hi) = (glam::Vec3::new(-0.1, -0.1, -0.1), glam::Vec3::new(0.66, 0.66, 0.66));
+    let mut probes = distinct_probes(lo, hi);
     // the distance maps of the same grid, traced
     let baked = strata_reference::Reference::new(&scene, 0.0)
         .with_progress(false)
@@ -496,5 +504,90 @@ fn probe_ao_modes_match_cpu_twin() {
             "{mode:?}: AO must darken a share of the box ({occluded} of {})",
             points.len()
         );
+    }
+}
+
+/// `probe-detail`: the gather's layer-0 output is Ê[B] − Ê[L_probe] — its own estimate minus
+/// the same estimate of the probes' SH radiance along the same taps — as the CPU twin
+/// computes it (`irradiance_cpu` with the probes), and the composite is
+/// max(G·E_probe + c·detail, 0) at every covered pixel (no AO here, so G = 1).
+#[test]
+fn probe_detail_gather_and_blend_match_cpu_twin() {
+    let gpu = common::gpu();
+    let scene = frozen("cornell");
+    let (w, h) = (64, 48);
+    let probes = distinct_probes(glam::Vec3::splat(-0.1), glam::Vec3::splat(0.66));
+    let rs = RadiositySettings {
+        radius: Some(0.5),
+        probe_detail: true,
+        temporal: None,
+        ..Default::default()
+    };
+    let mut r = renderer(&gpu, &scene, w, h, rs, Some(probes.clone()), None);
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+        .expect("frame renders without validation errors");
+    let u = r.radiosity_uniforms().unwrap();
+    assert_eq!(u.probe_detail, 1);
+    let zmip: Vec<ImageBuf> = (0..=u.max_mip)
+        .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
+        .collect();
+    let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
+    let (n0, n1) = (common::npack_normals(&npack, 0), common::npack_normals(&npack, 1));
+    let b0 = r.read_target_full(&gpu, "radiosity0", 0).unwrap();
+    let b1 = r.read_target_full(&gpu, "radiosity1", 0).unwrap();
+    let f = r.frame_uniforms();
+    let mut inputs = GatherInputs {
+        zmip: &zmip,
+        normals: [&n0, &n1],
+        radiosity: [&b0, &b1],
+        frame: &f,
+        uniforms: &u,
+        layers: 2,
+        probes: Some(&probes),
+    };
+    let raw = r.read_target_full(&gpu, "indirect-raw", 0).unwrap();
+    let (fw, fh) = (raw.width, raw.height);
+    let (mut close, mut negative, mut differs) = (0usize, 0usize, 0usize);
+    for y in 0..fh {
+        for x in 0..fw {
+            let (e, _) = irradiance_cpu(&inputs, 0, x, y);
+            inputs.probes = None;
+            let (plain, _) = irradiance_cpu(&inputs, 0, x, y);
+            inputs.probes = Some(&probes);
+            let g = raw.pixel(x, y);
+            let mut ok = true;
+            for c in 0..3 {
+                ok &= (g[c] - e[c]).abs() <= 2e-3 * e[c].abs() + 2e-3 * plain[c].abs() + 1e-4;
+            }
+            close += ok as usize;
+            negative += (e.min_element() < -1e-3) as usize;
+            differs += ((e - plain).abs().max_element() > 0.05 * plain.max_element().max(1e-3)) as usize;
+        }
+    }
+    let n = (fw * fh) as usize;
+    eprintln!("probe detail: {close}/{n} match the CPU, {negative} negative, {differs} differ from Ê[B]");
+    assert!(close as f32 >= 0.995 * n as f32, "{close}/{n} match the CPU");
+    assert!(
+        differs > n / 2 && negative > n / 50,
+        "weak test: {differs} differ, {negative} negative"
+    );
+    // the composite: E = max(E_probe + c·detail, 0) with the filtered detail
+    let detail = r.read_target(&gpu, "indirect").unwrap();
+    let probe = r.read_target(&gpu, "probe-irradiance").unwrap();
+    let blended = r.read_target(&gpu, "indirect-blended").unwrap();
+    let points = common::surface_points(&gpu, &r);
+    assert!(points.len() > n / 2, "the box fills the frame");
+    for s in &points {
+        let c = detail.data[s.i * 4 + 3];
+        for ch in 0..3 {
+            let want = (probe.data[s.i * 4 + ch] + c * detail.data[s.i * 4 + ch]).max(0.0);
+            let got = blended.data[s.i * 4 + ch];
+            assert!(
+                (got - want).abs() <= 2e-3 * want.abs() + 1e-3,
+                "pixel ({}, {}) channel {ch}: blended {got} vs {want}",
+                s.x,
+                s.y
+            );
+        }
     }
 }

@@ -91,6 +91,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             frame: &f,
             uniforms: &u,
             layers: 2,
+            probes: None,
         };
         for (receiver, target) in [(0usize, "indirect-raw"), (1, "indirect1-raw")] {
             let gpu_e = r.read_target_full(&gpu, target, 0).unwrap();

@@ -185,6 +185,16 @@ impl IrradianceProbes {
     /// the 8 surrounding probes (positions clamped to the grid), each weight times
     /// [`facing_weight`] and [`Self::visibility`], renormalised; all 8 when none is valid.
     pub fn irradiance(&self, p: Vec3, n: Vec3) -> Vec3 {
+        self.corner_weights(p, n)
+            .iter()
+            .map(|&(index, w)| self.probe_irradiance(index, n) * w)
+            .sum()
+    }
+
+    /// The 8 probes around p and their normalised blend weights for a receiver at p
+    /// with normal n, as [`Self::irradiance`] blends them (`probe_corners` and
+    /// `probe_weights` in `common/probes.wgsl`).
+    pub fn corner_weights(&self, p: Vec3, n: Vec3) -> [(usize, f32); 8] {
         let g = ((p - self.origin) / self.spacing).max(Vec3::ZERO);
         let max = Vec3::new(
             (self.dims[0] - 1) as f32,
@@ -194,9 +204,9 @@ impl IrradianceProbes {
         let g = g.min(max);
         let i0 = g.floor();
         let t = g - i0;
-        let (mut e, mut sum) = (Vec3::ZERO, 0.0f32);
-        let (mut e_all, mut sum_all) = (Vec3::ZERO, 0.0f32);
-        for corner in 0..8u32 {
+        let mut out = [(0usize, 0.0f32); 8];
+        let (mut sum, mut sum_all) = (0.0f32, 0.0f32);
+        for (corner, slot) in out.iter_mut().enumerate() {
             let o = Vec3::new(
                 (corner & 1) as f32,
                 ((corner >> 1) & 1) as f32,
@@ -208,20 +218,50 @@ impl IrradianceProbes {
                 * (if o.z > 0.0 { t.z } else { 1.0 - t.z });
             let index = (c.x as u32 + self.dims[0] * (c.y as u32 + self.dims[1] * c.z as u32)) as usize;
             let w = w * facing_weight(self.origin + c * self.spacing - p, n) * self.visibility(index, p, n);
-            let pe = self.probe_irradiance(index, n);
-            e_all += pe * w;
             sum_all += w;
             if self.valid[index] {
-                e += pe * w;
                 sum += w;
             }
+            *slot = (index, w);
         }
-        if sum > 1e-6 {
-            e / sum
-        } else {
-            e_all / sum_all.max(1e-6)
+        for (index, w) in &mut out {
+            *w = if sum > 1e-6 {
+                if self.valid[*index] {
+                    *w / sum
+                } else {
+                    0.0
+                }
+            } else {
+                *w / sum_all.max(1e-6)
+            };
         }
+        out
     }
+
+    /// The blended probes' incident radiance at p (receiver normal n) as order-2 SH
+    /// coefficients: L_lm = E_lm / Â_l ([`COSINE_LOBE`]), so that the cosine-weighted
+    /// hemisphere integral of [`sh_radiance`] (without its clamp) is
+    /// [`Self::irradiance`] (`probe_radiance_sh` in `common/probes.wgsl`).
+    pub fn radiance_sh(&self, p: Vec3, n: Vec3) -> [Vec3; 9] {
+        let mut l = [Vec3::ZERO; 9];
+        for (index, w) in self.corner_weights(p, n) {
+            for (i, li) in l.iter_mut().enumerate() {
+                *li += Vec3::from(self.coeffs[index][i]) * w;
+            }
+        }
+        for (i, li) in l.iter_mut().enumerate() {
+            *li /= COSINE_LOBE[sh_band(i)];
+        }
+        l
+    }
+}
+
+/// Radiance along unit direction `d` of order-2 SH radiance coefficients `l`, clamped
+/// at 0 (order 2 rings below zero near strong lobes; `sh_radiance` in
+/// `common/probes.wgsl`).
+pub fn sh_radiance(l: &[Vec3; 9], d: Vec3) -> Vec3 {
+    let y = sh9(d);
+    l.iter().zip(y).map(|(li, yi)| *li * yi).sum::<Vec3>().max(Vec3::ZERO)
 }
 
 /// The facing weight's floor: what a probe straight behind the receiver still counts
@@ -283,5 +323,46 @@ mod tests {
         let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), -Vec3::X).x / sh9(-Vec3::X)[0];
         let (w0, w1) = (0.25 * (1.0 + FACING_FLOOR), 0.75 * FACING_FLOOR);
         assert!((e - (w0 * 1.0 + w1 * 3.0) / (w0 + w1)).abs() < 1e-4, "{e}");
+    }
+
+    /// The probes' SH radiance integrates back to their irradiance: ∫ L(ω) max(ω·n, 0) dω
+    /// over the sphere (midpoint quadrature, no clamp active) equals
+    /// [`IrradianceProbes::irradiance`] for several normals of a direction-dependent probe.
+    #[test]
+    fn radiance_sh_integrates_to_the_irradiance() {
+        let mut p = IrradianceProbes::grid(Vec3::ZERO, Vec3::ONE, [1, 1, 1]);
+        p.coeffs[0] = [
+            [3.0, 2.5, 2.0],
+            [0.4, -0.2, 0.1],
+            [-0.3, 0.5, 0.2],
+            [0.2, 0.1, -0.4],
+            [0.1, -0.05, 0.08],
+            [-0.1, 0.06, 0.02],
+            [0.05, 0.1, -0.07],
+            [0.09, -0.02, 0.04],
+            [-0.06, 0.03, 0.1],
+        ];
+        for n in [Vec3::Y, Vec3::X, Vec3::new(0.3, -0.5, 0.8).normalize()] {
+            let l = p.radiance_sh(Vec3::splat(0.5), n);
+            let (nt, np) = (400, 800);
+            let mut e = Vec3::ZERO;
+            for i in 0..nt {
+                let theta = (i as f32 + 0.5) / nt as f32 * std::f32::consts::PI;
+                for j in 0..np {
+                    let phi = (j as f32 + 0.5) / np as f32 * 2.0 * std::f32::consts::PI;
+                    let d = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                    let r = sh_radiance(&l, d);
+                    assert!(r.min_element() > 0.0, "the clamp is active at {d}: {r}");
+                    let dw =
+                        theta.sin() * (std::f32::consts::PI / nt as f32) * (2.0 * std::f32::consts::PI / np as f32);
+                    e += r * d.dot(n).max(0.0) * dw;
+                }
+            }
+            let want = p.irradiance(Vec3::splat(0.5), n);
+            assert!(
+                (e - want).abs().max_element() < 2e-3 * want.max_element(),
+                "n {n}: {e} vs {want}"
+            );
+        }
     }
 }

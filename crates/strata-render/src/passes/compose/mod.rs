@@ -34,49 +34,31 @@ pub const OUTPUTS: [TargetDesc; 3] = [
     ),
 ];
 
+/// Mirrors `ProbeGrid` in `common/probes.wgsl`.
 #[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ComposeUniforms {
-    boost: u32,
-    use_probes: u32,
-    use_ao: u32,
-    use_glossy: u32,
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ProbeGridUniform {
     origin: [f32; 4],
+    /// w: the visibility test's normal offset
     spacing: [f32; 4],
+    /// w: 1 = distance maps (the visibility test)
     dims: [u32; 4],
 }
 
-pub struct ComposePass {
-    pass: FullscreenPass,
+/// The light probes on the GPU, as `common/probes.wgsl` reads them: the grid and the
+/// storage buffers `probes` (9 SH coefficients, validity in the first one's w) and
+/// `probe_depth` (distance moments). Without probes: a 1-probe dummy.
+pub struct ProbeGpu {
+    pub grid: ProbeGridUniform,
+    pub probes: wgpu::Buffer,
+    pub depth: wgpu::Buffer,
 }
 
-impl ComposePass {
-    /// `probes`: the static fallback (Fig. 9); AO modulates it when target `ao` exists.
-    /// `indirect`: the target holding E (rgb) and the confidence (a), e.g. `indirect`.
-    /// `glossy`: a target of outgoing radiance added as is (ILS's `ils-glossy`).
-    pub fn new(
-        gpu: &GpuContext,
-        scene: &GpuScene,
-        targets: &Targets,
-        boost: bool,
-        probes: Option<(&IrradianceProbes, crate::passes::radiosity::ProbeAo)>,
-        indirect: &'static str,
-        glossy: Option<&'static str>,
-    ) -> Self {
-        let probe_ao = probes.map_or(crate::passes::radiosity::ProbeAo::Off, |p| p.1);
-        let probes = probes.map(|p| p.0);
-        let use_ao =
-            probes.is_some() && targets.try_get("ao").is_some() && probe_ao != crate::passes::radiosity::ProbeAo::Off;
-        let u = ComposeUniforms {
-            boost: boost as u32,
-            use_probes: probes.is_some() as u32,
-            // 0: no AO, 1: × AV, 2: × GTAO's multi-bounce G(AV, ρ) (`ProbeAo`)
-            use_ao: if use_ao { probe_ao as u32 } else { 0 },
-            use_glossy: glossy.is_some() as u32,
+impl ProbeGpu {
+    pub fn new(gpu: &GpuContext, probes: Option<&IrradianceProbes>) -> Self {
+        let grid = ProbeGridUniform {
             origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
-            // w: the visibility test's normal offset
             spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(p.visibility_bias()).to_array()),
-            // w: 1 = distance maps (the visibility test)
             dims: probes.map_or([1, 1, 1, 0], |p| {
                 [p.dims[0], p.dims[1], p.dims[2], !p.depth.is_empty() as u32]
             }),
@@ -104,12 +86,74 @@ impl ComposePass {
                 },
             )
         };
-        let probe_buf = storage("light probes", bytemuck::cast_slice(&data));
         let depth: Vec<[f32; 2]> = match probes {
             Some(p) if !p.depth.is_empty() => p.depth.iter().flatten().copied().collect(),
             _ => vec![[0.0; 2]],
         };
-        let depth_buf = storage("light-probe distance maps", bytemuck::cast_slice(&depth));
+        Self {
+            grid,
+            probes: storage("light probes", bytemuck::cast_slice(&data)),
+            depth: storage("light-probe distance maps", bytemuck::cast_slice(&depth)),
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ComposeUniforms {
+    boost: u32,
+    use_probes: u32,
+    use_ao: u32,
+    use_glossy: u32,
+    grid: ProbeGridUniform,
+}
+
+/// How the composition uses the light probes.
+pub struct ComposeProbes<'a> {
+    pub probes: &'a ProbeGpu,
+    pub ao: crate::passes::radiosity::ProbeAo,
+    /// The probes plus c × the gather's detail term (`RadiositySettings::probe_detail`),
+    /// instead of DGB's blend by c.
+    pub detail: bool,
+}
+
+pub struct ComposePass {
+    pass: FullscreenPass,
+}
+
+impl ComposePass {
+    /// `probes`: the static fallback (Fig. 9); AO modulates it when target `ao` exists.
+    /// `indirect`: the target holding E (rgb) and the confidence (a), e.g. `indirect`.
+    /// `glossy`: a target of outgoing radiance added as is (ILS's `ils-glossy`).
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        boost: bool,
+        probes: Option<ComposeProbes>,
+        indirect: &'static str,
+        glossy: Option<&'static str>,
+    ) -> Self {
+        let probe_ao = probes.as_ref().map_or(crate::passes::radiosity::ProbeAo::Off, |p| p.ao);
+        let use_ao =
+            probes.is_some() && targets.try_get("ao").is_some() && probe_ao != crate::passes::radiosity::ProbeAo::Off;
+        let dummy;
+        let gpu_probes = match &probes {
+            Some(p) => p.probes,
+            None => {
+                dummy = ProbeGpu::new(gpu, None);
+                &dummy
+            }
+        };
+        let u = ComposeUniforms {
+            boost: boost as u32,
+            // 0: none, 1: DGB's blend, 2: probes + detail
+            use_probes: probes.as_ref().map_or(0, |p| if p.detail { 2 } else { 1 }),
+            // 0: no AO, 1: × AV, 2: × GTAO's multi-bounce G(AV, ρ) (`ProbeAo`)
+            use_ao: if use_ao { probe_ao as u32 } else { 0 },
+            use_glossy: glossy.is_some() as u32,
+            grid: gpu_probes.grid,
+        };
         let mut b = PassBuilder::new(gpu, targets, "compose")
             .shader("compose", include_str!("compose.wgsl"))
             .frame(scene)
@@ -121,10 +165,10 @@ impl ComposePass {
             .read_layer("csz", 0)
             // without AO the binding is filled by a target that is read anyway
             .read_layer(if use_ao { "ao" } else { indirect }, 0)
-            .storage(&probe_buf)
+            .storage(&gpu_probes.probes)
             // without glossy receivers the binding is filled by a target that is read anyway
             .read_layer(glossy.unwrap_or(indirect), 0)
-            .storage(&depth_buf);
+            .storage(&gpu_probes.depth);
         for t in &OUTPUTS {
             b = b.write(t.name);
         }

@@ -86,6 +86,12 @@ pub struct RadiositySettings {
     pub probe_ao: ProbeAo,
     /// The gather's normaliser ([`Normalisation`]; default `Bounded`, not in the paper).
     pub normalisation: Normalisation,
+    /// With light probes, E = G·E_probe + c·(Ê[B] − Ê[L_probe]) instead of DGB's
+    /// c·Ê[B] + (1 − c)·G·E_probe: the gather also evaluates the probes' order-2 SH
+    /// radiance along its own taps, and adds only the difference — what the probes miss
+    /// in the directions screen space saw (a control variate; docs/radiosity.md §
+    /// "Probe detail"). Not in the paper.
+    pub probe_detail: bool,
 }
 
 /// How AO's visibility AV modulates the light probes' irradiance in the composite
@@ -232,6 +238,7 @@ impl Default for RadiositySettings {
             probe_visibility: true,
             probe_ao: ProbeAo::MultiBounce,
             normalisation: Normalisation::Bounded,
+            probe_detail: false,
         }
     }
 }
@@ -345,7 +352,10 @@ pub struct RadiosityUniforms {
     pub hidden_black: u32,
     /// [`Normalisation`] as its discriminant: 0 = Eq. 4, 1 = π/Σ w·cos, 2 = π/max(Σ w·cos, ½ Σ w).
     pub normalisation: u32,
-    pub _pad: [u32; 3],
+    /// 1 = [`RadiositySettings::probe_detail`] (set by the pass when it has probes).
+    pub probe_detail: u32,
+    /// The probes' grid (set by the pass).
+    pub grid: crate::passes::compose::ProbeGridUniform,
 }
 
 impl RadiosityUniforms {
@@ -372,7 +382,8 @@ impl RadiosityUniforms {
             open_sky: s.open_sky as u32,
             hidden_black: s.hidden_black as u32,
             normalisation: s.normalisation as u32,
-            _pad: [0; 3],
+            probe_detail: s.probe_detail as u32,
+            grid: bytemuck::Zeroable::zeroed(),
         }
     }
 }
@@ -394,6 +405,8 @@ pub const OUTPUTS: [TargetDesc; 2] = [
 
 pub struct RadiosityPass {
     pass: FullscreenPass,
+    /// The probes' grid, when the gather has probes for the detail term.
+    grid: Option<crate::passes::compose::ProbeGridUniform>,
     /// Shaded region (the image plus the shaded part of the guard band).
     scissor: Option<[u32; 4]>,
     last: std::cell::Cell<RadiosityUniforms>,
@@ -402,7 +415,9 @@ pub struct RadiosityPass {
 impl RadiosityPass {
     /// Gathers from the radiosity buffers `b` (layer 0, layer 1) inside the
     /// `scissor` rectangle [x, y, w, h] (`None`: everywhere); `receiver1`: also
-    /// for layer 1's surfaces (only multi-bounce propagation reads them).
+    /// for layer 1's surfaces (only multi-bounce propagation reads them); `probes`: for
+    /// [`RadiositySettings::probe_detail`].
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -411,8 +426,17 @@ impl RadiosityPass {
         b: [&'static str; 2],
         scissor: Option<[u32; 4]>,
         receiver1: bool,
+        probes: Option<&crate::passes::compose::ProbeGpu>,
     ) -> Self {
         let zeroed: RadiosityUniforms = bytemuck::Zeroable::zeroed();
+        let dummy;
+        let gpu_probes = match probes {
+            Some(p) => p,
+            None => {
+                dummy = crate::passes::compose::ProbeGpu::new(gpu, None);
+                &dummy
+            }
+        };
         let mut builder = PassBuilder::new(gpu, targets, "radiosity")
             .shader("radiosity", include_str!("radiosity.wgsl"))
             .constant("LAYERS", layers as f64)
@@ -423,18 +447,25 @@ impl RadiosityPass {
             .read("npack")
             .read(b[0])
             // one layer: layer 0's buffer fills the binding
-            .read(if layers > 1 { b[1] } else { b[0] });
+            .read(if layers > 1 { b[1] } else { b[0] })
+            .storage(&gpu_probes.probes)
+            .storage(&gpu_probes.depth);
         for t in &OUTPUTS {
             builder = builder.write(t.name);
         }
         Self {
             pass: builder.build(),
+            grid: probes.map(|p| p.grid),
             scissor,
             last: std::cell::Cell::new(zeroed),
         }
     }
 
-    pub fn set_frame(&self, gpu: &GpuContext, u: RadiosityUniforms) {
+    pub fn set_frame(&self, gpu: &GpuContext, mut u: RadiosityUniforms) {
+        match self.grid {
+            Some(g) => u.grid = g,
+            None => u.probe_detail = 0,
+        }
         self.pass.set_uniforms(gpu, &u);
         self.last.set(u);
     }
@@ -552,6 +583,8 @@ pub struct GatherInputs<'a> {
     pub frame: &'a FrameUniforms,
     pub uniforms: &'a RadiosityUniforms,
     pub layers: u32,
+    /// The probes the gather's detail term reads (`uniforms.probe_detail`).
+    pub probes: Option<&'a strata_scene::probes::IrradianceProbes>,
 }
 
 /// CPU evaluation of exactly what `radiosity.wgsl` computes for receiver layer
@@ -583,6 +616,12 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let eye = Vec3::from_slice(&g.frame.eye[..3]);
     let (mut sum, mut wsum, mut wcsum, mut m_count, mut u_count) = (Vec3::ZERO, 0.0f32, 0.0f32, 0u32, 0u32);
+    // probe_detail (layer 0 only): Σ w·L_probe(ω̂)·cos over the same taps
+    let probe_sh = g
+        .probes
+        .filter(|_| receiver == 0 && u.probe_detail != 0)
+        .map(|p| p.radiance_sh(pos, n));
+    let mut sum_probe = Vec3::ZERO;
     for i in 0..u.samples {
         let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
         let d = spiral::tap_texel(tap.offset);
@@ -594,9 +633,9 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         let (tx, ty) = ((qx >> m) as u32, (qy >> m) as u32);
         let zs = g.zmip[m as usize].pixel(tx, ty);
         let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
-        // (light · cos · w, w, w · cos, carries light): a light-carrying term wins over a black
-        // occluder (`hidden_black`), which wins over nothing (as `union_term`)
-        let mut best: Option<(Vec3, f32, f32, bool)> = None;
+        // (light · cos · w, w, w · cos, carries light, ω̂): a light-carrying term wins over a
+        // black occluder (`hidden_black`), which wins over nothing (as `union_term`)
+        let mut best: Option<(Vec3, f32, f32, bool, Vec3)> = None;
         for (j, &zj) in zs.iter().enumerate().take(g.layers.min(2) as usize) {
             if zj <= 0.0 {
                 continue;
@@ -620,13 +659,13 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
             };
             if u.normal_test != 0 && wdir.dot(ny) >= 0.0 {
                 if u.hidden_black != 0 && best.is_none() {
-                    best = Some((Vec3::ZERO, wt, cos_x * wt, false));
+                    best = Some((Vec3::ZERO, wt, cos_x * wt, false, wdir));
                 }
                 continue;
             }
             let c = v3(g.radiosity[j], sx, sy) * cos_x * wt;
-            if best.is_none_or(|(b, _, _, light)| !light || luminance(c) > luminance(b)) {
-                best = Some((c, wt, cos_x * wt, true));
+            if best.is_none_or(|(b, _, _, light, _)| !light || luminance(c) > luminance(b)) {
+                best = Some((c, wt, cos_x * wt, true, wdir));
             }
         }
         // a background tap: the sky along its camera ray, weight h (`sky_term`)
@@ -636,10 +675,19 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
             let cos_x = dir.dot(n);
             if cos_x > 0.0 {
                 let wt = if u.solid_angle != 0 { tap.radius } else { 1.0 };
-                best = Some((Vec3::from_slice(&g.frame.sky[..3]) * cos_x * wt, wt, cos_x * wt, false));
+                best = Some((
+                    Vec3::from_slice(&g.frame.sky[..3]) * cos_x * wt,
+                    wt,
+                    cos_x * wt,
+                    false,
+                    dir,
+                ));
             }
         }
-        if let Some((b, wt, wc, light)) = best {
+        if let Some((b, wt, wc, light, dir)) = best {
+            if let Some(l) = &probe_sh {
+                sum_probe += strata_scene::probes::sh_radiance(l, dir) * wc;
+            }
             sum += b;
             wsum += wt;
             wcsum += wc;
@@ -664,7 +712,8 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         1 => wcsum,
         _ => wcsum.max(0.5 * wsum),
     };
-    (sum * (std::f32::consts::PI / denom), confidence)
+    // probe_detail: Ê[B] − Ê[L_probe] (same taps, weights, normaliser)
+    ((sum - sum_probe) * (std::f32::consts::PI / denom), confidence)
 }
 
 /// `radiosity.wgsl`'s `solid_angle_weight`: the solid angle (up to a constant

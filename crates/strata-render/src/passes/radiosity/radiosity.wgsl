@@ -9,6 +9,7 @@
 #import "common/packing.wgsl"
 #import "common/spiral.wgsl"
 #import "common/color.wgsl"
+#import "common/probes.wgsl"
 
 override LAYERS: u32 = 2u;
 // 1 = also gather for layer 1's receiver (needed only to propagate bounces
@@ -41,13 +42,17 @@ struct Radiosity {
     hidden_black: u32,
     // `estimate`'s normaliser: 0 = Eq. 4's 2π / Σ w, 1 = cosine, 2 = bounded cosine
     normalisation: u32,
+    // 1 = layer 0's output is the detail term Ê[B] − Ê[L_probe] (`probe_detail`)
+    probe_detail: u32,
+    grid: ProbeGrid,
 }
 
 // One tap's share of the sums: c.rgb = w · B(Y) max(ω̂·n̂_X, 0), c.a = w (< 0 for an
-// occluder or the sky, 0 for nothing), wc = w · max(ω̂·n̂_X, 0).
+// occluder or the sky, 0 for nothing), wc = w · max(ω̂·n̂_X, 0), dir = ω̂.
 struct Term {
     c: vec4f,
     wc: f32,
+    dir: vec3f,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -56,6 +61,9 @@ struct Term {
 @group(1) @binding(2) var npack: texture_2d<f32>;
 @group(1) @binding(3) var b0: texture_2d<f32>;
 @group(1) @binding(4) var b1: texture_2d<f32>;
+// the light probes (`common/probes.wgsl`; dummies without `probe_detail`)
+@group(1) @binding(5) var<storage, read> probes: array<Probe>;
+@group(1) @binding(6) var<storage, read> probe_depth: array<vec2f>;
 
 struct Out {
     // rgb = E (layer 0), a = confidence M/N
@@ -105,7 +113,7 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> Term {
                 if (rad.solid_angle != 0u) {
                     wo = solid_angle_weight(y, ny, w, vv, h);
                 }
-                return Term(vec4f(0.0, 0.0, 0.0, -wo), wo * cos_x);
+                return Term(vec4f(0.0, 0.0, 0.0, -wo), wo * cos_x, w);
             }
             return none;
         }
@@ -113,7 +121,7 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> Term {
             wt = solid_angle_weight(y, ny, w, vv, h);
         }
     }
-    return Term(vec4f(radiosity_of(src, j) * cos_x * wt, wt), wt * cos_x);
+    return Term(vec4f(radiosity_of(src, j) * cos_x * wt, wt), wt * cos_x, w);
 }
 
 // Solid angle (up to a constant) that the screen area represented by a tap at
@@ -150,7 +158,8 @@ fn union_term(a: Term, b: Term) -> Term {
 // surface at infinity (z²/d² → 1, cos_y/cos_view → 1), i.e. the tap's h.
 fn sky_term(x: vec3f, n: vec3f, src: vec2i, h: f32) -> Term {
     let y = world_from_csz(frame, vec2f(src) + 0.5, 1.0e4);
-    let cos_x = dot(normalize(y - x), n);
+    let d = normalize(y - x);
+    let cos_x = dot(d, n);
     if (cos_x <= 0.0) {
         var none: Term;
         return none;
@@ -159,7 +168,7 @@ fn sky_term(x: vec3f, n: vec3f, src: vec2i, h: f32) -> Term {
     if (rad.solid_angle != 0u) {
         wt = h;
     }
-    return Term(vec4f(frame.sky.rgb * cos_x * wt, -wt), wt * cos_x);
+    return Term(vec4f(frame.sky.rgb * cos_x * wt, -wt), wt * cos_x, d);
 }
 
 // Whether the tap at pixel `src` with layer-0 depth `z0` (0: background) tells the
@@ -236,6 +245,12 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     var m1 = 0.0;
     var u0 = 0.0;
     var u1 = 0.0;
+    // probe_detail: the probes' radiance along layer 0's taps, Σ w·L_probe(ω̂)·cos
+    var lsh: array<vec3f, 9>;
+    if (rad.probe_detail != 0u) {
+        lsh = probe_radiance_sh(rad.grid, x0, n0);
+    }
+    var sum_probe = vec3f(0.0);
     for (var i = 0u; i < rad.samples; i++) {
         let tap = spiral_tap(i, rad.samples, rad.tau, r_p, phi);
         let q = p + tap_texel(tap.offset);
@@ -269,6 +284,9 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         sum1 += vec4f(best1.c.rgb, abs(best1.c.a));
         wc0 += best0.wc;
         wc1 += best1.wc;
+        if (rad.probe_detail != 0u && best0.c.a != 0.0) {
+            sum_probe += sh_radiance(lsh, best0.dir) * best0.wc;
+        }
         let hit0 = select(0.0, 1.0, best0.c.a > 0.0);
         let hit1 = select(0.0, 1.0, best1.c.a > 0.0);
         m0 += hit0;
@@ -280,7 +298,9 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             }
         }
     }
-    o.e0 = estimate(sum0, wc0, m0, u0);
+    // probe_detail: Ê[B] − Ê[L_probe], the same taps, weights and normaliser (a control
+    // variate: what the probes miss in the directions the taps saw)
+    o.e0 = estimate(sum0 - vec4f(sum_probe, 0.0), wc0, m0, u0);
     o.e1 = estimate(sum1, wc1, m1, u1);
     return o;
 }

@@ -81,7 +81,30 @@ impl RadiosityStage {
             ["radiosity0", "radiosity1"]
         };
         let region = crate::passes::radiosity::shaded_region(targets.width, targets.height, guard, s.guard_band_shaded);
-        let gather = RadiosityPass::new(gpu, scene, targets, deep.layers, b, region, propagate.is_some());
+        // without the visibility test the probes blend as if they had no distance maps
+        let blind;
+        let probes = match probes {
+            Some(p) if !s.probe_visibility && !p.depth.is_empty() => {
+                blind = strata_scene::probes::IrradianceProbes {
+                    depth: Vec::new(),
+                    ..p.clone()
+                };
+                Some(&blind)
+            }
+            other => other,
+        };
+        let probe_gpu = probes.map(|p| crate::passes::compose::ProbeGpu::new(gpu, Some(p)));
+        let detail = s.probe_detail && probe_gpu.is_some();
+        let gather = RadiosityPass::new(
+            gpu,
+            scene,
+            targets,
+            deep.layers,
+            b,
+            region,
+            propagate.is_some(),
+            probe_gpu.as_ref().filter(|_| detail),
+        );
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
                 gpu,
@@ -118,24 +141,16 @@ impl RadiosityStage {
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
         }
-        // without the visibility test the probes blend as if they had no distance maps
-        let blind;
-        let probes = match probes {
-            Some(p) if !s.probe_visibility && !p.depth.is_empty() => {
-                blind = strata_scene::probes::IrradianceProbes {
-                    depth: Vec::new(),
-                    ..p.clone()
-                };
-                Some(&blind)
-            }
-            other => other,
-        };
         let compose = crate::passes::compose::ComposePass::new(
             gpu,
             scene,
             targets,
             s.boost,
-            probes.map(|p| (p, s.probe_ao)),
+            probe_gpu.as_ref().map(|p| crate::passes::compose::ComposeProbes {
+                probes: p,
+                ao: s.probe_ao,
+                detail,
+            }),
             "indirect",
             None,
         );

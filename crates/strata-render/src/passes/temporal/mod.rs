@@ -44,7 +44,6 @@ impl Default for TemporalSettings {
     }
 }
 
-
 impl TemporalSettings {
     /// The history's weight on frame `history_frames` (0 = no history) after a cut:
     /// α, or with [`ramp`](Self::ramp) min(α, n/(n + 1)). The CPU twin of `temporal.wgsl`'s.
@@ -171,6 +170,9 @@ mod tests {
             assert_eq!(a_off, if n == 0 { 0.0 } else { off.alpha }, "frame {n}");
         }
         // without the ramp the first frame keeps weight α^7 after 7 more frames
-        assert!((e_off - e_on).abs() > 0.1, "the ramp changed nothing ({e_on} vs {e_off})");
+        assert!(
+            (e_off - e_on).abs() > 0.1,
+            "the ramp changed nothing ({e_on} vs {e_off})"
+        );
     }
 }
