@@ -29,8 +29,16 @@ impl Reference<'_> {
     /// coefficients, validity and distance maps are replaced).
     pub fn bake_grid(&self, mut probes: IrradianceProbes, rays: u32, settings: &GiSettings) -> IrradianceProbes {
         let (lo, hi) = self.bvh().bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
-        let positions: Vec<Vec3> = (0..probes.count()).map(|i| probes.position(i)).collect();
         let rays = rays.max(1);
+        // probe relocation: a probe on or next to a surface moves off it first
+        probes.offsets = (0..probes.count())
+            .into_par_iter()
+            .map(|i| {
+                self.relocation(probes.grid_position(i), probes.spacing, probes.dims)
+                    .to_array()
+            })
+            .collect();
+        let positions: Vec<Vec3> = (0..probes.count()).map(|i| probes.position(i)).collect();
         let far = 2.0 * (hi - lo).length().max(1e-3);
         let texel_dirs: Vec<Vec3> = (0..DEPTH_TEXELS)
             .map(|t| {
@@ -88,6 +96,53 @@ impl Reference<'_> {
     }
 }
 
+impl Reference<'_> {
+    /// How far a probe at grid point `g` moves (probe relocation, as in DDGI): when the
+    /// plane of the nearest front face that [`RELOCATE_RAYS`] rays find is closer than
+    /// [`RELOCATE`] × the smallest spacing, along that face's normal until it is that far,
+    /// at most 0.45 × the spacing per axis (the probe stays in its cell). A probe on a
+    /// floor otherwise sees half of its distance map at zero and half far away, and the
+    /// visibility test's variance lets it leak through the floor.
+    pub fn relocation(&self, g: Vec3, spacing: Vec3, dims: [u32; 3]) -> Vec3 {
+        let min_spacing = (0..3)
+            .filter(|&i| dims[i] > 1)
+            .map(|i| spacing[i])
+            .fold(f32::INFINITY, f32::min);
+        if !min_spacing.is_finite() {
+            return Vec3::ZERO;
+        }
+        let want = RELOCATE * min_spacing;
+        // (distance to the face's plane, its normal towards the probe)
+        let mut nearest: Option<(f32, Vec3)> = None;
+        for k in 0..RELOCATE_RAYS {
+            let d = fibonacci_sphere(k, RELOCATE_RAYS);
+            let Some(h) = self.bvh().intersect(g, d, 0.0, want) else {
+                continue;
+            };
+            let s = self.bvh().surface(&h, d);
+            if !s.front_face {
+                continue;
+            }
+            let plane = h.t * d.dot(s.geometric_normal).abs();
+            if nearest.is_none_or(|(t, _)| plane < t) {
+                nearest = Some((plane, s.geometric_normal));
+            }
+        }
+        self.add_rays(RELOCATE_RAYS as u64);
+        match nearest {
+            Some((t, n)) => (n * (want - t)).clamp(-0.45 * spacing, 0.45 * spacing),
+            None => Vec3::ZERO,
+        }
+    }
+}
+
+/// Probes nearer than this fraction of the smallest probe spacing to a front face are
+/// moved off it ([`Reference::relocation`]).
+pub const RELOCATE: f32 = 0.25;
+
+/// Rays per probe that look for the nearest surface before relocation.
+pub const RELOCATE_RAYS: u32 = 256;
+
 /// One probe's irradiance coefficients, validity and distance map.
 type BakedProbe = ([[f32; 3]; 9], bool, [[f32; 2]; DEPTH_TEXELS]);
 
@@ -112,6 +167,48 @@ mod tests {
     use super::*;
     use glam::Mat4;
     use strata_scene::{shapes::MeshBuilder, Material, Object, Scene, SceneSettings};
+
+    /// A probe grid whose lower layer lies on a 10 cm slab's top face: relocation lifts
+    /// those probes by RELOCATE × the smallest spacing (1 m here), leaves the upper layer
+    /// where it was, and the lifted probe's distance map then hides it from a ceiling
+    /// receiver under the slab.
+    #[test]
+    fn probes_on_a_floor_move_off_it_and_do_not_leak_through() {
+        let mut geo = MeshBuilder::new();
+        geo.cuboid(Vec3::new(-10.0, -0.1, -10.0), Vec3::new(10.0, 0.0, 10.0));
+        let scene = Scene {
+            name: "slab".into(),
+            meshes: vec![geo.build("slab", 0)],
+            objects: vec![Object {
+                name: "slab".into(),
+                mesh: 0,
+                transform: Mat4::IDENTITY,
+                animation: None,
+            }],
+            materials: vec![Material::diffuse("grey", [0.5; 3])],
+            settings: SceneSettings::default(),
+            ..Default::default()
+        };
+        let grid = IrradianceProbes::grid(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), [2, 2, 1]);
+        let probes = Reference::new(&scene, 0.0).bake_grid(grid, 1024, &GiSettings::default());
+        for i in 0..probes.count() {
+            let moved = probes.position(i) - probes.grid_position(i);
+            let want = if probes.grid_position(i).y == 0.0 {
+                RELOCATE
+            } else {
+                0.0
+            };
+            assert!(
+                (moved - Vec3::new(0.0, want, 0.0)).length() < 0.02,
+                "probe {i} at {}: moved by {moved}",
+                probes.grid_position(i)
+            );
+        }
+        assert!(probes.valid.iter().all(|&v| v));
+        // under the slab, a ceiling (normal down) below probe 0
+        let v = probes.visibility(0, Vec3::new(-1.0, -0.3, 0.0), -Vec3::Y);
+        assert!(v < 0.05, "the lifted probe still sees through the slab: visibility {v}");
+    }
 
     /// Two probes 1 m either side of a wall (x = 0, 10 cm thick) and a receiver
     /// 0.5 m in front of it: the distance map of the probe behind the wall says the

@@ -358,7 +358,8 @@ fn coverage_confidence_is_near_one_inside_a_closed_box() {
 }
 
 /// A 3×3×3 grid of distinct, direction-dependent probes over `lo`..`hi` (a positive constant
-/// band, smaller signed higher bands), the centre one invalid.
+/// band, smaller signed higher bands), the centre one invalid, most moved off their grid
+/// points (relocation offsets).
 fn distinct_probes(lo: glam::Vec3, hi: glam::Vec3) -> IrradianceProbes {
     let mut probes = IrradianceProbes::grid(lo, hi, [3, 3, 3]);
     for (i, c) in probes.coeffs.iter_mut().enumerate() {
@@ -372,6 +373,16 @@ fn distinct_probes(lo: glam::Vec3, hi: glam::Vec3) -> IrradianceProbes {
         }
     }
     probes.valid[13] = false;
+    // relocated probes: a few centimetres off their grid points
+    probes.offsets = (0..probes.count())
+        .map(|i| {
+            [
+                0.02 * (i % 3) as f32 - 0.02,
+                0.03 * ((i / 3) % 2) as f32,
+                -0.01 * (i % 5) as f32,
+            ]
+        })
+        .collect();
     probes
 }
 
@@ -379,7 +390,7 @@ fn distinct_probes(lo: glam::Vec3, hi: glam::Vec3) -> IrradianceProbes {
 /// twin's `IrradianceProbes::irradiance` at every covered pixel — trilinear weights, the
 /// facing weight (probes behind the receiver's tangent plane barely count), the
 /// distance maps' visibility test and SH evaluation — for a 3×3×3 grid of distinct,
-/// direction-dependent probes, one of them invalid; without distance maps and with
+/// direction-dependent probes, one of them invalid, most relocated; without distance maps and with
 /// the path tracer's (the grid reaches outside the box, so walls hide probes).
 #[test]
 fn probe_field_matches_cpu_twin() {

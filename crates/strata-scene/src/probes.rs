@@ -60,6 +60,28 @@ pub struct IrradianceProbes {
     /// [`DEPTH_OCT`]² octahedral map ([`oct_encode`]). A receiver farther from the
     /// probe than that surface is likely hidden from it ([`chebyshev_visibility`]).
     pub depth: Vec<[[f32; 2]; DEPTH_TEXELS]>,
+    /// Per probe (empty: none): how far the bake moved it off its grid point, away from
+    /// a surface it sat on or next to (probe relocation). The trilinear weights keep
+    /// the grid points; the facing weight, the visibility test and the bake use the
+    /// moved position ([`Self::position`]).
+    pub offsets: Vec<[f32; 3]>,
+}
+
+/// The texel of an `n`×`n` octahedral map that a bilinear lookup one texel beyond the
+/// border (x or y in −1..=n) reads: the square's edges fold onto themselves (texel (n, j)
+/// lies beside (n − 1, n − 1 − j) on the sphere), and its four corners are one direction,
+/// so a texel diagonally beyond a corner is the opposite corner (`oct_wrap_texel` in
+/// `common/probes.wgsl`). Clamping to the edge instead joins directions that are far
+/// apart on the sphere and cuts the distance maps along the folds.
+pub fn oct_wrap_texel(x: i32, y: i32, n: i32) -> (usize, usize) {
+    let (out_x, out_y) = (!(0..n).contains(&x), !(0..n).contains(&y));
+    let (x, y) = match (out_x, out_y) {
+        (true, true) => (if x < 0 { n - 1 } else { 0 }, if y < 0 { n - 1 } else { 0 }),
+        (true, false) => (x.clamp(0, n - 1), n - 1 - y),
+        (false, true) => (n - 1 - x, y.clamp(0, n - 1)),
+        (false, false) => (x, y),
+    };
+    (x as usize, y as usize)
 }
 
 /// Texels per side of a probe's octahedral distance map.
@@ -103,6 +125,7 @@ impl IrradianceProbes {
             coeffs: vec![[[0.0; 3]; 9]; (dims[0] * dims[1] * dims[2]) as usize],
             valid: vec![true; (dims[0] * dims[1] * dims[2]) as usize],
             depth: Vec::new(),
+            offsets: Vec::new(),
         }
     }
 
@@ -110,8 +133,13 @@ impl IrradianceProbes {
         self.coeffs.len()
     }
 
-    /// Position of probe `index`.
+    /// Position of probe `index`: its grid point plus its relocation offset.
     pub fn position(&self, index: usize) -> Vec3 {
+        self.grid_position(index) + self.offsets.get(index).map_or(Vec3::ZERO, |o| Vec3::from(*o))
+    }
+
+    /// Grid point of probe `index`.
+    pub fn grid_position(&self, index: usize) -> Vec3 {
         let [dx, dy, _] = self.dims;
         let i = index as u32;
         let (x, y, z) = (i % dx, (i / dx) % dy, i / (dx * dy));
@@ -140,8 +168,7 @@ impl IrradianceProbes {
         for k in 0..4 {
             let (ox, oy) = (k & 1, k >> 1);
             let w = if ox == 1 { f.x } else { 1.0 - f.x } * if oy == 1 { f.y } else { 1.0 - f.y };
-            let x = (base.x as i32 + ox).clamp(0, DEPTH_OCT as i32 - 1) as usize;
-            let y = (base.y as i32 + oy).clamp(0, DEPTH_OCT as i32 - 1) as usize;
+            let (x, y) = oct_wrap_texel(base.x as i32 + ox, base.y as i32 + oy, DEPTH_OCT as i32);
             let t = map[y * DEPTH_OCT + x];
             m[0] += w * t[0];
             m[1] += w * t[1];
@@ -217,7 +244,7 @@ impl IrradianceProbes {
                 * (if o.y > 0.0 { t.y } else { 1.0 - t.y })
                 * (if o.z > 0.0 { t.z } else { 1.0 - t.z });
             let index = (c.x as u32 + self.dims[0] * (c.y as u32 + self.dims[1] * c.z as u32)) as usize;
-            let w = w * facing_weight(self.origin + c * self.spacing - p, n) * self.visibility(index, p, n);
+            let w = w * facing_weight(self.position(index) - p, n) * self.visibility(index, p, n);
             sum_all += w;
             if self.valid[index] {
                 sum += w;
@@ -364,5 +391,42 @@ mod tests {
                 "n {n}: {e} vs {want}"
             );
         }
+    }
+
+    /// Bilinear lookups in the distance map are continuous across the octahedral folds:
+    /// the points just inside the square's edge at (1 − ε, v) and (1 − ε, 1 − v) (and
+    /// the other three edges) are the same direction to within ε on the sphere, so their
+    /// moments agree for an arbitrary map (with the edge clamped they would differ by
+    /// whole texels' values).
+    #[test]
+    fn distance_map_lookups_are_continuous_across_the_folds() {
+        let mut p = IrradianceProbes::grid(Vec3::ZERO, Vec3::ONE, [1, 1, 1]);
+        p.depth = vec![std::array::from_fn(|t| {
+            let v = ((t * 37 + 11) % 23) as f32;
+            [v, v * v]
+        })];
+        let e = 1e-4;
+        let mut worst = 0.0f32;
+        for k in 1..20 {
+            let v = k as f32 / 20.0;
+            for (a, b) in [
+                (glam::Vec2::new(1.0 - e, v), glam::Vec2::new(1.0 - e, 1.0 - v)),
+                (glam::Vec2::new(e, v), glam::Vec2::new(e, 1.0 - v)),
+                (glam::Vec2::new(v, 1.0 - e), glam::Vec2::new(1.0 - v, 1.0 - e)),
+                (glam::Vec2::new(v, e), glam::Vec2::new(1.0 - v, e)),
+            ] {
+                let (da, db) = (oct_decode(a), oct_decode(b));
+                assert!(
+                    da.angle_between(db) < 1e-2,
+                    "{a} and {b} are not neighbours: {da} vs {db}"
+                );
+                let (ma, mb) = (p.depth_moments(0, da), p.depth_moments(0, db));
+                worst = worst.max((ma[0] - mb[0]).abs());
+            }
+        }
+        assert!(
+            worst < 0.05,
+            "the lookup jumps by {worst} across a fold (texel values 0..22)"
+        );
     }
 }

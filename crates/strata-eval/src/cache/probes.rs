@@ -20,8 +20,10 @@ pub const BOUNCES: u32 = 3;
 /// notice on stderr unless `quiet`).
 pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v4 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES}",
-        scene_fingerprint(scene, 0.0)
+        "v5 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} sharpness={}",
+        scene_fingerprint(scene, 0.0),
+        strata_reference::probes::RELOCATE,
+        strata_reference::probes::DEPTH_SHARPNESS
     );
     let key = RefCache::key(&description);
     if let Some(img) = cache.load(&key) {
@@ -46,8 +48,10 @@ pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<Irra
     Ok(probes)
 }
 
-/// Floats per row: 27 coefficients, the validity, the distance map's moments.
-const ROW: usize = 28 + 2 * DEPTH_TEXELS;
+/// Floats per row: 27 coefficients, the validity, the distance map's moments, the
+/// relocation offset.
+const ROW: usize = 28 + 2 * DEPTH_TEXELS + 3;
+const OFFSET: usize = 28 + 2 * DEPTH_TEXELS;
 
 /// Row 0: origin, spacing, dims; row 1 + i: probe i's 27 coefficients, its validity
 /// and its distance map (mean, mean square per texel).
@@ -60,7 +64,10 @@ fn encode(p: &IrradianceProbes) -> ImageBuf {
         img.data[row..row + 27].copy_from_slice(&c.concat());
         img.data[row + 27] = p.valid[i] as u32 as f32;
         if let Some(d) = p.depth.get(i) {
-            img.data[row + 28..row + ROW].copy_from_slice(&d.concat());
+            img.data[row + 28..row + OFFSET].copy_from_slice(&d.concat());
+        }
+        if let Some(o) = p.offsets.get(i) {
+            img.data[row + OFFSET..row + ROW].copy_from_slice(o);
         }
     }
     img
@@ -83,6 +90,9 @@ fn decode(img: &ImageBuf) -> Option<IrradianceProbes> {
     let depth = (0..count)
         .map(|i| std::array::from_fn(|t| std::array::from_fn(|c| d[ROW * (i + 1) + 28 + 2 * t + c])))
         .collect();
+    let offsets = (0..count)
+        .map(|i| std::array::from_fn(|c| d[ROW * (i + 1) + OFFSET + c]))
+        .collect();
     Some(IrradianceProbes {
         origin: Vec3::new(d[0], d[1], d[2]),
         spacing: Vec3::new(d[3], d[4], d[5]),
@@ -90,6 +100,7 @@ fn decode(img: &ImageBuf) -> Option<IrradianceProbes> {
         coeffs,
         valid,
         depth,
+        offsets,
     })
 }
 
@@ -109,6 +120,7 @@ mod tests {
         p.depth = (0..p.count())
             .map(|i| std::array::from_fn(|t| [i as f32 + t as f32, 0.25 * t as f32]))
             .collect();
+        p.offsets = (0..p.count()).map(|i| [0.1 * i as f32, -0.2, 0.05]).collect();
         assert_eq!(decode(&encode(&p)), Some(p));
     }
 }

@@ -68,10 +68,18 @@ impl ProbeGpu {
                 .coeffs
                 .iter()
                 .zip(&p.valid)
-                .flat_map(|(c, &valid)| {
-                    c.iter()
-                        .enumerate()
-                        .map(move |(i, rgb)| [rgb[0], rgb[1], rgb[2], if i == 0 { valid as u32 as f32 } else { 0.0 }])
+                .enumerate()
+                .flat_map(|(index, (c, &valid))| {
+                    let offset = p.offsets.get(index).copied().unwrap_or([0.0; 3]);
+                    // w: the validity (coefficient 0), the relocation offset (1–3)
+                    c.iter().enumerate().map(move |(i, rgb)| {
+                        let w = match i {
+                            0 => valid as u32 as f32,
+                            1..=3 => offset[i - 1],
+                            _ => 0.0,
+                        };
+                        [rgb[0], rgb[1], rgb[2], w]
+                    })
                 })
                 .collect(),
             None => vec![[0.0; 4]; 9],

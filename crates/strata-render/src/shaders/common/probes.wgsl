@@ -8,8 +8,14 @@
 #import "common/packing.wgsl"
 
 struct Probe {
-    // irradiance SH coefficients E_i (rgb), i = 0..8; c[0].w = 1 valid, 0 inside geometry
+    // irradiance SH coefficients E_i (rgb), i = 0..8; c[0].w = 1 valid, 0 inside geometry;
+    // (c[1].w, c[2].w, c[3].w) = the probe's relocation offset from its grid point
     c: array<vec4f, 9>,
+}
+
+// Where probe `index` (grid point g) sits: g plus its relocation offset.
+fn probe_position(index: u32, g: vec3f) -> vec3f {
+    return g + vec3f(probes[index].c[1].w, probes[index].c[2].w, probes[index].c[3].w);
 }
 
 struct ProbeGrid {
@@ -64,6 +70,24 @@ fn chebyshev_visibility(dist: f32, m: vec2f) -> f32 {
     return max(pr * pr * pr, VISIBILITY_FLOOR);
 }
 
+// The texel a bilinear lookup one texel beyond the map's border reads: the edges fold
+// onto themselves, the corners meet (as `probes::oct_wrap_texel`).
+fn oct_wrap_texel(t: vec2i) -> vec2i {
+    let n = PROBE_DEPTH_OCT;
+    let out_x = t.x < 0 || t.x >= n;
+    let out_y = t.y < 0 || t.y >= n;
+    if (out_x && out_y) {
+        return vec2i(select(0, n - 1, t.x < 0), select(0, n - 1, t.y < 0));
+    }
+    if (out_x) {
+        return vec2i(clamp(t.x, 0, n - 1), n - 1 - t.y);
+    }
+    if (out_y) {
+        return vec2i(n - 1 - t.x, clamp(t.y, 0, n - 1));
+    }
+    return t;
+}
+
 // How visible the receiver p (normal n) is from probe `index` at `probe_pos`
 // (as `IrradianceProbes::visibility`): its distance map, bilinear between texel
 // centres, at the direction to p moved off its surface.
@@ -83,7 +107,7 @@ fn probe_visibility(grid: ProbeGrid, index: u32, probe_pos: vec3f, p: vec3f, n: 
     for (var k = 0; k < 4; k++) {
         let o = vec2i(k & 1, k >> 1);
         let w = select(1.0 - f.x, f.x, o.x == 1) * select(1.0 - f.y, f.y, o.y == 1);
-        let t = clamp(vec2i(base) + o, vec2i(0), vec2i(PROBE_DEPTH_OCT - 1));
+        let t = oct_wrap_texel(vec2i(base) + o);
         m += w * probe_depth[index * u32(PROBE_DEPTH_OCT * PROBE_DEPTH_OCT) + u32(t.y * PROBE_DEPTH_OCT + t.x)];
     }
     return chebyshev_visibility(dist, m);
@@ -113,7 +137,7 @@ fn probe_corners(grid: ProbeGrid, p: vec3f, n: vec3f) -> ProbeCorners {
         let index = c.x + dims.x * (c.y + dims.y * c.z);
         // probes behind the receiver's tangent plane see the other side of its
         // surface (as `probes::facing_weight`)
-        let probe_pos = grid.origin.xyz + vec3f(c) * grid.spacing.xyz;
+        let probe_pos = probe_position(index, grid.origin.xyz + vec3f(c) * grid.spacing.xyz);
         let to_probe = probe_pos - p;
         let len = length(to_probe);
         var f = 0.5;
