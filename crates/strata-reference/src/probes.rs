@@ -168,6 +168,23 @@ mod tests {
     use glam::Mat4;
     use strata_scene::{shapes::MeshBuilder, Material, Object, Scene, SceneSettings};
 
+    /// A one-mesh scene of grey diffuse geometry.
+    fn grey_scene(name: &str, geo: MeshBuilder) -> Scene {
+        Scene {
+            name: name.into(),
+            meshes: vec![geo.build(name, 0)],
+            objects: vec![Object {
+                name: name.into(),
+                mesh: 0,
+                transform: Mat4::IDENTITY,
+                animation: None,
+            }],
+            materials: vec![Material::diffuse("grey", [0.5; 3])],
+            settings: SceneSettings::default(),
+            ..Default::default()
+        }
+    }
+
     /// A probe grid whose lower layer lies on a 10 cm slab's top face: relocation lifts
     /// those probes by RELOCATE × the smallest spacing (1 m here), leaves the upper layer
     /// where it was, and the lifted probe's distance map then hides it from a ceiling
@@ -176,19 +193,7 @@ mod tests {
     fn probes_on_a_floor_move_off_it_and_do_not_leak_through() {
         let mut geo = MeshBuilder::new();
         geo.cuboid(Vec3::new(-10.0, -0.1, -10.0), Vec3::new(10.0, 0.0, 10.0));
-        let scene = Scene {
-            name: "slab".into(),
-            meshes: vec![geo.build("slab", 0)],
-            objects: vec![Object {
-                name: "slab".into(),
-                mesh: 0,
-                transform: Mat4::IDENTITY,
-                animation: None,
-            }],
-            materials: vec![Material::diffuse("grey", [0.5; 3])],
-            settings: SceneSettings::default(),
-            ..Default::default()
-        };
+        let scene = grey_scene("slab", geo);
         let grid = IrradianceProbes::grid(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), [2, 2, 1]);
         let probes = Reference::new(&scene, 0.0).bake_grid(grid, 1024, &GiSettings::default());
         for i in 0..probes.count() {
@@ -219,19 +224,7 @@ mod tests {
         let mut geo = MeshBuilder::new();
         // a 10 cm thick slab (its faces outward: both probes see front faces)
         geo.cuboid(Vec3::new(-0.05, -10.0, -10.0), Vec3::new(0.05, 10.0, 10.0));
-        let scene = Scene {
-            name: "wall".into(),
-            meshes: vec![geo.build("wall", 0)],
-            objects: vec![Object {
-                name: "wall".into(),
-                mesh: 0,
-                transform: Mat4::IDENTITY,
-                animation: None,
-            }],
-            materials: vec![Material::diffuse("grey", [0.5; 3])],
-            settings: SceneSettings::default(),
-            ..Default::default()
-        };
+        let scene = grey_scene("wall", geo);
         let grid = IrradianceProbes::grid(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), [2, 1, 1]);
         let mut probes = Reference::new(&scene, 0.0).bake_grid(grid, 1024, &GiSettings::default());
         let [mean, mean2] = probes.depth_moments(0, Vec3::X);

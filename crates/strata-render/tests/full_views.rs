@@ -5,7 +5,7 @@
 mod common;
 
 use strata_render::frame::FrameCameras;
-use strata_render::passes::radiosity::{irradiance_cpu, GatherInputs, RadiositySettings};
+use strata_render::passes::radiosity::{irradiance_cpu, RadiositySettings};
 use strata_render::passes::tonemap::tonemap;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::probes::IrradianceProbes;
@@ -224,24 +224,8 @@ fn coverage_confidence_matches_cpu_and_bounds() {
             let mut r = renderer(&gpu, &scene, w, h, rs, None, None);
             r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
                 .expect("frame renders without validation errors");
-            let u = r.radiosity_uniforms().unwrap();
-            let zmip: Vec<ImageBuf> = (0..=u.max_mip)
-                .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
-                .collect();
-            let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
-            let (n0, n1) = (common::npack_normals(&npack, 0), common::npack_normals(&npack, 1));
-            let b0 = r.read_target_full(&gpu, "radiosity0", 0).unwrap();
-            let b1 = r.read_target_full(&gpu, "radiosity1", 0).unwrap();
-            let f = r.frame_uniforms();
-            let inputs = GatherInputs {
-                zmip: &zmip,
-                normals: [&n0, &n1],
-                radiosity: [&b0, &b1],
-                frame: &f,
-                uniforms: &u,
-                layers: 2,
-                probes: None,
-            };
+            let buffers = common::GatherBuffers::read(&gpu, &r);
+            let inputs = buffers.inputs(None);
             let gpu_e = r.read_target_full(&gpu, "indirect-raw", 0).unwrap();
             let (fw, fh) = (gpu_e.width, gpu_e.height);
             let mut close = 0usize;
@@ -537,25 +521,9 @@ fn probe_detail_gather_and_blend_match_cpu_twin() {
     let mut r = renderer(&gpu, &scene, w, h, rs, Some(probes.clone()), None);
     r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
         .expect("frame renders without validation errors");
-    let u = r.radiosity_uniforms().unwrap();
-    assert_eq!(u.probe_detail, 1);
-    let zmip: Vec<ImageBuf> = (0..=u.max_mip)
-        .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
-        .collect();
-    let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
-    let (n0, n1) = (common::npack_normals(&npack, 0), common::npack_normals(&npack, 1));
-    let b0 = r.read_target_full(&gpu, "radiosity0", 0).unwrap();
-    let b1 = r.read_target_full(&gpu, "radiosity1", 0).unwrap();
-    let f = r.frame_uniforms();
-    let mut inputs = GatherInputs {
-        zmip: &zmip,
-        normals: [&n0, &n1],
-        radiosity: [&b0, &b1],
-        frame: &f,
-        uniforms: &u,
-        layers: 2,
-        probes: Some(&probes),
-    };
+    let buffers = common::GatherBuffers::read(&gpu, &r);
+    assert_eq!(buffers.uniforms.probe_detail, 1);
+    let mut inputs = buffers.inputs(Some(&probes));
     let raw = r.read_target_full(&gpu, "indirect-raw", 0).unwrap();
     let (fw, fh) = (raw.width, raw.height);
     let (mut close, mut negative, mut differs) = (0usize, 0usize, 0usize);

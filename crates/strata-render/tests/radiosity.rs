@@ -6,7 +6,7 @@ mod common;
 use glam::{Mat4, Vec3};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
-use strata_render::passes::radiosity::{irradiance_cpu, GatherInputs, Normalisation, RadiositySettings};
+use strata_render::passes::radiosity::{irradiance_cpu, Normalisation, RadiositySettings};
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::shapes::MeshBuilder;
 use strata_scene::{procedural, Camera, ImageBuf, Material, Object, Scene, SceneSettings};
@@ -75,24 +75,8 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
         let mut r = renderer(&gpu, &scene, w, h, 2, rs);
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
             .expect("frame renders without validation errors");
-        let u = r.radiosity_uniforms().unwrap();
-        let zmip: Vec<ImageBuf> = (0..=u.max_mip)
-            .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
-            .collect();
-        let npack = r.read_target_full(&gpu, "npack", 0).unwrap();
-        let (n0, n1) = (common::npack_normals(&npack, 0), common::npack_normals(&npack, 1));
-        let b0 = r.read_target_full(&gpu, "radiosity0", 0).unwrap();
-        let b1 = r.read_target_full(&gpu, "radiosity1", 0).unwrap();
-        let f = r.frame_uniforms();
-        let inputs = GatherInputs {
-            zmip: &zmip,
-            normals: [&n0, &n1],
-            radiosity: [&b0, &b1],
-            frame: &f,
-            uniforms: &u,
-            layers: 2,
-            probes: None,
-        };
+        let buffers = common::GatherBuffers::read(&gpu, &r);
+        let inputs = buffers.inputs(None);
         for (receiver, target) in [(0usize, "indirect-raw"), (1, "indirect1-raw")] {
             let gpu_e = r.read_target_full(&gpu, target, 0).unwrap();
             let (mut close, mut lit, mut worst) = (0usize, 0usize, 0.0f32);

@@ -243,3 +243,49 @@ pub fn ils_vpl_sum(
     }
     e
 }
+
+/// The radiosity gather's read-back inputs after a frame (the depth MIP chain, both layers'
+/// normals and radiosity, the frame and gather uniforms): what `irradiance_cpu` evaluates.
+pub struct GatherBuffers {
+    pub zmip: Vec<strata_scene::ImageBuf>,
+    pub normals: [strata_scene::ImageBuf; 2],
+    pub radiosity: [strata_scene::ImageBuf; 2],
+    pub frame: strata_render::frame::FrameUniforms,
+    pub uniforms: strata_render::passes::radiosity::RadiosityUniforms,
+}
+
+impl GatherBuffers {
+    pub fn read(gpu: &GpuContext, r: &Renderer) -> Self {
+        let uniforms = r.radiosity_uniforms().unwrap();
+        let zmip = (0..=uniforms.max_mip)
+            .map(|m| r.read_target_mip(gpu, "zmip", m).unwrap())
+            .collect();
+        let npack = r.read_target_full(gpu, "npack", 0).unwrap();
+        Self {
+            zmip,
+            normals: [npack_normals(&npack, 0), npack_normals(&npack, 1)],
+            radiosity: [
+                r.read_target_full(gpu, "radiosity0", 0).unwrap(),
+                r.read_target_full(gpu, "radiosity1", 0).unwrap(),
+            ],
+            frame: r.frame_uniforms(),
+            uniforms,
+        }
+    }
+
+    /// Two layers, and `probes` for the detail term.
+    pub fn inputs<'a>(
+        &'a self,
+        probes: Option<&'a strata_scene::probes::IrradianceProbes>,
+    ) -> strata_render::passes::radiosity::GatherInputs<'a> {
+        strata_render::passes::radiosity::GatherInputs {
+            zmip: &self.zmip,
+            normals: [&self.normals[0], &self.normals[1]],
+            radiosity: [&self.radiosity[0], &self.radiosity[1]],
+            frame: &self.frame,
+            uniforms: &self.uniforms,
+            layers: 2,
+            probes,
+        }
+    }
+}
