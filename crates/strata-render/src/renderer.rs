@@ -448,8 +448,6 @@ pub struct Renderer {
     last_frame: FrameUniforms,
     /// Last frame's depths are in `csz-history` (false before the first frame).
     has_history: bool,
-    /// Consecutive frames whose temporal filters had a valid history (0 after a cut).
-    history_frames: u32,
     /// Last frame's layers ≥ 1 had their oracle (false on a single-pass
     /// variant's first frame), so its temporally filtered outputs are usable.
     history_layers_valid: bool,
@@ -627,9 +625,13 @@ impl Renderer {
         }
         if ao.as_ref().is_some_and(|a| a.temporal.is_some()) {
             copies.push(("ao-temporal", "ao-temporal-history"));
+            let [n, h] = crate::passes::ao::stage::AO_FRAMES;
+            copies.push((n, h));
         }
         if radiosity.as_ref().is_some_and(|r| r.temporal.is_some()) {
             copies.push(("indirect-temporal", "indirect-temporal-history"));
+            let [n, h] = crate::passes::radiosity::stage::INDIRECT_FRAMES;
+            copies.push((n, h));
         }
         if radiosity.as_ref().is_some_and(|r| r.propagate.is_some()) {
             // the next bounce reflects the best estimate of E there is: with probes, the blend
@@ -668,7 +670,6 @@ impl Renderer {
             history,
             last_frame: bytemuck::Zeroable::zeroed(),
             has_history: false,
-            history_frames: 0,
             history_layers_valid: false,
             frames_rendered: 0,
             profiler,
@@ -766,18 +767,12 @@ impl Renderer {
         // history computed from oracle-less layers would linger for many
         // frames (α^n): temporal filters start the average afresh instead
         let temporal_history = self.has_history && self.history_layers_valid;
-        // frames in a row with a valid history (the temporal filters' start-up ramp)
-        self.history_frames = if temporal_history {
-            self.history_frames.saturating_add(1)
-        } else {
-            0
-        };
         let max_mip = self.targets.try_get("zmip").map_or(0, |t| t.desc.mips - 1);
         if let (Some(stage), Some(s)) = (&self.ao, &self.settings.ao) {
             let au = AoUniforms::new(s, scene, &u, max_mip, self.frames_rendered);
             stage.ao.set_frame(gpu, au);
             if let Some(t) = &stage.temporal {
-                t.set_frame(gpu, self.history_frames);
+                t.set_frame(gpu, temporal_history);
             }
         }
         if let Some(b) = &self.bzb {
@@ -790,7 +785,7 @@ impl Renderer {
                 p.set_frame(gpu, temporal_history);
             }
             if let Some(t) = &stage.temporal {
-                t.set_frame(gpu, self.history_frames);
+                t.set_frame(gpu, temporal_history);
             }
         }
         self.scene_gpu.update_objects(gpu, frame, variant.next_transforms());

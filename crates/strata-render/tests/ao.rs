@@ -331,6 +331,65 @@ fn temporal_filter_blends_valid_and_rejects_failed_reprojections() {
     }
 }
 
+/// The start-up ramp counts per pixel: a frame whose reprojection fails everywhere (the
+/// previous camera far away) resets every pixel's count to 0, so the next frame blends
+/// with weight 1/2 again (a frame counter would give 2/3), and the count then grows by one
+/// per accepted frame.
+#[test]
+fn temporal_ramp_restarts_per_pixel_after_a_failed_reprojection() {
+    let gpu = common::gpu();
+    let scene = frozen("cornell");
+    let (w, h) = (64, 64);
+    let mut settings = temporal_settings(0.85);
+    settings.temporal.as_mut().unwrap().clamp_history = false;
+    let mut r = ao_renderer(&gpu, &scene, w, h, 2, settings);
+    let cam = scene.camera;
+    let mut moved = cam;
+    let shift = (cam.target - cam.eye).normalize() * -2.0;
+    moved.eye += shift;
+    moved.target += shift;
+    let still = FrameCameras::fixed(cam);
+    r.render(&gpu, &scene, &still, 0.0).unwrap();
+    r.render(&gpu, &scene, &still, 1.0).unwrap();
+    let frames = |r: &Renderer| r.read_target(&gpu, "ao-temporal-frames").unwrap().data;
+    let csz = r.read_target(&gpu, "csz").unwrap().data;
+    let covered: Vec<usize> = (0..csz.len()).filter(|&i| csz[i] > 0.0).collect();
+    assert!(covered.len() > 1000);
+    assert!(covered.iter().all(|&i| frames(&r)[i] == 1.0), "one accepted frame");
+    // every reprojection fails: the counts restart
+    r.render(
+        &gpu,
+        &scene,
+        &FrameCameras {
+            previous: moved,
+            ..still
+        },
+        2.0,
+    )
+    .unwrap();
+    assert!(
+        frames(&r).iter().all(|&n| n == 0.0),
+        "a failed reprojection keeps no count"
+    );
+    let history = r.read_target(&gpu, "ao-temporal").unwrap().data;
+    r.render(&gpu, &scene, &still, 3.0).unwrap();
+    let (e, out, n) = (
+        r.read_target(&gpu, "ao-raw").unwrap().data,
+        r.read_target(&gpu, "ao-temporal").unwrap().data,
+        frames(&r),
+    );
+    let mut differs = 0;
+    for &i in &covered {
+        assert_eq!(n[i], 1.0, "pixel {i}: count {}", n[i]);
+        let want = 0.5 * e[i] + 0.5 * history[i];
+        assert!((out[i] - want).abs() < 1e-5, "pixel {i}: {} vs {want}", out[i]);
+        differs += ((e[i] - history[i]).abs() > 1e-3) as usize;
+    }
+    assert!(differs > 100, "weak test: {differs} pixels differ from their history");
+    r.render(&gpu, &scene, &still, 4.0).unwrap();
+    assert!(covered.iter().all(|&i| frames(&r)[i] == 2.0), "two accepted frames");
+}
+
 /// A single-pass variant's first frame has no oracle, so its layer 1 (and the
 /// AO computed from it) is wrong; the next frame must not average it in.
 #[test]

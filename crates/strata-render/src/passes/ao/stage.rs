@@ -55,6 +55,9 @@ impl AoStage {
             ] {
                 targets.create(gpu, TargetDesc::new(name, F::R32Float, 1, doc));
             }
+            for t in crate::passes::temporal::frames_targets(AO_FRAMES) {
+                targets.create(gpu, t);
+            }
             filtered = "ao-temporal";
         }
         let temporal = s.temporal.as_ref().map(|t| {
@@ -67,6 +70,7 @@ impl AoStage {
                 crate::passes::ao::OUTPUT.name,
                 "ao-temporal-history",
                 "ao-temporal",
+                AO_FRAMES,
                 deep.layers,
             )
         });
@@ -246,3 +250,6 @@ fn deinterleaved(
     };
     Ok((ao, before, gather))
 }
+
+/// The AO temporal filter's per-pixel count and its copy from last frame.
+pub(crate) const AO_FRAMES: [&str; 2] = ["ao-temporal-frames", "ao-temporal-frames-history"];

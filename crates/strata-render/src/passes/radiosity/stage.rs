@@ -42,6 +42,9 @@ impl RadiosityStage {
             ] {
                 targets.create(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc));
             }
+            for t in crate::passes::temporal::frames_targets(INDIRECT_FRAMES) {
+                targets.create(gpu, t);
+            }
             filtered = "indirect-temporal";
         }
         targets.create(
@@ -115,6 +118,7 @@ impl RadiosityStage {
                 "indirect-raw",
                 "indirect-temporal-history",
                 "indirect-temporal",
+                INDIRECT_FRAMES,
                 deep.layers,
             )
         });
@@ -179,3 +183,6 @@ impl RadiosityStage {
         v
     }
 }
+
+/// The indirect temporal filter's per-pixel count and its copy from last frame.
+pub(crate) const INDIRECT_FRAMES: [&str; 2] = ["indirect-temporal-frames", "indirect-temporal-frames-history"];

@@ -26,10 +26,12 @@ pub struct TemporalSettings {
     /// that changed — is pulled to what this frame sees instead of fading over
     /// 1/(1 − α) frames.
     pub clamp_history: bool,
-    /// Average the first frames after a cut (or after the start) with equal weights:
-    /// frame n of history blends with α_n = min(α, n/(n + 1)), the running mean, until
-    /// n/(n + 1) reaches α (n = 6 for α = 0.85) and the paper's EWMA takes over. Off:
-    /// α from the first frame, so the oldest frame keeps weight α^n (not in the paper).
+    /// Average the first frames of a pixel's history with equal weights: where the
+    /// history has been accepted n frames in a row (counted per pixel, so a cut or a
+    /// disocclusion restarts it) it blends with α_n = min(α, n/(n + 1)), the running
+    /// mean, until n/(n + 1) reaches α (n = 6 for α = 0.85) and the paper's EWMA takes
+    /// over. Off: α from the first frame, so the oldest frame keeps weight α^n (not in
+    /// the paper).
     pub ramp: bool,
 }
 
@@ -45,8 +47,9 @@ impl Default for TemporalSettings {
 }
 
 impl TemporalSettings {
-    /// The history's weight on frame `history_frames` (0 = no history) after a cut:
-    /// α, or with [`ramp`](Self::ramp) min(α, n/(n + 1)). The CPU twin of `temporal.wgsl`'s.
+    /// The history's weight where it has been accepted `history_frames` frames in a row
+    /// (0 = no history): α, or with [`ramp`](Self::ramp) min(α, n/(n + 1)). The CPU twin
+    /// of `temporal.wgsl`'s.
     pub fn history_weight(&self, history_frames: u32) -> f32 {
         if history_frames == 0 {
             0.0
@@ -79,13 +82,14 @@ impl TemporalSettings {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TemporalUniforms {
-    /// The history's weight this frame ([`TemporalSettings::history_weight`]; 0 = no
-    /// history).
     pub alpha: f32,
     pub max_distance: f32,
     pub layers: u32,
     /// 1 = [`TemporalSettings::clamp_history`].
     pub clamp: u32,
+    pub has_history: u32,
+    /// 1 = [`TemporalSettings::ramp`].
+    pub ramp: u32,
 }
 
 /// Filters target `input` with `history` (last frame's `output`) into `output`.
@@ -96,6 +100,8 @@ pub struct TemporalPass {
 }
 
 impl TemporalPass {
+    /// `frames`: the per-pixel count of accepted histories and its copy from last frame
+    /// (`<output>-frames`, `<output>-frames-history`; [`frames_targets`]).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
@@ -106,41 +112,55 @@ impl TemporalPass {
         input: &'static str,
         history: &'static str,
         output: &'static str,
+        frames: [&'static str; 2],
         layers: u32,
     ) -> Self {
-        let u = TemporalUniforms {
-            alpha: 0.0,
-            max_distance: settings.max_distance,
-            layers,
-            clamp: settings.clamp_history as u32,
-        };
+        let settings = *settings;
         let pass = PassBuilder::new(gpu, targets, name)
             .shader("temporal", include_str!("temporal.wgsl"))
             .frame(scene)
-            .uniforms(&u)
+            .uniforms(&Self::uniforms(&settings, layers, false))
             .read(input)
             .read(history)
             .read("zpack")
             .read_array("csz-history")
+            .read(frames[1])
             .write(output)
+            .write(frames[0])
             .build();
-        Self {
-            settings: *settings,
+        Self { settings, layers, pass }
+    }
+
+    fn uniforms(s: &TemporalSettings, layers: u32, has_history: bool) -> TemporalUniforms {
+        TemporalUniforms {
+            alpha: s.alpha,
+            max_distance: s.max_distance,
             layers,
-            pass,
+            clamp: s.clamp_history as u32,
+            has_history: has_history as u32,
+            ramp: s.ramp as u32,
         }
     }
 
-    /// How many frames in a row `history` has been valid (0: it holds nothing).
-    pub fn set_frame(&self, gpu: &GpuContext, history_frames: u32) {
-        let u = TemporalUniforms {
-            alpha: self.settings.history_weight(history_frames),
-            max_distance: self.settings.max_distance,
-            layers: self.layers,
-            clamp: self.settings.clamp_history as u32,
-        };
-        self.pass.set_uniforms(gpu, &u);
+    /// Whether `history` holds last frame's output.
+    pub fn set_frame(&self, gpu: &GpuContext, has_history: bool) {
+        self.pass
+            .set_uniforms(gpu, &Self::uniforms(&self.settings, self.layers, has_history));
     }
+}
+
+/// The per-pixel count of accepted histories of the temporal filter writing `output`
+/// and last frame's copy (R16Float: whole numbers up to the cap 1024 are exact).
+pub fn frames_targets(names: [&'static str; 2]) -> [crate::frame::TargetDesc; 2] {
+    [
+        crate::frame::TargetDesc::new(
+            names[0],
+            wgpu::TextureFormat::R16Float,
+            1,
+            "frames in a row the temporal filter accepted this pixel's history (the start-up ramp)",
+        ),
+        crate::frame::TargetDesc::new(names[1], wgpu::TextureFormat::R16Float, 1, "last frame's count"),
+    ]
 }
 
 crate::passes::builder::delegate_pass!(TemporalPass);

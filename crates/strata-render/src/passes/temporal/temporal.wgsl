@@ -8,15 +8,27 @@
 
 // Matches `temporal::TemporalUniforms`.
 struct Temporal {
-    // the history's weight this frame: α, or min(α, n/(n + 1)) on the n-th frame
-    // after a cut with the start-up ramp; 0 before the first frame: no history
     alpha: f32,
     max_distance: f32,
     // layers in csz-history
     layers: u32,
     // 1 = clamp the history to the current input's 3×3 range
     clamp_history: u32,
+    // 0 before the first frame (or after a cut): no history
+    has_history: u32,
+    // 1 = the start-up ramp: the history's weight is min(α, n/(n + 1)) where it has
+    // been accepted n frames in a row (`TemporalSettings::history_weight`)
+    ramp: u32,
 }
+
+struct Out {
+    @location(0) e: vec4f,
+    // how many frames in a row this pixel's history has been accepted (capped)
+    @location(1) frames: vec4f,
+}
+
+// The count's cap: far beyond where the ramp reaches α (fits f16 exactly).
+const MAX_FRAMES: f32 = 1024.0;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var<uniform> temporal: Temporal;
@@ -24,20 +36,31 @@ struct Temporal {
 @group(1) @binding(2) var history: texture_2d<f32>;
 @group(1) @binding(3) var zpack: texture_2d<f32>;
 @group(1) @binding(4) var csz_history: texture_2d_array<f32>;
+// last frame's per-pixel count (`frames` output)
+@group(1) @binding(5) var frames_history: texture_2d<f32>;
 
 @fragment
-fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
     let p = vec2i(pos.xy);
     let e = textureLoad(current, p, 0);
+    var o = Out(e, vec4f(0.0));
     let z = textureLoad(zpack, p, 0).r;
-    if (temporal.alpha == 0.0 || z <= 0.0) {
-        return e;
+    if (temporal.has_history == 0u || z <= 0.0) {
+        return o;
     }
     // reverse reprojection of X = layer 0's surface into frame t − 1; accept
     // when it lies on either layer of last frame
     let r = reproject(frame, world_from_csz(frame, vec2f(p) + 0.5, z));
     if (matching_layer(csz_history, r, temporal.layers, temporal.max_distance) < 0) {
-        return e;
+        return o;
+    }
+    // the count at the reprojected point's nearest pixel, plus this frame
+    let last = vec2i(textureDimensions(frames_history)) - 1;
+    let n = min(textureLoad(frames_history, clamp(vec2i(floor(r.c)), vec2i(0), last), 0).r + 1.0, MAX_FRAMES);
+    o.frames = vec4f(n, 0.0, 0.0, 0.0);
+    var alpha = temporal.alpha;
+    if (temporal.ramp != 0u) {
+        alpha = min(alpha, n / (n + 1.0));
     }
     var h = bilinear_at(history, r.c);
     if (temporal.clamp_history != 0u) {
@@ -55,5 +78,6 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         }
         h = clamp(h, lo, hi);
     }
-    return mix(e, h, temporal.alpha);
+    o.e = mix(e, h, alpha);
+    return o;
 }
