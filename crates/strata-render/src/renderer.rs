@@ -297,7 +297,8 @@ impl RenderSettings {
     /// Upper bound of the GPU memory a renderer with these settings allocates for
     /// `scene`, in bytes: every screen target (exactly where the pass declares its
     /// list, a documented bound for targets a stage creates internally: AO ≤ 24,
-    /// radiosity ≤ 48 bytes per pixel), the shadow maps, and the scene's vertex,
+    /// radiosity ≤ 48 bytes per pixel, plus their temporal filters' per-pixel counts),
+    /// the shadow maps, and the scene's vertex,
     /// index and texture data.
     pub fn estimated_bytes(&self, scene: &Scene) -> u64 {
         use crate::frame::TargetDesc;
@@ -325,14 +326,28 @@ impl RenderSettings {
         if let Some(levels) = levels {
             bytes += desc_bytes(&DepthMipSettings { levels }.output(self.deep.layers, w, h), w, h);
         }
-        if self.ao.is_some() {
+        // the temporal filters' per-pixel counts (the start-up ramp)
+        let frames = |names| sum(&crate::passes::temporal::frames_targets(names));
+        if let Some(a) = &self.ao {
             bytes += px * 24;
+            if a.temporal.is_some() {
+                bytes += frames(crate::passes::ao::stage::AO_FRAMES);
+            }
         }
-        if self.radiosity.is_some() {
+        if let Some(r) = &self.radiosity {
             bytes += sum(&crate::passes::radiosity::OUTPUTS)
                 + sum(&crate::passes::radiosity::BOUNCE_OUTPUTS)
                 + sum(&crate::passes::compose::OUTPUTS)
                 + px * 48;
+            if r.temporal.is_some() {
+                bytes += frames(crate::passes::radiosity::stage::INDIRECT_FRAMES);
+            }
+            // the probe buffers of the composition and the gather (each a 1-probe dummy
+            // without probes or without the detail term): 64 KiB bounds a small buffer
+            let per_pass = self.probes.as_ref().map_or(0, |p| {
+                (p.count() * (9 * 16 + strata_scene::probes::DEPTH_TEXELS * 8)) as u64
+            });
+            bytes += 2 * (per_pass + 2 * 65536);
         }
         if self.reflections.is_some() {
             bytes += sum(&crate::passes::reflections::OUTPUTS);
