@@ -342,12 +342,11 @@ impl RenderSettings {
             if r.temporal.is_some() {
                 bytes += frames(crate::passes::radiosity::stage::INDIRECT_FRAMES);
             }
-            // the probe buffers of the composition and the gather (each a 1-probe dummy
-            // without probes or without the detail term): 64 KiB bounds a small buffer
-            let per_pass = self.probes.as_ref().map_or(0, |p| {
+            // the probe buffers, shared by the composition and the gather (without probes,
+            // each pass binds two 1-probe dummies): 64 KiB bounds a small buffer
+            bytes += self.probes.as_ref().map_or(4 * 65536, |p| {
                 (p.count() * (9 * 16 + strata_scene::probes::DEPTH_TEXELS * 8)) as u64
             });
-            bytes += 2 * (per_pass + 2 * 65536);
         }
         if self.reflections.is_some() {
             bytes += sum(&crate::passes::reflections::OUTPUTS);

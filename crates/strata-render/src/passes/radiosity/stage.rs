@@ -106,7 +106,8 @@ impl RadiosityStage {
             b,
             region,
             propagate.is_some(),
-            probe_gpu.as_ref().filter(|_| detail),
+            // the compose pass's buffers (the detail term reads them; otherwise unread)
+            probe_gpu.as_ref(),
         );
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
