@@ -147,8 +147,8 @@ pub const RELOCATE_RAYS: u32 = 256;
 type BakedProbe = ([[f32; 3]; 9], bool, [[f32; 2]; DEPTH_TEXELS]);
 
 /// Exponent of the cosine lobe that spreads a ray's distance over the distance
-/// map's texels (about a texel's width at 8 × 8).
-pub const DEPTH_SHARPNESS: i32 = 20;
+/// map's texels (about a texel's width at 16 × 16, as DDGI's).
+pub const DEPTH_SHARPNESS: i32 = 50;
 
 /// A probe whose rays hit back faces this often is inside geometry (invalid).
 pub const INSIDE_BACKFACE_FRACTION: f32 = 0.25;

@@ -20,9 +20,10 @@ pub const BOUNCES: u32 = 3;
 /// notice on stderr unless `quiet`).
 pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v5 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} sharpness={}",
+        "v6 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} depth={}² sharpness={}",
         scene_fingerprint(scene, 0.0),
         strata_reference::probes::RELOCATE,
+        strata_scene::probes::DEPTH_OCT,
         strata_reference::probes::DEPTH_SHARPNESS
     );
     let key = RefCache::key(&description);

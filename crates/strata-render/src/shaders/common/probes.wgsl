@@ -54,7 +54,7 @@ fn probe_irradiance(index: u32, n: vec3f) -> vec3f {
 const FACING_FLOOR: f32 = 0.002;
 
 // As `probes::DEPTH_OCT` and `probes::VISIBILITY_FLOOR`.
-const PROBE_DEPTH_OCT: i32 = 8;
+const PROBE_DEPTH_OCT: i32 = 16;
 const VISIBILITY_FLOOR: f32 = 0.002;
 
 // Chebyshev's bound that a receiver at `dist` is visible from a probe whose
