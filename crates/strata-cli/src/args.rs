@@ -211,6 +211,34 @@ pub fn parse_set(kv: &str) -> Result<(String, f64), String> {
     Ok((name.trim().to_string(), v))
 }
 
+fn parse_probe_grid(s: &str) -> Result<[u32; 3], String> {
+    let bad = || {
+        format!(
+            "'{s}' is not NX,NY,NZ with each in 1..=64 and at most {} probes",
+            MAX_PROBES
+        )
+    };
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    match v[..] {
+        [x, y, z] if [x, y, z].iter().all(|d| (1..=64).contains(d)) && x * y * z <= MAX_PROBES => Ok([x, y, z]),
+        _ => Err(bad()),
+    }
+}
+
+/// The most probes `--probe-grid` takes (about 72 MB of probe buffers).
+const MAX_PROBES: u32 = 32768;
+
+impl RadiosityArgs {
+    /// The light-probe grid: `--probe-grid`, else the default.
+    pub fn probe_grid(&self) -> [u32; 3] {
+        self.probe_grid.unwrap_or(strata_eval::cache::probes::GRID)
+    }
+}
+
 fn parse_technique(s: &str) -> Result<&'static strata_render::technique::Technique, String> {
     strata_render::technique::find(s).map_err(|e| e.to_string())
 }
@@ -262,6 +290,11 @@ pub struct RadiosityArgs {
     /// docs/radiosity.md).
     #[arg(long)]
     pub indirect_weights: Option<String>,
+    /// Light-probe grid "NX,NY,NZ": probes per axis over the scene's bounds, each 1..=64, at
+    /// most 32768 in all (default 16,8,16). The bake's time grows with the count; each grid
+    /// is cached apart (docs/radiosity.md § "Probe grid").
+    #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_probe_grid)]
+    pub probe_grid: Option<[u32; 3]>,
 }
 
 impl RadiosityArgs {

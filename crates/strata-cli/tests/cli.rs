@@ -2082,3 +2082,59 @@ fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
     let bias = p["converged_vs_path_tracer"]["rmse"].as_f64().unwrap();
     assert!(bias > 0.0);
 }
+
+/// `--probe-grid` reaches the bake (the notice names its count and shape; each grid is
+/// cached apart, a repeated grid is not baked again) and a malformed or oversized grid
+/// is one line naming the flag and the range.
+#[test]
+fn probe_grid_reaches_the_bake_and_is_range_checked() {
+    let out = scratch("probe-grid.png");
+    for bad in ["0,8,16", "16,8", "64,64,64", "a,b,c"] {
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "full",
+            "--probe-grid",
+            bad,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_one_line_error(&o, &["--probe-grid", "1..=64", "32768"]);
+    }
+    let cache = scratch("probe-grid-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let run = |grid: &str| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
+        cmd.args([
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            "full",
+            "--probe-grid",
+            grid,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--force",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        cmd.env("STRATA_CACHE", &cache);
+        if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+            cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+        }
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let e = run("2,3,2");
+    assert!(e.contains("baking 12 light probes (2×3×2,"), "{e}");
+    let e = run("2,3,2");
+    assert!(!e.contains("baking"), "a cached grid is baked again: {e}");
+    let e = run("3,2,2");
+    assert!(e.contains("baking 12 light probes (3×2×2,"), "{e}");
+}

@@ -11,16 +11,16 @@ use strata_scene::{ImageBuf, Scene};
 
 use super::{scene_fingerprint, RefCache};
 
-/// Probes per axis, rays per probe, path bounces.
+/// Probes per axis (the default grid), rays per probe, path bounces.
 pub const GRID: [u32; 3] = [16, 8, 16];
 pub const RAYS: u32 = 4096;
 pub const BOUNCES: u32 = 3;
 
-/// The scene's probes at animation frame 0 (static lighting), from the cache or baked (with a
-/// notice on stderr unless `quiet`).
-pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
+/// The scene's probes at animation frame 0 (static lighting) on a `grid` of probes per axis
+/// ([`GRID`] by default), from the cache or baked (with a notice on stderr unless `quiet`).
+pub fn scene_probes(scene: &Scene, grid: [u32; 3], cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v6 probes {} grid={GRID:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} depth={}² sharpness={}",
+        "v6 probes {} grid={grid:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} depth={}² sharpness={}",
         scene_fingerprint(scene, 0.0),
         strata_reference::probes::RELOCATE,
         strata_scene::probes::DEPTH_OCT,
@@ -34,15 +34,18 @@ pub fn scene_probes(scene: &Scene, cache: &RefCache, quiet: bool) -> Result<Irra
     }
     if !quiet {
         eprintln!(
-            "baking {} light probes ({RAYS} paths each)…",
-            GRID.iter().product::<u32>()
+            "baking {} light probes ({}×{}×{}, {RAYS} paths each)…",
+            grid.iter().product::<u32>(),
+            grid[0],
+            grid[1],
+            grid[2]
         );
     }
     let settings = GiSettings {
         bounces: BOUNCES,
         ..Default::default()
     };
-    let probes = Reference::new(scene, 0.0).bake_probes(GRID, RAYS, &settings);
+    let probes = Reference::new(scene, 0.0).bake_probes(grid, RAYS, &settings);
     if let Err(e) = cache.store(&key, &encode(&probes), &description) {
         tracing::warn!("could not cache the light probes: {e:#}");
     }

@@ -36,6 +36,8 @@ pub struct GiEvalSettings {
     /// Bake the probes from this scene instead (stale probes; sky and ambient off as for
     /// the evaluated scene).
     pub probes_from: Option<String>,
+    /// The probes' grid, probes per axis (`cache::probes::GRID` by default).
+    pub probe_grid: [u32; 3],
     /// Warm up along the camera path (frames f − warmup … f) instead of at a still camera.
     pub moving: bool,
 }
@@ -117,12 +119,22 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     // the probes see the scene as evaluated: sky and ambient off
     let probes = match (g.probes, &g.probes_from) {
         (false, _) => None,
-        (true, None) => Some(crate::cache::probes::scene_probes(&scene, &cache, !s.progress)?),
+        (true, None) => Some(crate::cache::probes::scene_probes(
+            &scene,
+            g.probe_grid,
+            &cache,
+            !s.progress,
+        )?),
         (true, Some(other)) => {
             let mut source = strata_scene::load_scene(other).map_err(|e| anyhow::anyhow!("--probes-from: {e}"))?;
             source.settings.ambient = [0.0; 3];
             source.settings.sky = [0.0; 3];
-            Some(crate::cache::probes::scene_probes(&source, &cache, !s.progress)?)
+            Some(crate::cache::probes::scene_probes(
+                &source,
+                g.probe_grid,
+                &cache,
+                !s.progress,
+            )?)
         }
     };
     let evaluate = |layers: u32| -> Result<GiResult> {
