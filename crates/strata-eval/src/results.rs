@@ -424,6 +424,9 @@ pub struct GiEval {
     /// The scene the probes were baked from when not the evaluated one (`--probes-from`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub probes_from: Option<String>,
+    /// The probes' grid, probes per axis (`--probe-grid`), when blended with probes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe_grid: Option<[u32; 3]>,
     /// The warm-up followed the camera path (`--moving`).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub moving: bool,

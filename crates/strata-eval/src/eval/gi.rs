@@ -215,6 +215,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         ref_bounces: g.bounces,
         probes: g.probes,
         probes_from: g.probes_from.clone(),
+        probe_grid: g.probes.then_some(g.probe_grid),
         moving: g.moving,
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
