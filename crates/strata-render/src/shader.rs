@@ -64,3 +64,45 @@ pub fn module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderM
         source: wgpu::ShaderSource::Wgsl(compose(source).into()),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    /// The value of `const NAME: T = VALUE;` in WGSL `source` (a `u`/`i` suffix dropped).
+    fn wgsl_const(source: &str, name: &str) -> f64 {
+        let prefix = format!("const {name}:");
+        let line = source
+            .lines()
+            .map(str::trim)
+            .find(|l| l.starts_with(&prefix))
+            .unwrap_or_else(|| panic!("no `const {name}` in the WGSL"));
+        let value = line.split('=').nth(1).expect("const without a value");
+        let value = value.trim().trim_end_matches(';').trim_end_matches(['u', 'i']);
+        value.parse().unwrap_or_else(|e| panic!("`{line}`: {e}"))
+    }
+
+    /// Constants that WGSL and their Rust CPU twins both declare are equal, so that a
+    /// change on one side (e.g. the probes' distance-map size) cannot leave the other
+    /// behind.
+    #[test]
+    fn wgsl_constants_equal_their_rust_twins() {
+        let probes = include_str!("shaders/common/probes.wgsl");
+        let radiosity = include_str!("passes/radiosity/radiosity.wgsl");
+        let hbao = include_str!("passes/abuffer/hbao_compute.wgsl");
+        use strata_scene::probes as p;
+        let pairs: [(&str, &str, f64); 6] = [
+            (probes, "PROBE_DEPTH_OCT", p::DEPTH_OCT as f64),
+            (probes, "FACING_FLOOR", p::FACING_FLOOR as f64),
+            (probes, "VISIBILITY_FLOOR", p::VISIBILITY_FLOOR as f64),
+            (radiosity, "COVERAGE_COS", crate::passes::radiosity::COVERAGE_COS as f64),
+            (hbao, "TILE", crate::passes::abuffer::ao::TILE as f64),
+            (hbao, "SHARED_TEXELS", crate::passes::abuffer::ao::SHARED_TEXELS as f64),
+        ];
+        for (source, name, rust) in pairs {
+            let wgsl = wgsl_const(source, name);
+            assert!(
+                (wgsl as f32 - rust as f32).abs() <= 1e-7 * rust.abs() as f32,
+                "WGSL {name} = {wgsl}, Rust twin = {rust}"
+            );
+        }
+    }
+}
