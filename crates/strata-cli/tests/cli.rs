@@ -6,6 +6,18 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn strata(args: &[&str]) -> Output {
+    strata_cmd(args).output().expect("failed to start strata")
+}
+
+/// `strata ARGS` with `$STRATA_CACHE` = `cache` (probe bakes and references land there).
+fn strata_cached(args: &[&str], cache: &Path) -> Output {
+    strata_cmd(args)
+        .env("STRATA_CACHE", cache)
+        .output()
+        .expect("failed to start strata")
+}
+
+fn strata_cmd(args: &[&str]) -> Command {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
     cmd.args(args);
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
@@ -13,7 +25,7 @@ fn strata(args: &[&str]) -> Output {
         std::fs::create_dir_all(&dir).unwrap();
         cmd.env("XDG_RUNTIME_DIR", dir);
     }
-    cmd.output().expect("failed to start strata")
+    cmd
 }
 
 fn stderr(o: &Output) -> String {
@@ -524,30 +536,27 @@ fn render_full_is_brighter_than_direct_in_shadow_and_lists_its_passes() {
     let cache = scratch("probe-cache");
     let _ = std::fs::remove_dir_all(&cache);
     let run = |technique: &str, out: &Path| {
-        let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
-        cmd.args([
-            "render",
-            "--scene",
-            "mirror",
-            "--technique",
-            technique,
-            "--layers",
-            "2",
-            "--width",
-            "64",
-            "--height",
-            "48",
-            "--warmup",
-            "2",
-            "--force",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        cmd.env("STRATA_CACHE", &cache);
-        if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-            cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
-        }
-        cmd.output().unwrap()
+        strata_cached(
+            &[
+                "render",
+                "--scene",
+                "mirror",
+                "--technique",
+                technique,
+                "--layers",
+                "2",
+                "--width",
+                "64",
+                "--height",
+                "48",
+                "--warmup",
+                "2",
+                "--force",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &cache,
+        )
     };
     let (direct, full) = (scratch("mirror-direct.exr"), scratch("mirror-full.exr"));
     let o = run("direct", &direct);
@@ -811,31 +820,27 @@ fn bench_radiosity_and_reflections_time_their_passes() {
 #[test]
 fn soak_500_frames_keeps_memory_flat() {
     let cache = scratch("soak-cache");
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
-    cmd.args([
-        "soak",
-        "--scene",
-        "atrium",
-        "--technique",
-        "full",
-        "--layers",
-        "2",
-        "--width",
-        "128",
-        "--height",
-        "72",
-        "--frames",
-        "500",
-        "--sample-every",
-        "100",
-        "--json",
-    ]);
-    cmd.env("STRATA_CACHE", &cache);
-    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir().join("strata-xdg-cli-tests"));
-        std::fs::create_dir_all(std::env::temp_dir().join("strata-xdg-cli-tests")).unwrap();
-    }
-    let v = json_of(&cmd.output().unwrap());
+    let v = json_of(&strata_cached(
+        &[
+            "soak",
+            "--scene",
+            "atrium",
+            "--technique",
+            "full",
+            "--layers",
+            "2",
+            "--width",
+            "128",
+            "--height",
+            "72",
+            "--frames",
+            "500",
+            "--sample-every",
+            "100",
+            "--json",
+        ],
+        &cache,
+    ));
     let samples = v["samples"].as_array().expect("samples");
     assert_eq!(samples.len(), 5, "{v}");
     assert_eq!(samples[4]["frame"], 500);
@@ -2106,28 +2111,25 @@ fn probe_grid_reaches_the_bake_and_is_range_checked() {
     let cache = scratch("probe-grid-cache");
     let _ = std::fs::remove_dir_all(&cache);
     let run = |grid: &str| {
-        let mut cmd = Command::new(env!("CARGO_BIN_EXE_strata"));
-        cmd.args([
-            "render",
-            "--scene",
-            "cornell",
-            "--technique",
-            "full",
-            "--probe-grid",
-            grid,
-            "--width",
-            "32",
-            "--height",
-            "24",
-            "--force",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        cmd.env("STRATA_CACHE", &cache);
-        if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-            cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
-        }
-        let o = cmd.output().unwrap();
+        let o = strata_cached(
+            &[
+                "render",
+                "--scene",
+                "cornell",
+                "--technique",
+                "full",
+                "--probe-grid",
+                grid,
+                "--width",
+                "32",
+                "--height",
+                "24",
+                "--force",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &cache,
+        );
         assert!(o.status.success(), "{}", stderr(&o));
         stderr(&o)
     };
