@@ -425,7 +425,8 @@ mod tests {
             }
         }
         // the two lookups lie 2e apart in uv, 2e·DEPTH_OCT texels: bilinear over texel
-        // values 0..22 moves at most that × 22 (a clamped lookup jumps by texel values)
+        // values 0..22 moves at most that × 22; the bound allows twice that (a clamped
+        // lookup jumps by whole texel values)
         let bound = 2.0 * (2.0 * e * DEPTH_OCT as f32) * 22.0;
         assert!(
             worst < bound,
