@@ -88,14 +88,22 @@ mod tests {
         let probes = include_str!("shaders/common/probes.wgsl");
         let radiosity = include_str!("passes/radiosity/radiosity.wgsl");
         let hbao = include_str!("passes/abuffer/hbao_compute.wgsl");
+        let deep = include_str!("passes/deep_gbuffer/deep_gbuffer.wgsl");
+        let dss = include_str!("shaders/common/dss.wgsl");
         use strata_scene::probes as p;
-        let pairs: [(&str, &str, f64); 6] = [
+        let pairs: [(&str, &str, f64); 8] = [
             (probes, "PROBE_DEPTH_OCT", p::DEPTH_OCT as f64),
             (probes, "FACING_FLOOR", p::FACING_FLOOR as f64),
             (probes, "VISIBILITY_FLOOR", p::VISIBILITY_FLOOR as f64),
             (radiosity, "COVERAGE_COS", crate::passes::radiosity::COVERAGE_COS as f64),
             (hbao, "TILE", crate::passes::abuffer::ao::TILE as f64),
             (hbao, "SHARED_TEXELS", crate::passes::abuffer::ao::SHARED_TEXELS as f64),
+            (
+                deep,
+                "SURFACE_TOLERANCE",
+                crate::passes::deep_gbuffer::SURFACE_TOLERANCE as f64,
+            ),
+            (dss, "DSS_COPLANAR", crate::passes::bzb::dss::COPLANAR as f64),
         ];
         for (source, name, rust) in pairs {
             let wgsl = wgsl_const(source, name);

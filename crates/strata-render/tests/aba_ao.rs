@@ -477,16 +477,23 @@ fn compute_vs_twin_sized(
     let got = raw(gpu, &r);
     let (mut worst, mut worst_border, mut border_dark, mut beyond) = (0.0f32, 0.0f32, 0, 0);
     assert_eq!((got.width, got.height), (w, h));
+    let max_ulps = if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+        0
+    } else {
+        4
+    };
     for y in 0..h {
         for x in 0..w {
             let want = ambient_visibility_cpu(&lists, &occ, &frame, &u, x, y);
             let have = got.pixel(x, y)[0];
             let d = (have - want).abs();
-            // the same f32 operations in the same order: bit for bit on lavapipe
-            assert_eq!(
-                have.to_bits(),
-                want.to_bits(),
-                "({x}, {y}): GPU {have} vs CPU twin {want}"
+            // the same f32 operations in the same order: bit for bit on lavapipe; a GPU
+            // driver may contract a*b+c into one fma or round a division differently
+            // (NVIDIA 580: 1 ulp at a few pixels), so elsewhere a few ulps
+            let ulps = (have.to_bits() as i64 - want.to_bits() as i64).unsigned_abs();
+            assert!(
+                ulps <= max_ulps,
+                "({x}, {y}): GPU {have} vs CPU twin {want}: {ulps} ulps apart (at most {max_ulps} on this adapter)"
             );
             worst = worst.max(d);
             if tile_border(x, y) {

@@ -438,6 +438,11 @@ fn dss_converges_to_the_ray_traced_ao_of_the_same_surfel_cloud() {
             let origins = r.read_target(&gpu, "bzb-origins").unwrap();
             let normals = common::npack_normals(&r.read_target(&gpu, "npack").unwrap(), 0);
             let dirs = r.read_target(&gpu, "bzb-directions").unwrap();
+            eprintln!(
+                "{:?}, {} surfels read back",
+                r.dss_counts(&gpu).unwrap().unwrap(),
+                s.len()
+            );
             let (mut av, mut px) = (Vec::new(), Vec::new());
             let m = 256;
             for (_, p, t) in samples(&dirs, w, h, 1, 1) {
@@ -451,6 +456,9 @@ fn dss_converges_to_the_ray_traced_ao_of_the_same_surfel_cloud() {
                     if dss::ray_occluded(o, n, d, &s, radius, t_min) {
                         occ += 1;
                     }
+                }
+                if px.len() % 200 == 0 {
+                    eprintln!("pixel {p:?} (texel {t:?}): origin {o:.5}, normal {n:.5}, {occ}/{m} occluded");
                 }
                 av.push(1.0 - occ as f32 / m as f32);
                 px.push(p);
@@ -472,7 +480,9 @@ fn dss_converges_to_the_ray_traced_ao_of_the_same_surfel_cloud() {
             mae / n,
             bias / n
         );
-        assert!(occluded > 100, "the scene has occlusion to estimate");
+        // 130 on lavapipe, 73 on NVIDIA 580: the ~45 surfels are a random thinning
+        // hashed from position bits, which differ by an ulp between drivers
+        assert!(occluded > 50, "the scene has occlusion to estimate");
     }
     // error falls like 1/√S (0.5 from S=1 to 4, 0.25 to 16), bias stays small
     let (e1, e4, e16) = (results[0].1, results[1].1, results[2].1);
@@ -499,7 +509,15 @@ fn unoccluded_plane_is_ao_one_with_dss() {
         for target in ["bzb-raw", "ao"] {
             let img = r.read_target(&gpu, target).unwrap();
             let min = img.data.iter().cloned().fold(f32::MAX, f32::min);
-            assert!(min >= 0.999, "visibility {visibility}: {target} min {min}");
+            let dark: Vec<_> = (0..img.height)
+                .flat_map(|y| (0..img.width).map(move |x| (x, y)))
+                .filter(|&(x, y)| img.pixel(x, y)[0] < 0.999)
+                .take(8)
+                .collect();
+            assert!(
+                min >= 0.999,
+                "visibility {visibility}: {target} min {min} (first dark pixels {dark:?}, {counts:?})"
+            );
         }
     }
 }

@@ -132,15 +132,22 @@ fn min_separation_holds_for_every_variant_and_k() {
 fn agreement_with_oracle(scene: &Scene, w: u32, h: u32, dz: f32, j: usize) -> f64 {
     let gpu = common::gpu();
     let gpu_layers = static_layers(&gpu, scene, w, h, (j + 1) as u32, Variant::Peel, dz);
-    let oracle =
-        Reference::new(scene, 0.0)
-            .with_progress(false)
-            .layers(&scene.camera, w, h, &LayerSettings::new(j + 1, dz));
+    let oracle = Reference::new(scene, 0.0).with_progress(false).layers(
+        &scene.camera,
+        w,
+        h,
+        // the construction's tie rule: surfaces within δ·z are one surface
+        &LayerSettings {
+            depth_tolerance: strata_render::passes::deep_gbuffer::SURFACE_TOLERANCE,
+            ..LayerSettings::new(j + 1, dz)
+        },
+    );
     let zr = &oracle.layers[j].depth.data;
     let zg = &gpu_layers[j];
     let mut agree = 0;
     let mut covered = 0;
-    for (a, b) in zg.iter().zip(zr) {
+    let mut misses = Vec::new();
+    for (i, (a, b)) in zg.iter().zip(zr).enumerate() {
         covered += (*a > 0.0 || b.is_finite()) as usize;
         let ok = if *a <= 0.0 || !b.is_finite() {
             *a <= 0.0 && !b.is_finite()
@@ -148,6 +155,10 @@ fn agreement_with_oracle(scene: &Scene, w: u32, h: u32, dz: f32, j: usize) -> f6
             (a - b).abs() <= 1e-3 * b
         };
         agree += ok as usize;
+        if !ok && misses.len() < 4 {
+            let oracle_z: Vec<f32> = oracle.layers.iter().map(|l| l.depth.data[i]).collect();
+            misses.push(((i as u32 % w, i as u32 / w), *a, oracle_z));
+        }
     }
     assert!(
         covered > (w * h / 20) as usize,
@@ -156,7 +167,7 @@ fn agreement_with_oracle(scene: &Scene, w: u32, h: u32, dz: f32, j: usize) -> f6
     );
     let frac = agree as f64 / (w * h) as f64;
     eprintln!(
-        "{} layer {j} Δz={dz}: {:.3}% agree with the CPU oracle",
+        "{} layer {j} Δz={dz}: {:.3}% agree with the CPU oracle (first misses: pixel, GPU z, oracle layers {misses:?})",
         scene.name,
         100.0 * frac
     );
@@ -177,10 +188,11 @@ fn zero_separation_is_classic_depth_peeling() {
     for scene in static_scenes() {
         assert!(agreement_with_oracle(&scene, 128, 96, 0.0, 1) >= 0.99, "{}", scene.name);
     }
-    // Third layer too (k = 3). Measured 98.9 %: the misses sit on box corners,
-    // where two faces meet within the oracle's 1e-5 relative depth tolerance.
+    // Third layer too (k = 3). Before the construction shared the oracle's tie
+    // rule, layer 2 re-captured layer 1's floor wherever the peel interpolated
+    // its depth beyond the stored one: 98.9 % on lavapipe, 97.4 % on NVIDIA 580.
     let cornell = procedural::builtin("cornell").unwrap();
-    assert!(agreement_with_oracle(&cornell, 96, 96, 0.0, 2) >= 0.98);
+    assert!(agreement_with_oracle(&cornell, 96, 96, 0.0, 2) >= 0.995);
 }
 
 /// Mismatch percentage of `v`'s layer 1 against the peel of the same frame, per

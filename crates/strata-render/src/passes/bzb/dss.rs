@@ -206,6 +206,18 @@ pub fn unshuffle(level: u32, s: u32, p: [u32; 2], seed: u32) -> (u32, [u32; 2]) 
     (sigma_inverse(off[1] * b + off[0], nb, level, s, seed), nb)
 }
 
+/// Fraction of t_min within which a disk's plane passing the receiver makes the
+/// disk the receiver's own surface (WGSL twin: `DSS_COPLANAR`).
+pub const COPLANAR: f32 = 0.1;
+
+/// A ray–disk hit at `t` occludes: past t_min, and the disk's plane (centre
+/// `c`, normal `ns`) does not pass within COPLANAR·t_min of the receiver `o`
+/// (receivers reconstructed a few 1e-5 off their surface would otherwise see
+/// their own surface's disks hit at grazing angles). WGSL: `dss_occluding_hit`.
+pub fn occluding_hit(o: Vec3, c: Vec3, ns: Vec3, t: f32, t_min: f32) -> bool {
+    t > t_min && (c - o).dot(ns).abs() > COPLANAR * t_min
+}
+
 /// `dss_ray_disk` (§4.2): t of o + t·d on the disk (centre c, unit normal n,
 /// radius r), both faces; `None` on a miss.
 pub fn ray_disk(o: Vec3, d: Vec3, c: Vec3, n: Vec3, r: f32) -> Option<f32> {
@@ -267,7 +279,7 @@ pub fn dss_hit(
                 continue;
             }
             if let Some(t) = ray_disk(o, d, sf.position, sf.normal, sf.radius * scale) {
-                if t > t_min && best.is_none_or(|b| t < b) {
+                if occluding_hit(o, sf.position, sf.normal, t, t_min) && best.is_none_or(|b| t < b) {
                     best = Some(t);
                 }
             }
@@ -474,7 +486,8 @@ pub fn ray_occluded(o: Vec3, n: Vec3, d: Vec3, surfels: &[Surfel], outer: f32, t
         dist > 0.0
             && dist <= outer
             && above_tangent_plane(o, n, sf.position)
-            && ray_disk(o, d, sf.position, sf.normal, sf.radius).is_some_and(|t| t > t_min)
+            && ray_disk(o, d, sf.position, sf.normal, sf.radius)
+                .is_some_and(|t| occluding_hit(o, sf.position, sf.normal, t, t_min))
     })
 }
 

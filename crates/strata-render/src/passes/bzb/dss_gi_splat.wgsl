@@ -41,7 +41,7 @@ fn fs_gi_visibility(in: SplatVertex) -> VisibilityOut {
     }
     let r = DSS_GI_COVER * cr.w * f32(1u << in.level);
     let t = dss_ray_disk(o.xyz, d.xyz, cr.xyz, n, r);
-    if (!(t > dss.t_min)) {
+    if (!dss_occluding_hit(o.xyz, cr.xyz, n, t, dss.t_min)) {
         discard;
     }
     var out: VisibilityOut;

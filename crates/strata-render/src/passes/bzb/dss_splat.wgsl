@@ -8,7 +8,8 @@
 // (inner, outer]; the surfel stands for 4^l surfels on level l (one of 4^l
 // sub-images receives it), so it is enlarged to radius r·2^l.
 //   fs_visibility: disks centred above the receiver's tangent plane only;
-//                  ray–disk hit at t > t_min → depth t²/(outer + r·2^l)², payload 1
+//                  ray–disk hit at t > t_min, disk plane not through the
+//                  receiver (dss_occluding_hit) → depth t²/(outer + r·2^l)², payload 1
 //                  (depth test Less per level band, no blending); miss → discard.
 //   fs_additive:   the disk's form-factor occlusion, summed by additive blending
 //                  (the original shell splatting, no visibility).
@@ -119,7 +120,7 @@ fn fs_visibility(in: SplatVertex) -> VisibilityOut {
     }
     let r = cr.w * f32(1u << in.level);
     let t = dss_ray_disk(o.xyz, d.xyz, cr.xyz, n, r);
-    if (!(t > dss.t_min)) {
+    if (!dss_occluding_hit(o.xyz, cr.xyz, n, t, dss.t_min)) {
         discard;
     }
     var out: VisibilityOut;

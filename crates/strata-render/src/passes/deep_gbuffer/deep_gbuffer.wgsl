@@ -97,6 +97,10 @@ fn vs_single(@location(0) position: vec3f, @location(1) normal: vec3f, @location
     return vertex(0u, position, normal, uv);
 }
 
+// Relative depth within which a fragment counts as the oracle's surface (Rust
+// twin: deep_gbuffer::SURFACE_TOLERANCE).
+const SURFACE_TOLERANCE: f32 = 1e-4;
+
 // Index of the oracle layer that layer `layer` is tested against.
 fn oracle_layer(layer: u32) -> i32 {
     switch (ORACLE) {
@@ -132,8 +136,11 @@ fn passes_min_separation(in: VsOut, layer: u32) -> bool {
         return true;
     }
     let zc = textureLoad(oracle_csz, vec2i(floor(c)), oracle_layer(layer), 0).r;
-    // An empty oracle texel is infinitely far: nothing lies beyond it.
-    return zc > 0.0 && z > zc + deep.min_separation;
+    // An empty oracle texel is infinitely far: nothing lies beyond it. Within
+    // SURFACE_TOLERANCE·zc of the oracle is the oracle's own surface: without
+    // it, Δz = 0 re-captures that surface wherever this pass interpolates its
+    // depth slightly beyond the stored one.
+    return zc > 0.0 && z > zc + deep.min_separation + SURFACE_TOLERANCE * zc;
 }
 
 struct GBufferOut {

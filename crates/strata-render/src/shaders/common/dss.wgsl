@@ -112,6 +112,17 @@ fn dss_ray_disk(o: vec3f, d: vec3f, c: vec3f, n: vec3f, r: f32) -> f32 {
     return t;
 }
 
+// A hit occludes when it lies past t_min and the disk's plane does not pass
+// within DSS_COPLANAR·t_min of the receiver: such a disk holds the receiver's
+// own surface, and a receiver reconstructed a few 1e-5 off it (NVIDIA 580;
+// lavapipe reconstructs it on the plane) would see it hit at grazing angles.
+// Rust twin: dss::occluding_hit, dss::COPLANAR.
+const DSS_COPLANAR: f32 = 0.1;
+
+fn dss_occluding_hit(o: vec3f, c: vec3f, ns: vec3f, t: f32, t_min: f32) -> bool {
+    return t > t_min && abs(dot(c - o, ns)) > DSS_COPLANAR * t_min;
+}
+
 // Shell of level l around a surfel (§4.1): (inner, outer] = (0, d_max] on
 // level 0, (d_max·2^(l−1), d_max·2^l] above.
 fn dss_shell(level: u32, d_max: f32) -> vec2f {
