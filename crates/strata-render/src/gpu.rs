@@ -294,6 +294,20 @@ impl GpuContext {
         Ok(out)
     }
 
+    /// Copies a COPY_SRC (storage) buffer into a fresh staging buffer and reads it.
+    pub fn read_storage(&self, buf: &wgpu::Buffer) -> Result<Vec<u8>, RenderError> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: buf.size(),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(buf, 0, &staging, 0, buf.size());
+        self.queue.submit([enc.finish()]);
+        self.read_buffer(&staging)
+    }
+
     /// Maps a MAP_READ buffer and copies it out.
     pub fn read_buffer(&self, buf: &wgpu::Buffer) -> Result<Vec<u8>, RenderError> {
         let (tx, rx) = std::sync::mpsc::channel();

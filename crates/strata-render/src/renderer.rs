@@ -906,6 +906,11 @@ impl Renderer {
         self.bzb.as_ref().map(|b| b.uniforms())
     }
 
+    /// With BZB AOV splatting: the last frame's depth tiles (`bzb-zminmax`).
+    pub fn bzb_zminmax(&self, gpu: &GpuContext) -> Option<Result<Vec<[f32; 2]>, RenderError>> {
+        Some(self.bzb.as_ref()?.zminmax()?.read_tiles(gpu))
+    }
+
     /// BZB §4.3 / Table 2: the DSS surfel counts of the last frame (`bzb-ao` with `splat = dss`).
     pub fn dss_counts(&self, gpu: &GpuContext) -> Option<Result<crate::passes::bzb::dss::SurfelCounts, RenderError>> {
         let b = self.bzb.as_ref()?;

@@ -523,3 +523,48 @@ fn depth_tile_culling_leaves_the_image_unchanged() {
         }
     }
 }
+
+/// `bzb-zminmax` (one workgroup per tile, a workgroup reduction) equals its CPU
+/// twin over `bzb-origins`: every level, partial tiles at the borders (odd size).
+#[test]
+fn depth_tiles_equal_their_cpu_twin() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("atrium").unwrap();
+    let (w, h) = (147, 83);
+    let mut r = Renderer::new(
+        &gpu,
+        &scene,
+        RenderSettings {
+            width: w,
+            height: h,
+            ..settings(BzbSettings::default())
+        },
+    )
+    .unwrap();
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
+    let got = r.bzb_zminmax(&gpu).expect("AOV splats have depth tiles").unwrap();
+    let origins = r.read_target(&gpu, "bzb-origins").unwrap();
+    let f = r.frame_uniforms();
+    let (eye, fwd) = (Vec3::from_slice(&f.eye[..3]), Vec3::from_slice(&f.cam_forward[..3]));
+    let want = bzb::zminmax_tiles(w, h, |x, y| {
+        let o = origins.pixel(x, y);
+        (o[3] > 0.0).then(|| (Vec3::new(o[0], o[1], o[2]) - eye).dot(fwd))
+    });
+    assert_eq!(got.len(), want.len());
+    assert_eq!(got.len() as u32, bzb::zminmax_tile_count(w, h));
+    let mut filled = 0;
+    for (i, (g, c)) in got.iter().zip(&want).enumerate() {
+        for k in 0..2 {
+            assert!(
+                (g[k] - c[k]).abs() <= 1e-5 * c[k].abs().max(1.0),
+                "tile {i}: GPU {g:?} vs CPU {c:?}"
+            );
+        }
+        filled += (c[0] <= c[1]) as u32;
+    }
+    assert!(
+        filled > got.len() as u32 / 2,
+        "{filled} of {} tiles hold receivers",
+        got.len()
+    );
+}

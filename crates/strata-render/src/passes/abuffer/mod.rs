@@ -1117,11 +1117,11 @@ impl ABufferStage {
     pub fn read_lists(&self, gpu: &GpuContext) -> Result<FragmentLists, RenderError> {
         let s = &self.shared;
         let u32s = |b: &wgpu::Buffer| -> Result<Vec<u32>, RenderError> {
-            Ok(bytemuck::cast_slice::<u8, u32>(&read_storage(gpu, b)?).to_vec())
+            Ok(bytemuck::cast_slice::<u8, u32>(&gpu.read_storage(b)?).to_vec())
         };
         let stats = u32s(&s.stats)?;
         let counts = u32s(&s.counts)?;
-        let node_bytes = read_storage(gpu, &s.nodes)?;
+        let node_bytes = gpu.read_storage(&s.nodes)?;
         let nodes: &[GpuFragment] = bytemuck::cast_slice(&node_bytes);
         let (w, h) = (s.width, s.height);
         let px = (w * h) as usize;
@@ -1283,19 +1283,6 @@ pub fn far_depth(scene: &strata_scene::Scene, camera: &strata_scene::Camera, fra
         }
     }
     far
-}
-
-fn read_storage(gpu: &GpuContext, buf: &wgpu::Buffer) -> Result<Vec<u8>, RenderError> {
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("abuffer-readback"),
-        size: buf.size(),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_buffer_to_buffer(buf, 0, &staging, 0, buf.size());
-    gpu.queue.submit([enc.finish()]);
-    gpu.read_buffer(&staging)
 }
 
 impl ABufferPass {

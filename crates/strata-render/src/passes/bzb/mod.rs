@@ -483,9 +483,42 @@ pub fn zminmax_tile_count(w: u32, h: u32) -> u32 {
 
 /// Min/max receiver depth per tile (compute), for the splat pass's culling.
 pub struct ZMinMaxPass {
-    pipeline: wgpu::ComputePipeline,
+    /// One pipeline per level (override LEVEL) and that level's tile count.
+    levels: Vec<(wgpu::ComputePipeline, u32)>,
     group: wgpu::BindGroup,
-    tiles: u32,
+    buffer: wgpu::Buffer,
+}
+
+impl ZMinMaxPass {
+    /// The last frame's (min, max) receiver depth per tile, levels in
+    /// [`ZMINMAX_TILES`] order then the whole image, row-major tiles.
+    pub fn read_tiles(&self, gpu: &GpuContext) -> Result<Vec<[f32; 2]>, crate::RenderError> {
+        let bytes = gpu.read_storage(&self.buffer)?;
+        Ok(bytemuck::cast_slice::<u8, [f32; 2]>(&bytes).to_vec())
+    }
+}
+
+/// The CPU twin of `bzb-zminmax`: (min, max) camera depth `z(x, y)` of the
+/// receivers (`Some`) over every tile, in the GPU buffer's order.
+pub fn zminmax_tiles(w: u32, h: u32, z: impl Fn(u32, u32) -> Option<f32>) -> Vec<[f32; 2]> {
+    let mut out = Vec::new();
+    let sizes = ZMINMAX_TILES.iter().copied().chain([w.max(h)]);
+    for t in sizes {
+        for ty in 0..h.div_ceil(t) {
+            for tx in 0..w.div_ceil(t) {
+                let mut r = [3.0e38f32, -3.0e38];
+                for y in ty * t..((ty + 1) * t).min(h) {
+                    for x in tx * t..((tx + 1) * t).min(w) {
+                        if let Some(v) = z(x, y) {
+                            r = [r[0].min(v), r[1].max(v)];
+                        }
+                    }
+                }
+                out.push(r);
+            }
+        }
+    }
+    out
 }
 
 impl Pass for ZMinMaxPass {
@@ -502,10 +535,13 @@ impl Pass for ZMinMaxPass {
             label: Some("bzb-zminmax"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.frame_bind_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
-        pass.dispatch_workgroups(self.tiles.div_ceil(64), 1, 1);
+        // finest level first: each coarser level reads the one below
+        for (pipeline, tiles) in &self.levels {
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups(tiles.div_ceil(64), 1, 1);
+        }
     }
 }
 
@@ -688,7 +724,7 @@ impl BzbStage {
         let tiles = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("bzb-zminmax"),
             size: tile_count as u64 * 8,
-            usage: wgpu::BufferUsages::STORAGE,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         let (zminmax, splat, dss) = match s.splat {
@@ -800,18 +836,30 @@ impl BzbStage {
             immediate_size: 0,
         });
         let module = crate::shader::module(device, "bzb-zminmax", bzb_shader!("bzb_zminmax.wgsl"));
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("bzb-zminmax"),
-            layout: Some(&pl),
-            module: &module,
-            entry_point: Some("cs_main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let (w, h) = (targets.width, targets.height);
+        let sizes = ZMINMAX_TILES.iter().copied().chain([w.max(h)]);
+        let levels: Vec<_> = sizes
+            .enumerate()
+            .map(|(level, t)| {
+                let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("bzb-zminmax"),
+                    layout: Some(&pl),
+                    module: &module,
+                    entry_point: Some("cs_main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &[("LEVEL", level as f64)],
+                        ..Default::default()
+                    },
+                    cache: None,
+                });
+                (pipeline, w.div_ceil(t) * h.div_ceil(t))
+            })
+            .collect();
+        debug_assert_eq!(levels.iter().map(|l| l.1).sum::<u32>(), tile_count);
         ZMinMaxPass {
-            pipeline,
+            levels,
             group,
-            tiles: tile_count,
+            buffer: tiles.clone(),
         }
     }
 
@@ -883,6 +931,11 @@ impl BzbStage {
         }
         v.extend([&self.reconstruct as &dyn Pass, &self.blur_h, &self.blur_v]);
         v
+    }
+
+    /// The AOV splats' depth tiles (`splat = aov`).
+    pub fn zminmax(&self) -> Option<&ZMinMaxPass> {
+        self.zminmax.as_ref()
     }
 
     /// The DSS stage (`splat = dss`).
