@@ -856,24 +856,31 @@ mod tests {
     /// Runs DB + blur over a synthetic `w`×`h` frame whose pixel (x, y) lies on
     /// plane `plane(x, y)` (facing the camera at depth 1 + plane) with
     /// irradiance `value(plane)`; returns the blurred irradiance (r) and the DB.
+    /// One context per test, shared by its filter runs: creating and dropping a
+    /// Vulkan device per run (8 in a test) crashed the NVIDIA 580 driver twice
+    /// (SIGSEGV) when four test binaries ran at once.
+    fn gpu() -> GpuContext {
+        GpuContext::new(&crate::GpuOptions::default()).expect("a Vulkan adapter")
+    }
+
     fn filter(
+        gpu: &GpuContext,
         s: &IlsSettings,
         w: u32,
         h: u32,
         plane: impl Fn(u32, u32) -> u32,
         value: impl Fn(u32) -> f32,
     ) -> (Vec<f32>, Vec<f32>) {
-        let gpu = GpuContext::new(&crate::GpuOptions::default()).expect("a Vulkan adapter");
         let scene = strata_scene::procedural::plane();
-        let scene_gpu = GpuScene::new(&gpu, &scene);
+        let scene_gpu = GpuScene::new(gpu, &scene);
         let cam = scene.camera;
         let u = FrameUniforms::new(&scene, &FrameCameras::fixed(cam), w, h, 0.0, 1.0);
-        scene_gpu.update_frame(&gpu, &u);
+        scene_gpu.update_frame(gpu, &u);
         let mut targets = Targets::new(w, h);
         for t in [GBUFFER, IRRADIANCE, INDIRECT] {
-            targets.create(&gpu, t);
+            targets.create(gpu, t);
         }
-        let (db, bh, bv) = filter_passes(&gpu, &scene_gpu, &mut targets, s, IRRADIANCE.name, INDIRECT.name);
+        let (db, bh, bv) = filter_passes(gpu, &scene_gpu, &mut targets, s, IRRADIANCE.name, INDIRECT.name);
         let n = [-u.cam_forward[0], -u.cam_forward[1], -u.cam_forward[2]];
         let mut g = Vec::new();
         let mut e = Vec::new();
@@ -885,11 +892,11 @@ mod tests {
                 e.push([v, v, v, 1.0]);
             }
         }
-        upload(&gpu, &targets.get(GBUFFER.name).texture, &g);
-        upload(&gpu, &targets.get(IRRADIANCE.name).texture, &e);
+        upload(gpu, &targets.get(GBUFFER.name).texture, &g);
+        upload(gpu, &targets.get(IRRADIANCE.name).texture, &e);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for p in [&db, &bh, &bv] {
-            Pass::encode(p, &gpu, &scene_gpu, &targets, &mut enc);
+            Pass::encode(p, gpu, &scene_gpu, &targets, &mut enc);
         }
         gpu.queue.submit([enc.finish()]);
         gpu.check_errors().expect("no wgpu validation error");
@@ -913,8 +920,9 @@ mod tests {
 
     #[test]
     fn blur_keeps_a_constant_image_constant() {
+        let gpu = gpu();
         for bilinear in [false, true] {
-            let (out, db) = filter(&settings(bilinear), 37, 29, |_, _| 0, |_| 0.75);
+            let (out, db) = filter(&gpu, &settings(bilinear), 37, 29, |_, _| 0, |_| 0.75);
             assert!(db.iter().all(|&d| d == 0.0), "one plane has no discontinuity");
             for (i, v) in out.iter().enumerate() {
                 assert!((v - 0.75).abs() <= 1e-3, "bilinear {bilinear}: texel {i} = {v}");
@@ -929,12 +937,13 @@ mod tests {
         let (w, h) = (40u32, 30u32);
         let quadrant = |x: u32, y: u32| (x >= 17) as u32 + 2 * (y >= 13) as u32;
         let values = [1.0f32, 4.0, 0.25, 2.0];
+        let gpu = gpu();
         for (bilinear, per_axis) in [(false, false), (true, false), (false, true), (true, true)] {
             let s = IlsSettings {
                 per_axis_discontinuities: per_axis,
                 ..settings(bilinear)
             };
-            let (out, db) = filter(&s, w, h, quadrant, |p| values[p as usize]);
+            let (out, db) = filter(&gpu, &s, w, h, quadrant, |p| values[p as usize]);
             // DB: exactly the pixels before a boundary (x = 16 or y = 12)
             for y in 0..h {
                 for x in 0..w {
@@ -954,7 +963,7 @@ mod tests {
                 normal_threshold_deg: 180.0,
                 ..s
             };
-            let (out, db) = filter(&blind, w, h, quadrant, |p| values[p as usize]);
+            let (out, db) = filter(&gpu, &blind, w, h, quadrant, |p| values[p as usize]);
             assert!(db.iter().all(|&d| d == 0.0));
             let v = out[(5 * w + 16) as usize];
             assert!(
