@@ -40,8 +40,9 @@ fn sh9(d: vec3f) -> array<f32, 9> {
     );
 }
 
-fn probe_irradiance(index: u32, n: vec3f) -> vec3f {
-    var y = sh9(n);
+// Probe `index`'s irradiance for a normal n whose SH basis is `basis` (sh9(n)).
+fn probe_irradiance(index: u32, basis: array<f32, 9>) -> vec3f {
+    var y = basis;
     var e = vec3f(0.0);
     for (var i = 0u; i < 9u; i++) {
         e += probes[index].c[i].rgb * y[i];
@@ -113,9 +114,53 @@ fn probe_visibility(grid: ProbeGrid, index: u32, probe_pos: vec3f, p: vec3f, n: 
     return chebyshev_visibility(dist, m);
 }
 
-// The 8 probes around p with their blend weights for a receiver at p (normal n):
-// trilinear × how much each faces the receiver × how visible the receiver is from
-// it (as `IrradianceProbes::irradiance`); `valid` = 0 for probes inside geometry.
+// One of the 8 probes around p (corner bits x, y, z) and its blend weight for a
+// receiver at p (normal n): trilinear × how much it faces the receiver × how
+// visible the receiver is from it (as `IrradianceProbes::irradiance`).
+struct ProbeCorner {
+    index: u32,
+    w: f32,
+}
+
+// The grid cell of p: its lowest corner and p's position in it.
+struct ProbeCell {
+    i0: vec3f,
+    t: vec3f,
+}
+
+fn probe_cell(grid: ProbeGrid, p: vec3f) -> ProbeCell {
+    let mx = vec3f(grid.dims.xyz) - 1.0;
+    let g = min(max((p - grid.origin.xyz) / grid.spacing.xyz, vec3f(0.0)), mx);
+    let i0 = floor(g);
+    return ProbeCell(i0, g - i0);
+}
+
+fn probe_corner(grid: ProbeGrid, cell: ProbeCell, p: vec3f, n: vec3f, corner: u32) -> ProbeCorner {
+    let dims = grid.dims.xyz;
+    let mx = vec3f(dims) - 1.0;
+    let i0 = cell.i0;
+    let t = cell.t;
+    let o = vec3f(f32(corner & 1u), f32((corner >> 1u) & 1u), f32((corner >> 2u) & 1u));
+    let c = vec3u(min(i0 + o, mx));
+    let w3 = mix(1.0 - t, t, o);
+    let w = w3.x * w3.y * w3.z;
+    let index = c.x + dims.x * (c.y + dims.y * c.z);
+    if (w == 0.0) {
+        return ProbeCorner(index, 0.0);
+    }
+    // probes behind the receiver's tangent plane see the other side of its
+    // surface (as `probes::facing_weight`)
+    let probe_pos = probe_position(index, grid.origin.xyz + vec3f(c) * grid.spacing.xyz);
+    let to_probe = probe_pos - p;
+    let len = length(to_probe);
+    var f = 0.5;
+    if (len > 1e-4) {
+        f = 0.5 * (dot(to_probe / len, n) + 1.0);
+    }
+    return ProbeCorner(index, w * (f * f + FACING_FLOOR) * probe_visibility(grid, index, probe_pos, p, n));
+}
+
+// The 8 corners with their weights; `valid` = 0 for probes inside geometry.
 struct ProbeCorners {
     index: array<u32, 8>,
     w: array<f32, 8>,
@@ -124,30 +169,13 @@ struct ProbeCorners {
 
 fn probe_corners(grid: ProbeGrid, p: vec3f, n: vec3f) -> ProbeCorners {
     var out: ProbeCorners;
-    let dims = grid.dims.xyz;
-    let mx = vec3f(dims) - 1.0;
-    let g = min(max((p - grid.origin.xyz) / grid.spacing.xyz, vec3f(0.0)), mx);
-    let i0 = floor(g);
-    let t = g - i0;
+    let cell = probe_cell(grid, p);
     for (var corner = 0u; corner < 8u; corner++) {
-        let o = vec3f(f32(corner & 1u), f32((corner >> 1u) & 1u), f32((corner >> 2u) & 1u));
-        let c = vec3u(min(i0 + o, mx));
-        let w3 = mix(1.0 - t, t, o);
-        var w = w3.x * w3.y * w3.z;
-        let index = c.x + dims.x * (c.y + dims.y * c.z);
-        // probes behind the receiver's tangent plane see the other side of its
-        // surface (as `probes::facing_weight`)
-        let probe_pos = probe_position(index, grid.origin.xyz + vec3f(c) * grid.spacing.xyz);
-        let to_probe = probe_pos - p;
-        let len = length(to_probe);
-        var f = 0.5;
-        if (len > 1e-4) {
-            f = 0.5 * (dot(to_probe / len, n) + 1.0);
-        }
-        out.index[corner] = index;
-        out.w[corner] = w * (f * f + FACING_FLOOR) * probe_visibility(grid, index, probe_pos, p, n);
+        let k = probe_corner(grid, cell, p, n, corner);
+        out.index[corner] = k.index;
+        out.w[corner] = k.w;
         // probes inside geometry (validity in coefficient 0's w) get no weight
-        out.valid[corner] = probes[index].c[0].w;
+        out.valid[corner] = probes[k.index].c[0].w;
     }
     return out;
 }
@@ -173,16 +201,32 @@ fn probe_weights(corners: ProbeCorners) -> array<f32, 8> {
     return out;
 }
 
-// The probes' irradiance at receiver p with normal n.
+// The probes' irradiance at receiver p with normal n: `probe_weights`' blend in one
+// pass over the corners (no per-pixel arrays: the composition's hot path).
 fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f) -> vec3f {
-    // `var`: naga indexes arrays dynamically only through memory
-    var k = probe_corners(grid, p, n);
-    var w = probe_weights(k);
+    var sum = 0.0;
+    var sum_all = 0.0;
     var e = vec3f(0.0);
-    for (var i = 0u; i < 8u; i++) {
-        e += probe_irradiance(k.index[i], n) * w[i];
+    var e_all = vec3f(0.0);
+    let cell = probe_cell(grid, p);
+    let basis = sh9(n);
+    for (var corner = 0u; corner < 8u; corner++) {
+        let k = probe_corner(grid, cell, p, n, corner);
+        if (k.w == 0.0) {
+            // outside the grid (clamped) or on a cell face: skip the reads
+            continue;
+        }
+        let valid = probes[k.index].c[0].w;
+        let ek = probe_irradiance(k.index, basis);
+        sum += k.w * valid;
+        sum_all += k.w;
+        e += ek * (k.w * valid);
+        e_all += ek * k.w;
     }
-    return e;
+    if (sum > 1e-6) {
+        return e / sum;
+    }
+    return e_all / max(sum_all, 1e-6);
 }
 
 // The blended probes' incident radiance at p (receiver normal n) as order-2 SH:
