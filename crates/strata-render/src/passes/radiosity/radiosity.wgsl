@@ -53,6 +53,8 @@ struct Term {
     c: vec4f,
     wc: f32,
     dir: vec3f,
+    // max(ω̂·n̂_X, 0) of a light-carrying term, whose c.rgb `with_light` fills
+    cx: f32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -87,11 +89,12 @@ fn radiosity_of(p: vec2i, layer: u32) -> vec3f {
     return textureLoad(b1, p, 0).rgb;
 }
 
-// Eq. 4–5 term of sample Y (layer j, pixel src) for receiver X (normal n), with
-// w = 1 (Eq. 4) or, with `solid_angle`, w ∝ the solid angle the tap's screen area
-// subtends at X (`solid_angle_weight`); c.a = w when Y passes Eq. 5 (and lies
-// within r). `h` = the tap's screen radius.
-fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> Term {
+// Eq. 4–5 term of sample Y (layer j, pixel src, normal ny: read once per tap for
+// both layers and receivers) for receiver X (normal n), with w = 1 (Eq. 4) or,
+// with `solid_angle`, w ∝ the solid angle the tap's screen area subtends at X
+// (`solid_angle_weight`); c.a = w when Y passes Eq. 5 (and lies within r). `h` =
+// the tap's screen radius.
+fn term(x: vec3f, n: vec3f, y: vec3f, ny: vec3f, j: u32, src: vec2i, h: f32) -> Term {
     var none: Term;
     let v = y - x;
     let vv = dot(v, v);
@@ -105,7 +108,6 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> Term {
     }
     var wt = 1.0;
     if (rad.normal_test != 0u || rad.solid_angle != 0u) {
-        let ny = normal_of(src, j);
         if (rad.normal_test != 0u && dot(w, ny) >= 0.0) {
             if (rad.hidden_black != 0u) {
                 // a black occluder: weight, no light (a < 0 marks it)
@@ -113,7 +115,7 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> Term {
                 if (rad.solid_angle != 0u) {
                     wo = solid_angle_weight(y, ny, w, vv, h);
                 }
-                return Term(vec4f(0.0, 0.0, 0.0, -wo), wo * cos_x, w);
+                return Term(vec4f(0.0, 0.0, 0.0, -wo), wo * cos_x, w, 0.0);
             }
             return none;
         }
@@ -121,7 +123,17 @@ fn term(x: vec3f, n: vec3f, y: vec3f, j: u32, src: vec2i, h: f32) -> Term {
             wt = solid_angle_weight(y, ny, w, vv, h);
         }
     }
-    return Term(vec4f(radiosity_of(src, j) * cos_x * wt, wt), wt * cos_x, w);
+    // c.rgb = B(Y)·cos·w once `with_light` has read B (once for both receivers)
+    return Term(vec4f(0.0, 0.0, 0.0, wt), wt * cos_x, w, cos_x);
+}
+
+// A light-carrying term (c.a > 0) with its radiosity B filled in.
+fn with_light(t: Term, b: vec3f) -> Term {
+    var o = t;
+    if (t.c.a > 0.0) {
+        o.c = vec4f(b * t.cx * t.c.a, t.c.a);
+    }
+    return o;
 }
 
 // Solid angle (up to a constant) that the screen area represented by a tap at
@@ -168,7 +180,7 @@ fn sky_term(x: vec3f, n: vec3f, src: vec2i, h: f32) -> Term {
     if (rad.solid_angle != 0u) {
         wt = h;
     }
-    return Term(vec4f(frame.sky.rgb * cos_x * wt, -wt), wt * cos_x, d);
+    return Term(vec4f(frame.sky.rgb * cos_x * wt, -wt), wt * cos_x, d, 0.0);
 }
 
 // Whether the tap at pixel `src` with layer-0 depth `z0` (0: background) tells the
@@ -263,14 +275,30 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         let src = mip_source_pixel(zmip, t, m);
         var best0: Term;
         var best1: Term;
+        // both layers' normals live in one npack texel
+        var nn = vec4f(0.0);
+        if ((rad.normal_test != 0u || rad.solid_angle != 0u) && zs.x > 0.0) {
+            nn = textureLoad(npack, src, 0);
+        }
         for (var j = 0u; j < min(LAYERS, 2u); j++) {
             if (zs[j] <= 0.0) {
                 continue;
             }
             let y = world_from_csz(frame, vec2f(src) + 0.5, zs[j]);
-            best0 = union_term(best0, term(x0, n0, y, j, src, tap.radius));
+            let ny = oct_decode(select(nn.ba, nn.rg, j == 0u));
+            var t0 = term(x0, n0, y, ny, j, src, tap.radius);
+            var t1: Term;
             if (has1) {
-                best1 = union_term(best1, term(x1, n1, y, j, src, tap.radius));
+                t1 = term(x1, n1, y, ny, j, src, tap.radius);
+            }
+            if (t0.c.a > 0.0 || t1.c.a > 0.0) {
+                let b = radiosity_of(src, j);
+                t0 = with_light(t0, b);
+                t1 = with_light(t1, b);
+            }
+            best0 = union_term(best0, t0);
+            if (has1) {
+                best1 = union_term(best1, t1);
             }
         }
         if (rad.open_sky != 0u && zs.x <= 0.0) {
