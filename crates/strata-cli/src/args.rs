@@ -519,7 +519,9 @@ pub struct EvalArgs {
     /// full: instead of the sky-off GI comparison, measure what `render --technique full`
     /// shows (probes on): pixels clipped in the final image and the probe-only / blended /
     /// gbuffer-only views, |blended − probe-only|, and the chroma of fixed regions against the
-    /// path-traced frame with sky (docs/image-quality.md).
+    /// path-traced frame with sky (docs/image-quality.md). The frame compared with the
+    /// (Lambertian) path tracer has the GGX specular lobe off; `final-specular` is the frame
+    /// with it, as `render` shows it.
     #[arg(long)]
     pub views: bool,
     /// Static frames rendered before the evaluated one (gi: the progressive bounces and the

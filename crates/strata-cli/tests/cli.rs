@@ -648,7 +648,19 @@ fn eval_full_views_reports_clipping_blend_and_region_chroma() {
     let v = json_of(&o);
     let views = v["views"].as_array().expect("views");
     let names: Vec<&str> = views.iter().map(|x| x["view"].as_str().unwrap()).collect();
-    assert_eq!(names, ["final", "probe-only", "blended", "gbuffer-only"]);
+    assert_eq!(
+        names,
+        ["final", "probe-only", "blended", "gbuffer-only", "final-specular"]
+    );
+    // the frame compared with the (Lambertian) path tracer has no GGX lobe; the frame as
+    // `render` shows it adds that lobe's light and nothing else
+    let mean = |i: usize| views[i]["mean"].as_f64().unwrap();
+    assert!(
+        mean(0) <= mean(4) + 1e-9,
+        "final {} > final-specular {}",
+        mean(0),
+        mean(4)
+    );
     for x in views {
         let c = x["clip_fraction"].as_f64().unwrap();
         assert!((0.0..=0.01).contains(&c), "{}: {c} of the pixels clipped", x["view"]);

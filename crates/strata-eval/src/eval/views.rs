@@ -11,6 +11,11 @@
 //!   direct + ρ/π·E with E = the probes only, the blend, the deep G-buffer only — and of the
 //!   path-traced frame (sky on, the same exposure and tone curve).
 //!
+//! Everything compared with the path tracer (ꟻLIP, outliers, chroma, the `final` view) is
+//! rendered with the GPU's direct GGX specular lobe off, as `eval gi`, `ils` and `bzb` do: the
+//! path tracer is Lambertian. The `final-specular` view is the frame exactly as `render` shows
+//! it, for its clipping.
+//!
 //! Regions are rectangles in normalised image coordinates; a pixel counts when it is a surface
 //! whose albedo is near-neutral (chroma (max − min)/max < 0.3: the banners themselves are out).
 
@@ -168,12 +173,29 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
     })?;
-    let mut r = Renderer::new(&gpu, &scene, settings)?;
     let fixed = FrameCameras::fixed(camera);
-    for _ in 0..s.warmup.max(1) + 1 {
-        r.render(&gpu, &scene, &fixed, s.scene.frame)?;
-    }
-    // what `render` writes: the final image and the three views (display values, linear)
+    let warm = |settings: RenderSettings| -> Result<Renderer> {
+        let mut r = Renderer::new(&gpu, &scene, settings)?;
+        for _ in 0..s.warmup.max(1) + 1 {
+            r.render(&gpu, &scene, &fixed, s.scene.frame)?;
+        }
+        Ok(r)
+    };
+    // The frame exactly as `render` shows it (GGX specular lobe on): its clipping only. The
+    // path tracer is Lambertian, so everything compared with it below comes from the same
+    // settings with the GPU's direct specular lobe off (as `eval gi`, `ils` and `bzb` do).
+    let shown_final = {
+        let r = warm(settings.clone())?;
+        clip_of("final-specular", &r.read_target(&gpu, "ldr")?)
+    };
+    let r = warm(RenderSettings {
+        lighting: strata_render::passes::lighting::LightingSettings {
+            specular: false,
+            ..settings.lighting.clone()
+        },
+        ..settings
+    })?;
+    // the final image and the three views (display values, linear)
     let final_img = r.read_target(&gpu, "ldr")?;
     let names = ["probe-only", "blended", "gbuffer-only"];
     let views: Vec<ImageBuf> = names
@@ -182,6 +204,7 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
         .collect::<Result<_, _>>()?;
     let mut clips = vec![clip_of("final", &final_img)];
     clips.extend(names.iter().zip(&views).map(|(n, v)| clip_of(n, v)));
+    clips.push(shown_final);
 
     // composites direct + ρ/π·E for each E, as sRGB display values (the frame's tone curve)
     let direct = rgb(&r.read_target(&gpu, "hdr")?);
