@@ -402,7 +402,7 @@ static AO_SETTINGS: [SettingInfo; 14] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 18] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 19] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -455,6 +455,12 @@ static RADIOSITY_SETTINGS: [SettingInfo; 18] = [
         "probe-detail",
         "on: with probes, E = G*E_probe + c*(E_screen - E_probe along the same taps): the gather adds only what the probes miss in the directions it saw (not in the paper); off: DGB's blend c*E_screen + (1 - c)*G*E_probe",
         probe_detail,
+        ["off", "on"]
+    ),
+    radiosity_switch!(
+        "one-sided-confidence",
+        "on: where the gather's irradiance is darker than the probes' (luminance), the probe blend's confidence c is scaled by their ratio: the light screen space lacks comes from surfaces it cannot see, which the probes do (not in the paper, docs/image-quality.md); off: DGB's c everywhere",
+        one_sided_confidence,
         ["off", "on"]
     ),
     radiosity_switch!(

@@ -15,7 +15,8 @@ struct Compose {
     // 1 = Eq. 7's boost on the reflected indirect light
     boost: u32,
     // 1 = blend with the light probes by the confidence c, 2 = the probes plus c × the
-    // gather's screen-space detail (`radiosity::RadiositySettings::probe_detail`)
+    // gather's screen-space detail (`radiosity::RadiositySettings::probe_detail`), 3 = as 1
+    // with a one-sided c (`radiosity::probe_blend`)
     use_probes: u32,
     // the probe term × AV (1), × GTAO's multi-bounce G(AV, rho) (2), or not (0)
     use_ao: u32,
@@ -93,7 +94,14 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             // probes miss in the directions its taps saw
             e = max(ep + c * g.rgb, vec3f(0.0));
         } else {
-            e = c * g.rgb + (1.0 - c) * ep;
+            // DGB Fig. 9; one-sided (3): c × min(1, Y(E_dgb) / Y(E_probe)), as
+            // `radiosity::probe_blend`
+            var cb = c;
+            if (compose.use_probes == 3u) {
+                let y = vec3f(0.2126, 0.7152, 0.0722);
+                cb = c * min(1.0, dot(g.rgb, y) / max(dot(ep, y), 1e-6));
+            }
+            e = cb * g.rgb + (1.0 - cb) * ep;
         }
     }
     o.blended = vec4f(e, c);

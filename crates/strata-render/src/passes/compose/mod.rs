@@ -123,6 +123,9 @@ pub struct ComposeProbes<'a> {
     /// The probes plus c × the gather's detail term (`RadiositySettings::probe_detail`),
     /// instead of DGB's blend by c.
     pub detail: bool,
+    /// DGB's blend with a one-sided confidence
+    /// (`RadiositySettings::one_sided_confidence`, `radiosity::probe_blend`).
+    pub one_sided: bool,
 }
 
 pub struct ComposePass {
@@ -155,8 +158,12 @@ impl ComposePass {
         };
         let u = ComposeUniforms {
             boost: boost as u32,
-            // 0: none, 1: DGB's blend, 2: probes + detail
-            use_probes: probes.as_ref().map_or(0, |p| if p.detail { 2 } else { 1 }),
+            // 0: none, 1: DGB's blend, 2: probes + detail, 3: DGB's blend, one-sided c
+            use_probes: probes.as_ref().map_or(0, |p| match (p.detail, p.one_sided) {
+                (true, _) => 2,
+                (false, true) => 3,
+                (false, false) => 1,
+            }),
             // 0: no AO, 1: × AV, 2: × GTAO's multi-bounce G(AV, ρ) (`ProbeAo`)
             use_ao: if use_ao { probe_ao as u32 } else { 0 },
             use_glossy: glossy.is_some() as u32,

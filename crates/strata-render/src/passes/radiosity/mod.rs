@@ -92,6 +92,31 @@ pub struct RadiositySettings {
     /// in the directions screen space saw (a control variate; docs/radiosity.md §
     /// "Probe detail"). Not in the paper.
     pub probe_detail: bool,
+    /// With light probes, the blend's confidence is one-sided: where the gather's
+    /// irradiance is darker (in luminance) than the probes', c is scaled by the ratio of
+    /// the two ([`probe_blend`]). Screen space misses the light of surfaces it cannot see
+    /// (hidden behind the layers, off-screen), which the probes do see; where it sees
+    /// more, that is the local detail the coarse probes cannot resolve, and c stands.
+    /// Not in the paper (default true; off: DGB's c everywhere).
+    pub one_sided_confidence: bool,
+}
+
+/// Rec. 709 luminance weights of [`probe_blend`]'s comparison.
+pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// DGB Fig. 9's blend of the gather's irradiance `e_dgb` (confidence `c`) with the probes'
+/// `e_probe` (× AO's factor): c·E_dgb + (1 − c)·E_probe, or with `one_sided`
+/// ([`RadiositySettings::one_sided_confidence`]) the same with c' = c·min(1, Y(E_dgb) /
+/// Y(E_probe)). CPU twin of compose.wgsl's blend.
+pub fn probe_blend(e_dgb: Vec3, c: f32, e_probe: Vec3, one_sided: bool) -> Vec3 {
+    let c = c.clamp(0.0, 1.0);
+    let c = if one_sided {
+        let y = Vec3::from(LUMINANCE);
+        c * (e_dgb.dot(y) / e_probe.dot(y).max(1e-6)).min(1.0)
+    } else {
+        c
+    };
+    c * e_dgb + (1.0 - c) * e_probe
 }
 
 /// How AO's visibility AV modulates the light probes' irradiance in the composite
@@ -239,6 +264,7 @@ impl Default for RadiositySettings {
             probe_ao: ProbeAo::MultiBounce,
             normalisation: Normalisation::Bounded,
             probe_detail: false,
+            one_sided_confidence: true,
         }
     }
 }

@@ -155,6 +155,7 @@ impl RadiosityStage {
                 probes: p,
                 ao: s.probe_ao,
                 detail,
+                one_sided: s.one_sided_confidence,
             }),
             "indirect",
             None,
