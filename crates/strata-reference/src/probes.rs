@@ -4,7 +4,9 @@
 
 use glam::Vec3;
 use rayon::prelude::*;
-use strata_scene::probes::{oct_decode, sh9, sh_band, IrradianceProbes, COSINE_LOBE, DEPTH_OCT, DEPTH_TEXELS};
+use strata_scene::probes::{
+    fibonacci_sphere, oct_decode, sh9, sh_band, IrradianceProbes, COSINE_LOBE, DEPTH_OCT, DEPTH_TEXELS,
+};
 
 use crate::gi::GiSettings;
 use crate::sampling::{hash, Rng};
@@ -169,15 +171,6 @@ pub const LOBE_CUTOFF: f32 = 1e-7;
 
 /// A probe whose rays hit back faces this often is inside geometry (invalid).
 pub const INSIDE_BACKFACE_FRACTION: f32 = 0.25;
-
-/// The k-th of n nearly uniform unit directions (spherical Fibonacci).
-fn fibonacci_sphere(k: u32, n: u32) -> Vec3 {
-    let golden = 0.618_034_f32;
-    let z = 1.0 - (2.0 * k as f32 + 1.0) / n as f32;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * std::f32::consts::PI * ((k as f32 * golden).fract());
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
 
 #[cfg(test)]
 mod tests {

@@ -576,6 +576,11 @@ impl Renderer {
                 r,
                 settings.guard_pixels(),
                 settings.probes.as_ref(),
+                settings
+                    .ao
+                    .as_ref()
+                    .and_then(|a| a.radius)
+                    .unwrap_or(scene.settings.ao_radius),
             )),
             None => None,
         };

@@ -423,7 +423,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 19] = [
     ),
     enum_setting!(
         "probe-ao",
-        "how AO darkens the light probes' irradiance: off, plain (x AV, DGB Fig. 9: occluders are black) or multibounce (x GTAO's multi-bounce G(AV, albedo): occluders reflect light too; not in the paper)",
+        "how AO darkens the light probes' irradiance: off, plain (x AV, DGB Fig. 9: occluders are black), multibounce (x GTAO's multi-bounce G(AV, albedo): occluders reflect light too; not in the paper) or relative (x G(AV, albedo) / G(V_probe, albedo), at most 1: only the occlusion the probes' bake does not hold, V_probe their own openness within the AO radius from their distance maps; not in the paper)",
         radiosity_of,
         radiosity_mut,
         probe_ao,
@@ -431,6 +431,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 19] = [
             crate::passes::radiosity::ProbeAo::Off => "off",
             crate::passes::radiosity::ProbeAo::Plain => "plain",
             crate::passes::radiosity::ProbeAo::MultiBounce => "multibounce",
+            crate::passes::radiosity::ProbeAo::Relative => "relative",
         ]
     ),
     radiosity_switch!(

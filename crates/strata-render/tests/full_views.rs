@@ -445,17 +445,33 @@ fn probe_field_matches_cpu_twin() {
 }
 
 /// Issue 14: with AO running, the composite's probe term is E_probe × AV (`ProbeAo::Plain`,
-/// DGB Fig. 9) or E_probe × G(AV, ρ) per channel (`ProbeAo::MultiBounce`, GTAO's multi-bounce
-/// fit, the default): GPU = CPU twin (`ao_multibounce`) at every covered pixel of Cornell,
-/// whose corners give AO something to darken; and the multi-bounce factor lies in [AV, 1].
+/// DGB Fig. 9), E_probe × G(AV, ρ) per channel (`ProbeAo::MultiBounce`, GTAO's multi-bounce
+/// fit) or E_probe × min(1, G(AV, ρ) / G(V_probe, ρ)) (`ProbeAo::Relative`, the default, with
+/// V_probe the probes' own openness from their distance maps): GPU = CPU twin
+/// (`probe_ao_factor`, `IrradianceProbes::openness_at`) at every covered pixel of Cornell,
+/// whose corners give AO something to darken; every factor lies in [AV, 1], and the relative
+/// one is never below the multi-bounce one.
 #[test]
 fn probe_ao_modes_match_cpu_twin() {
-    use strata_render::passes::radiosity::{ao_multibounce, ProbeAo};
+    use strata_render::passes::radiosity::{ao_multibounce, probe_ao_factor, ProbeAo};
+    use strata_scene::probes::{oct_decode, DEPTH_OCT, DEPTH_TEXELS};
     let gpu = common::gpu();
     let scene = frozen("cornell");
     let (w, h) = (64, 48);
-    let probes = constant_probes([1.0, 0.8, 0.6]);
-    for mode in [ProbeAo::Plain, ProbeAo::MultiBounce] {
+    // distance maps: surfaces 5 cm below every probe, nothing above, so the probes'
+    // openness within the AO radius depends on the normal (1 up, ½ sideways, 0 down)
+    let mut probes = constant_probes([1.0, 0.8, 0.6]);
+    let mut map = [[0.0f32; 2]; DEPTH_TEXELS];
+    for (t, m) in map.iter_mut().enumerate() {
+        let uv = glam::Vec2::new((t % DEPTH_OCT) as f32 + 0.5, (t / DEPTH_OCT) as f32 + 0.5) / DEPTH_OCT as f32;
+        let d = if oct_decode(uv).y < 0.0 { 0.05 } else { 500.0 };
+        *m = [d, d * d];
+    }
+    probes.depth = vec![map; probes.count()];
+    let r = scene.settings.ao_radius;
+    let open: Vec<[f32; 4]> = (0..probes.count()).map(|i| probes.openness_sh(i, r)).collect();
+    let mut relative_lighter = 0usize;
+    for mode in [ProbeAo::Plain, ProbeAo::MultiBounce, ProbeAo::Relative] {
         let rs = RadiositySettings {
             probe_ao: mode,
             ..Default::default()
@@ -475,20 +491,24 @@ fn probe_ao_modes_match_cpu_twin() {
             let av = field.data[s.i * 4 + 3];
             occluded += (av < 0.9) as usize;
             let e = probes.irradiance(s.p, s.n);
+            let v = probes.openness_at(&open, s.p, s.n);
             for c in 0..3 {
                 let rho = albedo.data[s.i * albedo.channels as usize + c];
-                let factor = match mode {
-                    ProbeAo::MultiBounce => ao_multibounce(av, rho),
-                    _ => av,
-                };
+                let factor = probe_ao_factor(mode, av, v, rho);
                 assert!(
                     (av - 1e-6..=1.0 + 1e-6).contains(&factor),
-                    "G({av}, {rho}) = {factor} is outside [AV, 1]"
+                    "{mode:?}: G({av}, {rho}) = {factor} is outside [AV, 1]"
                 );
+                if mode == ProbeAo::Relative {
+                    // only the occlusion the probes lack: never darker than × G(AV, ρ)
+                    let g = ao_multibounce(av, rho);
+                    assert!(factor >= g - 1e-6, "relative {factor} < G {g}");
+                    relative_lighter += (factor > g + 0.02) as usize;
+                }
                 let (got, want) = (field.data[s.i * 4 + c], e[c] * factor);
                 assert!(
                     (got - want).abs() <= 5e-3 * want.abs().max(0.05),
-                    "{mode:?}, pixel ({}, {}) channel {c}: GPU {got} vs CPU {want} (AV {av}, ρ {rho})",
+                    "{mode:?}, pixel ({}, {}) channel {c}: GPU {got} vs CPU {want} (AV {av}, V_probe {v}, ρ {rho})",
                     s.x,
                     s.y
                 );
@@ -500,6 +520,10 @@ fn probe_ao_modes_match_cpu_twin() {
             points.len()
         );
     }
+    assert!(
+        relative_lighter > 100,
+        "weak test: relative differs from multibounce at {relative_lighter} samples"
+    );
 }
 
 /// `probe-detail`: the gather's layer-0 output is Ê[B] − Ê[L_probe] — its own estimate minus

@@ -31,6 +31,44 @@ pub fn sh9(d: Vec3) -> [f32; 9] {
     ]
 }
 
+/// The k-th of n nearly uniform unit directions (spherical Fibonacci).
+pub fn fibonacci_sphere(k: u32, n: u32) -> Vec3 {
+    let golden = 0.618_034_f32;
+    let z = 1.0 - (2.0 * k as f32 + 1.0) / n as f32;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * ((k as f32 * golden).fract());
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// [`IrradianceProbes::openness_sh`] of a probe open in every direction (1 for every
+/// normal: 1/Y_0 in band 0).
+pub const OPEN_EVERYWHERE: [f32; 4] = [1.0 / 0.282_095, 0.0, 0.0, 0.0];
+
+/// Directions [`IrradianceProbes::openness_sh`] projects over.
+pub const OPENNESS_RAYS: u32 = 512;
+
+/// The complementary error function, erfc(x) = 1 − erf(x), to 1.5·10⁻⁷ (Abramowitz &
+/// Stegun 7.1.26, mirrored for x < 0).
+pub fn erfc(x: f32) -> f32 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.327_591_1 * z);
+    let poly = t * (0.254_829_6 + t * (-0.284_496_74 + t * (1.421_413_7 + t * (-1.453_152_1 + t * 1.061_405_4))));
+    let r = poly * (-z * z).exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
+}
+
+/// The chance that a direction's first surface lies beyond `r`, for a distance map texel's
+/// moments (mean, mean square): a normal distribution of that mean and variance, its
+/// deviation at least 1 % of the mean.
+pub fn open_fraction(r: f32, mean: f32, mean2: f32) -> f32 {
+    let sigma = (mean2 - mean * mean).max(0.0).sqrt().max(0.01 * mean).max(1e-6);
+    0.5 * erfc((r - mean) / (sigma * std::f32::consts::SQRT_2))
+}
+
 /// Band of coefficient i.
 pub fn sh_band(i: usize) -> usize {
     match i {
@@ -265,6 +303,56 @@ impl IrradianceProbes {
         out
     }
 
+    /// Probe `index`'s openness within radius `r` as order-1 SH (Y_0..Y_3), convolved with
+    /// the clamped cosine and divided by π: [`Self::openness`] for a normal n is the
+    /// cosine-weighted share of the hemisphere around n whose first surface (distance map,
+    /// [`open_fraction`]) lies beyond r — the ambient visibility that the probe's baked
+    /// irradiance already holds. 1 for every n without distance maps.
+    pub fn openness_sh(&self, index: usize, r: f32) -> [f32; 4] {
+        if self.depth.is_empty() {
+            return OPEN_EVERYWHERE;
+        }
+        let mut o = [0.0f32; 4];
+        for k in 0..OPENNESS_RAYS {
+            let d = fibonacci_sphere(k, OPENNESS_RAYS);
+            // the texel holding d (a bilinear lookup would blur each surface's edge over
+            // a band of texels, about a fifth of a hemisphere at 16×16)
+            let st = (oct_encode(d) * DEPTH_OCT as f32).floor();
+            let (x, y) = (
+                st.x.clamp(0.0, DEPTH_OCT as f32 - 1.0),
+                st.y.clamp(0.0, DEPTH_OCT as f32 - 1.0),
+            );
+            let [mean, mean2] = self.depth[index][y as usize * DEPTH_OCT + x as usize];
+            let v = open_fraction(r, mean, mean2);
+            for (oi, yi) in o.iter_mut().zip(sh9(d)) {
+                *oi += v * yi;
+            }
+        }
+        let dw = 4.0 * std::f32::consts::PI / OPENNESS_RAYS as f32;
+        // Â_l / π: 1 for band 0, 2/3 for band 1
+        let mut out = [0.0f32; 4];
+        for (i, (out, oi)) in out.iter_mut().zip(o).enumerate() {
+            *out = oi * dw * COSINE_LOBE[sh_band(i)] / std::f32::consts::PI;
+        }
+        out
+    }
+
+    /// Probe `index`'s openness for normal `n` from its [`Self::openness_sh`] coefficients
+    /// `v`, clamped to [0, 1] (`probe_openness` in `common/probes.wgsl`).
+    pub fn openness(v: &[f32; 4], n: Vec3) -> f32 {
+        let y = sh9(n);
+        (0..4).map(|i| v[i] * y[i]).sum::<f32>().clamp(0.0, 1.0)
+    }
+
+    /// The probes' openness at receiver p (normal n), blended with [`Self::irradiance`]'s
+    /// weights; `v` = every probe's [`Self::openness_sh`].
+    pub fn openness_at(&self, v: &[[f32; 4]], p: Vec3, n: Vec3) -> f32 {
+        self.corner_weights(p, n)
+            .iter()
+            .map(|&(index, w)| Self::openness(&v[index], n) * w)
+            .sum()
+    }
+
     /// The blended probes' incident radiance at p (receiver normal n) as order-2 SH
     /// coefficients: L_lm = E_lm / Â_l ([`COSINE_LOBE`]), so that the cosine-weighted
     /// hemisphere integral of [`sh_radiance`] (without its clamp) is
@@ -314,6 +402,52 @@ pub fn facing_weight(to_probe: Vec3, n: Vec3) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn erfc_matches_tabulated_values() {
+        for (x, want) in [
+            (0.0f32, 1.0f32),
+            (0.5, 0.479_500_1),
+            (1.0, 0.157_299_2),
+            (2.0, 0.004_677_7),
+            (-1.0, 1.842_700_8),
+        ] {
+            assert!((erfc(x) - want).abs() < 2e-6, "erfc({x}) = {} vs {want}", erfc(x));
+        }
+        // the normal model: half the mass beyond the mean, almost none 4σ short of it
+        assert!((open_fraction(1.0, 1.0, 1.01) - 0.5).abs() < 1e-6);
+        assert!(open_fraction(1.4, 1.0, 1.01) < 1e-4);
+        assert!(open_fraction(0.6, 1.0, 1.01) > 1.0 - 1e-4);
+    }
+
+    /// A probe whose lower half-space (z < 0) has surfaces 5 cm away and whose upper half
+    /// is open: its openness within r = 0.5 is exactly the cosine-weighted share of the
+    /// hemisphere above z = 0 (order-1 SH holds a half-space's cosine convolution exactly):
+    /// 1 facing up, 0 facing down, ½ sideways; open everywhere without distance maps.
+    #[test]
+    fn openness_of_a_half_space_is_its_cosine_weighted_share() {
+        let mut p = IrradianceProbes::grid(Vec3::ZERO, Vec3::ONE, [1, 1, 1]);
+        let v = p.openness_sh(0, 0.5);
+        for n in [Vec3::X, -Vec3::Z, Vec3::new(1.0, 2.0, -3.0).normalize()] {
+            assert!((IrradianceProbes::openness(&v, n) - 1.0).abs() < 1e-5);
+        }
+        let mut map = [[0.0f32; 2]; DEPTH_TEXELS];
+        for (t, m) in map.iter_mut().enumerate() {
+            let uv = glam::Vec2::new((t % DEPTH_OCT) as f32 + 0.5, (t / DEPTH_OCT) as f32 + 0.5) / DEPTH_OCT as f32;
+            let d = if oct_decode(uv).z < 0.0 { 0.05 } else { 50.0 };
+            *m = [d, d * d];
+        }
+        p.depth = vec![map];
+        let v = p.openness_sh(0, 0.5);
+        for (n, want) in [(Vec3::Z, 1.0), (-Vec3::Z, 0.0), (Vec3::X, 0.5), (-Vec3::Y, 0.5)] {
+            let got = IrradianceProbes::openness(&v, n);
+            // texels straddling the plane z = 0 count as near or far whole
+            assert!((got - want).abs() < 0.06, "n = {n}: openness {got} vs {want}");
+        }
+        // beyond the near surfaces' distance nothing is open below
+        let near = p.openness_sh(0, 0.01);
+        assert!((IrradianceProbes::openness(&near, -Vec3::Z) - 1.0).abs() < 0.02);
+    }
 
     /// A probe of uniform radiance L gives irradiance πL for every normal.
     #[test]

@@ -18,7 +18,8 @@ struct Compose {
     // gather's screen-space detail (`radiosity::RadiositySettings::probe_detail`), 3 = as 1
     // with a one-sided c (`radiosity::probe_blend`)
     use_probes: u32,
-    // the probe term × AV (1), × GTAO's multi-bounce G(AV, rho) (2), or not (0)
+    // the probe term × AV (1), × GTAO's multi-bounce G(AV, rho) (2), × G(AV, rho) /
+    // G(V_probe, rho) at most 1 (3, `radiosity::ProbeAo::Relative`), or not (0)
     use_ao: u32,
     // 1 = add the glossy receivers' radiance (ILS `ils-glossy`) as is
     use_glossy: u32,
@@ -82,12 +83,17 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         if (compose.use_ao != 0u) {
             av = textureLoad(ao, p, 0).r;
             occlusion = vec3f(av);
-            if (compose.use_ao == 2u) {
+            if (compose.use_ao >= 2u) {
                 occlusion = ao_multibounce(av, rho);
             }
         }
         let x = world_from_csz(frame, vec2f(p) + 0.5, z);
-        let ep = probe_field(compose.grid, x, oct_decode(nrm.rg)) * occlusion;
+        let field = probe_field(compose.grid, x, oct_decode(nrm.rg));
+        if (compose.use_ao == 3u) {
+            // only the occlusion the probes do not hold (`radiosity::probe_ao_factor`)
+            occlusion = min(occlusion / max(ao_multibounce(field.a, rho), vec3f(1e-3)), vec3f(1.0));
+        }
+        let ep = field.rgb * occlusion;
         o.probe = vec4f(ep, av);
         if (compose.use_probes == 2u) {
             // E = G·E_probe + c·(Ê[B] − Ê[L_probe]): the gather's estimate of what the

@@ -55,7 +55,9 @@ pub struct ProbeGpu {
 }
 
 impl ProbeGpu {
-    pub fn new(gpu: &GpuContext, probes: Option<&IrradianceProbes>) -> Self {
+    /// `ao_radius`: the AO's world-space radius r, for each probe's own openness within r
+    /// (`IrradianceProbes::openness_sh`, `ProbeAo::Relative`); `None`: every probe open.
+    pub fn new(gpu: &GpuContext, probes: Option<&IrradianceProbes>, ao_radius: Option<f32>) -> Self {
         let grid = ProbeGridUniform {
             origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
             spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(p.visibility_bias()).to_array()),
@@ -71,11 +73,17 @@ impl ProbeGpu {
                 .enumerate()
                 .flat_map(|(index, (c, &valid))| {
                     let offset = p.offsets.get(index).copied().unwrap_or([0.0; 3]);
-                    // w: the validity (coefficient 0), the relocation offset (1–3)
+                    let open = match ao_radius {
+                        Some(r) => p.openness_sh(index, r),
+                        None => strata_scene::probes::OPEN_EVERYWHERE,
+                    };
+                    // w: the validity (coefficient 0), the relocation offset (1–3), the
+                    // openness within the AO radius as order-1 SH (4–7)
                     c.iter().enumerate().map(move |(i, rgb)| {
                         let w = match i {
                             0 => valid as u32 as f32,
                             1..=3 => offset[i - 1],
+                            4..=7 => open[i - 4],
                             _ => 0.0,
                         };
                         [rgb[0], rgb[1], rgb[2], w]
@@ -152,7 +160,7 @@ impl ComposePass {
         let gpu_probes = match &probes {
             Some(p) => p.probes,
             None => {
-                dummy = ProbeGpu::new(gpu, None);
+                dummy = ProbeGpu::new(gpu, None, None);
                 &dummy
             }
         };

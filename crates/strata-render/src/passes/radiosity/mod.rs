@@ -132,6 +132,25 @@ pub enum ProbeAo {
     /// reflect light too, the more the brighter the receiver's albedo ρ, so AV darkens
     /// less than × AV does (G(AV, ρ) ≥ AV, G(1, ρ) = 1; not in the paper).
     MultiBounce = 2,
+    /// × G(AV, ρ) / G(V_probe, ρ), at most 1: only the occlusion the probes do not hold
+    /// already. V_probe is the blended probes' own openness within the AO radius, from
+    /// their distance maps (`IrradianceProbes::openness_sh`): the baked irradiance of a
+    /// probe near a wall already lacks the light that wall blocks, so × G alone removes
+    /// it twice. Occluders the bake has not seen (a moved object) still darken fully.
+    /// Without distance maps V_probe = 1 and this is `MultiBounce`. Not in the paper.
+    Relative = 3,
+}
+
+/// The factor by which AO darkens the probes' irradiance in channel ρ ([`ProbeAo`]; CPU
+/// twin of compose.wgsl's `occlusion`): `av` the receiver's AV, `open` the blended probes'
+/// openness V_probe (`IrradianceProbes::openness_at`).
+pub fn probe_ao_factor(mode: ProbeAo, av: f32, open: f32, rho: f32) -> f32 {
+    match mode {
+        ProbeAo::Off => 1.0,
+        ProbeAo::Plain => av,
+        ProbeAo::MultiBounce => ao_multibounce(av, rho),
+        ProbeAo::Relative => (ao_multibounce(av, rho) / ao_multibounce(open, rho).max(1e-3)).min(1.0),
+    }
 }
 
 /// GTAO's multi-bounce fit G(AV, ρ) per colour channel (CPU twin of `ao_multibounce` in
@@ -261,7 +280,7 @@ impl Default for RadiositySettings {
             open_sky: false,
             hidden_black: false,
             probe_visibility: true,
-            probe_ao: ProbeAo::MultiBounce,
+            probe_ao: ProbeAo::Relative,
             normalisation: Normalisation::Bounded,
             probe_detail: false,
             one_sided_confidence: true,
@@ -459,7 +478,7 @@ impl RadiosityPass {
         let gpu_probes = match probes {
             Some(p) => p,
             None => {
-                dummy = crate::passes::compose::ProbeGpu::new(gpu, None);
+                dummy = crate::passes::compose::ProbeGpu::new(gpu, None, None);
                 &dummy
             }
         };

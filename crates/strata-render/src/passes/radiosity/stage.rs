@@ -29,6 +29,7 @@ impl RadiosityStage {
         s: &RadiositySettings,
         guard: u32,
         probes: Option<&strata_scene::probes::IrradianceProbes>,
+        ao_radius: f32,
     ) -> Self {
         use wgpu::TextureFormat as F;
         for t in crate::passes::radiosity::OUTPUTS {
@@ -96,7 +97,8 @@ impl RadiosityStage {
             }
             other => other,
         };
-        let probe_gpu = probes.map(|p| crate::passes::compose::ProbeGpu::new(gpu, Some(p)));
+        let open_radius = (s.probe_ao == crate::passes::radiosity::ProbeAo::Relative).then_some(ao_radius);
+        let probe_gpu = probes.map(|p| crate::passes::compose::ProbeGpu::new(gpu, Some(p), open_radius));
         let detail = s.probe_detail && probe_gpu.is_some();
         let gather = RadiosityPass::new(
             gpu,

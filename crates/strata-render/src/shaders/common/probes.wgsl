@@ -201,13 +201,25 @@ fn probe_weights(corners: ProbeCorners) -> array<f32, 8> {
     return out;
 }
 
-// The probes' irradiance at receiver p with normal n: `probe_weights`' blend in one
-// pass over the corners (no per-pixel arrays: the composition's hot path).
-fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f) -> vec3f {
+// Probe `index`'s openness within the AO radius for a normal whose SH basis is `basis`:
+// order-1 SH in c[4..7].w, clamped to [0, 1] (as `IrradianceProbes::openness`).
+fn probe_openness(index: u32, basis: array<f32, 9>) -> f32 {
+    var y = basis;
+    var v = 0.0;
+    for (var i = 0u; i < 4u; i++) {
+        v += probes[index].c[4u + i].w * y[i];
+    }
+    return clamp(v, 0.0, 1.0);
+}
+
+// The probes' irradiance (rgb) and openness (a) at receiver p with normal n:
+// `probe_weights`' blend in one pass over the corners (no per-pixel arrays: the
+// composition's hot path; as `IrradianceProbes::irradiance` and `openness_at`).
+fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f) -> vec4f {
     var sum = 0.0;
     var sum_all = 0.0;
-    var e = vec3f(0.0);
-    var e_all = vec3f(0.0);
+    var e = vec4f(0.0);
+    var e_all = vec4f(0.0);
     let cell = probe_cell(grid, p);
     let basis = sh9(n);
     for (var corner = 0u; corner < 8u; corner++) {
@@ -217,7 +229,7 @@ fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f) -> vec3f {
             continue;
         }
         let valid = probes[k.index].c[0].w;
-        let ek = probe_irradiance(k.index, basis);
+        let ek = vec4f(probe_irradiance(k.index, basis), probe_openness(k.index, basis));
         sum += k.w * valid;
         sum_all += k.w;
         e += ek * (k.w * valid);
