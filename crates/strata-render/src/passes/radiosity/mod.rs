@@ -291,8 +291,8 @@ impl Default for RadiositySettings {
 impl RadiositySettings {
     /// DGB's estimator exactly as published: per-pixel (not per-frame) spiral
     /// rotation, Eq. 4's equal tap weights and normaliser, probes blended without a
-    /// visibility test and darkened by × AV, the temporal filter's α from the first
-    /// frame (the rest as [`Default`]).
+    /// visibility test and darkened by × AV with DGB's confidence c, the temporal filter's
+    /// α from the first frame (the rest as [`Default`]).
     pub fn paper() -> Self {
         Self {
             temporal_noise: false,
@@ -304,6 +304,7 @@ impl RadiositySettings {
             normalisation: Normalisation::Hemisphere,
             probe_visibility: false,
             probe_ao: ProbeAo::Plain,
+            one_sided_confidence: false,
             ..Default::default()
         }
     }
