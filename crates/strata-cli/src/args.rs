@@ -527,7 +527,7 @@ pub struct EvalArgs {
     /// Static frames rendered before the evaluated one (gi: the progressive bounces and the
     /// temporal filter build up; 8 is a short history, a camera held still reaches its
     /// steady state by about 32: docs/radiosity.md § "Cosine normalisation"), 0..=1000.
-    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=1000))]
+    #[arg(long, default_value_t = strata_render::ACCUMULATION_WARMUP, value_parser = clap::value_parser!(u32).range(0..=1000))]
     pub warmup: u32,
     /// Folder of cached reference images (default: $STRATA_CACHE, else $XDG_CACHE_HOME/strata/reference, else ~/.cache/strata/reference).
     #[arg(long)]
@@ -579,9 +579,11 @@ pub struct RenderArgs {
     #[arg(long)]
     pub timings: bool,
     /// Frames rendered before the output frame (along the camera path), 0..=1000, so temporal
-    /// filters and progressive bounces (DGB §3.3) have history.
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=1000))]
-    pub warmup: u32,
+    /// filters and progressive bounces (DGB §3.3) have history. Default: 8 where the frame
+    /// builds up over frames (AO's and the radiosity's temporal filters, the progressive
+    /// bounces), else 0; `--warmup 0` shows the first frame after a cut.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1000))]
+    pub warmup: Option<u32>,
 }
 
 /// What a frame renders: scene, camera, technique and its settings (shared by

@@ -103,7 +103,14 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     // Frames before the output one: single-pass layers test against last
     // frame's depths, temporal filters and progressive bounces accumulate.
-    let warmup = a.warmup.max(r.settings.deep.uses_history() as u32);
+    let warmup = a
+        .warmup
+        .unwrap_or(if r.accumulates() {
+            strata_render::ACCUMULATION_WARMUP
+        } else {
+            0
+        })
+        .max(r.settings.deep.uses_history() as u32);
     for i in (1..=warmup).rev() {
         let t = f.scene.frame - i as f32;
         r.render(&gpu, &scene, &cameras_at(&scene, &f.scene, t), t)?;

@@ -350,6 +350,85 @@ fn render_ao_writes_visibility_in_unit_range_darker_in_corners() {
     assert!(max > 0.95 && min < 0.6, "AV range {min}..{max} is not an AO image");
 }
 
+/// `render` without `--warmup` warms a frame that builds up over frames (AO's temporal
+/// filter) up by `ACCUMULATION_WARMUP` frames, and a frame that does not (direct light) by
+/// none; the warmed-up AO is closer to the ray-traced obscurance than the first frame after a
+/// cut (issue 14: the demo's single-frame `atrium-ao.png` showed one frame's sampling pattern).
+#[test]
+fn render_warms_up_accumulating_frames_by_default() {
+    let render = |technique: &str, warmup: Option<&str>, name: &str| -> strata_scene::ImageBuf {
+        let out = scratch(name);
+        let mut args = vec![
+            "render",
+            "--scene",
+            "cornell",
+            "--technique",
+            technique,
+            "--layers",
+            "2",
+            "--width",
+            "96",
+            "--height",
+            "96",
+            "--force",
+            "--out",
+        ];
+        args.push(out.to_str().unwrap());
+        if let Some(w) = warmup {
+            args.extend(["--warmup", w]);
+        }
+        let o = strata(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        strata_scene::ImageBuf::load(&out).unwrap()
+    };
+    let auto = render("ao", None, "warmup-auto.exr");
+    let eight = render(
+        "ao",
+        Some(&strata_render::ACCUMULATION_WARMUP.to_string()),
+        "warmup-8.exr",
+    );
+    let first = render("ao", Some("0"), "warmup-0.exr");
+    assert_eq!(auto.data, eight.data, "the default is ACCUMULATION_WARMUP frames");
+    assert_ne!(auto.data, first.data, "AO accumulates: the warm-up changes the frame");
+    assert_eq!(
+        render("direct", None, "warmup-direct-auto.exr").data,
+        render("direct", Some("0"), "warmup-direct-0.exr").data,
+        "direct light does not accumulate: no warm-up by default"
+    );
+    let reference = scratch("warmup-obscurance.exr");
+    let o = strata(&[
+        "reference",
+        "--scene",
+        "cornell",
+        "--kind",
+        "obscurance",
+        "--spp",
+        "512",
+        "--width",
+        "96",
+        "--height",
+        "96",
+        "--quiet",
+        "--out",
+        reference.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = strata_scene::ImageBuf::load(&reference).unwrap();
+    let rmse = |img: &strata_scene::ImageBuf| {
+        let sq: f64 = (img.data.chunks_exact(img.channels as usize))
+            .zip(reference.data.chunks_exact(reference.channels as usize))
+            .map(|(a, b)| (a[0] as f64 - b[0] as f64).powi(2))
+            .sum();
+        (sq / (96.0 * 96.0)).sqrt()
+    };
+    let (warm, cut) = (rmse(&auto), rmse(&first));
+    eprintln!("AV RMSE vs the 512-spp obscurance: default {warm:.5}, --warmup 0 {cut:.5}");
+    assert!(
+        warm < cut,
+        "the warmed-up AO ({warm}) is no closer to the reference than the first frame ({cut})"
+    );
+}
+
 #[test]
 fn eval_ao_prints_errors_and_caches_the_reference() {
     let cache = scratch("ref-cache");

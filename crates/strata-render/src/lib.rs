@@ -19,7 +19,7 @@ pub mod technique;
 
 pub use gpu::{GpuContext, GpuOptions};
 pub use profiler::PassTimings;
-pub use renderer::{RenderSettings, Renderer};
+pub use renderer::{RenderSettings, Renderer, ACCUMULATION_WARMUP};
 
 /// Errors from the GPU side; each names what is wrong and what is valid.
 #[derive(Debug, thiserror::Error)]

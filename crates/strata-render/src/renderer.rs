@@ -138,6 +138,13 @@ impl std::str::FromStr for GuardBand {
     }
 }
 
+
+/// Frames `strata render` draws before its output frame when `--warmup` is not given and
+/// the frame [accumulates](Renderer::accumulates), and `strata eval`'s default warm-up:
+/// by then the temporal filters' start-up ramp has reached the paper's α (it averages the
+/// first frames' sampling patterns equally) and the progressive bounces have propagated 8 times.
+pub const ACCUMULATION_WARMUP: u32 = 8;
+
 /// What to render and how.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -879,6 +886,18 @@ impl Renderer {
             Some(i) => i.set_vpls(gpu, vpls),
             None => Err(RenderError::Parameter("set_vpls: the renderer has no ils stage".into())),
         }
+    }
+
+    /// Whether this frame's output builds up over frames: AO's or the radiosity's
+    /// temporal filter (DGB §3.3), or the radiosity's progressive bounces. The first
+    /// frame after a cut then shows one frame's sampling pattern and a single bounce;
+    /// `strata render` warms such frames up by [`ACCUMULATION_WARMUP`] unless told otherwise.
+    pub fn accumulates(&self) -> bool {
+        self.ao.as_ref().is_some_and(|a| a.temporal.is_some())
+            || self
+                .radiosity
+                .as_ref()
+                .is_some_and(|r| r.temporal.is_some() || r.propagate.is_some())
     }
 
     /// The A-buffer stage (read-back of its lists and compressed nodes), if on.

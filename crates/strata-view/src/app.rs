@@ -550,10 +550,9 @@ impl App {
             a.extend(["--debug-view".to_string(), d.clone()]);
         }
         // temporal filters and progressive bounces: as many static frames as the viewer drew
+        // (always given: `render`'s own default warms an accumulating frame up)
         let warm = self.still_frames.saturating_sub(1).min(60);
-        if warm > 0 {
-            a.extend(["--warmup".to_string(), warm.to_string()]);
-        }
+        a.extend(["--warmup".to_string(), warm.to_string()]);
         a.extend(["--out".to_string(), out.display().to_string()]);
         a.iter().map(|s| crate::shell_quote(s)).collect::<Vec<_>>().join(" ")
     }
