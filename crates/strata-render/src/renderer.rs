@@ -138,7 +138,6 @@ impl std::str::FromStr for GuardBand {
     }
 }
 
-
 /// Frames `strata render` draws before its output frame when `--warmup` is not given and
 /// the frame [accumulates](Renderer::accumulates), and `strata eval`'s default warm-up:
 /// by then the temporal filters' start-up ramp has reached the paper's α (it averages the
@@ -561,7 +560,14 @@ impl Renderer {
             );
         }
         let ao = match &settings.ao {
-            Some(a) => Some(AoStage::new(gpu, &scene_gpu, &mut targets, &settings.deep, a)?),
+            Some(a) => Some(AoStage::new(
+                gpu,
+                &scene_gpu,
+                &mut targets,
+                &settings.deep,
+                a,
+                a.resolve(scene).0,
+            )?),
             None => None,
         };
         let bzb = match &settings.bzb {

@@ -282,7 +282,7 @@ static DIRECT_SETTINGS: [SettingInfo; 3] = [
     },
 ];
 
-static AO_SETTINGS: [SettingInfo; 14] = [
+static AO_SETTINGS: [SettingInfo; 15] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
@@ -398,6 +398,14 @@ static AO_SETTINGS: [SettingInfo; 14] = [
         ao_of,
         ao_mut,
         filter_obscurance,
+        ["off", "on"]
+    ),
+    bool_setting!(
+        "blur-distance",
+        "on: the bilateral reconstruction also weighs a tap by its surface's world distance from X, max(0, 1 - d^2/r^2) with r the AO radius (not in the paper; a surface seen at a grazing angle no longer averages pixels metres apart); off: DGB's plane and normal weights",
+        ao_of,
+        ao_mut,
+        distance_weight,
         ["off", "on"]
     ),
 ];

@@ -717,3 +717,60 @@ fn filtered_obscurance_is_eq1_before_the_square_root_and_resolves_to_av() {
         eprintln!("{pattern:?}: {close}/{n} S within 1e-4, resolve vs AV worst {worst}");
     }
 }
+
+/// The AO's reconstruction with the distance weight (`AoSettings::distance_weight`, the
+/// default): each GPU pass equals `bilateral_cpu` over the same buffers, and on the
+/// interior (the outside ground seen through the window at a grazing angle, the floor far
+/// off) the weight cuts taps that DGB's plane and normal weights accept.
+#[test]
+fn distance_weighted_reconstruction_matches_its_cpu_twin_and_cuts_far_taps() {
+    use strata_render::passes::bilateral::{bilateral_cpu, distance_weight};
+    let gpu = common::gpu();
+    let scene = frozen("interior");
+    let (w, h, layers) = (128u32, 128u32, 2u32);
+    let s = AoSettings {
+        temporal: None,
+        ..AoSettings::default()
+    };
+    assert!(s.distance_weight, "on by default");
+    let mut r = ao_renderer(&gpu, &scene, w, h, layers, s.clone());
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+        .expect("frame renders without validation errors");
+    let read = |name: &str| r.read_target_full(&gpu, name, 0).unwrap();
+    let (raw, gpu_h, gpu_v) = (read("ao-raw"), read("ao-blur-h"), read("ao-obscurance"));
+    let zpack = read("zpack");
+    let normals = common::npack_normals(&read("npack"), 0);
+    let f = r.frame_uniforms();
+    let radius = s.resolve(&scene).0;
+    let blur = s.reconstruction(radius);
+    assert_eq!(blur.world_radius, Some(radius));
+    let twin = |src: &ImageBuf, b, vertical| bilateral_cpu(src, &zpack, &normals, &f, b, vertical);
+    let n = (w * h) as usize;
+    // R16F targets
+    let near = |g: &ImageBuf, c: &ImageBuf| {
+        (0..n)
+            .filter(|&i| {
+                let (g, c) = (g.data[i * g.channels as usize], c.data[i]);
+                (g - c).abs() <= 2e-3 + 2e-3 * c.abs()
+            })
+            .count()
+    };
+    let (close_h, close_v) = (
+        near(&gpu_h, &twin(&raw, &blur, false)),
+        near(&gpu_v, &twin(&gpu_h, &blur, true)),
+    );
+    // both passes, with and without the distance weight, from the same raw S
+    let with = twin(&twin(&raw, &blur, false), &blur, true);
+    let paper = twin(&twin(&raw, &s.blur, false), &s.blur, true);
+    let cut = (0..n).filter(|&i| (with.data[i] - paper.data[i]).abs() > 0.01).count();
+    eprintln!("GPU = twin: {close_h}/{n} (h), {close_v}/{n} (v); the distance weight moves {cut} pixels by > 0.01");
+    assert!(close_h as f32 >= 0.995 * n as f32, "h: {close_h}/{n} GPU = CPU twin");
+    assert!(close_v as f32 >= 0.995 * n as f32, "v: {close_v}/{n} GPU = CPU twin");
+    assert!(
+        cut >= n / 200,
+        "test is weak: the distance weight moves only {cut} pixels"
+    );
+    assert_eq!(distance_weight(0.0, radius), 1.0);
+    assert_eq!(distance_weight(radius * radius, radius), 0.0);
+    assert_eq!(distance_weight(4.0 * radius * radius, radius), 0.0);
+}

@@ -11,6 +11,7 @@
 //! | `glasshouse` | coloured glass panes overlapping in view, a translucent sphere before opaque blocks: ≥ 8 transparent crossings per pixel (A-buffer OIT, ABA) |
 //! | `still-life` | glossy and diffuse objects on a cloth, an orange emitter hidden from the camera, a hollow "skull" box whose inside the emitter cannot see (bounced z-buffer Fig. 1 / Fig. 8 rows 2–3) |
 //! | `dominoes` | 115 coloured dominoes in a spiral on a glossy metal floor, 1,382 triangles (bounced z-buffer Fig. 8, last rows) |
+//! | `interior` | a furnished room: a mullioned window, ceiling–wall edges, a table and slatted chairs, a bookshelf, a sofa, skirting boards, a floor lamp (AO on thin frames and concave edges, issue 14) |
 //!
 //! Static geometry is merged into one object per material, named after the
 //! material (e.g. `banner_red`); animated parts are separate objects.
@@ -34,6 +35,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "glasshouse",
     "still-life",
     "dominoes",
+    "interior",
 ];
 
 /// The built-in scene called `name`, or `None` when there is none.
@@ -49,6 +51,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "glasshouse" => Some(glasshouse()),
         "still-life" => Some(still_life()),
         "dominoes" => Some(dominoes()),
+        "interior" => Some(interior()),
         _ => None,
     }
 }
@@ -591,6 +594,140 @@ pub fn dense() -> Scene {
         ambient: [0.03; 3],
     };
     b.finish(camera, vec![sun], settings)
+}
+
+/// A furnished room, 6 × 2.7 × 5.5 m (x ∈ [−3, 3], z ∈ [−4, 1.5]), the case issue 14
+/// was filed on (a furnished interior's AO at radius 0.5): a window in the back wall
+/// split by 4 cm mullions and a transom, the ceiling meeting the walls in concave
+/// edges, a table on thin legs with two slatted chairs, a bookshelf of books
+/// against the right wall, a sofa, a picture frame, 1.5 cm skirting boards and a
+/// floor lamp on a 3 cm pole. A sun shines in through the window, a point light
+/// hangs under the ceiling; outside, a ground plane and a facade.
+pub fn interior() -> Scene {
+    let mut b = SceneBuilder::new("interior");
+    let wall = b.material(Material::diffuse("wall", [0.78, 0.76, 0.72]));
+    let floor = b.material(Material::diffuse("floor", [0.46, 0.33, 0.21]));
+    let wood = b.material(Material::diffuse("wood", [0.52, 0.38, 0.26]));
+    let frame = b.material(Material::diffuse("window_frame", [0.85, 0.85, 0.83]));
+    let fabric = b.material(Material::diffuse("fabric", [0.32, 0.38, 0.48]));
+    let dark = b.material(Material::diffuse("dark", [0.12, 0.11, 0.1]));
+    let outside = b.material(Material::diffuse("outside", [0.5, 0.5, 0.47]));
+    let books = [
+        b.material(Material::diffuse("book_red", [0.6, 0.1, 0.08])),
+        b.material(Material::diffuse("book_green", [0.12, 0.4, 0.15])),
+        b.material(Material::diffuse("book_cream", [0.75, 0.7, 0.55])),
+    ];
+    let (x0, x1, z0, z1, h, t) = (-3.0f32, 3.0f32, -4.0f32, 1.5f32, 2.7f32, 0.2f32);
+    // floor, ceiling and walls (boxes outside the room); the back wall (z = z0) has a
+    // window opening x ∈ [−1.2, 1.2], y ∈ [0.9, 2.2]
+    b.geo(floor).cuboid(v(x0, -t, z0), v(x1, 0.0, z1));
+    b.geo(wall).cuboid(v(x0 - t, h, z0 - t), v(x1 + t, h + t, z1 + t));
+    b.geo(wall).cuboid(v(x0 - t, -t, z0), v(x0, h, z1));
+    b.geo(wall).cuboid(v(x1, -t, z0), v(x1 + t, h, z1));
+    b.geo(wall).cuboid(v(x0 - t, -t, z1), v(x1 + t, h, z1 + t));
+    let (wx0, wx1, wy0, wy1) = (-1.2f32, 1.2f32, 0.9f32, 2.2f32);
+    b.geo(wall).cuboid(v(x0 - t, -t, z0 - t), v(wx0, h, z0));
+    b.geo(wall).cuboid(v(wx1, -t, z0 - t), v(x1 + t, h, z0));
+    b.geo(wall).cuboid(v(wx0, -t, z0 - t), v(wx1, wy0, z0));
+    b.geo(wall).cuboid(v(wx0, wy1, z0 - t), v(wx1, h, z0));
+    // window: frame, sill, two 4 cm mullions and a transom
+    let (fz0, fz1) = (z0 - 0.12, z0 - 0.04);
+    b.geo(frame).cuboid(v(wx0, wy0, fz0), v(wx0 + 0.06, wy1, fz1));
+    b.geo(frame).cuboid(v(wx1 - 0.06, wy0, fz0), v(wx1, wy1, fz1));
+    b.geo(frame).cuboid(v(wx0, wy1 - 0.06, fz0), v(wx1, wy1, fz1));
+    b.geo(frame)
+        .cuboid(v(wx0 - 0.05, wy0 - 0.04, z0 - 0.12), v(wx1 + 0.05, wy0, z0 + 0.12));
+    for x in [-0.42f32, 0.38] {
+        b.geo(frame).cuboid(v(x, wy0, fz0), v(x + 0.04, wy1, fz1));
+    }
+    b.geo(frame).cuboid(v(wx0, 1.62, fz0), v(wx1, 1.66, fz1));
+    // outside: ground and a facade across the street
+    b.geo(outside).cuboid(v(-12.0, -0.5, -16.0), v(12.0, -0.3, z0 - t));
+    b.geo(outside).cuboid(v(-12.0, -0.3, -16.5), v(12.0, 2.0, -16.0));
+    // skirting boards, 8 cm high and 1.5 cm thick, along the walls but the front one
+    let (sk, sh) = (0.015f32, 0.08f32);
+    b.geo(wood).cuboid(v(x0, 0.0, z0), v(wx0, sh, z0 + sk));
+    b.geo(wood).cuboid(v(wx1, 0.0, z0), v(x1, sh, z0 + sk));
+    b.geo(wood).cuboid(v(x0, 0.0, z0 + sk), v(x0 + sk, sh, z1));
+    b.geo(wood).cuboid(v(x1 - sk, 0.0, z0 + sk), v(x1, sh, z1));
+    // table on 5 cm legs
+    let (tx0, tx1, tz0, tz1) = (-0.8f32, 0.6f32, -2.6f32, -1.8f32);
+    b.geo(wood).cuboid(v(tx0, 0.72, tz0), v(tx1, 0.76, tz1));
+    for (x, z) in [
+        (tx0 + 0.04, tz0 + 0.04),
+        (tx1 - 0.09, tz0 + 0.04),
+        (tx0 + 0.04, tz1 - 0.09),
+        (tx1 - 0.09, tz1 - 0.09),
+    ] {
+        b.geo(wood).cuboid(v(x, 0.0, z), v(x + 0.05, 0.72, z + 0.05));
+    }
+    // two chairs: 3 cm legs, a seat, a back of three slats
+    for (cx, cz, back_z) in [(-0.45f32, -1.45f32, 1.0f32), (0.15, -2.95, -1.0)] {
+        let (sx0, sz0) = (cx - 0.21, cz - 0.21);
+        b.geo(wood).cuboid(v(sx0, 0.44, sz0), v(sx0 + 0.42, 0.47, sz0 + 0.42));
+        for (dx, dz) in [(0.0, 0.0), (0.39, 0.0), (0.0, 0.39), (0.39, 0.39)] {
+            b.geo(wood)
+                .cuboid(v(sx0 + dx, 0.0, sz0 + dz), v(sx0 + dx + 0.03, 0.44, sz0 + dz + 0.03));
+        }
+        let bz = if back_z > 0.0 { sz0 + 0.39 } else { sz0 };
+        b.geo(wood).cuboid(v(sx0, 0.85, bz), v(sx0 + 0.42, 0.9, bz + 0.03));
+        for k in 0..3 {
+            let x = sx0 + 0.06 + 0.14 * k as f32;
+            b.geo(wood).cuboid(v(x, 0.47, bz), v(x + 0.03, 0.85, bz + 0.03));
+        }
+    }
+    // bookshelf against the right wall: sides, five shelves, books
+    let (bx0, bz0, bz1, bh) = (x1 - 0.35, -3.6f32, -2.2f32, 2.0f32);
+    b.geo(wood).cuboid(v(bx0, 0.0, bz0), v(x1, bh, bz0 + 0.02));
+    b.geo(wood).cuboid(v(bx0, 0.0, bz1 - 0.02), v(x1, bh, bz1));
+    for k in 0..5 {
+        let y = 0.05 + 0.48 * k as f32;
+        b.geo(wood).cuboid(v(bx0, y, bz0 + 0.02), v(x1, y + 0.02, bz1 - 0.02));
+        if k < 4 {
+            let mut z = bz0 + 0.04;
+            let mut i = 0usize;
+            while z < bz1 - 0.1 {
+                let w = 0.03 + 0.012 * ((i * 7 + k * 3) % 5) as f32;
+                let top = y + 0.02 + 0.26 + 0.03 * ((i * 5 + k) % 4) as f32;
+                b.geo(books[(i + k) % 3])
+                    .cuboid(v(bx0 + 0.05, y + 0.02, z), v(x1 - 0.03, top, z + w));
+                z += w + 0.004;
+                i += 1;
+            }
+        }
+    }
+    // sofa against the left wall, a picture frame above it
+    b.geo(fabric).cuboid(v(x0, 0.0, -2.9), v(x0 + 0.9, 0.42, -0.9));
+    b.geo(fabric).cuboid(v(x0, 0.42, -2.9), v(x0 + 0.22, 0.85, -0.9));
+    b.geo(fabric).cuboid(v(x0 + 0.22, 0.42, -2.9), v(x0 + 0.9, 0.62, -2.72));
+    b.geo(fabric).cuboid(v(x0 + 0.22, 0.42, -1.08), v(x0 + 0.9, 0.62, -0.9));
+    b.geo(dark).cuboid(v(x0, 1.25, -2.3), v(x0 + 0.03, 1.85, -1.5));
+    // floor lamp: base, a 3 cm pole, a shade
+    b.geo(dark).cylinder(v(1.9, 0.0, -0.6), 0.16, 0.03, 24, true);
+    b.geo(dark).cylinder(v(1.9, 0.03, -0.6), 0.015, 1.45, 12, true);
+    b.geo(frame).cylinder(v(1.9, 1.48, -0.6), 0.2, 0.25, 24, false);
+    let lights = vec![
+        Light::Sun {
+            direction: v(0.25, -0.55, 0.8).normalize(),
+            color: [1.0, 0.95, 0.85],
+            illuminance: 4.0,
+        },
+        Light::Point {
+            position: v(0.0, 2.45, -1.2),
+            color: [1.0, 0.9, 0.75],
+            intensity: 6.0,
+        },
+    ];
+    let camera = Camera::new(v(-2.3, 1.55, 1.1), v(0.9, 1.25, -3.6), Vec3::Y, 62.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.5,
+        min_separation: 0.1,
+        radiosity_radius: 3.0,
+        exposure: 1.0,
+        sky: [0.45, 0.55, 0.75],
+        ambient: [0.02; 3],
+    };
+    b.finish(camera, lights, settings)
 }
 
 /// DGB §3.6 test scene: a mirror floor (metallic 1, roughness 0) in front of a

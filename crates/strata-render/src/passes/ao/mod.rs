@@ -78,6 +78,14 @@ pub struct AoSettings {
     /// (`docs/ao.md`), and so does the per-frame rotation's temporal
     /// accumulation. Default true since issue 14 (false = DGB's order).
     pub filter_obscurance: bool,
+    /// Not in the paper: the bilateral reconstruction also weighs each tap by its
+    /// surface's world distance from X, × max(0, 1 − |Y − X|²/r²) with r the AO radius
+    /// ([`BilateralSettings::world_radius`]). The paper's plane and normal weights accept
+    /// a neighbour anywhere on X's plane, so on a surface seen at a grazing angle (a floor
+    /// far away, the ground through a window) pixels a metre apart, farther than r, are
+    /// averaged and a concave corner's occlusion spreads along the plane (issue 14's
+    /// "dark halos"; docs/ao.md). Default true (false = DGB's weights).
+    pub distance_weight: bool,
 }
 
 impl Default for AoSettings {
@@ -105,6 +113,7 @@ impl Default for AoSettings {
             temporal: Some(TemporalSettings::default()),
             deinterleave: None,
             filter_obscurance: true,
+            distance_weight: true,
         }
     }
 }
@@ -156,6 +165,15 @@ impl AoSettings {
     }
 
     /// r, β, ε for `scene`.
+    /// The bilateral reconstruction's settings: [`AoSettings::blur`] with the world radius
+    /// r of [`AoSettings::distance_weight`] (`radius` = the resolved r).
+    pub fn reconstruction(&self, radius: f32) -> BilateralSettings {
+        BilateralSettings {
+            world_radius: self.blur.world_radius.or(self.distance_weight.then_some(radius)),
+            ..self.blur
+        }
+    }
+
     pub fn resolve(&self, scene: &Scene) -> (f32, f32, f32) {
         let r = self.radius.unwrap_or(scene.settings.ao_radius);
         (r, self.bias.unwrap_or(0.01 * r), self.epsilon.unwrap_or(0.01 * r * r))

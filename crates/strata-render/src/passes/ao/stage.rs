@@ -37,6 +37,7 @@ impl AoStage {
         targets: &mut Targets,
         deep: &DeepGBufferSettings,
         s: &AoSettings,
+        radius: f32,
     ) -> Result<Self, RenderError> {
         use wgpu::TextureFormat as F;
         targets.create(gpu, crate::passes::ao::OUTPUT);
@@ -88,7 +89,7 @@ impl AoStage {
         } else {
             "ao"
         };
-        let [blur_h, blur_v] = reconstruction(gpu, scene, targets, &s.blur, filtered, blurred);
+        let [blur_h, blur_v] = reconstruction(gpu, scene, targets, &s.reconstruction(radius), filtered, blurred);
         let resolve = s.filter_obscurance.then(|| {
             crate::passes::builder::PassBuilder::new(gpu, targets, "ao-resolve")
                 .shader("ao-resolve", include_str!("ao_resolve.wgsl"))

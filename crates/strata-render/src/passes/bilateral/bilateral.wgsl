@@ -1,6 +1,7 @@
 // Separable bilateral reconstruction (DGB §3.1: "normal and plane weights"):
 // each tap's weight = spatial Gaussian × plane weight (distance of the tap's
-// surface from X's tangent plane, relative to X's depth) × normal weight.
+// surface from X's tangent plane, relative to X's depth) × normal weight
+// (× a world-distance weight when `inv_radius2` > 0: not in the paper).
 #import "common/fullscreen.wgsl"
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
@@ -18,6 +19,9 @@ struct Bilateral {
     normal_power: u32,
     // Gaussian weight of tap |k| in gauss[k / 4][k % 4]
     gauss: array<vec4f, 9>,
+    // 1/R²: taps whose surface lies R or more from X get no weight (0: off;
+    // `bilateral::distance_weight`)
+    inv_radius2: f32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -64,7 +68,11 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
             normal *= c;
         }
         let a = u32(abs(k));
-        let w = blur.gauss[a / 4u][a % 4u] * plane * normal;
+        var w = blur.gauss[a / 4u][a % 4u] * plane * normal;
+        if (blur.inv_radius2 > 0.0) {
+            let d = y - x;
+            w *= max(0.0, 1.0 - dot(d, d) * blur.inv_radius2);
+        }
         sum += w * textureLoad(src, q, 0);
         weight += w;
     }

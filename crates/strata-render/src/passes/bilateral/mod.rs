@@ -2,15 +2,19 @@
 //! [SGNS07]), reusable by every noisy screen-space estimate: a horizontal and a
 //! vertical [`BilateralPass`].
 
-use crate::frame::Targets;
+use glam::Vec3;
+use strata_scene::ImageBuf;
+
+use crate::frame::{FrameUniforms, Targets};
 use crate::gpu::GpuContext;
+use crate::passes::ao::world_from_csz;
 use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
 
 /// Defaults: radius 4 taps with step 2 pixels (SAO's AO blur: 9 taps spanning
 /// ±8 px per direction), Gaussian σ = 0.75·radius taps (SAO's radius-4 kernel has
 /// σ ≈ 3), plane weight max(0, 1 − 100·d/z) (zero once the tap's surface is 1 % of
-/// X's depth off X's tangent plane), normal weight (n_X·n_Y)^8.
+/// X's depth off X's tangent plane), normal weight (n_X·n_Y)^8, no distance weight.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BilateralSettings {
     /// Taps on each side (0 disables the filter).
@@ -20,6 +24,17 @@ pub struct BilateralSettings {
     pub plane_sharpness: f32,
     /// Exponent of the normal weight (n_X·n_Y)^p, 0..=32.
     pub normal_power: u32,
+    /// World distance R beyond which a tap's surface gets no weight: × max(0, 1 − |Y − X|²/R²)
+    /// ([`distance_weight`]). Not in the paper (its weights see only X's tangent plane and
+    /// normal, so on a surface seen at a grazing angle neighbouring pixels metres apart
+    /// are averaged). `None`: off. AO sets it to its radius (`ao::AoSettings::distance_weight`).
+    pub world_radius: Option<f32>,
+}
+
+/// The bilateral filter's distance weight of a tap whose surface lies `d2` = |Y − X|² from
+/// X, for world radius `r` (CPU twin of bilateral.wgsl's): 1 at X, 0 from R on.
+pub fn distance_weight(d2: f32, r: f32) -> f32 {
+    (1.0 - d2 / (r * r)).max(0.0)
 }
 
 impl Default for BilateralSettings {
@@ -29,6 +44,7 @@ impl Default for BilateralSettings {
             step: 2,
             plane_sharpness: 100.0,
             normal_power: 8,
+            world_radius: None,
         }
     }
 }
@@ -56,6 +72,11 @@ impl BilateralSettings {
                 self.normal_power
             ));
         }
+        if let Some(r) = self.world_radius {
+            if !(r > 0.0 && r.is_finite()) {
+                return Err(format!("blur world radius {r} is out of range: must be > 0"));
+            }
+        }
         Ok(())
     }
 
@@ -63,6 +84,65 @@ impl BilateralSettings {
     pub fn taps(&self) -> u32 {
         2 * self.radius + 1
     }
+}
+
+/// CPU twin of one direction of `bilateral.wgsl` on channel 0 of `src`: along x, or
+/// along y when `vertical`; `csz` = camera-space depth per pixel (channel 0; ≤ 0 = no
+/// surface), `normals` = unit normals (3 channels), `frame` = the frame's uniforms.
+pub fn bilateral_cpu(
+    src: &ImageBuf,
+    csz: &ImageBuf,
+    normals: &ImageBuf,
+    frame: &FrameUniforms,
+    s: &BilateralSettings,
+    vertical: bool,
+) -> ImageBuf {
+    let u = BilateralUniforms::new(s);
+    let (w, h) = (src.width as i32, src.height as i32);
+    let normal = |x: i32, y: i32| {
+        let p = normals.pixel(x as u32, y as u32);
+        Vec3::new(p[0], p[1], p[2])
+    };
+    let at = |x: i32, y: i32, z: f32| world_from_csz(frame, [x as f32 + 0.5, y as f32 + 0.5], z);
+    let mut out = ImageBuf::new(src.width, src.height, 1);
+    for py in 0..h {
+        for px in 0..w {
+            let centre = src.pixel(px as u32, py as u32)[0];
+            let z = csz.pixel(px as u32, py as u32)[0];
+            let o = (py * w + px) as usize;
+            if z <= 0.0 || u.radius == 0 {
+                out.data[o] = centre;
+                continue;
+            }
+            let (x, n) = (at(px, py, z), normal(px, py));
+            let (mut sum, mut weight) = (centre, 1.0f32);
+            for k in -u.radius..=u.radius {
+                let (qx, qy) = if vertical {
+                    (px, py + k * u.step)
+                } else {
+                    (px + k * u.step, py)
+                };
+                if k == 0 || qx < 0 || qy < 0 || qx >= w || qy >= h {
+                    continue;
+                }
+                let zq = csz.pixel(qx as u32, qy as u32)[0];
+                if zq <= 0.0 {
+                    continue;
+                }
+                let y = at(qx, qy, zq);
+                let plane = (1.0 - u.plane_sharpness * n.dot(y - x).abs() / z).max(0.0);
+                let c = n.dot(normal(qx, qy)).max(0.0);
+                let mut wt = u.gauss[k.unsigned_abs() as usize] * plane * c.powi(u.normal_power as i32);
+                if let Some(r) = s.world_radius {
+                    wt *= distance_weight((y - x).length_squared(), r);
+                }
+                sum += wt * src.pixel(qx as u32, qy as u32)[0];
+                weight += wt;
+            }
+            out.data[o] = sum / weight;
+        }
+    }
+    out
 }
 
 /// Mirrors `Bilateral` in `bilateral.wgsl`.
@@ -75,6 +155,9 @@ pub struct BilateralUniforms {
     normal_power: u32,
     /// Gaussian weight of tap |k| (k ≤ 32, index k).
     gauss: [f32; 36],
+    /// 1/R² of [`BilateralSettings::world_radius`] (0: no distance weight).
+    inv_radius2: f32,
+    _pad: [f32; 3],
 }
 
 impl BilateralUniforms {
@@ -87,6 +170,8 @@ impl BilateralUniforms {
             plane_sharpness: s.plane_sharpness,
             normal_power: s.normal_power,
             gauss,
+            inv_radius2: s.world_radius.map_or(0.0, |r| 1.0 / (r * r)),
+            _pad: [0.0; 3],
         }
     }
 }
