@@ -19,8 +19,8 @@ impl Reference<'_> {
     /// more than [`INSIDE_BACKFACE_FRACTION`] of the time lie inside geometry
     /// and are marked invalid. Each probe's distance map ([`IrradianceProbes::depth`])
     /// holds the moments of its rays' first-hit distances, weighted per texel by
-    /// cos^[`DEPTH_SHARPNESS`] between the ray and the texel's direction (misses
-    /// count as twice the scene's diagonal).
+    /// cos^[`DEPTH_SHARPNESS`] between the ray and the texel's direction, each distance
+    /// clamped to [`DEPTH_RANGE`] × the grid cell's diagonal (misses count as that).
     pub fn bake_probes(&self, dims: [u32; 3], rays: u32, settings: &GiSettings) -> IrradianceProbes {
         let (lo, hi) = self.bvh().bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
         let inset = (hi - lo) * 0.05;
@@ -41,7 +41,7 @@ impl Reference<'_> {
             })
             .collect();
         let positions: Vec<Vec3> = (0..probes.count()).map(|i| probes.position(i)).collect();
-        let far = 2.0 * (hi - lo).length().max(1e-3);
+        let far = depth_range(probes.spacing, lo, hi);
         // Each texel's lobe: the rays (the same Fibonacci directions for every probe) whose
         // weight cos^DEPTH_SHARPNESS exceeds LOBE_CUTOFF, in ray order, so a probe's
         // moments sum only the rays that matter (about 1/7 of them at 16×16).
@@ -164,6 +164,20 @@ type BakedProbe = ([[f32; 3]; 9], bool, [[f32; 2]; DEPTH_TEXELS]);
 /// map's texels (about a texel's width at 16 × 16, as DDGI's).
 pub const DEPTH_SHARPNESS: i32 = 50;
 
+/// The distance maps hold first-hit distances clamped to this many grid-cell diagonals
+/// (DDGI's 1.5): a receiver is never farther than one diagonal from the probes it blends,
+/// so longer distances tell its visibility test nothing — and a miss stored as a long
+/// distance inflates the variance of every texel whose lobe it reaches, which
+/// Chebyshev's bound then reads as "visible" (sky light leaking through a wall into the
+/// room's concave edges; docs/radiosity.md § "Distance-map range").
+pub const DEPTH_RANGE: f32 = 1.5;
+
+/// [`DEPTH_RANGE`] × the diagonal of a grid cell of `spacing`, or twice the scene's
+/// diagonal (`lo`..`hi`) where that is shorter.
+pub fn depth_range(spacing: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    (DEPTH_RANGE * spacing.length()).min(2.0 * (hi - lo).length()).max(1e-3)
+}
+
 /// Ray weights below this are left out of a distance-map texel's moments (at cos⁵⁰, rays
 /// more than 44° off the texel's direction; on the warehouse the moments moved by at most
 /// 4.4e-4 relative, the irradiance coefficients not at all).
@@ -245,8 +259,11 @@ mod tests {
         );
         assert!(probes.valid.iter().all(|&v| v), "both probes are outside the slab");
         assert!(mean2 >= mean * mean - 1e-4, "moments {mean}, {mean2}");
-        // open side: nothing within twice the scene's size
-        assert!(probes.depth_moments(0, -Vec3::X)[0] > 5.0);
+        // open side: the misses read the distance maps' range, 1.5 grid-cell diagonals
+        let range = depth_range(probes.spacing, Vec3::splat(-10.0), Vec3::splat(10.0));
+        assert!((range - 1.5 * 2.0).abs() < 1e-3, "range {range}");
+        let [open, open2] = probes.depth_moments(0, -Vec3::X);
+        assert!((open - range).abs() < 1e-3 && (open2 - range * range).abs() < 1e-2, "open side {open}, {open2}");
         // a floor-like receiver: both probes lie in its tangent plane (equal facing weights)
         let (p, n) = (Vec3::new(0.5, 0.0, 0.0), Vec3::Y);
         let far = probes.visibility(0, p, n);
@@ -273,6 +290,30 @@ mod tests {
             (e_blind - 3.25).abs() < 0.05,
             "without distance maps the far probe leaks in: {e_blind}"
         );
+    }
+
+    /// A probe 1 m behind a wall that ends 25 cm beside the line to a receiver in front of
+    /// it: the texel's lobe reaches past the wall's edge, so a few of its rays miss. Stored
+    /// as the scene's far distance, those misses made the texel's variance so large that
+    /// Chebyshev's bound called the receiver visible (sky light leaking into a room's
+    /// concave edges); clamped to the maps' range the receiver stays hidden.
+    #[test]
+    fn misses_in_a_lobe_do_not_make_a_hidden_receiver_visible() {
+        let mut geo = MeshBuilder::new();
+        // a 10 cm wall at x = 0 whose edge is at z = 0
+        geo.cuboid(Vec3::new(-0.05, -10.0, -10.0), Vec3::new(0.05, 10.0, 0.0));
+        let scene = grey_scene("edge", geo);
+        let grid = IrradianceProbes::grid(Vec3::new(-1.0, 0.0, -0.55), Vec3::new(1.0, 0.0, -0.55), [2, 1, 1]);
+        let probes = Reference::new(&scene, 0.0).bake_grid(grid, 4096, &GiSettings::default());
+        let (p, n) = (Vec3::new(0.5, 0.0, -0.4), Vec3::Y);
+        let d = p + n * probes.visibility_bias() - probes.position(0);
+        let [mean, mean2] = probes.depth_moments(0, d.normalize());
+        let wall = 0.95 / d.normalize().x;
+        let sd = (mean2 - mean * mean).max(0.0).sqrt();
+        let v = probes.visibility(0, p, n);
+        eprintln!("wall at {wall:.3}, texel mean {mean:.3} sd {sd:.3}, receiver at {:.3}: visibility {v:.4}", d.length());
+        assert!(mean > 1.02 * wall, "the lobe does not reach past the edge (mean {mean}, wall {wall})");
+        assert!(v < 0.05, "the receiver behind the wall is visible: {v}");
     }
 
     /// Inside a closed box whose walls emit L and reflect nothing, every probe

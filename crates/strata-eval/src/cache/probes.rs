@@ -20,12 +20,13 @@ pub const BOUNCES: u32 = 3;
 /// ([`GRID`] by default), from the cache or baked (with a notice on stderr unless `quiet`).
 pub fn scene_probes(scene: &Scene, grid: [u32; 3], cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v6 probes {} grid={grid:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} depth={}² sharpness={} cutoff={:e}",
+        "v7 probes {} grid={grid:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} depth={}² sharpness={} cutoff={:e} range={}",
         scene_fingerprint(scene, 0.0),
         strata_reference::probes::RELOCATE,
         strata_scene::probes::DEPTH_OCT,
         strata_reference::probes::DEPTH_SHARPNESS,
-        strata_reference::probes::LOBE_CUTOFF
+        strata_reference::probes::LOBE_CUTOFF,
+        strata_reference::probes::DEPTH_RANGE
     );
     let key = RefCache::key(&description);
     if let Some(img) = cache.load(&key) {
