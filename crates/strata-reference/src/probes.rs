@@ -263,7 +263,10 @@ mod tests {
         let range = depth_range(probes.spacing, Vec3::splat(-10.0), Vec3::splat(10.0));
         assert!((range - 1.5 * 2.0).abs() < 1e-3, "range {range}");
         let [open, open2] = probes.depth_moments(0, -Vec3::X);
-        assert!((open - range).abs() < 1e-3 && (open2 - range * range).abs() < 1e-2, "open side {open}, {open2}");
+        assert!(
+            (open - range).abs() < 1e-3 && (open2 - range * range).abs() < 1e-2,
+            "open side {open}, {open2}"
+        );
         // a floor-like receiver: both probes lie in its tangent plane (equal facing weights)
         let (p, n) = (Vec3::new(0.5, 0.0, 0.0), Vec3::Y);
         let far = probes.visibility(0, p, n);
@@ -311,8 +314,14 @@ mod tests {
         let wall = 0.95 / d.normalize().x;
         let sd = (mean2 - mean * mean).max(0.0).sqrt();
         let v = probes.visibility(0, p, n);
-        eprintln!("wall at {wall:.3}, texel mean {mean:.3} sd {sd:.3}, receiver at {:.3}: visibility {v:.4}", d.length());
-        assert!(mean > 1.02 * wall, "the lobe does not reach past the edge (mean {mean}, wall {wall})");
+        eprintln!(
+            "wall at {wall:.3}, texel mean {mean:.3} sd {sd:.3}, receiver at {:.3}: visibility {v:.4}",
+            d.length()
+        );
+        assert!(
+            mean > 1.02 * wall,
+            "the lobe does not reach past the edge (mean {mean}, wall {wall})"
+        );
         assert!(v < 0.05, "the receiver behind the wall is visible: {v}");
     }
 

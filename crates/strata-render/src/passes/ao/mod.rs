@@ -164,7 +164,6 @@ impl AoSettings {
         Ok(())
     }
 
-    /// r, β, ε for `scene`.
     /// The bilateral reconstruction's settings: [`AoSettings::blur`] with the world radius
     /// r of [`AoSettings::distance_weight`] (`radius` = the resolved r).
     pub fn reconstruction(&self, radius: f32) -> BilateralSettings {
@@ -174,6 +173,7 @@ impl AoSettings {
         }
     }
 
+    /// r, β, ε for `scene`.
     pub fn resolve(&self, scene: &Scene) -> (f32, f32, f32) {
         let r = self.radius.unwrap_or(scene.settings.ao_radius);
         (r, self.bias.unwrap_or(0.01 * r), self.epsilon.unwrap_or(0.01 * r * r))
