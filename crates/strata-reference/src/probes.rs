@@ -235,7 +235,7 @@ mod tests {
         }
         assert!(probes.valid.iter().all(|&v| v));
         // under the slab, a ceiling (normal down) below probe 0
-        let v = probes.visibility(0, Vec3::new(-1.0, -0.3, 0.0), -Vec3::Y);
+        let v = probes.visibility(0, Vec3::new(-1.0, -0.3, 0.0), -Vec3::Y, Vec3::ZERO);
         assert!(v < 0.05, "the lifted probe still sees through the slab: visibility {v}");
     }
 
@@ -269,8 +269,8 @@ mod tests {
         );
         // a floor-like receiver: both probes lie in its tangent plane (equal facing weights)
         let (p, n) = (Vec3::new(0.5, 0.0, 0.0), Vec3::Y);
-        let far = probes.visibility(0, p, n);
-        let near = probes.visibility(1, p, n);
+        let far = probes.visibility(0, p, n, Vec3::ZERO);
+        let near = probes.visibility(1, p, n, Vec3::ZERO);
         assert!(far < 0.01, "the probe behind the wall: visibility {far}");
         assert_eq!(near, 1.0, "the probe in front of the receiver");
         // the receiver's light: the near probe's, not a blend with the far one's
@@ -278,7 +278,7 @@ mod tests {
         probes.coeffs[0][0] = [10.0; 3];
         probes.coeffs[1] = [[0.0; 3]; 9];
         probes.coeffs[1][0] = [1.0; 3];
-        let e = probes.irradiance(p, n).x / strata_scene::probes::sh9(n)[0];
+        let e = probes.irradiance(p, n, Vec3::ZERO).x / strata_scene::probes::sh9(n)[0];
         assert!(
             (e - 1.0).abs() < 0.05,
             "receiver in front of the wall: {e} (near probe 1, far probe 10)"
@@ -287,7 +287,7 @@ mod tests {
             depth: Vec::new(),
             ..probes.clone()
         };
-        let e_blind = blind.irradiance(p, n).x / strata_scene::probes::sh9(n)[0];
+        let e_blind = blind.irradiance(p, n, Vec3::ZERO).x / strata_scene::probes::sh9(n)[0];
         // trilinear weights 1/4 and 3/4: 0.25 · 10 + 0.75 · 1
         assert!(
             (e_blind - 3.25).abs() < 0.05,
@@ -313,7 +313,7 @@ mod tests {
         let [mean, mean2] = probes.depth_moments(0, d.normalize());
         let wall = 0.95 / d.normalize().x;
         let sd = (mean2 - mean * mean).max(0.0).sqrt();
-        let v = probes.visibility(0, p, n);
+        let v = probes.visibility(0, p, n, Vec3::ZERO);
         eprintln!(
             "wall at {wall:.3}, texel mean {mean:.3} sd {sd:.3}, receiver at {:.3}: visibility {v:.4}",
             d.length()
@@ -323,6 +323,44 @@ mod tests {
             "the lobe does not reach past the edge (mean {mean}, wall {wall})"
         );
         assert!(v < 0.05, "the receiver behind the wall is visible: {v}");
+    }
+
+    /// A room's inner corner between two 20 cm walls, and a probe outside, 0.67 m behind
+    /// the back wall and 0.84 m along it (`interior`'s probe beside its back-left corner).
+    /// The texel that holds the corner receiver's direction lies 16° from the walls'
+    /// outer corner, so its lobe mixes the back wall's outer face with the open sky
+    /// beyond the corner, and Chebyshev's bound on that texel passed the receiver: sky
+    /// light along the room's concave edges. Moved towards a viewer inside the room
+    /// (`IrradianceProbes::view_bias`), the receiver is seen farther from the outer
+    /// corner and farther behind the wall, and the probe fails the test.
+    #[test]
+    fn a_view_bias_hides_an_inner_corner_from_a_probe_beyond_the_outer_corner() {
+        let mut geo = MeshBuilder::new();
+        // the left wall (room at x > 0) and the back wall (room at z > 0)
+        geo.cuboid(Vec3::new(-0.2, -10.0, -0.2), Vec3::new(0.0, 10.0, 10.0));
+        geo.cuboid(Vec3::new(0.0, -10.0, -0.2), Vec3::new(10.0, 10.0, 0.0));
+        let scene = grey_scene("corner", geo);
+        // one cell of `interior`'s grid (spacing 1.44 × 0.44 × 1.09 m: the view bias, 0.4 ×
+        // the smallest, and the maps' range, 1.5 cell diagonals, are that scene's); probe 0
+        // outside
+        let lo = Vec3::new(0.84, 0.0, -0.67);
+        let grid = IrradianceProbes::grid(lo, lo + Vec3::new(1.44, 0.437, 1.092), [2, 2, 2]);
+        let probes = Reference::new(&scene, 0.0).bake_grid(grid, 4096, &GiSettings::default());
+        assert!(probes.position(0).distance(lo) < 1e-4, "probe 0 stays where it is");
+        // on the left wall, 1 cm from the corner, seen from inside the room
+        let (p, n) = (Vec3::new(0.0, 0.08, 0.01), Vec3::X);
+        let view = (Vec3::new(0.7, 0.0, 5.1) - p).normalize();
+        let unbiased = probes.visibility(0, p, n, Vec3::ZERO);
+        let biased = probes.visibility(0, p, n, view);
+        eprintln!("visibility of the corner receiver: {unbiased:.3} without the view bias, {biased:.4} with it");
+        assert!(
+            unbiased > 0.3,
+            "the straddling texel no longer passes the receiver: {unbiased}"
+        );
+        assert!(
+            biased < 0.05,
+            "the receiver in the corner is visible through the wall: {biased}"
+        );
     }
 
     /// Inside a closed box whose walls emit L and reflect nothing, every probe

@@ -414,8 +414,10 @@ fn probe_field_matches_cpu_twin() {
         };
         for s in &points {
             let av = field.data[s.i * 4 + 3];
-            let want = probes.irradiance(s.p, s.n) * av;
-            let free = blind.irradiance(s.p, s.n) * av;
+            // seen from the camera, as the composition sees it
+            let view = (scene.camera.eye - s.p).normalize();
+            let want = probes.irradiance(s.p, s.n, view) * av;
+            let free = blind.irradiance(s.p, s.n, view) * av;
             hidden += ((want - free).abs().max_element() > 0.05 * free.max_element()) as usize;
             for c in 0..3 {
                 let got = field.data[s.i * 4 + c];
@@ -490,8 +492,9 @@ fn probe_ao_modes_match_cpu_twin() {
         for s in &points {
             let av = field.data[s.i * 4 + 3];
             occluded += (av < 0.9) as usize;
-            let e = probes.irradiance(s.p, s.n);
-            let v = probes.openness_at(&open, s.p, s.n);
+            let view = (scene.camera.eye - s.p).normalize();
+            let e = probes.irradiance(s.p, s.n, view);
+            let v = probes.openness_at(&open, s.p, s.n, view);
             for c in 0..3 {
                 let rho = albedo.data[s.i * albedo.channels as usize + c];
                 let factor = probe_ao_factor(mode, av, v, rho);

@@ -132,6 +132,15 @@ pub const DEPTH_TEXELS: usize = DEPTH_OCT * DEPTH_OCT;
 /// by itself ([`IrradianceProbes::visibility_bias`]; compose.wgsl gets it as `spacing.w`).
 pub const VISIBILITY_BIAS: f32 = 0.1;
 
+/// … and this fraction of the smallest spacing towards the viewer
+/// ([`IrradianceProbes::view_bias`]; `origin.w` in the shaders). The segment from a
+/// visible point to the eye is free space, so the moved point stays on the receiver's
+/// side of every wall, while a probe beyond a thin wall now sees it farther behind
+/// that wall's outer corner: the distance-map texels there straddle the wall and the
+/// sky beyond, and their variance passed a receiver right in the corner
+/// (DDGI's view bias, Majercik et al. 2021; `docs/radiosity.md` § "View bias").
+pub const VIEW_BIAS: f32 = 0.4;
+
 /// Chebyshev's bound on the chance that a receiver at distance `dist` from a probe
 /// is visible from it, given the mean `mean` and mean square `mean2` of the
 /// distance to the probe's first surface in that direction: 1 in front of the
@@ -218,25 +227,38 @@ impl IrradianceProbes {
     /// [`VISIBILITY_BIAS`] × the smallest spacing between probes (over the axes with more
     /// than one probe; a single probe: 0).
     pub fn visibility_bias(&self) -> f32 {
+        VISIBILITY_BIAS * self.min_spacing()
+    }
+
+    /// How far a receiver moves towards the viewer before the visibility test:
+    /// [`VIEW_BIAS`] × the smallest spacing between probes.
+    pub fn view_bias(&self) -> f32 {
+        VIEW_BIAS * self.min_spacing()
+    }
+
+    /// The smallest spacing between probes over the axes with more than one (a single
+    /// probe: 0).
+    fn min_spacing(&self) -> f32 {
         let spacing = (0..3)
             .filter(|&i| self.dims[i] > 1)
             .map(|i| self.spacing[i])
             .fold(f32::INFINITY, f32::min);
         if spacing.is_finite() {
-            VISIBILITY_BIAS * spacing
+            spacing
         } else {
             0.0
         }
     }
 
-    /// How visible a receiver at `p` (normal `n`) is from probe `index`: 1 without
-    /// distance maps, else [`chebyshev_visibility`] of the receiver moved by
-    /// [`Self::visibility_bias`] along `n`.
-    pub fn visibility(&self, index: usize, p: Vec3, n: Vec3) -> f32 {
+    /// How visible a receiver at `p` (normal `n`, unit direction `view` towards the
+    /// viewer, or zero for none) is from probe `index`: 1 without distance maps, else
+    /// [`chebyshev_visibility`] of the receiver moved by [`Self::visibility_bias`] along
+    /// `n` and [`Self::view_bias`] along `view`.
+    pub fn visibility(&self, index: usize, p: Vec3, n: Vec3, view: Vec3) -> f32 {
         if self.depth.is_empty() {
             return 1.0;
         }
-        let x = p + n * self.visibility_bias();
+        let x = p + n * self.visibility_bias() + view * self.view_bias();
         let d = x - self.position(index);
         let dist = d.length();
         if dist <= 1e-6 {
@@ -248,9 +270,10 @@ impl IrradianceProbes {
 
     /// Irradiance at `p` for normal `n`: trilinear blend of the valid ones of
     /// the 8 surrounding probes (positions clamped to the grid), each weight times
-    /// [`facing_weight`] and [`Self::visibility`], renormalised; all 8 when none is valid.
-    pub fn irradiance(&self, p: Vec3, n: Vec3) -> Vec3 {
-        self.corner_weights(p, n)
+    /// [`facing_weight`] and [`Self::visibility`] (seen along `view`, as there),
+    /// renormalised; all 8 when none is valid.
+    pub fn irradiance(&self, p: Vec3, n: Vec3, view: Vec3) -> Vec3 {
+        self.corner_weights(p, n, view)
             .iter()
             .map(|&(index, w)| self.probe_irradiance(index, n) * w)
             .sum()
@@ -259,7 +282,7 @@ impl IrradianceProbes {
     /// The 8 probes around p and their normalised blend weights for a receiver at p
     /// with normal n, as [`Self::irradiance`] blends them (`probe_corners` and
     /// `probe_weights` in `common/probes.wgsl`).
-    pub fn corner_weights(&self, p: Vec3, n: Vec3) -> [(usize, f32); 8] {
+    pub fn corner_weights(&self, p: Vec3, n: Vec3, view: Vec3) -> [(usize, f32); 8] {
         let g = ((p - self.origin) / self.spacing).max(Vec3::ZERO);
         let max = Vec3::new(
             (self.dims[0] - 1) as f32,
@@ -282,7 +305,7 @@ impl IrradianceProbes {
                 * (if o.y > 0.0 { t.y } else { 1.0 - t.y })
                 * (if o.z > 0.0 { t.z } else { 1.0 - t.z });
             let index = (c.x as u32 + self.dims[0] * (c.y as u32 + self.dims[1] * c.z as u32)) as usize;
-            let w = w * facing_weight(self.position(index) - p, n) * self.visibility(index, p, n);
+            let w = w * facing_weight(self.position(index) - p, n) * self.visibility(index, p, n, view);
             sum_all += w;
             if self.valid[index] {
                 sum += w;
@@ -346,8 +369,8 @@ impl IrradianceProbes {
 
     /// The probes' openness at receiver p (normal n), blended with [`Self::irradiance`]'s
     /// weights; `v` = every probe's [`Self::openness_sh`].
-    pub fn openness_at(&self, v: &[[f32; 4]], p: Vec3, n: Vec3) -> f32 {
-        self.corner_weights(p, n)
+    pub fn openness_at(&self, v: &[[f32; 4]], p: Vec3, n: Vec3, view: Vec3) -> f32 {
+        self.corner_weights(p, n, view)
             .iter()
             .map(|&(index, w)| Self::openness(&v[index], n) * w)
             .sum()
@@ -357,9 +380,9 @@ impl IrradianceProbes {
     /// coefficients: L_lm = E_lm / Â_l ([`COSINE_LOBE`]), so that the cosine-weighted
     /// hemisphere integral of [`sh_radiance`] (without its clamp) is
     /// [`Self::irradiance`] (`probe_radiance_sh` in `common/probes.wgsl`).
-    pub fn radiance_sh(&self, p: Vec3, n: Vec3) -> [Vec3; 9] {
+    pub fn radiance_sh(&self, p: Vec3, n: Vec3, view: Vec3) -> [Vec3; 9] {
         let mut l = [Vec3::ZERO; 9];
-        for (index, w) in self.corner_weights(p, n) {
+        for (index, w) in self.corner_weights(p, n, view) {
             for (i, li) in l.iter_mut().enumerate() {
                 *li += Vec3::from(self.coeffs[index][i]) * w;
             }
@@ -457,7 +480,7 @@ mod tests {
         let l = 0.7;
         p.coeffs[0][0] = [COSINE_LOBE[0] * l * (4.0 * std::f32::consts::PI).sqrt(); 3];
         for n in [Vec3::X, Vec3::Y, -Vec3::Z, Vec3::new(1.0, 1.0, 0.0).normalize()] {
-            let e = p.irradiance(Vec3::splat(0.3), n);
+            let e = p.irradiance(Vec3::splat(0.3), n, Vec3::ZERO);
             assert!((e.x - std::f32::consts::PI * l).abs() < 1e-3, "{e}");
         }
     }
@@ -468,20 +491,20 @@ mod tests {
         p.coeffs[0][0] = [1.0; 3];
         p.coeffs[1][0] = [3.0; 3];
         let y0 = sh9(Vec3::Y)[0];
-        assert!((p.irradiance(Vec3::new(0.5, 0.0, 0.0), Vec3::Y).x - 1.5 * y0).abs() < 1e-5);
-        assert!((p.irradiance(Vec3::new(9.0, 0.0, 0.0), Vec3::Y).x - 3.0 * y0).abs() < 1e-5);
+        assert!((p.irradiance(Vec3::new(0.5, 0.0, 0.0), Vec3::Y, Vec3::ZERO).x - 1.5 * y0).abs() < 1e-5);
+        assert!((p.irradiance(Vec3::new(9.0, 0.0, 0.0), Vec3::Y, Vec3::ZERO).x - 3.0 * y0).abs() < 1e-5);
         assert_eq!(p.position(1), Vec3::new(2.0, 0.0, 0.0));
         // an invalid probe gets no weight
         p.valid[1] = false;
-        assert!((p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::Y).x - y0).abs() < 1e-5);
+        assert!((p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::Y, Vec3::ZERO).x - y0).abs() < 1e-5);
         // a receiver facing probe 1 (normal +x, probe 0 behind it): weights
         // 0.25 · floor and 0.75 · (1 + floor) at x = 1.5
         p.valid[1] = true;
-        let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::X).x / sh9(Vec3::X)[0];
+        let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), Vec3::X, Vec3::ZERO).x / sh9(Vec3::X)[0];
         let (w0, w1) = (0.25 * FACING_FLOOR, 0.75 * (1.0 + FACING_FLOOR));
         assert!((e - (w0 * 1.0 + w1 * 3.0) / (w0 + w1)).abs() < 1e-4, "{e}");
         // facing away from probe 1: probe 0 wins
-        let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), -Vec3::X).x / sh9(-Vec3::X)[0];
+        let e = p.irradiance(Vec3::new(1.5, 0.0, 0.0), -Vec3::X, Vec3::ZERO).x / sh9(-Vec3::X)[0];
         let (w0, w1) = (0.25 * (1.0 + FACING_FLOOR), 0.75 * FACING_FLOOR);
         assert!((e - (w0 * 1.0 + w1 * 3.0) / (w0 + w1)).abs() < 1e-4, "{e}");
     }
@@ -504,7 +527,7 @@ mod tests {
             [-0.06, 0.03, 0.1],
         ];
         for n in [Vec3::Y, Vec3::X, Vec3::new(0.3, -0.5, 0.8).normalize()] {
-            let l = p.radiance_sh(Vec3::splat(0.5), n);
+            let l = p.radiance_sh(Vec3::splat(0.5), n, Vec3::ZERO);
             let (nt, np) = (400, 800);
             let mut e = Vec3::ZERO;
             for i in 0..nt {
@@ -519,7 +542,7 @@ mod tests {
                     e += r * d.dot(n).max(0.0) * dw;
                 }
             }
-            let want = p.irradiance(Vec3::splat(0.5), n);
+            let want = p.irradiance(Vec3::splat(0.5), n, Vec3::ZERO);
             assert!(
                 (e - want).abs().max_element() < 2e-3 * want.max_element(),
                 "n {n}: {e} vs {want}"

@@ -88,7 +88,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             }
         }
         let x = world_from_csz(frame, vec2f(p) + 0.5, z);
-        let field = probe_field(compose.grid, x, oct_decode(nrm.rg));
+        let field = probe_field(compose.grid, x, oct_decode(nrm.rg), normalize(frame.eye.xyz - x));
         if (compose.use_ao == 3u) {
             // only the occlusion the probes do not hold (`radiosity::probe_ao_factor`)
             occlusion = min(occlusion / max(ao_multibounce(field.a, rho), vec3f(1e-3)), vec3f(1.0));

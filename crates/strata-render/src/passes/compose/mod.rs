@@ -59,7 +59,7 @@ impl ProbeGpu {
     /// (`IrradianceProbes::openness_sh`, `ProbeAo::Relative`); `None`: every probe open.
     pub fn new(gpu: &GpuContext, probes: Option<&IrradianceProbes>, ao_radius: Option<f32>) -> Self {
         let grid = ProbeGridUniform {
-            origin: probes.map_or([0.0; 4], |p| p.origin.extend(0.0).to_array()),
+            origin: probes.map_or([0.0; 4], |p| p.origin.extend(p.view_bias()).to_array()),
             spacing: probes.map_or([1.0; 4], |p| p.spacing.extend(p.visibility_bias()).to_array()),
             dims: probes.map_or([1, 1, 1, 0], |p| {
                 [p.dims[0], p.dims[1], p.dims[2], !p.depth.is_empty() as u32]

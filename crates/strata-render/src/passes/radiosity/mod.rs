@@ -666,7 +666,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     let probe_sh = g
         .probes
         .filter(|_| receiver == 0 && u.probe_detail != 0)
-        .map(|p| p.radiance_sh(pos, n));
+        .map(|p| p.radiance_sh(pos, n, (eye - pos).normalize()));
     let mut sum_probe = Vec3::ZERO;
     for i in 0..u.samples {
         let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);

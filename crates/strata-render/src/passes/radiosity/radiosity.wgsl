@@ -260,7 +260,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     // probe_detail: the probes' radiance along layer 0's taps, Σ w·L_probe(ω̂)·cos
     var lsh: array<vec3f, 9>;
     if (rad.probe_detail != 0u) {
-        lsh = probe_radiance_sh(rad.grid, x0, n0);
+        lsh = probe_radiance_sh(rad.grid, x0, n0, normalize(frame.eye.xyz - x0));
     }
     var sum_probe = vec3f(0.0);
     for (var i = 0u; i < rad.samples; i++) {

@@ -19,8 +19,9 @@ fn probe_position(index: u32, g: vec3f) -> vec3f {
 }
 
 struct ProbeGrid {
-    // the grid's origin (xyz); spacing (xyz; w: the visibility test's normal offset
-    // of the receiver); probes per axis (xyz; w: 1 = the probes have distance maps)
+    // the grid's origin (xyz; w: the visibility test's offset of the receiver towards
+    // the viewer); spacing (xyz; w: its offset along the normal); probes per axis (xyz;
+    // w: 1 = the probes have distance maps)
     origin: vec4f,
     spacing: vec4f,
     dims: vec4u,
@@ -89,14 +90,15 @@ fn oct_wrap_texel(t: vec2i) -> vec2i {
     return t;
 }
 
-// How visible the receiver p (normal n) is from probe `index` at `probe_pos`
-// (as `IrradianceProbes::visibility`): its distance map, bilinear between texel
-// centres, at the direction to p moved off its surface.
-fn probe_visibility(grid: ProbeGrid, index: u32, probe_pos: vec3f, p: vec3f, n: vec3f) -> f32 {
+// How visible the receiver p (normal n, unit direction v towards the viewer) is from
+// probe `index` at `probe_pos` (as `IrradianceProbes::visibility`): its distance map,
+// bilinear between texel centres, at the direction to p moved off its surface and
+// towards the viewer.
+fn probe_visibility(grid: ProbeGrid, index: u32, probe_pos: vec3f, p: vec3f, n: vec3f, v: vec3f) -> f32 {
     if (grid.dims.w == 0u) {
         return 1.0;
     }
-    let d = p + n * grid.spacing.w - probe_pos;
+    let d = p + n * grid.spacing.w + v * grid.origin.w - probe_pos;
     let dist = length(d);
     if (dist <= 1e-6) {
         return 1.0;
@@ -135,7 +137,7 @@ fn probe_cell(grid: ProbeGrid, p: vec3f) -> ProbeCell {
     return ProbeCell(i0, g - i0);
 }
 
-fn probe_corner(grid: ProbeGrid, cell: ProbeCell, p: vec3f, n: vec3f, corner: u32) -> ProbeCorner {
+fn probe_corner(grid: ProbeGrid, cell: ProbeCell, p: vec3f, n: vec3f, v: vec3f, corner: u32) -> ProbeCorner {
     let dims = grid.dims.xyz;
     let mx = vec3f(dims) - 1.0;
     let i0 = cell.i0;
@@ -157,7 +159,7 @@ fn probe_corner(grid: ProbeGrid, cell: ProbeCell, p: vec3f, n: vec3f, corner: u3
     if (len > 1e-4) {
         f = 0.5 * (dot(to_probe / len, n) + 1.0);
     }
-    return ProbeCorner(index, w * (f * f + FACING_FLOOR) * probe_visibility(grid, index, probe_pos, p, n));
+    return ProbeCorner(index, w * (f * f + FACING_FLOOR) * probe_visibility(grid, index, probe_pos, p, n, v));
 }
 
 // The 8 corners with their weights; `valid` = 0 for probes inside geometry.
@@ -167,11 +169,11 @@ struct ProbeCorners {
     valid: array<f32, 8>,
 }
 
-fn probe_corners(grid: ProbeGrid, p: vec3f, n: vec3f) -> ProbeCorners {
+fn probe_corners(grid: ProbeGrid, p: vec3f, n: vec3f, v: vec3f) -> ProbeCorners {
     var out: ProbeCorners;
     let cell = probe_cell(grid, p);
     for (var corner = 0u; corner < 8u; corner++) {
-        let k = probe_corner(grid, cell, p, n, corner);
+        let k = probe_corner(grid, cell, p, n, v, corner);
         out.index[corner] = k.index;
         out.w[corner] = k.w;
         // probes inside geometry (validity in coefficient 0's w) get no weight
@@ -212,10 +214,10 @@ fn probe_openness(index: u32, basis: array<f32, 9>) -> f32 {
     return clamp(v, 0.0, 1.0);
 }
 
-// The probes' irradiance (rgb) and openness (a) at receiver p with normal n:
+// The probes' irradiance (rgb) and openness (a) at receiver p with normal n, seen along v:
 // `probe_weights`' blend in one pass over the corners (no per-pixel arrays: the
 // composition's hot path; as `IrradianceProbes::irradiance` and `openness_at`).
-fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f) -> vec4f {
+fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f, v: vec3f) -> vec4f {
     var sum = 0.0;
     var sum_all = 0.0;
     var e = vec4f(0.0);
@@ -223,7 +225,7 @@ fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f) -> vec4f {
     let cell = probe_cell(grid, p);
     let basis = sh9(n);
     for (var corner = 0u; corner < 8u; corner++) {
-        let k = probe_corner(grid, cell, p, n, corner);
+        let k = probe_corner(grid, cell, p, n, v, corner);
         if (k.w == 0.0) {
             // outside the grid (clamped) or on a cell face: skip the reads
             continue;
@@ -241,12 +243,12 @@ fn probe_field(grid: ProbeGrid, p: vec3f, n: vec3f) -> vec4f {
     return e_all / max(sum_all, 1e-6);
 }
 
-// The blended probes' incident radiance at p (receiver normal n) as order-2 SH:
+// The blended probes' incident radiance at p (receiver normal n, seen along v) as order-2 SH:
 // L_lm = E_lm / Â_l with Â = (π, 2π/3, π/4) (Ramamoorthi & Hanrahan 2001), so that
 // ∫ L(ω) max(ω·n, 0) dω over the hemisphere returns the irradiance the SH holds.
-fn probe_radiance_sh(grid: ProbeGrid, p: vec3f, n: vec3f) -> array<vec3f, 9> {
+fn probe_radiance_sh(grid: ProbeGrid, p: vec3f, n: vec3f, v: vec3f) -> array<vec3f, 9> {
     // `var`: naga indexes arrays dynamically only through memory
-    var k = probe_corners(grid, p, n);
+    var k = probe_corners(grid, p, n, v);
     var w = probe_weights(k);
     var l: array<vec3f, 9>;
     for (var i = 0u; i < 8u; i++) {
