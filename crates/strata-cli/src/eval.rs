@@ -86,9 +86,18 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 ..Default::default()
             };
             for (name, value) in &a.set.values {
+                let had_ao = render.ao.is_some();
                 a.technique
                     .set(&mut render, name, *value)
                     .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
+                // this comparison runs no AO: an AO setting, or how AO darkens the probes,
+                // would change nothing
+                if (!had_ao && render.ao.is_some()) || name == "probe-ao" {
+                    anyhow::bail!(
+                        "--set {name}: eval --technique {} compares the radiosity and probes without AO, so AO settings have no effect here (--views measures the frame with AO)",
+                        a.technique.name
+                    );
+                }
             }
             let rs = render.radiosity.expect("set above");
             let g = gi::GiEvalSettings {

@@ -785,6 +785,26 @@ fn radiosity_estimator_switches_are_range_checked() {
     }
 }
 
+/// `eval --technique gi` runs no AO: an AO setting (or how AO darkens the probes) given with
+/// `--set` is an error naming it, not a number measured without it.
+#[test]
+fn eval_gi_refuses_ao_settings_it_would_ignore() {
+    for set in ["samples=5", "blur-distance=0", "probe-ao=1"] {
+        let o = strata(&[
+            "eval",
+            "--scene",
+            "cornell",
+            "--technique",
+            "gi",
+            "--set",
+            set,
+            "--json",
+        ]);
+        let name = set.split('=').next().unwrap();
+        assert_one_line_error(&o, &[name, "without AO", "--views"]);
+    }
+}
+
 /// `eval --technique gi` blends with light probes by default (what `render --technique full`
 /// shows) and evaluates the screen-space radiosity alone with `--no-probes`; both report the
 /// indirect and full errors; `--set` reaches the radiosity's registry settings.
