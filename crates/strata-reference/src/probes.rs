@@ -111,12 +111,19 @@ impl Reference<'_> {
 }
 
 impl Reference<'_> {
-    /// How far a probe at grid point `g` moves (probe relocation, as in DDGI): when the
-    /// plane of the nearest front face that [`RELOCATE_RAYS`] rays find is closer than
-    /// [`RELOCATE`] × the smallest spacing, along that face's normal until it is that far,
-    /// at most 0.45 × the spacing per axis (the probe stays in its cell). A probe on a
-    /// floor otherwise sees half of its distance map at zero and half far away, and the
-    /// visibility test's variance lets it leak through the floor.
+    /// How far a probe at grid point `g` moves (probe relocation, as in DDGI), at most
+    /// 0.45 × the spacing per axis (the probe stays in its cell):
+    /// - near a surface: when the plane of the nearest front face that [`RELOCATE_RAYS`]
+    ///   rays find is closer than [`RELOCATE`] × the smallest spacing, along that face's
+    ///   normal until it is that far. A probe on a floor otherwise sees half of its
+    ///   distance map at zero and half far away, and the visibility test's variance lets
+    ///   it leak through the floor;
+    /// - then, if it is inside geometry (at least [`INSIDE_BACKFACE_FRACTION`] of those
+    ///   rays leave through back faces, as the bake's validity test counts them): out
+    ///   through the nearest back face, to [`RELOCATE`] × the smallest spacing beyond it.
+    ///   A probe inside a sofa or a table top otherwise stays invalid, and the receivers
+    ///   around that object blend only the probes left, often ones in its shadow. Where
+    ///   that step would leave the cell, the probe stays (and the bake marks it invalid).
     pub fn relocation(&self, g: Vec3, spacing: Vec3, dims: [u32; 3]) -> Vec3 {
         let min_spacing = (0..3)
             .filter(|&i| dims[i] > 1)
@@ -126,11 +133,41 @@ impl Reference<'_> {
             return Vec3::ZERO;
         }
         let want = RELOCATE * min_spacing;
+        let limit = 0.45 * spacing;
+        let off = self.off_surface(g, want).clamp(-limit, limit);
+        // inside geometry: the nearest back face (its distance, the ray's direction)
+        let p = g + off;
+        let (mut back, mut nearest_back) = (0u32, None::<(f32, Vec3)>);
+        for k in 0..RELOCATE_RAYS {
+            let d = fibonacci_sphere(k, RELOCATE_RAYS);
+            let Some(h) = self.bvh().intersect(p, d, 0.0, f32::INFINITY) else {
+                continue;
+            };
+            if !self.bvh().surface(&h, d).front_face {
+                back += 1;
+                if nearest_back.is_none_or(|(t, _)| h.t < t) {
+                    nearest_back = Some((h.t, d));
+                }
+            }
+        }
+        self.add_rays(RELOCATE_RAYS as u64);
+        if (back as f32) < INSIDE_BACKFACE_FRACTION * RELOCATE_RAYS as f32 {
+            return off;
+        }
+        match nearest_back {
+            Some((t, d)) if (off + d * (t + want)).abs().cmple(limit).all() => off + d * (t + want),
+            _ => off,
+        }
+    }
+
+    /// The move that takes a probe at `p` to `want` from the plane of the nearest front face
+    /// within `want` (zero when there is none).
+    fn off_surface(&self, p: Vec3, want: f32) -> Vec3 {
         // (distance to the face's plane, its normal towards the probe)
         let mut nearest: Option<(f32, Vec3)> = None;
         for k in 0..RELOCATE_RAYS {
             let d = fibonacci_sphere(k, RELOCATE_RAYS);
-            let Some(h) = self.bvh().intersect(g, d, 0.0, want) else {
+            let Some(h) = self.bvh().intersect(p, d, 0.0, want) else {
                 continue;
             };
             let s = self.bvh().surface(&h, d);
@@ -143,10 +180,7 @@ impl Reference<'_> {
             }
         }
         self.add_rays(RELOCATE_RAYS as u64);
-        match nearest {
-            Some((t, n)) => (n * (want - t)).clamp(-0.45 * spacing, 0.45 * spacing),
-            None => Vec3::ZERO,
-        }
+        nearest.map_or(Vec3::ZERO, |(t, n)| n * (want - t))
     }
 }
 
@@ -363,6 +397,34 @@ mod tests {
         );
     }
 
+    /// A probe whose grid point lies 10 cm inside a solid block (a sofa, a table top) moves
+    /// out through the block's nearest face to RELOCATE × the smallest spacing beyond it,
+    /// and is valid there; a probe beside the block stays put.
+    #[test]
+    fn probes_inside_an_object_step_out_through_its_nearest_face() {
+        let mut geo = MeshBuilder::new();
+        // a 1.2 × 0.5 × 1.2 m block on the ground; grid points at y = 0.4 inside and beside it
+        geo.cuboid(Vec3::new(-0.6, 0.0, -0.6), Vec3::new(0.6, 0.5, 0.6));
+        let scene = grey_scene("block", geo);
+        let grid = IrradianceProbes::grid(Vec3::new(0.0, 0.4, 0.0), Vec3::new(2.0, 2.4, 2.0), [2, 2, 2]);
+        let probes = Reference::new(&scene, 0.0).bake_grid(grid, 1024, &GiSettings::default());
+        let want = RELOCATE * 2.0;
+        let moved = probes.position(0) - probes.grid_position(0);
+        assert!(
+            (moved - Vec3::new(0.0, 0.1 + want, 0.0)).length() < 0.02,
+            "probe 0 (inside the block's top, 10 cm under it): moved by {moved}"
+        );
+        assert!(probes.valid[0], "the probe above the block is outside geometry");
+        for i in 1..probes.count() {
+            assert_eq!(
+                probes.position(i),
+                probes.grid_position(i),
+                "probe {i} is clear of the block"
+            );
+            assert!(probes.valid[i], "probe {i}");
+        }
+    }
+
     /// Inside a closed box whose walls emit L and reflect nothing, every probe
     /// sees radiance L in every direction: irradiance πL for every normal.
     #[test]
@@ -400,12 +462,14 @@ mod tests {
             probes.valid.iter().all(|&v| v),
             "inward-facing walls: every probe is outside geometry"
         );
-        // the same box with outward faces is a solid: every probe is inside it
+        // the same box with outward faces is a solid: probes 0.8 m inside it, 0.4 m apart,
+        // cannot step out within their cells (relocation) and stay invalid
         let mut solid = scene.clone();
         for t in solid.meshes[0].indices.chunks_exact_mut(3) {
             t.swap(1, 2);
         }
-        let inside = Reference::new(&solid, 0.0).bake_probes([2, 2, 2], 64, &GiSettings::default());
+        let deep = IrradianceProbes::grid(Vec3::splat(-0.2), Vec3::splat(0.2), [2, 2, 2]);
+        let inside = Reference::new(&solid, 0.0).bake_grid(deep, 64, &GiSettings::default());
         assert!(
             inside.valid.iter().all(|&v| !v),
             "probes inside a solid must be invalid"

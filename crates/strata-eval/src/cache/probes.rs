@@ -20,7 +20,7 @@ pub const BOUNCES: u32 = 3;
 /// ([`GRID`] by default), from the cache or baked (with a notice on stderr unless `quiet`).
 pub fn scene_probes(scene: &Scene, grid: [u32; 3], cache: &RefCache, quiet: bool) -> Result<IrradianceProbes> {
     let description = format!(
-        "v7 probes {} grid={grid:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{} depth={}² sharpness={} cutoff={:e} range={}",
+        "v8 probes {} grid={grid:?} rays={RAYS} bounces={BOUNCES} relocate=plane×{}+inside depth={}² sharpness={} cutoff={:e} range={}",
         scene_fingerprint(scene, 0.0),
         strata_reference::probes::RELOCATE,
         strata_scene::probes::DEPTH_OCT,
