@@ -300,6 +300,11 @@ pub struct SceneSettings {
     pub sky: [f32; 3],
     /// Ambient term added to direct lighting (the probe fallback replaces it later).
     pub ambient: [f32; 3],
+    /// The box `[lo, hi]` the light probes' grid spans (scene units). `None`: the scene's
+    /// bounds inset by 5 % per axis. A room inside a large scene (a street, a terrain)
+    /// otherwise spends most of its probes outdoors, and its receivers blend probes a
+    /// metre or more apart.
+    pub probe_bounds: Option<[[f32; 3]; 2]>,
 }
 
 impl Default for SceneSettings {
@@ -311,6 +316,7 @@ impl Default for SceneSettings {
             exposure: 1.0,
             sky: [0.0; 3],
             ambient: [0.03; 3],
+            probe_bounds: None,
         }
     }
 }
@@ -545,6 +551,13 @@ impl Scene {
             return Err(format!(
                 "settings {st:?} are out of range: lengths and exposure finite and > 0, colours finite"
             ));
+        }
+        if let Some([lo, hi]) = st.probe_bounds {
+            if !(fin3(&lo) && fin3(&hi) && (0..3).all(|i| lo[i] <= hi[i])) {
+                return Err(format!(
+                    "settings.probe_bounds {lo:?}..{hi:?} is out of range: finite, and lo <= hi on every axis"
+                ));
+            }
         }
         if !self.objects.is_empty() {
             let (lo, hi) = self.bounds(0.0);

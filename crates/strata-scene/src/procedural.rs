@@ -235,6 +235,7 @@ pub fn cornell() -> Scene {
         exposure: 1.0,
         sky: [0.0; 3],
         ambient: [0.0; 3],
+        probe_bounds: None,
     };
     b.finish(camera, lights, settings)
 }
@@ -399,6 +400,7 @@ pub fn atrium() -> Scene {
         exposure: 0.5,
         sky: [0.3, 0.45, 0.75],
         ambient: [0.03; 3],
+        probe_bounds: None,
     };
     let mut scene = b.finish(camera, vec![sun], settings);
     scene.camera_path = path;
@@ -504,6 +506,7 @@ pub fn warehouse() -> Scene {
         exposure: 0.8,
         sky: [0.0; 3],
         ambient: [0.02; 3],
+        probe_bounds: None,
     };
     b.finish(camera, lights, settings)
 }
@@ -529,6 +532,7 @@ pub fn plane() -> Scene {
         exposure: 1.0,
         sky: [0.0; 3],
         ambient: [0.0; 3],
+        probe_bounds: None,
     };
     b.finish(camera, vec![sun], settings)
 }
@@ -557,6 +561,7 @@ pub fn column_wall() -> Scene {
         exposure: 1.0,
         sky: [0.2, 0.25, 0.35],
         ambient: [0.03; 3],
+        probe_bounds: None,
     };
     b.finish(camera, vec![sun], settings)
 }
@@ -592,6 +597,7 @@ pub fn dense() -> Scene {
         exposure: 1.0,
         sky: [0.2, 0.25, 0.35],
         ambient: [0.03; 3],
+        probe_bounds: None,
     };
     b.finish(camera, vec![sun], settings)
 }
@@ -726,6 +732,9 @@ pub fn interior() -> Scene {
         exposure: 1.0,
         sky: [0.45, 0.55, 0.75],
         ambient: [0.02; 3],
+        // the room and the street before its window: the scene's bounds (24 m of street)
+        // would put most probes outdoors, 1.4 m apart
+        probe_bounds: Some([[-3.3, -0.25, -6.0], [3.3, 2.85, 1.65]]),
     };
     b.finish(camera, lights, settings)
 }
@@ -776,6 +785,7 @@ pub fn mirror() -> Scene {
         exposure: 1.0,
         sky: [0.4, 0.5, 0.7],
         ambient: [0.03; 3],
+        probe_bounds: None,
     };
     b.finish(camera, vec![sun], settings)
 }
@@ -851,6 +861,7 @@ pub fn glasshouse() -> Scene {
         exposure: 1.0,
         sky: [0.3, 0.4, 0.55],
         ambient: [0.05; 3],
+        probe_bounds: None,
     };
     b.finish(camera, lights, settings)
 }
@@ -955,6 +966,7 @@ pub fn still_life() -> Scene {
         exposure: 1.0,
         sky: [0.0; 3],
         ambient: [0.01; 3],
+        probe_bounds: None,
     };
     b.finish(camera, lights, settings)
 }
@@ -1017,6 +1029,7 @@ pub fn dominoes() -> Scene {
         exposure: 1.0,
         sky: [0.25, 0.3, 0.4],
         ambient: [0.03; 3],
+        probe_bounds: None,
     };
     b.finish(camera, vec![sun], settings)
 }

@@ -28,6 +28,11 @@ pub fn scene_probes(scene: &Scene, grid: [u32; 3], cache: &RefCache, quiet: bool
         strata_reference::probes::LOBE_CUTOFF,
         strata_reference::probes::DEPTH_RANGE
     );
+    // the scene's own probe volume (keys without one stay as they were)
+    let description = match scene.settings.probe_bounds {
+        Some(b) => format!("{description} bounds={b:?}"),
+        None => description,
+    };
     let key = RefCache::key(&description);
     if let Some(img) = cache.load(&key) {
         if let Some(p) = decode(&img) {
@@ -47,7 +52,11 @@ pub fn scene_probes(scene: &Scene, grid: [u32; 3], cache: &RefCache, quiet: bool
         bounces: BOUNCES,
         ..Default::default()
     };
-    let probes = Reference::new(scene, 0.0).bake_probes(grid, RAYS, &settings);
+    let reference = Reference::new(scene, 0.0);
+    let probes = match scene.settings.probe_bounds {
+        Some([lo, hi]) => reference.bake_grid(IrradianceProbes::grid(lo.into(), hi.into(), grid), RAYS, &settings),
+        None => reference.bake_probes(grid, RAYS, &settings),
+    };
     if let Err(e) = cache.store(&key, &encode(&probes), &description) {
         tracing::warn!("could not cache the light probes: {e:#}");
     }

@@ -113,6 +113,8 @@
 //! exposure = 1.0          # > 0
 //! sky = [0.3, 0.45, 0.75] # >= 0
 //! ambient = [0.03, 0.03, 0.03]  # >= 0
+//! probe_bounds = [[-3.0, 0.0, -4.0], [3.0, 2.7, 1.5]]  # light-probe volume [lo, hi];
+//!                         # default: the scene's bounds inset by 5 %
 //!
 //! [ground]                # optional horizontal ground quad (object and material "ground")
 //! y = 0.0                 # default: the scene's lowest point

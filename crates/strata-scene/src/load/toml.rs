@@ -170,6 +170,7 @@ struct TomlSettings {
     exposure: Option<f32>,
     sky: Option<[f32; 3]>,
     ambient: Option<[f32; 3]>,
+    probe_bounds: Option<[[f32; 3]; 2]>,
 }
 
 #[derive(Deserialize)]
@@ -621,6 +622,15 @@ fn apply_settings(s: &TomlSettings, ck: &Check, st: &mut SceneSettings) -> Resul
     if let Some(c) = s.ambient {
         st.ambient = ck.color("settings.ambient", c)?;
     }
+    if let Some([lo, hi]) = s.probe_bounds {
+        if !(lo.iter().chain(&hi).all(|x| x.is_finite()) && (0..3).all(|i| lo[i] <= hi[i])) {
+            return Err(ck.err(
+                "settings.probe_bounds",
+                format!("[{lo:?}, {hi:?}] is out of range: [lo, hi] with finite values and lo <= hi on every axis"),
+            ));
+        }
+        st.probe_bounds = Some([lo, hi]);
+    }
     Ok(())
 }
 
@@ -736,6 +746,10 @@ fn transform_scene(scene: &mut Scene, xf: Mat4, scale: f32) {
     scene.settings.ao_radius *= scale;
     scene.settings.min_separation *= scale;
     scene.settings.radiosity_radius *= scale;
+    if let Some([lo, hi]) = &mut scene.settings.probe_bounds {
+        let (a, b) = (xf.transform_point3((*lo).into()), xf.transform_point3((*hi).into()));
+        (*lo, *hi) = (a.min(b).to_array(), a.max(b).to_array());
+    }
 }
 
 /// The first 20 distinct names, sorted, for an error listing the valid ones, and
