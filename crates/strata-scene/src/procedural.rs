@@ -734,7 +734,7 @@ pub fn interior() -> Scene {
         ambient: [0.02; 3],
         // the room and the street before its window: the scene's bounds (24 m of street)
         // would put most probes outdoors, 1.4 m apart
-        probe_bounds: Some([[-3.3, -0.25, -6.0], [3.3, 2.85, 1.65]]),
+        probe_bounds: Some([[-3.3, -0.25, -16.3], [3.3, 2.85, 1.65]]),
     };
     b.finish(camera, lights, settings)
 }
