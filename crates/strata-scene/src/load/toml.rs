@@ -766,3 +766,18 @@ fn name_list<'a>(names: impl Iterator<Item = &'a str>) -> (Vec<&'a str>, String)
     names.truncate(20);
     (names, more)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A base scene's probe volume moves with `scale` and `translate` like its geometry.
+    #[test]
+    fn the_probe_volume_moves_with_the_scene() {
+        let mut scene = crate::procedural::builtin("cornell").unwrap();
+        scene.settings.probe_bounds = Some([[0.0, 0.0, 0.0], [0.5, 0.25, 1.0]]);
+        let xf = Mat4::from_translation(Vec3::X) * Mat4::from_scale(Vec3::splat(2.0));
+        transform_scene(&mut scene, xf, 2.0);
+        assert_eq!(scene.settings.probe_bounds, Some([[1.0, 0.0, 0.0], [2.0, 0.5, 2.0]]));
+    }
+}
