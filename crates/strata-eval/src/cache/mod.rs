@@ -186,7 +186,12 @@ pub fn scene_fingerprint(scene: &Scene, frame: f32) -> String {
         eat(bytemuck::cast_slice(&o.transform_at(frame).to_cols_array()));
         eat(&(o.mesh as u64).to_le_bytes());
     }
-    eat(format!("{}{:?}", materials_fingerprint(&scene.materials), scene.settings).as_bytes());
+    eat(format!(
+        "{}{}",
+        materials_fingerprint(&scene.materials),
+        settings_fingerprint(&scene.settings)
+    )
+    .as_bytes());
     format!("scene={} tris={} geometry={h:016x}", scene.name, scene.triangle_count(),)
 }
 
@@ -213,6 +218,20 @@ fn materials_fingerprint(materials: &[strata_scene::Material]) -> String {
         t
     };
     format!("[{}]", materials.iter().map(one).collect::<Vec<_>>().join(", "))
+}
+
+/// The scene settings as text for [`scene_fingerprint`], by the rule of
+/// [`materials_fingerprint`]: the fields settings had when converged references were first
+/// cached, in their `Debug` form, then each later field only where it is set.
+fn settings_fingerprint(s: &strata_scene::SceneSettings) -> String {
+    let mut t = format!(
+        "SceneSettings {{ ao_radius: {:?}, min_separation: {:?}, radiosity_radius: {:?}, exposure: {:?}, sky: {:?}, ambient: {:?} }}",
+        s.ao_radius, s.min_separation, s.radiosity_radius, s.exposure, s.sky, s.ambient
+    );
+    if let Some(b) = s.probe_bounds {
+        t += &format!(" probe_bounds={b:?}");
+    }
+    t
 }
 
 /// [`RefCache::default_dir`] with the environment given as a function (testable without touching
@@ -429,6 +448,20 @@ mod tests {
         m[0].texture_alpha = false;
         m[0].glossy = true;
         assert_ne!(materials_fingerprint(&m), old);
+    }
+
+    #[test]
+    fn settings_fingerprint_is_the_old_debug_text_until_a_new_field_is_set() {
+        // `probe_bounds` (added 2026-11-27) first changed every scene's key, and with it
+        // every cached converged reference
+        let mut s = strata_scene::SceneSettings {
+            sky: [0.25, 0.5, 1.0],
+            ..Default::default()
+        };
+        let old = "SceneSettings { ao_radius: 1.0, min_separation: 0.5, radiosity_radius: 8.0, exposure: 1.0, sky: [0.25, 0.5, 1.0], ambient: [0.03, 0.03, 0.03] }";
+        assert_eq!(settings_fingerprint(&s), old);
+        s.probe_bounds = Some([[0.0; 3], [1.0; 3]]);
+        assert_ne!(settings_fingerprint(&s), old);
     }
 
     #[test]
