@@ -232,10 +232,23 @@ fn parse_probe_grid(s: &str) -> Result<[u32; 3], String> {
 /// The most probes `--probe-grid` takes (about 72 MB of probe buffers).
 const MAX_PROBES: u32 = 32768;
 
+fn parse_probe_rays(s: &str) -> Result<u32, String> {
+    let range = strata_eval::cache::probes::RAYS_RANGE;
+    s.trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|n| range.contains(n))
+        .ok_or_else(|| format!("'{s}' is out of range: paths per probe must be in {range:?}"))
+}
+
 impl RadiosityArgs {
-    /// The light-probe grid: `--probe-grid`, else the default.
-    pub fn probe_grid(&self) -> [u32; 3] {
-        self.probe_grid.unwrap_or(strata_eval::cache::probes::GRID)
+    /// How the light probes are baked: `--probe-grid` and `--probe-rays`, else the defaults.
+    pub fn probe_bake(&self) -> strata_eval::cache::probes::ProbeBake {
+        let d = strata_eval::cache::probes::ProbeBake::default();
+        strata_eval::cache::probes::ProbeBake {
+            grid: self.probe_grid.unwrap_or(d.grid),
+            rays: self.probe_rays.unwrap_or(d.rays),
+        }
     }
 }
 
@@ -295,6 +308,11 @@ pub struct RadiosityArgs {
     /// is cached apart (docs/radiosity.md § "Probe grid").
     #[arg(long, value_name = "NX,NY,NZ", value_parser = parse_probe_grid)]
     pub probe_grid: Option<[u32; 3]>,
+    /// Paths per light probe in its bake, 64..=1048576 (default 16384). The bake's noise falls
+    /// as 1/√N and its time grows with N; each count is cached apart (docs/radiosity.md §
+    /// "Rays per probe").
+    #[arg(long, value_name = "N", value_parser = parse_probe_rays)]
+    pub probe_rays: Option<u32>,
 }
 
 impl RadiosityArgs {

@@ -105,7 +105,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 fig10: a.fig10,
                 probes: !a.no_probes,
                 probes_from: a.probes_from.clone(),
-                probe_grid: a.radiosity.probe_grid(),
+                probe_bake: a.radiosity.probe_bake(),
                 moving: a.moving,
             };
             EvalResult::Gi(gi::run(&s, &rs, &g)?)
@@ -306,7 +306,7 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
     settings.probes = Some(strata_eval::cache::probes::scene_probes(
         &scene,
-        a.radiosity.probe_grid(),
+        a.radiosity.probe_bake(),
         &strata_eval::cache::RefCache::new(&s.cache),
         !s.progress,
     )?);

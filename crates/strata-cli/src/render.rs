@@ -54,7 +54,7 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
     if settings.radiosity.is_some() && !f.no_probes {
         settings.probes = Some(strata_eval::cache::probes::scene_probes(
             scene,
-            f.radiosity.probe_grid(),
+            f.radiosity.probe_bake(),
             &strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir()),
             false,
         )?);

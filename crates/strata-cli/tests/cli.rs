@@ -2199,29 +2199,34 @@ fn ils_progressive_mode_converges_and_approaches_the_path_tracer() {
     assert!(bias > 0.0);
 }
 
-/// `--probe-grid` reaches the bake (the notice names its count and shape; each grid is
-/// cached apart, a repeated grid is not baked again) and a malformed or oversized grid
-/// is one line naming the flag and the range.
+/// `--probe-grid` and `--probe-rays` reach the bake (the notice names the count, shape
+/// and paths; each bake is cached apart, a repeated one is not baked again) and a
+/// malformed or out-of-range value is one line naming the flag and the range.
 #[test]
-fn probe_grid_reaches_the_bake_and_is_range_checked() {
+fn probe_grid_and_rays_reach_the_bake_and_are_range_checked() {
     let out = scratch("probe-grid.png");
-    for bad in ["0,8,16", "16,8", "64,64,64", "a,b,c"] {
-        let o = strata(&[
+    let bad_run = |flag: &str, bad: &str| {
+        strata(&[
             "render",
             "--scene",
             "cornell",
             "--technique",
             "full",
-            "--probe-grid",
+            flag,
             bad,
             "--out",
             out.to_str().unwrap(),
-        ]);
-        assert_one_line_error(&o, &["--probe-grid", "1..=64", "32768"]);
+        ])
+    };
+    for bad in ["0,8,16", "16,8", "64,64,64", "a,b,c"] {
+        assert_one_line_error(&bad_run("--probe-grid", bad), &["--probe-grid", "1..=64", "32768"]);
+    }
+    for bad in ["0", "63", "1048577", "x"] {
+        assert_one_line_error(&bad_run("--probe-rays", bad), &["--probe-rays", "64..=1048576"]);
     }
     let cache = scratch("probe-grid-cache");
     let _ = std::fs::remove_dir_all(&cache);
-    let run = |grid: &str| {
+    let run = |grid: &str, rays: &str| {
         let o = strata_cached(
             &[
                 "render",
@@ -2231,6 +2236,8 @@ fn probe_grid_reaches_the_bake_and_is_range_checked() {
                 "full",
                 "--probe-grid",
                 grid,
+                "--probe-rays",
+                rays,
                 "--width",
                 "32",
                 "--height",
@@ -2244,10 +2251,12 @@ fn probe_grid_reaches_the_bake_and_is_range_checked() {
         assert!(o.status.success(), "{}", stderr(&o));
         stderr(&o)
     };
-    let e = run("2,3,2");
-    assert!(e.contains("baking 12 light probes (2×3×2,"), "{e}");
-    let e = run("2,3,2");
-    assert!(!e.contains("baking"), "a cached grid is baked again: {e}");
-    let e = run("3,2,2");
+    let e = run("2,3,2", "256");
+    assert!(e.contains("baking 12 light probes (2×3×2, 256 paths each)"), "{e}");
+    let e = run("2,3,2", "256");
+    assert!(!e.contains("baking"), "a cached bake is baked again: {e}");
+    let e = run("3,2,2", "256");
     assert!(e.contains("baking 12 light probes (3×2×2,"), "{e}");
+    let e = run("3,2,2", "512");
+    assert!(e.contains("baking 12 light probes (3×2×2, 512 paths each)"), "{e}");
 }

@@ -427,6 +427,9 @@ pub struct GiEval {
     /// The probes' grid, probes per axis (`--probe-grid`), when blended with probes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub probe_grid: Option<[u32; 3]>,
+    /// Paths per probe of the bake (`--probe-rays`), when blended with probes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe_rays: Option<u32>,
     /// The warm-up followed the camera path (`--moving`).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub moving: bool,

@@ -425,6 +425,42 @@ mod tests {
         }
     }
 
+    /// The bake's noise (two seeds' difference) falls as 1/√rays: 16× the paths, ¼ the
+    /// noise (docs/radiosity.md § "Rays per probe").
+    #[test]
+    fn bake_noise_falls_as_one_over_the_root_of_the_rays() {
+        let scene = strata_scene::procedural::builtin("cornell").unwrap();
+        let r = Reference::new(&scene, 0.0);
+        let noise = |rays: u32| {
+            let bake = |seed| {
+                let s = GiSettings {
+                    bounces: 3,
+                    seed,
+                    ..Default::default()
+                };
+                r.bake_probes([3, 3, 3], rays, &s)
+            };
+            let (a, b) = (bake(0), bake(1));
+            let y = Vec3::new(0.2126, 0.7152, 0.0722);
+            let (mut sum, mut count) = (0.0f32, 0);
+            for i in (0..a.count()).filter(|&i| a.valid[i]) {
+                for n in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+                    let (ea, eb) = (a.probe_irradiance(i, n).dot(y), b.probe_irradiance(i, n).dot(y));
+                    if ea + eb > 1e-4 {
+                        sum += 2.0 * (ea - eb).abs() / (ea + eb);
+                        count += 1;
+                    }
+                }
+            }
+            assert!(count > 20, "{count} probe normals lit");
+            sum / count as f32
+        };
+        let (n256, n4096) = (noise(256), noise(4096));
+        assert!(n256 > 0.01, "two seeds should differ at 256 paths: {n256}");
+        let ratio = n4096 / n256;
+        assert!((0.15..0.4).contains(&ratio), "noise {n256} → {n4096}: ratio {ratio}, 1/√16 = 0.25");
+    }
+
     /// Inside a closed box whose walls emit L and reflect nothing, every probe
     /// sees radiance L in every direction: irradiance πL for every normal.
     #[test]

@@ -37,7 +37,7 @@ pub struct GiEvalSettings {
     /// the evaluated scene).
     pub probes_from: Option<String>,
     /// The probes' grid, probes per axis (`cache::probes::GRID` by default).
-    pub probe_grid: [u32; 3],
+    pub probe_bake: crate::cache::probes::ProbeBake,
     /// Warm up along the camera path (frames f − warmup … f) instead of at a still camera.
     pub moving: bool,
 }
@@ -121,7 +121,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         (false, _) => None,
         (true, None) => Some(crate::cache::probes::scene_probes(
             &scene,
-            g.probe_grid,
+            g.probe_bake,
             &cache,
             !s.progress,
         )?),
@@ -131,7 +131,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
             source.settings.sky = [0.0; 3];
             Some(crate::cache::probes::scene_probes(
                 &source,
-                g.probe_grid,
+                g.probe_bake,
                 &cache,
                 !s.progress,
             )?)
@@ -215,7 +215,8 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         ref_bounces: g.bounces,
         probes: g.probes,
         probes_from: g.probes_from.clone(),
-        probe_grid: g.probes.then_some(g.probe_grid),
+        probe_grid: g.probes.then_some(g.probe_bake.grid),
+        probe_rays: g.probes.then_some(g.probe_bake.rays),
         moving: g.moving,
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
