@@ -458,7 +458,10 @@ mod tests {
         let (n256, n4096) = (noise(256), noise(4096));
         assert!(n256 > 0.01, "two seeds should differ at 256 paths: {n256}");
         let ratio = n4096 / n256;
-        assert!((0.15..0.4).contains(&ratio), "noise {n256} → {n4096}: ratio {ratio}, 1/√16 = 0.25");
+        assert!(
+            (0.15..0.4).contains(&ratio),
+            "noise {n256} → {n4096}: ratio {ratio}, 1/√16 = 0.25"
+        );
     }
 
     /// Inside a closed box whose walls emit L and reflect nothing, every probe
