@@ -410,7 +410,7 @@ static AO_SETTINGS: [SettingInfo; 15] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 19] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 20] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -483,6 +483,14 @@ static RADIOSITY_SETTINGS: [SettingInfo; 19] = [
         "on: hash the frame index into the gather's spiral rotation, so the temporal filter averages different tap patterns (the paper hashes the pixel only)",
         temporal_noise,
         ["off", "on"]
+    ),
+    setting!(
+        "tap-visibility",
+        "steps of a visibility test for the hidden layer's radiosity taps: a layer-1 sender counts as nothing when a point between it and the receiver lies within the scene's min separation behind a surface of either layer (0 = off, as the paper; else 2..=32; not in the paper, docs/radiosity.md)",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(radiosity_of(s).tap_visibility as f64),
+        |s, v| radiosity_mut(s).tap_visibility = v as u32
     ),
     setting!(
         "indirect-samples",

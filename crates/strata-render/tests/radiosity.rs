@@ -42,7 +42,8 @@ fn frozen(name: &str) -> Scene {
 
 /// One bounce on the GPU equals Eq. 4–5 evaluated on the CPU over the read-back
 /// depth chain, normals and radiosity buffers with the same taps, for layer 0
-/// and layer 1 receivers, with and without the n̂_Y test.
+/// and layer 1 receivers, with and without the n̂_Y test, and with the hidden taps'
+/// visibility test (which must then change the light of some pixels).
 #[test]
 fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     let gpu = common::gpu();
@@ -50,16 +51,18 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     // normalisation): the paper's Eq. 4, the default weights and normaliser, and the two
     // non-paper tap rules (the atrium has a sky)
     use Normalisation::*;
-    for (name, normal_test, solid_angle, open_sky, hidden_black, normalisation) in [
-        ("atrium", true, false, false, false, Hemisphere),
-        ("cornell", false, false, false, false, Hemisphere),
-        ("warehouse", true, false, false, false, Hemisphere),
-        ("atrium", true, true, false, false, Hemisphere),
-        ("cornell", false, true, false, false, Bounded),
-        ("warehouse", true, true, false, false, Bounded),
-        ("atrium", true, true, true, true, Cosine),
-        ("warehouse", true, false, true, true, Hemisphere),
-        ("warehouse", true, false, false, true, Cosine),
+    for (name, normal_test, solid_angle, open_sky, hidden_black, normalisation, tap_visibility) in [
+        ("atrium", true, false, false, false, Hemisphere, 0),
+        ("cornell", false, false, false, false, Hemisphere, 0),
+        ("warehouse", true, false, false, false, Hemisphere, 0),
+        ("atrium", true, true, false, false, Hemisphere, 0),
+        ("cornell", false, true, false, false, Bounded, 0),
+        ("warehouse", true, true, false, false, Bounded, 0),
+        ("atrium", true, true, true, true, Cosine, 0),
+        ("warehouse", true, false, true, true, Hemisphere, 0),
+        ("warehouse", true, false, false, true, Cosine, 0),
+        ("warehouse", true, true, false, false, Bounded, 8),
+        ("atrium", true, true, false, false, Bounded, 8),
     ] {
         let scene = frozen(name);
         let (w, h) = (96, 64);
@@ -69,6 +72,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             open_sky,
             hidden_black,
             normalisation,
+            tap_visibility,
             radius: Some(4.0),
             ..Default::default()
         };
@@ -77,6 +81,27 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             .expect("frame renders without validation errors");
         let buffers = common::GatherBuffers::read(&gpu, &r);
         let inputs = buffers.inputs(None);
+        if tap_visibility > 0 {
+            // the same buffers without the test: the test must matter somewhere
+            let mut off = *inputs.uniforms;
+            off.vis_steps = 0;
+            let plain = strata_render::passes::radiosity::GatherInputs {
+                uniforms: &off,
+                ..buffers.inputs(None)
+            };
+            let changed = (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .filter(|&(x, y)| {
+                    let (a, b) = (irradiance_cpu(&inputs, 0, x, y).0, irradiance_cpu(&plain, 0, x, y).0);
+                    (a - b).abs().max_element() > 0.01 * b.max_element() + 1e-4
+                })
+                .count();
+            eprintln!("{name}: tap visibility changes {changed} pixels");
+            assert!(
+                changed >= 20,
+                "{name}: the tap visibility test changed {changed} pixels"
+            );
+        }
         for (receiver, target) in [(0usize, "indirect-raw"), (1, "indirect1-raw")] {
             let gpu_e = r.read_target_full(&gpu, target, 0).unwrap();
             let (mut close, mut lit, mut worst) = (0usize, 0usize, 0.0f32);

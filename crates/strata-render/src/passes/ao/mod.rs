@@ -478,6 +478,20 @@ pub fn obscurance(u: &AoUniforms, v: Vec3, n: Vec3) -> f32 {
     (1.0 - vv / r2) * ((v.dot(n) - u.bias) / (vv + u.epsilon).sqrt()).max(0.0)
 }
 
+/// Pixel position of world point `q`, `None` at or before the near plane: the inverse of
+/// [`world_from_csz`] (`pixel_of_world` in common/camera.wgsl).
+pub fn pixel_of_world(f: &FrameUniforms, q: Vec3) -> Option<[f32; 2]> {
+    let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let v = q - v3(f.eye);
+    let z = v.dot(v3(f.cam_forward));
+    if z <= f.eye[3] {
+        return None;
+    }
+    let (right, up) = (v3(f.cam_right), v3(f.cam_up));
+    let ndc = [v.dot(right) / right.dot(right) / z, v.dot(up) / up.dot(up) / z];
+    Some([(ndc[0] * 0.5 + 0.5) * f.size[0], (0.5 - ndc[1] * 0.5) * f.size[1]])
+}
+
 /// `camera.wgsl`'s `world_from_csz` on the CPU.
 pub fn world_from_csz(f: &FrameUniforms, pix: [f32; 2], z: f32) -> Vec3 {
     let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);

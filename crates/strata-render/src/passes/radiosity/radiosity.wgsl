@@ -45,6 +45,12 @@ struct Radiosity {
     // 1 = layer 0's output is the detail term Ê[B] − Ê[L_probe] (`probe_detail`)
     probe_detail: u32,
     grid: ProbeGrid,
+    // > 1: layer-1 taps whose segment from the receiver passes through a surface the
+    // layers hold (tested at this many steps, `segment_blocked`) count as nothing
+    vis_steps: u32,
+    // how far behind each layer's surface counts as solid: the scene's Δz
+    thickness: f32,
+    _pad: vec2u,
 }
 
 // One tap's share of the sums: c.rgb = w · B(Y) max(ω̂·n̂_X, 0), c.a = w (< 0 for an
@@ -125,6 +131,35 @@ fn term(x: vec3f, n: vec3f, y: vec3f, ny: vec3f, j: u32, src: vec2i, h: f32) -> 
     }
     // c.rgb = B(Y)·cos·w once `with_light` has read B (once for both receivers)
     return Term(vec4f(0.0, 0.0, 0.0, wt), wt * cos_x, w, cos_x);
+}
+
+// Whether the segment from receiver x to sender y passes through a surface the deep
+// G-buffer holds: one of the `vis_steps − 1` points between them lies behind a layer's
+// surface on its camera ray by less than `thickness` (inside that surface's object; the
+// layers say nothing of the Δz behind each surface). CPU twin:
+// `radiosity::segment_blocked`.
+fn segment_blocked(x: vec3f, y: vec3f) -> bool {
+    let size = vec2i(textureDimensions(zmip, 0));
+    for (var s = 1u; s < rad.vis_steps; s++) {
+        let t = f32(s) / f32(rad.vis_steps);
+        let pt = mix(x, y, t);
+        let pix = pixel_of_world(frame, pt);
+        if (pix.z == 0.0) {
+            continue;
+        }
+        let q = vec2i(floor(pix.xy));
+        if (any(q < vec2i(0)) || any(q >= size)) {
+            continue;
+        }
+        let zl = textureLoad(zmip, q, 0);
+        let d = csz_of(frame, pt);
+        for (var j = 0u; j < min(LAYERS, 2u); j++) {
+            if (zl[j] > 0.0 && d > zl[j] * 1.001 + 0.01 && d < zl[j] + rad.thickness) {
+                return true;
+            }
+        }
+    }
+    return false;
 }
 
 // A light-carrying term (c.a > 0) with its radiosity B filled in.
@@ -290,6 +325,17 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             var t1: Term;
             if (has1) {
                 t1 = term(x1, n1, y, ny, j, src, tap.radius);
+            }
+            // a hidden (layer-1) sender that the layers show behind a surface from the
+            // receiver sends nothing (`RadiositySettings::tap_visibility`)
+            if (rad.vis_steps > 1u && j == 1u) {
+                var none: Term;
+                if (t0.c.a > 0.0 && segment_blocked(x0, y)) {
+                    t0 = none;
+                }
+                if (t1.c.a > 0.0 && segment_blocked(x1, y)) {
+                    t1 = none;
+                }
             }
             if (t0.c.a > 0.0 || t1.c.a > 0.0) {
                 let b = radiosity_of(src, j);
