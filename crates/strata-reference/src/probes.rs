@@ -125,13 +125,9 @@ impl Reference<'_> {
     ///   around that object blend only the probes left, often ones in its shadow. Where
     ///   that step would leave the cell, the probe stays (and the bake marks it invalid).
     pub fn relocation(&self, g: Vec3, spacing: Vec3, dims: [u32; 3]) -> Vec3 {
-        let min_spacing = (0..3)
-            .filter(|&i| dims[i] > 1)
-            .map(|i| spacing[i])
-            .fold(f32::INFINITY, f32::min);
-        if !min_spacing.is_finite() {
+        let Some(min_spacing) = strata_scene::probes::min_spacing(spacing, dims) else {
             return Vec3::ZERO;
-        }
+        };
         let want = RELOCATE * min_spacing;
         let limit = 0.45 * spacing;
         let off = self.off_surface(g, want).clamp(-limit, limit);

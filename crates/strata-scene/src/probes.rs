@@ -160,6 +160,15 @@ pub fn chebyshev_visibility(dist: f32, mean: f32, mean2: f32) -> f32 {
 /// probe's test rejects with no weight).
 pub const VISIBILITY_FLOOR: f32 = 0.002;
 
+/// The smallest of a grid's `spacing` over the axes with more than one probe (`dims`);
+/// `None` for a single probe.
+pub fn min_spacing(spacing: Vec3, dims: [u32; 3]) -> Option<f32> {
+    (0..3)
+        .filter(|&i| dims[i] > 1)
+        .map(|i| spacing[i])
+        .min_by(f32::total_cmp)
+}
+
 impl IrradianceProbes {
     /// Probe positions of a grid spanning `lo`..`hi` with `dims` probes per axis.
     pub fn grid(lo: Vec3, hi: Vec3, dims: [u32; 3]) -> Self {
@@ -239,15 +248,7 @@ impl IrradianceProbes {
     /// The smallest spacing between probes over the axes with more than one (a single
     /// probe: 0).
     fn min_spacing(&self) -> f32 {
-        let spacing = (0..3)
-            .filter(|&i| self.dims[i] > 1)
-            .map(|i| self.spacing[i])
-            .fold(f32::INFINITY, f32::min);
-        if spacing.is_finite() {
-            spacing
-        } else {
-            0.0
-        }
+        min_spacing(self.spacing, self.dims).unwrap_or(0.0)
     }
 
     /// How visible a receiver at `p` (normal `n`, unit direction `view` towards the
