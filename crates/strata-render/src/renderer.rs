@@ -824,8 +824,14 @@ impl Renderer {
         if let Some(b) = &self.bzb {
             b.set_frame(gpu, scene, frame, self.animated);
         }
+        // the deep G-buffer's minimum separation Δz (its override, else the scene's)
+        let dz = self
+            .settings
+            .deep
+            .min_separation
+            .unwrap_or(scene.settings.min_separation);
         if let (Some(stage), Some(s)) = (&self.radiosity, &self.settings.radiosity) {
-            let ru = RadiosityUniforms::new(s, scene, &u, max_mip, self.frames_rendered);
+            let ru = RadiosityUniforms::new(s, scene, &u, max_mip, self.frames_rendered, dz);
             stage.gather.set_frame(gpu, ru);
             if let Some(p) = &stage.propagate {
                 p.set_frame(gpu, temporal_history);
@@ -835,11 +841,6 @@ impl Renderer {
             }
         }
         self.scene_gpu.update_objects(gpu, frame, variant.next_transforms());
-        let dz = self
-            .settings
-            .deep
-            .min_separation
-            .unwrap_or(scene.settings.min_separation);
         for g in &self.geometry {
             g.set_frame(gpu, dz, self.has_history);
         }

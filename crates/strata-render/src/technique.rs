@@ -486,7 +486,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 20] = [
     ),
     setting!(
         "tap-visibility",
-        "steps of a visibility test for the hidden layer's radiosity taps: a layer-1 sender counts as nothing when a point between it and the receiver lies within the scene's min separation behind a surface of either layer (0 = off, as the paper; else 2..=32; not in the paper, docs/radiosity.md)",
+        "steps of a visibility test for the hidden layer's radiosity taps: a layer-1 sender counts as nothing when a point between it and the receiver lies within the deep G-buffer's min separation behind a surface of either layer (0 = off, as the paper; else 2..=32; not in the paper, docs/radiosity.md)",
         Range::Closed(0.0, 32.0),
         true,
         |s| Some(radiosity_of(s).tap_visibility as f64),

@@ -459,7 +459,8 @@ pub struct RadiosityUniforms {
     pub grid: crate::passes::compose::ProbeGridUniform,
     /// [`RadiositySettings::tap_visibility`].
     pub vis_steps: u32,
-    /// The scene's minimum separation Δz: how far behind a layer's surface counts as solid.
+    /// The deep G-buffer's minimum separation Δz: how far behind a layer's surface counts
+    /// as solid.
     pub thickness: f32,
     pub _pad: [u32; 2],
 }
@@ -471,6 +472,7 @@ impl RadiosityUniforms {
         frame: &FrameUniforms,
         max_mip: u32,
         frame_index: u32,
+        min_separation: f32,
     ) -> Self {
         Self {
             radius: s.radius.unwrap_or(scene.settings.radiosity_radius),
@@ -491,7 +493,7 @@ impl RadiosityUniforms {
             probe_detail: s.probe_detail as u32,
             grid: bytemuck::Zeroable::zeroed(),
             vis_steps: s.tap_visibility,
-            thickness: scene.settings.min_separation,
+            thickness: min_separation,
             _pad: [0; 2],
         }
     }

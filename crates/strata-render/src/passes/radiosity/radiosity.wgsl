@@ -48,7 +48,7 @@ struct Radiosity {
     // > 1: layer-1 taps whose segment from the receiver passes through a surface the
     // layers hold (tested at this many steps, `segment_blocked`) count as nothing
     vis_steps: u32,
-    // how far behind each layer's surface counts as solid: the scene's Δz
+    // how far behind each layer's surface counts as solid: the deep G-buffer's Δz
     thickness: f32,
     _pad: vec2u,
 }
