@@ -17,10 +17,17 @@ fn range_json(r: Range) -> serde_json::Value {
         Range::HalfOpen(a, b) => (Some(a), Some(b), true, false),
         Range::AtLeast(a) => (Some(a), None, true, false),
         Range::Above(a) => (Some(a), None, false, false),
+        Range::OffOr(_, b) => (Some(0.0), Some(b), true, true),
+    };
+    // OffOr: the values strictly between 0 and `off_or_from` are out of range
+    let off_or_from = match r {
+        Range::OffOr(a, _) => Some(a),
+        _ => None,
     };
     serde_json::json!({
         "text": r.to_string(), "min": min, "max": max,
         "min_inclusive": min_inclusive, "max_inclusive": max_inclusive,
+        "off_or_from": off_or_from,
     })
 }
 

@@ -48,6 +48,8 @@ pub enum Range {
     AtLeast(f64),
     /// > a
     Above(f64),
+    /// 0 (off) or a..=b, a > 0
+    OffOr(f64, f64),
 }
 
 impl Range {
@@ -57,6 +59,7 @@ impl Range {
             Range::HalfOpen(a, b) => (a..b).contains(&v),
             Range::AtLeast(a) => v >= a && v.is_finite(),
             Range::Above(a) => v > a && v.is_finite(),
+            Range::OffOr(a, b) => v == 0.0 || (a..=b).contains(&v),
         }
     }
 }
@@ -68,6 +71,7 @@ impl std::fmt::Display for Range {
             Range::HalfOpen(a, b) => write!(f, "[{a}, {b})"),
             Range::AtLeast(a) => write!(f, ">= {a}"),
             Range::Above(a) => write!(f, "> {a}"),
+            Range::OffOr(a, b) => write!(f, "0 or {a}..={b}"),
         }
     }
 }
@@ -486,8 +490,8 @@ static RADIOSITY_SETTINGS: [SettingInfo; 20] = [
     ),
     setting!(
         "tap-visibility",
-        "steps of a visibility test for the hidden layer's radiosity taps: a layer-1 sender counts as nothing when a point between it and the receiver lies within the deep G-buffer's min separation behind a surface of either layer (0 = off, as the paper; else 2..=32; not in the paper, docs/radiosity.md)",
-        Range::Closed(0.0, 32.0),
+        "steps of a visibility test for the hidden layer's radiosity taps: a layer-1 sender counts as nothing for layer 0's receiver when a point between them lies within the deep G-buffer's min separation behind a surface of either layer (0 = off, as the paper; not in the paper, docs/radiosity.md)",
+        Range::OffOr(2.0, radiosity::MAX_TAP_VISIBILITY as f64),
         true,
         |s| Some(radiosity_of(s).tap_visibility as f64),
         |s, v| radiosity_mut(s).tap_visibility = v as u32
@@ -1627,6 +1631,16 @@ mod tests {
                     Range::Above(a) => {
                         check(a + step, true);
                         check(a, false);
+                    }
+                    Range::OffOr(a, b) => {
+                        check(0.0, true);
+                        check(a, true);
+                        check(b, true);
+                        check(b + step, false);
+                        if a - step > 0.0 {
+                            check(a - step, false);
+                        }
+                        check(-step, false);
                     }
                 }
                 assert!(!info.doc.is_empty());

@@ -100,13 +100,14 @@ pub struct RadiositySettings {
     /// Not in the paper (default true; off: DGB's c everywhere).
     pub one_sided_confidence: bool,
     /// A visibility test for the hidden layer's taps (0 = none, as the paper; else the
-    /// steps along the segment, at least 2): a layer-1 sender counts as nothing when a
-    /// point between it and the receiver lies within Δz behind a surface of either
+    /// steps along the segment, at least 2): a layer-1 sender counts as nothing for layer
+    /// 0's receiver when a point between them lies within Δz behind a surface of either
     /// layer ([`segment_blocked`]). Layer-1 senders are hidden from the camera, most often
     /// by the very surface that hides them from the receiver: without the test the red
-    /// floor behind the warehouse's partition lights the wall in front of it. Costs
-    /// about 2× the gather on lavapipe at 8 steps (docs/radiosity.md § "Visibility of
-    /// hidden taps"). Not in the paper (default 0).
+    /// floor behind the warehouse's partition lights the wall in front of it. Layer 1's
+    /// receiver (whose E feeds only the next bounce) is not tested. Costs about +60 % of
+    /// the gather on lavapipe at 8 steps (docs/radiosity.md § "Visibility of hidden
+    /// taps"). Not in the paper (default 0).
     pub tap_visibility: u32,
 }
 
@@ -774,9 +775,10 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
                 }
                 continue;
             }
-            // a hidden sender behind a surface from the receiver (`tap_visibility`)
+            // a hidden sender behind a surface from layer 0's receiver (`tap_visibility`)
             if u.vis_steps > 1
                 && j == 1
+                && receiver == 0
                 && segment_blocked(g.frame, &g.zmip[0], g.layers, u.vis_steps, u.thickness, pos, yv)
             {
                 continue;

@@ -326,16 +326,12 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             if (has1) {
                 t1 = term(x1, n1, y, ny, j, src, tap.radius);
             }
-            // a hidden (layer-1) sender that the layers show behind a surface from the
-            // receiver sends nothing (`RadiositySettings::tap_visibility`)
-            if (rad.vis_steps > 1u && j == 1u) {
+            // a hidden (layer-1) sender that the layers show behind a surface from layer
+            // 0's receiver sends nothing to it (`RadiositySettings::tap_visibility`; layer
+            // 1's receiver, whose E only feeds the next bounce, is not tested)
+            if (rad.vis_steps > 1u && j == 1u && t0.c.a > 0.0 && segment_blocked(x0, y)) {
                 var none: Term;
-                if (t0.c.a > 0.0 && segment_blocked(x0, y)) {
-                    t0 = none;
-                }
-                if (t1.c.a > 0.0 && segment_blocked(x1, y)) {
-                    t1 = none;
-                }
+                t0 = none;
             }
             if (t0.c.a > 0.0 || t1.c.a > 0.0) {
                 let b = radiosity_of(src, j);
