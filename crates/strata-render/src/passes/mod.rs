@@ -77,6 +77,18 @@ pub(crate) fn clear_attachment(view: &wgpu::TextureView) -> Option<wgpu::RenderP
     })
 }
 
+/// A depth attachment cleared to 1 (the far plane) and stored.
+pub(crate) fn clear_depth_attachment(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations {
+            load: wgpu::LoadOp::Clear(1.0),
+            store: wgpu::StoreOp::Store,
+        }),
+        stencil_ops: None,
+    }
+}
+
 /// A fragment-stage float texture binding (`filterable` for sampled reads).
 pub(crate) fn texture_entry(
     binding: u32,

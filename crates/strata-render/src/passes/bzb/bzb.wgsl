@@ -6,6 +6,8 @@
 #import "common/frame.wgsl"
 #import "common/spiral.wgsl"
 #import "common/bzb_geometry.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
 
 const BZB_PI: f32 = 3.14159265358979;
 
@@ -42,6 +44,37 @@ fn zminmax_tile(level: u32) -> u32 {
 // (W×H) tile at (s % cols, s / cols) of the bounced z-buffer.
 fn bzb_tile_origin(s: u32, cols: u32, size: vec2u) -> vec2u {
     return vec2u(s % cols, s / cols) * size;
+}
+
+// The bounced z-buffer's texel at fragment position `pos`: sub-image s, pixel p, and
+// layer 0's x_p and n_p there (§3.1); `ok` is false past the last direction and on the
+// background.
+struct BzbTexel {
+    ok: bool,
+    s: u32,
+    p: vec2u,
+    x: vec3f,
+    n: vec3f,
+}
+
+fn bzb_texel(f: Frame, u: Bzb, pos: vec2f, zpack: texture_2d<f32>, npack: texture_2d<f32>) -> BzbTexel {
+    var o: BzbTexel;
+    let size = vec2u(f.size.xy);
+    let texel = vec2u(pos);
+    let tile = texel / size;
+    o.s = tile.y * u.cols + tile.x;
+    o.p = texel % size;
+    if (o.s >= u.directions) {
+        return o;
+    }
+    let z = textureLoad(zpack, vec2i(o.p), 0).r;
+    if (z <= 0.0) {
+        return o;
+    }
+    o.n = oct_decode(textureLoad(npack, vec2i(o.p), 0).rg);
+    o.x = world_from_csz(f, vec2f(o.p) + 0.5, z);
+    o.ok = true;
+    return o;
 }
 
 // Two uniforms in [0, 1) from a hash of (pixel, direction index, seed); 24 bits
@@ -115,15 +148,10 @@ fn bzb_edge_term(n: vec3f, v0: vec3f, v1: vec3f) -> f32 {
     return angle * dot(n, c) / len;
 }
 
-// The no-visibility baseline's analytic AOV occlusion of triangle (a, b, c) at x
-// (normal n): 0 outside the volume {dist(x, T) < r}; inside, the polygon form
-// factor (1/2π)|Σ edge terms| of T clipped to x's hemisphere above height β
-// (the bias: T's own plane never occludes), times the falloff 1 − (h/r)² with h
-// the distance from x to T's plane (exact binary AO within r of an infinite plane).
-fn bzb_aov_occlusion(x: vec3f, n: vec3f, a: vec3f, b: vec3f, c: vec3f, r: f32, beta: f32) -> f32 {
-    if (!(bzb_triangle_dist2(x, a, b, c) < r * r)) {
-        return 0.0;
-    }
+// Point-to-polygon form factor of triangle (a, b, c) seen from x (normal n), clipped
+// to x's hemisphere above height β (the bias: T's own plane never occludes):
+// (1/2π)|Σ edge terms| of the clipped polygon. bzb-gi's additive baseline uses it bare.
+fn bzb_clipped_form_factor(x: vec3f, n: vec3f, a: vec3f, b: vec3f, c: vec3f, beta: f32) -> f32 {
     // clip the triangle (relative to x) to n·v >= β (Sutherland–Hodgman, ≤ 4 vertices)
     var v = array<vec3f, 3>(a - x, b - x, c - x);
     var poly: array<vec3f, 4>;
@@ -149,8 +177,23 @@ fn bzb_aov_occlusion(x: vec3f, n: vec3f, a: vec3f, b: vec3f, c: vec3f, r: f32, b
     for (var i = 0u; i < count; i++) {
         sum += bzb_edge_term(n, poly[i], poly[(i + 1u) % count]);
     }
+    return min(1.0, abs(sum) / (2.0 * BZB_PI));
+}
+
+// The no-visibility baseline's analytic AOV occlusion of triangle (a, b, c) at x
+// (normal n): 0 outside the volume {dist(x, T) < r}; inside, the clipped form factor
+// (`bzb_clipped_form_factor`) times the falloff 1 − (h/r)² with h the distance from x
+// to T's plane (exact binary AO within r of an infinite plane).
+fn bzb_aov_occlusion(x: vec3f, n: vec3f, a: vec3f, b: vec3f, c: vec3f, r: f32, beta: f32) -> f32 {
+    if (!(bzb_triangle_dist2(x, a, b, c) < r * r)) {
+        return 0.0;
+    }
+    let ff = bzb_clipped_form_factor(x, n, a, b, c, beta);
+    if (ff == 0.0) {
+        return 0.0;
+    }
     let nor = normalize(cross(b - a, c - a));
     let h = abs(dot(nor, x - a));
     let falloff = max(0.0, 1.0 - h * h / (r * r));
-    return min(1.0, abs(sum) / (2.0 * BZB_PI)) * falloff;
+    return ff * falloff;
 }

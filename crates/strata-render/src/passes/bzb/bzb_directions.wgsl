@@ -20,20 +20,11 @@ struct DirectionsOut {
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> DirectionsOut {
     var o: DirectionsOut;
-    let size = vec2u(frame.size.xy);
-    let texel = vec2u(pos.xy);
-    let tile = texel / size;
-    let s = tile.y * bzb.cols + tile.x;
-    let p = texel % size;
-    if (s >= bzb.directions) {
+    let t = bzb_texel(frame, bzb, pos.xy, zpack, npack);
+    if (!t.ok) {
         return o;
     }
-    let z = textureLoad(zpack, vec2i(p), 0).r;
-    if (z <= 0.0) {
-        return o;
-    }
-    let n = oct_decode(textureLoad(npack, vec2i(p), 0).rg);
-    o.origin = vec4f(world_from_csz(frame, vec2f(p) + 0.5, z), 1.0);
-    o.direction = bzb_direction(n, bzb_sample_uniforms(p, s, bzb.seed), bzb.hemisphere);
+    o.origin = vec4f(t.x, 1.0);
+    o.direction = bzb_direction(t.n, bzb_sample_uniforms(t.p, t.s, bzb.seed), bzb.hemisphere);
     return o;
 }

@@ -23,34 +23,25 @@ struct DirectionsOut {
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> DirectionsOut {
     var o: DirectionsOut;
-    let size = vec2u(frame.size.xy);
-    let texel = vec2u(pos.xy);
-    let tile = texel / size;
-    let s = tile.y * bzb.cols + tile.x;
-    let p = texel % size;
-    if (s >= bzb.directions) {
+    let t = bzb_texel(frame, bzb, pos.xy, zpack, npack);
+    if (!t.ok) {
         return o;
     }
-    let z = textureLoad(zpack, vec2i(p), 0).r;
-    if (z <= 0.0) {
-        return o;
-    }
-    let n = oct_decode(textureLoad(npack, vec2i(p), 0).rg);
-    let x = world_from_csz(frame, vec2f(p) + 0.5, z);
-    let nrm = textureLoad(normal_tex, vec2i(p), 0);
-    let glossy = textureLoad(emission_tex, vec2i(p), 0).a > 1.5;
-    let rho = textureLoad(albedo_tex, vec2i(p), 0).rgb;
-    let v = normalize(frame.eye.xyz - x);
-    o.origin = vec4f(x, 1.0);
+    let p = vec2i(t.p);
+    let nrm = textureLoad(normal_tex, p, 0);
+    let glossy = textureLoad(emission_tex, p, 0).a > 1.5;
+    let rho = textureLoad(albedo_tex, p, 0).rgb;
+    let v = normalize(frame.eye.xyz - t.x);
+    o.origin = vec4f(t.x, 1.0);
     o.direction = bzb_gi_direction(
-        n,
+        t.n,
         v,
         glossy,
         rho,
         nrm.z,
         nrm.w,
-        bzb_gi_lobe_uniform(p, s, bzb.seed),
-        bzb_sample_uniforms(p, s, bzb.seed),
+        bzb_gi_lobe_uniform(t.p, t.s, bzb.seed),
+        bzb_sample_uniforms(t.p, t.s, bzb.seed),
     );
     return o;
 }

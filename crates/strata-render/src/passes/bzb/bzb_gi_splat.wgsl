@@ -53,36 +53,6 @@ fn fs_gi_visibility(in: SplatVertex) -> GiVisibilityOut {
     return out;
 }
 
-// Point-to-polygon form factor F of triangle (a, b, c) seen from x (normal n),
-// clipped to n·(y − x) ≥ β: (1/2π)|Σ edge terms| (the AOV term without falloff).
-fn gi_form_factor(x: vec3f, n: vec3f, a: vec3f, b: vec3f, c: vec3f, beta: f32) -> f32 {
-    var v = array<vec3f, 3>(a - x, b - x, c - x);
-    var poly: array<vec3f, 4>;
-    var count = 0u;
-    for (var i = 0u; i < 3u; i++) {
-        let p = v[i];
-        let q = v[(i + 1u) % 3u];
-        let hp = dot(n, p) - beta;
-        let hq = dot(n, q) - beta;
-        if (hp >= 0.0) {
-            poly[count] = p;
-            count++;
-        }
-        if ((hp >= 0.0) != (hq >= 0.0)) {
-            poly[count] = p + (q - p) * (hp / (hp - hq));
-            count++;
-        }
-    }
-    if (count < 3u) {
-        return 0.0;
-    }
-    var sum = 0.0;
-    for (var i = 0u; i < count; i++) {
-        sum += bzb_edge_term(n, poly[i], poly[(i + 1u) % count]);
-    }
-    return min(1.0, abs(sum) / (2.0 * BZB_PI));
-}
-
 @fragment
 fn fs_gi_additive(in: SplatVertex) -> @location(0) vec4f {
     let texel = vec2i(in.position.xy);
@@ -100,7 +70,7 @@ fn fs_gi_additive(in: SplatVertex) -> @location(0) vec4f {
     if (!(bzb_triangle_dist2(o.xyz, v[0], v[1], v[2]) < gi.d_max * gi.d_max)) {
         discard;
     }
-    let ff = gi_form_factor(o.xyz, n, v[0], v[1], v[2], gi.t_min);
+    let ff = bzb_clipped_form_factor(o.xyz, n, v[0], v[1], v[2], gi.t_min);
     if (ff <= 0.0) {
         discard;
     }

@@ -70,40 +70,18 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     let lo = min(min(a, b), c) - vec3f(bzb.radius);
     let hi = max(max(a, b), c) + vec3f(bzb.radius);
     let size = frame.size.xy;
-    var rmin = vec2f(1e30);
-    var rmax = vec2f(-1e30);
-    var in_front = 0u;
-    // camera-depth range of the grown box: every receiver it can occlude is in it
-    var zlo = 1e30;
-    var zhi = -1e30;
-    for (var k = 0u; k < 8u; k++) {
-        let q = select(lo, hi, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
-        let zq = dot(q - frame.eye.xyz, frame.cam_forward.xyz);
-        zlo = min(zlo, zq);
-        zhi = max(zhi, zq);
-        let p = pixel_of_world(frame, q);
-        if (p.z > 0.0) {
-            in_front++;
-            rmin = min(rmin, p.xy);
-            rmax = max(rmax, p.xy);
-        }
-    }
-    if (in_front == 0u) {
-        // the whole volume is behind the camera
+    // the camera-depth range of the grown box: every receiver it can occlude is in it
+    let sb = screen_box(frame, lo, hi);
+    if (!sb.visible) {
         return out;
     }
-    if (in_front < 8u) {
-        // the volume crosses the near plane: cover the whole sub-image
-        rmin = vec2f(0.0);
-        rmax = size;
-    }
-    rmin = clamp(floor(rmin) - 1.0, vec2f(0.0), size);
-    rmax = clamp(ceil(rmax) + 1.0, vec2f(0.0), size);
+    let rmin = clamp(floor(sb.rmin) - 1.0, vec2f(0.0), size);
+    let rmax = clamp(ceil(sb.rmax) + 1.0, vec2f(0.0), size);
     if (any(rmax <= rmin)) {
         return out;
     }
     // issue 13 item 4: no receiver under the splat within its depth range
-    if (bzb.culling == 1u && !receivers_in_range(rmin, rmax, zlo, zhi)) {
+    if (bzb.culling == 1u && !receivers_in_range(rmin, rmax, sb.zlo, sb.zhi)) {
         return out;
     }
     // corners of two triangles: (0,0) (1,0) (0,1) / (0,1) (1,0) (1,1)

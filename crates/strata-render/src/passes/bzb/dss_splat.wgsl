@@ -55,31 +55,15 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     let outer = dss_shell(level, dss.d_max).y;
     let lo = c - vec3f(outer);
     let hi = c + vec3f(outer);
-    let size = frame.size.xy;
-    var rmin = vec2f(1e30);
-    var rmax = vec2f(-1e30);
-    var in_front = 0u;
-    for (var k = 0u; k < 8u; k++) {
-        let q = select(lo, hi, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
-        let p = pixel_of_world(frame, q);
-        if (p.z > 0.0) {
-            in_front++;
-            rmin = min(rmin, p.xy);
-            rmax = max(rmax, p.xy);
-        }
-    }
-    if (in_front == 0u) {
+    let sb = screen_box(frame, lo, hi);
+    if (!sb.visible) {
         return out;
-    }
-    if (in_front < 8u) {
-        rmin = vec2f(0.0);
-        rmax = size;
     }
     // in neighbourhoods of 2^l × 2^l pixels (the sub-image's texels)
     let b = f32(1u << level);
     let sub = vec2f(dss.plane >> vec2u(level));
-    rmin = clamp(floor(rmin / b) - 1.0, vec2f(0.0), sub);
-    rmax = clamp(ceil(rmax / b) + 1.0, vec2f(0.0), sub);
+    let rmin = clamp(floor(sb.rmin / b) - 1.0, vec2f(0.0), sub);
+    let rmax = clamp(ceil(sb.rmax / b) + 1.0, vec2f(0.0), sub);
     if (any(rmax <= rmin)) {
         return out;
     }

@@ -577,14 +577,9 @@ impl Pass for SplatPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let depth = self.visibility.then(|| wgpu::RenderPassDepthStencilAttachment {
-            view: &targets.get(DEPTH.name).view,
-            depth_ops: Some(wgpu::Operations {
-                load: wgpu::LoadOp::Clear(1.0),
-                store: wgpu::StoreOp::Store,
-            }),
-            stencil_ops: None,
-        });
+        let depth = self
+            .visibility
+            .then(|| crate::passes::clear_depth_attachment(&targets.get(DEPTH.name).view));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("bzb-splat"),
             color_attachments: &[crate::passes::clear_attachment(&targets.get(self.payload).view)],

@@ -162,30 +162,57 @@ fn empty(a: f32) -> ShadeOut {
     return o;
 }
 
-// SNSM on the tiled sub-buffers (writes the tiled irradiance buffer, Fig. 3 c).
-@fragment
-fn fs_snsm(@builtin(position) pos: vec4f) -> ShadeOut {
-    let t = vec2u(pos.xy);
+// What a tiled texel shades (Fig. 3 c): the G-buffer sample `g` at image pixel `pix`,
+// VPLs first, first + stride, … (its sub-buffer's share, or all of them), the sum
+// scaled by `scale` = N / N_s. `state`: 0 = nothing (padding, background), 1 = a
+// sub-buffer without VPLs (fewer VPLs than sub-buffers), 2 = shade.
+struct Share {
+    g: vec4f,
+    pix: vec2u,
+    first: u32,
+    stride: u32,
+    scale: f32,
+    state: u32,
+}
+
+fn share_of(t: vec2u) -> Share {
+    var o: Share;
     if (ils_is_padding(t, shade.geo)) {
-        return empty(0.0);
+        return o;
     }
-    let g = textureLoad(gbuffer, vec2i(t), 0);
-    if (g.w <= 0.0) {
-        return empty(0.0);
+    o.g = textureLoad(gbuffer, vec2i(t), 0);
+    if (o.g.w <= 0.0) {
+        return o;
     }
-    let pix = ils_gather_index(t, shade.geo);
+    o.pix = ils_gather_index(t, shade.geo);
+    o.state = 2u;
+    o.stride = 1u;
+    o.scale = 1.0;
     if (shade.all_vpls != 0u) {
-        return vpl_sum(g, pix, 0u, 1u);
+        return o;
     }
     let ij = ils_sub_buffer(t, shade.geo);
     let s = ij.y * shade.geo.pattern.x + ij.x;
     let big_s = shade.sub_buffers;
     if (s >= shade.vpl_count) {
-        // fewer VPLs than sub-buffers: this one has none
-        return empty(1.0);
+        o.state = 1u;
+        return o;
     }
     let n_s = (shade.vpl_count - s + big_s - 1u) / big_s;
-    return scaled(vpl_sum(g, pix, s, big_s), f32(shade.vpl_count) / f32(n_s));
+    o.first = s;
+    o.stride = big_s;
+    o.scale = f32(shade.vpl_count) / f32(n_s);
+    return o;
+}
+
+// SNSM on the tiled sub-buffers (writes the tiled irradiance buffer, Fig. 3 c).
+@fragment
+fn fs_snsm(@builtin(position) pos: vec4f) -> ShadeOut {
+    let a = share_of(vec2u(pos.xy));
+    if (a.state < 2u) {
+        return empty(f32(a.state));
+    }
+    return scaled(vpl_sum(a.g, a.pix, a.first, a.stride), a.scale);
 }
 
 // Brute force ("no IS", Table 4): every pixel, all N VPLs.
@@ -202,26 +229,11 @@ fn fs_brute_force(@builtin(position) pos: vec4f) -> ShadeOut {
 // SSM on the tiled sub-buffers (same assignment and scaling as fs_snsm).
 @fragment
 fn fs_ssm(@builtin(position) pos: vec4f) -> ShadeOut {
-    let t = vec2u(pos.xy);
-    if (ils_is_padding(t, shade.geo)) {
-        return empty(0.0);
+    let a = share_of(vec2u(pos.xy));
+    if (a.state < 2u) {
+        return empty(f32(a.state));
     }
-    let g = textureLoad(gbuffer, vec2i(t), 0);
-    if (g.w <= 0.0) {
-        return empty(0.0);
-    }
-    let pix = ils_gather_index(t, shade.geo);
-    if (shade.all_vpls != 0u) {
-        return vpl_sum_ssm(g, pix, 0u, 1u);
-    }
-    let ij = ils_sub_buffer(t, shade.geo);
-    let s = ij.y * shade.geo.pattern.x + ij.x;
-    let big_s = shade.sub_buffers;
-    if (s >= shade.vpl_count) {
-        return empty(1.0);
-    }
-    let n_s = (shade.vpl_count - s + big_s - 1u) / big_s;
-    return scaled(vpl_sum_ssm(g, pix, s, big_s), f32(shade.vpl_count) / f32(n_s));
+    return scaled(vpl_sum_ssm(a.g, a.pix, a.first, a.stride), a.scale);
 }
 
 // Brute force with VPL shadows: every pixel, all N VPLs, each with its visibility.

@@ -435,20 +435,10 @@ impl Pass for InterleavePass {
     }
 }
 
-/// §4.5's DB pass (from `ils-gbuffer`) and the two blur passes `src` →
-/// `ils-blur-h` → `dst` (creates `ils-discontinuity` and `ils-blur-h`).
-fn filter_passes(
-    gpu: &GpuContext,
-    scene_gpu: &GpuScene,
-    targets: &mut Targets,
-    s: &IlsSettings,
-    src: &'static str,
-    dst: &'static str,
-) -> (FullscreenPass, FullscreenPass, FullscreenPass) {
-    targets.create(gpu, DISCONTINUITY);
-    targets.create(gpu, BLUR_H);
-    let [rx, ry] = s.blur_radius();
-    let filter = |radius: u32, dir: [i32; 2]| FilterUniforms {
+/// §4.5's filter uniforms for a blur of `radius` texels along `dir` (the DB pass: 0,
+/// [0, 0]).
+fn filter_uniforms(s: &IlsSettings, radius: u32, dir: [i32; 2]) -> FilterUniforms {
+    FilterUniforms {
         depth_threshold: s.depth_threshold,
         normal_cos: s.normal_threshold_deg.to_radians().cos(),
         radius,
@@ -461,17 +451,47 @@ fn filter_passes(
         } else {
             3
         },
-    };
+    }
+}
+
+/// §4.5's DB pass (from `ils-gbuffer`) and the two blur passes `src` →
+/// `ils-blur-h` → `dst` (creates `ils-discontinuity` and `ils-blur-h`).
+fn filter_passes(
+    gpu: &GpuContext,
+    scene_gpu: &GpuScene,
+    targets: &mut Targets,
+    s: &IlsSettings,
+    src: &'static str,
+    dst: &'static str,
+) -> (FullscreenPass, FullscreenPass, FullscreenPass) {
+    targets.create(gpu, DISCONTINUITY);
+    targets.create(gpu, BLUR_H);
     let discontinuity = PassBuilder::new(gpu, targets, "ils-db")
         .shader("ils-filter", include_str!("ils_filter.wgsl"))
         .entry("fs_discontinuity")
         .frame(scene_gpu)
-        .uniforms(&filter(0, [0, 0]))
+        .uniforms(&filter_uniforms(s, 0, [0, 0]))
         .read(GBUFFER.name)
         .write(DISCONTINUITY.name)
         .build();
+    let (h, v) = blur_passes(gpu, scene_gpu, targets, s, ["ils-blur-h", "ils-blur-v"], src, dst);
+    (discontinuity, h, v)
+}
+
+/// The separable discontinuity-aware blur (§4.5) `src` → `ils-blur-h` → `dst`, passes
+/// named `names` (horizontal, vertical); the DB and `ils-blur-h` must exist.
+fn blur_passes(
+    gpu: &GpuContext,
+    scene_gpu: &GpuScene,
+    targets: &mut Targets,
+    s: &IlsSettings,
+    names: [&'static str; 2],
+    src: &'static str,
+    dst: &'static str,
+) -> (FullscreenPass, FullscreenPass) {
+    let [rx, ry] = s.blur_radius();
     let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("ils blur bilinear"),
+        label: Some(names[0]),
         mag_filter: wgpu::FilterMode::Linear,
         min_filter: wgpu::FilterMode::Linear,
         ..Default::default()
@@ -490,9 +510,9 @@ fn filter_passes(
             .write(dst)
             .build()
     };
-    let h = blur("ils-blur-h", src, BLUR_H.name, filter(rx, [1, 0]));
-    let v = blur("ils-blur-v", BLUR_H.name, dst, filter(ry, [0, 1]));
-    (discontinuity, h, v)
+    let h = blur(names[0], src, BLUR_H.name, filter_uniforms(s, rx, [1, 0]));
+    let v = blur(names[1], BLUR_H.name, dst, filter_uniforms(s, ry, [0, 1]));
+    (h, v)
 }
 
 /// The same blur (kernel, DB) over the glossy receivers' radiance, `GLOSSY` →
@@ -504,48 +524,8 @@ fn glossy_blur_passes(
     s: &IlsSettings,
 ) -> (FullscreenPass, FullscreenPass) {
     targets.create(gpu, GLOSSY_BLURRED);
-    let [rx, ry] = s.blur_radius();
-    let filter = |radius: u32, dir: [i32; 2]| FilterUniforms {
-        depth_threshold: s.depth_threshold,
-        normal_cos: s.normal_threshold_deg.to_radians().cos(),
-        radius,
-        sigma: radius.max(1) as f32,
-        dir,
-        bilinear: s.bilinear as u32,
-        channel: if s.per_axis_discontinuities {
-            (dir[1] != 0) as u32
-        } else {
-            3
-        },
-    };
-    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("ils glossy blur bilinear"),
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        ..Default::default()
-    });
-    let blur = |name: &'static str, src: &'static str, dst: &'static str, u: FilterUniforms| {
-        let src_t = targets.get(src);
-        let db = targets.get(DISCONTINUITY.name);
-        PassBuilder::new(gpu, targets, name)
-            .shader("ils-filter", include_str!("ils_filter.wgsl"))
-            .entry("fs_blur")
-            .frame(scene_gpu)
-            .uniforms(&u)
-            .view(src, &src_t.view, wgpu::TextureViewDimension::D2, true)
-            .view(DISCONTINUITY.name, &db.view, wgpu::TextureViewDimension::D2, true)
-            .sampler(&sampler, wgpu::SamplerBindingType::Filtering)
-            .write(dst)
-            .build()
-    };
-    let h = blur("ils-blur-glossy-h", GLOSSY.name, BLUR_H.name, filter(rx, [1, 0]));
-    let v = blur(
-        "ils-blur-glossy-v",
-        BLUR_H.name,
-        GLOSSY_BLURRED.name,
-        filter(ry, [0, 1]),
-    );
-    (h, v)
+    let names = ["ils-blur-glossy-h", "ils-blur-glossy-v"];
+    blur_passes(gpu, scene_gpu, targets, s, names, GLOSSY.name, GLOSSY_BLURRED.name)
 }
 
 /// The ILS passes of a frame (see the module docs).

@@ -21,7 +21,7 @@ use glam::{Mat4, Vec3};
 
 use crate::frame::{Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
-use crate::scene_gpu::{GpuScene, VERTEX_LAYOUT};
+use crate::scene_gpu::GpuScene;
 use crate::RenderError;
 
 use super::GpuVpl;
@@ -146,67 +146,13 @@ impl VplShadowPass {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let views_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ils vpl shadow view"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(64),
-                },
-                count: None,
-            }],
-        });
-        let views_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ils vpl shadow views"),
-            layout: &views_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &views_buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(64),
-                }),
-            }],
-        });
-        // the point lights' depth-only shader: the face matrix at a dynamic offset
-        let module = crate::shader::module(device, "shadow", include_str!("../shadow/shadow.wgsl"));
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("ils vpl shadows"),
-            bind_group_layouts: &[Some(&views_layout), Some(&scene_gpu.object_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("ils vpl shadows"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(VERTEX_LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: wgpu::TextureFormat::Depth32Float,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 2.0,
-                    clamp: 0.0,
-                },
-            }),
-            multisample: Default::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
-        });
+        // the point lights' depth-only pipeline: the face matrix at a dynamic offset
+        let (views_group, pipeline) = crate::passes::shadow::depth_only_pipeline(
+            device,
+            &scene_gpu.object_layout,
+            &views_buffer,
+            "ils vpl shadows",
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("ils vpl shadow compare"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -273,14 +219,7 @@ impl Pass for VplShadowPass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("ils-vpl-shadows"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: Some(crate::passes::clear_depth_attachment(view)),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
