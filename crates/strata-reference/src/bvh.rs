@@ -48,6 +48,46 @@ pub(crate) const BOX_SCALE: f32 = 1.000_000_4;
 /// same hits. 2⁻¹⁸ ≈ 4e-6.
 pub(crate) const BOX_SLACK: f32 = 1.0 / 262_144.0;
 
+/// The start of a traversal: the root, the ray, the absolute box margin, the widened
+/// box range ([`box_range`]) and the root box's entry distance.
+pub(crate) struct TraversalStart {
+    pub root: ChildRef,
+    pub ray: Ray,
+    pub margin: f32,
+    pub btmin: f32,
+    pub btmax: f32,
+    pub root_near: f32,
+}
+
+/// [`TraversalStart`] of a tree with `root` (a node or leaf and its world bounds); `None`
+/// when the tree is empty, `[tmin, tmax]` is empty or not a number, the ray is not
+/// finite, or it misses the root box.
+#[inline(always)]
+pub(crate) fn start_traversal(
+    root: Option<(ChildRef, [f32; 3], [f32; 3])>,
+    origin: Vec3,
+    dir: Vec3,
+    tmin: f32,
+    tmax: f32,
+) -> Option<TraversalStart> {
+    let (root, root_min, root_max) = root?;
+    if !(tmin <= tmax) || !origin.is_finite() || !dir.is_finite() {
+        return None;
+    }
+    let ray = Ray::new(origin, dir);
+    let margin = ray.margin(dir, scale_of(&root_min, &root_max));
+    let (btmin, btmax) = box_range(tmin, tmax, margin);
+    let root_near = ray.hit_box(&root_min, &root_max, btmin, btmax);
+    (root_near != f32::INFINITY).then_some(TraversalStart {
+        root,
+        ray,
+        margin,
+        btmin,
+        btmax,
+        root_near,
+    })
+}
+
 /// The `[tmin, tmax]` range widened by [`BOX_SLACK`] and the absolute `margin`
 /// for box tests.
 #[inline(always)]
@@ -461,19 +501,17 @@ impl Bvh {
         ordered: bool,
         mut on_hit: impl FnMut(Hit, &mut f32) -> bool,
     ) {
-        let Some((root, root_min, root_max)) = self.root else {
+        let Some(TraversalStart {
+            root,
+            ray,
+            margin,
+            btmin,
+            mut btmax,
+            root_near,
+        }) = start_traversal(self.root, origin, dir, tmin, *tmax)
+        else {
             return;
         };
-        if !(tmin <= *tmax) || !origin.is_finite() || !dir.is_finite() {
-            return;
-        }
-        let ray = Ray::new(origin, dir);
-        let margin = ray.margin(dir, scale_of(&root_min, &root_max));
-        let (btmin, mut btmax) = box_range(tmin, *tmax, margin);
-        let root_near = ray.hit_box(&root_min, &root_max, btmin, btmax);
-        if root_near == f32::INFINITY {
-            return;
-        }
         // Uninitialised: zeroing 1 KiB per ray costs a few percent of throughput.
         let mut stack = [const { MaybeUninit::<(ChildRef, f32)>::uninit() }; STACK];
         let mut sp = 0usize;

@@ -35,7 +35,9 @@ use std::mem::MaybeUninit;
 use glam::Vec3;
 use strata_scene::WorldTriangle;
 
-use crate::bvh::{box_range, next_up, scale_of, Bvh, ChildRef, Hit, LeafPolicy, Ray, BOX_SCALE, LEAF};
+use crate::bvh::{
+    box_range, next_up, scale_of, start_traversal, Bvh, ChildRef, Hit, LeafPolicy, Ray, TraversalStart, BOX_SCALE, LEAF,
+};
 
 /// Children per node.
 pub(crate) const WIDTH: usize = 8;
@@ -439,19 +441,17 @@ impl WideBvh {
         mode: Mode,
         on_hit: &mut F,
     ) {
-        let Some((root, root_min, root_max)) = self.root else {
+        let Some(TraversalStart {
+            root,
+            ray,
+            margin,
+            btmin,
+            mut btmax,
+            root_near,
+        }) = start_traversal(self.root, origin, dir, tmin, *tmax)
+        else {
             return;
         };
-        if !(tmin <= *tmax) || !origin.is_finite() || !dir.is_finite() {
-            return;
-        }
-        let ray = Ray::new(origin, dir);
-        let margin = ray.margin(dir, scale_of(&root_min, &root_max));
-        let (btmin, mut btmax) = box_range(tmin, *tmax, margin);
-        let root_near = ray.hit_box(&root_min, &root_max, btmin, btmax);
-        if root_near == f32::INFINITY {
-            return;
-        }
         // Uninitialised: zeroing 8 KiB per ray would cost more than the traversal.
         let mut stack = [const { MaybeUninit::<(ChildRef, f32)>::uninit() }; STACK];
         let mut sp = 0usize;
