@@ -240,10 +240,18 @@ impl RenderSettings {
         }
         let (w, h) = self.internal_size();
         if w > MAX_SIZE || h > MAX_SIZE {
-            return Err(RenderError::Parameter(format!(
-                "guard band {} px makes the rendered size {w}x{h}: must stay within {MAX_SIZE}",
-                self.guard_pixels()
-            )));
+            let g = self.guard_pixels();
+            let fits = MAX_SIZE.saturating_sub(2 * g);
+            return Err(RenderError::Parameter(if fits < 8 {
+                format!(
+                    "guard band {g} px is out of range: must be at most {} px",
+                    (MAX_SIZE - 8) / 2
+                )
+            } else {
+                format!(
+                    "guard band {g} px makes the rendered size {w}x{h}: must stay within {MAX_SIZE} (with this guard band width and height must be in 8..={fits}, or set the guard band to 0)"
+                )
+            }));
         }
         if let Some(ao) = &self.ao {
             ao.validate().map_err(RenderError::Parameter)?;

@@ -412,7 +412,20 @@ fn invalid_settings_are_errors_naming_the_parameter() {
         GuardBand::default(),
     );
     assert!(e.contains("min-separation"), "{e}");
-    assert!(try_new(d, GuardBand::Pixels(9000)).contains("guard band"));
+    let e = try_new(d, GuardBand::Pixels(9000));
+    assert!(e.contains("guard band 9000 px") && e.contains("at most 4092"), "{e}");
+    assert!(!e.contains('\n'), "{e}");
+    // the largest size with the default guard band: the error says what fits
+    let e = RenderSettings {
+        width: 8192,
+        height: 8,
+        guard_band: GuardBand::Pixels(1),
+        ..Default::default()
+    }
+    .validate()
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("8194x10") && e.contains("8..=8190"), "{e}");
     assert!("12%".parse::<GuardBand>().unwrap() == GuardBand::Fraction(0.12));
     assert!("abc".parse::<GuardBand>().is_err());
     assert!("nope".parse::<Variant>().unwrap_err().contains("reproject"));

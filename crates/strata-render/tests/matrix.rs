@@ -11,8 +11,8 @@ mod common;
 use strata_render::frame::FrameCameras;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::ils::GpuVpl;
-use strata_render::technique::registry;
-use strata_render::{GpuContext, RenderSettings, Renderer};
+use strata_render::technique::{registry, Range};
+use strata_render::{GpuContext, RenderError, RenderSettings, Renderer};
 use strata_scene::probes::IrradianceProbes;
 use strata_scene::{procedural, ImageBuf, Scene};
 
@@ -210,5 +210,95 @@ fn algorithm_switching_settings_render_cleanly() {
     eprintln!(
         "algorithm settings: {} configurations, {images} images checked",
         2 * 2 * VARIANTS.len()
+    );
+}
+
+/// The values at the ends of a declared range that a user can type: both ends of a
+/// closed range, the last value below an open end, a large value for an unbounded one
+/// (10³ × the lower end, at least 10³), and 0 plus both ends for "0 or a..=b".
+fn range_ends(range: Range, integer: bool) -> Vec<f64> {
+    let step = if integer { 1.0 } else { 1e-3 };
+    let large = |a: f64| (a * 1e3).max(1e3);
+    match range {
+        Range::Closed(a, b) => vec![a, b],
+        Range::HalfOpen(a, b) => vec![a, b - step],
+        Range::AtLeast(a) => vec![a, large(a)],
+        Range::Above(a) => vec![
+            if integer {
+                a + 1.0
+            } else {
+                a + (a.abs() * 1e-6).max(1e-6)
+            },
+            large(a),
+        ],
+        Range::OffOr(a, b) => vec![0.0, a, b],
+    }
+}
+
+/// Every registered setting of every technique, alone at each end of its declared
+/// range (`range_ends`), on top of the technique's defaults, two layers: the frame
+/// renders twice (temporal filters see history) without a wgpu validation error and
+/// the technique's output holds only finite values. A resource refusal before any GPU
+/// work (an A-buffer pool over the adapter's largest buffer) is the one accepted error,
+/// and it must name the limit. A new setting joins by registering.
+#[test]
+fn every_setting_renders_cleanly_at_both_ends_of_its_range() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("cornell").expect("built-in scene");
+    let vpls = scene_vpls(&scene);
+    let (mut rendered, mut refused) = (0, 0);
+    for t in registry() {
+        for info in t.setting_list() {
+            for v in range_ends(info.range, info.integer) {
+                let base = RenderSettings {
+                    width: 32,
+                    height: 32,
+                    deep: DeepGBufferSettings {
+                        layers: 2,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let mut s = t.settings(&base, None).expect("default settings");
+                t.set(&mut s, info.name, v)
+                    .unwrap_or_else(|e| panic!("{} {}={v}: the declared end is refused: {e}", t.name, info.name));
+                if s.radiosity.is_some() {
+                    s.probes = Some(probes(&scene));
+                }
+                if let Some(ils) = &mut s.ils {
+                    ils.vpls = vpls.clone();
+                }
+                let what = format!("{} {}={v}", t.name, info.name);
+                let mut r = match Renderer::new(&gpu, &scene, s) {
+                    Ok(r) => r,
+                    Err(e) => {
+                        let text = e.to_string();
+                        assert!(
+                            !matches!(e, RenderError::Validation(_)) && text.contains("largest storage buffer"),
+                            "{what}: renderer: {text}"
+                        );
+                        refused += 1;
+                        continue;
+                    }
+                };
+                for f in 0..2 {
+                    let time = f as f32;
+                    r.render(&gpu, &scene, &FrameCameras::along_path(&scene, time), time)
+                        .unwrap_or_else(|e| panic!("{what}: frame {f}: {e}"));
+                }
+                let out = r
+                    .read_target_full(&gpu, t.output, 0)
+                    .unwrap_or_else(|e| panic!("{what}: {}: {e}", t.output));
+                assert_eq!(non_finite(&out), 0, "{what}: {} has non-finite values", t.output);
+                gpu.check_errors().unwrap_or_else(|e| panic!("{what}: read-back: {e}"));
+                rendered += 1;
+            }
+        }
+    }
+    // at most the two A-buffer techniques' largest pool
+    assert!(refused <= 2, "{refused} refusals");
+    assert!(rendered > 200, "only {rendered} configurations rendered");
+    eprintln!(
+        "setting range ends: {rendered} configurations rendered cleanly, {refused} refused with a one-line error"
     );
 }
