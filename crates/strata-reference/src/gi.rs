@@ -30,9 +30,9 @@
 //! Glossy vertices sample [`Ggx::sample`] (lobe selection, visible normals)
 //! instead of the cosine, weight the path by f·cos/pdf, and combine the two
 //! ways of reaching an emissive triangle by multiple importance sampling
-//! (power heuristic, β = 2): the NEE sample is weighted by p_light² / (p_light²
-//! + p_brdf²), and a bounce ray that hits an emitter's front face adds its
-//! emission weighted by p_brdf² / (p_light² + p_brdf²), both pdfs per solid
+//! (power heuristic, β = 2): the NEE sample is weighted by
+//! p_light² / (p_light² + p_brdf²), and a bounce ray that hits an emitter's front
+//! face adds its emission weighted by p_brdf² / (p_light² + p_brdf²), both pdfs per solid
 //! angle (p_light = P(triangle) / area · d² / cos θ_light). Lambertian vertices
 //! keep NEE alone (weight 1, no emission on bounce hits), exactly as before.
 //! Point, spot and sun lights are deltas: NEE only, f evaluated toward them.

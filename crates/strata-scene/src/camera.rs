@@ -125,7 +125,7 @@ impl Camera {
                 self.fov_y_deg
             ));
         }
-        if !(self.near > 0.0) || !self.near.is_finite() {
+        if self.near <= 0.0 || !self.near.is_finite() {
             return Err(format!("camera near {} is out of range: must be > 0", self.near));
         }
         let m = crate::model::MAX_COORDINATE;

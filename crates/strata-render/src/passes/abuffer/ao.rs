@@ -173,7 +173,7 @@ impl AbaAoSettings {
             epsilon: self.epsilon,
             intensity: self.intensity,
             turns: self.turns,
-            blur: self.blur.clone(),
+            blur: self.blur,
             samples: self.samples.min(crate::passes::ao::MAX_SAMPLES),
             ..Default::default()
         };
