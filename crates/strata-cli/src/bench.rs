@@ -175,6 +175,9 @@ fn print_gbuffer(g: &GbufferBench) {
         println!("{:<10} {:>10.3} {:>10.3}", p.name, p.median_ms, p.min_ms);
     }
     println!("{:<10} {:>10.3} {:>10.3}", "total", g.total_median_ms, g.total_min_ms);
+    if r.shadow_maps_cached {
+        println!("(no object moves: the shadow maps are drawn in the warm-up frame and kept, so `shadow` is ~0)");
+    }
 }
 
 fn print_stage(name: &str, s: &StageBench) {

@@ -32,6 +32,11 @@ pub struct BenchRun {
     pub frames: u32,
     pub triangles: usize,
     pub device: String,
+    /// No object moves, so the renderer draws the shadow maps in the warm-up frame only
+    /// and the timed frames' `shadow` pass is ≈ 0 ms (false in results written before
+    /// 2026-11-27, when every frame redrew them).
+    #[serde(default)]
+    pub shadow_maps_cached: bool,
 }
 
 /// `strata bench gbuffer`: per-pass times of the single-layer frame.
@@ -698,6 +703,7 @@ mod tests {
                 frames: 2,
                 triangles: 30,
                 device: "lavapipe".into(),
+                shadow_maps_cached: true,
             },
             layers: 2,
             passes: vec![PassTime {

@@ -525,7 +525,7 @@ impl Renderer {
         let lights = gpu_lights_for(scene, 0.0, &settings.shadow);
         let geometry = deep_gbuffer::geometry_passes(gpu, &scene_gpu, &targets, &settings.deep)?;
         let pack = deep_gbuffer::PackPass::new(gpu, &targets, &settings.deep);
-        let (shadow, lighting, tonemap) = if settings.shade {
+        let (mut shadow, lighting, tonemap) = if settings.shade {
             let matrices = crate::lights::shadow_matrices(scene, 0.0, &lights);
             let shadow = shadow::ShadowPass::new(gpu, &scene_gpu, &matrices, &settings.shadow);
             let lighting = lighting::LightingPass::new(
@@ -703,7 +703,12 @@ impl Renderer {
         }
         let history = (!copies.is_empty()).then_some(HistoryPass { copies });
         let profiler = Profiler::new(gpu, 32);
-        let animated = scene.objects.iter().any(|o| o.animation.is_some());
+        let animated = scene.animated();
+        // nothing moves: the shadow maps of frame 0 serve every frame (an animated
+        // scene's `update` re-renders them each frame)
+        if let Some(s) = &mut shadow {
+            s.set_cached(!animated);
+        }
         let r = Self {
             settings,
             scene_gpu,
@@ -733,6 +738,12 @@ impl Renderer {
         validate_pass_order(&r.pass_infos()).map_err(RenderError::Other)?;
         gpu.check_errors()?;
         Ok(r)
+    }
+
+    /// Whether the shadow maps of the first frame serve every frame (a scene with no
+    /// animated object); false without shadow maps.
+    pub fn shadow_maps_cached(&self) -> bool {
+        self.shadow.as_ref().is_some_and(|s| s.cached())
     }
 
     /// The frame's passes in execution order.

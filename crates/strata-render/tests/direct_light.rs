@@ -93,3 +93,50 @@ fn exposure_scales_hdr_linearly() {
         mean(&a)
     );
 }
+
+/// Shadow maps are rendered once for a static scene and every frame for an animated
+/// one: a renderer that has drawn earlier frames gives the same direct light (`hdr`,
+/// no temporal state) at frame t as a fresh renderer that draws only frame t, on
+/// `cornell` (static, cached maps) and on `atrium` (its statue slides, so its shadow
+/// moves: frame 0 and frame t must differ, or the test would prove nothing).
+#[test]
+fn cached_shadow_maps_match_a_fresh_frame_and_follow_animation() {
+    use strata_render::frame::FrameCameras;
+    use strata_render::{RenderSettings, Renderer};
+    let gpu = common::gpu();
+    let settings = RenderSettings {
+        width: 96,
+        height: 64,
+        ..Default::default()
+    };
+    for (name, cached) in [("cornell", true), ("atrium", false)] {
+        let scene = procedural::builtin(name).expect("built-in scene");
+        // a fixed camera, so that only the scene's own motion changes the frame
+        let camera = FrameCameras::fixed(scene.camera);
+        let t = 15.0;
+        let mut running = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
+        assert_eq!(running.shadow_maps_cached(), cached, "{name}");
+        running.render(&gpu, &scene, &camera, 0.0).unwrap();
+        let first = running.read_target(&gpu, "hdr").unwrap();
+        for f in [5.0, 10.0, t] {
+            running.render(&gpu, &scene, &camera, f).unwrap();
+        }
+        let later = running.read_target(&gpu, "hdr").unwrap();
+        let mut fresh = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
+        fresh.render(&gpu, &scene, &camera, t).unwrap();
+        let expected = fresh.read_target(&gpu, "hdr").unwrap();
+        let differ = |a: &strata_scene::ImageBuf, b: &strata_scene::ImageBuf| {
+            a.data
+                .iter()
+                .zip(&b.data)
+                .filter(|(x, y)| (*x - *y).abs() > 1e-4 * y.abs().max(1.0))
+                .count()
+        };
+        assert_eq!(differ(&later, &expected), 0, "{name}: frame {t} after earlier frames");
+        let moved = differ(&first, &expected);
+        eprintln!("{name}: {moved} values change between frame 0 and frame {t}");
+        if !cached {
+            assert!(moved > 50, "{name}: the animation changed only {moved} values");
+        }
+    }
+}

@@ -352,6 +352,11 @@ impl Scene {
         self.objects.iter().map(|o| self.meshes[o.mesh].triangle_count()).sum()
     }
 
+    /// Whether any object moves (rigid animation); lights and materials never do.
+    pub fn animated(&self) -> bool {
+        self.objects.iter().any(|o| o.animation.is_some())
+    }
+
     /// The camera at `frame`: the camera path's when there is one, else the static camera.
     pub fn camera_at(&self, frame: f32) -> Camera {
         match &self.camera_path {

@@ -55,6 +55,7 @@ pub(crate) fn bench_run(spec: &SceneSpec, frames: u32, scene: &Scene, gpu: &GpuC
         frames,
         triangles: scene.triangle_count(),
         device: gpu.describe(),
+        shadow_maps_cached: !scene.animated(),
     }
 }
 
