@@ -174,6 +174,9 @@ impl GpuScene {
             mag_filter: wgpu::FilterMode::Linear,
             min_filter: wgpu::FilterMode::Linear,
             mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            // floors and walls at grazing angles keep their texture detail (as the path
+            // tracer's per-pixel average does; docs/deep-gbuffer.md)
+            anisotropy_clamp: 16,
             ..Default::default()
         });
         let textures: Vec<wgpu::TextureView> = scene.textures.iter().map(|t| upload_texture(gpu, t)).collect();
