@@ -62,6 +62,21 @@ impl Range {
             Range::OffOr(a, b) => v == 0.0 || (a..=b).contains(&v),
         }
     }
+
+    /// The range's extreme values a user can type, in `step`s (1 for an integer setting,
+    /// 10⁻³ otherwise): both ends of a closed range, the last step before an open end,
+    /// the first step above an exclusive lower end, and 0 plus both ends of "0 or a..=b".
+    /// An unbounded range gives its lower end only.
+    pub fn ends(self, integer: bool) -> Vec<f64> {
+        let step = if integer { 1.0 } else { 1e-3 };
+        match self {
+            Range::Closed(a, b) => vec![a, b],
+            Range::HalfOpen(a, b) => vec![a, b - step],
+            Range::AtLeast(a) => vec![a],
+            Range::Above(a) => vec![a + step],
+            Range::OffOr(a, b) => vec![0.0, a, b],
+        }
+    }
 }
 
 impl std::fmt::Display for Range {
@@ -1609,33 +1624,24 @@ mod tests {
                     }
                 };
                 let step = if info.integer { 1.0 } else { 1e-3 };
+                for v in info.range.ends(info.integer) {
+                    check(v, true);
+                }
+                // the first value outside each end
                 match info.range {
                     Range::Closed(a, b) => {
-                        check(a, true);
-                        check(b, true);
                         check(b + step, false);
                         if a - step >= 0.0 || !info.integer {
                             check(a - step, false);
                         }
                     }
                     Range::HalfOpen(a, b) => {
-                        check(a, true);
-                        check(b - step, true);
                         check(b, false);
                         check(a - step, false);
                     }
-                    Range::AtLeast(a) => {
-                        check(a, true);
-                        check(a - step, false);
-                    }
-                    Range::Above(a) => {
-                        check(a + step, true);
-                        check(a, false);
-                    }
+                    Range::AtLeast(a) => check(a - step, false),
+                    Range::Above(a) => check(a, false),
                     Range::OffOr(a, b) => {
-                        check(0.0, true);
-                        check(a, true);
-                        check(b, true);
                         check(b + step, false);
                         if a - step > 0.0 {
                             check(a - step, false);

@@ -213,26 +213,14 @@ fn algorithm_switching_settings_render_cleanly() {
     );
 }
 
-/// The values at the ends of a declared range that a user can type: both ends of a
-/// closed range, the last value below an open end, a large value for an unbounded one
-/// (10³ × the lower end, at least 10³), and 0 plus both ends for "0 or a..=b".
+/// The values at the ends of a declared range that a user can type (`Range::ends`),
+/// and for an unbounded range a large one too (10³ × the lower end, at least 10³).
 fn range_ends(range: Range, integer: bool) -> Vec<f64> {
-    let step = if integer { 1.0 } else { 1e-3 };
-    let large = |a: f64| (a * 1e3).max(1e3);
-    match range {
-        Range::Closed(a, b) => vec![a, b],
-        Range::HalfOpen(a, b) => vec![a, b - step],
-        Range::AtLeast(a) => vec![a, large(a)],
-        Range::Above(a) => vec![
-            if integer {
-                a + 1.0
-            } else {
-                a + (a.abs() * 1e-6).max(1e-6)
-            },
-            large(a),
-        ],
-        Range::OffOr(a, b) => vec![0.0, a, b],
+    let mut v = range.ends(integer);
+    if let Range::AtLeast(a) | Range::Above(a) = range {
+        v.push((a * 1e3).max(1e3));
     }
+    v
 }
 
 /// Every registered setting of every technique, alone at each end of its declared
