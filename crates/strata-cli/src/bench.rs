@@ -191,6 +191,9 @@ fn print_stage(name: &str, s: &StageBench) {
         println!("{:<18} {:>10.3} {:>10.3}", p.name, p.median_ms, p.min_ms);
     }
     println!("{}", s.split_line(name));
+    if s.settings.get("vpl_shadow_maps_cached") == Some(&serde_json::Value::Bool(true)) {
+        println!("(the VPLs and the scene hold still: the VPL shadow maps are drawn in the warm-up frame and kept, so `ils-vpl-shadows` is ~0; --set vpl-shadow-cache=0 times their redraw)");
+    }
 }
 
 fn print_deep(d: &DeepBench, f0: f32) {

@@ -746,6 +746,12 @@ impl Renderer {
         self.shadow.as_ref().is_some_and(|s| s.cached())
     }
 
+    /// Whether ILS's VPL shadow maps of the first frame serve the next ones until
+    /// `set_vpls` (`IlsSettings::vpl_shadow_maps_cached`); false without them.
+    pub fn vpl_shadow_maps_cached(&self) -> bool {
+        self.ils.as_ref().is_some_and(|i| i.vpl_shadow_maps_cached())
+    }
+
     /// The frame's passes in execution order.
     fn passes(&self) -> Vec<&dyn Pass> {
         let mut v: Vec<&dyn Pass> = Vec::new();

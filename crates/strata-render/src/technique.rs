@@ -598,7 +598,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 15] = [
+static ILS_SETTINGS: [SettingInfo; 16] = [
     SettingInfo {
         name: "shadows",
         doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
@@ -622,6 +622,15 @@ static ILS_SETTINGS: [SettingInfo; 15] = [
         |s| Some(ils_of(s).vpl_shadow_resolution as f64),
         |s, v| ils_mut(s).vpl_shadow_resolution = v as u32
     ),
+    SettingInfo {
+        name: "vpl-shadow-cache",
+        doc: "VPL shadow maps (shadows = vpl) of VPLs that stay put in a scene with no animated object: redraw every frame (as ILS §6.3's fresh VPL sets must) or keep those of the first frame until new VPLs arrive (not in the paper)",
+        range: Range::Closed(0.0, 1.0),
+        integer: true,
+        get: |s| Some(ils_of(s).vpl_shadow_cache as u32 as f64),
+        set: |s, v| ils_mut(s).vpl_shadow_cache = v != 0.0,
+        values: &["redraw", "keep"],
+    },
     setting!(
         "vpls",
         "VPLs N the caller generates by instant radiosity (ILS Table 4: 480)",

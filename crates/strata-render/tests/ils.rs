@@ -370,3 +370,68 @@ fn vpl_shadow_maps_match_traced_visibility() {
         );
     }
 }
+
+/// SSM's kept VPL shadow maps (`vpl_shadow_cache`, on by default): in a static scene
+/// the maps of the first frame serve the next ones, and new VPLs (`set_vpls`) redraw
+/// them. A renderer that drew VPL set A for two frames and then set B for one gives
+/// B's irradiance exactly as a fresh renderer that redraws every frame; the two sets'
+/// images must differ, or the check would prove nothing. An animated scene redraws
+/// every frame, and SNSM has no maps to keep.
+#[test]
+fn kept_vpl_shadow_maps_match_a_fresh_frame_and_follow_new_vpls() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("cornell").unwrap();
+    let set = |seed| {
+        Reference::new(&scene, 0.0).vpls(&VplSettings {
+            paths: 48,
+            seed,
+            ..Default::default()
+        })
+    };
+    let (a, b) = (set(1), set(2));
+    let ssm = |v: &[Vpl], keep: bool| IlsSettings {
+        shadows: strata_render::passes::ils::VplShadows::ShadowMaps,
+        vpl_shadow_resolution: 32,
+        vpl_shadow_cache: keep,
+        ..base(&scene, v)
+    };
+    let camera = FrameCameras::fixed(scene.camera);
+    let mut kept = render(&gpu, &scene, ssm(&a, true));
+    assert!(kept.vpl_shadow_maps_cached());
+    kept.render(&gpu, &scene, &camera, 0.0).unwrap();
+    let kept_a = irradiance(&gpu, &kept);
+    let fresh_a = irradiance(&gpu, &render(&gpu, &scene, ssm(&a, false)));
+    kept.set_vpls(&gpu, &gpu_vpls(&b)).unwrap();
+    kept.render(&gpu, &scene, &camera, 0.0).unwrap();
+    let kept_b = irradiance(&gpu, &kept);
+    let redrawn = render(&gpu, &scene, ssm(&b, false));
+    assert!(!redrawn.vpl_shadow_maps_cached());
+    let fresh_b = irradiance(&gpu, &redrawn);
+    let differ = |x: &ImageBuf, y: &ImageBuf| {
+        x.data
+            .iter()
+            .zip(&y.data)
+            .filter(|(p, q)| (*p - *q).abs() > 1e-5 * q.abs().max(1.0))
+            .count()
+    };
+    assert_eq!(differ(&kept_a, &fresh_a), 0, "set A: the kept maps' second frame");
+    assert_eq!(differ(&kept_b, &fresh_b), 0, "set B after set A's kept maps");
+    let changed = differ(&fresh_a, &fresh_b);
+    eprintln!(
+        "{changed} of {} values differ between the two VPL sets",
+        fresh_a.data.len()
+    );
+    assert!(
+        changed > fresh_a.data.len() / 4,
+        "the two VPL sets light alike: {changed}"
+    );
+    // an animated scene redraws; SNSM keeps nothing
+    let atrium = procedural::builtin("atrium").unwrap();
+    assert!(atrium.animated());
+    assert!(!render(&gpu, &atrium, ssm(&a, true)).vpl_shadow_maps_cached());
+    let snsm = IlsSettings {
+        vpl_shadow_cache: true,
+        ..base(&scene, &a)
+    };
+    assert!(!render(&gpu, &scene, snsm).vpl_shadow_maps_cached());
+}

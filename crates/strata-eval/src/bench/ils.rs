@@ -50,6 +50,8 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<IlsBench> {
         "blur": ils.blur,
         "bilinear": ils.bilinear,
         "shadows": ils.shadows.name(),
+        // the warm-up frame draws the VPL shadow maps and the timed frames keep them
+        "vpl_shadow_maps_cached": ils.vpl_shadow_maps_cached(&scene),
     });
     let brute = configure(true)?;
     // the frames' own pass lists (with `shadows = vpl`: ils-vpl-shadows, ils-ssm)

@@ -34,13 +34,13 @@ pub fn run(
     // every error (preset, setting, range) before any GPU work
     let checked = configure(stage.layers)?;
     // ILS: the caller's VPLs, generated once (static scene)
-    let vpls = match &checked.ils {
-        Some(i) => Some(crate::vpls::scene_vpls(
-            &stage.scene.load()?.0,
-            stage.scene.frame,
-            i.vpl_count,
-        )),
-        None => None,
+    let (vpls, vpl_maps_kept) = match &checked.ils {
+        Some(i) => {
+            let scene = stage.scene.load()?.0;
+            let v = crate::vpls::scene_vpls(&scene, stage.scene.frame, i.vpl_count);
+            (Some(v), i.vpl_shadow_maps_cached(&scene))
+        }
+        None => (None, false),
     };
     // ILS: the frame's own ILS passes (with `shadows = vpl`: ils-vpl-shadows, ils-ssm)
     let passes: Vec<&str> = match &checked.ils {
@@ -66,6 +66,8 @@ pub fn run(
         "preset": preset.or(technique.presets.first().copied()),
         "variant": stage.variant.to_string(),
         "set": set.iter().map(|(n, v)| (n.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        // the warm-up frame draws ILS's VPL shadow maps and the timed frames keep them
+        "vpl_shadow_maps_cached": vpl_maps_kept,
     });
     stage::run(Stage {
         stage,

@@ -162,6 +162,11 @@ pub struct IlsSettings {
     pub shadows: VplShadows,
     /// SSM: texels per side of each of a VPL's six cube faces, 8..=512.
     pub vpl_shadow_resolution: u32,
+    /// SSM: keep the VPL shadow maps from frame to frame while the VPLs (`set_vpls`)
+    /// and the scene (no animated object) hold still; false redraws them every frame,
+    /// as §6.3's fresh VPL sets must (what the bench's per-map cost measures). Not in
+    /// the paper; default true.
+    pub vpl_shadow_cache: bool,
 }
 
 impl Default for IlsSettings {
@@ -181,6 +186,7 @@ impl Default for IlsSettings {
             normal_threshold_deg: 25.0,
             shadows: VplShadows::None,
             vpl_shadow_resolution: 64,
+            vpl_shadow_cache: true,
         }
     }
 }
@@ -294,6 +300,13 @@ impl IlsSettings {
         } else {
             "ils-snsm"
         }
+    }
+
+    /// Whether the VPL shadow maps of the first frame serve the next ones (SSM with
+    /// `vpl_shadow_cache` in a scene with no animated object, whose motion would change
+    /// every VPL's view) until `set_vpls`.
+    pub fn vpl_shadow_maps_cached(&self, scene: &strata_scene::Scene) -> bool {
+        self.shadows.traced() && self.vpl_shadow_cache && !scene.animated()
     }
 
     /// Bytes of the VPL shadow maps (SSM): N layers of six R² Depth32Float faces, plus the
@@ -627,13 +640,11 @@ impl IlsStage {
         };
         let vpl_shadows = match s.shadows {
             VplShadows::None => None,
-            VplShadows::ShadowMaps => Some(ssm::VplShadowPass::new(
-                gpu,
-                scene_gpu,
-                scene,
-                &s.vpls,
-                s.vpl_shadow_resolution,
-            )?),
+            VplShadows::ShadowMaps => {
+                let mut p = ssm::VplShadowPass::new(gpu, scene_gpu, scene, &s.vpls, s.vpl_shadow_resolution)?;
+                p.set_cached(s.vpl_shadow_maps_cached(scene));
+                Some(p)
+            }
         };
         let ssm_uniforms = vpl_shadows.as_ref().map_or([0.0; 3], |p| {
             [
@@ -758,6 +769,11 @@ impl IlsStage {
         self.shade_uniforms.vpl_count = vpls.len() as u32;
         self.shade.set_uniforms(gpu, &self.shade_uniforms);
         Ok(())
+    }
+
+    /// Whether the VPL shadow maps are kept from frame to frame (SSM only).
+    pub(crate) fn vpl_shadow_maps_cached(&self) -> bool {
+        self.vpl_shadows.as_ref().is_some_and(|p| p.cached())
     }
 
     pub(crate) fn passes(&self) -> Vec<&dyn Pass> {

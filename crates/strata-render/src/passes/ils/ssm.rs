@@ -15,7 +15,12 @@
 //! 180 MiB; plus 6 · N · (256 + 64) bytes of face matrices (0.9 MiB for 480).
 //!
 //! **Cost.** The scene is drawn 6N times per frame (2880 draws for 480 VPLs): the
-//! price §6.3 pays for visibility, which SNSM (§6.2) skips.
+//! price §6.3 pays for visibility, which SNSM (§6.2) skips. §6.3 draws fresh VPL sets,
+//! so it pays it every frame; VPLs that stay put in a scene that does not move keep
+//! their maps ([`VplShadowPass::set_cached`]) until new VPLs arrive
+//! ([`VplShadowPass::set_vpls`]).
+
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{Mat4, Vec3};
 
@@ -48,6 +53,10 @@ pub(crate) struct VplShadowPass {
     count: usize,
     eye_offset: f32,
     bounds: (Vec3, f32),
+    /// The maps are kept from frame to frame ([`Self::set_cached`]).
+    cached: bool,
+    /// The maps hold the current VPLs' depth (cleared by [`Self::set_vpls`]).
+    rendered: AtomicBool,
 }
 
 /// Scene centre and bounding radius (as `crate::lights` fits its shadow frusta).
@@ -173,6 +182,8 @@ impl VplShadowPass {
             count: 0,
             eye_offset: eye_offset(scene),
             bounds: scene_sphere(scene),
+            cached: false,
+            rendered: AtomicBool::new(false),
         };
         pass.set_vpls(gpu, vpls);
         Ok(pass)
@@ -193,6 +204,20 @@ impl VplShadowPass {
             gpu.queue.write_buffer(&self.matrices, 0, bytemuck::cast_slice(&packed));
         }
         self.count = vpls.len();
+        self.rendered.store(false, Ordering::Relaxed);
+    }
+
+    /// Keep the maps from frame to frame instead of redrawing them: for VPLs that stay
+    /// put in a scene that does not move (`IlsSettings::vpl_shadow_cache`, and the
+    /// renderer turns it off when an object is animated).
+    pub(crate) fn set_cached(&mut self, cached: bool) {
+        self.cached = cached;
+        self.rendered.store(false, Ordering::Relaxed);
+    }
+
+    /// Whether the maps are kept from frame to frame.
+    pub(crate) fn cached(&self) -> bool {
+        self.cached
     }
 
     pub(crate) fn eye_offset(&self) -> f32 {
@@ -214,6 +239,9 @@ impl Pass for VplShadowPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        if self.cached && self.rendered.swap(true, Ordering::Relaxed) {
+            return;
+        }
         let r = self.resolution as f32;
         for (k, view) in self.layer_views.iter().enumerate().take(self.count) {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
