@@ -1083,7 +1083,7 @@ static BZB_GI_SETTINGS: [SettingInfo; 11] = [
     ),
     setting!(
         "dmax",
-        "largest sender distance d_max in scene units (BZB §3.2; default: the scene's bounding-box diagonal)",
+        "largest sender distance d_max in scene units (BZB §3.2; default: the scene's bounding-box diagonal). bzb-gi: a ray that hits nothing within it brings the sky's light only while d_max spans the scene (at least the diagonal)",
         Range::Above(0.0),
         false,
         |s| bzb_gi_of(s).d_max.map(f64::from),

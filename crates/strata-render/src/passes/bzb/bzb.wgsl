@@ -17,7 +17,9 @@ struct Bzb {
     radius: f32,
     t_min: f32,
     inv_r2: f32,
-    _pad0: f32,
+    // bzb-gi: 1 = a ray that hits no sender within d_max has left the scene (d_max ≥
+    // the scene's diagonal) and brings the sky's radiance (`frame.sky`); 0 = nothing
+    escape_sky: u32,
     // S directions per pixel, sub-image grid cols × rows (S <= cols·rows)
     directions: u32,
     cols: u32,

@@ -57,7 +57,9 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             continue;
         }
         count += 1.0;
-        let l = textureLoad(payload, texel, 0).rgb;
+        // no sender within d_max (payload alpha 0): the sky, once d_max spans the scene
+        let hit = textureLoad(payload, texel, 0);
+        let l = select(hit.rgb, frame.sky.rgb, hit.a == 0.0 && bzb.escape_sky != 0u);
         let c = max(0.0, dot(n, d.xyz));
         if (glossy) {
             sum += ggx_eval(n, v, d.xyz, rho, nrm.z, nrm.w) * l * (c / d.w);

@@ -17,7 +17,8 @@
 //!    no Rect light carries it. Nearest sender wins. Without visibility
 //!    (baseline) every triangle within d_max adds π·F·L (form factor F,
 //!    radiance at a hashed point of it) by additive blending.
-//! 3. `bzb-reconstruct` (§3.3): mean over s of L · f · cos θ / α; Lambert
+//! 3. `bzb-reconstruct` (§3.3): mean over s of L · f · cos θ / α, with L the
+//!    sky's radiance for a ray that hit nothing when d_max spans the scene; Lambert
 //!    receivers into `bzb-gi-raw` as irradiance (compose applies ρ/π), glossy
 //!    ones into `bzb-gi-glossy-raw` as radiance.
 //! 4. `bzb-gi-blur-h/-v`, `bzb-gi-glossy-blur-h/-v`: the cross-bilateral filter
@@ -46,7 +47,9 @@ pub struct BzbGiSettings {
     pub directions: u32,
     /// true: bounced z-buffer (nearest sender per direction); false: the additive baseline.
     pub visibility: bool,
-    /// Largest sender distance d_max (world units); `None` = the scene's diagonal.
+    /// Largest sender distance d_max (world units); `None` = the scene's diagonal. A ray
+    /// that hits no sender within d_max brings the sky's radiance when d_max is at
+    /// least the diagonal (it has left the scene), and nothing otherwise.
     pub d_max: Option<f32>,
     /// Ray t_min (world units); `None` = 0.01 × the scene's AO radius.
     pub bias: Option<f32>,
@@ -162,10 +165,7 @@ impl BzbGiSettings {
 
     /// (d_max, t_min) for `scene`.
     pub fn resolve(&self, scene: &Scene) -> (f32, f32) {
-        let d_max = self.d_max.unwrap_or_else(|| {
-            let (lo, hi) = scene.bounds(0.0);
-            (hi - lo).length().max(1e-3)
-        });
+        let d_max = self.d_max.unwrap_or_else(|| scene_diagonal(scene));
         (d_max, self.bias.unwrap_or(0.01 * scene.settings.ao_radius))
     }
 
@@ -203,7 +203,7 @@ impl BzbGiSettings {
             radius: d_max,
             t_min,
             inv_r2: 1.0 / (d_max * d_max),
-            _pad0: 0.0,
+            escape_sky: (d_max >= scene_diagonal(scene)) as u32,
             directions: self.directions,
             cols,
             rows,
@@ -216,6 +216,13 @@ impl BzbGiSettings {
             culling: self.culling as u32,
         }
     }
+}
+
+/// The scene's bounding-box diagonal: the default d_max, and the distance past which
+/// a ray from any surface has left the scene (misses then bring the sky's light).
+fn scene_diagonal(scene: &Scene) -> f32 {
+    let (lo, hi) = scene.bounds(0.0);
+    (hi - lo).length().max(1e-3)
 }
 
 /// Mirrors `BzbGi` in `bzb_gi.wgsl`.

@@ -256,7 +256,9 @@ pub struct BzbUniforms {
     pub radius: f32,
     pub t_min: f32,
     pub inv_r2: f32,
-    pub _pad0: f32,
+    /// bzb-gi: 1 = rays that hit nothing within d_max see the sky (d_max ≥ the scene's
+    /// diagonal); always 0 for AO.
+    pub escape_sky: u32,
     pub directions: u32,
     pub cols: u32,
     pub rows: u32,
@@ -275,7 +277,7 @@ impl BzbUniforms {
             radius,
             t_min,
             inv_r2: 1.0 / (radius * radius),
-            _pad0: 0.0,
+            escape_sky: 0,
             directions: s.directions,
             cols,
             rows,
