@@ -77,6 +77,38 @@ pub(crate) fn clear_attachment(view: &wgpu::TextureView) -> Option<wgpu::RenderP
     })
 }
 
+/// Whether a pass whose output can outlive the frame (shadow maps of a static scene)
+/// must draw: with `cached` off every frame draws; on, the first frame after
+/// [`Self::invalidate`] (or creation) does and the next ones keep its output.
+#[derive(Debug, Default)]
+pub(crate) struct DrawOnce {
+    cached: bool,
+    /// The output is current (cleared by `invalidate`).
+    drawn: std::sync::atomic::AtomicBool,
+}
+
+impl DrawOnce {
+    /// Keep the output from frame to frame (`true`) or draw every frame; the next frame draws.
+    pub fn set_cached(&mut self, cached: bool) {
+        self.cached = cached;
+        self.invalidate();
+    }
+
+    pub fn cached(&self) -> bool {
+        self.cached
+    }
+
+    /// The next frame draws (its inputs changed).
+    pub fn invalidate(&self) {
+        self.drawn.store(false, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Whether this frame draws; marks the output current.
+    pub fn must_draw(&self) -> bool {
+        !(self.cached && self.drawn.swap(true, std::sync::atomic::Ordering::Relaxed))
+    }
+}
+
 /// A depth attachment cleared to 1 (the far plane) and stored.
 pub(crate) fn clear_depth_attachment(view: &wgpu::TextureView) -> wgpu::RenderPassDepthStencilAttachment<'_> {
     wgpu::RenderPassDepthStencilAttachment {

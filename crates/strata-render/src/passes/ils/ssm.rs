@@ -20,8 +20,6 @@
 //! their maps ([`VplShadowPass::set_cached`]) until new VPLs arrive
 //! ([`VplShadowPass::set_vpls`]).
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use glam::{Mat4, Vec3};
 
 use crate::frame::{Pass, PassInfo, Targets};
@@ -53,10 +51,9 @@ pub(crate) struct VplShadowPass {
     count: usize,
     eye_offset: f32,
     bounds: (Vec3, f32),
-    /// The maps are kept from frame to frame ([`Self::set_cached`]).
-    cached: bool,
-    /// The maps hold the current VPLs' depth (cleared by [`Self::set_vpls`]).
-    rendered: AtomicBool,
+    /// Whether a frame draws the maps (kept for fixed VPLs: [`Self::set_cached`];
+    /// [`Self::set_vpls`] redraws).
+    draw: crate::passes::DrawOnce,
 }
 
 /// Scene centre and bounding radius (as `crate::lights` fits its shadow frusta).
@@ -182,8 +179,7 @@ impl VplShadowPass {
             count: 0,
             eye_offset: eye_offset(scene),
             bounds: scene_sphere(scene),
-            cached: false,
-            rendered: AtomicBool::new(false),
+            draw: Default::default(),
         };
         pass.set_vpls(gpu, vpls);
         Ok(pass)
@@ -204,20 +200,19 @@ impl VplShadowPass {
             gpu.queue.write_buffer(&self.matrices, 0, bytemuck::cast_slice(&packed));
         }
         self.count = vpls.len();
-        self.rendered.store(false, Ordering::Relaxed);
+        self.draw.invalidate();
     }
 
     /// Keep the maps from frame to frame instead of redrawing them: for VPLs that stay
     /// put in a scene that does not move (`IlsSettings::vpl_shadow_cache`, and the
     /// renderer turns it off when an object is animated).
     pub(crate) fn set_cached(&mut self, cached: bool) {
-        self.cached = cached;
-        self.rendered.store(false, Ordering::Relaxed);
+        self.draw.set_cached(cached);
     }
 
     /// Whether the maps are kept from frame to frame.
     pub(crate) fn cached(&self) -> bool {
-        self.cached
+        self.draw.cached()
     }
 
     pub(crate) fn eye_offset(&self) -> f32 {
@@ -239,7 +234,7 @@ impl Pass for VplShadowPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        if self.cached && self.rendered.swap(true, Ordering::Relaxed) {
+        if !self.draw.must_draw() {
             return;
         }
         let r = self.resolution as f32;

@@ -4,8 +4,6 @@
 //! layers' view-projections are also kept in a storage buffer
 //! ([`ShadowPass::matrices`]) that the lighting pass indexes by layer.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use crate::frame::{Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
 
@@ -46,10 +44,9 @@ pub struct ShadowPass {
     /// Every layer's view-projection, tightly packed (`array<mat4x4f>`).
     pub matrices: wgpu::Buffer,
     layer_views: Vec<wgpu::TextureView>,
-    /// The maps are kept from frame to frame (a static scene: [`Self::set_cached`]).
-    cached: bool,
-    /// The maps hold the current matrices' depth (cleared by [`Self::update`]).
-    rendered: AtomicBool,
+    /// Whether a frame draws the maps (kept in a static scene: [`Self::set_cached`];
+    /// [`Self::update`] redraws).
+    draw: crate::passes::DrawOnce,
 }
 
 /// The depth-only pipeline that renders a shadow map's face (`shadow.wgsl`, two-sided,
@@ -192,28 +189,26 @@ impl ShadowPass {
             array_view,
             matrices: matrices_buffer,
             layer_views,
-            cached: false,
-            rendered: AtomicBool::new(false),
+            draw: Default::default(),
         }
     }
 
     /// Whether the maps are kept from frame to frame ([`Self::set_cached`]).
     pub fn cached(&self) -> bool {
-        self.cached
+        self.draw.cached()
     }
 
     /// Keep the maps from frame to frame instead of re-rendering them: for a scene whose
     /// geometry and lights do not move (the renderer sets it when no object is
     /// animated). [`Self::update`] still re-renders them.
     pub fn set_cached(&mut self, cached: bool) {
-        self.cached = cached;
-        self.rendered.store(false, Ordering::Relaxed);
+        self.draw.set_cached(cached);
     }
 
     /// Re-uploads the layers' matrices (animated scenes move the fitted bounds
     /// and the lights); the layer count is fixed at creation.
     pub fn update(&self, gpu: &GpuContext, matrices: &[[[f32; 4]; 4]]) {
-        self.rendered.store(false, Ordering::Relaxed);
+        self.draw.invalidate();
         for (i, m) in matrices.iter().enumerate().take(self.layer_views.len()) {
             gpu.queue
                 .write_buffer(&self.views_buffer, i as u64 * STRIDE, bytemuck::bytes_of(m));
@@ -233,7 +228,7 @@ impl Pass for ShadowPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        if self.cached && self.rendered.swap(true, Ordering::Relaxed) {
+        if !self.draw.must_draw() {
             return;
         }
         for (slot, view) in self.layer_views.iter().enumerate() {
