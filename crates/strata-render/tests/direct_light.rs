@@ -125,13 +125,7 @@ fn cached_shadow_maps_match_a_fresh_frame_and_follow_animation() {
         let mut fresh = Renderer::new(&gpu, &scene, settings.clone()).unwrap();
         fresh.render(&gpu, &scene, &camera, t).unwrap();
         let expected = fresh.read_target(&gpu, "hdr").unwrap();
-        let differ = |a: &strata_scene::ImageBuf, b: &strata_scene::ImageBuf| {
-            a.data
-                .iter()
-                .zip(&b.data)
-                .filter(|(x, y)| (*x - *y).abs() > 1e-4 * y.abs().max(1.0))
-                .count()
-        };
+        let differ = |a: &strata_scene::ImageBuf, b: &strata_scene::ImageBuf| common::values_differing(a, b, 1e-4);
         assert_eq!(differ(&later, &expected), 0, "{name}: frame {t} after earlier frames");
         let moved = differ(&first, &expected);
         eprintln!("{name}: {moved} values change between frame 0 and frame {t}");

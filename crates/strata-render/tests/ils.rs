@@ -407,13 +407,7 @@ fn kept_vpl_shadow_maps_match_a_fresh_frame_and_follow_new_vpls() {
     let redrawn = render(&gpu, &scene, ssm(&b, false));
     assert!(!redrawn.vpl_shadow_maps_cached());
     let fresh_b = irradiance(&gpu, &redrawn);
-    let differ = |x: &ImageBuf, y: &ImageBuf| {
-        x.data
-            .iter()
-            .zip(&y.data)
-            .filter(|(p, q)| (*p - *q).abs() > 1e-5 * q.abs().max(1.0))
-            .count()
-    };
+    let differ = |x: &ImageBuf, y: &ImageBuf| common::values_differing(x, y, 1e-5);
     assert_eq!(differ(&kept_a, &fresh_a), 0, "set A: the kept maps' second frame");
     assert_eq!(differ(&kept_b, &fresh_b), 0, "set B after set A's kept maps");
     let changed = differ(&fresh_a, &fresh_b);

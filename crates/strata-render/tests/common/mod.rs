@@ -98,6 +98,16 @@ pub fn shared_scene(rel: &str) -> Option<std::path::PathBuf> {
     }
 }
 
+/// How many values of `a` differ from `b`'s by more than `rel` × max(|b|, 1) (the
+/// same-frame-twice comparisons of cached passes).
+pub fn values_differing(a: &strata_scene::ImageBuf, b: &strata_scene::ImageBuf, rel: f32) -> usize {
+    a.data
+        .iter()
+        .zip(&b.data)
+        .filter(|(x, y)| (*x - *y).abs() > rel * y.abs().max(1.0))
+        .count()
+}
+
 /// World normals of layer `layer` (0 or 1) decoded from a read-back `npack`
 /// (Oct16, RGBA8) exactly as the shaders decode them.
 pub fn npack_normals(npack: &strata_scene::ImageBuf, layer: usize) -> strata_scene::ImageBuf {
