@@ -14,8 +14,10 @@
 //! **Memory:** N · 6 · R² · 4 bytes: 480 VPLs at R = 64 are 45 MiB, at R = 128
 //! 180 MiB; plus 6 · N · (256 + 64) bytes of face matrices (0.9 MiB for 480).
 //!
-//! **Cost.** The scene is drawn 6N times per frame (2880 draws for 480 VPLs): the
-//! price §6.3 pays for visibility, which SNSM (§6.2) skips. §6.3 draws fresh VPL sets,
+//! **Cost.** The scene is drawn up to 6N times per frame (2880 draws for 480 VPLs):
+//! the price §6.3 pays for visibility, which SNSM (§6.2) skips. A face that no
+//! direction of the VPL's lit hemisphere selects ([`lit_faces`]: the face opposite an
+//! axis-aligned normal) is not drawn. §6.3 draws fresh VPL sets,
 //! so it pays it every frame; VPLs that stay put in a scene that does not move keep
 //! their maps ([`VplShadowPass::set_cached`]) until new VPLs arrive
 //! ([`VplShadowPass::set_vpls`]).
@@ -49,6 +51,8 @@ pub(crate) struct VplShadowPass {
     resolution: u32,
     /// VPLs whose maps are rendered (≤ the layers).
     count: usize,
+    /// Per VPL, the faces its lit hemisphere can look up ([`lit_faces`]).
+    faces: Vec<[bool; 6]>,
     eye_offset: f32,
     bounds: (Vec3, f32),
     /// Whether a frame draws the maps (kept for fixed VPLs: [`Self::set_cached`];
@@ -79,6 +83,24 @@ pub fn face_matrices(vpls: &[GpuVpl], eye_offset: f32, (centre, radius): (Vec3, 
             (0..6).map(move |f| crate::lights::cube_face_matrix(eye, f, radius, centre))
         })
         .collect()
+}
+
+/// Which cube faces (`crate::lights::CUBE_FACES` order) a VPL with normal `n` can
+/// look up: the shading selects a face by the major axis of the direction d from the
+/// VPL and only for receivers in its lit hemisphere (the VPL term's cos θ_y > 0). The
+/// directions whose major axis is face f's a form the cone spanned by a ± b ± c (b, c
+/// the other two axes), so max dot(d, n) over it is at one of those four corners: a
+/// face whose corners all have dot ≤ 0 is never looked up and need not be drawn
+/// (the face opposite an axis-aligned normal; a tilted normal keeps all six).
+pub fn lit_faces(n: Vec3) -> [bool; 6] {
+    let axes = [Vec3::X, Vec3::Y, Vec3::Z];
+    std::array::from_fn(|f| {
+        let a = crate::lights::CUBE_FACES[f];
+        let (b, c) = (axes[(f / 2 + 1) % 3], axes[(f / 2 + 2) % 3]);
+        [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+            .iter()
+            .any(|&(sb, sc)| n.dot(a + sb * b + sc * c) > 0.0)
+    })
 }
 
 /// World-space size of one shadow-map texel at distance 1 from the eye (R texels over a
@@ -177,6 +199,7 @@ impl VplShadowPass {
             layer_views,
             resolution,
             count: 0,
+            faces: Vec::new(),
             eye_offset: eye_offset(scene),
             bounds: scene_sphere(scene),
             draw: Default::default(),
@@ -200,6 +223,10 @@ impl VplShadowPass {
             gpu.queue.write_buffer(&self.matrices, 0, bytemuck::cast_slice(&packed));
         }
         self.count = vpls.len();
+        self.faces = vpls
+            .iter()
+            .map(|v| lit_faces(Vec3::from_slice(&v.normal[..3])))
+            .collect();
         self.draw.invalidate();
     }
 
@@ -248,7 +275,7 @@ impl Pass for VplShadowPass {
                 multiview_mask: None,
             });
             pass.set_pipeline(&self.pipeline);
-            for face in 0..6u32 {
+            for face in (0..6u32).filter(|&f| self.faces[k][f as usize]) {
                 // face f of the 3×2 atlas
                 let (x, y) = ((face % 3) as f32 * r, (face / 3) as f32 * r);
                 pass.set_viewport(x, y, r, r, 0.0, 1.0);
@@ -258,5 +285,59 @@ impl Pass for VplShadowPass {
                 scene.draw_all(&mut pass, 1, None);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The face the shading picks for direction d (ils_snsm.wgsl's `vpl_visibility`).
+    fn face_of(d: Vec3) -> usize {
+        let a = d.abs();
+        let mut face = 4;
+        if a.x >= a.y && a.x >= a.z {
+            face = 0;
+        } else if a.y >= a.z {
+            face = 2;
+        }
+        if (face == 0 && d.x < 0.0) || (face == 2 && d.y < 0.0) || (face == 4 && d.z < 0.0) {
+            face += 1;
+        }
+        face
+    }
+
+    /// Skipping faces is conservative: for random normals and random directions of
+    /// their lit hemisphere, the face the shading looks up is always drawn; an
+    /// axis-aligned normal skips exactly the opposite face, and a tilted one none.
+    #[test]
+    fn skipped_faces_are_never_looked_up_from_the_lit_hemisphere() {
+        let mut h = 1u32;
+        let mut rnd = || {
+            h = crate::spiral::pcg_hash(h);
+            (h >> 8) as f32 / 16_777_216.0 * 2.0 - 1.0
+        };
+        let mut skipped = 0;
+        for _ in 0..2000 {
+            let n = Vec3::new(rnd(), rnd(), rnd()).normalize_or(Vec3::Y);
+            let lit = lit_faces(n);
+            skipped += lit.iter().filter(|&&l| !l).count();
+            for _ in 0..200 {
+                let d = Vec3::new(rnd(), rnd(), rnd());
+                if d.dot(n) > 0.0 {
+                    assert!(lit[face_of(d)], "n {n}, d {d}: face {} skipped", face_of(d));
+                }
+            }
+        }
+        // random normals: a face is skipped only near the axes
+        assert!(skipped < 2000, "{skipped} faces skipped for 2000 random normals");
+        for (f, &a) in crate::lights::CUBE_FACES.iter().enumerate() {
+            let lit = lit_faces(a);
+            let opposite = f ^ 1;
+            for (g, &l) in lit.iter().enumerate() {
+                assert_eq!(l, g != opposite, "normal {a}: face {g}");
+            }
+        }
+        assert_eq!(lit_faces(Vec3::new(1.0, 1.0, 0.3).normalize()), [true; 6]);
     }
 }
