@@ -559,7 +559,8 @@ impl Renderer {
             || settings
                 .radiosity
                 .as_ref()
-                .is_some_and(|r| r.temporal.is_some() || r.delta > 0.0);
+                .is_some_and(|r| r.temporal.is_some() || r.delta > 0.0)
+            || settings.bzb_gi.as_ref().is_some_and(|g| g.temporal.is_some());
         if temporal_on && targets.try_get("csz-history").is_none() {
             let l = settings.deep.array_layers();
             targets.create(
@@ -629,6 +630,7 @@ impl Renderer {
                     pcf_radius: settings.lighting.pcf_radius,
                     area_penumbrae: settings.lighting.area_penumbrae,
                 },
+                settings.deep.layers,
             )?),
             _ => None,
         };
@@ -686,6 +688,16 @@ impl Renderer {
             copies.push(("indirect-temporal", "indirect-temporal-history"));
             let [n, h] = crate::passes::radiosity::stage::INDIRECT_FRAMES;
             copies.push((n, h));
+        }
+        if settings.bzb_gi.as_ref().is_some_and(|g| g.temporal.is_some()) {
+            for k in 0..2 {
+                copies.push((
+                    crate::passes::bzb::gi::TEMPORAL[2 * k].name,
+                    crate::passes::bzb::gi::TEMPORAL[2 * k + 1].name,
+                ));
+                let [n, h] = crate::passes::bzb::gi::TEMPORAL_FRAMES[k];
+                copies.push((n, h));
+            }
         }
         if radiosity.as_ref().is_some_and(|r| r.propagate.is_some()) {
             // the next bounce reflects the best estimate of E there is: with probes, the blend
@@ -890,7 +902,15 @@ impl Renderer {
             }
         }
         if let Some(g) = &self.bzb_gi {
-            g.set_frame(gpu, scene, frame, self.animated, &self.lights);
+            g.set_frame(
+                gpu,
+                scene,
+                frame,
+                self.animated,
+                &self.lights,
+                self.frames_rendered,
+                temporal_history,
+            );
         }
         let mut encoder = gpu
             .device
@@ -930,6 +950,7 @@ impl Renderer {
                 .radiosity
                 .as_ref()
                 .is_some_and(|r| r.temporal.is_some() || r.propagate.is_some())
+            || self.settings.bzb_gi.as_ref().is_some_and(|g| g.temporal.is_some())
     }
 
     /// The A-buffer stage (read-back of its lists and compressed nodes), if on.

@@ -1043,7 +1043,7 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.clone().unwrap_or_default()
 }
 
-static BZB_GI_SETTINGS: [SettingInfo; 11] = [
+static BZB_GI_SETTINGS: [SettingInfo; 12] = [
     splat_setting!(
         "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
         bzb_gi_of,
@@ -1128,6 +1128,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 11] = [
         true,
         |s| Some(bzb_gi_of(s).filter.step as f64),
         |s, v| bzb_gi_mut(s).filter.step = v as u32
+    ),
+    setting!(
+        "alpha",
+        "temporal filter weight α of the history (DGB §3.3's filter on the reconstructed light before the bilateral filter, directions re-drawn every frame; not in BZB). 0 = off, the default: every frame stands alone",
+        Range::HalfOpen(0.0, 1.0),
+        false,
+        |s| Some(bzb_gi_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
+        |s, v| set_alpha(&mut bzb_gi_mut(s).temporal, v, Default::default())
     ),
 ];
 

@@ -51,12 +51,14 @@ pub fn run(
         // BZB: the splatting algorithm's own passes (AOV or DSS)
         None => match (&checked.bzb, &checked.bzb_gi) {
             (Some(b), _) => b.pass_names().to_vec(),
-            // bzb-gi: the registry's (AOV) passes and DSS's; the frame times those it has
+            // bzb-gi: the registry's (AOV) passes, DSS's and the temporal filter's; the
+            // frame times those it has
             (None, Some(_)) => technique
                 .passes
                 .iter()
                 .copied()
                 .chain(strata_render::passes::bzb::gi::DSS_PASSES)
+                .chain(strata_render::passes::bzb::gi::TEMPORAL_PASSES)
                 .collect(),
             (None, None) => technique.passes.to_vec(),
         },

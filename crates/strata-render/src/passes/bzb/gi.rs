@@ -66,6 +66,12 @@ pub struct BzbGiSettings {
     /// DSS's levels, surfel size and frustum culling (`splat = dss`); the
     /// outermost shell reaches d_max.
     pub dss: super::dss::DssSettings,
+    /// DGB §3.3's temporal filter (reverse reprojection, EWMA) on the reconstructed
+    /// irradiance and glossy radiance before the bilateral filter, with the
+    /// directions re-drawn every frame (seed + frame): a still camera averages S new
+    /// directions per frame. `None` (the default, as the paper): every frame stands
+    /// alone. Not in BZB.
+    pub temporal: Option<crate::passes::temporal::TemporalSettings>,
 }
 
 impl Default for BzbGiSettings {
@@ -85,6 +91,7 @@ impl Default for BzbGiSettings {
             clamp: None,
             splat: super::Splat::Aov,
             dss: super::dss::DssSettings::default(),
+            temporal: None,
         }
     }
 }
@@ -127,6 +134,9 @@ impl BzbGiSettings {
             }
         }
         self.dss.validate()?;
+        if let Some(t) = &self.temporal {
+            t.validate()?;
+        }
         self.filter.validate()
     }
 
@@ -181,6 +191,7 @@ impl BzbGiSettings {
         let px = w as u64 * h as u64;
         px * (c * r) as u64 * (16 + 16 + 8 + 4)
             + px * 8 * 7
+            + self.temporal.map_or(0, |_| px * (4 * 8 + 4 * 2))
             + triangles * (48 + 80)
             + super::zminmax_tile_count(w, h) as u64 * 8
     }
@@ -437,6 +448,42 @@ pub const GLOSSY_BLUR_H: TargetDesc = TargetDesc::new(
     1,
     "bzb-gi glossy radiance after the horizontal bilateral pass",
 );
+/// The temporal filter's outputs (`BzbGiSettings::temporal`) and last frame's copies.
+pub const TEMPORAL: [TargetDesc; 4] = [
+    TargetDesc::new(
+        "bzb-gi-temporal",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "bzb-gi irradiance after the temporal filter (DGB §3.3)",
+    ),
+    TargetDesc::new(
+        "bzb-gi-temporal-history",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "last frame's bzb-gi-temporal",
+    ),
+    TargetDesc::new(
+        "bzb-gi-glossy-temporal",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "bzb-gi glossy radiance after the temporal filter",
+    ),
+    TargetDesc::new(
+        "bzb-gi-glossy-temporal-history",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "last frame's bzb-gi-glossy-temporal",
+    ),
+];
+/// The passes the temporal filter adds (`alpha` > 0; the registry lists the default frame's).
+pub const TEMPORAL_PASSES: [&str; 2] = ["bzb-gi-temporal", "bzb-gi-glossy-temporal"];
+
+/// The temporal filters' per-pixel counts and their copies (irradiance, glossy).
+pub const TEMPORAL_FRAMES: [[&str; 2]; 2] = [
+    ["bzb-gi-temporal-frames", "bzb-gi-temporal-frames-history"],
+    ["bzb-gi-glossy-temporal-frames", "bzb-gi-glossy-temporal-frames-history"],
+];
+
 pub const GLOSSY: TargetDesc = TargetDesc::new(
     "bzb-gi-glossy",
     wgpu::TextureFormat::Rgba16Float,
@@ -492,6 +539,8 @@ pub(crate) struct BzbGiStage {
     /// With visibility: the winners' radiance (deferred shading of the hits).
     shade: Option<FullscreenPass>,
     reconstruct: FullscreenPass,
+    /// `BzbGiSettings::temporal`: irradiance, glossy radiance.
+    temporal: Option<[crate::passes::temporal::TemporalPass; 2]>,
     blur: [BilateralPass; 4],
     compose: crate::passes::compose::ComposePass,
     splat_uniforms: wgpu::Buffer,
@@ -512,6 +561,7 @@ impl BzbGiStage {
         s: &BzbGiSettings,
         scene: &Scene,
         light: &LightInputs,
+        layers: u32,
     ) -> Result<Self, crate::RenderError> {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
@@ -805,13 +855,43 @@ impl BzbGiStage {
                 }),
             )?),
         };
+        // the temporal filter between the reconstruction and the bilateral filter
+        let (mut filtered, mut glossy_filtered) = (RAW.name, GLOSSY_RAW.name);
+        let temporal = s.temporal.as_ref().map(|t| {
+            for d in TEMPORAL.into_iter().chain(
+                TEMPORAL_FRAMES
+                    .into_iter()
+                    .flat_map(crate::passes::temporal::frames_targets),
+            ) {
+                targets.create(gpu, d);
+            }
+            (filtered, glossy_filtered) = (TEMPORAL[0].name, TEMPORAL[2].name);
+            let pass = |name, input, k: usize| {
+                crate::passes::temporal::TemporalPass::new(
+                    gpu,
+                    scene_gpu,
+                    targets,
+                    t,
+                    name,
+                    input,
+                    TEMPORAL[2 * k + 1].name,
+                    TEMPORAL[2 * k].name,
+                    TEMPORAL_FRAMES[k],
+                    layers,
+                )
+            };
+            [
+                pass(TEMPORAL_PASSES[0], RAW.name, 0),
+                pass(TEMPORAL_PASSES[1], GLOSSY_RAW.name, 1),
+            ]
+        });
         let blur = |name, input, output, vertical| {
             BilateralPass::new(gpu, scene_gpu, targets, &s.filter, name, input, output, vertical)
         };
         let blur = [
-            blur("bzb-gi-blur-h", RAW.name, BLUR_H.name, false),
+            blur("bzb-gi-blur-h", filtered, BLUR_H.name, false),
             blur("bzb-gi-blur-v", BLUR_H.name, crate::passes::ils::INDIRECT.name, true),
-            blur("bzb-gi-glossy-blur-h", GLOSSY_RAW.name, GLOSSY_BLUR_H.name, false),
+            blur("bzb-gi-glossy-blur-h", glossy_filtered, GLOSSY_BLUR_H.name, false),
             blur("bzb-gi-glossy-blur-v", GLOSSY_BLUR_H.name, GLOSSY.name, true),
         ];
         let compose = crate::passes::compose::ComposePass::new(
@@ -831,6 +911,7 @@ impl BzbGiStage {
             senders_pass,
             shade,
             reconstruct,
+            temporal,
             blur,
             compose,
             splat_uniforms,
@@ -845,8 +926,27 @@ impl BzbGiStage {
     }
 
     /// This frame's uniforms; animated scenes also get their triangles and lights at `frame`.
-    pub fn set_frame(&self, gpu: &GpuContext, scene: &Scene, frame: f32, animated: bool, lights: &[GpuLight]) {
-        let u = self.settings.uniforms(scene, self.count);
+    /// With the temporal filter the directions' seed moves on with `frame_index` (frames
+    /// rendered so far; 0 keeps the settings' seed) and `has_history` says whether last
+    /// frame's filtered output may be reprojected.
+    #[allow(clippy::too_many_arguments)]
+    pub fn set_frame(
+        &self,
+        gpu: &GpuContext,
+        scene: &Scene,
+        frame: f32,
+        animated: bool,
+        lights: &[GpuLight],
+        frame_index: u32,
+        has_history: bool,
+    ) {
+        let mut u = self.settings.uniforms(scene, self.count);
+        if let Some(t) = &self.temporal {
+            u.seed = self.settings.seed.wrapping_add(frame_index.wrapping_mul(0x9e37_79b9));
+            for p in t {
+                p.set_frame(gpu, has_history);
+            }
+        }
         self.directions.set_uniforms(gpu, &u);
         self.reconstruct.set_uniforms(gpu, &u);
         let u = self.settings.splat_uniforms(scene, self.count);
@@ -889,6 +989,9 @@ impl BzbGiStage {
             v.push(p);
         }
         v.push(&self.reconstruct);
+        if let Some(t) = &self.temporal {
+            v.extend(t.iter().map(|p| p as &dyn Pass));
+        }
         v.extend(self.blur.iter().map(|b| b as &dyn Pass));
         v.push(&self.compose);
         v
