@@ -1135,7 +1135,11 @@ static BZB_GI_SETTINGS: [SettingInfo; 12] = [
         Range::HalfOpen(0.0, 1.0),
         false,
         |s| Some(bzb_gi_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
-        |s, v| set_alpha(&mut bzb_gi_mut(s).temporal, v, Default::default())
+        |s, v| set_alpha(
+            &mut bzb_gi_mut(s).temporal,
+            v,
+            crate::passes::bzb::gi::BzbGiSettings::temporal_filter()
+        )
     ),
 ];
 

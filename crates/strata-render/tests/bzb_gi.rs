@@ -681,7 +681,7 @@ fn temporal_filter_averages_new_directions_on_a_still_camera() {
         ..Default::default()
     };
     let filtered = BzbGiSettings {
-        temporal: Some(Default::default()),
+        temporal: Some(BzbGiSettings::temporal_filter()),
         ..single.clone()
     };
     // (RMS error, mean relative error) of the floor's irradiance against π L (1 − F)

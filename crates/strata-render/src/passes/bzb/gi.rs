@@ -111,6 +111,17 @@ pub const DSS_PASSES: [&str; 8] = [
 ];
 
 impl BzbGiSettings {
+    /// The temporal filter `alpha` turns on: DGB's defaults without the history clamp.
+    /// A few directions per pixel make the current 3×3 neighbourhood a skewed sample
+    /// (most rays dark, a few bright), whose range often lies below the history's mean:
+    /// clamping pulled the average towards the median (the atrium's shade 2.5 % dark).
+    pub fn temporal_filter() -> crate::passes::temporal::TemporalSettings {
+        crate::passes::temporal::TemporalSettings {
+            clamp_history: false,
+            ..Default::default()
+        }
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         if !(1..=MAX_DIRECTIONS).contains(&self.directions) {
             return Err(format!(
