@@ -597,6 +597,20 @@ fn sky_scene(l: f32, h: f32, half: f32) -> Scene {
     scene
 }
 
+/// (GPU E, π L (1 − F)) of every floor pixel of `r` (at least half the image) in
+/// [`sky_scene`]`(l, h, half)`.
+fn sky_floor(gpu: &GpuContext, r: &Renderer, (w, hh): (u32, u32), (l, h, half): (f32, f32, f32)) -> Vec<(f64, f64)> {
+    let px = floor_irradiance(gpu, r, w, hh);
+    assert!(px.len() > (w * hh / 2) as usize, "{} floor pixels", px.len());
+    let side = (-half as f64, half as f64);
+    px.iter()
+        .map(|&(x, z, e)| {
+            let f = parallel_rect_form_factor([x, z], h as f64, side, side);
+            (e, std::f64::consts::PI * l as f64 * (1.0 - f))
+        })
+        .collect()
+}
+
 /// Rays that hit no sender have left the scene and bring the sky's light, once d_max
 /// spans the scene (the default: its diagonal): under a blocker the floor's
 /// irradiance is π L (1 − F) (mean within 2 %, every pixel within 15 %, as under the
@@ -623,17 +637,9 @@ fn sky_light_under_a_blocker_is_pi_l_times_one_minus_the_form_factor() {
     // over-occlude a little, measured 11 % darker on average, 19 % at worst)
     for (g, mean_tol, pixel_tol) in [(g.clone(), 0.02, 0.15), (dss(g.clone()), 0.15, 0.3)] {
         let r = render(&gpu, &scene, w, hh, g.clone());
-        let px = floor_irradiance(&gpu, &r, w, hh);
-        assert!(px.len() > (w * hh / 2) as usize, "{} floor pixels", px.len());
+        let px = sky_floor(&gpu, &r, (w, hh), (l, h, half));
         let (mut got, mut want, mut worst) = (0.0, 0.0, 0.0f64);
-        for &(x, z, e) in &px {
-            let f = parallel_rect_form_factor(
-                [x, z],
-                h as f64,
-                (-half as f64, half as f64),
-                (-half as f64, half as f64),
-            );
-            let expected = std::f64::consts::PI * l as f64 * (1.0 - f);
+        for &(e, expected) in &px {
             got += e;
             want += expected;
             worst = worst.max((e - expected).abs() / expected);
@@ -686,17 +692,9 @@ fn temporal_filter_averages_new_directions_on_a_still_camera() {
     };
     // (RMS error, mean relative error) of the floor's irradiance against π L (1 − F)
     let error = |r: &Renderer| {
-        let px = floor_irradiance(&gpu, r, w, hh);
-        assert!(px.len() > (w * hh / 2) as usize, "{} floor pixels", px.len());
+        let px = sky_floor(&gpu, r, (w, hh), (l, h, half));
         let (mut se, mut got, mut want) = (0.0, 0.0, 0.0);
-        for &(x, z, e) in &px {
-            let f = parallel_rect_form_factor(
-                [x, z],
-                h as f64,
-                (-half as f64, half as f64),
-                (-half as f64, half as f64),
-            );
-            let expected = std::f64::consts::PI * l as f64 * (1.0 - f);
+        for &(e, expected) in &px {
             se += (e - expected).powi(2);
             got += e;
             want += expected;
