@@ -622,15 +622,14 @@ static ILS_SETTINGS: [SettingInfo; 16] = [
         |s| Some(ils_of(s).vpl_shadow_resolution as f64),
         |s, v| ils_mut(s).vpl_shadow_resolution = v as u32
     ),
-    SettingInfo {
-        name: "vpl-shadow-cache",
-        doc: "VPL shadow maps (shadows = vpl) of VPLs that stay put in a scene with no animated object: redraw every frame (as ILS §6.3's fresh VPL sets must) or keep those of the first frame until new VPLs arrive (not in the paper)",
-        range: Range::Closed(0.0, 1.0),
-        integer: true,
-        get: |s| Some(ils_of(s).vpl_shadow_cache as u32 as f64),
-        set: |s, v| ils_mut(s).vpl_shadow_cache = v != 0.0,
-        values: &["redraw", "keep"],
-    },
+    bool_setting!(
+        "vpl-shadow-cache",
+        "VPL shadow maps (shadows = vpl) of VPLs that stay put in a scene with no animated object: redraw every frame (as ILS §6.3's fresh VPL sets must) or keep those of the first frame until new VPLs arrive (not in the paper)",
+        ils_of,
+        ils_mut,
+        vpl_shadow_cache,
+        ["redraw", "keep"]
+    ),
     setting!(
         "vpls",
         "VPLs N the caller generates by instant radiosity (ILS Table 4: 480)",
