@@ -3,7 +3,8 @@
 //! for the GPU passes and by the CPU evaluations that check them.
 //!
 //! The i-th of N taps around pixel (x, y) lies at `texel(x, y) + h_i û_i` with
-//! κ_i = (i + 0.5)/N, h_i = r_p κ_i, û_i = (cos θ_i, sin θ_i), θ_i = 2π κ_i τ + φ,
+//! κ_i = (i + 0.5)/N (the radiosity gather's default: (i + ξ)/N, [`spiral_tap_at`]),
+//! h_i = r_p κ_i, û_i = (cos θ_i, sin θ_i), θ_i = 2π κ_i τ + φ,
 //! and reads MIP level m_i = ⌊log2(h_i / q)⌋.
 
 use std::f32::consts::TAU as TWO_PI;
@@ -66,10 +67,23 @@ pub struct SpiralTap {
     pub radius: f32,
 }
 
+/// The per-pixel offset ξ ∈ [0, 1) of the taps' radii ([`spiral_tap_at`]): a second
+/// hash, independent of [`pixel_angle`]'s for the same pixel and seed.
+pub fn pixel_jitter(x: u32, y: u32, seed: u32) -> f32 {
+    let h = pcg_hash(pcg_hash(x.wrapping_add(pcg_hash(y.wrapping_add(pcg_hash(seed))))) ^ 0x5bd1_e995);
+    (h >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
 /// The i-th of `n` taps of a spiral of radius `r_p` pixels with `tau` turns,
-/// rotated by `phi`.
+/// rotated by `phi` (κ_i = (i + ½)/n).
 pub fn spiral_tap(i: u32, n: u32, tau: f32, r_p: f32, phi: f32) -> SpiralTap {
-    let kappa = (i as f32 + 0.5) / n as f32;
+    spiral_tap_at(i, n, tau, r_p, phi, 0.5)
+}
+
+/// [`spiral_tap`] with κ_i = (i + ξ)/n: ξ = ½ is the paper's spiral; a per-pixel,
+/// per-frame ξ ∈ [0, 1) spreads each tap over its whole stratum of radii.
+pub fn spiral_tap_at(i: u32, n: u32, tau: f32, r_p: f32, phi: f32, xi: f32) -> SpiralTap {
+    let kappa = (i as f32 + xi) / n as f32;
     let h = r_p * kappa;
     let theta = TWO_PI * kappa * tau + phi;
     SpiralTap {
@@ -129,6 +143,43 @@ mod tests {
             radii.sort_by(f32::total_cmp);
             radii.dedup();
             assert_eq!(radii.len(), n as usize, "n = {n}: radii not distinct");
+        }
+    }
+
+    /// `spiral_tap_at` with ξ from `pixel_jitter`: over frames (seeds) tap i of one pixel
+    /// lands at every radius of its stratum [i, i + 1)·r_p/n, evenly (8 bins each within
+    /// 15 % of uniform), ξ is independent of the rotation φ (their correlation is small),
+    /// and ξ = ½ is the paper's fixed radius.
+    #[test]
+    fn jittered_radii_fill_each_stratum_evenly() {
+        let (n, r_p) = (14u32, 100.0f32);
+        let tau = SpiralTurns::Optimal.tau(n);
+        for i in [0u32, 5, 13] {
+            assert_eq!(spiral_tap_at(i, n, tau, r_p, 0.7, 0.5), spiral_tap(i, n, tau, r_p, 0.7));
+            let (lo, hi) = (i as f32 * r_p / n as f32, (i + 1) as f32 * r_p / n as f32);
+            let mut hist = [0u32; 8];
+            let seeds = 4096u32;
+            let (mut sxy, mut sx, mut sy, mut sxx, mut syy) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+            for seed in 0..seeds {
+                let (xi, phi) = (pixel_jitter(17, 9, seed), pixel_angle(17, 9, seed) / TWO_PI);
+                assert!((0.0..1.0).contains(&xi));
+                let h = spiral_tap_at(i, n, tau, r_p, 0.0, xi).radius;
+                assert!(h >= lo - 1e-4 && h < hi + 1e-4, "tap {i}: h = {h} outside [{lo}, {hi})");
+                hist[(((h - lo) / (hi - lo)) * 8.0).clamp(0.0, 7.0) as usize] += 1;
+                let (a, b) = (xi as f64, phi as f64);
+                (sxy, sx, sy, sxx, syy) = (sxy + a * b, sx + a, sy + b, sxx + a * a, syy + b * b);
+            }
+            let expected = seeds as f32 / 8.0;
+            for (b, &c) in hist.iter().enumerate() {
+                assert!(
+                    (c as f32 - expected).abs() < 0.15 * expected,
+                    "tap {i}, bin {b}: {c} of {expected}"
+                );
+            }
+            let m = seeds as f64;
+            let corr =
+                (sxy / m - sx * sy / (m * m)) / ((sxx / m - (sx / m).powi(2)) * (syy / m - (sy / m).powi(2))).sqrt();
+            assert!(corr.abs() < 0.05, "ξ and φ correlate: {corr}");
         }
     }
 

@@ -429,7 +429,7 @@ static AO_SETTINGS: [SettingInfo; 15] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 20] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 21] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -496,6 +496,12 @@ static RADIOSITY_SETTINGS: [SettingInfo; 20] = [
         "tap weights of the gather: paper (DGB Eq. 4, every tap weighs 1) or solid-angle (each tap weighs the solid angle its screen area covers at the receiver, self-normalised)",
         solid_angle,
         ["paper", "solid-angle"]
+    ),
+    radiosity_switch!(
+        "radius-jitter",
+        "on: each gather tap's radius is drawn within its stratum, kappa_i = (i + xi)/N with xi per pixel and frame (no fixed rings: their averages of bright senders left static blotches; not in the paper); off: the paper's (i + 1/2)/N",
+        radius_jitter,
+        ["off", "on"]
     ),
     radiosity_switch!(
         "indirect-temporal-noise",

@@ -73,6 +73,8 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             hidden_black,
             normalisation,
             tap_visibility,
+            // Eq. 4's rows with the paper's fixed tap radii, the rest jittered
+            radius_jitter: solid_angle,
             radius: Some(4.0),
             ..Default::default()
         };

@@ -35,7 +35,8 @@ use crate::spiral::{self, SpiralTurns};
 /// (the spiral's rotation also hashes the frame index, so the temporal filter
 /// averages different tap patterns; the paper hashes the pixel only), `solid_angle`
 /// (taps weighted by the solid angle they cover instead of Eq. 4's equal weights)
-/// and `normalisation` (Eq. 4's 2π/Σw becomes π/max(Σw·cos, ½Σw)). The
+/// and `normalisation` (Eq. 4's 2π/Σw becomes π/max(Σw·cos, ½Σw)); since then
+/// `radius_jitter` (κ_i = (i + ξ)/N, docs/radiosity.md § "Jittered tap radii"). The
 /// paper's estimator: [`RadiositySettings::paper`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
@@ -109,6 +110,13 @@ pub struct RadiositySettings {
     /// the gather on lavapipe at 8 steps (docs/radiosity.md § "Visibility of hidden
     /// taps"). Not in the paper (default 0).
     pub tap_visibility: u32,
+    /// Each tap's radius is drawn within its stratum, κ_i = (i + ξ)/N with ξ per pixel
+    /// (and per frame with `temporal_noise`), instead of the paper's fixed (i + ½)/N. With
+    /// only the rotation random, tap i of a pixel always reads the same ring of radius
+    /// h_i, and the ring averages of bright, sharp-edged senders (the warehouse's red
+    /// patch) leave bands and blotches that stay put under the temporal filter
+    /// (docs/radiosity.md § "Jittered tap radii"). Not in the paper (default true).
+    pub radius_jitter: bool,
 }
 
 /// The most steps [`RadiositySettings::tap_visibility`] takes.
@@ -334,6 +342,7 @@ impl Default for RadiositySettings {
             probe_detail: false,
             one_sided_confidence: true,
             tap_visibility: 0,
+            radius_jitter: true,
         }
     }
 }
@@ -355,6 +364,7 @@ impl RadiositySettings {
             probe_visibility: false,
             probe_ao: ProbeAo::Plain,
             one_sided_confidence: false,
+            radius_jitter: false,
             ..Default::default()
         }
     }
@@ -463,7 +473,9 @@ pub struct RadiosityUniforms {
     /// The deep G-buffer's minimum separation Δz: how far behind a layer's surface counts
     /// as solid.
     pub thickness: f32,
-    pub _pad: [u32; 2],
+    /// 1 = [`RadiositySettings::radius_jitter`].
+    pub radius_jitter: u32,
+    pub _pad: u32,
 }
 
 impl RadiosityUniforms {
@@ -495,7 +507,8 @@ impl RadiosityUniforms {
             grid: bytemuck::Zeroable::zeroed(),
             vis_steps: s.tap_visibility,
             thickness: min_separation,
-            _pad: [0; 2],
+            radius_jitter: s.radius_jitter as u32,
+            _pad: 0,
         }
     }
 }
@@ -724,6 +737,11 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
     } else {
         0.0
     };
+    let xi = if u.radius_jitter != 0 {
+        spiral::pixel_jitter(x, y, u.seed)
+    } else {
+        0.5
+    };
     let (w, h) = (g.zmip[0].width as i32, g.zmip[0].height as i32);
     let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let eye = Vec3::from_slice(&g.frame.eye[..3]);
@@ -735,7 +753,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
         .map(|p| p.radiance_sh(pos, n, (eye - pos).normalize()));
     let mut sum_probe = Vec3::ZERO;
     for i in 0..u.samples {
-        let tap = spiral::spiral_tap(i, u.samples, u.tau, r_p, phi);
+        let tap = spiral::spiral_tap_at(i, u.samples, u.tau, r_p, phi, xi);
         let d = spiral::tap_texel(tap.offset);
         let (qx, qy) = (x as i32 + d[0], y as i32 + d[1]);
         if qx < 0 || qy < 0 || qx >= w || qy >= h {

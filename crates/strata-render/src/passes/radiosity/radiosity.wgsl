@@ -50,7 +50,9 @@ struct Radiosity {
     vis_steps: u32,
     // how far behind each layer's surface counts as solid: the deep G-buffer's Δz
     thickness: f32,
-    _pad: vec2u,
+    // 1 = each tap's radius within its stratum, κ_i = (i + ξ)/N (`pixel_jitter`)
+    radius_jitter: u32,
+    _pad: u32,
 }
 
 // One tap's share of the sums: c.rgb = w · B(Y) max(ω̂·n̂_X, 0), c.a = w (< 0 for an
@@ -283,6 +285,10 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     if (rad.rotate != 0u) {
         phi = pixel_angle(vec2u(p), rad.seed);
     }
+    var xi = 0.5;
+    if (rad.radius_jitter != 0u) {
+        xi = pixel_jitter(vec2u(p), rad.seed);
+    }
     let size = vec2i(textureDimensions(zmip, 0));
     var sum0 = vec4f(0.0);
     var sum1 = vec4f(0.0);
@@ -299,7 +305,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     }
     var sum_probe = vec3f(0.0);
     for (var i = 0u; i < rad.samples; i++) {
-        let tap = spiral_tap(i, rad.samples, rad.tau, r_p, phi);
+        let tap = spiral_tap_at(i, rad.samples, rad.tau, r_p, phi, xi);
         let q = p + tap_texel(tap.offset);
         if (any(q < vec2i(0)) || any(q >= size)) {
             continue;

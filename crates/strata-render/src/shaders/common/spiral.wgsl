@@ -25,9 +25,22 @@ struct SpiralTap {
     radius: f32,
 }
 
+// Per-pixel offset ξ in [0, 1) of the taps' radii (`spiral_tap_at`): a second hash,
+// independent of `pixel_angle`'s for the same pixel and seed.
+fn pixel_jitter(p: vec2u, seed: u32) -> f32 {
+    let h = pcg_hash(pcg_hash(p.x + pcg_hash(p.y + pcg_hash(seed))) ^ 0x5bd1e995u);
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
 // The i-th of n taps: κ_i = (i + 0.5)/n, h_i = r_p κ_i, θ_i = 2π κ_i τ + φ.
 fn spiral_tap(i: u32, n: u32, tau: f32, r_p: f32, phi: f32) -> SpiralTap {
-    let kappa = (f32(i) + 0.5) / f32(n);
+    return spiral_tap_at(i, n, tau, r_p, phi, 0.5);
+}
+
+// `spiral_tap` with κ_i = (i + ξ)/n: ξ = ½ is the paper's spiral; a per-pixel, per-frame
+// ξ in [0, 1) spreads each tap over its whole stratum of radii.
+fn spiral_tap_at(i: u32, n: u32, tau: f32, r_p: f32, phi: f32, xi: f32) -> SpiralTap {
+    let kappa = (f32(i) + xi) / f32(n);
     let h = r_p * kappa;
     let theta = SPIRAL_TWO_PI * kappa * tau + phi;
     return SpiralTap(vec2f(h * cos(theta), h * sin(theta)), h);
