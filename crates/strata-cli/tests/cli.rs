@@ -1816,6 +1816,101 @@ fn bzb_gi_renders_with_and_without_visibility() {
     assert_eq!(e.trim().lines().count(), 1, "{e}");
 }
 
+/// The side-by-side evaluations (`bzb-ao`, `aba-ao`, `bzb-gi`) write a JSON with every
+/// configuration's errors and, with `--report`, a page with one error row per configuration
+/// (the JSON's numbers) and each configuration's image and ꟻLIP maps beside the references:
+/// every file on disk, distinct images for distinct configurations.
+#[test]
+fn side_by_side_evals_write_json_and_report_pages() {
+    let cache = scratch("side-by-side-cache");
+    for (technique, images) in [
+        (
+            "bzb-ao",
+            &[
+                "reference-binary.png",
+                "bzb-ao.png",
+                "bzb-ao-visibility-off-additive.png",
+                "ao-2-layers.png",
+                "flip-binary-bzb-ao.png",
+            ][..],
+        ),
+        (
+            "aba-ao",
+            &[
+                "reference-obscurance.png",
+                "aba-ao.png",
+                "aba-ao-multilayer-off.png",
+                "flip-obscurance-aba-ao.png",
+            ][..],
+        ),
+        (
+            "bzb-gi",
+            &[
+                "reference-indirect.png",
+                "indirect-bzb-gi.png",
+                "indirect-bzb-gi-visibility-off-additive.png",
+                "full-dgb-radiosity-2-layers-one-bounce.png",
+                "flip-indirect-bzb-gi.png",
+            ][..],
+        ),
+    ] {
+        let report = scratch(&format!("side-by-side-{technique}"));
+        let _ = std::fs::remove_dir_all(&report);
+        let v = json_of(&strata(&[
+            "eval",
+            "--scene",
+            "cornell",
+            "--technique",
+            technique,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--ref-spp",
+            "16",
+            "--json",
+            "--quiet",
+            "--cache",
+            cache.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ]));
+        assert_eq!(v["technique"], technique, "{v}");
+        let others = if technique == "aba-ao" {
+            ["layers_1", "dgb_2_layers"]
+        } else {
+            ["no_visibility", "dgb_2_layers"]
+        };
+        for x in [&v, &v[others[0]], &v[others[1]]] {
+            let flip = x["flip"]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{technique}: no flip in {x}"));
+            assert!(flip > 0.0 && flip < 1.0, "{technique}: FLIP {flip}");
+        }
+        let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+        // one error row per configuration, with the JSON's numbers
+        assert!(
+            html.contains("Errors by configuration"),
+            "{technique}: no configuration table"
+        );
+        for x in [&v, &v[others[0]], &v[others[1]]] {
+            let flip = format!("{:.4}", x["flip"].as_f64().unwrap());
+            assert!(html.contains(&flip), "{technique}: FLIP {flip} not on the page");
+        }
+        for f in images {
+            assert!(
+                html.contains(f) && report.join(f).exists(),
+                "{technique}: {f} missing from the report"
+            );
+        }
+        let (a, b) = (
+            std::fs::read(report.join(images[1])).unwrap(),
+            std::fs::read(report.join(images[2])).unwrap(),
+        );
+        assert_ne!(a, b, "{technique}: two configurations wrote the same image");
+    }
+}
+
 /// Issue 13 (DSS): `--set splat=dss` renders in both modes with the surfel
 /// counts printed by `--timings`, and bad DSS settings are one-line errors naming the setting.
 #[test]

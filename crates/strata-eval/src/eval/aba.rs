@@ -15,16 +15,13 @@ use strata_render::passes::abuffer::ABufferSettings;
 use strata_render::passes::ao::AoSettings;
 use strata_render::RenderSettings;
 
-use super::ao::{av_setup, evaluate_av, render_settings, DEFAULT_CAP};
+use super::ao::{av_setup, evaluate_av, render_settings, write_side_by_side_report, DEFAULT_CAP};
 use super::{noise_warnings, EvalSettings};
-use crate::results::AoEval;
+use crate::results::{AoEval, EvalResult};
 
 /// `abuffer` with its `ao` as configured (radius, bias, ε default to `ao`'s, then the
 /// scene's); `ao` are the DGB AO settings of the 2-layer comparison.
 pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Result<AoEval> {
-    if s.report.is_some() {
-        bail!("--report is not available for --technique aba-ao yet: drop --report (the JSON has every error)");
-    }
     if s.frames.is_some() {
         bail!("--frames is not available for --technique aba-ao (it has no temporal filter): drop --frames");
     }
@@ -93,23 +90,38 @@ pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Resu
         gpu.describe(),
         None,
         noise_warnings(&[
-            ("aba-ao vs obscurance", &main.obscurance),
-            ("aba-ao vs binary AO", &main.binary),
+            ("aba-ao vs obscurance", &main.errors.obscurance),
+            ("aba-ao vs binary AO", &main.errors.binary),
         ]),
     );
     run.layers = 0;
-    Ok(AoEval {
+    let out = AoEval {
         run,
         samples: aba.samples,
         radius,
         bias: beta,
         epsilon,
-        errors: main,
-        layers_1: Some(single),
+        errors: main.errors,
+        layers_1: Some(single.errors),
         by_layers: Vec::new(),
         directions: None,
         visibility: None,
         no_visibility: None,
-        dgb_2_layers: Some(dgb),
-    })
+        dgb_2_layers: Some(dgb.errors),
+    };
+    if let Some(dir) = &s.report {
+        write_side_by_side_report(
+            dir,
+            s,
+            "aba-ao",
+            &EvalResult::AbaAo(out.clone()),
+            (&ref_obscurance.image, &ref_binary.image),
+            &[
+                ("aba-ao", &main),
+                ("aba-ao multilayer=off", &single),
+                ("ao, 2 layers", &dgb),
+            ],
+        )?;
+    }
+    Ok(out)
 }

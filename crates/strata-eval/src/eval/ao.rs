@@ -20,12 +20,30 @@ use crate::results::{AoErrors, AoEval, EvalResult};
 pub const DEFAULT_CAP: u32 = 32_768;
 
 /// One GPU AO evaluation: the image and its errors against both references.
-struct AoResult {
-    layers: u32,
-    av: ImageBuf,
-    errors: AoErrors,
-    obscurance_map: ImageBuf,
-    binary_map: ImageBuf,
+pub(crate) struct AoResult {
+    pub(crate) layers: u32,
+    pub(crate) av: ImageBuf,
+    pub(crate) errors: AoErrors,
+    pub(crate) obscurance_map: ImageBuf,
+    pub(crate) binary_map: ImageBuf,
+}
+
+impl AoResult {
+    /// `av` (of a `layers`-layer configuration) against both references.
+    fn of(layers: u32, av: ImageBuf, (ref_obscurance, ref_binary): (&RefImage, &RefImage)) -> Result<Self> {
+        let (obscurance, obscurance_map) = compare(&ref_obscurance.image, &av)?;
+        let (binary, binary_map) = compare(&ref_binary.image, &av)?;
+        Ok(Self {
+            layers,
+            errors: AoErrors {
+                obscurance: ref_obscurance.annotate(obscurance, &av),
+                binary: ref_binary.annotate(binary, &av),
+            },
+            av,
+            obscurance_map,
+            binary_map,
+        })
+    }
 }
 
 pub(crate) fn render_settings(s: &EvalSettings, layers: u32, ao: &AoSettings) -> RenderSettings {
@@ -55,19 +73,7 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
     let evaluate = |layers: u32| -> Result<AoResult> {
         let mut r = Renderer::new(&gpu, &scene, render_settings(s, layers, settings))?;
         let av = render_frame(&mut r, &gpu, &scene, s, s.scene.frame)?;
-        let (obscurance, obscurance_map) = compare(&ref_obscurance.image, &av)?;
-        let (binary, binary_map) = compare(&ref_binary.image, &av)?;
-        let (obscurance, binary) = (
-            ref_obscurance.annotate(obscurance, &av),
-            ref_binary.annotate(binary, &av),
-        );
-        Ok(AoResult {
-            layers,
-            av,
-            errors: AoErrors { obscurance, binary },
-            obscurance_map,
-            binary_map,
-        })
+        AoResult::of(layers, av, (&ref_obscurance, &ref_binary))
     };
     let k = s.deep.layers;
     let mut results = s.layer_counts().into_iter().map(evaluate).collect::<Result<Vec<_>>>()?;
@@ -179,9 +185,10 @@ pub(crate) fn evaluate_av(
     s: &EvalSettings,
     rs: RenderSettings,
     what: &str,
-    (ref_obscurance, ref_binary): (&RefImage, &RefImage),
+    refs: (&RefImage, &RefImage),
     note: impl Fn(&Renderer) -> Result<String>,
-) -> Result<AoErrors> {
+) -> Result<AoResult> {
+    let layers = rs.deep.layers;
     let mut r = Renderer::new(gpu, scene, rs)?;
     let start = std::time::Instant::now();
     let av = render_frame(&mut r, gpu, scene, s, s.scene.frame)?;
@@ -190,12 +197,74 @@ pub(crate) fn evaluate_av(
         start.elapsed().as_secs_f64(),
         note(&r)?
     );
-    let (obscurance, _) = compare(&ref_obscurance.image, &av)?;
-    let (binary, _) = compare(&ref_binary.image, &av)?;
-    Ok(AoErrors {
-        obscurance: ref_obscurance.annotate(obscurance, &av),
-        binary: ref_binary.annotate(binary, &av),
-    })
+    AoResult::of(layers, av, refs)
+}
+
+/// A file name for a configuration's label: lower-case letters and digits, every other run of
+/// characters one '-' ("bzb-ao visibility=off (additive)" → "bzb-ao-visibility-off-additive").
+pub(crate) fn slug(label: &str) -> String {
+    label
+        .to_ascii_lowercase()
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .filter(|w| !w.is_empty())
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
+/// `--report` of the side-by-side AO evaluations (`bzb-ao`, `aba-ao`: `technique`): the
+/// result's tables, both references, then each configuration's AV (`rows`: label, result)
+/// beside its ꟻLIP maps against both.
+pub(crate) fn write_side_by_side_report(
+    dir: &Path,
+    s: &EvalSettings,
+    technique: &str,
+    result: &EvalResult,
+    (ref_obscurance, ref_binary): (&ImageBuf, &ImageBuf),
+    rows: &[(&str, &AoResult)],
+) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
+    let fig = |img: &ImageBuf, name: &str, caption: String| figure(dir, img, name, caption);
+    let mut sections = vec![Section::new("Ground truth")
+        .text(format!(
+            "AV = 1 − AO (white = unoccluded), {}×{} pixels, frame {}, shown as grey bytes 255·AV; ꟻLIP maps use the magma scale. Binary AO within r is what the bounced z-buffer and the A-buffer estimate; DGB Eq. 2's obscurance is what deep-G-buffer AO estimates. Both references: {} spp.",
+            s.scene.width,
+            s.scene.height,
+            s.scene.frame,
+            result.run().ref_spp
+        ))
+        .figures(vec![
+            fig(ref_binary, "reference-binary.png", "binary AV within r".into())?,
+            fig(ref_obscurance, "reference-obscurance.png", "obscurance (DGB Eq. 2)".into())?,
+        ])];
+    for (label, r) in rows {
+        let (name, e) = (slug(label), &r.errors);
+        sections.push(Section::new(*label).figures(vec![
+            fig(
+                &r.av,
+                &format!("{name}.png"),
+                format!(
+                    "{label}: ꟻLIP {:.4} vs binary, {:.4} vs obscurance",
+                    e.binary.flip, e.obscurance.flip
+                ),
+            )?,
+            fig(
+                &r.binary_map,
+                &format!("flip-binary-{name}.png"),
+                "ꟻLIP vs binary AV".into(),
+            )?,
+            fig(
+                &r.obscurance_map,
+                &format!("flip-obscurance-{name}.png"),
+                "ꟻLIP vs obscurance".into(),
+            )?,
+        ]));
+    }
+    write_report(
+        dir,
+        format!("strata eval: {technique} on {}", s.scene.scene),
+        result,
+        sections,
+    )
 }
 
 /// Renders frame `f` (after frame f − 1 when the first frame has no history

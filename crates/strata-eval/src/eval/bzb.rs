@@ -10,16 +10,13 @@ use strata_render::passes::ao::AoSettings;
 use strata_render::passes::bzb::BzbSettings;
 use strata_render::RenderSettings;
 
-use super::ao::{av_setup, evaluate_av, render_settings, DEFAULT_CAP};
+use super::ao::{av_setup, evaluate_av, render_settings, write_side_by_side_report, DEFAULT_CAP};
 use super::{noise_warnings, EvalSettings};
-use crate::results::AoEval;
+use crate::results::{AoEval, EvalResult};
 
 /// `bzb` as configured (its radius and bias default to `ao`'s, then the scene's);
 /// `ao` are the DGB AO settings of the 2-layer comparison.
 pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEval> {
-    if s.report.is_some() {
-        bail!("--report is not available for --technique bzb-ao yet: drop --report (the JSON has every error)");
-    }
     if s.frames.is_some() {
         bail!("--frames is not available for --technique bzb-ao (it has no temporal filter): drop --frames");
     }
@@ -60,23 +57,38 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
         "binary AO within r (cosine-weighted hemisphere rays), and DGB Eq. 2 obscurance over all surfaces",
         gpu.describe(),
         None,
-        noise_warnings(&[("bzb-ao vs binary AO", &main.binary)]),
+        noise_warnings(&[("bzb-ao vs binary AO", &main.errors.binary)]),
     );
     run.layers = 1;
-    Ok(AoEval {
+    let out = AoEval {
         run,
         samples: bzb.directions,
         radius,
         bias: bzb.bias.unwrap_or(0.01 * radius),
         epsilon,
-        errors: main,
+        errors: main.errors,
         layers_1: None,
         by_layers: Vec::new(),
         directions: Some(bzb.directions),
         visibility: Some(bzb.visibility),
-        no_visibility: Some(no_visibility),
-        dgb_2_layers: Some(dgb),
-    })
+        no_visibility: Some(no_visibility.errors),
+        dgb_2_layers: Some(dgb.errors),
+    };
+    if let Some(dir) = &s.report {
+        write_side_by_side_report(
+            dir,
+            s,
+            "bzb-ao",
+            &EvalResult::Bzb(out.clone()),
+            (&ref_obscurance.image, &ref_binary.image),
+            &[
+                ("bzb-ao", &main),
+                ("bzb-ao visibility=off (additive)", &no_visibility),
+                ("ao, 2 layers", &dgb),
+            ],
+        )?;
+    }
+    Ok(out)
 }
 
 /// `strata eval --technique bzb-gi`: the bounced-z-buffer GI (one bounce) against the
@@ -100,9 +112,6 @@ pub fn run_gi(
     use crate::metrics::{compare_radiance, display};
     use crate::results::GiErrors;
 
-    if s.report.is_some() {
-        bail!("--report is not available for --technique bzb-gi yet: drop --report (the JSON has every error)");
-    }
     if s.frames.is_some() {
         bail!("--frames is not available for --technique bzb-gi (it has no temporal filter): drop --frames");
     }
@@ -152,8 +161,8 @@ pub fn run_gi(
         adapter: s.adapter.clone(),
     })?;
     let fixed = FrameCameras::fixed(camera);
-    // (errors, splat ms, frame ms) of one configuration after `renders` frames
-    let evaluate = |rs: RenderSettings, renders: u32| -> Result<(GiErrors, f64, f64)> {
+    // (errors, splat ms, frame ms, images) of one configuration after `renders` frames
+    let evaluate = |rs: RenderSettings, renders: u32| -> Result<(GiErrors, f64, f64, GiImages)> {
         let mut r = Renderer::new(&gpu, &scene, rs)?;
         let mut timings = Default::default();
         for _ in 0..renders {
@@ -166,23 +175,29 @@ pub fn run_gi(
             *o = (*o - d).max(0.0);
         }
         gpu.check_errors()?;
-        let (f, _) = compare_radiance(&ref_total.image, &full, exposure)?;
-        let (i, _) = compare_radiance(&ref_indirect.image, &ind, exposure)?;
+        let (f, full_map) = compare_radiance(&ref_total.image, &full, exposure)?;
+        let (i, indirect_map) = compare_radiance(&ref_indirect.image, &ind, exposure)?;
         let errors = GiErrors {
             full: ref_total.annotate(f, &display(&full, exposure)),
             indirect: ref_indirect.annotate(i, &display(&ind, exposure)),
         };
         // AOV-style triangle splats: bzb-splat; DSS surfels: dss-splat
         let splat = timings.get("bzb-splat").or_else(|| timings.get("dss-splat"));
-        Ok((errors, splat.unwrap_or(f64::NAN), timings.total()))
+        let images = GiImages {
+            full,
+            indirect: ind,
+            full_map,
+            indirect_map,
+        };
+        Ok((errors, splat.unwrap_or(f64::NAN), timings.total(), images))
     };
-    let (errors, splat_ms, frame_ms) = evaluate(main.clone(), 1)?;
-    let (no_visibility, splat_ms_no_visibility, _) = evaluate(baseline, 1)?;
-    let (dgb_2_layers, _, _) = evaluate(dgb, s.warmup.max(1) + 1)?;
-    let (errors, no_visibility) = if gi.visibility {
-        (errors, no_visibility)
+    let (errors, splat_ms, frame_ms, images) = evaluate(main.clone(), 1)?;
+    let (no_visibility, splat_ms_no_visibility, _, images_no_visibility) = evaluate(baseline, 1)?;
+    let (dgb_2_layers, _, _, images_dgb) = evaluate(dgb, s.warmup.max(1) + 1)?;
+    let (errors, no_visibility, images, images_no_visibility) = if gi.visibility {
+        (errors, no_visibility, images, images_no_visibility)
     } else {
-        (no_visibility, errors)
+        (no_visibility, errors, images_no_visibility, images)
     };
     let (splat_ms, splat_ms_no_visibility) = if gi.visibility {
         (splat_ms, splat_ms_no_visibility)
@@ -199,7 +214,7 @@ pub fn run_gi(
         noise_warnings(&[("bzb-gi indirect", &errors.indirect), ("bzb-gi full", &errors.full)]),
     );
     run.layers = 1;
-    Ok(crate::results::BzbGiEval {
+    let out = crate::results::BzbGiEval {
         run,
         directions: gi.directions,
         visibility: true,
@@ -211,5 +226,93 @@ pub fn run_gi(
         splat_ms,
         splat_ms_no_visibility,
         frame_ms,
-    })
+    };
+    if let Some(dir) = &s.report {
+        write_gi_report(
+            dir,
+            s,
+            &out,
+            (&ref_indirect.image, &ref_total.image),
+            exposure,
+            &[
+                ("bzb-gi", &out.errors, &images),
+                (
+                    "bzb-gi visibility=off (additive)",
+                    &out.no_visibility,
+                    &images_no_visibility,
+                ),
+                ("DGB radiosity, 2 layers, one bounce", &out.dgb_2_layers, &images_dgb),
+            ],
+        )?;
+    }
+    Ok(out)
+}
+
+/// One bzb-gi evaluation's images: linear radiance of the frame and of its indirect
+/// light, and their ꟻLIP maps against the path tracer.
+struct GiImages {
+    full: strata_scene::ImageBuf,
+    indirect: strata_scene::ImageBuf,
+    full_map: strata_scene::ImageBuf,
+    indirect_map: strata_scene::ImageBuf,
+}
+
+/// `--report` of `eval --technique bzb-gi`: the result's tables, the path tracer's indirect
+/// light and frame, then each configuration's (`rows`: label, errors, images) indirect light
+/// and frame beside their ꟻLIP maps, tonemapped with the scene's exposure.
+fn write_gi_report(
+    dir: &std::path::Path,
+    s: &EvalSettings,
+    out: &crate::results::BzbGiEval,
+    (ref_indirect, ref_total): (&strata_scene::ImageBuf, &strata_scene::ImageBuf),
+    exposure: f32,
+    rows: &[(&str, &crate::results::GiErrors, &GiImages)],
+) -> Result<()> {
+    use super::{figure, write_report};
+    use crate::metrics::display;
+    use crate::report::Section;
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
+    let shown =
+        |img: &strata_scene::ImageBuf, name: &str, caption: String| figure(dir, &display(img, exposure), name, caption);
+    let map = |img: &strata_scene::ImageBuf, name: &str, caption: String| figure(dir, img, name, caption);
+    let mut sections = vec![Section::new("Path tracer, one indirect bounce")
+        .text(format!(
+            "{}×{} pixels, frame {}, {} spp; sky and ambient off. Tonemapped with the scene's exposure ({exposure}); indirect = the composed frame − the direct light. ꟻLIP maps use the magma scale. {} directions per pixel, d_max {:.3}.",
+            s.scene.width, s.scene.height, s.scene.frame, out.run.ref_spp, out.directions, out.d_max
+        ))
+        .figures(vec![
+            shown(ref_indirect, "reference-indirect.png", "indirect light".into())?,
+            shown(ref_total, "reference-full.png", "direct + indirect".into())?,
+        ])];
+    for (label, e, img) in rows {
+        let name = super::ao::slug(label);
+        sections.push(Section::new(*label).figures(vec![
+            shown(
+                &img.indirect,
+                &format!("indirect-{name}.png"),
+                format!("indirect: ꟻLIP {:.4}, RMSE {:.4}", e.indirect.flip, e.indirect.rmse),
+            )?,
+            map(
+                &img.indirect_map,
+                &format!("flip-indirect-{name}.png"),
+                "ꟻLIP of the indirect light".into(),
+            )?,
+            shown(
+                &img.full,
+                &format!("full-{name}.png"),
+                format!("frame: ꟻLIP {:.4}", e.full.flip),
+            )?,
+            map(
+                &img.full_map,
+                &format!("flip-full-{name}.png"),
+                "ꟻLIP of the frame".into(),
+            )?,
+        ]));
+    }
+    write_report(
+        dir,
+        format!("strata eval: bzb-gi on {}", s.scene.scene),
+        &crate::results::EvalResult::BzbGi(out.clone()),
+        sections,
+    )
 }

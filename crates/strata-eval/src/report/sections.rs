@@ -51,12 +51,44 @@ const GI_HEADER: [&str; 9] = [
     "flicker",
 ];
 
-/// One row of an error table: the label, then the cells.
+/// One row of an error table: the label (a layer count, or a configuration of a side-by-side
+/// evaluation), then the cells.
 struct ErrorRow {
-    layers: u32,
+    label: String,
+    /// The layer count, for the error-against-layers plot (`None`: a configuration).
+    layers: Option<u32>,
     cells: Vec<Cell>,
     /// (FLIP, MAE) for the plot.
     flip_mae: (f32, f32),
+}
+
+impl ErrorRow {
+    fn layers(layers: u32, cells: Vec<Cell>, flip_mae: (f32, f32)) -> Self {
+        Self {
+            label: layers.to_string(),
+            layers: Some(layers),
+            cells,
+            flip_mae,
+        }
+    }
+
+    fn configuration(label: &str, cells: Vec<Cell>, flip_mae: (f32, f32)) -> Self {
+        Self {
+            label: label.into(),
+            layers: None,
+            cells,
+            flip_mae,
+        }
+    }
+}
+
+/// The cells of an AO row: the errors against the obscurance, then against binary AO.
+fn ao_cells(x: &crate::results::AoErrors) -> Vec<Cell> {
+    [
+        stats_cells(&x.obscurance),
+        vec![x.binary.flip.into(), x.binary.mae.into()],
+    ]
+    .concat()
 }
 
 fn stats_cells(s: &ErrorStats) -> Vec<Cell> {
@@ -78,16 +110,39 @@ fn gi_cells(x: &crate::results::GiErrors) -> Vec<Cell> {
 /// present, and the plots.
 pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Section>> {
     let run = r.run();
+    let ao_row = |label: &str, x: &crate::results::AoErrors| {
+        ErrorRow::configuration(label, ao_cells(x), (x.obscurance.flip, x.obscurance.mae))
+    };
+    let gi_row = |label: &str, x: &crate::results::GiErrors| {
+        ErrorRow::configuration(label, gi_cells(x), (x.indirect.flip, x.indirect.mae))
+    };
     let (what, header, rows, fig10): (_, &[&str], Vec<ErrorRow>, Option<&Fig10>) = match r {
-        EvalResult::Ao(e) | EvalResult::Bzb(e) | EvalResult::AbaAo(e) => {
-            let row = |layers: u32, x: &crate::results::AoErrors| ErrorRow {
-                layers,
-                cells: [
-                    stats_cells(&x.obscurance),
-                    vec![x.binary.flip.into(), x.binary.mae.into()],
-                ]
-                .concat(),
-                flip_mae: (x.obscurance.flip, x.obscurance.mae),
+        // the side-by-side evaluations: one row per configuration
+        EvalResult::Bzb(e) => {
+            let mut rows = vec![ao_row("bzb-ao", &e.errors)];
+            rows.extend(e.no_visibility.as_ref().map(|x| ao_row("visibility=off (additive)", x)));
+            rows.extend(e.dgb_2_layers.as_ref().map(|x| ao_row("DGB AO, 2 layers", x)));
+            ("AO against the ray-traced obscurance", &AO_HEADER[..], rows, None)
+        }
+        EvalResult::AbaAo(e) => {
+            let mut rows = vec![ao_row("aba-ao", &e.errors)];
+            rows.extend(e.layers_1.as_ref().map(|x| ao_row("multilayer=off", x)));
+            rows.extend(e.dgb_2_layers.as_ref().map(|x| ao_row("DGB AO, 2 layers", x)));
+            ("AO against the ray-traced obscurance", &AO_HEADER[..], rows, None)
+        }
+        EvalResult::BzbGi(e) => (
+            "bounced-z-buffer GI against the one-bounce path tracer",
+            &GI_HEADER[..],
+            vec![
+                gi_row("bzb-gi", &e.errors),
+                gi_row("visibility=off (additive)", &e.no_visibility),
+                gi_row("DGB radiosity, 2 layers, one bounce", &e.dgb_2_layers),
+            ],
+            None,
+        ),
+        EvalResult::Ao(e) => {
+            let row = |layers: u32, x: &crate::results::AoErrors| {
+                ErrorRow::layers(layers, ao_cells(x), (x.obscurance.flip, x.obscurance.mae))
             };
             let mut rows: Vec<ErrorRow> = e.by_layers.iter().map(|b| row(b.layers, &b.errors)).collect();
             if rows.is_empty() {
@@ -97,10 +152,8 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
             ("AO against the ray-traced obscurance", &AO_HEADER[..], rows, None)
         }
         EvalResult::Gi(e) => {
-            let row = |layers: u32, x: &crate::results::GiErrors| ErrorRow {
-                layers,
-                cells: gi_cells(x),
-                flip_mae: (x.indirect.flip, x.indirect.mae),
+            let row = |layers: u32, x: &crate::results::GiErrors| {
+                ErrorRow::layers(layers, gi_cells(x), (x.indirect.flip, x.indirect.mae))
             };
             let mut rows: Vec<ErrorRow> = e.by_layers.iter().map(|b| row(b.layers, &b.errors)).collect();
             if rows.is_empty() {
@@ -114,41 +167,43 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
                 e.fig10.as_ref(),
             )
         }
-        EvalResult::BzbGi(e) => (
-            "bounced-z-buffer GI against the one-bounce path tracer",
-            &GI_HEADER[..],
-            vec![ErrorRow {
-                layers: 1,
-                cells: gi_cells(&e.errors),
-                flip_mae: (e.errors.indirect.flip, e.errors.indirect.mae),
-            }],
-            None,
-        ),
         EvalResult::Oit(e) => (
             "A-buffer OIT against the CPU compositing",
             &OIT_HEADER[..],
-            vec![ErrorRow {
-                layers: 1,
-                cells: stats_cells(&e.errors),
-                flip_mae: (e.errors.flip, e.errors.mae),
-            }],
+            vec![ErrorRow::layers(
+                1,
+                stats_cells(&e.errors),
+                (e.errors.flip, e.errors.mae),
+            )],
             None,
         ),
         EvalResult::Ils(e) => (
             "interleaved VPL shading against the one-bounce path tracer",
             &GI_HEADER[..],
-            vec![ErrorRow {
-                layers: 1,
-                cells: gi_cells(&e.errors),
-                flip_mae: (e.errors.indirect.flip, e.errors.indirect.mae),
-            }],
+            vec![ErrorRow::layers(
+                1,
+                gi_cells(&e.errors),
+                (e.errors.indirect.flip, e.errors.indirect.mae),
+            )],
             None,
         ),
     };
-    let mut errors = Table::new(format!("Errors by layer count ({what})"), header);
+    let by_configuration = rows.iter().any(|r| r.layers.is_none());
+    let mut header = header.to_vec();
+    let caption = if by_configuration {
+        header[0] = "configuration";
+        format!("Errors by configuration ({what})")
+    } else {
+        format!("Errors by layer count ({what})")
+    };
+    let mut errors = Table::new(caption, &header);
     for r in &rows {
-        let flicker = run.flicker.as_ref().filter(|_| r.layers == run.layers).map(|f| f.mean);
-        let mut cells = vec![Cell::Text(r.layers.to_string())];
+        let flicker = run
+            .flicker
+            .as_ref()
+            .filter(|_| r.layers == Some(run.layers))
+            .map(|f| f.mean);
+        let mut cells = vec![Cell::Text(r.label.clone())];
         cells.extend(r.cells.iter().cloned());
         cells.push(flicker.into());
         errors.row(cells);
@@ -164,6 +219,8 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         "fig10",
         "brute_force",
         "flicker_per_frame",
+        "no_visibility",
+        "dgb_2_layers",
         "ref_noise",
         "outliers",
         "ref_outliers",
@@ -260,7 +317,15 @@ fn technique(r: &EvalResult) -> &'static str {
 
 fn eval_plots(run: &EvalRun, rows: &[ErrorRow], dir: &Path, prefix: &str) -> Result<Vec<ReportImage>> {
     let mut figs = Vec::new();
-    let points = |f: fn(&ErrorRow) -> f32| rows.iter().map(|r| (r.layers as f64, f(r) as f64)).collect();
+    let points = |f: fn(&ErrorRow) -> f32| {
+        rows.iter()
+            .filter_map(|r| Some((r.layers? as f64, f(r) as f64)))
+            .collect::<Vec<_>>()
+    };
+    if points(|r| r.flip_mae.0).len() < 2 {
+        // one layer count, or configurations side by side: the tables say it all
+        return flicker_plot(run, dir, prefix, figs);
+    }
     let svg = plot::lines(
         &format!("Error against layers ({})", run.scene),
         "layers k",
@@ -276,6 +341,11 @@ fn eval_plots(run: &EvalRun, rows: &[ErrorRow], dir: &Path, prefix: &str) -> Res
         svg,
         "FLIP and MAE against the layer count k".into(),
     )?);
+    flicker_plot(run, dir, prefix, figs)
+}
+
+/// `figs` and, when the run measured flicker, its per-frame plot.
+fn flicker_plot(run: &EvalRun, dir: &Path, prefix: &str, mut figs: Vec<ReportImage>) -> Result<Vec<ReportImage>> {
     if let Some(f) = run.flicker.as_ref().filter(|f| !f.per_frame.is_empty()) {
         let pts = f.per_frame.iter().map(|p| (p[0], p[1])).collect();
         let svg = plot::lines(
