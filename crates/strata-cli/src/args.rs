@@ -524,7 +524,7 @@ pub struct EvalArgs {
     /// irradiance probes for the coarse-scale fallback").
     #[arg(long)]
     pub no_probes: bool,
-    /// gi: bake the light probes from this scene (built-in name or file) instead of the
+    /// gi and full --views: bake the light probes from this scene (built-in name or file) instead of the
     /// evaluated one: stale probes, as after a change the static bake has not seen (a moved
     /// object, a recoloured surface), which only the screen-space radiosity can follow.
     #[arg(long, value_name = "SCENE", conflicts_with = "no_probes")]

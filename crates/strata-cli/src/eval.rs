@@ -16,11 +16,12 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     let is_aba = a.technique.name == "aba-ao";
     let is_bzb_gi = a.technique.name == "bzb-gi";
     // flags that only the deep-G-buffer GI comparison reads: an error elsewhere, not ignored
+    // (--views reads --probes-from too)
     if a.views || a.technique.eval != EvalKind::Radiance || is_bzb_gi {
         let gi_only = [
             ("--fig10", a.fig10),
             ("--no-probes", a.no_probes),
-            ("--probes-from", a.probes_from.is_some()),
+            ("--probes-from", a.probes_from.is_some() && !a.views),
             ("--moving", a.moving),
         ];
         if let Some((flag, _)) = gi_only.iter().find(|f| f.1) {
@@ -304,13 +305,19 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
     }
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    // the probes of another scene (`--probes-from`): a bake that has not seen a change
+    let source = match &a.probes_from {
+        Some(other) => strata_scene::load_scene(other).map_err(|e| anyhow::anyhow!("--probes-from: {e}"))?,
+        None => scene,
+    };
     settings.probes = Some(strata_eval::cache::probes::scene_probes(
-        &scene,
+        &source,
         a.radiosity.probe_bake(),
         &strata_eval::cache::RefCache::new(&s.cache),
         !s.progress,
     )?);
-    let e = views::run(s, settings)?;
+    let mut e = views::run(s, settings)?;
+    e.probes_from = a.probes_from.clone();
     if a.json {
         println!("{}", to_json_string(&e)?);
         return Ok(());

@@ -702,7 +702,7 @@ fn unknown_preset_lists_the_valid_ones() {
 fn eval_full_views_reports_clipping_blend_and_region_chroma() {
     let cache = scratch("views-cache");
     let _ = std::fs::remove_dir_all(&cache);
-    let o = strata(&[
+    let args = vec![
         "eval",
         "--scene",
         "mirror",
@@ -723,8 +723,8 @@ fn eval_full_views_reports_clipping_blend_and_region_chroma() {
         "--quiet",
         "--cache",
         cache.to_str().unwrap(),
-    ]);
-    let v = json_of(&o);
+    ];
+    let v = json_of(&strata(&args));
     let views = v["views"].as_array().expect("views");
     let names: Vec<&str> = views.iter().map(|x| x["view"].as_str().unwrap()).collect();
     assert_eq!(
@@ -758,6 +758,22 @@ fn eval_full_views_reports_clipping_blend_and_region_chroma() {
     for r in regions {
         assert!(r["chroma_reference"].as_f64().is_some_and(|x| x >= 0.0), "{r}");
     }
+    assert!(v.get("probes_from").is_none(), "{v}");
+    // probes baked from another scene (stale probes): read, and said in the JSON; the same
+    // scene by name gives the same bake, so the same numbers; another scene's probes change
+    // the probe-only composite
+    let mut named = args.clone();
+    named.extend(["--probes-from", "mirror"]);
+    let same = json_of(&strata(&named));
+    assert_eq!(same["probes_from"], "mirror");
+    assert_eq!(same["flip_blended"], v["flip_blended"]);
+    let mut other = args.clone();
+    other.extend(["--probes-from", "plane"]);
+    let stale = json_of(&strata(&other));
+    assert_ne!(stale["flip_probe_only"], v["flip_probe_only"], "{stale}");
+    let mut bad = args.clone();
+    bad.extend(["--probes-from", "no-such-scene"]);
+    assert_one_line_error(&strata(&bad), &["--probes-from", "no-such-scene"]);
     let o = strata(&["eval", "--scene", "plane", "--technique", "ao", "--views"]);
     assert_one_line_error(&o, &["--views", "full"]);
     let o = strata(&[

@@ -110,6 +110,9 @@ pub struct ViewsEval {
     pub flip_probe_only: f32,
     pub flip_gbuffer_only: f32,
     pub regions: Vec<RegionChroma>,
+    /// The scene the probes were baked from when not the evaluated one (`--probes-from`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probes_from: Option<String>,
 }
 
 /// sRGB display value (0..1) → CIELAB (a*, b*), D65.
@@ -360,5 +363,6 @@ pub fn run(s: &EvalSettings, settings: RenderSettings) -> Result<ViewsEval> {
         flip_probe_only: flips[0],
         flip_gbuffer_only: flips[2],
         regions,
+        probes_from: None,
     })
 }
