@@ -48,10 +48,14 @@ $S render --scene atrium --technique ils --width "$W" --height "$H" --out "$OUT/
 echo "[strata demo] A-buffer (ABA): OIT and opacity-aware multilayer AO on glasshouse; aba-ao vs single-layer and DGB AO on atrium" >&2
 $S render --scene glasshouse --technique oit --width "$W" --height "$H" --out "$OUT/glasshouse-oit.png" --force
 $S render --scene glasshouse --technique aba-ao --width "$W" --height "$H" --out "$OUT/glasshouse-aba-ao.png" --force
-$S eval --scene atrium --technique aba-ao --width 320 --height 180 --json --quiet > "$OUT/eval-aba-ao.json"
+$S eval --scene atrium --technique aba-ao --width 320 --height 180 --json --quiet \
+  --report "$OUT/aba-ao-eval" --force > "$OUT/eval-aba-ao.json"
 cat "$OUT/eval-aba-ao.json"
-echo "[strata demo] bounced z-buffer AO (BZB) on atrium" >&2
+echo "[strata demo] bounced z-buffer AO (BZB) on atrium; bzb-ao vs its additive baseline and DGB AO" >&2
 $S render --scene atrium --technique bzb-ao --width "$W" --height "$H" --out "$OUT/atrium-bzb-ao.png" --force
+$S eval --scene atrium --technique bzb-ao --width 320 --height 180 --json --quiet \
+  --report "$OUT/bzb-ao-eval" --force > "$OUT/eval-bzb-ao.json"
+cat "$OUT/eval-bzb-ao.json"
 echo "[strata demo] GPU timings" >&2
 $S bench gbuffer --scene atrium --width "$W" --height "$H" --frames 5 --json > "$OUT/bench-gbuffer.json"
 cat "$OUT/bench-gbuffer.json"
