@@ -604,7 +604,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 16] = [
+static ILS_SETTINGS: [SettingInfo; 17] = [
     SettingInfo {
         name: "shadows",
         doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
@@ -737,6 +737,14 @@ static ILS_SETTINGS: [SettingInfo; 16] = [
         true,
         |s| Some(ils_of(s).bilinear as u32 as f64),
         |s, v| ils_mut(s).bilinear = v != 0.0
+    ),
+    bool_setting!(
+        "blur-weights",
+        "tap weights of the blur: gaussian (ILS §4.5) or equal-subsets (each Gaussian weight divided by the window's sum over its sub-buffer, so on a flat region the n (m) sub-buffers of a row (column) weigh the same and no grid remains; not in the paper)",
+        ils_of,
+        ils_mut,
+        equal_subsets,
+        ["gaussian", "equal-subsets"]
     ),
     setting!(
         "per-axis-db",

@@ -18,6 +18,12 @@ struct Filter {
     // B: the DB channel that stops the blur: 3 = §4.5's flag (three positive
     // neighbours), 0 / 1 = differs from the +x / +y neighbour (per-axis option)
     channel: u32,
+    // B: > 1 = the interleave period along `dir` (equal sub-buffer weights)
+    period: u32,
+    // B: the tap weight at offset ±k is weights[k / 4][k % 4], k in 0..=radius
+    // (`ils::blur_weights`: the Gaussian, or with a period divided by the window's sum
+    // over the tap's sub-buffer)
+    weights: array<vec4f, 9>,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -71,8 +77,10 @@ fn fs_discontinuity(@builtin(position) pos: vec4f) -> @location(0) vec4f {
 
 // ---- B ----
 
-fn gauss(k: f32) -> f32 {
-    return exp(-0.5 * k * k / (filt.sigma * filt.sigma));
+// The weight of the tap at offset k in [−radius, radius] (symmetric in k).
+fn weight(k: i32) -> f32 {
+    let a = u32(abs(k));
+    return filt.weights[a / 4u][a % 4u];
 }
 
 fn flag(p: vec2i) -> bool {
@@ -88,15 +96,16 @@ fn flag(p: vec2i) -> bool {
 fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
     let d = filt.dir;
     let r = i32(filt.radius);
-    var sum = textureLoad(src, c, 0).rgb;
-    var wsum = 1.0;
+    let w0 = weight(0);
+    var sum = w0 * textureLoad(src, c, 0).rgb;
+    var wsum = w0;
     var prev_similar = !flag(c);
     for (var k = 1; k <= r; k++) {
         let q = c + k * d;
         if (!prev_similar || any(q >= size)) {
             break;
         }
-        let w = gauss(f32(k));
+        let w = weight(k);
         sum += w * textureLoad(src, q, 0).rgb;
         wsum += w;
         prev_similar = !flag(q);
@@ -106,7 +115,7 @@ fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
         if (any(q < vec2i(0)) || flag(q)) {
             break;
         }
-        let w = gauss(f32(k));
+        let w = weight(-k);
         sum += w * textureLoad(src, q, 0).rgb;
         wsum += w;
     }
@@ -124,16 +133,17 @@ fn blur_bilinear(c: vec2i, size: vec2i) -> vec4f {
     let r = i32(filt.radius);
     let inv = 1.0 / vec2f(size);
     let centre = vec2f(c) + 0.5;
-    var sum = textureLoad(src, c, 0).rgb;
-    var wsum = 1.0;
+    let w0 = weight(0);
+    var sum = w0 * textureLoad(src, c, 0).rgb;
+    var wsum = w0;
     for (var side = 0; side < 2; side++) {
         let s = select(-1, 1, side == 0);
         if (s > 0 && flag(c)) {
             continue;
         }
         for (var k = 1; k <= r; k += 2) {
-            let wa = gauss(f32(k));
-            let wb = select(0.0, gauss(f32(k + 1)), k + 1 <= r);
+            let wa = weight(s * k);
+            let wb = select(0.0, weight(s * (k + 1)), k + 1 <= r);
             let last = c + s * select(k, k + 1, k + 1 <= r) * d;
             if (any(last < vec2i(0)) || any(last >= size)) {
                 break;

@@ -148,6 +148,13 @@ pub struct IlsSettings {
     pub blur: f32,
     /// Fig. 4 b: two texels per bilinear tap (false: Fig. 4 a, texel centres).
     pub bilinear: bool,
+    /// Not in the paper: each tap's Gaussian weight is divided by the sum of the
+    /// Gaussian over the window's taps of the same sub-buffer (offset mod n along x, mod
+    /// m along y), so on a flat region every sub-buffer of a row (column) weighs the
+    /// same and the blur removes the interleaved pattern exactly. §4.5's plain Gaussian
+    /// weighs them unequally (n = 8, radius 4: 0.75 to 1.22), which leaves a faint n×m
+    /// grid on flat walls (docs/ils.md § "Equal sub-buffer weights"). Default true.
+    pub equal_subsets: bool,
     /// Not in the paper: the horizontal blur stops only at discontinuities
     /// towards (x+1, y), the vertical one towards (x, y+1), instead of at
     /// §4.5's flag over all three positive neighbours (which leaves pixels along
@@ -181,6 +188,7 @@ impl Default for IlsSettings {
             all_vpls_per_sub_buffer: false,
             blur: 1.0,
             bilinear: true,
+            equal_subsets: true,
             per_axis_discontinuities: false,
             depth_threshold: 0.02,
             normal_threshold_deg: 25.0,
@@ -415,6 +423,34 @@ struct FilterUniforms {
     dir: [i32; 2],
     bilinear: u32,
     channel: u32,
+    /// The interleave period along `dir` with [`IlsSettings::equal_subsets`], else 0.
+    period: u32,
+    _pad: [u32; 3],
+    /// [`blur_weights`], four per vec4.
+    weights: [[f32; 4]; 9],
+}
+
+/// Taps per side the blur's weight table holds: ⌊4 · 16 / 2⌋ (blur ≤ 4, pattern ≤ 16).
+const MAX_BLUR_RADIUS: usize = 32;
+
+/// The blur's tap weights at offsets 0..=`radius` (the same at −k): the Gaussian of σ =
+/// `sigma`, and with `period` > 1 ([`IlsSettings::equal_subsets`]) each divided by the
+/// Gaussian's sum over the window's taps of the same sub-buffer (offsets ≡ k mod
+/// `period` in [−radius, radius]), so that on a flat region every sub-buffer weighs 1.
+/// The CPU side of `weight` in `ils_filter.wgsl`.
+pub fn blur_weights(radius: u32, sigma: f32, period: u32) -> Vec<f32> {
+    let gauss = |k: i32| (-0.5 * (k * k) as f32 / (sigma * sigma)).exp();
+    let r = radius as i32;
+    (0..=r)
+        .map(|k| {
+            if period <= 1 {
+                return gauss(k);
+            }
+            let p = period as i32;
+            let class: f32 = (-r..=r).filter(|j| (j - k).rem_euclid(p) == 0).map(gauss).sum();
+            gauss(k) / class
+        })
+        .collect()
 }
 
 /// BS or BG of one target into another, as a frame pass (also used by the
@@ -451,11 +487,24 @@ impl Pass for InterleavePass {
 /// §4.5's filter uniforms for a blur of `radius` texels along `dir` (the DB pass: 0,
 /// [0, 0]).
 fn filter_uniforms(s: &IlsSettings, radius: u32, dir: [i32; 2]) -> FilterUniforms {
+    let period = match (s.equal_subsets, dir) {
+        (true, [0, 0]) | (false, _) => 0,
+        (true, [_, 0]) => s.pattern[0],
+        (true, _) => s.pattern[1],
+    };
+    let sigma = radius.max(1) as f32;
+    let mut weights = [[0.0f32; 4]; 9];
+    for (k, w) in blur_weights(radius.min(MAX_BLUR_RADIUS as u32), sigma, period)
+        .into_iter()
+        .enumerate()
+    {
+        weights[k / 4][k % 4] = w;
+    }
     FilterUniforms {
         depth_threshold: s.depth_threshold,
         normal_cos: s.normal_threshold_deg.to_radians().cos(),
         radius,
-        sigma: radius.max(1) as f32,
+        sigma,
         dir,
         bilinear: s.bilinear as u32,
         // §4.5's three-neighbour flag (a), or the flag of the blur's own axis (r, g)
@@ -464,6 +513,9 @@ fn filter_uniforms(s: &IlsSettings, radius: u32, dir: [i32; 2]) -> FilterUniform
         } else {
             3
         },
+        period,
+        _pad: [0; 3],
+        weights,
     }
 }
 
@@ -865,7 +917,7 @@ mod tests {
         w: u32,
         h: u32,
         plane: impl Fn(u32, u32) -> u32,
-        value: impl Fn(u32) -> f32,
+        value: impl Fn(u32, u32, u32) -> f32,
     ) -> (Vec<f32>, Vec<f32>) {
         let scene = strata_scene::procedural::plane();
         let scene_gpu = GpuScene::new(gpu, &scene);
@@ -884,7 +936,7 @@ mod tests {
             for x in 0..w {
                 let p = plane(x, y);
                 g.push([n[0], n[1], n[2], 1.0 + p as f32]);
-                let v = value(p);
+                let v = value(x, y, p);
                 e.push([v, v, v, 1.0]);
             }
         }
@@ -918,10 +970,73 @@ mod tests {
     fn blur_keeps_a_constant_image_constant() {
         let gpu = gpu();
         for bilinear in [false, true] {
-            let (out, db) = filter(&gpu, &settings(bilinear), 37, 29, |_, _| 0, |_| 0.75);
+            let (out, db) = filter(&gpu, &settings(bilinear), 37, 29, |_, _| 0, |_, _, _| 0.75);
             assert!(db.iter().all(|&d| d == 0.0), "one plane has no discontinuity");
             for (i, v) in out.iter().enumerate() {
                 assert!((v - 0.75).abs() <= 1e-3, "bilinear {bilinear}: texel {i} = {v}");
+            }
+        }
+    }
+
+    /// `blur_weights`: with a period, the taps of each sub-buffer in the window sum to 1
+    /// (every pattern size and kernel scale); without, the plain Gaussian (1 at the centre).
+    #[test]
+    fn blur_weights_give_every_sub_buffer_the_same_total() {
+        for period in 1..=16u32 {
+            for blur in [0.5f32, 1.0, 2.0, 4.0] {
+                let r = (blur * period as f32 * 0.5).floor() as i32;
+                let w = blur_weights(r as u32, r.max(1) as f32, period);
+                let plain = blur_weights(r as u32, r.max(1) as f32, 0);
+                assert_eq!(plain[0], 1.0);
+                if period == 1 || r == 0 {
+                    continue;
+                }
+                let p = period as i32;
+                // the sub-buffers the window reaches
+                for class in (-r..=r).map(|k| k.rem_euclid(p)) {
+                    let total: f32 = (-r..=r)
+                        .filter(|k| (k - class).rem_euclid(p) == 0)
+                        .map(|k| w[k.unsigned_abs() as usize])
+                        .sum();
+                    assert!(
+                        (total - 1.0).abs() < 1e-5,
+                        "period {period}, blur {blur}, class {class}: {total}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The gathered image of one flat plane is the 8×6 interleaved pattern of its
+    /// sub-buffers' values. With equal sub-buffer weights (the default) every pixel at
+    /// least a kernel radius from the border blurs to the mean of the 48 values (texel
+    /// taps: exactly; bilinear taps: within 0.4 %); §4.5's plain Gaussian leaves the grid
+    /// (the control, ~1 %).
+    #[test]
+    fn equal_subset_weights_remove_the_interleaved_pattern() {
+        let (w, h) = (48u32, 36u32);
+        // 48 distinct values k/64, exact in f16
+        let v = |x: u32, y: u32| (8 + ((x % 8) * 6 + y % 6) * 7 % 48) as f32 / 64.0;
+        let mean = (0..8).flat_map(|i| (0..6).map(move |j| v(i, j))).sum::<f32>() / 48.0;
+        let gpu = gpu();
+        for (bilinear, equal) in [(false, true), (true, true), (false, false), (true, false)] {
+            let s = IlsSettings {
+                equal_subsets: equal,
+                ..settings(bilinear)
+            };
+            let [rx, ry] = s.blur_radius();
+            let (out, _) = filter(&gpu, &s, w, h, |_, _| 0, |x, y, _| v(x, y));
+            let worst = (ry..h - ry)
+                .flat_map(|y| (rx..w - rx).map(move |x| (x, y)))
+                .map(|(x, y)| (out[(y * w + x) as usize] - mean).abs() / mean)
+                .fold(0.0f32, f32::max);
+            eprintln!("bilinear {bilinear}, equal sub-buffers {equal}: worst relative deviation {worst}");
+            if equal {
+                // texel taps: exact; bilinear taps: the sampler's sub-texel precision
+                let bound = if bilinear { 4e-3 } else { 1e-4 };
+                assert!(worst < bound, "bilinear {bilinear}: the pattern remains ({worst})");
+            } else {
+                assert!(worst > 5e-3, "control: the Gaussian removed the pattern ({worst})");
             }
         }
     }
@@ -939,7 +1054,7 @@ mod tests {
                 per_axis_discontinuities: per_axis,
                 ..settings(bilinear)
             };
-            let (out, db) = filter(&gpu, &s, w, h, quadrant, |p| values[p as usize]);
+            let (out, db) = filter(&gpu, &s, w, h, quadrant, |_, _, p| values[p as usize]);
             // DB: exactly the pixels before a boundary (x = 16 or y = 12)
             for y in 0..h {
                 for x in 0..w {
@@ -959,7 +1074,7 @@ mod tests {
                 normal_threshold_deg: 180.0,
                 ..s
             };
-            let (out, db) = filter(&gpu, &blind, w, h, quadrant, |p| values[p as usize]);
+            let (out, db) = filter(&gpu, &blind, w, h, quadrant, |_, _, p| values[p as usize]);
             assert!(db.iter().all(|&d| d == 0.0));
             let v = out[(5 * w + 16) as usize];
             assert!(
