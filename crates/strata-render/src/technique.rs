@@ -429,7 +429,7 @@ static AO_SETTINGS: [SettingInfo; 15] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 21] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 22] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -498,6 +498,12 @@ static RADIOSITY_SETTINGS: [SettingInfo; 21] = [
         ["paper", "solid-angle"]
     ),
     radiosity_switch!(
+        "tap-visibility-senders",
+        "which taps --tap-visibility tests: hidden (layer-1 senders, by whether a point between lies within min separation behind a surface) or all (the visible senders too, and every segment also by whether it passes from in front of the visible surface to behind it between two steps: no light through thin walls; 3-4x the gather's cost at 8 steps on lavapipe)",
+        tap_visibility_all,
+        ["hidden", "all"]
+    ),
+    radiosity_switch!(
         "radius-jitter",
         "on: each gather tap's radius is drawn within its stratum, kappa_i = (i + xi)/N with xi per pixel and frame (no fixed rings: their averages of bright senders left static blotches; not in the paper); off: the paper's (i + 1/2)/N",
         radius_jitter,
@@ -511,7 +517,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 21] = [
     ),
     setting!(
         "tap-visibility",
-        "steps of a visibility test for the hidden layer's radiosity taps: a layer-1 sender counts as nothing for layer 0's receiver when a point between them lies within the deep G-buffer's min separation behind a surface of either layer (0 = off, as the paper; not in the paper, docs/radiosity.md)",
+        "steps of a visibility test for the radiosity taps (which ones: --tap-visibility-senders): a sender counts as nothing for layer 0's receiver when a point between them lies within the deep G-buffer's min separation behind a surface of either layer (0 = off, as the paper; not in the paper, docs/radiosity.md)",
         Range::OffOr(2.0, radiosity::MAX_TAP_VISIBILITY as f64),
         true,
         |s| Some(radiosity_of(s).tap_visibility as f64),

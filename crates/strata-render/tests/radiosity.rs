@@ -51,18 +51,20 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     // normalisation): the paper's Eq. 4, the default weights and normaliser, and the two
     // non-paper tap rules (the atrium has a sky)
     use Normalisation::*;
-    for (name, normal_test, solid_angle, open_sky, hidden_black, normalisation, tap_visibility) in [
-        ("atrium", true, false, false, false, Hemisphere, 0),
-        ("cornell", false, false, false, false, Hemisphere, 0),
-        ("warehouse", true, false, false, false, Hemisphere, 0),
-        ("atrium", true, true, false, false, Hemisphere, 0),
-        ("cornell", false, true, false, false, Bounded, 0),
-        ("warehouse", true, true, false, false, Bounded, 0),
-        ("atrium", true, true, true, true, Cosine, 0),
-        ("warehouse", true, false, true, true, Hemisphere, 0),
-        ("warehouse", true, false, false, true, Cosine, 0),
-        ("warehouse", true, true, false, false, Bounded, 8),
-        ("atrium", true, true, false, false, Bounded, 8),
+    // (…, tap visibility steps, and whether it tests every tap or only the hidden ones)
+    for (name, normal_test, solid_angle, open_sky, hidden_black, normalisation, (tap_visibility, tap_visibility_all)) in [
+        ("atrium", true, false, false, false, Hemisphere, (0, true)),
+        ("cornell", false, false, false, false, Hemisphere, (0, true)),
+        ("warehouse", true, false, false, false, Hemisphere, (0, true)),
+        ("atrium", true, true, false, false, Hemisphere, (0, true)),
+        ("cornell", false, true, false, false, Bounded, (0, true)),
+        ("warehouse", true, true, false, false, Bounded, (0, true)),
+        ("atrium", true, true, true, true, Cosine, (0, true)),
+        ("warehouse", true, false, true, true, Hemisphere, (0, true)),
+        ("warehouse", true, false, false, true, Cosine, (0, true)),
+        ("warehouse", true, true, false, false, Bounded, (8, false)),
+        ("warehouse", true, true, false, false, Bounded, (8, true)),
+        ("atrium", true, true, false, false, Bounded, (8, true)),
     ] {
         let scene = frozen(name);
         let (w, h) = (96, 64);
@@ -73,6 +75,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             hidden_black,
             normalisation,
             tap_visibility,
+            tap_visibility_all,
             // Eq. 4's rows with the paper's fixed tap radii, the rest jittered
             radius_jitter: solid_angle,
             radius: Some(4.0),
@@ -216,6 +219,123 @@ fn light_seen_only_by_layer_1_reaches_the_floor_with_two_layers_only() {
     eprintln!("mean indirect E: k=1 {:.4}, k=2 {:.4}", results[0], results[1]);
     assert!(results[0] < 1e-4, "1 layer found light it cannot see: {}", results[0]);
     assert!(results[1] > 0.05, "2 layers did not light the floor: {}", results[1]);
+}
+
+/// A floor split by a thin wall (4 cm, below the 0.5 m min separation) standing along
+/// x = 0, and an emitter beyond it (x > 0) that the camera, above the near side, sees over
+/// the wall. No light source, black sky: on the first frame only the emitter sends light,
+/// and the wall hides it from the whole near floor (every segment from there crosses x = 0
+/// below the wall's top).
+fn thin_wall_scene() -> Scene {
+    let v = Vec3::new;
+    let mut floor = MeshBuilder::new();
+    floor.rect(Vec3::ZERO, v(2.5, 0.0, 0.0), v(0.0, 0.0, 2.5));
+    let mut emitter = MeshBuilder::new();
+    emitter.quad_facing(
+        [
+            v(0.3, 0.0, -1.5),
+            v(1.8, 0.0, -1.5),
+            v(1.8, 1.0, -1.5),
+            v(0.3, 1.0, -1.5),
+        ],
+        v(0.0, 0.0, 1.0),
+    );
+    let mut wall = MeshBuilder::new();
+    wall.cuboid(v(-0.02, 0.0, -2.5), v(0.02, 1.2, 2.5));
+    let materials = vec![
+        Material::diffuse("floor", [0.7, 0.7, 0.7]),
+        Material::emissive("emitter", [4.0, 3.0, 2.0]),
+        Material::diffuse("wall", [0.5, 0.5, 0.5]),
+    ];
+    let meshes = vec![
+        floor.build("floor", 0),
+        emitter.build("emitter", 1),
+        wall.build("wall", 2),
+    ];
+    let objects = (0..3)
+        .map(|i| Object {
+            name: materials[i].name.clone(),
+            mesh: i,
+            transform: Mat4::IDENTITY,
+            animation: None,
+        })
+        .collect();
+    Scene {
+        name: "thin-wall".into(),
+        meshes,
+        objects,
+        materials,
+        lights: vec![],
+        camera: Camera::new(v(-1.6, 4.0, 3.5), v(0.3, 0.0, -0.6), Vec3::Y, 60.0, 0.05),
+        settings: SceneSettings {
+            min_separation: 0.5,
+            sky: [0.0; 3],
+            ambient: [0.0; 3],
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// Tap visibility of the visible senders (`tap_visibility_all`): behind a thin wall, which
+/// no test point lands inside, the emitter the camera sees over the wall no longer lights
+/// the near floor, which it cannot see; the floor beside the emitter keeps its light.
+#[test]
+fn tap_visibility_keeps_a_visible_emitters_light_behind_a_thin_wall() {
+    let gpu = common::gpu();
+    let scene = thin_wall_scene();
+    let (w, h) = (128, 96);
+    let mut near_far = Vec::new();
+    for all in [false, true] {
+        let rs = RadiositySettings {
+            radius: Some(4.0),
+            temporal: None,
+            tap_visibility: 8,
+            tap_visibility_all: all,
+            ..Default::default()
+        };
+        let mut r = renderer(&gpu, &scene, w, h, 2, rs);
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let e = r.read_target(&gpu, "indirect-raw").unwrap();
+        let (mut near, mut far) = ((0.0f64, 0usize), (0.0f64, 0usize));
+        for s in common::surface_points(&gpu, &r) {
+            if s.n.y < 0.99 || s.p.y > 0.01 {
+                continue; // the floor only
+            }
+            let lum = e.data[s.i * 4..s.i * 4 + 3].iter().sum::<f32>() as f64;
+            if s.p.x < -0.3 {
+                near = (near.0 + lum, near.1 + 1);
+            } else if s.p.x > 0.3 && s.p.z > -1.4 && s.p.z < 0.0 {
+                far = (far.0 + lum, far.1 + 1);
+            }
+        }
+        assert!(
+            near.1 > 500 && far.1 > 100,
+            "weak test: {} near, {} far floor pixels",
+            near.1,
+            far.1
+        );
+        near_far.push((near.0 / near.1 as f64, far.0 / far.1 as f64));
+    }
+    let [(near_hidden, far_hidden), (near_all, far_all)] = near_far[..] else {
+        unreachable!()
+    };
+    eprintln!(
+        "near floor E: hidden taps only {near_hidden:.4}, all {near_all:.4}; far floor {far_hidden:.4} / {far_all:.4}"
+    );
+    assert!(
+        near_hidden > 0.05,
+        "no light leaks through the wall to begin with: {near_hidden}"
+    );
+    assert!(
+        near_all < 0.1 * near_hidden,
+        "the wall still passes the emitter's light: {near_all} vs {near_hidden}"
+    );
+    assert!(
+        far_all > 0.9 * far_hidden,
+        "the emitter's own side lost light: {far_all} vs {far_hidden}"
+    );
 }
 
 /// A closed grey box (albedo ρ) lit by a point light, seen from inside.

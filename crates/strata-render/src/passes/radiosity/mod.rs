@@ -108,8 +108,18 @@ pub struct RadiositySettings {
     /// floor behind the warehouse's partition lights the wall in front of it. Layer 1's
     /// receiver (whose E feeds only the next bounce) is not tested. Costs about +60 % of
     /// the gather on lavapipe at 8 steps (docs/radiosity.md § "Visibility of hidden
-    /// taps"). Not in the paper (default 0).
+    /// taps"); [`tap_visibility_all`](Self::tap_visibility_all) extends it to every tap.
+    /// Not in the paper (default 0).
     pub tap_visibility: u32,
+    /// With [`tap_visibility`](Self::tap_visibility) on, the visible (layer-0) senders are
+    /// tested too, and every segment also by whether it pierces the visible surface between
+    /// two steps ([`segment_blocked`]'s crossing test). Screen space otherwise lights a
+    /// receiver with every visible surface in its hemisphere, walls or not: the warehouse's
+    /// back wall beside the partition took the lit room behind it (docs/radiosity.md §
+    /// "Visible senders too"). 3–4× the gather's cost at 8 steps on lavapipe (+60 %
+    /// without). Not in the paper (default true; off: hidden senders only, slab test only,
+    /// as before).
+    pub tap_visibility_all: bool,
     /// Each tap's radius is drawn within its stratum, κ_i = (i + ξ)/N with ξ per pixel
     /// (and per frame with `temporal_noise`), instead of the paper's fixed (i + ½)/N. With
     /// only the rotation random, tap i of a pixel always reads the same ring of radius
@@ -122,38 +132,90 @@ pub struct RadiositySettings {
 /// The most steps [`RadiositySettings::tap_visibility`] takes.
 pub const MAX_TAP_VISIBILITY: u32 = 32;
 
+/// Where two of [`segment_blocked`]'s steps show different surfaces, its crossing test
+/// adds `SEG_SUB − 1` points between them.
+pub const SEG_SUB: u32 = 4;
+
 /// Whether the segment from receiver `x` to sender `y` passes through a surface the
-/// layers hold: one of the `steps − 1` points between them, projected to its pixel,
-/// lies behind that pixel's layer-0 or layer-1 depth (`zmip` level 0) by more than
-/// 0.1 % + 1 cm and less than `thickness`. CPU twin of `segment_blocked` in
-/// radiosity.wgsl.
+/// layers hold, tested at its `steps − 1` inner points, each projected to its pixel
+/// (`zmip` level 0):
+/// - `slab`: a point lies behind that pixel's layer-0 or layer-1 depth by more than
+///   0.1 % + 1 cm and less than `thickness`;
+/// - `crossing`: a point lies behind layer 0's depth (by the same margin) while the last
+///   point before it (first the receiver `x` itself) lay in front of or on it, and the two
+///   pixels show one continuous visible surface: their layer-0 depths differ by no more
+///   than the two points' camera-space depths do, plus `thickness`. The segment went
+///   through that surface (a thin wall that no point lands inside). Where two steps'
+///   pixels show different surfaces (a silhouette between them, e.g. a wall's top seen
+///   from above), [`SEG_SUB`] − 1 more points between them join the chain, for the short
+///   stretch just behind the wall that the camera does not see. Points off screen or
+///   behind the eye break the chain.
+///
+/// CPU twin of `segment_blocked` in radiosity.wgsl.
+#[allow(clippy::too_many_arguments)]
 pub fn segment_blocked(
     f: &FrameUniforms,
     zmip: &ImageBuf,
     layers: u32,
     steps: u32,
     thickness: f32,
+    (slab, crossing): (bool, bool),
     x: Vec3,
     y: Vec3,
 ) -> bool {
-    for s in 1..steps {
-        let pt = x.lerp(y, s as f32 / steps as f32);
-        let Some([px, py]) = crate::passes::ao::pixel_of_world(f, pt) else {
-            continue;
-        };
+    let eye = Vec3::from_slice(&f.eye[..3]);
+    let forward = Vec3::from_slice(&f.cam_forward[..3]);
+    // (both layers' depths at the point's pixel, the point's own depth)
+    type SegPoint = ([f32; 2], f32);
+    let point = |t: f32| -> Option<SegPoint> {
+        let pt = x.lerp(y, t);
+        let [px, py] = crate::passes::ao::pixel_of_world(f, pt)?;
         let (qx, qy) = (px.floor() as i64, py.floor() as i64);
         if qx < 0 || qy < 0 || qx >= zmip.width as i64 || qy >= zmip.height as i64 {
-            continue;
+            return None;
         }
         let zl = zmip.pixel(qx as u32, qy as u32);
-        let d = (pt - Vec3::from_slice(&f.eye[..3])).dot(Vec3::from_slice(&f.cam_forward[..3]));
-        if zl
-            .iter()
-            .take(layers.min(2) as usize)
-            .any(|&z| z > 0.0 && d > z * 1.001 + 0.01 && d < z + thickness)
-        {
-            return true;
+        Some(([zl[0], zl[1]], (pt - eye).dot(forward)))
+    };
+    let behind = |z: f32, d: f32| z > 0.0 && d > z * 1.001 + 0.01;
+    let continuous = |a: SegPoint, b: SegPoint| (b.0[0] - a.0[0]).abs() <= (b.1 - a.1).abs() + thickness;
+    // the last point, if it lay in front of (or on) layer 0
+    let front_of = |p: Option<SegPoint>| p.filter(|&(zl, d)| zl[0] > 0.0 && !behind(zl[0], d));
+    // one link of the chain: whether `cur` lies behind a surface continuous with the last
+    // point in front; then `cur` becomes the last point
+    let chain = |last: &mut Option<SegPoint>, cur: Option<SegPoint>| {
+        let hit = matches!((*last, cur), (Some(a), Some(b)) if behind(b.0[0], b.1) && continuous(a, b));
+        *last = front_of(cur);
+        hit
+    };
+    let mut last = front_of(point(0.0));
+    let mut prev_t = 0.0;
+    for s in 1..steps {
+        let t = s as f32 / steps as f32;
+        let cur = point(t);
+        if let Some((zl, d)) = cur.filter(|_| slab) {
+            if zl
+                .iter()
+                .take(layers.min(2) as usize)
+                .any(|&z| behind(z, d) && d < z + thickness)
+            {
+                return true;
+            }
         }
+        if crossing {
+            if matches!((last, cur), (Some(a), Some(b)) if !continuous(a, b)) {
+                for k in 1..SEG_SUB {
+                    let tk = prev_t + (t - prev_t) * (k as f32 / SEG_SUB as f32);
+                    if chain(&mut last, point(tk)) {
+                        return true;
+                    }
+                }
+            }
+            if chain(&mut last, cur) {
+                return true;
+            }
+        }
+        prev_t = t;
     }
     false
 }
@@ -342,6 +404,7 @@ impl Default for RadiositySettings {
             probe_detail: false,
             one_sided_confidence: true,
             tap_visibility: 0,
+            tap_visibility_all: true,
             radius_jitter: true,
         }
     }
@@ -475,7 +538,8 @@ pub struct RadiosityUniforms {
     pub thickness: f32,
     /// 1 = [`RadiositySettings::radius_jitter`].
     pub radius_jitter: u32,
-    pub _pad: u32,
+    /// 1 = [`RadiositySettings::tap_visibility_all`].
+    pub vis_all: u32,
 }
 
 impl RadiosityUniforms {
@@ -508,7 +572,7 @@ impl RadiosityUniforms {
             vis_steps: s.tap_visibility,
             thickness: min_separation,
             radius_jitter: s.radius_jitter as u32,
-            _pad: 0,
+            vis_all: s.tap_visibility_all as u32,
         }
     }
 }
@@ -793,11 +857,21 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
                 }
                 continue;
             }
-            // a hidden sender behind a surface from layer 0's receiver (`tap_visibility`)
+            // a sender behind a surface from layer 0's receiver (`tap_visibility`: hidden
+            // senders, and with `vis_all` the visible ones too)
             if u.vis_steps > 1
-                && j == 1
+                && (j == 1 || u.vis_all != 0)
                 && receiver == 0
-                && segment_blocked(g.frame, &g.zmip[0], g.layers, u.vis_steps, u.thickness, pos, yv)
+                && segment_blocked(
+                    g.frame,
+                    &g.zmip[0],
+                    g.layers,
+                    u.vis_steps,
+                    u.thickness,
+                    (j == 1, u.vis_all != 0),
+                    pos,
+                    yv,
+                )
             {
                 continue;
             }

@@ -52,7 +52,9 @@ struct Radiosity {
     thickness: f32,
     // 1 = each tap's radius within its stratum, κ_i = (i + ξ)/N (`pixel_jitter`)
     radius_jitter: u32,
-    _pad: u32,
+    // 1 = with vis_steps > 1, layer-0 taps are tested too, and every tap also by whether
+    // its segment pierces the visible surface (`segment_blocked`'s crossing)
+    vis_all: u32,
 }
 
 // One tap's share of the sums: c.rgb = w · B(Y) max(ω̂·n̂_X, 0), c.a = w (< 0 for an
@@ -135,31 +137,93 @@ fn term(x: vec3f, n: vec3f, y: vec3f, ny: vec3f, j: u32, src: vec2i, h: f32) -> 
     return Term(vec4f(0.0, 0.0, 0.0, wt), wt * cos_x, w, cos_x);
 }
 
+// One point of a visibility segment against the layers at its pixel: zl = both layers'
+// csz there, d = the point's own csz; ok = false off screen or behind the eye.
+struct SegPoint {
+    ok: bool,
+    zl: vec2f,
+    d: f32,
+}
+
+fn seg_point(pt: vec3f) -> SegPoint {
+    var o: SegPoint;
+    let pix = pixel_of_world(frame, pt);
+    let q = vec2i(floor(pix.xy));
+    if (pix.z == 0.0 || any(q < vec2i(0)) || any(q >= vec2i(textureDimensions(zmip, 0)))) {
+        return o;
+    }
+    let z = textureLoad(zmip, q, 0);
+    return SegPoint(true, z.xy, csz_of(frame, pt));
+}
+
+// The point lies behind layer 0's surface at its pixel (beyond 0.1 % + 1 cm).
+fn seg_behind(p: SegPoint) -> bool {
+    return p.zl.x > 0.0 && p.d > p.zl.x * 1.001 + 0.01;
+}
+
+// Two points' pixels show one continuous visible surface: their layer-0 depths differ by
+// no more than the points' own depths do, plus the thickness Δz.
+fn seg_continuous(a: SegPoint, b: SegPoint) -> bool {
+    return abs(b.zl.x - a.zl.x) <= abs(b.d - a.d) + rad.thickness;
+}
+
 // Whether the segment from receiver x to sender y passes through a surface the deep
-// G-buffer holds: one of the `vis_steps − 1` points between them lies behind a layer's
-// surface on its camera ray by less than `thickness` (inside that surface's object; the
-// layers say nothing of the Δz behind each surface). CPU twin:
-// `radiosity::segment_blocked`.
-fn segment_blocked(x: vec3f, y: vec3f) -> bool {
-    let size = vec2i(textureDimensions(zmip, 0));
+// G-buffer holds, tested at its `vis_steps − 1` inner points:
+// - slab: a point lies behind a layer's surface on its camera ray by less than
+//   `thickness` (inside that surface's object; the layers say nothing of the Δz behind
+//   each surface);
+// - crossing: a point lies behind layer 0's surface while the previous one (first the
+//   receiver itself) lay in front of it on one continuous visible surface
+//   (`seg_continuous`): the segment went through that surface, as a ray through a thin
+//   wall does, which the slab test misses when no point lands inside the wall. Where two
+//   steps' pixels show different surfaces (the segment passes a silhouette, e.g. a wall's
+//   top seen from above), `SEG_SUB − 1` more points between them join the chain, for the
+//   short stretch just behind the wall that the camera does not see.
+// CPU twin: `radiosity::segment_blocked`.
+const SEG_SUB: u32 = 4u;
+
+// One link of the crossing chain: whether `cur` lies behind a surface continuous with the
+// last point in front; then `cur` becomes the last point.
+fn seg_chain(prev: ptr<function, SegPoint>, was_front: ptr<function, bool>, cur: SegPoint) -> bool {
+    if (!cur.ok) {
+        *was_front = false;
+        return false;
+    }
+    let behind = seg_behind(cur);
+    let hit = *was_front && behind && seg_continuous(*prev, cur);
+    *was_front = cur.zl.x > 0.0 && !behind;
+    *prev = cur;
+    return hit;
+}
+
+fn segment_blocked(x: vec3f, y: vec3f, slab: bool, crossing: bool) -> bool {
+    var prev = seg_point(x);
+    var was_front = prev.ok && prev.zl.x > 0.0 && !seg_behind(prev);
+    var prev_t = 0.0;
     for (var s = 1u; s < rad.vis_steps; s++) {
         let t = f32(s) / f32(rad.vis_steps);
-        let pt = mix(x, y, t);
-        let pix = pixel_of_world(frame, pt);
-        if (pix.z == 0.0) {
-            continue;
+        let cur = seg_point(mix(x, y, t));
+        if (slab && cur.ok) {
+            for (var j = 0u; j < min(LAYERS, 2u); j++) {
+                if (cur.zl[j] > 0.0 && cur.d > cur.zl[j] * 1.001 + 0.01 && cur.d < cur.zl[j] + rad.thickness) {
+                    return true;
+                }
+            }
         }
-        let q = vec2i(floor(pix.xy));
-        if (any(q < vec2i(0)) || any(q >= size)) {
-            continue;
-        }
-        let zl = textureLoad(zmip, q, 0);
-        let d = csz_of(frame, pt);
-        for (var j = 0u; j < min(LAYERS, 2u); j++) {
-            if (zl[j] > 0.0 && d > zl[j] * 1.001 + 0.01 && d < zl[j] + rad.thickness) {
+        if (crossing) {
+            if (was_front && cur.ok && !seg_continuous(prev, cur)) {
+                for (var k = 1u; k < SEG_SUB; k++) {
+                    let tk = mix(prev_t, t, f32(k) / f32(SEG_SUB));
+                    if (seg_chain(&prev, &was_front, seg_point(mix(x, y, tk)))) {
+                        return true;
+                    }
+                }
+            }
+            if (seg_chain(&prev, &was_front, cur)) {
                 return true;
             }
         }
+        prev_t = t;
     }
     return false;
 }
@@ -332,10 +396,12 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             if (has1) {
                 t1 = term(x1, n1, y, ny, j, src, tap.radius);
             }
-            // a hidden (layer-1) sender that the layers show behind a surface from layer
-            // 0's receiver sends nothing to it (`RadiositySettings::tap_visibility`; layer
-            // 1's receiver, whose E only feeds the next bounce, is not tested)
-            if (rad.vis_steps > 1u && j == 1u && t0.c.a > 0.0 && segment_blocked(x0, y)) {
+            // a sender that the layers show behind a surface from layer 0's receiver sends
+            // nothing to it (`RadiositySettings::tap_visibility`: hidden, layer-1 senders,
+            // and with `vis_all` the visible ones too; layer 1's receiver, whose E only
+            // feeds the next bounce, is not tested)
+            if (rad.vis_steps > 1u && (j == 1u || rad.vis_all != 0u) && t0.c.a > 0.0
+                && segment_blocked(x0, y, j == 1u, rad.vis_all != 0u)) {
                 var none: Term;
                 t0 = none;
             }
