@@ -272,30 +272,27 @@ fn xdotool(d: &str, args: &[&str]) -> String {
     text(&o.stdout)
 }
 
-/// Starts `strata view` on cornell for `frames` frames (screenshot `shot`) under
-/// `x` and waits for its window: (child, window id). `None` (with the skip
-/// noted) when xdotool is missing.
-fn view_window(x: &XServer, test: &str, frames: &str, shot: &std::path::Path) -> Option<(std::process::Child, String)> {
+/// Starts `strata view` on cornell under `x` and waits for its window: (child, window
+/// id). With `frames`, a `--frames` run that writes `shot` at its end; without,
+/// interactive, in `shot`'s folder (where F12 saves `strata-view-001.png`) until the test
+/// ends it. `None` (with the skip noted) when xdotool is missing.
+fn view_window(
+    x: &XServer,
+    test: &str,
+    frames: Option<&str>,
+    shot: &std::path::Path,
+) -> Option<(std::process::Child, String)> {
     if find_on_path("xdotool").is_none() {
         strata_scene::skip::note_skip(test, "xdotool not found on PATH (scripts/setup.sh installs it)");
         return None;
     }
+    let mut args = vec!["view", "--scene", "cornell"];
+    if let Some(n) = frames {
+        args.extend(["--frames", n, "--screenshot", shot.to_str().unwrap()]);
+    }
     let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
-        .args(
-            [
-                &[
-                    "view",
-                    "--scene",
-                    "cornell",
-                    "--frames",
-                    frames,
-                    "--screenshot",
-                    shot.to_str().unwrap(),
-                ][..],
-                &SIZE,
-            ]
-            .concat(),
-        )
+        .args([&args[..], &SIZE].concat())
+        .current_dir(shot.parent().unwrap())
         .env("DISPLAY", &x.display)
         .env("XDG_RUNTIME_DIR", std::env::temp_dir())
         .stdout(Stdio::piped())
@@ -334,9 +331,12 @@ fn real_x_key_and_mouse_events_move_the_camera() {
         return;
     };
     let dir = scratch("xevents");
-    let shot = dir.join("shot.png");
-    // the window, then real X events through XTEST: hold W, right-drag to the right
-    let Some((child, id)) = view_window(&x, "view::real_x_key_and_mouse_events_move_the_camera", "300", &shot) else {
+    // F12's name for the first screenshot in the viewer's working directory
+    let shot = dir.join("strata-view-001.png");
+    // the window (interactive: a --frames run could end before the events arrive when the
+    // cores are busy), then real X events through XTEST: hold W, right-drag to the right
+    let Some((mut child, id)) = view_window(&x, "view::real_x_key_and_mouse_events_move_the_camera", None, &shot)
+    else {
         return;
     };
     xdotool(&x.display, &["windowfocus", "--sync", &id]);
@@ -361,9 +361,24 @@ fn real_x_key_and_mouse_events_move_the_camera() {
             "3",
         ],
     );
-    let o = child.wait_with_output().unwrap();
-    ok(&o);
-    let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
+    // F12 until the screenshot is saved (it waits for a full-resolution, settled frame);
+    // its command file is written last
+    let cmd_txt = shot.with_extension("cmd.txt");
+    let t0 = Instant::now();
+    let cmd = loop {
+        if let Some(c) = std::fs::read_to_string(&cmd_txt).ok().filter(|c| c.ends_with('\n')) {
+            break c;
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            let o = child.wait_with_output().unwrap();
+            panic!("the viewer exited ({status}) before F12 saved: {}", text(&o.stderr));
+        }
+        assert!(t0.elapsed() < Duration::from_secs(180), "F12 saved nothing in 180 s");
+        xdotool(&x.display, &["key", "--window", &id, "F12"]);
+        std::thread::sleep(Duration::from_secs(1));
+    };
+    child.kill().unwrap();
+    child.wait().unwrap();
     let flag = |f: &str| -> Vec<f32> {
         cmd.split(&format!(" {f} "))
             .nth(1)
@@ -447,7 +462,12 @@ fn unmapped_window_keeps_running_and_finishes() {
     };
     let dir = scratch("unmap");
     let shot = dir.join("shot.png");
-    let Some((child, id)) = view_window(&x, "view::unmapped_window_keeps_running_and_finishes", "150", &shot) else {
+    let Some((child, id)) = view_window(
+        &x,
+        "view::unmapped_window_keeps_running_and_finishes",
+        Some("150"),
+        &shot,
+    ) else {
         return;
     };
     // hidden (what minimising does without a window manager), then shown again
