@@ -1282,8 +1282,8 @@ impl Renderer {
             img = ImageBuf::new(w, h, 3);
             for (o, l) in img.data.chunks_exact_mut(3).zip(&lists.lists) {
                 if let Some(f) = l.get(k) {
-                    for c in 0..3 {
-                        o[c] = f.radiance[c] * f.alpha;
+                    for (o, r) in o.iter_mut().zip(f.radiance) {
+                        *o = r * f.alpha;
                     }
                 }
             }

@@ -575,7 +575,7 @@ fn grazing_floor_texture_keeps_its_detail() {
                     );
                     let s = -camera.eye.y / d.y;
                     let p = camera.eye + d * s;
-                    if !(d.y < 0.0) || p.x.abs() >= 20.0 || p.z.abs() >= 20.0 {
+                    if d.y >= 0.0 || d.y.is_nan() || p.x.abs() >= 20.0 || p.z.abs() >= 20.0 {
                         all_floor = false;
                         break;
                     }

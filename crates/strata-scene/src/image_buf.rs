@@ -66,8 +66,8 @@ impl ImageBuf {
         let px = self.to_rgba32();
         let mut bytes = Vec::with_capacity(px.len() * 4);
         for p in px {
-            for c in 0..3 {
-                let v = p[c].clamp(0.0, 1.0);
+            for &v in &p[..3] {
+                let v = v.clamp(0.0, 1.0);
                 let v = if srgb { linear_to_srgb(v) } else { v };
                 bytes.push((v * 255.0 + 0.5) as u8);
             }

@@ -380,8 +380,8 @@ impl Scene {
                     material: m.material as u32,
                     object: oi as u32,
                 };
-                for k in 0..3 {
-                    let i = t[k] as usize;
+                for (k, &i) in t.iter().enumerate() {
+                    let i = i as usize;
                     tri.p[k] = xf.transform_point3(Vec3::from(m.positions[i]));
                     tri.n[k] = (nxf * Vec3::from(m.normals[i])).normalize_or_zero();
                     tri.uv[k] = m.uvs[i];

@@ -221,6 +221,7 @@ impl MeshBuilder {
     /// smooth intrados (the arch's underside, facing the opening) and the top
     /// face; the two vertical sides are left open (they abut the neighbouring
     /// panels in an arcade).
+    #[allow(clippy::too_many_arguments)]
     pub fn arch_panel(
         &mut self,
         center_x: f32,

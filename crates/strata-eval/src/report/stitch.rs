@@ -26,8 +26,8 @@ pub struct StitchSettings {
 
 /// A result file of the folder.
 enum Parsed {
-    Eval(EvalResult),
-    Bench(BenchResult),
+    Eval(Box<EvalResult>),
+    Bench(Box<BenchResult>),
     Other(serde_json::Value),
 }
 
@@ -35,7 +35,7 @@ fn parse(text: &str) -> Result<Parsed> {
     let v: serde_json::Value = serde_json::from_str(text)?;
     if v.get("technique").is_some() {
         if let Ok(e) = serde_json::from_value(v.clone()) {
-            return Ok(Parsed::Eval(e));
+            return Ok(Parsed::Eval(Box::new(e)));
         }
     }
     if v.get("bench").is_some() || v.get("rows").is_some() {
@@ -45,7 +45,7 @@ fn parse(text: &str) -> Result<Parsed> {
             m.entry("bench").or_insert_with(|| "deep-gbuffer".into());
         }
         if let Ok(b) = serde_json::from_value(tagged) {
-            return Ok(Parsed::Bench(b));
+            return Ok(Parsed::Bench(Box::new(b)));
         }
     }
     Ok(Parsed::Other(v))

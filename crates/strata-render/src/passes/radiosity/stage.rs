@@ -21,6 +21,7 @@ pub(crate) struct RadiosityStage {
 }
 
 impl RadiosityStage {
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
