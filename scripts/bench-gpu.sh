@@ -60,6 +60,8 @@ run abuffer-glasshouse bench abuffer --scene glasshouse --width 1280 --height 72
 # BZB Table 1 (768×512)
 run bzb-atrium bench bzb --scene atrium --width 768 --height 512 --frames 5
 run technique-bzb-gi bench technique --technique bzb-gi --scene still-life --width 768 --height 512 --frames 3
+run bzb-gi-still-life bench bzb --technique bzb-gi --scene still-life --width 768 --height 512 --frames 3
+run bzb-gi-dominoes bench bzb --technique bzb-gi --scene dominoes --width 768 --height 512 --frames 3
 
 # CPU reference tracer throughput on this machine's cores
 run reference-atrium bench reference --scene atrium --width 256 --height 256

@@ -769,9 +769,20 @@ pub enum BenchWhat {
 pub struct BenchBzbArgs {
     #[command(flatten)]
     pub stage: BenchStageArgs,
-    /// Settings of technique `bzb-ao` (e.g. --set directions=4 --set ao-radius=1); visibility is the bench's.
+    /// Which bounced z-buffer technique: bzb-ao (BZB Table 1's AO column) or bzb-gi (its
+    /// indirect-light columns: still-life, dominoes).
+    #[arg(long, default_value = "bzb-ao", value_parser = parse_bzb_technique)]
+    pub technique: String,
+    /// Settings of the technique (e.g. --set directions=4 --set ao-radius=1, --set splat=dss); visibility is the bench's.
     #[command(flatten)]
     pub set: SetArgs,
+}
+
+fn parse_bzb_technique(s: &str) -> Result<String, String> {
+    match s {
+        "bzb-ao" | "bzb-gi" => Ok(s.to_string()),
+        _ => Err(format!("'{s}': bench bzb times bzb-ao or bzb-gi")),
+    }
 }
 
 #[derive(Args)]

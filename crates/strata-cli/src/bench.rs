@@ -38,7 +38,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             b.stage.json,
         ),
         BenchWhat::Bzb(b) => (
-            BenchResult::Bzb(Box::new(bzb::run(&(&b.stage).into(), &b.set.values)?)),
+            BenchResult::Bzb(Box::new(bzb::run(&(&b.stage).into(), &b.technique, &b.set.values)?)),
             b.stage.json,
         ),
         BenchWhat::Reflections(b) => {
@@ -107,13 +107,14 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             }
         }
         BenchResult::Bzb(b) => {
-            print_stage("bzb-ao (bounced z-buffer)", &b.visibility);
+            let t = &b.technique;
+            print_stage(&format!("{t} (bounced z-buffer)"), &b.visibility);
             let baseline = if b.dss.is_some() {
-                "bzb-ao visibility=off (additive shell splatting)"
+                format!("{t} visibility=off (additive shell splatting)")
             } else {
-                "bzb-ao visibility=off (AOV baseline)"
+                format!("{t} visibility=off (additive baseline)")
             };
-            print_stage(baseline, &b.no_visibility);
+            print_stage(&baseline, &b.no_visibility);
             println!(
                 "visibility step: splat {:.2}x, whole technique {:.2}x the baseline; {} triangles, S = {}, {:.1} MiB",
                 b.splat_ratio,
@@ -129,8 +130,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                     ("additive (no visibility)", &d.stages_no_visibility),
                 ] {
                     println!(
-                        "DSS Table 1, {name}: surfelization {:.1} ms (tessellate {:.1}, fine {:.1}, filter {:.1}), shuffling {:.1}, splatting {:.1}, unshuffling {:.1}, reduction {:.1}, blurring {:.1}, total {:.1} ms",
-                        t.surfelization_ms, t.tessellate_ms, t.fine_ms, t.filter_ms, t.shuffling_ms, t.splatting_ms, t.unshuffling_ms, t.reduction_ms, t.blurring_ms, t.total_ms
+                        "DSS Table 1, {name}: surfelization {:.1} ms (tessellate {:.1}, fine {:.1}, filter {:.1}, shade {:.1}), shuffling {:.1}, splatting {:.1}, unshuffling {:.1}, reduction {:.1}, blurring {:.1}, total {:.1} ms",
+                        t.surfelization_ms, t.tessellate_ms, t.fine_ms, t.filter_ms, t.shade_ms, t.shuffling_ms, t.splatting_ms, t.unshuffling_ms, t.reduction_ms, t.blurring_ms, t.total_ms
                     );
                 }
                 let c = &d.counts;

@@ -1405,6 +1405,87 @@ fn ils_renders_benches_and_refuses_bad_settings() {
     assert!(names.contains(&"ils-brute-force"), "{names:?}");
 }
 
+/// `strata bench bzb` times both bounced z-buffer techniques (BZB Table 1: AO and the
+/// indirect-light columns) with and without visibility, DSS included; GI's layered
+/// framebuffer holds radiance, so it is larger than AO's (Table 3: 18 against 6 MB);
+/// another technique is a one-line error.
+#[test]
+fn bench_bzb_times_ao_and_gi_with_and_without_visibility() {
+    let run = |technique: &str, extra: &[&str]| {
+        let mut a = vec![
+            "bench",
+            "bzb",
+            "--technique",
+            technique,
+            "--scene",
+            "cornell",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--frames",
+            "1",
+            "--json",
+        ];
+        a.extend(extra);
+        json_of(&strata(&a))
+    };
+    let mut layered = Vec::new();
+    for (technique, extra, splat) in [
+        ("bzb-ao", &[][..], "bzb-splat"),
+        ("bzb-gi", &[][..], "bzb-splat"),
+        ("bzb-ao", &["--set", "splat=dss"][..], "dss-splat"),
+        ("bzb-gi", &["--set", "splat=dss"][..], "dss-splat"),
+    ] {
+        let v = run(technique, extra);
+        assert_eq!(
+            (v["bench"].as_str(), v["technique"].as_str()),
+            (Some("bzb"), Some(technique)),
+            "{v}"
+        );
+        for run in ["visibility", "no_visibility"] {
+            let names: Vec<&str> = v[run]["passes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| p["name"].as_str().unwrap())
+                .collect();
+            assert!(names.contains(&splat), "{technique} {extra:?} {run}: {names:?}");
+            if technique == "bzb-gi" {
+                assert!(names.contains(&"bzb-gi-blur-h"), "{names:?}");
+            }
+        }
+        assert!(
+            v["splat_ratio"].as_f64().is_some_and(|x| x.is_finite() && x > 0.0),
+            "{v}"
+        );
+        assert!(v["memory_bytes"].as_u64().is_some_and(|b| b > 0), "{v}");
+        if let Some(d) = v.get("dss") {
+            assert!(d["counts"]["surfels"].as_u64().is_some_and(|n| n > 0), "{d}");
+            let shade = d["stages"]["shade_ms"].as_f64().unwrap();
+            assert_eq!(shade > 0.0, technique == "bzb-gi", "only GI shades its surfels: {d}");
+            layered.push(d["memory"]["layered_framebuffer"].as_u64().unwrap());
+        }
+    }
+    assert!(
+        layered[1] > 2 * layered[0],
+        "GI's layered framebuffer {} vs AO's {}",
+        layered[1],
+        layered[0]
+    );
+    let o = strata(&[
+        "bench",
+        "bzb",
+        "--technique",
+        "ao",
+        "--scene",
+        "cornell",
+        "--frames",
+        "1",
+    ]);
+    assert_one_line_error(&o, &["--technique", "bzb-ao or bzb-gi"]);
+}
+
 /// Issue 11: `strata eval --technique ils` compares the interleaved image with
 /// the brute force of the same VPLs and with the one-bounce path tracer (low
 /// `--ref-spp` cap: the numbers are only checked to exist and be sane); `eval

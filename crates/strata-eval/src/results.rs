@@ -181,10 +181,17 @@ pub enum BenchResult {
     Bzb(Box<BzbBench>),
 }
 
-/// `strata bench bzb`: the `bzb-ao` frame with the bounced z-buffer (depth test, nearest
-/// occluder) and without (additive AOV baseline), same splats.
+fn bzb_ao_name() -> String {
+    "bzb-ao".into()
+}
+
+/// `strata bench bzb`: the `bzb-ao` or `bzb-gi` frame with the bounced z-buffer (depth
+/// test, nearest sender) and without (the additive baseline), same splats.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BzbBench {
+    /// `bzb-ao` or `bzb-gi` (results written before `bench bzb --technique` are AO).
+    #[serde(default = "bzb_ao_name")]
+    pub technique: String,
     pub triangles: u64,
     /// S directions per pixel.
     pub directions: u32,
@@ -220,11 +227,15 @@ pub struct DssBench {
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct DssStages {
-    /// dss-tessellate + dss-fine + dss-filter (Table 1's "tessellation").
+    /// dss-tessellate + dss-fine + dss-filter (Table 1's "tessellation"), and for bzb-gi
+    /// dss-gi-shade (the surfels' direct light, shaded at surfelization, BZB §4.3).
     pub surfelization_ms: f64,
     pub tessellate_ms: f64,
     pub fine_ms: f64,
     pub filter_ms: f64,
+    /// dss-gi-shade (bzb-gi only; 0 for AO and in results from before it was timed).
+    #[serde(default)]
+    pub shade_ms: f64,
     /// bzb-directions + dss-shuffle (direction setup and shuffling).
     pub shuffling_ms: f64,
     pub splatting_ms: f64,

@@ -988,8 +988,12 @@ impl Renderer {
         Some(self.bzb.as_ref()?.zminmax()?.read_tiles(gpu))
     }
 
-    /// BZB §4.3 / Table 2: the DSS surfel counts of the last frame (`bzb-ao` with `splat = dss`).
+    /// BZB §4.3 / Table 2: the DSS surfel counts of the last frame (`bzb-ao` or `bzb-gi`
+    /// with `splat = dss`).
     pub fn dss_counts(&self, gpu: &GpuContext) -> Option<Result<crate::passes::bzb::dss::SurfelCounts, RenderError>> {
+        if let Some(g) = &self.bzb_gi {
+            return Some(g.dss()?.read_counts(gpu, g.triangle_count()));
+        }
         let b = self.bzb.as_ref()?;
         Some(b.dss()?.read_counts(gpu, b.triangle_count()))
     }

@@ -451,10 +451,13 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
         BenchResult::Bzb(b) => {
             for (what, s) in [
                 ("bounced z-buffer", &b.visibility),
-                ("AOV baseline, no visibility", &b.no_visibility),
+                ("additive baseline, no visibility", &b.no_visibility),
             ] {
                 section = section.table(pass_table(
-                    format!("BZB Table 1, {what}: splat ratio {:.2}x", b.splat_ratio),
+                    format!(
+                        "BZB Table 1, {}, {what}: splat ratio {:.2}x",
+                        b.technique, b.splat_ratio
+                    ),
                     &[("", &s.passes, (s.total_median_ms, s.total_min_ms))],
                 ));
             }

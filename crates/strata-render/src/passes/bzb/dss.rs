@@ -1126,12 +1126,19 @@ impl DssStage {
 pub fn memory(u: &DssUniforms) -> DssMemory {
     let big = (u.cols * u.plane[0]) as u64 * (u.levels * u.rows * u.plane[1]) as u64;
     let out = (u.cols * u.size[0]) as u64 * (u.levels * u.rows * u.size[1]) as u64;
+    // AO's payload is one f16 (occlusion), GI's four (radiance and the hit flag): BZB
+    // Table 3's "float textures" against "3D vectors"; GI also keeps each surfel's radiance
+    let payload = if u.gi != 0 { 8 } else { 2 };
+    let surfel_radiance = if u.gi != 0 { u.surfel_capacity as u64 * 32 } else { 0 };
     DssMemory {
         shuffled_positions: big * 16,
         shuffled_directions: big * 16,
-        layered_framebuffer: big * (2 + if u.visibility == 1 { 4 } else { 0 }) + out * 2,
+        layered_framebuffer: big * (payload + if u.visibility == 1 { 4 } else { 0 }) + out * payload,
         framebuffer_layout: 0,
-        surfels: u.tri_capacity as u64 * 48 + u.fine_capacity as u64 * 32 + u.surfel_capacity as u64 * 32,
+        surfels: u.tri_capacity as u64 * 48
+            + u.fine_capacity as u64 * 32
+            + u.surfel_capacity as u64 * 32
+            + surfel_radiance,
     }
 }
 
@@ -1146,6 +1153,17 @@ pub struct DssMemory {
     pub framebuffer_layout: u64,
     /// Sub-triangle, fine-surfel and surfel buffers at capacity.
     pub surfels: u64,
+}
+
+impl DssMemory {
+    /// Every row of Table 3.
+    pub fn total(&self) -> u64 {
+        self.shuffled_positions
+            + self.shuffled_directions
+            + self.layered_framebuffer
+            + self.framebuffer_layout
+            + self.surfels
+    }
 }
 
 fn read_buffer(
