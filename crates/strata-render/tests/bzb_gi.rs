@@ -499,6 +499,89 @@ fn dss_surfel_radiance_equals_the_cpu_twin_on_a_sunlit_plane_and_an_emitter() {
     assert!(lamp > 10 && floor_n > 10, "{lamp} emitter and {floor_n} floor surfels");
 }
 
+/// Senders read their base-colour texture: a triangle's ρ is the base colour times the
+/// texture's mean over it (`gi::sender_texture_means`). On the CPU: a texture red for
+/// u < ½ and green beyond, on the triangle (0,0), (1,0), (0,1) in UV, averages to exactly
+/// ¾ red + ¼ green (the sub-triangle grid follows u = ½); an untextured triangle gets 1.
+/// On the GPU: the sunlit plane of the surfel test, white with a uniform texture c, has
+/// surfels of radiance c/π · E cos θ (the base colour alone would give 1/π · E cos θ).
+#[test]
+fn senders_read_their_base_colour_texture() {
+    use strata_scene::model::{Light, Texture};
+    let (red, green) = ([230u8, 40, 20], [30u8, 200, 60]);
+    let lin = |c: [u8; 3]| Vec3::from(c.map(strata_scene::model::srgb_to_linear));
+    let tri = [Vec3::ZERO, Vec3::X, Vec3::Z];
+    let mut scene = common::polygons_scene("textured", &[&tri, &tri], Camera::default(), 0.1);
+    scene.meshes[0].uvs = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    scene.materials[0].base_color = [1.0; 3];
+    scene.materials[0].base_color_texture = Some(0);
+    scene.materials.push(Material::diffuse("plain", [0.5; 3]));
+    scene.meshes[1].material = 1;
+    scene.textures.push(Texture {
+        name: "halves".into(),
+        width: 2,
+        height: 1,
+        rgba8: [red, green].iter().flat_map(|c| [c[0], c[1], c[2], 255]).collect(),
+    });
+    let means = gi::sender_texture_means(&scene);
+    let want = lin(red) * 0.75 + lin(green) * 0.25;
+    assert!(
+        (Vec3::from(means[0]) - want).abs().max_element() < 1e-5,
+        "{means:?} vs {want}"
+    );
+    assert_eq!(means[1], [1.0; 3], "no texture: the base colour alone");
+
+    let gpu = common::gpu();
+    let floor = [
+        Vec3::new(-4.0, 0.0, -4.0),
+        Vec3::new(-4.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, -4.0),
+    ];
+    let camera = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 60.0, 0.01);
+    let mut scene = common::polygons_scene("sunlit-textured", &[&floor], camera, 0.1);
+    scene.materials[0].base_color = [1.0; 3];
+    scene.materials[0].base_color_texture = Some(0);
+    scene.textures.push(Texture {
+        name: "c".into(),
+        width: 1,
+        height: 1,
+        rgba8: vec![red[0], red[1], red[2], 255],
+    });
+    let dir = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let (color, illuminance) = ([1.0f32, 0.8, 0.6], 3.0f32);
+    scene.lights.push(Light::Sun {
+        direction: dir,
+        color,
+        illuminance,
+    });
+    let r = render(
+        &gpu,
+        &scene,
+        32,
+        24,
+        dss(BzbGiSettings {
+            directions: 1,
+            ..Default::default()
+        }),
+    );
+    let surfels = r.dss_gi_surfels(&gpu).expect("bzb-gi DSS stage").unwrap();
+    assert!(surfels.len() > 50, "{} surfels", surfels.len());
+    let want = Vec3::from(color) * lin(red) * (illuminance / std::f32::consts::PI * Vec3::Y.dot(-dir));
+    let worst = surfels
+        .iter()
+        .map(|(_, front, _)| ((*front - want) / want).abs().max_element())
+        .fold(0.0f32, f32::max);
+    eprintln!(
+        "{} textured surfels: worst relative error {worst:.5} (want {want})",
+        surfels.len()
+    );
+    assert!(
+        worst < 2e-3,
+        "surfel radiance off by {worst} relative to c/π E cos θ = {want}"
+    );
+}
+
 /// BZB Fig. 1 with DSS surfels: without visibility the hidden emitter's
 /// surfels add π·F·L through the blocker (≈ the analytic π L F: surfel area
 /// matches the mesh area in expectation); with the bounced z-buffer the

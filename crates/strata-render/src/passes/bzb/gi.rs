@@ -403,14 +403,68 @@ pub fn direction(n: Vec3, v: Vec3, glossy: Option<Glossy>, u_lobe: f32, u: [f32;
     }
 }
 
+/// Subdivisions per edge of [`sender_texture_means`]: n² texture reads per triangle.
+pub const SENDER_TEXTURE_SUBDIVISIONS: u32 = 8;
+
+/// Each triangle's mean base-colour texture over its surface, in
+/// `Scene::world_triangles` order (linear RGB; 1 where the material has no texture). The
+/// texture is read (nearest texel, wrap, as the CPU reference reads it) at the centroids
+/// of the n × n equal sub-triangles of the triangle ([`SENDER_TEXTURE_SUBDIVISIONS`]):
+/// exact for a texture whose colour regions follow that grid, and the texture's mean
+/// over a triangle that tiles it many times. The splats carry no UVs, so one colour per
+/// triangle stands for its texture: a sender lights receivers from a distance, where
+/// the bounce averages its texture anyway. UVs do not animate: computed once per scene.
+pub fn sender_texture_means(scene: &Scene) -> Vec<[f32; 3]> {
+    let lut: Vec<f32> = (0..=255u8).map(strata_scene::model::srgb_to_linear).collect();
+    let n = SENDER_TEXTURE_SUBDIVISIONS;
+    let mut points = Vec::with_capacity((n * n) as usize);
+    for i in 0..n {
+        for j in 0..n - i {
+            let (a, b) = (i as f32, j as f32);
+            points.push(((a + 1.0 / 3.0) / n as f32, (b + 1.0 / 3.0) / n as f32));
+            if i + j + 1 < n {
+                points.push(((a + 2.0 / 3.0) / n as f32, (b + 2.0 / 3.0) / n as f32));
+            }
+        }
+    }
+    scene
+        .world_triangles(0.0)
+        .iter()
+        .map(|t| {
+            let m = &scene.materials[t.material as usize];
+            let Some(tex) = m
+                .base_color_texture
+                .and_then(|i| scene.textures.get(i))
+                .filter(|x| x.width > 0 && x.height > 0 && x.rgba8.len() >= (x.width * x.height * 4) as usize)
+            else {
+                return [1.0; 3];
+            };
+            let mut sum = [0.0f64; 3];
+            for &(a, b) in &points {
+                let uv = [0, 1].map(|k| t.uv[0][k] * (1.0 - a - b) + t.uv[1][k] * a + t.uv[2][k] * b);
+                let (u, v) = (uv[0] - uv[0].floor(), uv[1] - uv[1].floor());
+                let x = ((u * tex.width as f32) as u32).min(tex.width - 1);
+                let y = ((v * tex.height as f32) as u32).min(tex.height - 1);
+                let i = ((y * tex.width + x) * 4) as usize;
+                for (s, &byte) in sum.iter_mut().zip(&tex.rgba8[i..i + 3]) {
+                    *s += lut[byte as usize] as f64;
+                }
+            }
+            sum.map(|s| (s / points.len() as f64) as f32)
+        })
+        .collect()
+}
+
 /// Per-triangle sender data as `bzb_gi_splat.wgsl` pulls it: 5 vec4 per
 /// triangle, (n0, ρ.r), (n1, ρ.g), (n2, ρ.b), (emission, glossy), (roughness,
-/// metallic, 0, 0). ρ is the material's base colour (textures are not read).
-pub fn sender_data(scene: &Scene, frame: f32) -> Vec<[f32; 4]> {
+/// metallic, 0, 0). ρ is the material's base colour times the triangle's mean texture
+/// (`texture_means`, from [`sender_texture_means`]).
+pub fn sender_data(scene: &Scene, frame: f32, texture_means: &[[f32; 3]]) -> Vec<[f32; 4]> {
     let mut out = Vec::new();
-    for t in scene.world_triangles(frame) {
+    for (k, t) in scene.world_triangles(frame).iter().enumerate() {
         let m = &scene.materials[t.material as usize];
-        let rho = m.base_color;
+        let tex = texture_means.get(k).copied().unwrap_or([1.0; 3]);
+        let rho = [0, 1, 2].map(|c| m.base_color[c] * tex[c]);
         for (n, r) in t.n.iter().zip(rho) {
             out.push(n.extend(r).to_array());
         }
@@ -559,6 +613,8 @@ pub(crate) struct BzbGiStage {
     lights: wgpu::Buffer,
     triangles: wgpu::Buffer,
     senders: wgpu::Buffer,
+    /// Each triangle's mean base-colour texture ([`sender_texture_means`]).
+    texture_means: Vec<[f32; 3]>,
     count: u32,
     settings: BzbGiSettings,
     base: GiUniforms,
@@ -615,7 +671,8 @@ impl BzbGiStage {
         }
         let data = super::triangle_data(scene, 0.0);
         let count = (data.len() / 3) as u32;
-        let senders_data = sender_data(scene, 0.0);
+        let texture_means = sender_texture_means(scene);
+        let senders_data = sender_data(scene, 0.0, &texture_means);
         let limit = device.limits().max_storage_buffer_binding_size;
         let sender_bytes = (senders_data.len() * 16).max(80) as u64;
         if sender_bytes > limit {
@@ -930,6 +987,7 @@ impl BzbGiStage {
             lights,
             triangles,
             senders,
+            texture_means,
             count,
             settings: s.clone(),
             base,
@@ -974,7 +1032,7 @@ impl BzbGiStage {
         if animated && self.count > 0 {
             let data = super::triangle_data(scene, frame);
             gpu.queue.write_buffer(&self.triangles, 0, bytemuck::cast_slice(&data));
-            let senders = sender_data(scene, frame);
+            let senders = sender_data(scene, frame, &self.texture_means);
             gpu.queue.write_buffer(&self.senders, 0, bytemuck::cast_slice(&senders));
             if !lights.is_empty() {
                 gpu.queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));
