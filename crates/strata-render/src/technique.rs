@@ -499,7 +499,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 22] = [
     ),
     radiosity_switch!(
         "tap-visibility-senders",
-        "which taps --tap-visibility tests: hidden (layer-1 senders, by whether a point between lies within min separation behind a surface) or all (the visible senders too, and every segment also by whether it passes from in front of the visible surface to behind it between two steps: no light through thin walls; 3-4x the gather's cost at 8 steps on lavapipe)",
+        "which taps --tap-visibility tests: hidden (layer-1 senders, by whether a point between lies within min separation behind a surface) or all (the visible senders too, by whether the segment passes from in front of the visible surface to behind it between two steps, and the hidden ones by both tests: no light through thin walls; 3-4x the gather's cost at 8 steps on lavapipe)",
         tap_visibility_all,
         ["hidden", "all"]
     ),

@@ -112,8 +112,9 @@ pub struct RadiositySettings {
     /// Not in the paper (default 0).
     pub tap_visibility: u32,
     /// With [`tap_visibility`](Self::tap_visibility) on, the visible (layer-0) senders are
-    /// tested too, and every segment also by whether it pierces the visible surface between
-    /// two steps ([`segment_blocked`]'s crossing test). Screen space otherwise lights a
+    /// tested too, by whether their segment pierces the visible surface between two steps
+    /// ([`segment_blocked`]'s crossing test), and the hidden ones by both tests (the slab
+    /// test on visible senders darkened the surroundings of thin ledges into outliers). Screen space otherwise lights a
     /// receiver with every visible surface in its hemisphere, walls or not: the warehouse's
     /// back wall beside the partition took the lit room behind it (docs/radiosity.md §
     /// "Visible senders too"). 3–4× the gather's cost at 8 steps on lavapipe (+60 %
