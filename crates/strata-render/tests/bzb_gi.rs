@@ -438,23 +438,8 @@ fn dss(g: BzbGiSettings) -> BzbGiSettings {
 /// L and the back nothing, and the unlit floor's surfels are black.
 #[test]
 fn dss_surfel_radiance_equals_the_cpu_twin_on_a_sunlit_plane_and_an_emitter() {
-    use strata_scene::model::Light;
     let gpu = common::gpu();
-    let floor = [
-        Vec3::new(-4.0, 0.0, -4.0),
-        Vec3::new(-4.0, 0.0, 4.0),
-        Vec3::new(4.0, 0.0, 4.0),
-        Vec3::new(4.0, 0.0, -4.0),
-    ];
-    let camera = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 60.0, 0.01);
-    let mut scene = common::polygons_scene("sunlit", &[&floor], camera, 0.1);
-    let dir = Vec3::new(0.3, -1.0, 0.2).normalize();
-    let (color, illuminance) = ([1.0f32, 0.8, 0.6], 3.0f32);
-    scene.lights.push(Light::Sun {
-        direction: dir,
-        color,
-        illuminance,
-    });
+    let (scene, dir, sun) = sunlit_floor("sunlit");
     let g = dss(BzbGiSettings {
         directions: 1,
         ..Default::default()
@@ -463,7 +448,7 @@ fn dss_surfel_radiance_equals_the_cpu_twin_on_a_sunlit_plane_and_an_emitter() {
     let surfels = r.dss_gi_surfels(&gpu).expect("bzb-gi DSS stage").unwrap();
     assert!(surfels.len() > 50, "{} surfels", surfels.len());
     let cos = Vec3::Y.dot(-dir);
-    let want = Vec3::from(color) * (illuminance * 0.5 / std::f32::consts::PI * cos);
+    let want = sun * (0.5 / std::f32::consts::PI * cos);
     let mut worst = 0.0f32;
     for (s, front, back) in &surfels {
         assert!(
@@ -499,6 +484,27 @@ fn dss_surfel_radiance_equals_the_cpu_twin_on_a_sunlit_plane_and_an_emitter() {
     assert!(lamp > 10 && floor_n > 10, "{lamp} emitter and {floor_n} floor surfels");
 }
 
+/// The surfel tests' sunlit plane: an 8 m grey (ρ = 0.5) floor seen from 3 m above,
+/// under a sun: (scene, the sun's direction, its colour × illuminance).
+fn sunlit_floor(name: &str) -> (Scene, Vec3, Vec3) {
+    let floor = [
+        Vec3::new(-4.0, 0.0, -4.0),
+        Vec3::new(-4.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, -4.0),
+    ];
+    let camera = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 60.0, 0.01);
+    let mut scene = common::polygons_scene(name, &[&floor], camera, 0.1);
+    let dir = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let (color, illuminance) = ([1.0f32, 0.8, 0.6], 3.0f32);
+    scene.lights.push(strata_scene::model::Light::Sun {
+        direction: dir,
+        color,
+        illuminance,
+    });
+    (scene, dir, Vec3::from(color) * illuminance)
+}
+
 /// Senders read their base-colour texture: a triangle's ρ is the base colour times the
 /// texture's mean over it (`gi::sender_texture_means`). On the CPU: a texture red for
 /// u < ½ and green beyond, on the triangle (0,0), (1,0), (0,1) in UV, averages to exactly
@@ -507,7 +513,7 @@ fn dss_surfel_radiance_equals_the_cpu_twin_on_a_sunlit_plane_and_an_emitter() {
 /// surfels of radiance c/π · E cos θ (the base colour alone would give 1/π · E cos θ).
 #[test]
 fn senders_read_their_base_colour_texture() {
-    use strata_scene::model::{Light, Texture};
+    use strata_scene::model::Texture;
     let (red, green) = ([230u8, 40, 20], [30u8, 200, 60]);
     let lin = |c: [u8; 3]| Vec3::from(c.map(strata_scene::model::srgb_to_linear));
     let tri = [Vec3::ZERO, Vec3::X, Vec3::Z];
@@ -532,14 +538,7 @@ fn senders_read_their_base_colour_texture() {
     assert_eq!(means[1], [1.0; 3], "no texture: the base colour alone");
 
     let gpu = common::gpu();
-    let floor = [
-        Vec3::new(-4.0, 0.0, -4.0),
-        Vec3::new(-4.0, 0.0, 4.0),
-        Vec3::new(4.0, 0.0, 4.0),
-        Vec3::new(4.0, 0.0, -4.0),
-    ];
-    let camera = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 60.0, 0.01);
-    let mut scene = common::polygons_scene("sunlit-textured", &[&floor], camera, 0.1);
+    let (mut scene, dir, sun) = sunlit_floor("sunlit-textured");
     scene.materials[0].base_color = [1.0; 3];
     scene.materials[0].base_color_texture = Some(0);
     scene.textures.push(Texture {
@@ -547,13 +546,6 @@ fn senders_read_their_base_colour_texture() {
         width: 1,
         height: 1,
         rgba8: vec![red[0], red[1], red[2], 255],
-    });
-    let dir = Vec3::new(0.3, -1.0, 0.2).normalize();
-    let (color, illuminance) = ([1.0f32, 0.8, 0.6], 3.0f32);
-    scene.lights.push(Light::Sun {
-        direction: dir,
-        color,
-        illuminance,
     });
     let r = render(
         &gpu,
@@ -567,7 +559,7 @@ fn senders_read_their_base_colour_texture() {
     );
     let surfels = r.dss_gi_surfels(&gpu).expect("bzb-gi DSS stage").unwrap();
     assert!(surfels.len() > 50, "{} surfels", surfels.len());
-    let want = Vec3::from(color) * lin(red) * (illuminance / std::f32::consts::PI * Vec3::Y.dot(-dir));
+    let want = sun * lin(red) * (Vec3::Y.dot(-dir) / std::f32::consts::PI);
     let worst = surfels
         .iter()
         .map(|(_, front, _)| ((*front - want) / want).abs().max_element())

@@ -136,6 +136,41 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     }
 }
 
+/// A scene of `parts` (one object and material each) with no light source, a black
+/// sky and no ambient light (min separation 0.5 m): only emissive parts send light.
+fn emitter_only_scene(name: &str, parts: Vec<(MeshBuilder, Material)>, camera: Camera) -> Scene {
+    let (meshes, materials): (Vec<_>, Vec<_>) = parts
+        .into_iter()
+        .enumerate()
+        .map(|(i, (mesh, material))| (mesh.build(&material.name, i), material))
+        .unzip();
+    let objects = materials
+        .iter()
+        .enumerate()
+        .map(|(i, m)| Object {
+            name: m.name.clone(),
+            mesh: i,
+            transform: Mat4::IDENTITY,
+            animation: None,
+        })
+        .collect();
+    Scene {
+        name: name.into(),
+        meshes,
+        objects,
+        materials,
+        lights: vec![],
+        camera,
+        settings: SceneSettings {
+            min_separation: 0.5,
+            sky: [0.0; 3],
+            ambient: [0.0; 3],
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
 /// A floor, an emitter facing the camera and a larger board in front of it that
 /// hides it: no light source, black sky. Only the deep G-buffer's layer 1 sees
 /// the emitter, so only 2 layers light the floor.
@@ -158,39 +193,15 @@ fn hidden_emitter_scene() -> Scene {
         [v(-0.9, 0.0, 0.0), v(0.9, 0.0, 0.0), v(0.9, 1.6, 0.0), v(-0.9, 1.6, 0.0)],
         v(0.0, 0.0, 1.0),
     );
-    let materials = vec![
-        Material::diffuse("floor", [0.7, 0.7, 0.7]),
-        Material::emissive("emitter", [4.0, 3.0, 2.0]),
-        Material::diffuse("board", [0.5, 0.5, 0.5]),
-    ];
-    let meshes = vec![
-        floor.build("floor", 0),
-        emitter.build("emitter", 1),
-        board.build("board", 2),
-    ];
-    let objects = (0..3)
-        .map(|i| Object {
-            name: materials[i].name.clone(),
-            mesh: i,
-            transform: Mat4::IDENTITY,
-            animation: None,
-        })
-        .collect();
-    Scene {
-        name: "hidden-emitter".into(),
-        meshes,
-        objects,
-        materials,
-        lights: vec![],
-        camera: Camera::new(v(0.0, 1.2, 4.0), v(0.0, 0.4, -0.5), Vec3::Y, 50.0, 0.05),
-        settings: SceneSettings {
-            min_separation: 0.5,
-            sky: [0.0; 3],
-            ambient: [0.0; 3],
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+    emitter_only_scene(
+        "hidden-emitter",
+        vec![
+            (floor, Material::diffuse("floor", [0.7, 0.7, 0.7])),
+            (emitter, Material::emissive("emitter", [4.0, 3.0, 2.0])),
+            (board, Material::diffuse("board", [0.5, 0.5, 0.5])),
+        ],
+        Camera::new(v(0.0, 1.2, 4.0), v(0.0, 0.4, -0.5), Vec3::Y, 50.0, 0.05),
+    )
 }
 
 #[test]
@@ -242,39 +253,15 @@ fn thin_wall_scene() -> Scene {
     );
     let mut wall = MeshBuilder::new();
     wall.cuboid(v(-0.02, 0.0, -2.5), v(0.02, 1.2, 2.5));
-    let materials = vec![
-        Material::diffuse("floor", [0.7, 0.7, 0.7]),
-        Material::emissive("emitter", [4.0, 3.0, 2.0]),
-        Material::diffuse("wall", [0.5, 0.5, 0.5]),
-    ];
-    let meshes = vec![
-        floor.build("floor", 0),
-        emitter.build("emitter", 1),
-        wall.build("wall", 2),
-    ];
-    let objects = (0..3)
-        .map(|i| Object {
-            name: materials[i].name.clone(),
-            mesh: i,
-            transform: Mat4::IDENTITY,
-            animation: None,
-        })
-        .collect();
-    Scene {
-        name: "thin-wall".into(),
-        meshes,
-        objects,
-        materials,
-        lights: vec![],
-        camera: Camera::new(v(-1.6, 4.0, 3.5), v(0.3, 0.0, -0.6), Vec3::Y, 60.0, 0.05),
-        settings: SceneSettings {
-            min_separation: 0.5,
-            sky: [0.0; 3],
-            ambient: [0.0; 3],
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+    emitter_only_scene(
+        "thin-wall",
+        vec![
+            (floor, Material::diffuse("floor", [0.7, 0.7, 0.7])),
+            (emitter, Material::emissive("emitter", [4.0, 3.0, 2.0])),
+            (wall, Material::diffuse("wall", [0.5, 0.5, 0.5])),
+        ],
+        Camera::new(v(-1.6, 4.0, 3.5), v(0.3, 0.0, -0.6), Vec3::Y, 60.0, 0.05),
+    )
 }
 
 /// Tap visibility of the visible senders (`tap_visibility_all`): behind a thin wall, which
