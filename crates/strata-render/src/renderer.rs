@@ -389,7 +389,7 @@ impl RenderSettings {
             bytes += b.estimated_bytes(w, h, scene.triangle_count() as u64);
         }
         if let Some(g) = &self.bzb_gi {
-            bytes += g.estimated_bytes(w, h, scene.triangle_count() as u64) + sum(&crate::passes::compose::OUTPUTS);
+            bytes += g.estimated_bytes(scene, w, h) + sum(&crate::passes::compose::OUTPUTS);
         }
         let geometry: u64 = scene
             .meshes

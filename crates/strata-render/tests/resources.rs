@@ -33,16 +33,23 @@ fn settings(technique: &str, w: u32, h: u32, layers: u32) -> RenderSettings {
 fn estimate_bounds_what_a_renderer_allocates() {
     let gpu = common::gpu();
     let mut results = Vec::new();
-    for (scene_name, technique, w, h, layers) in [
-        ("cornell", "direct", 160, 120, 1),
-        ("atrium", "ao", 256, 144, 2),
-        ("atrium", "full", 256, 144, 2),
-        ("warehouse", "full", 200, 100, 3),
-        ("cornell", "ils", 150, 100, 1),
-        ("atrium", "ils", 256, 144, 2),
+    // (…, a setting of the technique, e.g. DSS splats for the bounced z-buffer)
+    for (scene_name, technique, w, h, layers, set) in [
+        ("cornell", "direct", 160, 120, 1, None),
+        ("atrium", "ao", 256, 144, 2, None),
+        ("atrium", "full", 256, 144, 2, None),
+        ("warehouse", "full", 200, 100, 3, None),
+        ("cornell", "ils", 150, 100, 1, None),
+        ("atrium", "ils", 256, 144, 2, None),
+        ("cornell", "bzb-ao", 96, 64, 1, Some(("splat", 1.0))),
+        ("cornell", "bzb-gi", 96, 64, 1, None),
+        ("cornell", "bzb-gi", 96, 64, 1, Some(("splat", 1.0))),
     ] {
         let scene = procedural::builtin(scene_name).unwrap();
-        let s = settings(technique, w, h, layers);
+        let mut s = settings(technique, w, h, layers);
+        if let Some((name, value)) = set {
+            technique::find(technique).unwrap().set(&mut s, name, value).unwrap();
+        }
         let estimate = s.estimated_bytes(&scene);
         let before = allocated(&gpu);
         let mut r = Renderer::new(&gpu, &scene, s).unwrap();

@@ -55,8 +55,7 @@ pub fn run(stage: &StageSettings, technique: &str, set: &[(String, f64)]) -> Res
                     dss_tables(stage, &scene, &rs, &on, &off, u, g.dss.levels, g.dss.surfel_px)
                 })
                 .transpose()?;
-            let dss_bytes = dss.as_ref().map_or(0, |d| d.memory.total());
-            (g.directions, g.estimated_bytes(w, h, tris) + dss_bytes, dss)
+            (g.directions, g.estimated_bytes(&scene, w, h), dss)
         }
         (b, None) => {
             let b = b.clone().unwrap_or_default();

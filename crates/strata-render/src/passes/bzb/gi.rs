@@ -196,11 +196,18 @@ impl BzbGiSettings {
         (cols, self.directions.div_ceil(cols))
     }
 
-    /// GPU bytes at `w`×`h` with `triangles` triangles.
-    pub fn estimated_bytes(&self, w: u32, h: u32, triangles: u64) -> u64 {
+    /// GPU bytes for `scene` at `w`×`h`; with `splat = dss` the DSS buffers at capacity
+    /// too ([`super::dss::memory`]).
+    pub fn estimated_bytes(&self, scene: &Scene, w: u32, h: u32) -> u64 {
+        let triangles = scene.triangle_count() as u64;
+        let dss = if self.splat == super::Splat::Dss {
+            super::dss::memory(&self.dss_uniforms(scene, w, h, triangles as u32)).total()
+        } else {
+            0
+        };
         let (c, r) = self.grid();
         let px = w as u64 * h as u64;
-        px * (c * r) as u64 * (16 + 16 + 8 + 4)
+        dss + px * (c * r) as u64 * (16 + 16 + 8 + 4)
             + px * 8 * 7
             + self.temporal.map_or(0, |_| px * (4 * 8 + 4 * 2))
             + triangles * (48 + 80)
