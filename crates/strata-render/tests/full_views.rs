@@ -278,7 +278,7 @@ fn coverage_confidence_matches_cpu_and_bounds() {
 fn coverage_confidence_is_near_one_inside_a_closed_box() {
     use glam::{Mat4, Vec3};
     use strata_scene::shapes::MeshBuilder;
-    use strata_scene::{Camera, Material, Object, SceneSettings};
+    use strata_scene::{Camera, Material, Object};
     let gpu = common::gpu();
     let v = Vec3::new;
     let mut walls = MeshBuilder::new();
@@ -299,12 +299,7 @@ fn coverage_confidence_is_near_one_inside_a_closed_box() {
             intensity: 10.0,
         }],
         camera: Camera::new(v(1.5, 1.5, 1.5), v(-2.0, 1.0, -2.0), Vec3::Y, 80.0, 0.05),
-        settings: SceneSettings {
-            min_separation: 0.5,
-            sky: [0.0; 3],
-            ambient: [0.0; 3],
-            ..Default::default()
-        },
+        settings: common::unlit_settings(),
         ..Default::default()
     };
     let mean = |coverage: bool, radius: f32| {

@@ -9,7 +9,7 @@ use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::radiosity::{irradiance_cpu, Normalisation, RadiositySettings};
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::shapes::MeshBuilder;
-use strata_scene::{procedural, Camera, ImageBuf, Material, Object, Scene, SceneSettings};
+use strata_scene::{procedural, Camera, ImageBuf, Material, Object, Scene};
 
 fn renderer(gpu: &GpuContext, scene: &Scene, w: u32, h: u32, layers: u32, rs: RadiositySettings) -> Renderer {
     Renderer::new(
@@ -161,12 +161,7 @@ fn emitter_only_scene(name: &str, parts: Vec<(MeshBuilder, Material)>, camera: C
         materials,
         lights: vec![],
         camera,
-        settings: SceneSettings {
-            min_separation: 0.5,
-            sky: [0.0; 3],
-            ambient: [0.0; 3],
-            ..Default::default()
-        },
+        settings: common::unlit_settings(),
         ..Default::default()
     }
 }
@@ -347,12 +342,7 @@ fn closed_box(rho: f32) -> Scene {
             intensity: 10.0,
         }],
         camera: Camera::new(v(1.5, 1.5, 1.5), v(-2.0, 1.0, -2.0), Vec3::Y, 80.0, 0.05),
-        settings: SceneSettings {
-            min_separation: 0.5,
-            sky: [0.0; 3],
-            ambient: [0.0; 3],
-            ..Default::default()
-        },
+        settings: common::unlit_settings(),
         ..Default::default()
     }
 }

@@ -41,6 +41,17 @@ pub fn polygons_scene(name: &str, polygons: &[&[glam::Vec3]], camera: Camera, ao
     }
 }
 
+/// Scene settings with no sky and no ambient light (only lights and emitters light the
+/// frame), the deep G-buffer's minimum separation 0.5 m.
+pub fn unlit_settings() -> strata_scene::model::SceneSettings {
+    strata_scene::model::SceneSettings {
+        min_separation: 0.5,
+        sky: [0.0; 3],
+        ambient: [0.0; 3],
+        ..Default::default()
+    }
+}
+
 use strata_render::frame::FrameCameras;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, Scene};
