@@ -2,7 +2,8 @@
 // payload L(y → x) times the receiver's BRDF × cos θ / α. Lambert receivers
 // write the irradiance E = mean L cos θ/α (compose multiplies by ρ/π after the
 // filter, as for DGB radiosity and ILS); glossy receivers write the outgoing
-// radiance mean f_GGX(v, ω) L cos θ/α into the glossy target. Without
+// radiance mean f_GGX(v, ω) L cos θ/α into the glossy target, divided by
+// ggx_demodulation (compose multiplies it back after the filters). Without
 // visibility the payload of sub-image 0 is already the summed irradiance
 // (Lambert) or glossy radiance of every splat (bzb_gi_splat.wgsl).
 #import "common/fullscreen.wgsl"
@@ -71,7 +72,9 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     if (glossy) {
         // DSS without visibility (hemisphere = 1) sums irradiance for every
         // receiver: glossy ones reflect it as a Lambert surface of albedo ρ
-        o.glossy = vec4f(select(mean, mean * rho * (1.0 / BZB_PI), bzb.hemisphere == 1u), 1.0);
+        let l = select(mean, mean * rho * (1.0 / BZB_PI), bzb.hemisphere == 1u);
+        // demodulated (common/ggx.wgsl): the filters blur the light, compose multiplies A back
+        o.glossy = vec4f(l / ggx_demodulation(dot(n, v), rho, nrm.z, nrm.w), 1.0);
     } else {
         o.irradiance = vec4f(mean, 1.0);
     }

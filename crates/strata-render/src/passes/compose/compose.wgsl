@@ -10,6 +10,7 @@
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
 #import "common/probes.wgsl"
+#import "common/ggx.wgsl"
 
 struct Compose {
     // 1 = Eq. 7's boost on the reflected indirect light
@@ -21,7 +22,8 @@ struct Compose {
     // the probe term × AV (1), × GTAO's multi-bounce G(AV, rho) (2), × G(AV, rho) /
     // G(V_probe, rho) at most 1 (3, `radiosity::ProbeAo::Relative`), or not (0)
     use_ao: u32,
-    // 1 = add the glossy receivers' radiance (ILS `ils-glossy`) as is
+    // 1 = add the glossy receivers' radiance (ILS `ils-glossy`, `bzb-gi-glossy`), stored
+    // divided by ggx_demodulation (so the filters before compose keep textures sharp)
     use_glossy: u32,
     grid: ProbeGrid,
 }
@@ -113,7 +115,10 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     o.blended = vec4f(e, c);
     o.hdr = vec4f(direct.rgb + rho / 3.14159265358979 * e * k, direct.a);
     if (compose.use_glossy != 0u) {
-        o.hdr = vec4f(o.hdr.rgb + textureLoad(glossy, p, 0).rgb, o.hdr.a);
+        let x = world_from_csz(frame, vec2f(p) + 0.5, z);
+        let nv = dot(oct_decode(nrm.rg), normalize(frame.eye.xyz - x));
+        let a = ggx_demodulation(nv, textureLoad(albedo, p, 0).rgb, nrm.z, nrm.w);
+        o.hdr = vec4f(o.hdr.rgb + textureLoad(glossy, p, 0).rgb * a, o.hdr.a);
     }
     return o;
 }

@@ -46,7 +46,8 @@ struct Shade {
 @group(1) @binding(8) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
 
 // Lambert receivers: (E, 1) in location 0 and (0, 0, 0, 1) in location 1; glossy
-// ones: (0, 0, 0, 1) and (L_o, 1) (Σ_k vpl_glossy_radiance, common/vpl.wgsl).
+// ones: (0, 0, 0, 1) and (L_o / A, 1) (L_o = Σ_k vpl_glossy_radiance, common/vpl.wgsl;
+// A = ggx_demodulation at the pixel, which compose multiplies back after the blur).
 struct ShadeOut {
     @location(0) irradiance: vec4f,
     @location(1) glossy: vec4f,
@@ -55,12 +56,14 @@ struct ShadeOut {
 struct Receiver {
     glossy: bool,
     view: vec3f,
+    // the glossy radiance's demodulation (common/ggx.wgsl)
+    demodulation: vec3f,
     rho: vec3f,
     roughness: f32,
     metallic: f32,
 }
 
-fn receiver(pix: vec2u, x: vec3f) -> Receiver {
+fn receiver(pix: vec2u, x: vec3f, n: vec3f) -> Receiver {
     var r: Receiver;
     let p = vec2i(pix);
     r.glossy = textureLoad(emission_tex, p, 0).a > 1.5;
@@ -70,6 +73,7 @@ fn receiver(pix: vec2u, x: vec3f) -> Receiver {
         r.metallic = nrm.w;
         r.rho = textureLoad(albedo_tex, p, 0).rgb;
         r.view = normalize(frame.eye.xyz - x);
+        r.demodulation = ggx_demodulation(dot(n, r.view), r.rho, r.roughness, r.metallic);
     }
     return r;
 }
@@ -85,7 +89,7 @@ fn shade_out(e: vec3f, r: Receiver) -> ShadeOut {
     var o: ShadeOut;
     if (r.glossy) {
         o.irradiance = vec4f(0.0, 0.0, 0.0, 1.0);
-        o.glossy = vec4f(e, 1.0);
+        o.glossy = vec4f(e / r.demodulation, 1.0);
     } else {
         o.irradiance = vec4f(e, 1.0);
         o.glossy = vec4f(0.0, 0.0, 0.0, 1.0);
@@ -124,7 +128,7 @@ fn vpl_visibility(k: u32, v: Vpl, x: vec3f, n: vec3f) -> f32 {
 // vpl_sum with each VPL's term times its visibility (SSM).
 fn vpl_sum_ssm(g: vec4f, pix: vec2u, first: u32, step: u32) -> ShadeOut {
     let x = world_from_csz(frame, vec2f(pix) + 0.5, g.w);
-    let r = receiver(pix, x);
+    let r = receiver(pix, x, g.xyz);
     var e = vec3f(0.0);
     for (var k = first; k < shade.vpl_count; k += step) {
         let term = vpl_term(k, x, g.xyz, r);
@@ -140,7 +144,7 @@ fn vpl_sum_ssm(g: vec4f, pix: vec2u, first: u32, step: u32) -> ShadeOut {
 // of image pixel `pix` with packed G-buffer texel `g`.
 fn vpl_sum(g: vec4f, pix: vec2u, first: u32, step: u32) -> ShadeOut {
     let x = world_from_csz(frame, vec2f(pix) + 0.5, g.w);
-    let r = receiver(pix, x);
+    let r = receiver(pix, x, g.xyz);
     var e = vec3f(0.0);
     for (var k = first; k < shade.vpl_count; k += step) {
         e += vpl_term(k, x, g.xyz, r);

@@ -64,3 +64,24 @@ fn ggx_eval(n: vec3f, v: vec3f, l: vec3f, rho: vec3f, roughness: f32, metallic: 
     }
     return f;
 }
+
+// A smooth stand-in for f's directional albedo ∫ f(v, l) (n·l) dl at n·v = nv, the
+// twin of `strata_reference::brdf::demodulation_albedo`: the diffuse lobe exactly,
+// the specular lobe by Karis's fit of the split sum's scale and bias (F0 · A + B;
+// Karis 2014, "Physically based shading on mobile"). Glossy radiance is divided by
+// it before the screen-space filters and multiplied back in compose, so the filters
+// blur the lighting and not the textures. At least 1e-3 per channel.
+fn ggx_demodulation(nv: f32, rho: vec3f, roughness: f32, metallic: f32) -> vec3f {
+    let m = clamp(metallic, 0.0, 1.0);
+    let r = clamp(roughness, 0.0, 1.0);
+    let c = clamp(nv, 0.0, 1.0);
+    let f0 = mix(vec3f(GGX_DIELECTRIC_F0), rho, m);
+    let q = r * vec4f(-1.0, -0.0275, -0.572, 0.022) + vec4f(1.0, 0.0425, 1.04, -0.04);
+    let a004 = min(q.x * q.x, exp2(-9.28 * c)) * q.x + q.y;
+    let scale = -1.04 * a004 + q.z;
+    let bias = 1.04 * a004 + q.w;
+    // 1 − F_d(n·l) averaged over the cosine-weighted hemisphere
+    let transmitted = 1.0 - (GGX_DIELECTRIC_F0 + (1.0 - GGX_DIELECTRIC_F0) * (2.0 / 42.0));
+    let diffuse = rho * ((1.0 - m) * (1.0 - ggx_schlick_dielectric(c)) * transmitted);
+    return max(diffuse + f0 * scale + vec3f(bias), vec3f(1e-3));
+}
