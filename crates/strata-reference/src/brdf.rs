@@ -96,12 +96,7 @@ const DIFFUSE_TRANSMITTED: f32 = 1.0 - (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * 
 pub fn demodulation_albedo(nv: f32, rho: Vec3, roughness: f32, metallic: f32) -> Vec3 {
     let (m, r, c) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0), nv.clamp(0.0, 1.0));
     let f0 = Vec3::splat(DIELECTRIC_F0).lerp(rho, m);
-    let q = [
-        r * -1.0 + 1.0,
-        r * -0.0275 + 0.0425,
-        r * -0.572 + 1.04,
-        r * 0.022 - 0.04,
-    ];
+    let q = [1.0 - r, r * -0.0275 + 0.0425, r * -0.572 + 1.04, r * 0.022 - 0.04];
     let a004 = (q[0] * q[0]).min((-9.28 * c).exp2()) * q[0] + q[1];
     let (scale, bias) = (-1.04 * a004 + q[2], 1.04 * a004 + q[3]);
     let diffuse = rho * ((1.0 - m) * (1.0 - schlick_dielectric(c)) * DIFFUSE_TRANSMITTED);

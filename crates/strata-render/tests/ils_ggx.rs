@@ -495,7 +495,7 @@ fn glossy_blur_keeps_the_receivers_texture() {
         height: size,
         rgba8: (0..size * size)
             .flat_map(|i| {
-                let c = if ((i % size) / 4 + i / size / 4) % 2 == 0 {
+                let c = if ((i % size) / 4 + i / size / 4).is_multiple_of(2) {
                     light
                 } else {
                     dark
