@@ -610,7 +610,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 17] = [
+static ILS_SETTINGS: [SettingInfo; 18] = [
     SettingInfo {
         name: "shadows",
         doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
@@ -759,6 +759,14 @@ static ILS_SETTINGS: [SettingInfo; 17] = [
         true,
         |s| Some(ils_of(s).per_axis_discontinuities as u32 as f64),
         |s, v| ils_mut(s).per_axis_discontinuities = v != 0.0
+    ),
+    setting!(
+        "refine",
+        "after the blur, pixels that averaged less than this share of the n*m VPL subsets (edges, thin features: speckles) are shaded again with all N VPLs (0 = off; not in ILS)",
+        Range::Closed(0.0, 1.0),
+        false,
+        |s| Some(ils_of(s).refine as f64),
+        |s, v| ils_mut(s).refine = v as f32
     ),
     setting!(
         "depth-threshold",

@@ -429,3 +429,101 @@ fn kept_vpl_shadow_maps_match_a_fresh_frame_and_follow_new_vpls() {
     };
     assert!(!render(&gpu, &scene, snsm).vpl_shadow_maps_cached());
 }
+
+/// `ils-refine` (not in the paper): with `refine` = t, the pixels whose blur
+/// averaged less than t of the n·m VPL subsets (the blurred target's alpha) hold the
+/// brute force's value (all N VPLs, the same shading code) in both the irradiance
+/// and the glossy radiance, and every other pixel keeps its blurred value, bit for
+/// bit. On still-life (glossy and Lambert receivers, 8×6, t = 0.5) some pixels of
+/// each kind are refined; with SSM the refined pixels test the VPLs' shadow maps as
+/// the brute force does.
+#[test]
+fn refined_pixels_hold_the_brute_force_and_the_others_the_blur() {
+    use strata_render::passes::ils::VplShadows;
+    let gpu = common::gpu();
+    let scene = procedural::builtin("still-life").unwrap();
+    let v = vpls(&scene, 96);
+    for shadows in [VplShadows::None, VplShadows::ShadowMaps] {
+        let settings = |brute_force: bool, refine: f32| IlsSettings {
+            vpls: gpu_vpls(&v),
+            brute_force,
+            refine,
+            shadows,
+            vpl_shadow_resolution: 32,
+            ..Default::default()
+        };
+        let read = |r: &Renderer, name: &str| {
+            let img = r.read_target(&gpu, name).unwrap();
+            gpu.check_errors().unwrap();
+            img
+        };
+        let brute = render(&gpu, &scene, settings(true, 0.0));
+        let refined = render(&gpu, &scene, settings(false, 0.5));
+        let (blurred, blurred_glossy) = (read(&refined, "indirect"), read(&refined, "ils-glossy-blurred"));
+        let (out, out_glossy) = (read(&refined, "ils-refined"), read(&refined, "ils-glossy-refined"));
+        let (bf, bf_glossy) = (read(&brute, "ils-irradiance"), read(&brute, "ils-glossy"));
+        let (csz, emission) = (read(&refined, "csz"), read(&refined, "emission"));
+        let (mut kept, mut lambert, mut glossy) = (0, 0, 0);
+        let csz_stride = csz.data.len() / (W * H) as usize;
+        for i in 0..(W * H) as usize {
+            let px = |img: &ImageBuf| Vec3::from_slice(&img.data[i * 4..i * 4 + 3]);
+            if csz.data[i * csz_stride] <= 0.0 || blurred.data[i * 4 + 3] >= 0.5 {
+                assert_eq!(px(&out), px(&blurred), "{shadows:?}: pixel {i} keeps the blur");
+                assert_eq!(px(&out_glossy), px(&blurred_glossy), "{shadows:?}: pixel {i} (glossy)");
+                kept += 1;
+                continue;
+            }
+            assert_eq!(px(&out), px(&bf), "{shadows:?}: refined pixel {i} = the brute force");
+            assert_eq!(
+                px(&out_glossy),
+                px(&bf_glossy),
+                "{shadows:?}: refined pixel {i} (glossy)"
+            );
+            if emission.data[i * 4 + 3] > 1.5 {
+                glossy += 1;
+            } else {
+                lambert += 1;
+            }
+        }
+        eprintln!("{shadows:?}: {lambert} Lambert and {glossy} glossy pixels refined, {kept} kept");
+        assert!(
+            lambert > 20 && glossy > 5 && kept > 1000,
+            "{lambert} / {glossy} / {kept}"
+        );
+    }
+}
+
+/// The blur's coverage (alpha of `indirect`): on a wall that fills the frame there
+/// are no discontinuities, so an inner pixel averages all 8×6 subsets (1), and the
+/// corner (0, 0), cut by the image border, takes 5 of the 8 columns (its own and
+/// two bilinear taps of two) in each of 4 of the 6 rows (its own, a tap of two and
+/// the radius-3 end): 5/8 · 4/6.
+#[test]
+fn blur_coverage_is_the_share_of_vpl_subsets_averaged() {
+    let gpu = common::gpu();
+    let camera = strata_scene::Camera::new(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::Y, 60.0, 0.05);
+    let wall = [
+        Vec3::new(-10.0, -10.0, 0.0),
+        Vec3::new(10.0, -10.0, 0.0),
+        Vec3::new(10.0, 10.0, 0.0),
+        Vec3::new(-10.0, 10.0, 0.0),
+    ];
+    let scene = common::polygons_scene("wall", &[&wall], camera, 0.1);
+    let vpl = GpuVpl::new([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0; 3]);
+    let r = render(
+        &gpu,
+        &scene,
+        IlsSettings {
+            vpls: Arc::from(vec![vpl; 48]),
+            ..Default::default()
+        },
+    );
+    let img = r.read_target(&gpu, "indirect").unwrap();
+    gpu.check_errors().unwrap();
+    let a = |x: u32, y: u32| img.data[((y * W + x) * 4 + 3) as usize];
+    let corner = 5.0 / 8.0 * 4.0 / 6.0;
+    assert!((a(0, 0) - corner).abs() < 2e-3, "corner {} vs {corner}", a(0, 0));
+    for (x, y) in [(32, 32), (10, 20), (W - 9, H - 9)] {
+        assert!((a(x, y) - 1.0).abs() < 1e-3, "({x}, {y}): {}", a(x, y));
+    }
+}

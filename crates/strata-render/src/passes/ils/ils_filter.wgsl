@@ -20,6 +20,8 @@ struct Filter {
     channel: u32,
     // B: > 1 = the interleave period along `dir` (equal sub-buffer weights)
     period: u32,
+    // B: the interleave pattern's size along `dir` (n or m), for the coverage
+    pattern: u32,
     // B: the tap weight at offset ±k is weights[k / 4][k % 4], k in 0..=radius
     // (`ils::blur_weights`: the Gaussian, or with a period divided by the window's sum
     // over the tap's sub-buffer)
@@ -87,6 +89,16 @@ fn flag(p: vec2i) -> bool {
     return textureLoad(discontinuity, p, 0)[filt.channel] > 0.0;
 }
 
+// Not in the paper: the share of the n·m sub-buffers (VPL subsets) a blurred pixel
+// averaged, in alpha. Taps along `dir` are contiguous, so `texels` of them cover
+// min(texels, pattern) of the pattern's columns (rows); the vertical pass multiplies
+// by the mean coverage of the rows it took (the source's alpha: 1 before the
+// horizontal pass). `ils-refine` shades the pixels below a threshold again.
+fn coverage(texels: f32, alpha_sum: f32) -> f32 {
+    let p = f32(max(filt.pattern, 1u));
+    return min(texels, p) / p * (alpha_sum / texels);
+}
+
 // §4.5: from a pixel not on a discontinuity, both directions are explored; a
 // neighbour is blended while the pixel before it (towards the centre) is
 // similar to it, i.e. texel c + k·d needs DB(c + (k − 1)·d) = 0 going +d and
@@ -97,8 +109,11 @@ fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
     let d = filt.dir;
     let r = i32(filt.radius);
     let w0 = weight(0);
-    var sum = w0 * textureLoad(src, c, 0).rgb;
+    let s0 = textureLoad(src, c, 0);
+    var sum = w0 * s0.rgb;
     var wsum = w0;
+    var texels = 1.0;
+    var alpha = s0.a;
     var prev_similar = !flag(c);
     for (var k = 1; k <= r; k++) {
         let q = c + k * d;
@@ -106,8 +121,11 @@ fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
             break;
         }
         let w = weight(k);
-        sum += w * textureLoad(src, q, 0).rgb;
+        let t = textureLoad(src, q, 0);
+        sum += w * t.rgb;
         wsum += w;
+        texels += 1.0;
+        alpha += t.a;
         prev_similar = !flag(q);
     }
     for (var k = 1; k <= r; k++) {
@@ -116,10 +134,13 @@ fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
             break;
         }
         let w = weight(-k);
-        sum += w * textureLoad(src, q, 0).rgb;
+        let t = textureLoad(src, q, 0);
+        sum += w * t.rgb;
         wsum += w;
+        texels += 1.0;
+        alpha += t.a;
     }
-    return vec4f(sum / wsum, 1.0);
+    return vec4f(sum / wsum, coverage(texels, alpha));
 }
 
 // Fig. 4 b: texels k and k + 1 in one bilinear tap at k + w_{k+1}/(w_k + w_{k+1})
@@ -134,8 +155,11 @@ fn blur_bilinear(c: vec2i, size: vec2i) -> vec4f {
     let inv = 1.0 / vec2f(size);
     let centre = vec2f(c) + 0.5;
     let w0 = weight(0);
-    var sum = w0 * textureLoad(src, c, 0).rgb;
+    let s0 = textureLoad(src, c, 0);
+    var sum = w0 * s0.rgb;
     var wsum = w0;
+    var texels = 1.0;
+    var alpha = s0.a;
     for (var side = 0; side < 2; side++) {
         let s = select(-1, 1, side == 0);
         if (s > 0 && flag(c)) {
@@ -153,11 +177,16 @@ fn blur_bilinear(c: vec2i, size: vec2i) -> vec4f {
             if (textureSampleLevel(discontinuity, bilinear_sampler, uv, 0.0)[filt.channel] > 0.0) {
                 break;
             }
-            sum += (wa + wb) * textureSampleLevel(src, bilinear_sampler, uv, 0.0).rgb;
+            let t = textureSampleLevel(src, bilinear_sampler, uv, 0.0);
+            sum += (wa + wb) * t.rgb;
             wsum += wa + wb;
+            // one texel in the last tap of an odd radius (wb = 0), else two
+            let n = select(1.0, 2.0, k + 1 <= r);
+            texels += n;
+            alpha += n * t.a;
         }
     }
-    return vec4f(sum / wsum, 1.0);
+    return vec4f(sum / wsum, coverage(texels, alpha));
 }
 
 @fragment

@@ -12,6 +12,7 @@
 //! | `ils-db` | §4.5 DB | discontinuity buffer (depth and normal vs the three positive neighbours) |
 //! | `ils-blur-h`, `ils-blur-v` | §4.5 B | separable Gaussian blur stopping at discontinuities (Fig. 4 a or b) |
 //! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers") |
+//! | `ils-refine` | – | only with [`IlsSettings::refine`]: pixels the blur averaged too few VPL subsets for, shaded with all N VPLs (not in the paper) |
 //! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance + blurred glossy radiance (the shared compose pass) |
 //!
 //! With [`IlsSettings::brute_force`] the three middle passes are replaced by
@@ -29,7 +30,8 @@
 //! in compose after the blur (§4.5: object colours are never filtered).
 //! Receivers of `Material::glossy` materials (emission.a = 2 in the G-buffer)
 //! get Σ_k f_GGX(v, l_k) Φ_k/π · (same clamped geometry term) instead, in a
-//! second target `ils-glossy` that compose adds as radiance.
+//! second target `ils-glossy` (divided by `ggx_demodulation`, so the blur keeps
+//! textures) that compose multiplies back and adds as radiance.
 //!
 //! **VPLs come from the caller.** strata-render does not trace light paths:
 //! the caller generates the VPLs on the CPU (`strata_reference::Reference::vpls`,
@@ -174,6 +176,11 @@ pub struct IlsSettings {
     /// as §6.3's fresh VPL sets must (what the bench's per-map cost measures). Not in
     /// the paper; default true.
     pub vpl_shadow_cache: bool,
+    /// Not in the paper: after the blur, pixels that averaged less than this share
+    /// of the n·m VPL subsets (edges, thin features: speckles) are shaded again with
+    /// all N VPLs (`ils-refine`, docs/ils.md § "Refining the pixels the blur misses").
+    /// 0..=1; 0 = off.
+    pub refine: f32,
 }
 
 impl Default for IlsSettings {
@@ -195,6 +202,7 @@ impl Default for IlsSettings {
             shadows: VplShadows::None,
             vpl_shadow_resolution: 64,
             vpl_shadow_cache: true,
+            refine: 0.0,
         }
     }
 }
@@ -220,6 +228,9 @@ impl IlsSettings {
             if !(d > 0.0 && d.is_finite()) {
                 return Err(format!("clamp-distance {d} is out of range: must be > 0"));
             }
+        }
+        if !(0.0..=1.0).contains(&self.refine) {
+            return Err(format!("refine {} is out of range: must be in 0..=1", self.refine));
         }
         if !(0.0..=4.0).contains(&self.blur) {
             return Err(format!("blur {} is out of range: must be in 0..=4", self.blur));
@@ -277,6 +288,11 @@ impl IlsSettings {
         self.blur > 0.0
     }
 
+    /// Whether `ils-refine` runs (after a blur of the interleaved frame).
+    pub fn refines(&self) -> bool {
+        self.refine > 0.0 && self.blurs() && !self.brute_force
+    }
+
     /// The frame's passes for these settings, in order.
     pub fn passes(&self) -> Vec<&'static str> {
         let mut v = vec!["ils-gbuffer"];
@@ -296,6 +312,9 @@ impl IlsSettings {
                 "ils-blur-glossy-h",
                 "ils-blur-glossy-v",
             ]);
+            if self.refines() {
+                v.push(REFINE_PASS);
+            }
         }
         v.push("compose");
         v
@@ -332,9 +351,10 @@ impl IlsSettings {
         let [n, m] = self.pattern;
         let tiled = (w.div_ceil(n.max(1)) * n.max(1)) as u64 * (h.div_ceil(m.max(1)) * m.max(1)) as u64;
         let px = w as u64 * h as u64;
-        // gbuffer 16 + irradiance 8 + glossy 8 + DB 8 + blur-h 8 + indirect 8 + compose 24; tiled: 16 + 8 + 8;
-        // the Blocks intermediates ≤ 2 more tiled-size buffers
-        px * 80 + tiled * (32 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
+        // gbuffer 16 + irradiance 8 + glossy 8 + DB 8 + blur-h 8 + indirect 8 + compose 24
+        // (+ refined 8 + 8); tiled: 16 + 8 + 8; the Blocks intermediates ≤ 2 more tiled-size buffers
+        let refined = if self.refines() { 16 } else { 0 };
+        px * (80 + refined) + tiled * (32 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
     }
 }
 
@@ -397,8 +417,22 @@ pub const INDIRECT: TargetDesc = TargetDesc::new(
     "indirect",
     wgpu::TextureFormat::Rgba16Float,
     1,
-    "indirect irradiance E of layer 0 (rgb), confidence 1 (a): ILS's blurred result",
+    "indirect irradiance E of layer 0 (rgb), ILS's blurred result; a = the share of the n·m VPL subsets the blur averaged",
 );
+pub const REFINED: TargetDesc = TargetDesc::new(
+    "ils-refined",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "indirect after ils-refine: pixels the blur averaged too few VPL subsets for shaded with all VPLs",
+);
+pub const GLOSSY_REFINED: TargetDesc = TargetDesc::new(
+    "ils-glossy-refined",
+    wgpu::TextureFormat::Rgba16Float,
+    1,
+    "ils-glossy-blurred after ils-refine",
+);
+/// The refinement pass (`IlsSettings::refine`).
+pub const REFINE_PASS: &str = "ils-refine";
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -407,7 +441,8 @@ struct ShadeUniforms {
     vpl_count: u32,
     sub_buffers: u32,
     all_vpls: u32,
-    _pad0: u32,
+    /// `IlsSettings::refine` (ils_refine.wgsl)
+    refine: f32,
     max_geometry: f32,
     /// SSM: eye offset, texel size at distance 1, half a texel in face uv.
     ssm: [f32; 3],
@@ -425,7 +460,9 @@ struct FilterUniforms {
     channel: u32,
     /// The interleave period along `dir` with [`IlsSettings::equal_subsets`], else 0.
     period: u32,
-    _pad: [u32; 3],
+    /// The interleave pattern's size along `dir` (the blur's coverage; 0 for the DB).
+    pattern: u32,
+    _pad: [u32; 2],
     /// [`blur_weights`], four per vec4.
     weights: [[f32; 4]; 9],
 }
@@ -514,7 +551,12 @@ fn filter_uniforms(s: &IlsSettings, radius: u32, dir: [i32; 2]) -> FilterUniform
             3
         },
         period,
-        _pad: [0; 3],
+        pattern: match dir {
+            [0, 0] => 0,
+            [_, 0] => s.pattern[0],
+            _ => s.pattern[1],
+        },
+        _pad: [0; 2],
         weights,
     }
 }
@@ -606,12 +648,38 @@ pub(crate) struct IlsStage {
     blur_v: Option<FullscreenPass>,
     glossy_h: Option<FullscreenPass>,
     glossy_v: Option<FullscreenPass>,
+    /// `IlsSettings::refine`: the pixels the blur averaged too few VPL subsets for
+    refine: Option<FullscreenPass>,
     compose: crate::passes::compose::ComposePass,
     vpl_buffer: wgpu::Buffer,
     vpl_capacity: usize,
     shade_uniforms: ShadeUniforms,
     /// SSM's shadow maps (`shadows = vpl`).
     vpl_shadows: Option<ssm::VplShadowPass>,
+}
+
+/// A shading pass's WGSL: the shared VPL shading (`ils_vpl_shading.wgsl`) and the
+/// file with its bindings and entry points.
+macro_rules! shading_shader {
+    ($file:literal) => {
+        concat!(include_str!("ils_vpl_shading.wgsl"), "\n", include_str!($file))
+    };
+}
+
+/// SSM's bindings after a shading pass's others: the VPLs' shadow maps, their
+/// comparison sampler and face matrices (none without VPL shadows).
+fn with_vpl_shadows<'a>(b: PassBuilder<'a>, shadows: &'a Option<ssm::VplShadowPass>) -> PassBuilder<'a> {
+    match shadows {
+        Some(p) => b
+            .depth_view(
+                "ils-vpl-shadow-maps",
+                &p.array_view,
+                wgpu::TextureViewDimension::D2Array,
+            )
+            .sampler(&p.sampler, wgpu::SamplerBindingType::Comparison)
+            .storage(&p.matrices),
+        None => b,
+    }
 }
 
 fn vpl_buffer(gpu: &GpuContext, vpls: &[GpuVpl]) -> wgpu::Buffer {
@@ -710,7 +778,7 @@ impl IlsStage {
             vpl_count: s.vpls.len() as u32,
             sub_buffers: if s.brute_force { 1 } else { n * m },
             all_vpls: s.all_vpls_per_sub_buffer as u32,
-            _pad0: 0,
+            refine: s.refine,
             max_geometry: s.max_geometry(scene),
             ssm: ssm_uniforms,
         };
@@ -747,7 +815,7 @@ impl IlsStage {
                 ),
             };
             let b = PassBuilder::new(gpu, targets, name)
-                .shader("ils-snsm", include_str!("ils_snsm.wgsl"))
+                .shader("ils-snsm", shading_shader!("ils_snsm.wgsl"))
                 .entry(entry)
                 .frame(scene_gpu)
                 .uniforms(&shade_uniforms)
@@ -756,18 +824,10 @@ impl IlsStage {
                 .read_layer("normal", 0)
                 .read_layer("albedo", 0)
                 .read_layer("emission", 0);
-            let b = match &vpl_shadows {
-                Some(p) => b
-                    .depth_view(
-                        "ils-vpl-shadow-maps",
-                        &p.array_view,
-                        wgpu::TextureViewDimension::D2Array,
-                    )
-                    .sampler(&p.sampler, wgpu::SamplerBindingType::Comparison)
-                    .storage(&p.matrices),
-                None => b,
-            };
-            b.write(output).write(output_glossy).build()
+            with_vpl_shadows(b, &vpl_shadows)
+                .write(output)
+                .write(output_glossy)
+                .build()
         };
 
         let (mut discontinuity, mut blur_h, mut blur_v) = (None, None, None);
@@ -780,6 +840,37 @@ impl IlsStage {
             (INDIRECT.name, GLOSSY_BLURRED.name)
         } else {
             (IRRADIANCE.name, GLOSSY.name)
+        };
+        let mut refine = None;
+        let (shown, glossy_shown) = if s.refines() {
+            targets.create(gpu, REFINED);
+            targets.create(gpu, GLOSSY_REFINED);
+            let entry = if vpl_shadows.is_some() {
+                "fs_refine_ssm"
+            } else {
+                "fs_refine"
+            };
+            let b = PassBuilder::new(gpu, targets, REFINE_PASS)
+                .shader("ils-refine", shading_shader!("ils_refine.wgsl"))
+                .entry(entry)
+                .frame(scene_gpu)
+                .uniforms(&shade_uniforms)
+                .read(GBUFFER.name)
+                .storage(&vpl_buffer)
+                .read_layer("normal", 0)
+                .read_layer("albedo", 0)
+                .read_layer("emission", 0)
+                .read(shown)
+                .read(glossy_shown);
+            refine = Some(
+                with_vpl_shadows(b, &vpl_shadows)
+                    .write(REFINED.name)
+                    .write(GLOSSY_REFINED.name)
+                    .build(),
+            );
+            (REFINED.name, GLOSSY_REFINED.name)
+        } else {
+            (shown, glossy_shown)
         };
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
@@ -797,6 +888,7 @@ impl IlsStage {
             blur_v,
             glossy_h,
             glossy_v,
+            refine,
             compose,
             vpl_capacity: s.vpls.len().max(1),
             vpl_buffer,
@@ -820,6 +912,9 @@ impl IlsStage {
         }
         self.shade_uniforms.vpl_count = vpls.len() as u32;
         self.shade.set_uniforms(gpu, &self.shade_uniforms);
+        if let Some(p) = &self.refine {
+            p.set_uniforms(gpu, &self.shade_uniforms);
+        }
         Ok(())
     }
 
@@ -849,6 +944,7 @@ impl IlsStage {
             &self.blur_v,
             &self.glossy_h,
             &self.glossy_v,
+            &self.refine,
         ]
         .into_iter()
         .flatten()
