@@ -62,6 +62,10 @@ pub fn run(a: &SoakArgs) -> Result<()> {
     let mut samples = Vec::new();
     for i in 0..a.frames {
         let t = f.scene.frame + i as f32;
+        // ILS with moving objects: this frame's VPLs (the first frame's were built in)
+        if i > 0 {
+            strata_eval::vpls::refresh_vpls(&mut r, &gpu, &scene, t)?;
+        }
         r.render(&gpu, &scene, &cameras_at(&scene, &f.scene, t), t)?;
         let done = i + 1;
         // the first sample after one interval: allocator pools and caches are warm by then

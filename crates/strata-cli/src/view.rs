@@ -141,6 +141,9 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         motion_scale: a.motion_scale,
         adapter: f.gpu.adapter.clone(),
         settings,
+        vpls: Some(Box::new(|scene, t, count| {
+            strata_eval::vpls::scene_vpls(scene, t, count).to_vec()
+        })),
     })
     .map_err(|e| anyhow::anyhow!(e))
 }

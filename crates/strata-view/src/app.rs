@@ -53,6 +53,10 @@ pub struct Shown {
 pub struct App {
     gfx: Option<Gfx>,
     pub(crate) settings_fn: SettingsFn,
+    /// Per-frame VPLs for ILS in scenes with animated objects (`ViewOptions::vpls`).
+    vpls_fn: Option<crate::VplsFn>,
+    /// The frame the full and the reduced renderer's VPLs were made for (None: as built).
+    vpls_at: [Option<f32>; 2],
     pub(crate) adapter_opt: Option<String>,
     pub(crate) adapter_name: String,
     pub(crate) scene: Scene,
@@ -120,6 +124,8 @@ impl App {
         App {
             gfx: None,
             settings_fn: o.settings,
+            vpls_fn: o.vpls,
+            vpls_at: [None; 2],
             adapter_opt: o.adapter,
             adapter_name: String::new(),
             cam: CameraControl::new(o.camera, scale),
@@ -241,6 +247,7 @@ impl App {
                 self.view_names = r.debug_view_names();
                 self.full = Some(r);
                 self.reduced = None;
+                self.vpls_at = [None; 2];
                 self.reduced_tried = false;
                 self.used_last = 0;
                 self.settings = Some(settings);
@@ -360,6 +367,7 @@ impl App {
                     if (0.1..=1.0).contains(&s) {
                         self.motion_scale = s;
                         self.reduced = None;
+                        self.vpls_at[1] = None;
                         self.reduced_tried = false;
                     } else {
                         self.say(format!("motion scale {s} is out of range: must be in 0.1..=1"), true);
@@ -456,6 +464,7 @@ impl App {
             self.reduced_tried = true;
             if let Some(s) = self.reduced_settings() {
                 self.reduced = Renderer::new(gpu, &self.scene, s).ok();
+                self.vpls_at[1] = None;
             }
         }
         let use_reduced = reduced && self.reduced.is_some();
@@ -476,6 +485,14 @@ impl App {
             current: cam,
             next_view: cam.view(),
         };
+        // ILS in a scene with moving objects: the VPLs of this frame's geometry
+        if let (Some(vpls), Some(ils)) = (&self.vpls_fn, &r.settings.ils) {
+            if self.scene.animated() && self.vpls_at[which as usize - 1] != Some(self.frame_t) {
+                let v = vpls(&self.scene, self.frame_t, ils.vpl_count);
+                r.set_vpls(gpu, &v)?;
+                self.vpls_at[which as usize - 1] = Some(self.frame_t);
+            }
+        }
         let t = r.render(gpu, &self.scene, &cams, self.frame_t)?;
         let t_name = strata_render::technique::find(&self.spec.technique).map(|t| t.display);
         let (image, srgb) = match &self.debug_view {

@@ -26,6 +26,11 @@ pub use script::Script;
 /// settings for `scene`; the error is one line naming the flag and its valid range.
 pub type SettingsFn = Box<dyn Fn(&Scene, &[String]) -> Result<RenderSettings, String>>;
 
+/// The VPLs of `scene` at frame `t` from `count` light paths (instant radiosity; the
+/// caller's generator, as for `strata render`): ILS in scenes with animated objects gets
+/// new VPLs whenever the frame changes.
+pub type VplsFn = Box<dyn Fn(&Scene, f32, u32) -> Vec<strata_render::passes::ils::GpuVpl>>;
+
 /// The technique-related `strata render` flags the panels edit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSpec {
@@ -136,6 +141,9 @@ pub struct ViewOptions {
     pub motion_scale: f32,
     pub adapter: Option<String>,
     pub settings: SettingsFn,
+    /// Per-frame VPLs for ILS when the scene has animated objects (None: the VPLs the
+    /// settings were built with stay).
+    pub vpls: Option<VplsFn>,
 }
 
 /// Opens the window and runs until it is closed (or `frames` are done). Errors are one

@@ -336,14 +336,23 @@ impl IlsSettings {
         self.shadows.traced() && self.vpl_shadow_cache && !scene.animated()
     }
 
+    /// How many VPLs the renderer holds room for: those passed, and in a scene with
+    /// animated objects as many as `vpl_count` one-bounce paths can make (one per path),
+    /// so that the callers' per-frame VPLs (`Renderer::set_vpls`) fit.
+    pub fn vpl_capacity(&self, scene: &strata_scene::Scene) -> usize {
+        let regenerated = if scene.animated() { self.vpl_count as usize } else { 0 };
+        self.vpls.len().max(regenerated).max(1)
+    }
+
     /// Bytes of the VPL shadow maps (SSM): N layers of six R² Depth32Float faces, plus the
-    /// face matrices (256-byte uniform stride + packed storage copy).
+    /// face matrices (256-byte uniform stride + packed storage copy); N at most
+    /// `vpl_capacity` of an animated scene.
     pub fn shadow_map_bytes(&self) -> u64 {
         if !self.shadows.traced() {
             return 0;
         }
         let r = self.vpl_shadow_resolution as u64;
-        self.vpls.len().max(1) as u64 * 6 * (r * r * 4 + 256 + 64)
+        self.vpls.len().max(self.vpl_count as usize).max(1) as u64 * 6 * (r * r * 4 + 256 + 64)
     }
 
     /// Upper bound of the stage's target bytes at `w`×`h` (tiled buffers included).
@@ -354,7 +363,10 @@ impl IlsSettings {
         // gbuffer 16 + irradiance 8 + glossy 8 + DB 8 + blur-h 8 + indirect 8 + compose 24
         // (+ refined 8 + 8); tiled: 16 + 8 + 8; the Blocks intermediates ≤ 2 more tiled-size buffers
         let refined = if self.refines() { 16 } else { 0 };
-        px * (80 + refined) + tiled * (32 + 24) + self.vpls.len() as u64 * 48 + self.shadow_map_bytes()
+        px * (80 + refined)
+            + tiled * (32 + 24)
+            + self.vpls.len().max(self.vpl_count as usize) as u64 * 48
+            + self.shadow_map_bytes()
     }
 }
 
@@ -682,13 +694,17 @@ fn with_vpl_shadows<'a>(b: PassBuilder<'a>, shadows: &'a Option<ssm::VplShadowPa
     }
 }
 
-fn vpl_buffer(gpu: &GpuContext, vpls: &[GpuVpl]) -> wgpu::Buffer {
+/// The VPL buffer: `vpls`, then zeros up to `capacity` (at least one VPL).
+fn vpl_buffer(gpu: &GpuContext, vpls: &[GpuVpl], capacity: usize) -> wgpu::Buffer {
     use wgpu::util::DeviceExt;
-    let zero = [GpuVpl::new([0.0; 3], [0.0; 3], [0.0; 3])];
-    let data: &[GpuVpl] = if vpls.is_empty() { &zero } else { vpls };
+    let mut data = vpls.to_vec();
+    data.resize(
+        capacity.max(vpls.len()).max(1),
+        GpuVpl::new([0.0; 3], [0.0; 3], [0.0; 3]),
+    );
     gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("ils vpls"),
-        contents: bytemuck::cast_slice(data),
+        contents: bytemuck::cast_slice(&data),
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
     })
 }
@@ -704,7 +720,8 @@ impl IlsStage {
         s.validate().map_err(RenderError::Parameter)?;
         let (w, h) = (targets.width, targets.height);
         let [n, m] = s.pattern;
-        let vpl_buffer = vpl_buffer(gpu, &s.vpls);
+        let capacity = s.vpl_capacity(scene);
+        let vpl_buffer = vpl_buffer(gpu, &s.vpls, capacity);
         // the compute BS/BG writes its destinations as storage textures: the split
         // G-buffer, and the gathered irradiance and glossy radiance
         let storage = match s.method {
@@ -761,7 +778,7 @@ impl IlsStage {
         let vpl_shadows = match s.shadows {
             VplShadows::None => None,
             VplShadows::ShadowMaps => {
-                let mut p = ssm::VplShadowPass::new(gpu, scene_gpu, scene, &s.vpls, s.vpl_shadow_resolution)?;
+                let mut p = ssm::VplShadowPass::new(gpu, scene_gpu, scene, &s.vpls, capacity, s.vpl_shadow_resolution)?;
                 p.set_cached(s.vpl_shadow_maps_cached(scene));
                 Some(p)
             }
@@ -890,7 +907,7 @@ impl IlsStage {
             glossy_v,
             refine,
             compose,
-            vpl_capacity: s.vpls.len().max(1),
+            vpl_capacity: capacity,
             vpl_buffer,
             shade_uniforms,
             vpl_shadows,

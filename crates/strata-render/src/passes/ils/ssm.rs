@@ -115,10 +115,12 @@ impl VplShadowPass {
         scene_gpu: &GpuScene,
         scene: &strata_scene::Scene,
         vpls: &[GpuVpl],
+        capacity: usize,
         resolution: u32,
     ) -> Result<Self, RenderError> {
         let device = &gpu.device;
-        let layers = vpls.len().max(1) as u32;
+        // one layer per VPL, for as many as `set_vpls` may later pass
+        let layers = vpls.len().max(capacity).max(1) as u32;
         let max_layers = device.limits().max_texture_array_layers;
         if layers > max_layers {
             return Err(RenderError::Parameter(format!(
