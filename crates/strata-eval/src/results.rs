@@ -516,6 +516,9 @@ pub struct IlsEval {
     pub split: String,
     pub blur: f32,
     pub bilinear: bool,
+    /// `ils-refine`'s coverage threshold (0 = off; `IlsSettings::refine`).
+    #[serde(default)]
+    pub refine: f32,
     /// `none` (SNSM: VPL visibility ignored) or `vpl` (SSM: per-VPL shadow maps, §4.3).
     pub shadows: String,
     /// Full image vs the brute force (every pixel, all N VPLs, same shadows): ꟻLIP and RMSE of

@@ -140,6 +140,7 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u3
         split: ils.method.name().to_string(),
         blur: ils.blur,
         bilinear: ils.bilinear,
+        refine: ils.refine,
         shadows: shadows.into(),
         flip_vs_brute: vs_brute.flip,
         rmse_vs_brute: vs_brute.rmse,

@@ -20,6 +20,7 @@
 #import "common/camera.wgsl"
 #import "common/interleave.wgsl"
 #import "common/vpl.wgsl"
+#import "common/lights.wgsl"
 
 struct Shade {
     geo: Interleave,
@@ -95,17 +96,7 @@ fn vpl_visibility(k: u32, v: Vpl, x: vec3f, n: vec3f) -> f32 {
     let eye = v.position.xyz + v.normal.xyz * shade.eye_offset;
     // normal offset of 1.5 texels at the receiver's distance
     let q = x + n * (1.5 * shade.texel_at_1 * length(x - eye));
-    let d = q - eye;
-    let a = abs(d);
-    var face = 4u;
-    if (a.x >= a.y && a.x >= a.z) {
-        face = 0u;
-    } else if (a.y >= a.z) {
-        face = 2u;
-    }
-    if ((face == 0u && d.x < 0.0) || (face == 2u && d.y < 0.0) || (face == 4u && d.z < 0.0)) {
-        face += 1u;
-    }
+    let face = cube_face(q - eye);
     let c = vpl_shadow_mats[k * 6u + face] * vec4f(q, 1.0);
     let ndc = c.xyz / c.w;
     if (c.w <= 0.0 || ndc.z > 1.0) {

@@ -18,6 +18,22 @@ struct GpuLight {
     shadow_view_proj: mat4x4f,
 }
 
+// The cube face of direction d from a point light or VPL: the major axis of d,
+// faces +X, −X, +Y, −Y, +Z, −Z (0..=5; `lights::cube_face_matrix` draws them).
+fn cube_face(d: vec3f) -> u32 {
+    let a = abs(d);
+    var face = 4u;
+    if (a.x >= a.y && a.x >= a.z) {
+        face = 0u;
+    } else if (a.y >= a.z) {
+        face = 2u;
+    }
+    if ((face == 0u && d.x < 0.0) || (face == 2u && d.y < 0.0) || (face == 4u && d.z < 0.0)) {
+        face += 1u;
+    }
+    return face;
+}
+
 // Irradiance factor of a one-sided rectangle (centre c, half-edges hu, hv,
 // emitting towards nl) at p with unit normal n: E / L = ½ Σ_i Θ_i (n · Γ_i),
 // Lambert's polygon formula over the rectangle clipped to the hemisphere above

@@ -14,18 +14,7 @@ fn shadow_layer(l: GpuLight, p: vec3f) -> u32 {
     if (l.kind.x != 1u) {
         return l.kind.y;
     }
-    let d = p - l.position.xyz;
-    let a = abs(d);
-    var face = 4u;
-    if (a.x >= a.y && a.x >= a.z) {
-        face = 0u;
-    } else if (a.y >= a.z) {
-        face = 2u;
-    }
-    if ((face == 0u && d.x < 0.0) || (face == 2u && d.y < 0.0) || (face == 4u && d.z < 0.0)) {
-        face += 1u;
-    }
-    return l.kind.y + face;
+    return l.kind.y + cube_face(p - l.position.xyz);
 }
 
 // Where p (normal n, distance `dist` to a local light) falls in light `l`'s
