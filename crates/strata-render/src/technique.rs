@@ -610,7 +610,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 18] = [
+static ILS_SETTINGS: [SettingInfo; 19] = [
     SettingInfo {
         name: "shadows",
         doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
@@ -767,6 +767,14 @@ static ILS_SETTINGS: [SettingInfo; 18] = [
         false,
         |s| Some(ils_of(s).refine as f64),
         |s, v| ils_mut(s).refine = v as f32
+    ),
+    setting!(
+        "refine-roughness",
+        "ils-refine also shades glossy receivers smoother than this roughness with all N VPLs (sharp lobes stay n*m blocks under the blur; 0 = off; not in ILS)",
+        Range::Closed(0.0, 1.0),
+        false,
+        |s| Some(ils_of(s).refine_roughness as f64),
+        |s, v| ils_mut(s).refine_roughness = v as f32
     ),
     setting!(
         "depth-threshold",

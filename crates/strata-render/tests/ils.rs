@@ -431,65 +431,72 @@ fn kept_vpl_shadow_maps_match_a_fresh_frame_and_follow_new_vpls() {
 }
 
 /// `ils-refine` (not in the paper): with `refine` = t, the pixels whose blur
-/// averaged less than t of the n·m VPL subsets (the blurred target's alpha) hold the
-/// brute force's value (all N VPLs, the same shading code) in both the irradiance
-/// and the glossy radiance, and every other pixel keeps its blurred value, bit for
-/// bit. On still-life (glossy and Lambert receivers, 8×6, t = 0.5) some pixels of
-/// each kind are refined; with SSM the refined pixels test the VPLs' shadow maps as
-/// the brute force does.
+/// averaged less than t of the n·m VPL subsets (the blurred target's alpha), and with
+/// `refine-roughness` = r the glossy receivers smoother than r, hold the brute force's
+/// value (all N VPLs, the same shading code) in both the irradiance and the glossy
+/// radiance, and every other pixel keeps its blurred value, bit for bit. On still-life
+/// (glossy and Lambert receivers, 8×6): t = 0.5 refines pixels of each kind; r = 0.3
+/// alone refines the gold sphere (0.25) and the vase (0.15) and no Lambert pixel. With
+/// SSM the refined pixels test the VPLs' shadow maps as the brute force does.
 #[test]
 fn refined_pixels_hold_the_brute_force_and_the_others_the_blur() {
     use strata_render::passes::ils::VplShadows;
     let gpu = common::gpu();
     let scene = procedural::builtin("still-life").unwrap();
     let v = vpls(&scene, 96);
+    let read = |r: &Renderer, name: &str| {
+        let img = r.read_target(&gpu, name).unwrap();
+        gpu.check_errors().unwrap();
+        img
+    };
     for shadows in [VplShadows::None, VplShadows::ShadowMaps] {
-        let settings = |brute_force: bool, refine: f32| IlsSettings {
+        let settings = |brute_force: bool, refine: f32, refine_roughness: f32| IlsSettings {
             vpls: gpu_vpls(&v),
             brute_force,
             refine,
+            refine_roughness,
             shadows,
             vpl_shadow_resolution: 32,
             ..Default::default()
         };
-        let read = |r: &Renderer, name: &str| {
-            let img = r.read_target(&gpu, name).unwrap();
-            gpu.check_errors().unwrap();
-            img
-        };
-        let brute = render(&gpu, &scene, settings(true, 0.0));
-        let refined = render(&gpu, &scene, settings(false, 0.5));
-        let (blurred, blurred_glossy) = (read(&refined, "indirect"), read(&refined, "ils-glossy-blurred"));
-        let (out, out_glossy) = (read(&refined, "ils-refined"), read(&refined, "ils-glossy-refined"));
+        let brute = render(&gpu, &scene, settings(true, 0.0, 0.0));
         let (bf, bf_glossy) = (read(&brute, "ils-irradiance"), read(&brute, "ils-glossy"));
-        let (csz, emission) = (read(&refined, "csz"), read(&refined, "emission"));
-        let (mut kept, mut lambert, mut glossy) = (0, 0, 0);
-        let csz_stride = csz.data.len() / (W * H) as usize;
-        for i in 0..(W * H) as usize {
-            let px = |img: &ImageBuf| Vec3::from_slice(&img.data[i * 4..i * 4 + 3]);
-            if csz.data[i * csz_stride] <= 0.0 || blurred.data[i * 4 + 3] >= 0.5 {
-                assert_eq!(px(&out), px(&blurred), "{shadows:?}: pixel {i} keeps the blur");
-                assert_eq!(px(&out_glossy), px(&blurred_glossy), "{shadows:?}: pixel {i} (glossy)");
-                kept += 1;
-                continue;
-            }
-            assert_eq!(px(&out), px(&bf), "{shadows:?}: refined pixel {i} = the brute force");
-            assert_eq!(
-                px(&out_glossy),
-                px(&bf_glossy),
-                "{shadows:?}: refined pixel {i} (glossy)"
+        for (t, r) in [(0.5f32, 0.0f32), (0.0, 0.3)] {
+            let refined = render(&gpu, &scene, settings(false, t, r));
+            let (blurred, blurred_glossy) = (read(&refined, "indirect"), read(&refined, "ils-glossy-blurred"));
+            let (out, out_glossy) = (read(&refined, "ils-refined"), read(&refined, "ils-glossy-refined"));
+            let (csz, emission, normal) = (
+                read(&refined, "csz"),
+                read(&refined, "emission"),
+                read(&refined, "normal"),
             );
-            if emission.data[i * 4 + 3] > 1.5 {
-                glossy += 1;
-            } else {
-                lambert += 1;
+            let (mut kept, mut lambert, mut glossy) = (0, 0, 0);
+            let csz_stride = csz.data.len() / (W * H) as usize;
+            for i in 0..(W * H) as usize {
+                let px = |img: &ImageBuf| Vec3::from_slice(&img.data[i * 4..i * 4 + 3]);
+                let is_glossy = emission.data[i * 4 + 3] > 1.5;
+                let sharp = is_glossy && normal.data[i * 4 + 2] < r;
+                let case = format!("{shadows:?}, refine {t}, refine-roughness {r}: pixel {i}");
+                if csz.data[i * csz_stride] <= 0.0 || (blurred.data[i * 4 + 3] >= t && !sharp) {
+                    assert_eq!(px(&out), px(&blurred), "{case} keeps the blur");
+                    assert_eq!(px(&out_glossy), px(&blurred_glossy), "{case} keeps the blur (glossy)");
+                    kept += 1;
+                    continue;
+                }
+                assert_eq!(px(&out), px(&bf), "{case} = the brute force");
+                assert_eq!(px(&out_glossy), px(&bf_glossy), "{case} = the brute force (glossy)");
+                if is_glossy {
+                    glossy += 1;
+                } else {
+                    lambert += 1;
+                }
             }
+            eprintln!(
+                "{shadows:?}, refine {t}, refine-roughness {r}: {lambert} Lambert and {glossy} glossy pixels refined, {kept} kept"
+            );
+            let lambert_ok = if t > 0.0 { lambert > 20 } else { lambert == 0 };
+            assert!(lambert_ok && glossy > 5 && kept > 1000, "{lambert} / {glossy} / {kept}");
         }
-        eprintln!("{shadows:?}: {lambert} Lambert and {glossy} glossy pixels refined, {kept} kept");
-        assert!(
-            lambert > 20 && glossy > 5 && kept > 1000,
-            "{lambert} / {glossy} / {kept}"
-        );
     }
 }
 

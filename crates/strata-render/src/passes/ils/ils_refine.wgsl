@@ -3,7 +3,8 @@
 // subsets there and they keep most of their subset's ×n·m noise: bright speckles
 // along silhouettes. The blur's alpha says which share of the subsets each pixel
 // averaged (`coverage` in ils_filter.wgsl); pixels below `shade.refine` are shaded
-// again with all N VPLs (the brute force at that pixel), the others keep the
+// again with all N VPLs (the brute force at that pixel), and so are glossy receivers
+// smoother than `shade.refine_roughness` (sharp lobes: n×m blocks); the others keep the
 // blurred values. Appended to ils_vpl_shading.wgsl.
 #import "common/fullscreen.wgsl"
 #import "common/frame.wgsl"
@@ -40,7 +41,9 @@ fn refined_at(p: vec2u) -> Refined {
     r.keep.irradiance = textureLoad(blurred, vec2i(p), 0);
     r.keep.glossy = textureLoad(blurred_glossy, vec2i(p), 0);
     r.g = textureLoad(gbuffer, vec2i(p), 0);
-    r.refined = r.g.w > 0.0 && r.keep.irradiance.a < shade.refine;
+    let p_i = vec2i(p);
+    let sharp = textureLoad(emission_tex, p_i, 0).a > 1.5 && textureLoad(normal_tex, p_i, 0).z < shade.refine_roughness;
+    r.refined = r.g.w > 0.0 && (r.keep.irradiance.a < shade.refine || sharp);
     return r;
 }
 

@@ -35,6 +35,11 @@ struct Shade {
     eye_offset: f32,
     texel_at_1: f32,
     half_texel: f32,
+    // ils-refine: glossy receivers rougher than this keep the blur (0 = every one does)
+    refine_roughness: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // Lambert receivers: (E, 1) in location 0 and (0, 0, 0, 1) in location 1; glossy

@@ -181,6 +181,11 @@ pub struct IlsSettings {
     /// all N VPLs (`ils-refine`, docs/ils.md § "Refining the pixels the blur misses").
     /// 0..=1; 0 = off.
     pub refine: f32,
+    /// Not in the paper: `ils-refine` also shades glossy receivers smoother than this
+    /// roughness with all N VPLs. Neighbours see different reflections in a sharp lobe,
+    /// so the blur cannot rebuild it from their subsets and it stays as n×m blocks.
+    /// 0..=1; 0 = off.
+    pub refine_roughness: f32,
 }
 
 impl Default for IlsSettings {
@@ -203,6 +208,7 @@ impl Default for IlsSettings {
             vpl_shadow_resolution: 64,
             vpl_shadow_cache: true,
             refine: 0.0,
+            refine_roughness: 0.0,
         }
     }
 }
@@ -231,6 +237,12 @@ impl IlsSettings {
         }
         if !(0.0..=1.0).contains(&self.refine) {
             return Err(format!("refine {} is out of range: must be in 0..=1", self.refine));
+        }
+        if !(0.0..=1.0).contains(&self.refine_roughness) {
+            return Err(format!(
+                "refine-roughness {} is out of range: must be in 0..=1",
+                self.refine_roughness
+            ));
         }
         if !(0.0..=4.0).contains(&self.blur) {
             return Err(format!("blur {} is out of range: must be in 0..=4", self.blur));
@@ -290,7 +302,7 @@ impl IlsSettings {
 
     /// Whether `ils-refine` runs (after a blur of the interleaved frame).
     pub fn refines(&self) -> bool {
-        self.refine > 0.0 && self.blurs() && !self.brute_force
+        (self.refine > 0.0 || self.refine_roughness > 0.0) && self.blurs() && !self.brute_force
     }
 
     /// The frame's passes for these settings, in order.
@@ -458,6 +470,9 @@ struct ShadeUniforms {
     max_geometry: f32,
     /// SSM: eye offset, texel size at distance 1, half a texel in face uv.
     ssm: [f32; 3],
+    /// `IlsSettings::refine_roughness`
+    refine_roughness: f32,
+    _pad: [u32; 3],
 }
 
 #[repr(C)]
@@ -798,6 +813,8 @@ impl IlsStage {
             refine: s.refine,
             max_geometry: s.max_geometry(scene),
             ssm: ssm_uniforms,
+            refine_roughness: s.refine_roughness,
+            _pad: [0; 3],
         };
         let shade = {
             let traced = vpl_shadows.is_some();
