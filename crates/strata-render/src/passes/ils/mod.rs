@@ -12,7 +12,7 @@
 //! | `ils-db` | §4.5 DB | discontinuity buffer (depth and normal vs the three positive neighbours) |
 //! | `ils-blur-h`, `ils-blur-v` | §4.5 B | separable Gaussian blur stopping at discontinuities (Fig. 4 a or b) |
 //! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers") |
-//! | `ils-refine` | – | only with [`IlsSettings::refine`]: pixels the blur averaged too few VPL subsets for, shaded with all N VPLs (not in the paper) |
+//! | `ils-refine` | – | only with [`IlsSettings::refine`] or [`IlsSettings::refine_roughness`]: pixels the blur averaged too few VPL subsets for, and sharp glossy receivers, shaded with all N VPLs (not in the paper) |
 //! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance + blurred glossy radiance (the shared compose pass) |
 //!
 //! With [`IlsSettings::brute_force`] the three middle passes are replaced by
@@ -455,7 +455,7 @@ pub const GLOSSY_REFINED: TargetDesc = TargetDesc::new(
     1,
     "ils-glossy-blurred after ils-refine",
 );
-/// The refinement pass (`IlsSettings::refine`).
+/// The refinement pass (`IlsSettings::refine`, `IlsSettings::refine_roughness`).
 pub const REFINE_PASS: &str = "ils-refine";
 
 #[repr(C)]
@@ -675,7 +675,8 @@ pub(crate) struct IlsStage {
     blur_v: Option<FullscreenPass>,
     glossy_h: Option<FullscreenPass>,
     glossy_v: Option<FullscreenPass>,
-    /// `IlsSettings::refine`: the pixels the blur averaged too few VPL subsets for
+    /// `IlsSettings::refine`, `refine_roughness`: the pixels the blur averaged too few
+    /// VPL subsets for, and sharp glossy receivers
     refine: Option<FullscreenPass>,
     compose: crate::passes::compose::ComposePass,
     vpl_buffer: wgpu::Buffer,
