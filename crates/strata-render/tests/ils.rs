@@ -32,18 +32,7 @@ fn gpu_vpls(v: &[Vpl]) -> Arc<[GpuVpl]> {
 }
 
 fn render(gpu: &GpuContext, scene: &Scene, ils: IlsSettings) -> Renderer {
-    let t = strata_render::technique::find("ils").unwrap();
-    let base = RenderSettings {
-        width: W,
-        height: H,
-        ..Default::default()
-    };
-    let mut s = t.settings(&base, None).unwrap();
-    s.ils = Some(ils);
-    let mut r = Renderer::new(gpu, scene, s).expect("renderer builds without validation errors");
-    r.render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0)
-        .expect("frame renders without validation errors");
-    r
+    common::ils_renderer(gpu, scene, ils, (W, H))
 }
 
 /// Largest |a − b| relative to the image's largest value.

@@ -164,28 +164,6 @@ fn gpu_glossy_vpl_radiance_equals_the_cpu_twin() {
     );
 }
 
-/// A W×H renderer of technique `ils` with `ils`, after one frame of `scene`'s camera.
-fn ils_frame(
-    gpu: &strata_render::GpuContext,
-    scene: &strata_scene::Scene,
-    ils: strata_render::passes::ils::IlsSettings,
-) -> strata_render::Renderer {
-    use strata_render::frame::FrameCameras;
-    use strata_render::{RenderSettings, Renderer};
-    let t = strata_render::technique::find("ils").unwrap();
-    let base = RenderSettings {
-        width: W,
-        height: H,
-        ..Default::default()
-    };
-    let mut s = t.settings(&base, None).unwrap();
-    s.ils = Some(ils);
-    let mut r = Renderer::new(gpu, scene, s).expect("renderer builds without validation errors");
-    r.render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0)
-        .expect("frame renders without validation errors");
-    r
-}
-
 /// One ILS frame of `scene` (in the first test `still-life`: gold metal sphere,
 /// blue glossy vase, Lambert cloth and boxes), its `ils-glossy` multiplied back by
 /// the CPU twin of its demodulation, and, per pixel, the CPU twin of what it must hold: from the
@@ -216,7 +194,7 @@ fn glossy_frame(
 ) -> GlossyFrame {
     let max_g = ils.max_geometry(scene);
     let brute_force = ils.brute_force;
-    let r = ils_frame(gpu, scene, ils);
+    let r = common::ils_renderer(gpu, scene, ils, (W, H));
     let read = |name: &str| {
         let img = r.read_target(gpu, name).unwrap();
         gpu.check_errors().unwrap();
@@ -447,7 +425,7 @@ fn composed(
     scene: &strata_scene::Scene,
     ils: strata_render::passes::ils::IlsSettings,
 ) -> [strata_scene::ImageBuf; 4] {
-    let r = ils_frame(gpu, scene, ils);
+    let r = common::ils_renderer(gpu, scene, ils, (W, H));
     ["hdr-full", "hdr", "albedo", "emission"].map(|name| {
         let img = r.read_target(gpu, name).unwrap();
         gpu.check_errors().unwrap();

@@ -239,6 +239,28 @@ pub fn surface_points(gpu: &GpuContext, r: &Renderer) -> Vec<SurfacePoint> {
     out
 }
 
+/// A `w`×`h` renderer of technique `ils` with `ils`, after one frame of `scene`'s camera
+/// at frame 0; panics on any wgpu validation error.
+pub fn ils_renderer(
+    gpu: &GpuContext,
+    scene: &Scene,
+    ils: strata_render::passes::ils::IlsSettings,
+    (w, h): (u32, u32),
+) -> Renderer {
+    let t = strata_render::technique::find("ils").unwrap();
+    let base = RenderSettings {
+        width: w,
+        height: h,
+        ..Default::default()
+    };
+    let mut s = t.settings(&base, None).unwrap();
+    s.ils = Some(ils);
+    let mut r = Renderer::new(gpu, scene, s).expect("renderer builds without validation errors");
+    r.render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0)
+        .expect("frame renders without validation errors");
+    r
+}
+
 /// ILS §4.3's VPL sum at pixel (x, y): Σ_k `term(k)` over all `n_all` VPLs
 /// (`brute_force`) or over the pixel's sub-buffer subset of pattern n×m
 /// (k ≡ j·n + i mod n·m for sub-buffer (i, j) = (x mod n, y mod m)), scaled by N/N_s.
