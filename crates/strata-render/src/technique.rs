@@ -714,7 +714,7 @@ static ILS_SETTINGS: [SettingInfo; 19] = [
     ),
     setting!(
         "brute-force",
-        "1 = every pixel shades all N VPLs (ILS Table 4's no IS)",
+        "1 = every pixel shades all N VPLs, unblurred (ILS Table 4's no IS)",
         Range::Closed(0.0, 1.0),
         true,
         |s| Some(ils_of(s).brute_force as u32 as f64),

@@ -108,6 +108,35 @@ fn one_by_one_pattern_and_all_vpls_per_sub_buffer_equal_the_brute_force() {
     }
 }
 
+/// The brute force is Table 4's standard deferred shading: no DB or blur runs, whatever
+/// `blur` says, so its frame with the default blur is its unblurred frame bit for bit
+/// (before 2026-11-28 it was blurred unless `blur=0` was set too).
+#[test]
+fn brute_force_is_never_blurred() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("cornell").unwrap();
+    let v = vpls(&scene, 96);
+    let frame = |blur: f32| {
+        let s = IlsSettings {
+            brute_force: true,
+            blur,
+            ..base(&scene, &v)
+        };
+        let passes = s.passes();
+        assert!(
+            !passes.iter().any(|p| p.starts_with("ils-blur") || *p == "ils-db"),
+            "blur {blur}: {passes:?}"
+        );
+        let r = render(&gpu, &scene, s);
+        let img = r.read_target(&gpu, "hdr-full").unwrap();
+        gpu.check_errors().unwrap();
+        img
+    };
+    let (unblurred, default_blur) = (frame(0.0), frame(IlsSettings::default().blur));
+    assert!(unblurred.data.iter().any(|&x| x > 0.0));
+    assert_eq!(unblurred.data, default_blur.data);
+}
+
 /// The three BS/BG methods in the frame (8×6, each sub-buffer its own VPL subset,
 /// blur on) give the same split G-buffer, gathered irradiance and blurred indirect
 /// light, bit for bit: the compute method writes storage targets, the others

@@ -17,7 +17,8 @@
 //!
 //! With [`IlsSettings::brute_force`] the three middle passes are replaced by
 //! `ils-brute-force`: every pixel, all N VPLs (Table 4's "no IS"), with the
-//! same shading code (`shaders/common/vpl.wgsl`).
+//! same shading code (`shaders/common/vpl.wgsl`); DB and B do not run then
+//! (nothing is interleaved, so there is nothing to blur).
 //!
 //! **VPL assignment.** VPL k goes to sub-buffer s = k mod (n·m), s = j·n + i,
 //! so the subsets partition the N VPLs; a pixel of sub-buffer s sums its
@@ -139,7 +140,8 @@ pub struct IlsSettings {
     /// d_c: the geometry term is clamped to 1/d_c² (scene units; `None`: 2 % of
     /// the scene's bounding-box diagonal).
     pub clamp_distance: Option<f32>,
-    /// Table 4's "no IS": every pixel shades all N VPLs (no BS, BG).
+    /// Table 4's "no IS": every pixel shades all N VPLs (no BS, BG, and no DB, B
+    /// whatever [`IlsSettings::blur`] says).
     pub brute_force: bool,
     /// Test hook: every sub-buffer shades all N VPLs (scale 1), so the gathered
     /// image must equal the brute force.
@@ -295,14 +297,16 @@ impl IlsSettings {
         self.pattern.map(|p| (self.blur * p as f32 * 0.5).floor() as u32)
     }
 
-    /// Whether the DB and blur passes run.
+    /// Whether the DB and blur passes run: `blur` > 0 on the interleaved frame.
+    /// The brute force is Table 4's "standard deferred shading": every pixel already
+    /// has all N VPLs, so it is never blurred, whatever `blur` says.
     pub fn blurs(&self) -> bool {
-        self.blur > 0.0
+        self.blur > 0.0 && !self.brute_force
     }
 
     /// Whether `ils-refine` runs (after a blur of the interleaved frame).
     pub fn refines(&self) -> bool {
-        (self.refine > 0.0 || self.refine_roughness > 0.0) && self.blurs() && !self.brute_force
+        (self.refine > 0.0 || self.refine_roughness > 0.0) && self.blurs()
     }
 
     /// The frame's passes for these settings, in order.
