@@ -519,6 +519,9 @@ pub struct IlsEval {
     /// `ils-refine`'s coverage threshold (0 = off; `IlsSettings::refine`).
     #[serde(default)]
     pub refine: f32,
+    /// Whether windows an edge cuts slide and are re-weighted (`IlsSettings::slide_window`).
+    #[serde(default)]
+    pub blur_slide: bool,
     /// `none` (SNSM: VPL visibility ignored) or `vpl` (SSM: per-VPL shadow maps, §4.3).
     pub shadows: String,
     /// Full image vs the brute force (every pixel, all N VPLs, same shadows): ꟻLIP and RMSE of

@@ -610,7 +610,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 19] = [
+static ILS_SETTINGS: [SettingInfo; 20] = [
     SettingInfo {
         name: "shadows",
         doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
@@ -759,6 +759,14 @@ static ILS_SETTINGS: [SettingInfo; 19] = [
         true,
         |s| Some(ils_of(s).per_axis_discontinuities as u32 as f64),
         |s, v| ils_mut(s).per_axis_discontinuities = v != 0.0
+    ),
+    setting!(
+        "blur-slide",
+        "1 = where an edge cuts the blur on one side, its window slides away from the edge to keep n (m) texels (not in ILS)",
+        Range::Closed(0.0, 1.0),
+        true,
+        |s| Some(ils_of(s).slide_window as u32 as f64),
+        |s, v| ils_mut(s).slide_window = v != 0.0
     ),
     setting!(
         "refine",

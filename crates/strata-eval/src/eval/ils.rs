@@ -141,6 +141,7 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u3
         blur: ils.blur,
         bilinear: ils.bilinear,
         refine: ils.refine,
+        blur_slide: ils.slide_window,
         shadows: shadows.into(),
         flip_vs_brute: vs_brute.flip,
         rmse_vs_brute: vs_brute.rmse,

@@ -22,6 +22,8 @@ struct Filter {
     period: u32,
     // B: the interleave pattern's size along `dir` (n or m), for the coverage
     pattern: u32,
+    // B: 1 = windows an edge cuts are re-weighted and slide (`slide_window`; not in the paper)
+    slide: u32,
     // B: the tap weight at offset ±k is weights[k / 4][k % 4], k in 0..=radius
     // (`ils::blur_weights`: the Gaussian, or with a period divided by the window's sum
     // over the tap's sub-buffer)
@@ -99,13 +101,19 @@ fn coverage(texels: f32, alpha_sum: f32) -> f32 {
     return min(texels, p) / p * (alpha_sum / texels);
 }
 
+// A blurred value and the number of texels its window held (2r + 1 when uncut).
+struct Blurred {
+    v: vec4f,
+    texels: f32,
+}
+
 // §4.5: from a pixel not on a discontinuity, both directions are explored; a
 // neighbour is blended while the pixel before it (towards the centre) is
 // similar to it, i.e. texel c + k·d needs DB(c + (k − 1)·d) = 0 going +d and
 // DB(c − k·d) = 0 going −d (the flag of a texel says it differs from its +x/+y
 // neighbours). From a pixel on a discontinuity only −d is explored. Colours of
 // objects are never filtered (albedo is applied after, in compose).
-fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
+fn blur_texels(c: vec2i, size: vec2i) -> Blurred {
     let d = filt.dir;
     let r = i32(filt.radius);
     let w0 = weight(0);
@@ -140,7 +148,7 @@ fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
         texels += 1.0;
         alpha += t.a;
     }
-    return vec4f(sum / wsum, coverage(texels, alpha));
+    return Blurred(vec4f(sum / wsum, coverage(texels, alpha)), texels);
 }
 
 // Fig. 4 b: texels k and k + 1 in one bilinear tap at k + w_{k+1}/(w_k + w_{k+1})
@@ -149,7 +157,7 @@ fn blur_texels(c: vec2i, size: vec2i) -> vec4f {
 // it is > 0. Going −d this tests exactly the two texels' flags; going +d it
 // tests flags k, k + 1 instead of k − 1, k (k − 1's was tested by the previous
 // tap, or is the centre's): never more permissive than the texel form.
-fn blur_bilinear(c: vec2i, size: vec2i) -> vec4f {
+fn blur_bilinear(c: vec2i, size: vec2i) -> Blurred {
     let d = filt.dir;
     let r = i32(filt.radius);
     let inv = 1.0 / vec2f(size);
@@ -186,6 +194,85 @@ fn blur_bilinear(c: vec2i, size: vec2i) -> vec4f {
             alpha += n * t.a;
         }
     }
+    return Blurred(vec4f(sum / wsum, coverage(texels, alpha)), texels);
+}
+
+// Not in the paper (`slide_window`). The last tap k in first..=last reachable from c along
+// s·dir under blur_texels' rules: going +d, texel k + 1 needs the flag of texel k clear
+// (its predecessor towards the centre); going −d, its own flag clear; both inside.
+fn reach(c: vec2i, size: vec2i, s: i32, first: i32, last: i32) -> i32 {
+    var k = first;
+    while (k < last) {
+        let q = c + (k + 1) * s * filt.dir;
+        if (any(q < vec2i(0)) || any(q >= size)) {
+            break;
+        }
+        if (select(flag(q), flag(c + k * filt.dir), s > 0)) {
+            break;
+        }
+        k++;
+    }
+    return k;
+}
+
+// Not in the paper (`slide_window`): the window [−a, b] along dir of a pixel whose
+// blur_texels (or blur_bilinear) window an edge or the border cuts on a side; (−1, −1)
+// when neither side is cut. When it holds fewer than L = min(2r + 1, pattern) texels and one side is
+// open, that side goes past r until the window holds L texels (or meets a cut).
+fn cut_window(c: vec2i, size: vec2i) -> vec2i {
+    let r = i32(filt.radius);
+    let l = min(2 * r + 1, i32(max(filt.pattern, 1u)));
+    var a = reach(c, size, -1, 0, r);
+    var b = reach(c, size, 1, 0, r);
+    if (a == r && b == r) {
+        // the bilinear form also drops the last +d tap when texel r is flagged (its
+        // tap reads the DB at r); the texel rule keeps it: sum it here, exactly
+        if (filt.bilinear != 0u && r > 0 && flag(c + r * filt.dir)) {
+            return vec2i(r);
+        }
+        return vec2i(-1);
+    }
+    if (a + b + 1 < l) {
+        if (b == r) {
+            b = reach(c, size, 1, r, l - 1 - a);
+        } else if (a == r) {
+            a = reach(c, size, -1, r, l - 1 - b);
+        }
+    }
+    return vec2i(a, b);
+}
+
+fn gauss(k: i32) -> f32 {
+    return exp(-0.5 * f32(k * k) / (filt.sigma * filt.sigma));
+}
+
+// The cut window's sum over its texels −a..=b. With equal sub-buffer weights each
+// tap's Gaussian is divided by the Gaussian's sum over the window's taps of the same
+// sub-buffer (offsets ≡ k mod period in [−a, b]), as `blur_weights` does for the whole
+// window, so every sub-buffer the window holds weighs 1 (a window of ≤ n texels: each
+// weighs 1); without them, the Gaussian.
+fn blur_cut(c: vec2i, ab: vec2i) -> vec4f {
+    let p = i32(filt.period);
+    var sum = vec3f(0.0);
+    var wsum = 0.0;
+    var alpha = 0.0;
+    // equal sub-buffer weights over ≤ period texels: each sub-buffer once, weight 1
+    let boxed = p > 1 && ab.x + ab.y + 1 <= p;
+    for (var k = -ab.x; k <= ab.y; k++) {
+        var w = select(gauss(k), 1.0, boxed);
+        if (p > 1 && !boxed) {
+            var same = 0.0;
+            for (var t = k - p * ((k + ab.x) / p); t <= ab.y; t += p) {
+                same += gauss(t);
+            }
+            w /= same;
+        }
+        let t = textureLoad(src, c + k * filt.dir, 0);
+        sum += w * t.rgb;
+        wsum += w;
+        alpha += t.a;
+    }
+    let texels = f32(ab.x + ab.y + 1);
     return vec4f(sum / wsum, coverage(texels, alpha));
 }
 
@@ -193,8 +280,18 @@ fn blur_bilinear(c: vec2i, size: vec2i) -> vec4f {
 fn fs_blur(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     let c = vec2i(pos.xy);
     let size = vec2i(textureDimensions(src));
+    var b: Blurred;
     if (filt.bilinear != 0u) {
-        return blur_bilinear(c, size);
+        b = blur_bilinear(c, size);
+    } else {
+        b = blur_texels(c, size);
     }
-    return blur_texels(c, size);
+    // only a window cut on a side pays for the slide
+    if (filt.slide != 0u && b.texels < f32(2u * filt.radius + 1u)) {
+        let ab = cut_window(c, size);
+        if (ab.x >= 0) {
+            return blur_cut(c, ab);
+        }
+    }
+    return b.v;
 }

@@ -164,6 +164,14 @@ pub struct IlsSettings {
     /// §4.5's flag over all three positive neighbours (which leaves pixels along
     /// an edge unblurred across it, visible as speckled outlines).
     pub per_axis_discontinuities: bool,
+    /// Not in the paper: where the blur is cut on one side (an edge), the window slides
+    /// away from the edge to keep min(2r + 1, n) contiguous texels along x (m along y)
+    /// while its other side stays on the surface, so a pixel beside an edge still
+    /// averages every VPL subset of its row (column) instead of keeping most of its own
+    /// subset's noise: the dark wedges and bright speckles along edges (docs/ils.md §
+    /// "Sliding the window at edges"). The slid window weighs its texels equally (equal
+    /// sub-buffer weights) or by the Gaussian of their offset. Default false.
+    pub slide_window: bool,
     /// DB: a neighbour is a discontinuity beyond this distance from the
     /// pixel's tangent plane, relative to its depth z (> 0).
     pub depth_threshold: f32,
@@ -204,6 +212,7 @@ impl Default for IlsSettings {
             bilinear: true,
             equal_subsets: true,
             per_axis_discontinuities: false,
+            slide_window: false,
             depth_threshold: 0.02,
             normal_threshold_deg: 25.0,
             shadows: VplShadows::None,
@@ -493,7 +502,9 @@ struct FilterUniforms {
     period: u32,
     /// The interleave pattern's size along `dir` (the blur's coverage; 0 for the DB).
     pattern: u32,
-    _pad: [u32; 2],
+    /// [`IlsSettings::slide_window`] (0 for the DB).
+    slide: u32,
+    _pad: u32,
     /// [`blur_weights`], four per vec4.
     weights: [[f32; 4]; 9],
 }
@@ -587,7 +598,8 @@ fn filter_uniforms(s: &IlsSettings, radius: u32, dir: [i32; 2]) -> FilterUniform
             [_, 0] => s.pattern[0],
             _ => s.pattern[1],
         },
-        _pad: [0; 2],
+        slide: (s.slide_window && dir != [0, 0]) as u32,
+        _pad: 0,
         weights,
     }
 }
@@ -1176,6 +1188,64 @@ mod tests {
         }
     }
 
+    /// `slide_window`: two planes side by side (an edge at x = 20) and the image border
+    /// cut the blur, and each plane's gathered image is the 8×6 interleaved pattern (the
+    /// right one twice the left). Both planes are wider than 8 and taller than 6 texels,
+    /// so with the sliding window every pixel, beside the edge and the border included,
+    /// averages all 48 sub-buffers of its own plane: its plane's mean (texel taps and
+    /// slid windows exactly; unslid bilinear taps within 0.4 %). With §4.5's flag the
+    /// column x = 19 is flagged (it differs from its +x neighbour), which stops the
+    /// vertical blur there, slid or not; with `per_axis_discontinuities` it is exact too.
+    /// Without the slide the pixels within a radius of the edge keep part of the
+    /// pattern (the control).
+    #[test]
+    fn sliding_windows_average_every_sub_buffer_beside_an_edge() {
+        let (w, h) = (48u32, 36u32);
+        let v = |x: u32, y: u32| (8 + ((x % 8) * 6 + y % 6) * 7 % 48) as f32 / 64.0;
+        let mean = (0..8).flat_map(|i| (0..6).map(move |j| v(i, j))).sum::<f32>() / 48.0;
+        let plane = |x: u32, _: u32| (x >= 20) as u32;
+        let gpu = gpu();
+        for (bilinear, per_axis, slide) in [
+            (false, false, true),
+            (true, false, true),
+            (false, true, true),
+            (true, true, true),
+            (false, true, false),
+            (true, false, false),
+        ] {
+            let s = IlsSettings {
+                slide_window: slide,
+                per_axis_discontinuities: per_axis,
+                ..settings(bilinear)
+            };
+            let (out, _) = filter(&gpu, &s, w, h, plane, |x, y, p| v(x, y) * (1 + p) as f32);
+            let deviation = |(x, y): (u32, u32)| {
+                let want = mean * (1 + plane(x, y)) as f32;
+                (out[(y * w + x) as usize] - want).abs() / want
+            };
+            let all = (0..h).flat_map(|y| (0..w).map(move |x| (x, y)));
+            let worst = all
+                .filter(|&(x, _)| per_axis || x != 19)
+                .map(deviation)
+                .fold(0.0f32, f32::max);
+            let beside = (8..h - 8).flat_map(|y| (12..28).map(move |x| (x, y)));
+            let worst_beside = beside.filter(|&(x, _)| x != 19).map(deviation).fold(0.0f32, f32::max);
+            eprintln!("bilinear {bilinear}, per-axis {per_axis}, slide {slide}: worst {worst}, beside the edge {worst_beside}");
+            if slide {
+                let bound = if bilinear { 4e-3 } else { 1e-4 };
+                assert!(
+                    worst < bound,
+                    "bilinear {bilinear}, per-axis {per_axis}: the pattern remains ({worst})"
+                );
+            } else {
+                assert!(
+                    worst_beside > 2e-2,
+                    "control: no pattern beside the edge ({worst_beside})"
+                );
+            }
+        }
+    }
+
     #[test]
     fn no_value_crosses_a_discontinuity() {
         // four quadrants at depths 1..4, each with its own irradiance; 8x6 kernel
@@ -1184,9 +1254,17 @@ mod tests {
         let quadrant = |x: u32, y: u32| (x >= 17) as u32 + 2 * (y >= 13) as u32;
         let values = [1.0f32, 4.0, 0.25, 2.0];
         let gpu = gpu();
-        for (bilinear, per_axis) in [(false, false), (true, false), (false, true), (true, true)] {
+        for (bilinear, per_axis, slide) in [
+            (false, false, false),
+            (true, false, false),
+            (false, true, false),
+            (true, true, false),
+            (false, false, true),
+            (true, true, true),
+        ] {
             let s = IlsSettings {
                 per_axis_discontinuities: per_axis,
+                slide_window: slide,
                 ..settings(bilinear)
             };
             let (out, db) = filter(&gpu, &s, w, h, quadrant, |_, _, p| values[p as usize]);
@@ -1199,7 +1277,7 @@ mod tests {
                     let want = values[quadrant(x, y) as usize];
                     assert!(
                         (v - want).abs() <= 1e-3 * want,
-                        "bilinear {bilinear} per-axis {per_axis}: ({x}, {y}) = {v}, its plane's {want}"
+                        "bilinear {bilinear} per-axis {per_axis} slide {slide}: ({x}, {y}) = {v}, its plane's {want}"
                     );
                 }
             }
