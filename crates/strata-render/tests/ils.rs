@@ -108,6 +108,41 @@ fn one_by_one_pattern_and_all_vpls_per_sub_buffer_equal_the_brute_force() {
     }
 }
 
+/// A scene without glossy materials has no glossy receivers: its frame does not blur the
+/// glossy radiance, which is 0, and compose reads that 0. Still-life, with glossy
+/// materials, blurs it.
+#[test]
+fn scenes_without_glossy_materials_skip_the_glossy_passes() {
+    let gpu = common::gpu();
+    for (name, glossy) in [("cornell", false), ("still-life", true)] {
+        let scene = procedural::builtin(name).unwrap();
+        assert_eq!(scene.materials.iter().any(|m| m.glossy), glossy, "{name}");
+        let v = vpls(&scene, 96);
+        let s = IlsSettings {
+            refine: 0.5,
+            ..base(&scene, &v)
+        };
+        let s = IlsSettings { blur: 1.0, ..s };
+        let r = render(&gpu, &scene, s.clone());
+        let names: Vec<&str> = r.pass_infos().iter().map(|p| p.name).collect();
+        let glossy_passes: Vec<&&str> = names.iter().filter(|n| n.starts_with("ils-blur-glossy")).collect();
+        assert_eq!(!glossy_passes.is_empty(), glossy, "{name}: {names:?}");
+        assert!(names
+            .iter()
+            .all(|n| !n.starts_with("ils-") || s.passes(&scene).contains(n)));
+        let g = r.read_target(&gpu, "ils-glossy").unwrap();
+        gpu.check_errors().unwrap();
+        let c = g.channels as usize;
+        let rgb = g.data.chunks(c).flat_map(|p| &p[..3]);
+        let nonzero = rgb.filter(|&&x| x != 0.0).count();
+        if glossy {
+            assert!(nonzero > 0, "{name}: the glossy receivers' radiance is 0");
+        } else {
+            assert_eq!(nonzero, 0, "{name}: glossy radiance without glossy receivers");
+        }
+    }
+}
+
 /// The brute force is Table 4's standard deferred shading: no DB or blur runs, whatever
 /// `blur` says, so its frame with the default blur is its unblurred frame bit for bit
 /// (before 2026-11-28 it was blurred unless `blur=0` was set too).
@@ -122,7 +157,7 @@ fn brute_force_is_never_blurred() {
             blur,
             ..base(&scene, &v)
         };
-        let passes = s.passes();
+        let passes = s.passes(&scene);
         assert!(
             !passes.iter().any(|p| p.starts_with("ils-blur") || *p == "ils-db"),
             "blur {blur}: {passes:?}"

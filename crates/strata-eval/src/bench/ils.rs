@@ -55,16 +55,9 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<IlsBench> {
     });
     let brute = configure(true)?;
     // the frames' own pass lists (with `shadows = vpl`: ils-vpl-shadows, ils-ssm)
-    let is_passes = ils.passes();
-    // "no IS" (Table 4): the brute force's own passes, its DB and blur not counted
-    let brute_passes: Vec<&str> = brute
-        .ils
-        .as_ref()
-        .expect("ILS is on")
-        .passes()
-        .into_iter()
-        .filter(|p| !p.starts_with("ils-db") && !p.starts_with("ils-blur"))
-        .collect();
+    let is_passes = ils.passes(&scene);
+    // "no IS" (Table 4): the brute force's own passes (it is never blurred)
+    let brute_passes = brute.ils.as_ref().expect("ILS is on").passes(&scene);
     let (w1, w2) = (with_vpls.clone(), with_vpls);
     let interleaved = stage::run(Stage {
         stage: &stage1,

@@ -34,19 +34,19 @@ pub fn run(
     // every error (preset, setting, range) before any GPU work
     let checked = configure(stage.layers)?;
     // ILS: the caller's VPLs, generated once (static scene)
-    let (vpls, vpl_maps_kept) = match &checked.ils {
+    let (vpls, vpl_maps_kept, ils_passes) = match &checked.ils {
         Some(i) => {
             let scene = stage.scene.load()?.0;
             let v = crate::vpls::scene_vpls(&scene, stage.scene.frame, i.vpl_count);
-            (Some(v), i.vpl_shadow_maps_cached(&scene))
+            (Some(v), i.vpl_shadow_maps_cached(&scene), i.passes(&scene))
         }
-        None => (None, false),
+        None => (None, false, Vec::new()),
     };
     // ILS: the frame's own ILS passes (with `shadows = vpl`: ils-vpl-shadows, ils-ssm)
     let passes: Vec<&str> = match &checked.ils {
-        Some(i) => {
+        Some(_) => {
             let before = technique.passes.iter().copied().take_while(|p| !p.starts_with("ils-"));
-            before.chain(i.passes()).chain(["tonemap"]).collect()
+            before.chain(ils_passes).chain(["tonemap"]).collect()
         }
         // BZB: the splatting algorithm's own passes (AOV or DSS)
         None => match (&checked.bzb, &checked.bzb_gi) {

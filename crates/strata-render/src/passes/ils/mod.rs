@@ -11,7 +11,7 @@
 //! | `ils-bg-glossy` | – | the same for the glossy receivers' GGX radiance (`ils-glossy`) |
 //! | `ils-db` | §4.5 DB | discontinuity buffer (depth and normal vs the three positive neighbours) |
 //! | `ils-blur-h`, `ils-blur-v` | §4.5 B | separable Gaussian blur stopping at discontinuities (Fig. 4 a or b) |
-//! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers") |
+//! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers"); only in scenes with glossy materials |
 //! | `ils-refine` | – | only with [`IlsSettings::refine`] or [`IlsSettings::refine_roughness`]: pixels the blur averaged too few VPL subsets for, and sharp glossy receivers, shaded with all N VPLs (not in the paper) |
 //! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance + blurred glossy radiance (the shared compose pass) |
 //!
@@ -318,8 +318,11 @@ impl IlsSettings {
         (self.refine > 0.0 || self.refine_roughness > 0.0) && self.blurs()
     }
 
-    /// The frame's passes for these settings, in order.
-    pub fn passes(&self) -> Vec<&'static str> {
+    /// The frame's passes for these settings in `scene`, in order. A scene without
+    /// glossy materials has no glossy receivers, so its glossy radiance is 0 and is not
+    /// blurred.
+    pub fn passes(&self, scene: &strata_scene::Scene) -> Vec<&'static str> {
+        let glossy = has_glossy_receivers(scene);
         let mut v = vec!["ils-gbuffer"];
         if self.shadows.traced() {
             v.push(VPL_SHADOW_PASS);
@@ -330,13 +333,10 @@ impl IlsSettings {
             v.extend(["ils-bs", self.shading_pass(), "ils-bg", "ils-bg-glossy"]);
         }
         if self.blurs() {
-            v.extend([
-                "ils-db",
-                "ils-blur-h",
-                "ils-blur-v",
-                "ils-blur-glossy-h",
-                "ils-blur-glossy-v",
-            ]);
+            v.extend(["ils-db", "ils-blur-h", "ils-blur-v"]);
+            if glossy {
+                v.extend(["ils-blur-glossy-h", "ils-blur-glossy-v"]);
+            }
             if self.refines() {
                 v.push(REFINE_PASS);
             }
@@ -530,6 +530,12 @@ pub fn blur_weights(radius: u32, sigma: f32, period: u32) -> Vec<f32> {
             gauss(k) / class
         })
         .collect()
+}
+
+/// Whether any material of `scene` is glossy (GGX): only then does the frame blur the
+/// glossy receivers' radiance (`ils-glossy` is 0 otherwise, and compose reads it as is).
+fn has_glossy_receivers(scene: &strata_scene::Scene) -> bool {
+    scene.materials.iter().any(|m| m.glossy)
 }
 
 /// BS or BG of one target into another, as a frame pass (also used by the
@@ -773,6 +779,7 @@ impl IlsStage {
             .write(GBUFFER.name)
             .build();
 
+        let glossy_receivers = has_glossy_receivers(scene);
         let (split, gather, gather_glossy, geo) = if s.brute_force {
             (None, None, None, None)
         } else {
@@ -886,9 +893,13 @@ impl IlsStage {
         let (shown, glossy_shown) = if s.blurs() {
             let (db, h, v) = filter_passes(gpu, scene_gpu, targets, s, IRRADIANCE.name, INDIRECT.name);
             (discontinuity, blur_h, blur_v) = (Some(db), Some(h), Some(v));
-            let (gh, gv) = glossy_blur_passes(gpu, scene_gpu, targets, s);
-            (glossy_h, glossy_v) = (Some(gh), Some(gv));
-            (INDIRECT.name, GLOSSY_BLURRED.name)
+            if glossy_receivers {
+                let (gh, gv) = glossy_blur_passes(gpu, scene_gpu, targets, s);
+                (glossy_h, glossy_v) = (Some(gh), Some(gv));
+                (INDIRECT.name, GLOSSY_BLURRED.name)
+            } else {
+                (INDIRECT.name, GLOSSY.name)
+            }
         } else {
             (IRRADIANCE.name, GLOSSY.name)
         };
