@@ -267,9 +267,11 @@ fn parse_guard_band(s: &str) -> Result<GuardBand, String> {
 /// Deep-G-buffer radiosity settings (DGB §3.2–3.5): a Table 2 preset, then overrides.
 #[derive(Args, Clone)]
 pub struct RadiosityArgs {
-    /// DGB Table 2 parameter set (presets/*.toml): high-performance, balanced, high-quality.
-    #[arg(long, default_value = "balanced")]
-    pub preset: String,
+    /// The technique's preset (`strata techniques` lists them): full's DGB Table 2 parameter
+    /// sets (presets/*.toml) high-performance, balanced (default), high-quality; ils's
+    /// standard (default), clean-edges, refined.
+    #[arg(long)]
+    pub preset: Option<String>,
     /// Indirect samples N per pixel, 1..=256 (default: the preset's).
     #[arg(long)]
     pub indirect_samples: Option<u32>,
@@ -316,8 +318,13 @@ pub struct RadiosityArgs {
 }
 
 impl RadiosityArgs {
+    /// The DGB Table 2 preset's name: `--preset`, or balanced.
+    pub fn radiosity_preset(&self) -> &str {
+        self.preset.as_deref().unwrap_or("balanced")
+    }
+
     pub fn settings(&self) -> Result<RadiositySettings, String> {
-        let preset = Preset::named(&self.preset).map_err(|e| format!("--preset: {e}"))?;
+        let preset = Preset::named(self.radiosity_preset()).map_err(|e| format!("--preset: {e}"))?;
         let mut s = preset.apply(RadiositySettings::default());
         if let Some(n) = self.indirect_samples {
             s.samples = n;

@@ -22,7 +22,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         ),
         BenchWhat::Radiosity(b) => {
             let rs = b.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?;
-            let r = radiosity::run(&(&b.stage).into(), &b.radiosity.preset, &rs)?;
+            let r = radiosity::run(&(&b.stage).into(), b.radiosity.radiosity_preset(), &rs)?;
             (BenchResult::Radiosity(r), b.stage.json)
         }
         BenchWhat::Technique(b) => {

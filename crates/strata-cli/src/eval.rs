@@ -35,7 +35,12 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         anyhow::bail!("--progressive is only read by --technique ils (ILS §6.3's physically-based mode)");
     }
     let result = match a.technique.eval {
-        EvalKind::VplRadiance => EvalResult::Ils(ils::run(&s, &a.set.values, a.progressive.map(|k| (k, a.bounces)))?),
+        EvalKind::VplRadiance => EvalResult::Ils(ils::run(
+            &s,
+            a.radiosity.preset.as_deref(),
+            &a.set.values,
+            a.progressive.map(|k| (k, a.bounces)),
+        )?),
         EvalKind::Composite => EvalResult::Oit(oit::run(&s, &a.set.values)?),
         // the registry's settings (--set), with --ao-radius/--ao-bias carried over
         EvalKind::AmbientVisibility if is_bzb || is_aba => {
@@ -296,7 +301,7 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
     };
     let mut settings = a
         .technique
-        .settings(&base, Some(a.radiosity.preset.as_str()))
+        .settings(&base, a.radiosity.preset.as_deref())
         .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
     settings.radiosity = Some(a.radiosity.settings().map_err(|e| anyhow::anyhow!(e))?);
     for (name, value) in &a.set.values {

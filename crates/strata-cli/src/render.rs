@@ -35,7 +35,11 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
         ao: Some(f.ao.settings()),
         ..Default::default()
     };
-    let preset = (!t.presets.is_empty()).then_some(f.radiosity.preset.as_str());
+    let preset = if t.presets.is_empty() {
+        None
+    } else {
+        f.radiosity.preset.as_deref()
+    };
     // configure fails only on an unknown preset
     let mut settings = t
         .settings(&base, preset)

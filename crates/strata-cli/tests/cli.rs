@@ -1374,6 +1374,8 @@ fn ils_renders_benches_and_refuses_bad_settings() {
         &["--debug-view", "ils-irradiance-tiled"][..],
         &["--debug-view", "ils-discontinuity", "--set", "bilinear=0"][..],
         &["--set", "brute-force=1", "--set", "blur=0"][..],
+        &["--preset", "clean-edges"][..],
+        &["--preset", "refined", "--set", "refine=0.25"][..],
     ] {
         let a = args(extra);
         let o = strata(&a.iter().map(String::as_str).collect::<Vec<_>>());
@@ -1385,6 +1387,10 @@ fn ils_renders_benches_and_refuses_bad_settings() {
         (&["--set", "split-block=12"][..], &["block size 12", "8..=1024"][..]),
         (&["--set", "vpls=70000"][..], &["vpls", "1..=65536"][..]),
         (&["--set", "blur=9"][..], &["blur", "0..=4"][..]),
+        (
+            &["--preset", "balanced"][..],
+            &["--preset", "standard, clean-edges, refined"][..],
+        ),
     ] {
         let a = args(extra);
         let o = strata(&a.iter().map(String::as_str).collect::<Vec<_>>());

@@ -522,6 +522,13 @@ pub struct IlsEval {
     /// Whether windows an edge cuts slide and are re-weighted (`IlsSettings::slide_window`).
     #[serde(default)]
     pub blur_slide: bool,
+    /// Whether each blur pass stops at its own axis's discontinuities only
+    /// (`IlsSettings::per_axis_discontinuities`).
+    #[serde(default)]
+    pub per_axis_db: bool,
+    /// The technique's preset (`--preset`; `standard` unless set), before `--set`.
+    #[serde(default)]
+    pub preset: String,
     /// `none` (SNSM: VPL visibility ignored) or `vpl` (SSM: per-VPL shadow maps, §4.3).
     pub shadows: String,
     /// Full image vs the brute force (every pixel, all N VPLs, same shadows): ꟻLIP and RMSE of

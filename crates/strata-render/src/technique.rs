@@ -1301,14 +1301,17 @@ fn configure_full(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), Re
 /// ILS §6.2's interactive mode: direct light + one-bounce VPLs, interleaved.
 /// The VPLs are the caller's to add (like the light probes): `IlsSettings::vpls`.
 fn configure_ils(s: &mut RenderSettings, preset: Option<&str>) -> Result<(), RenderError> {
-    no_preset("ils", preset)?;
+    let ils = s.ils.clone().unwrap_or_default();
+    let ils = ils
+        .with_preset(preset.unwrap_or(crate::passes::ils::PRESETS[0]))
+        .map_err(RenderError::Parameter)?;
     s.shade = true;
     s.abuffer = None;
     s.ao = None;
     s.radiosity = None;
     s.reflections = None;
     s.probes = None;
-    s.ils = Some(s.ils.clone().unwrap_or_default());
+    s.ils = Some(ils);
     s.bzb = None;
     s.bzb_gi = None;
     Ok(())
@@ -1521,7 +1524,7 @@ static REGISTRY: [Technique; 8] = [
         display: ("ldr", true),
         // against the brute force of the same VPLs and the one-bounce path tracer
         eval: EvalKind::VplRadiance,
-        presets: &[],
+        presets: &crate::passes::ils::PRESETS,
         passes: ILS_PASSES,
         settings: &[&DIRECT_SETTINGS, &ILS_SETTINGS],
         configure: configure_ils,

@@ -20,10 +20,16 @@ use super::{noise_warnings, write_report, EvalSettings, RefImage};
 use crate::metrics::{compare, compare_radiance, display};
 use crate::results::{EvalResult, GiErrors, IlsEval};
 
-/// `set`: the `ils` technique's settings (`vpls`, `interleave-n`, `shadows`, …), applied last
-/// and range-checked; the brute force is the same with `brute-force = 1`.
+/// `preset`: one of the `ils` technique's presets (`None`: standard); `set`: its settings
+/// (`vpls`, `interleave-n`, `shadows`, …), applied last and range-checked; the brute force
+/// is the same with `brute-force = 1`.
 /// `progressive`: §6.3's physically-based mode with (K sets, B bounces) ([`super::ils_progressive`]).
-pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u32)>) -> Result<IlsEval> {
+pub fn run(
+    s: &EvalSettings,
+    preset: Option<&str>,
+    set: &[(String, f64)],
+    progressive: Option<(u32, u32)>,
+) -> Result<IlsEval> {
     let rule = s.check(DEFAULT_CAP, 8)?;
     if s.deep.layers != 1 {
         bail!(
@@ -44,7 +50,9 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u3
             },
             ..s.render_settings(1)
         };
-        let mut r = t.settings(&base, None)?;
+        let mut r = t
+            .settings(&base, preset)
+            .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
         for (name, value) in set {
             t.set(&mut r, name, *value)
                 .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
@@ -142,6 +150,8 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)], progressive: Option<(u32, u3
         bilinear: ils.bilinear,
         refine: ils.refine,
         blur_slide: ils.slide_window,
+        per_axis_db: ils.per_axis_discontinuities,
+        preset: preset.unwrap_or(strata_render::passes::ils::PRESETS[0]).to_string(),
         shadows: shadows.into(),
         flip_vs_brute: vs_brute.flip,
         rmse_vs_brute: vs_brute.rmse,
