@@ -15,6 +15,9 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";
     let is_bzb_gi = a.technique.name == "bzb-gi";
+    if let (Some(p), true) = (&a.radiosity.preset, a.technique.presets.is_empty()) {
+        anyhow::bail!("--preset: technique '{}' has no presets (got '{p}')", a.technique.name);
+    }
     // flags that only the deep-G-buffer GI comparison reads: an error elsewhere, not ignored
     // (--views reads --probes-from too)
     if a.views || a.technique.eval != EvalKind::Radiance || is_bzb_gi {

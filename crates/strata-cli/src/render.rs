@@ -35,14 +35,9 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
         ao: Some(f.ao.settings()),
         ..Default::default()
     };
-    let preset = if t.presets.is_empty() {
-        None
-    } else {
-        f.radiosity.preset.as_deref()
-    };
-    // configure fails only on an unknown preset
+    // configure fails only on an unknown preset, or one given to a technique without
     let mut settings = t
-        .settings(&base, preset)
+        .settings(&base, f.radiosity.preset.as_deref())
         .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
     if settings.radiosity.is_some() {
         // the preset, then the radiosity flags

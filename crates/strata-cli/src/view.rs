@@ -111,11 +111,8 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     let t = f.technique;
     let spec = strata_view::RenderSpec {
         technique: t.name.to_string(),
-        preset: if t.presets.is_empty() {
-            None
-        } else {
-            f.radiosity.preset.clone()
-        },
+        // `settings_for` above refused a preset for a technique without presets
+        preset: f.radiosity.preset.clone(),
         layers: f.deep.layers,
         variant: f.deep.variant.to_string(),
         guard_band: guard.unwrap_or_else(|| "auto".into()),

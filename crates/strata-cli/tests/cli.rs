@@ -693,6 +693,13 @@ fn unknown_preset_lists_the_valid_ones() {
         "x.png",
     ]);
     assert_one_line_error(&o, &["--preset", "high-performance, balanced, high-quality"]);
+    // a technique without presets refuses one instead of ignoring it
+    for cmd in [&["render", "--out", "x.png"][..], &["eval"][..]] {
+        let mut a = cmd.to_vec();
+        a.extend(["--scene", "plane", "--technique", "ao", "--preset", "balanced"]);
+        let o = strata(&a);
+        assert_one_line_error(&o, &["--preset", "technique 'ao' has no presets"]);
+    }
 }
 
 /// `eval --technique full --views` (issue 14): what `render --technique full` shows, measured —

@@ -1428,6 +1428,8 @@ const BZB_GI_PASSES: &[&str] = &[
     "tonemap",
 ];
 
+/// The default frame's passes in every scene; `ils-blur-glossy-h`, `-v` join them in
+/// scenes with glossy materials, and the settings add others (`IlsSettings::passes`).
 const ILS_PASSES: &[&str] = &[
     "shadow",
     "lighting",
@@ -1439,8 +1441,6 @@ const ILS_PASSES: &[&str] = &[
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",
-    "ils-blur-glossy-h",
-    "ils-blur-glossy-v",
     "compose",
     "tonemap",
 ];

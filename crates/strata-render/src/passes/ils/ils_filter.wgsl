@@ -217,8 +217,9 @@ fn reach(c: vec2i, size: vec2i, s: i32, first: i32, last: i32) -> i32 {
 
 // Not in the paper (`slide_window`): the window [−a, b] along dir of a pixel whose
 // blur_texels (or blur_bilinear) window an edge or the border cuts on a side; (−1, −1)
-// when neither side is cut. When it holds fewer than L = min(2r + 1, pattern) texels and one side is
-// open, that side goes past r until the window holds L texels (or meets a cut).
+// when neither side is cut. When it holds fewer than L = min(2r + 1, pattern) texels
+// and one side is open, that side goes past r until the window holds L texels (or
+// meets a cut).
 fn cut_window(c: vec2i, size: vec2i) -> vec2i {
     let r = i32(filt.radius);
     let l = min(2 * r + 1, i32(max(filt.pattern, 1u)));

@@ -55,21 +55,6 @@ pub mod ssm;
 /// Most VPLs one frame accepts.
 pub const MAX_VPLS: u32 = 65536;
 
-/// The passes of the interleaved frame, in order (`strata bench` times them).
-pub const PASSES: &[&str] = &[
-    "ils-gbuffer",
-    "ils-bs",
-    "ils-snsm",
-    "ils-bg",
-    "ils-bg-glossy",
-    "ils-db",
-    "ils-blur-h",
-    "ils-blur-v",
-    "ils-blur-glossy-h",
-    "ils-blur-glossy-v",
-    "compose",
-];
-
 /// SSM's shadow-map pass (§4.3: one cube map per VPL, `ssm`).
 pub const VPL_SHADOW_PASS: &str = "ils-vpl-shadows";
 
