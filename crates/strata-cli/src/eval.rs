@@ -240,11 +240,18 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         EvalResult::Ils(e) => {
             let (i, f) = (&e.errors.indirect, &e.errors.full);
             println!(
-                "{} ils {} {} VPLs shadows={} {w}x{h}: vs brute force FLIP {:.4} RMSE {:.4} (indirect FLIP {:.4} RMSE {:.4}); vs path tracer indirect FLIP {:.4} RMSE {:.4}, full FLIP {:.4} RMSE {:.4} (brute force: indirect FLIP {:.4}, full FLIP {:.4}; reference {} spp, 1 bounce, noise FLIP {:.4})",
-                run.scene, e.pattern, e.vpls, e.shadows, e.flip_vs_brute, e.rmse_vs_brute, e.indirect_flip_vs_brute,
+                "{} ils {} {} VPLs shadows={} preset={} {w}x{h}: vs brute force FLIP {:.4} RMSE {:.4} (indirect FLIP {:.4} RMSE {:.4}); vs path tracer indirect FLIP {:.4} RMSE {:.4}, full FLIP {:.4} RMSE {:.4} (brute force: indirect FLIP {:.4}, full FLIP {:.4}; reference {} spp, 1 bounce, noise FLIP {:.4})",
+                run.scene, e.pattern, e.vpls, e.shadows, e.preset, e.flip_vs_brute, e.rmse_vs_brute, e.indirect_flip_vs_brute,
                 e.indirect_rmse_vs_brute, i.flip, i.rmse, f.flip, f.rmse, e.brute_force.indirect.flip,
                 e.brute_force.full.flip, run.ref_spp, noise(i)
             );
+            if let Some(r) = e.refined_share {
+                println!(
+                    "  ils-refine shaded {:.1} % of the pixels again (refine {})",
+                    100.0 * r,
+                    e.refine
+                );
+            }
             if let Some(p) = &e.progressive {
                 for q in &p.patterns {
                     match (q.frames_to_target, q.gpu_ms_to_target, q.vpl_ms_to_target) {

@@ -1554,7 +1554,10 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
         "{v}"
     );
     assert_eq!(v["ref_spp"], 4);
-    // §4.3 SSM: per-VPL shadow maps, named value on --set
+    assert_eq!(v["preset"], "standard", "{v}");
+    assert!(v.get("refined_share").is_none(), "no ils-refine without refine: {v}");
+    // §4.3 SSM: per-VPL shadow maps, named value on --set; the refined preset's
+    // ils-refine with them, and the share of the pixels it shaded
     let v = json_of(&run(&[
         "--set",
         "vpls=48",
@@ -1562,9 +1565,23 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
         "shadows=vpl",
         "--set",
         "vpl-shadow-resolution=16",
+        "--preset",
+        "refined",
     ]));
     assert_eq!(v["shadows"], "vpl", "{v}");
     assert!(v["reference"].as_str().unwrap().contains("SSM"), "{v}");
+    assert_eq!(
+        (&v["preset"], &v["refine"], &v["blur_slide"]),
+        (
+            &serde_json::json!("refined"),
+            &serde_json::json!(0.5),
+            &serde_json::json!(true)
+        )
+    );
+    assert!(
+        v["refined_share"].as_f64().is_some_and(|x| (0.0..=1.0).contains(&x)),
+        "{v}"
+    );
     // a 1x1 pattern is the brute force
     let v = json_of(&run(&[
         "--set",

@@ -529,6 +529,10 @@ pub struct IlsEval {
     /// The technique's preset (`--preset`; `standard` unless set), before `--set`.
     #[serde(default)]
     pub preset: String,
+    /// With `refine` or `refine-roughness`: the share of the pixels `ils-refine` shaded
+    /// again with all VPLs (their refined value differs from the blurred one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refined_share: Option<f32>,
     /// `none` (SNSM: VPL visibility ignored) or `vpl` (SSM: per-VPL shadow maps, §4.3).
     pub shadows: String,
     /// Full image vs the brute force (every pixel, all N VPLs, same shadows): ꟻLIP and RMSE of

@@ -85,14 +85,15 @@ pub fn run(
     let gpu = GpuContext::new(&GpuOptions {
         adapter: s.adapter.clone(),
     })?;
-    let render = |mut rs: RenderSettings| -> Result<(ImageBuf, ImageBuf)> {
+    let render = |mut rs: RenderSettings| -> Result<(ImageBuf, ImageBuf, Option<f32>)> {
         if let Some(i) = &mut rs.ils {
             i.vpls = vpls.clone();
         }
         let mut r = Renderer::new(&gpu, &scene, rs)?;
-        let out = render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, 1)?;
+        let (full, ind) = render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, 1)?;
+        let refined = refined_share(&r, &gpu)?;
         gpu.check_errors()?;
-        Ok(out)
+        Ok((full, ind, refined))
     };
     let progressive = match progressive {
         Some((k, b)) => Some(super::ils_progressive::run(
@@ -106,8 +107,8 @@ pub fn run(
         )?),
         None => None,
     };
-    let (full, ind) = render(is_settings)?;
-    let (brute_full, brute_ind) = render(brute_settings)?;
+    let (full, ind, refined_share) = render(is_settings)?;
+    let (brute_full, brute_ind, _) = render(brute_settings)?;
 
     let vs_reference = |full: &ImageBuf, ind: &ImageBuf| -> Result<GiErrors> {
         let (f, _) = compare_radiance(&ref_total.image, full, exposure)?;
@@ -151,6 +152,7 @@ pub fn run(
         refine: ils.refine,
         blur_slide: ils.slide_window,
         per_axis_db: ils.per_axis_discontinuities,
+        refined_share,
         preset: preset.unwrap_or(strata_render::passes::ils::PRESETS[0]).to_string(),
         shadows: shadows.into(),
         flip_vs_brute: vs_brute.flip,
@@ -170,4 +172,32 @@ pub fn run(
         )?;
     }
     Ok(out)
+}
+
+/// With `refine` or `refine-roughness`: the share of the pixels `ils-refine` shaded again,
+/// those whose refined irradiance or glossy radiance differs from the blurred one.
+fn refined_share(r: &Renderer, gpu: &GpuContext) -> Result<Option<f32>> {
+    let names = r.target_names();
+    if !names.contains(&"ils-refined") {
+        return Ok(None);
+    }
+    let glossy_blurred = if names.contains(&"ils-glossy-blurred") {
+        "ils-glossy-blurred"
+    } else {
+        "ils-glossy"
+    };
+    let pairs = [("indirect", "ils-refined"), (glossy_blurred, "ils-glossy-refined")];
+    let mut refined = Vec::new();
+    for (before, after) in pairs {
+        let (a, b) = (r.read_target(gpu, before)?, r.read_target(gpu, after)?);
+        let c = a.channels as usize;
+        let differs = a.data.chunks(c).zip(b.data.chunks(c)).map(|(x, y)| x[..3] != y[..3]);
+        if refined.is_empty() {
+            refined = differs.collect();
+        } else {
+            refined.iter_mut().zip(differs).for_each(|(r, d)| *r |= d);
+        }
+    }
+    let n = refined.iter().filter(|&&x| x).count();
+    Ok(Some(n as f32 / refined.len().max(1) as f32))
 }
