@@ -455,6 +455,79 @@ fn camera_path_playback_follows_the_scene_path() {
     assert!(flip(&shot, &r) < FLIP_BOUND);
 }
 
+/// CPU seconds (user + system) process `pid` has used, from /proc (Linux).
+fn cpu_seconds(pid: u32) -> f64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
+    // the fields after the command name, which ends with the last ')'
+    let f: Vec<&str> = stat[stat.rfind(')').unwrap() + 2..].split(' ').collect();
+    // utime, stime: fields 14 and 15 of stat(5), 12 and 13 after the name and state
+    let ticks: f64 = f[11].parse::<f64>().unwrap() + f[12].parse::<f64>().unwrap();
+    ticks / 100.0
+}
+
+/// An interactive viewer whose frame has settled (the default technique, `full`, is
+/// temporal: 61 still frames) stops drawing: it sleeps until an event instead of
+/// redrawing the same frame (it used 1.5 of the 2 cores before, 2026-11-28). A key (F12)
+/// wakes it: the screenshot is saved, and it sleeps again.
+#[test]
+fn settled_viewer_sleeps_until_an_event() {
+    let test = "view::settled_viewer_sleeps_until_an_event";
+    let Some(x) = xvfb(test) else {
+        return;
+    };
+    let dir = scratch("idle");
+    let shot = dir.join("strata-view-001.png");
+    let Some((mut child, id)) = view_window(&x, test, None, &shot) else {
+        return;
+    };
+    let pid = child.id();
+    // a 2-second window in which it used under 0.05 CPU seconds: asleep
+    let asleep_within = |limit: Duration| {
+        let t0 = Instant::now();
+        let mut last = cpu_seconds(pid);
+        while t0.elapsed() < limit {
+            std::thread::sleep(Duration::from_secs(2));
+            let now = cpu_seconds(pid);
+            if now - last < 0.05 {
+                return Some(t0.elapsed());
+            }
+            last = now;
+        }
+        None
+    };
+    // generous: under the full test run the cores are shared with other tests
+    let slept = asleep_within(Duration::from_secs(240));
+    let slept = slept.unwrap_or_else(|| {
+        child.kill().unwrap();
+        panic!("the settled viewer kept using the CPU for 240 s");
+    });
+    eprintln!("asleep after {slept:?}");
+    let cmd_txt = shot.with_extension("cmd.txt");
+    xdotool(&x.display, &["windowfocus", "--sync", &id]);
+    let t0 = Instant::now();
+    while std::fs::read_to_string(&cmd_txt)
+        .ok()
+        .filter(|c| c.ends_with('\n'))
+        .is_none()
+    {
+        if let Some(status) = child.try_wait().unwrap() {
+            let o = child.wait_with_output().unwrap();
+            panic!("the viewer exited ({status}) before F12 saved: {}", text(&o.stderr));
+        }
+        assert!(
+            t0.elapsed() < Duration::from_secs(180),
+            "F12 did not wake the viewer in 180 s"
+        );
+        xdotool(&x.display, &["key", "--window", &id, "F12"]);
+        std::thread::sleep(Duration::from_secs(1));
+    }
+    assert!(shot.exists());
+    let again = asleep_within(Duration::from_secs(120));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(again.is_some(), "the viewer did not sleep again after the screenshot");
+}
+
 #[test]
 fn unmapped_window_keeps_running_and_finishes() {
     let Some(x) = xvfb("view::unmapped_window_keeps_running_and_finishes") else {

@@ -111,7 +111,18 @@ pub struct App {
     fatal: Option<String>,
     /// The 3D frame failed with these settings: not retried until they change.
     broken: bool,
+    /// Nothing left to draw until an event arrives: the event loop waits instead of
+    /// redrawing (set after each frame, cleared by any window event).
+    idle: bool,
+    /// egui asked to be drawn again after this long (a blinking cursor, a tooltip).
+    repaint_after: Option<std::time::Duration>,
 }
+
+/// Still frames after which an interactive viewer stops drawing: a temporal technique's
+/// history converges over the 60 frames `--warmup` reproduces; others need the frame that
+/// single-pass layers build from the last one.
+const SETTLE_TEMPORAL: u32 = 61;
+const SETTLE: u32 = 3;
 
 fn scene_scale(scene: &Scene) -> f32 {
     let (lo, hi) = scene.bounds(0.0);
@@ -154,6 +165,8 @@ impl App {
             status: None,
             frames_done: 0,
             still_frames: 0,
+            idle: false,
+            repaint_after: None,
             actions: Vec::new(),
             pending_shot: None,
             shot_counter: 0,
@@ -177,6 +190,21 @@ impl App {
             fatal: None,
             broken: false,
         }
+    }
+
+    /// Nothing changes from frame to frame any more: not scripted, not playing, no action,
+    /// screenshot or camera move pending, and the full renderer drew enough still frames
+    /// (or failed). Interactive frames then draw only the UI, and the loop waits.
+    fn settled(&self) -> bool {
+        let accumulates = self.full.as_ref().is_some_and(|r| r.accumulates());
+        let settle = if accumulates { SETTLE_TEMPORAL } else { SETTLE };
+        self.frames.is_none()
+            && !self.playing
+            && self.actions.is_empty()
+            && self.pending_shot.is_none()
+            && self.screenshot.is_none()
+            && !self.cam.active()
+            && (self.broken || self.still_frames >= settle)
     }
 
     /// The shown frame is one `strata render` reproduces (see [`App::reproduce_command`]).
@@ -702,7 +730,13 @@ impl App {
             }
         }
         let reduced = moved && self.motion_scale < 1.0 && self.pending_shot.is_none();
-        let mut timing = match self.render_3d(&gfx.gpu, reduced, cam) {
+        // settled: the shown frame stays as it is (the UI still redraws)
+        let render = if !moved && self.settled() {
+            Ok(None)
+        } else {
+            self.render_3d(&gfx.gpu, reduced, cam)
+        };
+        let mut timing = match render {
             Ok(t) => t,
             Err(e) => {
                 let msg = one_line(&e.to_string());
@@ -751,6 +785,12 @@ impl App {
         let ctx = gfx.egui_state.egui_ctx().clone();
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
         let out = ctx.run_ui(raw, |ui| crate::ui::draw(self, ui));
+        let repaint = out
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .map_or(std::time::Duration::MAX, |v| v.repaint_delay);
+        self.idle = !moved && self.settled() && !repaint.is_zero();
+        self.repaint_after = (repaint < std::time::Duration::from_secs(3600)).then_some(repaint);
         gfx.egui_state.handle_platform_output(&gfx.window, out.platform_output);
         let prims = ctx.tessellate(out.shapes, out.pixels_per_point);
         for (id, deltas) in &out.textures_delta.set {
@@ -1013,6 +1053,9 @@ impl ApplicationHandler for Handler {
         };
         let resp = gfx.egui_state.on_window_event(&gfx.window, &event);
         let ctx = gfx.egui_state.egui_ctx().clone();
+        // any event may change the frame or the UI: draw again (the frame decides
+        // whether it settled)
+        app.idle = false;
         match event {
             WindowEvent::CloseRequested | WindowEvent::Destroyed => el.exit(),
             // zero size (minimised): keep the old configuration, frames are skipped
@@ -1084,10 +1127,27 @@ impl ApplicationHandler for Handler {
         }
     }
 
-    fn about_to_wait(&mut self, _el: &ActiveEventLoop) {
-        if let Some(g) = &self.app.gfx {
-            g.window.request_redraw();
+    fn new_events(&mut self, _el: &ActiveEventLoop, cause: winit::event::StartCause) {
+        // egui's repaint time came (`repaint_after`)
+        if matches!(cause, winit::event::StartCause::ResumeTimeReached { .. }) {
+            self.app.idle = false;
         }
+    }
+
+    fn about_to_wait(&mut self, el: &ActiveEventLoop) {
+        let Some(g) = &self.app.gfx else {
+            return;
+        };
+        if !self.app.idle {
+            el.set_control_flow(ControlFlow::Poll);
+            g.window.request_redraw();
+            return;
+        }
+        // settled: sleep until an event (or egui's repaint time)
+        el.set_control_flow(match self.app.repaint_after {
+            Some(d) => ControlFlow::WaitUntil(Instant::now() + d),
+            None => ControlFlow::Wait,
+        });
     }
 }
 

@@ -149,6 +149,12 @@ impl CameraControl {
         }
     }
 
+    /// A key is held or tapped, or a drag or wheel turn waits for the next step: the
+    /// camera will move.
+    pub fn active(&self) -> bool {
+        self.held.iter().chain(&self.tapped).any(|&k| k) || self.drag != (0.0, 0.0) || self.wheel != 0.0
+    }
+
     pub fn release_all(&mut self) {
         self.held = [false; 7];
         self.tapped = [false; 7];
