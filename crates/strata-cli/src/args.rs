@@ -808,6 +808,9 @@ pub struct BenchAbufferArgs {
 pub struct BenchIlsArgs {
     #[command(flatten)]
     pub stage: BenchStageArgs,
+    /// One of technique `ils`'s presets: standard (default), clean-edges, refined.
+    #[arg(long)]
+    pub preset: Option<String>,
     /// Settings of technique `ils` (e.g. --set vpls=480 --set interleave-n=8 --set interleave-m=6).
     #[command(flatten)]
     pub set: SetArgs,

@@ -30,7 +30,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             (BenchResult::Technique(r), b.stage.json)
         }
         BenchWhat::Ils(b) => (
-            BenchResult::Ils(Box::new(ils::run(&(&b.stage).into(), &b.set.values)?)),
+            BenchResult::Ils(Box::new(ils::run(
+                &(&b.stage).into(),
+                b.preset.as_deref(),
+                &b.set.values,
+            )?)),
             b.stage.json,
         ),
         BenchWhat::Abuffer(b) => (

@@ -1404,10 +1404,26 @@ fn ils_renders_benches_and_refuses_bad_settings() {
         assert_one_line_error(&o, needles);
     }
     let v = json_of(&strata(&[
-        "bench", "ils", "--scene", "cornell", "--width", "64", "--height", "48", "--frames", "2", "--layers", "1",
-        "--set", "vpls=96", "--json",
+        "bench",
+        "ils",
+        "--scene",
+        "cornell",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+        "--layers",
+        "1",
+        "--set",
+        "vpls=96",
+        "--preset",
+        "clean-edges",
+        "--json",
     ]));
     assert_eq!(v["bench"], "ils", "{v}");
+    assert_eq!(v["interleaved"]["preset"], "clean-edges", "{v}");
     assert!(v["speedup"].as_f64().is_some_and(|x| x > 0.0), "{v}");
     let names: Vec<&str> = v["brute_force"]["passes"]
         .as_array()

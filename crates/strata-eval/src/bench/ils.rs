@@ -12,13 +12,16 @@ use strata_render::technique;
 use super::stage::{self, Stage, StageSettings};
 use crate::results::IlsBench;
 
-/// `set`: the `ils` technique's settings (`vpls`, `interleave-n`, …), applied
-/// last and range-checked; the brute-force run is the same with `brute-force = 1`.
-pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<IlsBench> {
+/// `preset`: one of the `ils` technique's presets (`None`: standard); `set`: its settings
+/// (`vpls`, `interleave-n`, …), applied last and range-checked; the brute-force run is the
+/// same with `brute-force = 1`.
+pub fn run(stage: &StageSettings, preset: Option<&str>, set: &[(String, f64)]) -> Result<IlsBench> {
     let t = technique::find("ils")?;
     let (scene, _) = stage.scene.load()?;
     let configure = |brute: bool| -> Result<strata_render::RenderSettings> {
-        let mut s = t.settings(&stage.render_settings(1), None)?;
+        let mut s = t
+            .settings(&stage.render_settings(1), preset)
+            .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
         for (name, value) in set {
             t.set(&mut s, name, *value)
                 .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
@@ -44,6 +47,7 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<IlsBench> {
         ..stage.clone()
     };
     let extra = json!({
+        "preset": preset.unwrap_or(strata_render::passes::ils::PRESETS[0]),
         "vpls": ils.vpl_count,
         "pattern": format!("{}x{}", ils.pattern[0], ils.pattern[1]),
         "split": ils.method.name(),
