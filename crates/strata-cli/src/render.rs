@@ -35,7 +35,7 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
         ao: Some(f.ao.settings()),
         ..Default::default()
     };
-    // configure fails only on an unknown preset, or one given to a technique without
+    // configure fails only on an unknown preset, or a preset for a technique that has none
     let mut settings = t
         .settings(&base, f.radiosity.preset.as_deref())
         .map_err(|e| anyhow::anyhow!("--preset: {e}"))?;
