@@ -1118,6 +1118,10 @@ impl Renderer {
             // the split G-buffer's normals and depths (Fig. 3 b)
             v.extend(["ils-split-normal", "ils-split-csz"].map(String::from));
         }
+        if self.ils.is_some() && self.targets.try_get("ils-discontinuity").is_some() {
+            // the share of the VPL subsets each blurred pixel averaged (what `refine` reads)
+            v.push("ils-coverage".into());
+        }
         if self.radiosity.is_some() {
             // Fig. 9's views: confidence, G-buffer-only, probe-only, blended
             v.extend(["confidence", "gbuffer-only", "probe-only", "blended"].map(String::from));
@@ -1177,6 +1181,10 @@ impl Renderer {
             "ils-split-csz" => Ok(normalise(self.read_target(gpu, "ils-gbuffer-split")?.channel(3))),
             // §4.5's flag as grey
             "ils-discontinuity" => Ok(self.read_target(gpu, base)?.channel(3)),
+            // the blur's coverage (the blurred irradiance's alpha) as grey
+            "ils-coverage" if self.targets.try_get("ils-discontinuity").is_some() => {
+                Ok(self.read_target(gpu, "indirect")?.channel(3))
+            }
             "ils-irradiance" | "ils-irradiance-tiled" | "ils-blur-h" | "indirect" if self.ils.is_some() => {
                 Ok(pad_channels(&self.read_target(gpu, base)?, 3))
             }

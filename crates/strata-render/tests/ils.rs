@@ -586,4 +586,8 @@ fn blur_coverage_is_the_share_of_vpl_subsets_averaged() {
     for (x, y) in [(32, 32), (10, 20), (W - 9, H - 9)] {
         assert!((a(x, y) - 1.0).abs() < 1e-3, "({x}, {y}): {}", a(x, y));
     }
+    // the debug view `ils-coverage` shows exactly that alpha
+    let view = r.debug_view(&gpu, "ils-coverage", true).unwrap();
+    assert_eq!(view.channels, 1);
+    assert!(view.data.iter().enumerate().all(|(i, &v)| v == img.data[i * 4 + 3]));
 }
