@@ -113,6 +113,8 @@ pub(crate) struct PassBuilder<'a> {
     resources: Vec<Option<wgpu::BindingResource<'a>>>,
     inputs: Vec<&'static str>,
     outputs: Vec<&'static str>,
+    /// The stage the bindings are visible to: FRAGMENT, or COMPUTE after [`PassBuilder::compute`].
+    stage: wgpu::ShaderStages,
 }
 
 impl<'a> PassBuilder<'a> {
@@ -130,7 +132,15 @@ impl<'a> PassBuilder<'a> {
             resources: Vec::new(),
             inputs: Vec::new(),
             outputs: Vec::new(),
+            stage: wgpu::ShaderStages::FRAGMENT,
         }
+    }
+
+    /// Makes a compute pass instead ([`PassBuilder::build_compute`]): the bindings are
+    /// visible to the compute stage and `entry` names a compute entry point.
+    pub fn compute(mut self) -> Self {
+        self.stage = wgpu::ShaderStages::COMPUTE;
+        self
     }
 
     /// The WGSL (with `#import`s) and its label.
@@ -160,7 +170,7 @@ impl<'a> PassBuilder<'a> {
     fn push(mut self, ty: wgpu::BindingType, resource: Option<wgpu::BindingResource<'a>>) -> Self {
         self.layout_entries.push(wgpu::BindGroupLayoutEntry {
             binding: self.layout_entries.len() as u32,
-            visibility: wgpu::ShaderStages::FRAGMENT,
+            visibility: self.stage,
             ty,
             count: None,
         });
@@ -258,6 +268,18 @@ impl<'a> PassBuilder<'a> {
         )
     }
 
+    /// A read-write storage buffer (atomics, appended lists).
+    pub fn storage_rw(self, buffer: &'a wgpu::Buffer) -> Self {
+        self.push(
+            wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            Some(buffer.as_entire_binding()),
+        )
+    }
+
     /// A sampler of binding type `ty` (for the passes to come: ILS, A-buffer, BZB).
     #[allow(dead_code)]
     pub fn sampler(self, sampler: &'a wgpu::Sampler, ty: wgpu::SamplerBindingType) -> Self {
@@ -273,7 +295,29 @@ impl<'a> PassBuilder<'a> {
         self
     }
 
-    pub fn build(self) -> FullscreenPass {
+    /// Target `name` as a write-only storage texture (compute passes; declared as an output).
+    pub fn write_storage(mut self, name: &'static str) -> Self {
+        let t = self.targets.get(name);
+        self.outputs.push(name);
+        self.push(
+            wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: t.desc.format,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            Some(wgpu::BindingResource::TextureView(t.layer(0))),
+        )
+    }
+
+    /// The bind group, its uniform buffer, the pipeline layout and the shader module.
+    fn build_common(
+        &self,
+    ) -> (
+        wgpu::BindGroup,
+        Option<wgpu::Buffer>,
+        wgpu::PipelineLayout,
+        wgpu::ShaderModule,
+    ) {
         let device = &self.gpu.device;
         let (label, source) = self.shader.expect("a pass needs its WGSL");
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -316,6 +360,17 @@ impl<'a> PassBuilder<'a> {
             immediate_size: 0,
         });
         let module = crate::shader::module(device, label, source);
+        (group, uniforms, pipeline_layout, module)
+    }
+
+    pub fn build(self) -> FullscreenPass {
+        assert_eq!(
+            self.stage,
+            wgpu::ShaderStages::FRAGMENT,
+            "a compute pass is made by build_compute"
+        );
+        let (group, uniforms, pipeline_layout, module) = self.build_common();
+        let device = &self.gpu.device;
         let formats: Vec<Option<wgpu::ColorTargetState>> = self
             .outputs
             .iter()
@@ -339,5 +394,86 @@ impl<'a> PassBuilder<'a> {
             inputs: self.inputs,
             outputs: self.outputs,
         }
+    }
+
+    /// The compute pass (after [`PassBuilder::compute`]); its outputs are the targets
+    /// declared with [`PassBuilder::write_storage`].
+    pub fn build_compute(self) -> ComputePass {
+        assert_eq!(self.stage, wgpu::ShaderStages::COMPUTE, "declare .compute() first");
+        let (group, uniforms, pipeline_layout, module) = self.build_common();
+        let constants: Vec<(&str, f64)> = self.constants.clone();
+        let pipeline = self
+            .gpu
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(self.name),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(self.entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            });
+        ComputePass {
+            name: self.name,
+            pipeline,
+            group,
+            uniforms,
+            frame: self.frame_layout.is_some(),
+            inputs: self.inputs,
+            outputs: self.outputs,
+        }
+    }
+}
+
+/// A compute pass made by [`PassBuilder::build_compute`].
+pub(crate) struct ComputePass {
+    pub name: &'static str,
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    uniforms: Option<wgpu::Buffer>,
+    frame: bool,
+    inputs: Vec<&'static str>,
+    outputs: Vec<&'static str>,
+}
+
+impl ComputePass {
+    /// Replaces the pass's uniforms (declared with [`PassBuilder::uniforms`]).
+    pub fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
+        let buf = self.uniforms.as_ref().expect("the pass declared uniforms");
+        gpu.queue.write_buffer(buf, 0, bytemuck::bytes_of(value));
+    }
+
+    pub fn info(&self) -> PassInfo {
+        PassInfo {
+            name: self.name,
+            inputs: self.inputs.clone(),
+            outputs: self.outputs.clone(),
+        }
+    }
+
+    /// Records the pass with its workgroup counts read from `args` at `offset`
+    /// (`dispatch_workgroups_indirect`).
+    pub fn encode_indirect(
+        &self,
+        scene: &GpuScene,
+        encoder: &mut wgpu::CommandEncoder,
+        args: &wgpu::Buffer,
+        offset: wgpu::BufferAddress,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(self.name),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        let mut i = 0;
+        if self.frame {
+            pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+            i = 1;
+        }
+        pass.set_bind_group(i, &self.group, &[]);
+        pass.dispatch_workgroups_indirect(args, offset);
     }
 }

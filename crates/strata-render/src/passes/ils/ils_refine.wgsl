@@ -6,6 +6,12 @@
 // again with all N VPLs (the brute force at that pixel), and so are glossy receivers
 // smoother than `shade.refine_roughness` (sharp lobes: n×m blocks); the others keep the
 // blurred values. Appended to ils_vpl_shading.wgsl.
+//
+// Two steps, so that the few refined pixels do not hold up the many kept ones (a
+// fragment shader that shaded them in place made every SIMD group holding one refined
+// pixel wait for its N-VPL loop): `fs_refine_select` writes every pixel's blurred
+// value and appends the refined pixels to `refine_list`, and `cs_refine` shades the
+// list, 64 pixels per workgroup, dispatched indirectly with the list's own count.
 #import "common/fullscreen.wgsl"
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
@@ -23,10 +29,26 @@
 // the blurred irradiance (a = coverage) and glossy radiance
 @group(1) @binding(6) var blurred: texture_2d<f32>;
 @group(1) @binding(7) var blurred_glossy: texture_2d<f32>;
+// The refined pixels: `groups`, `y`, `z` are `cs_refine`'s indirect dispatch
+// (⌈count / REFINE_GROUP⌉, 1, 1), cleared to zero before `fs_refine_select`; each
+// pixel is packed as x | y << 16.
+struct RefineList {
+    groups: atomic<u32>,
+    y: atomic<u32>,
+    z: atomic<u32>,
+    count: atomic<u32>,
+    pixels: array<u32>,
+}
+@group(1) @binding(8) var<storage, read_write> refine_list: RefineList;
+// cs_refine's outputs (fs_refine_select writes them as colour attachments)
+@group(1) @binding(9) var refined_out: texture_storage_2d<rgba16float, write>;
+@group(1) @binding(10) var glossy_refined_out: texture_storage_2d<rgba16float, write>;
 // SSM only (as in ils_snsm.wgsl)
-@group(1) @binding(8) var vpl_shadow_maps: texture_depth_2d_array;
-@group(1) @binding(9) var vpl_shadow_sampler: sampler_comparison;
-@group(1) @binding(10) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
+@group(1) @binding(11) var vpl_shadow_maps: texture_depth_2d_array;
+@group(1) @binding(12) var vpl_shadow_sampler: sampler_comparison;
+@group(1) @binding(13) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
+
+const REFINE_GROUP: u32 = 64u;
 
 // The blurred values, alpha = coverage (`refined` false), or the pixel's G-buffer
 // sample to shade with every VPL.
@@ -47,24 +69,57 @@ fn refined_at(p: vec2u) -> Refined {
     return r;
 }
 
+// Every pixel's blurred value; the refined ones are also appended to the list
+// (their value here is replaced by cs_refine).
 @fragment
-fn fs_refine(@builtin(position) pos: vec4f) -> ShadeOut {
+fn fs_refine_select(@builtin(position) pos: vec4f) -> ShadeOut {
     let p = vec2u(pos.xy);
     let r = refined_at(p);
-    if (!r.refined) {
-        return r.keep;
+    if (r.refined) {
+        let i = atomicAdd(&refine_list.count, 1u);
+        refine_list.pixels[i] = p.x | (p.y << 16u);
+        if (i % REFINE_GROUP == 0u) {
+            atomicAdd(&refine_list.groups, 1u);
+            if (i == 0u) {
+                atomicStore(&refine_list.y, 1u);
+                atomicStore(&refine_list.z, 1u);
+            }
+        }
     }
-    return vpl_sum(r.g, p, 0u, 1u);
+    return r.keep;
+}
+
+// The list's pixel `i` as (x, y, 1), or z = 0 past the list's end.
+fn listed(i: u32) -> vec3u {
+    if (i >= atomicLoad(&refine_list.count)) {
+        return vec3u(0u, 0u, 0u);
+    }
+    let packed = refine_list.pixels[i];
+    return vec3u(packed & 0xffffu, packed >> 16u, 1u);
+}
+
+fn store_refined(p: vec2u, o: ShadeOut) {
+    textureStore(refined_out, vec2i(p), o.irradiance);
+    textureStore(glossy_refined_out, vec2i(p), o.glossy);
+}
+
+// The listed pixels shaded with all N VPLs (the brute force at that pixel).
+@compute @workgroup_size(REFINE_GROUP)
+fn cs_refine(@builtin(global_invocation_id) id: vec3u) {
+    let l = listed(id.x);
+    if (l.z == 0u) {
+        return;
+    }
+    store_refined(l.xy, vpl_sum(textureLoad(gbuffer, vec2i(l.xy), 0), l.xy, 0u, 1u));
 }
 
 // With VPL shadows (SSM): the refined pixels test each VPL's shadow map, as the
 // brute force does.
-@fragment
-fn fs_refine_ssm(@builtin(position) pos: vec4f) -> ShadeOut {
-    let p = vec2u(pos.xy);
-    let r = refined_at(p);
-    if (!r.refined) {
-        return r.keep;
+@compute @workgroup_size(REFINE_GROUP)
+fn cs_refine_ssm(@builtin(global_invocation_id) id: vec3u) {
+    let l = listed(id.x);
+    if (l.z == 0u) {
+        return;
     }
-    return vpl_sum_ssm(r.g, p, 0u, 1u);
+    store_refined(l.xy, vpl_sum_ssm(textureLoad(gbuffer, vec2i(l.xy), 0), l.xy, 0u, 1u));
 }

@@ -403,8 +403,9 @@ impl IlsSettings {
         let tiled = (w.div_ceil(n.max(1)) * n.max(1)) as u64 * (h.div_ceil(m.max(1)) * m.max(1)) as u64;
         let px = w as u64 * h as u64;
         // gbuffer 16 + irradiance 8 + glossy 8 + DB 8 + blur-h 8 + indirect 8 + compose 24
-        // (+ refined 8 + 8); tiled: 16 + 8 + 8; the Blocks intermediates ≤ 2 more tiled-size buffers
-        let refined = if self.refines() { 16 } else { 0 };
+        // (+ refined 8 + 8 + the refine list's 4); tiled: 16 + 8 + 8; the Blocks
+        // intermediates ≤ 2 more tiled-size buffers
+        let refined = if self.refines() { 20 } else { 0 };
         px * (80 + refined)
             + tiled * (32 + 24)
             + self.vpls.len().max(self.vpl_count as usize) as u64 * 48
@@ -716,7 +717,7 @@ pub(crate) struct IlsStage {
     glossy_v: Option<FullscreenPass>,
     /// `IlsSettings::refine`, `refine_roughness`: the pixels the blur averaged too few
     /// VPL subsets for, and sharp glossy receivers
-    refine: Option<FullscreenPass>,
+    refine: Option<RefinePass>,
     compose: crate::passes::compose::ComposePass,
     vpl_buffer: wgpu::Buffer,
     vpl_capacity: usize,
@@ -762,6 +763,130 @@ fn vpl_buffer(gpu: &GpuContext, vpls: &[GpuVpl], capacity: usize) -> wgpu::Buffe
         contents: bytemuck::cast_slice(&data),
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
     })
+}
+
+/// `ils-refine` (ils_refine.wgsl): `fs_refine_select` keeps every pixel's blurred
+/// value and lists the pixels to refine; `cs_refine` shades the listed ones with
+/// all N VPLs, dispatched indirectly by the list's count. One pass to the frame.
+pub(crate) struct RefinePass {
+    /// `RefineList`: the indirect dispatch (3 × u32), the count, one u32 per pixel
+    list: wgpu::Buffer,
+    /// the list's first 12 bytes, copied: a buffer bound read-write cannot also be
+    /// the dispatch's indirect buffer
+    args: wgpu::Buffer,
+    select: FullscreenPass,
+    shade: crate::passes::builder::ComputePass,
+}
+
+impl RefinePass {
+    /// `blurred`: the irradiance and glossy radiance the kept pixels show.
+    fn new(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &mut Targets,
+        uniforms: &ShadeUniforms,
+        vpl_buffer: &wgpu::Buffer,
+        vpl_shadows: &Option<ssm::VplShadowPass>,
+        blurred: [&'static str; 2],
+    ) -> Self {
+        let (w, h) = (targets.width, targets.height);
+        for t in [REFINED, GLOSSY_REFINED] {
+            targets.create_with_usage(gpu, t, [w, h], wgpu::TextureUsages::STORAGE_BINDING);
+        }
+        let list = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ils-refine list"),
+            size: 16 + 4 * (w as u64 * h as u64),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let args = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ils-refine dispatch"),
+            size: 12,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        // bindings 0–8 alike in both steps (ils_refine.wgsl), so one WGSL serves both
+        fn common<'a>(
+            b: PassBuilder<'a>,
+            scene_gpu: &'a GpuScene,
+            uniforms: &ShadeUniforms,
+            vpl_buffer: &'a wgpu::Buffer,
+            blurred: [&'static str; 2],
+            list: &'a wgpu::Buffer,
+        ) -> PassBuilder<'a> {
+            b.shader("ils-refine", shading_shader!("ils_refine.wgsl"))
+                .frame(scene_gpu)
+                .uniforms(uniforms)
+                .read(GBUFFER.name)
+                .storage(vpl_buffer)
+                .read_layer("normal", 0)
+                .read_layer("albedo", 0)
+                .read_layer("emission", 0)
+                .read(blurred[0])
+                .read(blurred[1])
+                .storage_rw(list)
+        }
+        let targets = &*targets;
+        let select = common(
+            PassBuilder::new(gpu, targets, REFINE_PASS),
+            scene_gpu,
+            uniforms,
+            vpl_buffer,
+            blurred,
+            &list,
+        )
+        .entry("fs_refine_select")
+        .write(REFINED.name)
+        .write(GLOSSY_REFINED.name)
+        .build();
+        let entry = if vpl_shadows.is_some() {
+            "cs_refine_ssm"
+        } else {
+            "cs_refine"
+        };
+        let b = common(
+            PassBuilder::new(gpu, targets, REFINE_PASS).compute(),
+            scene_gpu,
+            uniforms,
+            vpl_buffer,
+            blurred,
+            &list,
+        )
+        .entry(entry)
+        .write_storage(REFINED.name)
+        .write_storage(GLOSSY_REFINED.name);
+        let shade = with_vpl_shadows(b, vpl_shadows).build_compute();
+        Self {
+            list,
+            args,
+            select,
+            shade,
+        }
+    }
+
+    fn set_uniforms(&self, gpu: &GpuContext, u: &ShadeUniforms) {
+        self.select.set_uniforms(gpu, u);
+        self.shade.set_uniforms(gpu, u);
+    }
+}
+
+impl crate::frame::Pass for RefinePass {
+    fn info(&self) -> PassInfo {
+        let mut info = self.select.info();
+        for i in self.shade.info().inputs {
+            if !info.inputs.contains(&i) {
+                info.inputs.push(i);
+            }
+        }
+        info
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.list, 0, Some(16));
+        self.select.encode(scene, targets, encoder);
+        encoder.copy_buffer_to_buffer(&self.list, 0, &self.args, 0, Some(12));
+        self.shade.encode_indirect(scene, encoder, &self.args, 0);
+    }
 }
 
 impl IlsStage {
@@ -922,31 +1047,15 @@ impl IlsStage {
         };
         let mut refine = None;
         let (shown, glossy_shown) = if s.refines() {
-            targets.create(gpu, REFINED);
-            targets.create(gpu, GLOSSY_REFINED);
-            let entry = if vpl_shadows.is_some() {
-                "fs_refine_ssm"
-            } else {
-                "fs_refine"
-            };
-            let b = PassBuilder::new(gpu, targets, REFINE_PASS)
-                .shader("ils-refine", shading_shader!("ils_refine.wgsl"))
-                .entry(entry)
-                .frame(scene_gpu)
-                .uniforms(&shade_uniforms)
-                .read(GBUFFER.name)
-                .storage(&vpl_buffer)
-                .read_layer("normal", 0)
-                .read_layer("albedo", 0)
-                .read_layer("emission", 0)
-                .read(shown)
-                .read(glossy_shown);
-            refine = Some(
-                with_vpl_shadows(b, &vpl_shadows)
-                    .write(REFINED.name)
-                    .write(GLOSSY_REFINED.name)
-                    .build(),
-            );
+            refine = Some(RefinePass::new(
+                gpu,
+                scene_gpu,
+                targets,
+                &shade_uniforms,
+                &vpl_buffer,
+                &vpl_shadows,
+                [shown, glossy_shown],
+            ));
             (REFINED.name, GLOSSY_REFINED.name)
         } else {
             (shown, glossy_shown)
@@ -1023,11 +1132,13 @@ impl IlsStage {
             &self.blur_v,
             &self.glossy_h,
             &self.glossy_v,
-            &self.refine,
         ]
         .into_iter()
         .flatten()
         {
+            v.push(p);
+        }
+        if let Some(p) = &self.refine {
             v.push(p);
         }
         v.push(&self.compose);
