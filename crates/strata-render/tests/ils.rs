@@ -640,3 +640,55 @@ fn blur_coverage_is_the_share_of_vpl_subsets_averaged() {
     assert_eq!(view.channels, 1);
     assert!(view.data.iter().enumerate().all(|(i, &v)| v == img.data[i * 4 + 3]));
 }
+
+/// `ils-refine`'s list of refined pixels (`fs_refine_select` → `cs_refine`, dispatched
+/// by the list's own count), empty and not. On the frame-filling wall every pixel
+/// averages at least 5/8 · 4/6 ≈ 0.417 of the subsets (the corners), so `refine` =
+/// 0.4 refines none: the dispatch is empty and `ils-refined` is the blur bit for
+/// bit. With 0.9 the pixels near the border are refined (the full sum replaces the
+/// blur's partial one) and the inner ones keep the blur bit for bit, also in a
+/// second frame.
+#[test]
+fn refine_list_may_be_empty_and_changes_only_the_listed_pixels() {
+    let gpu = common::gpu();
+    let camera = strata_scene::Camera::new(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::Y, 60.0, 0.05);
+    let wall = [
+        Vec3::new(-10.0, -10.0, 0.0),
+        Vec3::new(10.0, -10.0, 0.0),
+        Vec3::new(10.0, 10.0, 0.0),
+        Vec3::new(-10.0, 10.0, 0.0),
+    ];
+    let scene = common::polygons_scene("wall", &[&wall], camera, 0.1);
+    // VPLs of different powers, so a pixel's subset differs from the blur
+    let vpls: Vec<GpuVpl> = (0..48)
+        .map(|k| GpuVpl::new([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0 + (k % 5) as f32; 3]))
+        .collect();
+    let settings = |refine: f32| IlsSettings {
+        vpls: Arc::from(vpls.clone()),
+        refine,
+        ..Default::default()
+    };
+    let read = |r: &Renderer, name: &str| {
+        let img = r.read_target(&gpu, name).unwrap();
+        gpu.check_errors().unwrap();
+        img
+    };
+    let none = render(&gpu, &scene, settings(0.4));
+    assert_eq!(read(&none, "ils-refined").data, read(&none, "indirect").data);
+
+    let mut r = render(&gpu, &scene, settings(0.9));
+    let (blurred, first) = (read(&r, "indirect"), read(&r, "ils-refined"));
+    let (mut refined, mut kept) = (0, 0);
+    for i in 0..(W * H) as usize {
+        let (b, o) = (&blurred.data[i * 4..i * 4 + 3], &first.data[i * 4..i * 4 + 3]);
+        if blurred.data[i * 4 + 3] < 0.9 {
+            refined += (b != o) as usize;
+        } else {
+            assert_eq!(b, o, "pixel {i} keeps the blur");
+            kept += 1;
+        }
+    }
+    assert!(refined > 100 && kept > 1000, "{refined} refined, {kept} kept");
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
+    assert_eq!(read(&r, "ils-refined").data, first.data, "the second frame");
+}
