@@ -429,7 +429,7 @@ static AO_SETTINGS: [SettingInfo; 15] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 22] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 23] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -502,6 +502,12 @@ static RADIOSITY_SETTINGS: [SettingInfo; 22] = [
         "which taps --tap-visibility tests: hidden (layer-1 senders, by whether a point between lies within min separation behind a surface) or all (the visible senders too, by whether the segment passes from in front of the visible surface to behind it between two steps, and the hidden ones by both tests: no light through thin walls; 3-4x the gather's cost at 8 steps on lavapipe)",
         tap_visibility_all,
         ["hidden", "all"]
+    ),
+    radiosity_switch!(
+        "gather-kernel",
+        "the radiosity gather as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup): the same shader code and values (not in the paper; docs/radiosity.md)",
+        compute_gather,
+        ["fragment", "compute"]
     ),
     radiosity_switch!(
         "radius-jitter",

@@ -463,6 +463,23 @@ impl ComputePass {
         args: &wgpu::Buffer,
         offset: wgpu::BufferAddress,
     ) {
+        self.record(scene, encoder, |pass| pass.dispatch_workgroups_indirect(args, offset));
+    }
+
+    /// Records the pass over `size` invocations in x and y, `group` per workgroup (the
+    /// shader's `@workgroup_size`; it skips the invocations past `size`).
+    pub fn encode_grid(&self, scene: &GpuScene, encoder: &mut wgpu::CommandEncoder, size: [u32; 2], group: [u32; 2]) {
+        self.record(scene, encoder, |pass| {
+            pass.dispatch_workgroups(size[0].div_ceil(group[0]), size[1].div_ceil(group[1]), 1)
+        });
+    }
+
+    fn record(
+        &self,
+        scene: &GpuScene,
+        encoder: &mut wgpu::CommandEncoder,
+        dispatch: impl FnOnce(&mut wgpu::ComputePass),
+    ) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some(self.name),
             timestamp_writes: None,
@@ -474,6 +491,6 @@ impl ComputePass {
             i = 1;
         }
         pass.set_bind_group(i, &self.group, &[]);
-        pass.dispatch_workgroups_indirect(args, offset);
+        dispatch(&mut pass);
     }
 }

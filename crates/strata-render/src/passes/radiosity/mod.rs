@@ -128,6 +128,10 @@ pub struct RadiositySettings {
     /// patch) leave bands and blotches that stay put under the temporal filter
     /// (docs/radiosity.md § "Jittered tap radii"). Not in the paper (default true).
     pub radius_jitter: bool,
+    /// The gather as a compute pass (8×8 pixels per workgroup, storage-texture outputs)
+    /// instead of a fullscreen fragment pass: the same shader code and the same values
+    /// (docs/radiosity.md § "The gather as a compute pass"). Not in the paper.
+    pub compute_gather: bool,
 }
 
 /// The most steps [`RadiositySettings::tap_visibility`] takes.
@@ -407,6 +411,7 @@ impl Default for RadiositySettings {
             tap_visibility: 0,
             tap_visibility_all: true,
             radius_jitter: true,
+            compute_gather: false,
         }
     }
 }
@@ -593,8 +598,14 @@ pub const OUTPUTS: [TargetDesc; 2] = [
     ),
 ];
 
+/// The gather's pipeline: a fullscreen fragment pass or its compute twin.
+enum GatherKernel {
+    Fragment(FullscreenPass),
+    Compute(crate::passes::builder::ComputePass),
+}
+
 pub struct RadiosityPass {
-    pass: FullscreenPass,
+    pass: GatherKernel,
     /// The probes' grid, when the gather has probes for the detail term.
     grid: Option<crate::passes::compose::ProbeGridUniform>,
     /// Shaded region (the image plus the shaded part of the guard band).
@@ -606,7 +617,8 @@ impl RadiosityPass {
     /// Gathers from the radiosity buffers `b` (layer 0, layer 1) inside the
     /// `scissor` rectangle [x, y, w, h] (`None`: everywhere); `receiver1`: also
     /// for layer 1's surfaces (only multi-bounce propagation reads them); `probes`: for
-    /// [`RadiositySettings::probe_detail`].
+    /// [`RadiositySettings::probe_detail`]; `compute`: [`RadiositySettings::compute_gather`]
+    /// (the outputs must then allow storage binding).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
@@ -617,6 +629,7 @@ impl RadiosityPass {
         scissor: Option<[u32; 4]>,
         receiver1: bool,
         probes: Option<&crate::passes::compose::ProbeGpu>,
+        compute: bool,
     ) -> Self {
         let zeroed: RadiosityUniforms = bytemuck::Zeroable::zeroed();
         let dummy;
@@ -627,7 +640,18 @@ impl RadiosityPass {
                 &dummy
             }
         };
-        let mut builder = PassBuilder::new(gpu, targets, "radiosity")
+        let mut builder = PassBuilder::new(gpu, targets, "radiosity");
+        if compute {
+            let [x0, y0, x1, y1] = scissor.map_or([0, 0, u32::MAX, u32::MAX], |[x, y, w, h]| [x, y, x + w, y + h]);
+            builder = builder
+                .compute()
+                .entry("cs_main")
+                .constant("SCISSOR_X0", x0 as f64)
+                .constant("SCISSOR_Y0", y0 as f64)
+                .constant("SCISSOR_X1", x1 as f64)
+                .constant("SCISSOR_Y1", y1 as f64);
+        }
+        builder = builder
             .shader("radiosity", include_str!("radiosity.wgsl"))
             .constant("LAYERS", layers as f64)
             .constant("RECEIVER1", receiver1 as u32 as f64)
@@ -640,11 +664,19 @@ impl RadiosityPass {
             .read(if layers > 1 { b[1] } else { b[0] })
             .storage(&gpu_probes.probes)
             .storage(&gpu_probes.depth);
-        for t in &OUTPUTS {
-            builder = builder.write(t.name);
-        }
+        let pass = if compute {
+            for t in &OUTPUTS {
+                builder = builder.write_storage(t.name);
+            }
+            GatherKernel::Compute(builder.build_compute())
+        } else {
+            for t in &OUTPUTS {
+                builder = builder.write(t.name);
+            }
+            GatherKernel::Fragment(builder.build())
+        };
         Self {
-            pass: builder.build(),
+            pass,
             grid: probes.map(|p| p.grid),
             scissor,
             last: std::cell::Cell::new(zeroed),
@@ -656,7 +688,10 @@ impl RadiosityPass {
             Some(g) => u.grid = g,
             None => u.probe_detail = 0,
         }
-        self.pass.set_uniforms(gpu, &u);
+        match &self.pass {
+            GatherKernel::Fragment(p) => p.set_uniforms(gpu, &u),
+            GatherKernel::Compute(p) => p.set_uniforms(gpu, &u),
+        }
         self.last.set(u);
     }
 
@@ -667,11 +702,20 @@ impl RadiosityPass {
 
 impl Pass for RadiosityPass {
     fn info(&self) -> PassInfo {
-        self.pass.info()
+        match &self.pass {
+            GatherKernel::Fragment(p) => p.info(),
+            GatherKernel::Compute(p) => p.info(),
+        }
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode_in(scene, targets, encoder, self.scissor);
+        match &self.pass {
+            GatherKernel::Fragment(p) => p.encode_in(scene, targets, encoder, self.scissor),
+            GatherKernel::Compute(p) => {
+                let t = targets.get(OUTPUTS[0].name);
+                p.encode_grid(scene, encoder, [t.texture.width(), t.texture.height()], [8, 8]);
+            }
+        }
     }
 }
 

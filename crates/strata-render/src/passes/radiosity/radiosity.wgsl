@@ -324,9 +324,8 @@ fn estimate(sum: vec4f, wc: f32, m: f32, u: f32) -> vec4f {
     return vec4f(sum.rgb * (3.14159265358979 / denom), c);
 }
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> Out {
-    let p = vec2i(pos.xy);
+// Layer 0's and layer 1's E at pixel p (zero where layer 0 is empty).
+fn gather(p: vec2i) -> Out {
     var o: Out;
     let z = textureLoad(zmip, p, 0);
     if (z.x <= 0.0) {
@@ -445,4 +444,33 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     o.e0 = estimate(sum0 - vec4f(sum_probe, 0.0), wc0, m0, u0);
     o.e1 = estimate(sum1, wc1, m1, u1);
     return o;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
+    return gather(vec2i(pos.xy));
+}
+
+// The same gather as a compute pass (`RadiositySettings::compute_gather`), 8×8 pixels
+// per workgroup, into storage textures. Outside the shaded rectangle [SCISSOR_X0,
+// SCISSOR_X1) × [SCISSOR_Y0, SCISSOR_Y1) it stores zero, as the fragment pass's clear
+// leaves there.
+override SCISSOR_X0: u32 = 0u;
+override SCISSOR_Y0: u32 = 0u;
+override SCISSOR_X1: u32 = 0xffffffffu;
+override SCISSOR_Y1: u32 = 0xffffffffu;
+@group(1) @binding(7) var e0_out: texture_storage_2d<rgba16float, write>;
+@group(1) @binding(8) var e1_out: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(e0_out))) {
+        return;
+    }
+    var o: Out;
+    if (all(id.xy >= vec2u(SCISSOR_X0, SCISSOR_Y0)) && all(id.xy < vec2u(SCISSOR_X1, SCISSOR_Y1))) {
+        o = gather(vec2i(id.xy));
+    }
+    textureStore(e0_out, id.xy, o.e0);
+    textureStore(e1_out, id.xy, o.e1);
 }

@@ -34,7 +34,13 @@ impl RadiosityStage {
     ) -> Self {
         use wgpu::TextureFormat as F;
         for t in crate::passes::radiosity::OUTPUTS {
-            targets.create(gpu, t);
+            // the compute gather writes them as storage textures
+            let usage = if s.compute_gather {
+                wgpu::TextureUsages::STORAGE_BINDING
+            } else {
+                wgpu::TextureUsages::empty()
+            };
+            targets.create_with_usage(gpu, t, [targets.width, targets.height], usage);
         }
         let mut filtered = "indirect-raw";
         if s.temporal.is_some() {
@@ -111,6 +117,7 @@ impl RadiosityStage {
             propagate.is_some(),
             // the compose pass's buffers (the detail term reads them; otherwise unread)
             probe_gpu.as_ref(),
+            s.compute_gather,
         );
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
