@@ -301,7 +301,7 @@ static DIRECT_SETTINGS: [SettingInfo; 3] = [
     },
 ];
 
-static AO_SETTINGS: [SettingInfo; 15] = [
+static AO_SETTINGS: [SettingInfo; 16] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
@@ -411,6 +411,18 @@ static AO_SETTINGS: [SettingInfo; 15] = [
         set: |s, v| ao_mut(s).deinterleave = (v >= 1.0).then(|| [v as u32 + 1; 2]),
         values: &["off", "2x2", "3x3", "4x4"],
     },
+    enum_setting!(
+        "ao-kernel",
+        "the AO pass (Eq. 1-2, not the deinterleaved one) as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/ao.md)",
+        ao_of,
+        ao_mut,
+        kernel,
+        [
+            crate::passes::Kernel::Auto => "auto",
+            crate::passes::Kernel::Fragment => "fragment",
+            crate::passes::Kernel::Compute => "compute",
+        ]
+    ),
     bool_setting!(
         "filter-obscurance",
         "on: the temporal and bilateral filters average Eq. 1's obscurance mean before the square root, then AV = 1 - sqrt (not in the paper; removes the brightening of few-tap deinterleaved AO); off: DGB's order",
@@ -503,11 +515,17 @@ static RADIOSITY_SETTINGS: [SettingInfo; 23] = [
         tap_visibility_all,
         ["hidden", "all"]
     ),
-    radiosity_switch!(
+    enum_setting!(
         "gather-kernel",
-        "the radiosity gather as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup): the same shader code and values (not in the paper; docs/radiosity.md)",
-        compute_gather,
-        ["fragment", "compute"]
+        "the radiosity gather as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/radiosity.md)",
+        radiosity_of,
+        radiosity_mut,
+        gather_kernel,
+        [
+            crate::passes::Kernel::Auto => "auto",
+            crate::passes::Kernel::Fragment => "fragment",
+            crate::passes::Kernel::Compute => "compute",
+        ]
     ),
     radiosity_switch!(
         "radius-jitter",

@@ -108,17 +108,27 @@ fn cornell_corners_and_under_boxes_are_darker_than_wall_centres() {
 }
 
 /// Reads back every buffer the AO shader read and re-evaluates Eq. 1–2 on the
-/// CPU with the same taps: the shader is the equation.
+/// CPU with the same taps: the shader is the equation. The last two rows run the
+/// pass as compute (`ao-kernel=compute`), the others as a fragment pass.
 #[test]
 fn gpu_ao_equals_cpu_eq1_eq2_over_the_same_buffers() {
+    use strata_render::passes::Kernel;
     let gpu = common::gpu();
-    for (name, layers) in [("atrium", 2u32), ("cornell", 2), ("column-wall", 1), ("atrium", 3)] {
+    for (name, layers, kernel) in [
+        ("atrium", 2u32, Kernel::Fragment),
+        ("cornell", 2, Kernel::Fragment),
+        ("column-wall", 1, Kernel::Fragment),
+        ("atrium", 3, Kernel::Fragment),
+        ("atrium", 2, Kernel::Compute),
+        ("column-wall", 1, Kernel::Compute),
+    ] {
         let scene = frozen(name);
         let (w, h) = (96, 64);
         // DGB's order: `ao-raw` holds Eq. 1's AV (with the default filter_obscurance it holds S,
         // checked by `filtered_obscurance_is_eq1_before_the_square_root_and_resolves_to_av`)
         let settings = AoSettings {
             filter_obscurance: false,
+            kernel,
             ..AoSettings::default()
         };
         let mut r = ao_renderer(&gpu, &scene, w, h, layers, settings);
@@ -148,13 +158,13 @@ fn gpu_ao_equals_cpu_eq1_eq2_over_the_same_buffers() {
         // the neighbour on one side only (GPU sin/cos differ from Rust's by ulps).
         assert!(
             close as f32 >= 0.995 * n as f32,
-            "{name} k={layers}: only {close}/{n} pixels within 1e-4 (worst {worst})"
+            "{name} k={layers} {kernel:?}: only {close}/{n} pixels within 1e-4 (worst {worst})"
         );
         assert!(
             occluded > n / 10,
             "{name}: test is weak, only {occluded} occluded pixels"
         );
-        eprintln!("{name} k={layers}: {close}/{n} within 1e-4, worst {worst}");
+        eprintln!("{name} k={layers} {kernel:?}: {close}/{n} within 1e-4, worst {worst}");
     }
 }
 

@@ -7,6 +7,7 @@ use glam::{Mat4, Vec3};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::radiosity::{irradiance_cpu, Normalisation, RadiositySettings};
+use strata_render::passes::Kernel;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::shapes::MeshBuilder;
 use strata_scene::{procedural, Camera, ImageBuf, Material, Object, Scene};
@@ -96,7 +97,11 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             // Eq. 4's rows with the paper's fixed tap radii, the rest jittered
             radius_jitter: solid_angle,
             radius: Some(4.0),
-            compute_gather,
+            gather_kernel: if compute_gather {
+                Kernel::Compute
+            } else {
+                Kernel::Fragment
+            },
             ..Default::default()
         };
         let mut r = renderer(&gpu, &scene, w, h, 2, rs);
@@ -638,7 +643,11 @@ fn gather_shades_only_the_requested_fraction_of_the_guard_band() {
                 },
                 radiosity: Some(RadiositySettings {
                     guard_band_shaded: 0.5,
-                    compute_gather,
+                    gather_kernel: if compute_gather {
+                        Kernel::Compute
+                    } else {
+                        Kernel::Fragment
+                    },
                     ..Default::default()
                 }),
                 ..Default::default()

@@ -17,6 +17,30 @@ use crate::frame::{PassInfo, Targets};
 use crate::gpu::GpuContext;
 use crate::scene_gpu::GpuScene;
 
+/// How a screen pass that has both forms runs: as a fullscreen fragment pass or as its
+/// compute twin (the same shader function over 8×8-pixel workgroups, storage-texture
+/// outputs). Not in the papers: an implementation choice with the same values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// Compute on GPUs, fragment on CPU adapters: an H100's fragment path ran the
+    /// radiosity gather 40× slower than compute, lavapipe's compute path 1.2× slower
+    /// than fragment (docs/benchmarks.md, 2026-11-28).
+    Auto,
+    Fragment,
+    Compute,
+}
+
+impl Kernel {
+    /// `Auto` resolved for an adapter: `true` for compute.
+    pub fn compute_on(self, gpu: &GpuContext) -> bool {
+        match self {
+            Kernel::Auto => gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu,
+            Kernel::Fragment => false,
+            Kernel::Compute => true,
+        }
+    }
+}
+
 /// A full-screen pass made by [`PassBuilder`].
 pub(crate) struct FullscreenPass {
     pub name: &'static str,
@@ -492,5 +516,78 @@ impl ComputePass {
         }
         pass.set_bind_group(i, &self.group, &[]);
         dispatch(&mut pass);
+    }
+}
+
+/// A screen pass built in either form ([`Kernel`]): a fullscreen fragment pass or its
+/// compute twin, 8×8 pixels per workgroup over its first output.
+pub(crate) enum ScreenPass {
+    Fragment(FullscreenPass),
+    Compute(ComputePass),
+}
+
+impl ScreenPass {
+    /// Declares the outputs (colour attachments or storage textures) and builds the
+    /// form `compute` asks for; a compute builder must have been made with
+    /// [`PassBuilder::compute`] and a compute `entry`.
+    pub fn build(mut builder: PassBuilder<'_>, outputs: &[&'static str], compute: bool) -> Self {
+        for &t in outputs {
+            builder = if compute {
+                builder.write_storage(t)
+            } else {
+                builder.write(t)
+            };
+        }
+        if compute {
+            ScreenPass::Compute(builder.build_compute())
+        } else {
+            ScreenPass::Fragment(builder.build())
+        }
+    }
+
+    pub fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
+        match self {
+            ScreenPass::Fragment(p) => p.set_uniforms(gpu, value),
+            ScreenPass::Compute(p) => p.set_uniforms(gpu, value),
+        }
+    }
+
+    pub fn info(&self) -> PassInfo {
+        match self {
+            ScreenPass::Fragment(p) => p.info(),
+            ScreenPass::Compute(p) => p.info(),
+        }
+    }
+
+    pub fn encode(&self, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        self.encode_in(scene, targets, encoder, None)
+    }
+
+    /// Records the pass; `scissor` limits the fragment form (the compute form covers its
+    /// whole first output, and its shader stores what the scissor would have left).
+    pub fn encode_in(
+        &self,
+        scene: &GpuScene,
+        targets: &Targets,
+        encoder: &mut wgpu::CommandEncoder,
+        scissor: Option<[u32; 4]>,
+    ) {
+        match self {
+            ScreenPass::Fragment(p) => p.encode_in(scene, targets, encoder, scissor),
+            ScreenPass::Compute(p) => {
+                let t = &targets.get(p.outputs[0]).texture;
+                p.encode_grid(scene, encoder, [t.width(), t.height()], [8, 8]);
+            }
+        }
+    }
+}
+
+impl crate::frame::Pass for ScreenPass {
+    fn info(&self) -> PassInfo {
+        ScreenPass::info(self)
+    }
+
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        self.encode_in(scene, targets, encoder, None)
     }
 }

@@ -4,6 +4,7 @@ pub mod abuffer;
 pub mod ao;
 pub mod bilateral;
 pub(crate) mod builder;
+pub use builder::Kernel;
 pub mod bzb;
 pub mod compose;
 pub mod deep_gbuffer;

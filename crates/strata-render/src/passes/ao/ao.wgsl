@@ -21,9 +21,8 @@ fn obscurance(v: vec3f, n: vec3f) -> f32 {
     return eq2_obscurance(v, n, ao.radius, ao.bias, ao.epsilon);
 }
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
-    let p = vec2i(pos.xy);
+// AV (or S with `output_obscurance`) at pixel p.
+fn ambient(p: vec2i) -> vec4f {
     let z = textureLoad(zmip, p, 0).r;
     if (z <= 0.0) {
         // no surface: unoccluded (AV 1, S 0)
@@ -67,4 +66,20 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     }
     let av = max(0.0, 1.0 - sqrt(s));
     return vec4f(av);
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    return ambient(vec2i(pos.xy));
+}
+
+// The same pass as compute (`AoSettings::kernel`), 8×8 pixels per workgroup.
+@group(1) @binding(3) var ao_out: texture_storage_2d<r32float, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(ao_out))) {
+        return;
+    }
+    textureStore(ao_out, id.xy, ambient(vec2i(id.xy)));
 }

@@ -4,7 +4,7 @@
 
 pub(crate) mod stage;
 
-use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::passes::builder::{Kernel, PassBuilder, ScreenPass};
 use glam::Vec3;
 use strata_scene::{ImageBuf, Scene};
 
@@ -86,6 +86,11 @@ pub struct AoSettings {
     /// averaged and a concave corner's occlusion spreads along the plane (issue 14's
     /// "dark halos"; docs/ao.md). Default true (false = DGB's weights).
     pub distance_weight: bool,
+    /// The AO pass (Eq. 1–2; not the deinterleaved one) as a fullscreen fragment pass
+    /// or as a compute pass (8×8 pixels per workgroup, storage-texture output): the same
+    /// shader code and values. Not in the paper (default [`Kernel::Auto`]: compute on
+    /// GPUs, fragment on CPU adapters; docs/ao.md § "The AO pass as compute").
+    pub kernel: Kernel,
 }
 
 impl Default for AoSettings {
@@ -114,6 +119,7 @@ impl Default for AoSettings {
             deinterleave: None,
             filter_obscurance: true,
             distance_weight: true,
+            kernel: Kernel::Auto,
         }
     }
 }
@@ -236,7 +242,7 @@ pub const OUTPUT: TargetDesc = TargetDesc::new(
 );
 
 pub struct AoPass {
-    pass: FullscreenPass,
+    pass: ScreenPass,
     last: std::cell::Cell<AoUniforms>,
     /// The split geometry of the deinterleaved pass (`ao-deint`); `None`: `ao`.
     ils: Option<crate::passes::interleave::IlsUniforms>,
@@ -278,17 +284,21 @@ pub const DEINT_RAW_TILED: TargetDesc = TargetDesc::new(
 );
 
 impl AoPass {
-    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32) -> Self {
+    /// `compute`: [`AoSettings::kernel`] resolved (the output must then allow storage binding).
+    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32, compute: bool) -> Self {
         let zeroed = AoUniforms::zeroed();
-        let pass = PassBuilder::new(gpu, targets, "ao")
+        let mut builder = PassBuilder::new(gpu, targets, "ao");
+        if compute {
+            builder = builder.compute().entry("cs_main");
+        }
+        let builder = builder
             .shader("ao", include_str!("ao.wgsl"))
             .constant("LAYERS", layers as f64)
             .frame(scene)
             .uniforms(&zeroed)
             .read("zmip")
-            .read("npack")
-            .write(OUTPUT.name)
-            .build();
+            .read("npack");
+        let pass = ScreenPass::build(builder, &[OUTPUT.name], compute);
         Self {
             pass,
             last: std::cell::Cell::new(zeroed),
@@ -319,7 +329,7 @@ impl AoPass {
             .write(DEINT_RAW_TILED.name)
             .build();
         Self {
-            pass,
+            pass: ScreenPass::Fragment(pass),
             last: std::cell::Cell::new(zeroed),
             ils: Some(ils),
         }

@@ -40,9 +40,16 @@ impl AoStage {
         radius: f32,
     ) -> Result<Self, RenderError> {
         use wgpu::TextureFormat as F;
-        targets.create(gpu, crate::passes::ao::OUTPUT);
+        // the compute AO pass writes its output as a storage texture
+        let compute = s.deinterleave.is_none() && s.kernel.compute_on(gpu);
+        let usage = if compute {
+            wgpu::TextureUsages::STORAGE_BINDING
+        } else {
+            wgpu::TextureUsages::empty()
+        };
+        targets.create_with_usage(gpu, crate::passes::ao::OUTPUT, [targets.width, targets.height], usage);
         let (ao, deint_before, deint_gather) = match s.deinterleave {
-            None => (AoPass::new(gpu, scene, targets, deep.layers), Vec::new(), None),
+            None => (AoPass::new(gpu, scene, targets, deep.layers, compute), Vec::new(), None),
             Some([n, m]) => {
                 let (ao, before, gather) = deinterleaved(gpu, scene, targets, deep.layers, n, m)?;
                 (ao, before, Some(gather))

@@ -11,7 +11,7 @@
 
 pub(crate) mod stage;
 
-use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::passes::builder::{FullscreenPass, Kernel, PassBuilder, ScreenPass};
 use glam::Vec3;
 use strata_scene::ImageBuf;
 
@@ -128,10 +128,11 @@ pub struct RadiositySettings {
     /// patch) leave bands and blotches that stay put under the temporal filter
     /// (docs/radiosity.md § "Jittered tap radii"). Not in the paper (default true).
     pub radius_jitter: bool,
-    /// The gather as a compute pass (8×8 pixels per workgroup, storage-texture outputs)
-    /// instead of a fullscreen fragment pass: the same shader code and the same values
-    /// (docs/radiosity.md § "The gather as a compute pass"). Not in the paper.
-    pub compute_gather: bool,
+    /// The gather as a fullscreen fragment pass or as a compute pass (8×8 pixels per
+    /// workgroup, storage-texture outputs): the same shader code and values
+    /// (docs/radiosity.md § "The gather as a compute pass"). Not in the paper (default
+    /// [`Kernel::Auto`]: compute on GPUs, fragment on CPU adapters).
+    pub gather_kernel: Kernel,
 }
 
 /// The most steps [`RadiositySettings::tap_visibility`] takes.
@@ -411,7 +412,7 @@ impl Default for RadiositySettings {
             tap_visibility: 0,
             tap_visibility_all: true,
             radius_jitter: true,
-            compute_gather: false,
+            gather_kernel: Kernel::Auto,
         }
     }
 }
@@ -598,14 +599,8 @@ pub const OUTPUTS: [TargetDesc; 2] = [
     ),
 ];
 
-/// The gather's pipeline: a fullscreen fragment pass or its compute twin.
-enum GatherKernel {
-    Fragment(FullscreenPass),
-    Compute(crate::passes::builder::ComputePass),
-}
-
 pub struct RadiosityPass {
-    pass: GatherKernel,
+    pass: ScreenPass,
     /// The probes' grid, when the gather has probes for the detail term.
     grid: Option<crate::passes::compose::ProbeGridUniform>,
     /// Shaded region (the image plus the shaded part of the guard band).
@@ -617,7 +612,7 @@ impl RadiosityPass {
     /// Gathers from the radiosity buffers `b` (layer 0, layer 1) inside the
     /// `scissor` rectangle [x, y, w, h] (`None`: everywhere); `receiver1`: also
     /// for layer 1's surfaces (only multi-bounce propagation reads them); `probes`: for
-    /// [`RadiositySettings::probe_detail`]; `compute`: [`RadiositySettings::compute_gather`]
+    /// [`RadiositySettings::probe_detail`]; `compute`: [`RadiositySettings::gather_kernel`] resolved
     /// (the outputs must then allow storage binding).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -664,17 +659,7 @@ impl RadiosityPass {
             .read(if layers > 1 { b[1] } else { b[0] })
             .storage(&gpu_probes.probes)
             .storage(&gpu_probes.depth);
-        let pass = if compute {
-            for t in &OUTPUTS {
-                builder = builder.write_storage(t.name);
-            }
-            GatherKernel::Compute(builder.build_compute())
-        } else {
-            for t in &OUTPUTS {
-                builder = builder.write(t.name);
-            }
-            GatherKernel::Fragment(builder.build())
-        };
+        let pass = ScreenPass::build(builder, &OUTPUTS.map(|t| t.name), compute);
         Self {
             pass,
             grid: probes.map(|p| p.grid),
@@ -688,10 +673,7 @@ impl RadiosityPass {
             Some(g) => u.grid = g,
             None => u.probe_detail = 0,
         }
-        match &self.pass {
-            GatherKernel::Fragment(p) => p.set_uniforms(gpu, &u),
-            GatherKernel::Compute(p) => p.set_uniforms(gpu, &u),
-        }
+        self.pass.set_uniforms(gpu, &u);
         self.last.set(u);
     }
 
@@ -702,20 +684,11 @@ impl RadiosityPass {
 
 impl Pass for RadiosityPass {
     fn info(&self) -> PassInfo {
-        match &self.pass {
-            GatherKernel::Fragment(p) => p.info(),
-            GatherKernel::Compute(p) => p.info(),
-        }
+        self.pass.info()
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        match &self.pass {
-            GatherKernel::Fragment(p) => p.encode_in(scene, targets, encoder, self.scissor),
-            GatherKernel::Compute(p) => {
-                let t = targets.get(OUTPUTS[0].name);
-                p.encode_grid(scene, encoder, [t.texture.width(), t.texture.height()], [8, 8]);
-            }
-        }
+        self.pass.encode_in(scene, targets, encoder, self.scissor);
     }
 }
 

@@ -33,9 +33,10 @@ impl RadiosityStage {
         ao_radius: f32,
     ) -> Self {
         use wgpu::TextureFormat as F;
+        let compute_gather = s.gather_kernel.compute_on(gpu);
         for t in crate::passes::radiosity::OUTPUTS {
             // the compute gather writes them as storage textures
-            let usage = if s.compute_gather {
+            let usage = if compute_gather {
                 wgpu::TextureUsages::STORAGE_BINDING
             } else {
                 wgpu::TextureUsages::empty()
@@ -117,7 +118,7 @@ impl RadiosityStage {
             propagate.is_some(),
             // the compose pass's buffers (the detail term reads them; otherwise unread)
             probe_gpu.as_ref(),
-            s.compute_gather,
+            compute_gather,
         );
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
