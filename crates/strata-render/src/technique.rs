@@ -516,11 +516,11 @@ static RADIOSITY_SETTINGS: [SettingInfo; 23] = [
         ["hidden", "all"]
     ),
     enum_setting!(
-        "gather-kernel",
-        "the radiosity gather as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/radiosity.md)",
+        "indirect-kernel",
+        "the radiosity gather and the indirect light's bilateral passes as fullscreen fragment passes or as compute passes (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/radiosity.md)",
         radiosity_of,
         radiosity_mut,
-        gather_kernel,
+        kernel,
         [
             crate::passes::Kernel::Auto => "auto",
             crate::passes::Kernel::Fragment => "fragment",

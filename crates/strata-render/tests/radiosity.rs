@@ -97,7 +97,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
             // Eq. 4's rows with the paper's fixed tap radii, the rest jittered
             radius_jitter: solid_angle,
             radius: Some(4.0),
-            gather_kernel: if compute_gather {
+            kernel: if compute_gather {
                 Kernel::Compute
             } else {
                 Kernel::Fragment
@@ -643,7 +643,7 @@ fn gather_shades_only_the_requested_fraction_of_the_guard_band() {
                 },
                 radiosity: Some(RadiositySettings {
                     guard_band_shaded: 0.5,
-                    gather_kernel: if compute_gather {
+                    kernel: if compute_gather {
                         Kernel::Compute
                     } else {
                         Kernel::Fragment
@@ -713,4 +713,53 @@ fn confidence_is_high_inside_a_box_and_low_facing_open_sky() {
     // so only taps reaching other walls count, even in a closed box
     assert!(inside > 0.1, "box interior confidence {inside}");
     assert!(open < 0.01, "open plane confidence {open}");
+}
+
+/// The indirect light's bilateral passes (`indirect-blur-h`, `-v`) equal `bilateral_cpu`
+/// over the same buffers (red channel, RGBA16F targets), as fragment passes and as
+/// their compute twins (`indirect-kernel=compute`, which also runs the gather as
+/// compute).
+#[test]
+fn indirect_blur_matches_its_cpu_twin_in_both_kernels() {
+    use strata_render::passes::bilateral::bilateral_cpu;
+    let gpu = common::gpu();
+    let scene = frozen("atrium");
+    let (w, h) = (96u32, 64u32);
+    for kernel in [Kernel::Fragment, Kernel::Compute] {
+        let rs = RadiositySettings {
+            temporal: None,
+            kernel,
+            ..Default::default()
+        };
+        let blur = rs.blur.clone();
+        let mut r = renderer(&gpu, &scene, w, h, 2, rs);
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
+        let read = |name: &str| r.read_target_full(&gpu, name, 0).unwrap();
+        let (raw, gpu_h, gpu_v) = (read("indirect-raw"), read("indirect-blur-h"), read("indirect"));
+        gpu.check_errors().unwrap();
+        let zpack = read("zpack");
+        let normals = common::npack_normals(&read("npack"), 0);
+        let f = r.frame_uniforms();
+        let twin = |src: &ImageBuf, vertical| bilateral_cpu(src, &zpack, &normals, &f, &blur, vertical);
+        let n = (raw.width * raw.height) as usize;
+        let near = |g: &ImageBuf, c: &ImageBuf| {
+            (0..n)
+                .filter(|&i| {
+                    let (g, c) = (g.data[i * 4], c.data[i * c.channels as usize]);
+                    (g - c).abs() <= 2e-3 + 2e-3 * c.abs()
+                })
+                .count()
+        };
+        let (close_h, close_v) = (near(&gpu_h, &twin(&raw, false)), near(&gpu_v, &twin(&gpu_h, true)));
+        let changed = (0..n)
+            .filter(|&i| (gpu_v.data[i * 4] - raw.data[i * 4]).abs() > 0.01)
+            .count();
+        eprintln!("{kernel:?}: GPU = twin {close_h}/{n} (h), {close_v}/{n} (v); {changed} pixels moved by > 0.01");
+        assert!(close_h as f32 >= 0.995 * n as f32, "{kernel:?} h: {close_h}/{n}");
+        assert!(close_v as f32 >= 0.995 * n as f32, "{kernel:?} v: {close_v}/{n}");
+        assert!(
+            changed >= n / 20,
+            "{kernel:?}: weak test, the blur moved {changed} pixels"
+        );
+    }
 }

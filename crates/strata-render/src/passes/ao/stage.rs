@@ -153,8 +153,9 @@ pub(crate) fn reconstruction(
         TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
     );
     [
-        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-h", input, "ao-blur-h", false),
-        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-v", "ao-blur-h", output, true),
+        // R16F outputs, which storage textures do not take: fragment passes only
+        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-h", input, "ao-blur-h", false, false),
+        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-v", "ao-blur-h", output, true, false),
     ]
 }
 

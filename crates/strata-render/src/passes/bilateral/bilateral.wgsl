@@ -30,9 +30,8 @@ struct Bilateral {
 @group(1) @binding(2) var zpack: texture_2d<f32>;
 @group(1) @binding(3) var npack: texture_2d<f32>;
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
-    let p = vec2i(pos.xy);
+// The filtered value at pixel p.
+fn filtered(p: vec2i) -> vec4f {
     let centre = textureLoad(src, p, 0);
     let z = textureLoad(zpack, p, 0).r;
     if (z <= 0.0 || blur.radius == 0) {
@@ -77,4 +76,20 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
         weight += w;
     }
     return sum / weight;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    return filtered(vec2i(pos.xy));
+}
+
+// The same pass as compute (`Kernel`), 8×8 pixels per workgroup, for RGBA16F outputs.
+@group(1) @binding(4) var out_rgba16f: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(out_rgba16f))) {
+        return;
+    }
+    textureStore(out_rgba16f, id.xy, filtered(vec2i(id.xy)));
 }

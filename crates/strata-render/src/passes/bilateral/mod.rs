@@ -8,7 +8,7 @@ use strata_scene::ImageBuf;
 use crate::frame::{FrameUniforms, Targets};
 use crate::gpu::GpuContext;
 use crate::passes::ao::world_from_csz;
-use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::passes::builder::{PassBuilder, ScreenPass};
 use crate::scene_gpu::GpuScene;
 
 /// Defaults: radius 4 taps with step 2 pixels (SAO's AO blur: 9 taps spanning
@@ -178,11 +178,13 @@ impl BilateralUniforms {
 
 /// One direction of the separable filter, from target `input` into `output`.
 pub struct BilateralPass {
-    pass: FullscreenPass,
+    pass: ScreenPass,
 }
 
 impl BilateralPass {
-    /// `vertical` picks the direction; `output` must already exist in `targets`.
+    /// `vertical` picks the direction; `output` must already exist in `targets`; `compute`:
+    /// the compute form ([`crate::passes::Kernel`]), for an RGBA16F `output` with storage
+    /// binding.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
@@ -193,17 +195,26 @@ impl BilateralPass {
         input: &'static str,
         output: &'static str,
         vertical: bool,
+        compute: bool,
     ) -> Self {
-        let pass = PassBuilder::new(gpu, targets, name)
+        let mut builder = PassBuilder::new(gpu, targets, name);
+        if compute {
+            assert_eq!(
+                targets.get(output).desc.format,
+                wgpu::TextureFormat::Rgba16Float,
+                "the compute bilateral pass writes RGBA16F"
+            );
+            builder = builder.compute().entry("cs_main");
+        }
+        let builder = builder
             .shader("bilateral", include_str!("bilateral.wgsl"))
             .constant("DIRECTION", vertical as u32 as f64)
             .frame(scene)
             .uniforms(&BilateralUniforms::new(settings))
             .read(input)
             .read("zpack")
-            .read("npack")
-            .write(output)
-            .build();
+            .read("npack");
+        let pass = ScreenPass::build(builder, &[output], compute);
         Self { pass }
     }
 }

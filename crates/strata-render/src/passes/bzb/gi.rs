@@ -961,7 +961,7 @@ impl BzbGiStage {
             ]
         });
         let blur = |name, input, output, vertical| {
-            BilateralPass::new(gpu, scene_gpu, targets, &s.filter, name, input, output, vertical)
+            BilateralPass::new(gpu, scene_gpu, targets, &s.filter, name, input, output, vertical, false)
         };
         let blur = [
             blur("bzb-gi-blur-h", filtered, BLUR_H.name, false),

@@ -758,6 +758,7 @@ impl BzbStage {
             RAW.name,
             "bzb-blur-h",
             false,
+            false,
         );
         let blur_v = BilateralPass::new(
             gpu,
@@ -768,6 +769,7 @@ impl BzbStage {
             "bzb-blur-h",
             "ao",
             true,
+            false,
         );
         Ok(Self {
             directions,

@@ -128,11 +128,11 @@ pub struct RadiositySettings {
     /// patch) leave bands and blotches that stay put under the temporal filter
     /// (docs/radiosity.md § "Jittered tap radii"). Not in the paper (default true).
     pub radius_jitter: bool,
-    /// The gather as a fullscreen fragment pass or as a compute pass (8×8 pixels per
-    /// workgroup, storage-texture outputs): the same shader code and values
-    /// (docs/radiosity.md § "The gather as a compute pass"). Not in the paper (default
-    /// [`Kernel::Auto`]: compute on GPUs, fragment on CPU adapters).
-    pub gather_kernel: Kernel,
+    /// The gather and the indirect light's bilateral passes as fullscreen fragment passes
+    /// or as compute passes (8×8 pixels per workgroup, storage-texture outputs): the same
+    /// shader code and values (docs/radiosity.md § "The gather as a compute pass"). Not in
+    /// the paper (default [`Kernel::Auto`]: compute on GPUs, fragment on CPU adapters).
+    pub kernel: Kernel,
 }
 
 /// The most steps [`RadiositySettings::tap_visibility`] takes.
@@ -412,7 +412,7 @@ impl Default for RadiositySettings {
             tap_visibility: 0,
             tap_visibility_all: true,
             radius_jitter: true,
-            gather_kernel: Kernel::Auto,
+            kernel: Kernel::Auto,
         }
     }
 }
@@ -612,7 +612,7 @@ impl RadiosityPass {
     /// Gathers from the radiosity buffers `b` (layer 0, layer 1) inside the
     /// `scissor` rectangle [x, y, w, h] (`None`: everywhere); `receiver1`: also
     /// for layer 1's surfaces (only multi-bounce propagation reads them); `probes`: for
-    /// [`RadiositySettings::probe_detail`]; `compute`: [`RadiositySettings::gather_kernel`] resolved
+    /// [`RadiositySettings::probe_detail`]; `compute`: [`RadiositySettings::kernel`] resolved
     /// (the outputs must then allow storage binding).
     #[allow(clippy::too_many_arguments)]
     pub fn new(

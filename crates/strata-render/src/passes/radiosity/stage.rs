@@ -33,14 +33,14 @@ impl RadiosityStage {
         ao_radius: f32,
     ) -> Self {
         use wgpu::TextureFormat as F;
-        let compute_gather = s.gather_kernel.compute_on(gpu);
+        // the compute gather and blurs write their outputs as storage textures
+        let compute = s.kernel.compute_on(gpu);
+        let usage = if compute {
+            wgpu::TextureUsages::STORAGE_BINDING
+        } else {
+            wgpu::TextureUsages::empty()
+        };
         for t in crate::passes::radiosity::OUTPUTS {
-            // the compute gather writes them as storage textures
-            let usage = if compute_gather {
-                wgpu::TextureUsages::STORAGE_BINDING
-            } else {
-                wgpu::TextureUsages::empty()
-            };
             targets.create_with_usage(gpu, t, [targets.width, targets.height], usage);
         }
         let mut filtered = "indirect-raw";
@@ -56,24 +56,13 @@ impl RadiosityStage {
             }
             filtered = "indirect-temporal";
         }
-        targets.create(
-            gpu,
-            TargetDesc::new(
-                "indirect-blur-h",
-                F::Rgba16Float,
-                1,
-                "indirect E after the horizontal bilateral pass",
-            ),
-        );
-        targets.create(
-            gpu,
-            TargetDesc::new(
-                "indirect",
-                F::Rgba16Float,
-                1,
-                "indirect irradiance E of layer 0 (rgb), confidence (a)",
-            ),
-        );
+        for (name, doc) in [
+            ("indirect-blur-h", "indirect E after the horizontal bilateral pass"),
+            ("indirect", "indirect irradiance E of layer 0 (rgb), confidence (a)"),
+        ] {
+            let size = [targets.width, targets.height];
+            targets.create_with_usage(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc), size, usage);
+        }
         let propagate = (s.delta > 0.0).then(|| {
             for t in crate::passes::radiosity::BOUNCE_OUTPUTS {
                 targets.create(gpu, t);
@@ -118,7 +107,7 @@ impl RadiosityStage {
             propagate.is_some(),
             // the compose pass's buffers (the detail term reads them; otherwise unread)
             probe_gpu.as_ref(),
-            compute_gather,
+            compute,
         );
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
@@ -143,6 +132,7 @@ impl RadiosityStage {
             filtered,
             "indirect-blur-h",
             false,
+            compute,
         );
         let blur_v = BilateralPass::new(
             gpu,
@@ -153,6 +143,7 @@ impl RadiosityStage {
             "indirect-blur-h",
             "indirect",
             true,
+            compute,
         );
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
