@@ -45,7 +45,7 @@ fn frozen(name: &str) -> Scene {
 /// depth chain, normals and radiosity buffers with the same taps, for layer 0
 /// and layer 1 receivers, with and without the n̂_Y test, and with the hidden taps'
 /// visibility test (which must then change the light of some pixels); the last rows
-/// run the gather as a compute pass (`gather-kernel=compute`). Fragment and compute
+/// run the gather as a compute pass (`indirect-kernel=compute`). Fragment and compute
 /// gathers each agree with the CPU on ≥ 99.5 % of the pixels; they differ from each
 /// other on a few more (atrium, default radius: 44 of 6,144), where a tap lands on a
 /// rounding boundary (texel, MIP level) and the two pipelines round differently.
@@ -57,7 +57,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     // non-paper tap rules (the atrium has a sky)
     use Normalisation::*;
     // (…, tap visibility steps, and whether it tests every tap or only the hidden ones;
-    // the gather as a compute pass, `gather-kernel=compute`)
+    // the gather as a compute pass, `indirect-kernel=compute`)
     for (
         name,
         normal_test,
@@ -620,14 +620,14 @@ fn per_frame_rotation_lets_the_temporal_filter_remove_the_pattern_noise() {
 
 /// Table 2's "fraction of guard band shaded": outside it the gather leaves
 /// E = 0 and confidence 0; inside (and in the whole image) it runs. Both as the
-/// fragment pass (a scissor) and as its compute twin (`gather-kernel=compute`, which
+/// fragment pass (a scissor) and as its compute twin (`indirect-kernel=compute`, which
 /// stores zero outside).
 #[test]
 fn gather_shades_only_the_requested_fraction_of_the_guard_band() {
     let gpu = common::gpu();
     let scene = frozen("cornell");
     let (w, h, g) = (64, 64, 16);
-    // the fragment pass (scissor) and its compute twin (`gather-kernel=compute`: zero outside)
+    // the fragment pass (scissor) and its compute twin (`indirect-kernel=compute`: zero outside)
     for compute_gather in [false, true] {
         let mut r = Renderer::new(
             &gpu,
