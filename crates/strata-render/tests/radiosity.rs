@@ -731,7 +731,7 @@ fn indirect_blur_matches_its_cpu_twin_in_both_kernels() {
             kernel,
             ..Default::default()
         };
-        let blur = rs.blur.clone();
+        let blur = rs.blur;
         let mut r = renderer(&gpu, &scene, w, h, 2, rs);
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
         let read = |name: &str| r.read_target_full(&gpu, name, 0).unwrap();
