@@ -602,6 +602,18 @@ fn refined_pixels_hold_the_brute_force_and_the_others_the_blur() {
     }
 }
 
+/// A wall 2 m in front of the camera that fills the frame (no discontinuities).
+fn frame_filling_wall() -> Scene {
+    let camera = strata_scene::Camera::new(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::Y, 60.0, 0.05);
+    let wall = [
+        Vec3::new(-10.0, -10.0, 0.0),
+        Vec3::new(10.0, -10.0, 0.0),
+        Vec3::new(10.0, 10.0, 0.0),
+        Vec3::new(-10.0, 10.0, 0.0),
+    ];
+    common::polygons_scene("wall", &[&wall], camera, 0.1)
+}
+
 /// The blur's coverage (alpha of `indirect`): on a wall that fills the frame there
 /// are no discontinuities, so an inner pixel averages all 8×6 subsets (1), and the
 /// corner (0, 0), cut by the image border, takes 5 of the 8 columns (its own and
@@ -610,14 +622,7 @@ fn refined_pixels_hold_the_brute_force_and_the_others_the_blur() {
 #[test]
 fn blur_coverage_is_the_share_of_vpl_subsets_averaged() {
     let gpu = common::gpu();
-    let camera = strata_scene::Camera::new(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::Y, 60.0, 0.05);
-    let wall = [
-        Vec3::new(-10.0, -10.0, 0.0),
-        Vec3::new(10.0, -10.0, 0.0),
-        Vec3::new(10.0, 10.0, 0.0),
-        Vec3::new(-10.0, 10.0, 0.0),
-    ];
-    let scene = common::polygons_scene("wall", &[&wall], camera, 0.1);
+    let scene = frame_filling_wall();
     let vpl = GpuVpl::new([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0; 3]);
     let r = render(
         &gpu,
@@ -651,14 +656,7 @@ fn blur_coverage_is_the_share_of_vpl_subsets_averaged() {
 #[test]
 fn refine_list_may_be_empty_and_changes_only_the_listed_pixels() {
     let gpu = common::gpu();
-    let camera = strata_scene::Camera::new(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, Vec3::Y, 60.0, 0.05);
-    let wall = [
-        Vec3::new(-10.0, -10.0, 0.0),
-        Vec3::new(10.0, -10.0, 0.0),
-        Vec3::new(10.0, 10.0, 0.0),
-        Vec3::new(-10.0, 10.0, 0.0),
-    ];
-    let scene = common::polygons_scene("wall", &[&wall], camera, 0.1);
+    let scene = frame_filling_wall();
     // VPLs of different powers, so a pixel's subset differs from the blur
     let vpls: Vec<GpuVpl> = (0..48)
         .map(|k| GpuVpl::new([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0 + (k % 5) as f32; 3]))

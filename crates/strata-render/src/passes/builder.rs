@@ -41,10 +41,9 @@ impl Kernel {
     }
 }
 
-/// A full-screen pass made by [`PassBuilder`].
-pub(crate) struct FullscreenPass {
-    pub name: &'static str,
-    pipeline: wgpu::RenderPipeline,
+/// What a built pass holds besides its pipeline, in either form.
+struct Bound {
+    name: &'static str,
     group: wgpu::BindGroup,
     uniforms: Option<wgpu::Buffer>,
     frame: bool,
@@ -52,19 +51,35 @@ pub(crate) struct FullscreenPass {
     outputs: Vec<&'static str>,
 }
 
-impl FullscreenPass {
-    /// Replaces the pass's uniforms (declared with [`PassBuilder::uniforms`]).
-    pub fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
+impl Bound {
+    fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
         let buf = self.uniforms.as_ref().expect("the pass declared uniforms");
         gpu.queue.write_buffer(buf, 0, bytemuck::bytes_of(value));
     }
 
-    pub fn info(&self) -> PassInfo {
+    fn info(&self) -> PassInfo {
         PassInfo {
             name: self.name,
             inputs: self.inputs.clone(),
             outputs: self.outputs.clone(),
         }
+    }
+}
+
+/// A full-screen pass made by [`PassBuilder`].
+pub(crate) struct FullscreenPass {
+    pipeline: wgpu::RenderPipeline,
+    bound: Bound,
+}
+
+impl FullscreenPass {
+    /// Replaces the pass's uniforms (declared with [`PassBuilder::uniforms`]).
+    pub fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
+        self.bound.set_uniforms(gpu, value)
+    }
+
+    pub fn info(&self) -> PassInfo {
+        self.bound.info()
     }
 
     /// Records the pass (clearing its outputs), shading only inside `scissor` when given.
@@ -75,13 +90,14 @@ impl FullscreenPass {
         encoder: &mut wgpu::CommandEncoder,
         scissor: Option<[u32; 4]>,
     ) {
-        let views: Vec<&wgpu::TextureView> = self.outputs.iter().map(|n| &targets.get(n).view).collect();
-        let groups: Vec<&wgpu::BindGroup> = if self.frame {
-            vec![&scene.frame_bind_group, &self.group]
+        let b = &self.bound;
+        let views: Vec<&wgpu::TextureView> = b.outputs.iter().map(|n| &targets.get(n).view).collect();
+        let groups: Vec<&wgpu::BindGroup> = if b.frame {
+            vec![&scene.frame_bind_group, &b.group]
         } else {
-            vec![&self.group]
+            vec![&b.group]
         };
-        super::fullscreen_pass_in(encoder, self.name, &self.pipeline, &views, &groups, scissor);
+        super::fullscreen_pass_in(encoder, b.name, &self.pipeline, &views, &groups, scissor);
     }
 
     pub fn encode(&self, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
@@ -387,6 +403,17 @@ impl<'a> PassBuilder<'a> {
         (group, uniforms, pipeline_layout, module)
     }
 
+    fn bound(self, group: wgpu::BindGroup, uniforms: Option<wgpu::Buffer>) -> Bound {
+        Bound {
+            name: self.name,
+            group,
+            uniforms,
+            frame: self.frame_layout.is_some(),
+            inputs: self.inputs,
+            outputs: self.outputs,
+        }
+    }
+
     pub fn build(self) -> FullscreenPass {
         assert_eq!(
             self.stage,
@@ -410,13 +437,8 @@ impl<'a> PassBuilder<'a> {
             &formats,
         );
         FullscreenPass {
-            name: self.name,
             pipeline,
-            group,
-            uniforms,
-            frame: self.frame_layout.is_some(),
-            inputs: self.inputs,
-            outputs: self.outputs,
+            bound: self.bound(group, uniforms),
         }
     }
 
@@ -441,41 +463,26 @@ impl<'a> PassBuilder<'a> {
                 cache: None,
             });
         ComputePass {
-            name: self.name,
             pipeline,
-            group,
-            uniforms,
-            frame: self.frame_layout.is_some(),
-            inputs: self.inputs,
-            outputs: self.outputs,
+            bound: self.bound(group, uniforms),
         }
     }
 }
 
 /// A compute pass made by [`PassBuilder::build_compute`].
 pub(crate) struct ComputePass {
-    pub name: &'static str,
     pipeline: wgpu::ComputePipeline,
-    group: wgpu::BindGroup,
-    uniforms: Option<wgpu::Buffer>,
-    frame: bool,
-    inputs: Vec<&'static str>,
-    outputs: Vec<&'static str>,
+    bound: Bound,
 }
 
 impl ComputePass {
     /// Replaces the pass's uniforms (declared with [`PassBuilder::uniforms`]).
     pub fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
-        let buf = self.uniforms.as_ref().expect("the pass declared uniforms");
-        gpu.queue.write_buffer(buf, 0, bytemuck::bytes_of(value));
+        self.bound.set_uniforms(gpu, value)
     }
 
     pub fn info(&self) -> PassInfo {
-        PassInfo {
-            name: self.name,
-            inputs: self.inputs.clone(),
-            outputs: self.outputs.clone(),
-        }
+        self.bound.info()
     }
 
     /// Records the pass with its workgroup counts read from `args` at `offset`
@@ -504,17 +511,18 @@ impl ComputePass {
         encoder: &mut wgpu::CommandEncoder,
         dispatch: impl FnOnce(&mut wgpu::ComputePass),
     ) {
+        let b = &self.bound;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(self.name),
+            label: Some(b.name),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
         let mut i = 0;
-        if self.frame {
+        if b.frame {
             pass.set_bind_group(0, &scene.frame_bind_group, &[]);
             i = 1;
         }
-        pass.set_bind_group(i, &self.group, &[]);
+        pass.set_bind_group(i, &b.group, &[]);
         dispatch(&mut pass);
     }
 }
@@ -575,7 +583,7 @@ impl ScreenPass {
         match self {
             ScreenPass::Fragment(p) => p.encode_in(scene, targets, encoder, scissor),
             ScreenPass::Compute(p) => {
-                let t = &targets.get(p.outputs[0]).texture;
+                let t = &targets.get(p.bound.outputs[0]).texture;
                 p.encode_grid(scene, encoder, [t.width(), t.height()], [8, 8]);
             }
         }
