@@ -298,21 +298,18 @@ impl<'a> PassBuilder<'a> {
 
     /// A read-only storage buffer.
     pub fn storage(self, buffer: &'a wgpu::Buffer) -> Self {
-        self.push(
-            wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            Some(buffer.as_entire_binding()),
-        )
+        self.storage_buffer(buffer, true)
     }
 
     /// A read-write storage buffer (atomics, appended lists).
     pub fn storage_rw(self, buffer: &'a wgpu::Buffer) -> Self {
+        self.storage_buffer(buffer, false)
+    }
+
+    fn storage_buffer(self, buffer: &'a wgpu::Buffer, read_only: bool) -> Self {
         self.push(
             wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                ty: wgpu::BufferBindingType::Storage { read_only },
                 has_dynamic_offset: false,
                 min_binding_size: None,
             },
