@@ -196,6 +196,21 @@ fn print_stage(name: &str, s: &StageBench) {
         println!("{:<18} {:>10.3} {:>10.3}", p.name, p.median_ms, p.min_ms);
     }
     println!("{}", s.split_line(name));
+    let forms: Vec<String> = [
+        ("ao_kernel", "AO pass"),
+        ("indirect_kernel", "radiosity gather and blurs"),
+    ]
+    .iter()
+    .filter_map(|(key, what)| {
+        s.settings
+            .get(*key)
+            .and_then(|v| v.as_str())
+            .map(|v| format!("{what}: {v}"))
+    })
+    .collect();
+    if !forms.is_empty() {
+        println!("({}; --set ao-kernel / indirect-kernel choose)", forms.join(", "));
+    }
     if s.settings.get("vpl_shadow_maps_cached") == Some(&serde_json::Value::Bool(true)) {
         println!("(the VPLs and the scene hold still: the VPL shadow maps are drawn in the warm-up frame and kept, so `ils-vpl-shadows` is ~0; --set vpl-shadow-cache=0 times their redraw)");
     }

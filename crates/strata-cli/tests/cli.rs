@@ -573,6 +573,29 @@ fn bench_ao_splits_first_layer_and_increment() {
     let (first, inc) = (v["layer1_ms"].as_f64().unwrap(), v["increment_ms"].as_f64().unwrap());
     assert!(total > 0.0 && first > 0.0);
     assert!((first + inc - total).abs() < 1e-6, "{first} + {inc} != {total}");
+    // the form `ao-kernel=auto` resolved to: fragment on CPU adapters, compute on GPUs
+    let cpu = v["device"].as_str().is_some_and(|d| d.contains("llvmpipe"));
+    assert_eq!(v["ao_kernel"], if cpu { "fragment" } else { "compute" }, "{v}");
+    assert!(v.get("indirect_kernel").is_none(), "no radiosity in bench ao: {v}");
+    // and what --set chooses
+    let o = strata(&[
+        "bench",
+        "technique",
+        "--technique",
+        "ao",
+        "--scene",
+        "column-wall",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "1",
+        "--set",
+        "ao-kernel=compute",
+        "--json",
+    ]);
+    assert_eq!(json_of(&o)["ao_kernel"], "compute");
 }
 
 /// `--deinterleave 2x2 --filter-obscurance`: the copy, both splits, `ao-deint`,

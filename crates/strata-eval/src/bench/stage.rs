@@ -78,6 +78,16 @@ pub(crate) fn run(b: Stage) -> Result<StageBench> {
     let spread = one
         .as_ref()
         .and_then(|o| Spread::of_differences(&k.frame_totals, &o.frame_totals));
+    // which form ran the passes that have two (`Kernel::Auto` resolves by adapter)
+    let mut settings = b.extra.as_object().cloned().unwrap_or_default();
+    let rs = (b.settings)(s.layers);
+    let form = |compute: bool| if compute { "compute" } else { "fragment" };
+    if let Some(ao) = &rs.ao {
+        settings.insert("ao_kernel".into(), form(ao.kernel.compute_on(&gpu)).into());
+    }
+    if let Some(rad) = &rs.radiosity {
+        settings.insert("indirect_kernel".into(), form(rad.kernel.compute_on(&gpu)).into());
+    }
     Ok(StageBench {
         run: bench_run(&s.scene, s.frames, &scene, &gpu),
         layers: s.layers,
@@ -89,7 +99,7 @@ pub(crate) fn run(b: Stage) -> Result<StageBench> {
         passes_layers_1: one.map(|o| o.passes),
         increment_within_noise: spread.map(|s| s.includes_zero()),
         increment_spread: spread,
-        settings: b.extra.as_object().cloned().unwrap_or_default(),
+        settings,
     })
 }
 
