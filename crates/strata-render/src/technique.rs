@@ -517,7 +517,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 23] = [
     ),
     enum_setting!(
         "indirect-kernel",
-        "the radiosity gather and the indirect light's bilateral passes as fullscreen fragment passes or as compute passes (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/radiosity.md)",
+        "the radiosity gather, the indirect light's bilateral passes and compose as fullscreen fragment passes or as compute passes (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/radiosity.md)",
         radiosity_of,
         radiosity_mut,
         kernel,

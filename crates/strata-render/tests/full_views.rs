@@ -596,7 +596,8 @@ fn probe_detail_gather_and_blend_match_cpu_twin() {
 /// The one-sided confidence (`RadiositySettings::one_sided_confidence`, default on): the GPU
 /// blend equals its CPU twin `probe_blend` at every surface pixel; where the gather is darker
 /// than the probes it leans towards the probes (never darker than DGB's blend), elsewhere it is
-/// DGB's blend exactly.
+/// DGB's blend exactly. Compose runs as a fragment pass and as its compute twin
+/// (`indirect-kernel=compute`).
 #[test]
 fn one_sided_blend_matches_cpu_twin() {
     use glam::Vec3;
@@ -605,54 +606,60 @@ fn one_sided_blend_matches_cpu_twin() {
     let scene = frozen("cornell");
     let (w, h) = (64, 48);
     const PROBE_SCALE: f32 = 0.2;
-    let mut probes = distinct_probes(Vec3::splat(-0.1), Vec3::splat(0.66));
-    // dimmed so that the gather is the brighter of the two at part of the box
-    for c in probes.coeffs.iter_mut().flatten().flatten() {
-        *c *= PROBE_SCALE;
-    }
-    let rs = RadiositySettings {
-        radius: Some(0.5),
-        temporal: None,
-        ..Default::default()
-    };
-    assert!(rs.one_sided_confidence, "on by default");
-    let mut r = renderer(&gpu, &scene, w, h, rs, Some(probes), None);
-    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
-        .expect("frame renders without validation errors");
-    let gather = r.read_target(&gpu, "indirect").unwrap();
-    let probe = r.read_target(&gpu, "probe-irradiance").unwrap();
-    let blended = r.read_target(&gpu, "indirect-blended").unwrap();
-    let points = common::surface_points(&gpu, &r);
-    let y = Vec3::from(LUMINANCE);
-    let (mut darker, mut brighter) = (0usize, 0usize);
-    for s in &points {
-        let at = |img: &ImageBuf| Vec3::from_slice(&img.data[s.i * 4..s.i * 4 + 3]);
-        let (g, ep, got) = (at(&gather), at(&probe), at(&blended));
-        let c = gather.data[s.i * 4 + 3];
-        let want = probe_blend(g, c, ep, true);
-        let dgb = probe_blend(g, c, ep, false);
-        assert!(
-            (got - want).abs().max_element() <= 2e-3 * want.max_element() + 1e-4,
-            "pixel ({}, {}): blended {got} vs CPU {want}",
-            s.x,
-            s.y
-        );
-        assert!(want.dot(y) >= dgb.dot(y) - 1e-6, "never darker than DGB's blend");
-        if c > 0.05 && g.dot(y) < 0.9 * ep.dot(y) {
-            darker += 1;
-            assert!((want - dgb).abs().max_element() > 0.0, "the probes weigh more");
-        } else if g.dot(y) >= ep.dot(y) {
-            brighter += 1;
-            assert_eq!(want, dgb, "where screen space sees more, DGB's c stands");
+    for kernel in [
+        strata_render::passes::Kernel::Fragment,
+        strata_render::passes::Kernel::Compute,
+    ] {
+        let mut probes = distinct_probes(Vec3::splat(-0.1), Vec3::splat(0.66));
+        // dimmed so that the gather is the brighter of the two at part of the box
+        for c in probes.coeffs.iter_mut().flatten().flatten() {
+            *c *= PROBE_SCALE;
         }
+        let rs = RadiositySettings {
+            radius: Some(0.5),
+            temporal: None,
+            kernel,
+            ..Default::default()
+        };
+        assert!(rs.one_sided_confidence, "on by default");
+        let mut r = renderer(&gpu, &scene, w, h, rs, Some(probes), None);
+        r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+            .expect("frame renders without validation errors");
+        let gather = r.read_target(&gpu, "indirect").unwrap();
+        let probe = r.read_target(&gpu, "probe-irradiance").unwrap();
+        let blended = r.read_target(&gpu, "indirect-blended").unwrap();
+        let points = common::surface_points(&gpu, &r);
+        let y = Vec3::from(LUMINANCE);
+        let (mut darker, mut brighter) = (0usize, 0usize);
+        for s in &points {
+            let at = |img: &ImageBuf| Vec3::from_slice(&img.data[s.i * 4..s.i * 4 + 3]);
+            let (g, ep, got) = (at(&gather), at(&probe), at(&blended));
+            let c = gather.data[s.i * 4 + 3];
+            let want = probe_blend(g, c, ep, true);
+            let dgb = probe_blend(g, c, ep, false);
+            assert!(
+                (got - want).abs().max_element() <= 2e-3 * want.max_element() + 1e-4,
+                "pixel ({}, {}): blended {got} vs CPU {want}",
+                s.x,
+                s.y
+            );
+            assert!(want.dot(y) >= dgb.dot(y) - 1e-6, "never darker than DGB's blend");
+            if c > 0.05 && g.dot(y) < 0.9 * ep.dot(y) {
+                darker += 1;
+                assert!((want - dgb).abs().max_element() > 0.0, "the probes weigh more");
+            } else if g.dot(y) >= ep.dot(y) {
+                brighter += 1;
+                assert_eq!(want, dgb, "where screen space sees more, DGB's c stands");
+            }
+        }
+        eprintln!(
+            "{kernel:?}: {} surface pixels: {darker} gather darker than the probes, {brighter} brighter",
+            points.len()
+        );
+        assert!(
+            darker > points.len() / 20 && brighter > points.len() / 20,
+            "weak test: {darker} darker, {brighter} brighter of {}",
+            points.len()
+        );
     }
-    eprintln!(
-        "{} surface pixels: {darker} gather darker than the probes, {brighter} brighter",
-        points.len()
-    );
-    assert!(
-        darker > points.len() / 20 && brighter > points.len() / 20,
-        "weak test: {darker} darker, {brighter} brighter of {}",
-        points.len()
-    );
 }

@@ -977,6 +977,7 @@ impl BzbGiStage {
             None,
             crate::passes::ils::INDIRECT.name,
             Some(GLOSSY.name),
+            false,
         );
         Ok(Self {
             directions,

@@ -60,9 +60,8 @@ fn ao_multibounce(av: f32, rho: vec3f) -> vec3f {
     return max(vec3f(av), ((av * a + b) * av + c) * av);
 }
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> Out {
-    let p = vec2i(pos.xy);
+// The composed pixel p.
+fn composed(p: vec2i) -> Out {
     var o: Out;
     let direct = textureLoad(hdr, p, 0);
     o.hdr = direct;
@@ -121,4 +120,25 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
         o.hdr = vec4f(o.hdr.rgb + textureLoad(glossy, p, 0).rgb * a, o.hdr.a);
     }
     return o;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
+    return composed(vec2i(pos.xy));
+}
+
+// The same pass as compute (`Kernel`, the radiosity stage's), 8×8 pixels per workgroup.
+@group(1) @binding(10) var hdr_out: texture_storage_2d<rgba16float, write>;
+@group(1) @binding(11) var blended_out: texture_storage_2d<rgba16float, write>;
+@group(1) @binding(12) var probe_out: texture_storage_2d<rgba16float, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(hdr_out))) {
+        return;
+    }
+    let o = composed(vec2i(id.xy));
+    textureStore(hdr_out, id.xy, o.hdr);
+    textureStore(blended_out, id.xy, o.blended);
+    textureStore(probe_out, id.xy, o.probe);
 }

@@ -6,7 +6,7 @@
 //! (`radiosity::ProbeAo`). Outputs `hdr-full`,
 //! `indirect-blended` (E, c) and `probe-irradiance` (AO's factor · E_probe, AV).
 
-use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::passes::builder::{PassBuilder, ScreenPass};
 use strata_scene::probes::IrradianceProbes;
 
 use crate::frame::{TargetDesc, Targets};
@@ -137,7 +137,7 @@ pub struct ComposeProbes<'a> {
 }
 
 pub struct ComposePass {
-    pass: FullscreenPass,
+    pass: ScreenPass,
 }
 
 impl ComposePass {
@@ -152,6 +152,7 @@ impl ComposePass {
         probes: Option<ComposeProbes>,
         indirect: &'static str,
         glossy: Option<&'static str>,
+        compute: bool,
     ) -> Self {
         let probe_ao = probes.as_ref().map_or(crate::passes::radiosity::ProbeAo::Off, |p| p.ao);
         let use_ao =
@@ -177,7 +178,11 @@ impl ComposePass {
             use_glossy: glossy.is_some() as u32,
             grid: gpu_probes.grid,
         };
-        let mut b = PassBuilder::new(gpu, targets, "compose")
+        let mut b = PassBuilder::new(gpu, targets, "compose");
+        if compute {
+            b = b.compute().entry("cs_main");
+        }
+        let b = b
             .shader("compose", include_str!("compose.wgsl"))
             .frame(scene)
             .uniforms(&u)
@@ -192,10 +197,9 @@ impl ComposePass {
             // without glossy receivers the binding is filled by a target that is read anyway
             .read_layer(glossy.unwrap_or(indirect), 0)
             .storage(&gpu_probes.depth);
-        for t in &OUTPUTS {
-            b = b.write(t.name);
+        Self {
+            pass: ScreenPass::build(b, &OUTPUTS.map(|t| t.name), compute),
         }
-        Self { pass: b.build() }
     }
 }
 

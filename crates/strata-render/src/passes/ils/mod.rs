@@ -1063,8 +1063,16 @@ impl IlsStage {
         for t in crate::passes::compose::OUTPUTS {
             targets.create(gpu, t);
         }
-        let compose =
-            crate::passes::compose::ComposePass::new(gpu, scene_gpu, targets, false, None, shown, Some(glossy_shown));
+        let compose = crate::passes::compose::ComposePass::new(
+            gpu,
+            scene_gpu,
+            targets,
+            false,
+            None,
+            shown,
+            Some(glossy_shown),
+            false,
+        );
         Ok(Self {
             gbuffer,
             split,

@@ -128,8 +128,8 @@ pub struct RadiositySettings {
     /// patch) leave bands and blotches that stay put under the temporal filter
     /// (docs/radiosity.md § "Jittered tap radii"). Not in the paper (default true).
     pub radius_jitter: bool,
-    /// The gather and the indirect light's bilateral passes as fullscreen fragment passes
-    /// or as compute passes (8×8 pixels per workgroup, storage-texture outputs): the same
+    /// The gather, the indirect light's bilateral passes and compose as fullscreen fragment
+    /// passes or as compute passes (8×8 pixels per workgroup, storage-texture outputs): the same
     /// shader code and values (docs/radiosity.md § "The gather as a compute pass"). Not in
     /// the paper (default [`Kernel::Auto`]: compute on GPUs, fragment on CPU adapters).
     pub kernel: Kernel,

@@ -146,7 +146,7 @@ impl RadiosityStage {
             compute,
         );
         for t in crate::passes::compose::OUTPUTS {
-            targets.create(gpu, t);
+            targets.create_with_usage(gpu, t, [targets.width, targets.height], usage);
         }
         let compose = crate::passes::compose::ComposePass::new(
             gpu,
@@ -161,6 +161,7 @@ impl RadiosityStage {
             }),
             "indirect",
             None,
+            compute,
         );
         Self {
             propagate,
