@@ -144,6 +144,7 @@ impl ComposePass {
     /// `probes`: the static fallback (Fig. 9); AO modulates it when target `ao` exists.
     /// `indirect`: the target holding E (rgb) and the confidence (a), e.g. `indirect`.
     /// `glossy`: a target of outgoing radiance added as is (ILS's `ils-glossy`).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
