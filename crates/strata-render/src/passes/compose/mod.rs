@@ -144,6 +144,8 @@ impl ComposePass {
     /// `probes`: the static fallback (Fig. 9); AO modulates it when target `ao` exists.
     /// `indirect`: the target holding E (rgb) and the confidence (a), e.g. `indirect`.
     /// `glossy`: a target of outgoing radiance added as is (ILS's `ils-glossy`).
+    /// `compute`: the compute form ([`crate::passes::Kernel`]; the outputs must then allow
+    /// storage binding).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
