@@ -12,6 +12,10 @@
 //!     .write(output)
 //!     .build();
 //! ```
+//!
+//! The same declarations make a compute pass: `.compute()` first, a compute `entry`,
+//! outputs as `.write_storage(name)`, then `.build_compute()`. [`ScreenPass`] builds
+//! either form of one shader function ([`Kernel`]).
 
 use crate::frame::{PassInfo, Targets};
 use crate::gpu::GpuContext;
@@ -177,7 +181,8 @@ impl<'a> PassBuilder<'a> {
     }
 
     /// Makes a compute pass instead ([`PassBuilder::build_compute`]): the bindings are
-    /// visible to the compute stage and `entry` names a compute entry point.
+    /// visible to the compute stage and `entry` names a compute entry point. Call it
+    /// before declaring any binding.
     pub fn compute(mut self) -> Self {
         self.stage = wgpu::ShaderStages::COMPUTE;
         self
