@@ -869,7 +869,7 @@ impl Renderer {
             .unwrap_or(scene.settings.min_separation);
         if let (Some(stage), Some(s)) = (&self.radiosity, &self.settings.radiosity) {
             let ru = RadiosityUniforms::new(s, scene, &u, max_mip, self.frames_rendered, dz);
-            stage.gather.set_frame(gpu, ru);
+            stage.set_frame(gpu, ru);
             if let Some(p) = &stage.propagate {
                 p.set_frame(gpu, temporal_history);
             }
@@ -966,6 +966,12 @@ impl Renderer {
     /// The radiosity pass's uniforms of the last rendered frame.
     pub fn radiosity_uniforms(&self) -> Option<RadiosityUniforms> {
         self.radiosity.as_ref().map(|r| r.gather.uniforms())
+    }
+
+    /// The reduced-resolution gather's upsampling uniforms this frame
+    /// (`RadiositySettings::gather_scale` > 1), for its CPU twin.
+    pub fn upsample_uniforms(&self) -> Option<crate::passes::radiosity::upsample::UpsampleUniforms> {
+        self.radiosity.as_ref()?.upsample.as_ref().map(|u| u.uniforms())
     }
 
     /// The AO pass's uniforms of the last rendered frame.

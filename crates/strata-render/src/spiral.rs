@@ -60,6 +60,15 @@ pub fn pixel_angle(x: u32, y: u32, seed: u32) -> f32 {
     (h >> 8) as f32 * (1.0 / 16_777_216.0) * TWO_PI
 }
 
+/// The full-resolution pixel that texel `t` of a gather run at 1/`s` resolution shades:
+/// one pixel of t's s×s block, the block's hashed phase plus `seed` stepping through all
+/// s² pixels in s² frames, clamped into an image of `size` pixels. Bit-identical to
+/// `spiral.wgsl`'s `block_pixel`; s = 1 gives `t`.
+pub fn block_pixel(t: [u32; 2], s: u32, seed: u32, size: [u32; 2]) -> [u32; 2] {
+    let k = pcg_hash(t[0].wrapping_add(pcg_hash(t[1] ^ 0x68e3_1da4))).wrapping_add(seed) % (s * s);
+    [(t[0] * s + k % s).min(size[0] - 1), (t[1] * s + k / s).min(size[1] - 1)]
+}
+
 /// One spiral tap: screen offset in pixels and its radius h_i.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpiralTap {
@@ -110,6 +119,31 @@ pub fn tap_texel(offset: [f32; 2]) -> [i32; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each block's pixel lies in its block (or on the image's last row or column), s = 1
+    /// is the identity, and s² consecutive seeds visit every pixel of a block once.
+    #[test]
+    fn block_pixel_cycles_through_its_block() {
+        let size = [13, 9];
+        for t in [[0u32, 0], [3, 2], [6, 4]] {
+            assert_eq!(block_pixel(t, 1, 17, size), t);
+            for s in [2u32, 3] {
+                let mut seen = std::collections::HashSet::new();
+                for seed in 40..40 + s * s {
+                    let p = block_pixel(t, s, seed, size);
+                    for a in 0..2 {
+                        let lo = (t[a] * s).min(size[a] - 1);
+                        assert!(p[a] >= lo && p[a] < (t[a] * s + s).min(size[a]), "{t:?} s={s}: {p:?}");
+                    }
+                    seen.insert(p);
+                }
+                let inside = (0..2).all(|a| t[a] * s + s <= size[a]);
+                if inside {
+                    assert_eq!(seen.len() as u32, s * s, "{t:?} s={s}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn listing3_values() {

@@ -441,7 +441,7 @@ static AO_SETTINGS: [SettingInfo; 16] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 23] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 24] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -546,6 +546,14 @@ static RADIOSITY_SETTINGS: [SettingInfo; 23] = [
         true,
         |s| Some(radiosity_of(s).tap_visibility as f64),
         |s, v| radiosity_mut(s).tap_visibility = v as u32
+    ),
+    setting!(
+        "gather-scale",
+        "the radiosity gather's resolution divisor s: at s > 1 it shades one pixel of each s x s block (a different one each frame) and a joint bilateral upsampling fills the rest (1 = every pixel, as the paper; not in the paper, docs/radiosity.md)",
+        Range::Closed(1.0, radiosity::upsample::MAX_GATHER_SCALE as f64),
+        true,
+        |s| Some(radiosity_of(s).gather_scale as f64),
+        |s, v| radiosity_mut(s).gather_scale = v as u32
     ),
     setting!(
         "indirect-samples",

@@ -159,6 +159,99 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
     }
 }
 
+/// The reduced-resolution gather (`gather-scale`, not in the paper), on the second
+/// frame (seed 1, so `block_pixel` has moved on from frame 0's pixels): each
+/// low-resolution texel equals Eq. 4–5 on the CPU at the pixel it shades, and the
+/// full-resolution `indirect-raw` / `indirect1-raw` equal the CPU twin of the joint
+/// bilateral upsampling of the read-back low-resolution gather, for both receivers,
+/// at scales 2 and 3, as fragment and as compute passes.
+#[test]
+fn reduced_resolution_gather_and_upsampling_match_their_cpu_twins() {
+    use strata_render::passes::radiosity::upsample::upsample_cpu;
+    let gpu = common::gpu();
+    for (name, scale, kernel) in [
+        ("atrium", 2u32, Kernel::Fragment),
+        ("warehouse", 3, Kernel::Compute),
+        ("cornell", 2, Kernel::Compute),
+    ] {
+        let scene = frozen(name);
+        let (w, h) = (96u32, 64u32);
+        let rs = RadiositySettings {
+            gather_scale: scale,
+            radius: Some(4.0),
+            kernel,
+            ..Default::default()
+        };
+        let mut r = renderer(&gpu, &scene, w, h, 2, rs);
+        for _ in 0..2 {
+            r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+                .expect("frame renders without validation errors");
+        }
+        let mut buffers = common::GatherBuffers::read(&gpu, &r);
+        // with progressive bounces the gather reads this frame's B with last frame's E
+        // reflected (§3.3), which also makes it gather for layer 1's receiver
+        buffers.radiosity = ["bounce0", "bounce1"].map(|b| r.read_target_full(&gpu, b, 0).unwrap());
+        let inputs = buffers.inputs(None);
+        let up = r.upsample_uniforms().expect("an upsampling pass at scale > 1");
+        assert_eq!((up.scale, up.seed), (scale, inputs.uniforms.seed));
+        assert_eq!(up.seed, 1, "temporal noise: the second frame's seed");
+        let n = (w * h) as usize;
+        for (receiver, low_name, full_name) in [
+            (0usize, "indirect-raw-low", "indirect-raw"),
+            (1, "indirect1-raw-low", "indirect1-raw"),
+        ] {
+            let low = r.read_target_full(&gpu, low_name, 0).unwrap();
+            assert_eq!((low.width, low.height), (w.div_ceil(scale), h.div_ceil(scale)));
+            let (mut close, mut lit) = (0usize, 0usize);
+            for ty in 0..low.height {
+                for tx in 0..low.width {
+                    let p = strata_render::spiral::block_pixel([tx, ty], scale, up.seed, [w, h]);
+                    let (e, conf) = irradiance_cpu(&inputs, receiver, p[0], p[1]);
+                    let g = low.pixel(tx, ty);
+                    let mut ok = (g[3] - conf).abs() < 1e-3;
+                    for c in 0..3 {
+                        ok &= (g[c] - e[c]).abs() <= 2e-3 * e[c].abs() + 1e-4;
+                    }
+                    close += ok as usize;
+                    lit += (e.max_element() > 1e-3) as usize;
+                }
+            }
+            let m = (low.width * low.height) as usize;
+            eprintln!("{name} s={scale} receiver {receiver}: gather {close}/{m} match, {lit} lit");
+            assert!(
+                close as f32 >= 0.995 * m as f32,
+                "{name} s={scale} layer {receiver}: {close}/{m}"
+            );
+            assert!(lit > m / 20, "{name} layer {receiver}: weak test, {lit} lit texels");
+
+            let want = upsample_cpu(
+                &low,
+                &buffers.zmip[0],
+                &buffers.normals[receiver],
+                &buffers.frame,
+                &up,
+                receiver,
+            );
+            let got = r.read_target_full(&gpu, full_name, 0).unwrap();
+            let (mut close, mut lit) = (0usize, 0usize);
+            for y in 0..h {
+                for x in 0..w {
+                    let (a, b) = (got.pixel(x, y), want.pixel(x, y));
+                    let ok = (0..4).all(|c| (a[c] - b[c]).abs() <= 2e-3 * b[c].abs() + 1e-4);
+                    close += ok as usize;
+                    lit += (b[..3].iter().any(|&v| v > 1e-3)) as usize;
+                }
+            }
+            eprintln!("{name} s={scale} receiver {receiver}: upsampled {close}/{n} match, {lit} lit");
+            assert!(
+                close as f32 >= 0.995 * n as f32,
+                "{name} s={scale} layer {receiver}: {close}/{n}"
+            );
+            assert!(lit > n / 20, "{name} layer {receiver}: weak test, {lit} lit pixels");
+        }
+    }
+}
+
 /// A scene of `parts` (one object and material each) with no light source, a black
 /// sky and no ambient light (min separation 0.5 m): only emissive parts send light.
 fn emitter_only_scene(name: &str, parts: Vec<(MeshBuilder, Material)>, camera: Camera) -> Scene {

@@ -10,6 +10,7 @@
 //! (Eq. 6 with the Lambertian 1/π made explicit).
 
 pub(crate) mod stage;
+pub mod upsample;
 
 use crate::passes::builder::{FullscreenPass, Kernel, PassBuilder, ScreenPass};
 use glam::Vec3;
@@ -133,6 +134,13 @@ pub struct RadiositySettings {
     /// shader code and values (docs/radiosity.md § "The gather as a compute pass"). Not in
     /// the paper (default [`Kernel::Auto`]: compute on GPUs, fragment on CPU adapters).
     pub kernel: Kernel,
+    /// The gather's resolution divisor s, 1..=[`upsample::MAX_GATHER_SCALE`]: at s > 1 the
+    /// gather shades one pixel of each s×s block (a different one each frame with
+    /// `temporal_noise`, all s² in s² frames) and a joint bilateral upsampling (the
+    /// indirect blur's plane and normal weights) fills the rest before the temporal
+    /// filter (docs/radiosity.md § "Reduced-resolution gather"). Not in the paper (default
+    /// 1: every pixel, as DGB).
+    pub gather_scale: u32,
 }
 
 /// The most steps [`RadiositySettings::tap_visibility`] takes.
@@ -413,6 +421,7 @@ impl Default for RadiositySettings {
             tap_visibility_all: true,
             radius_jitter: true,
             kernel: Kernel::Auto,
+            gather_scale: 1,
         }
     }
 }
@@ -477,6 +486,13 @@ impl RadiositySettings {
             return Err(format!(
                 "propagation damping δ {} is out of range: must be in [0, 1]",
                 self.delta
+            ));
+        }
+        if !(1..=upsample::MAX_GATHER_SCALE).contains(&self.gather_scale) {
+            return Err(format!(
+                "radiosity gather-scale {} is out of range: must be in 1..={}",
+                self.gather_scale,
+                upsample::MAX_GATHER_SCALE
             ));
         }
         self.mips.validate()?;
@@ -613,7 +629,9 @@ impl RadiosityPass {
     /// `scissor` rectangle [x, y, w, h] (`None`: everywhere); `receiver1`: also
     /// for layer 1's surfaces (only multi-bounce propagation reads them); `probes`: for
     /// [`RadiositySettings::probe_detail`]; `compute`: [`RadiositySettings::kernel`] resolved
-    /// (the outputs must then allow storage binding).
+    /// (the outputs must then allow storage binding); `scale`:
+    /// [`RadiositySettings::gather_scale`] (> 1: into [`upsample::LOW_OUTPUTS`], `scissor` in
+    /// full-resolution pixels).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
@@ -625,7 +643,10 @@ impl RadiosityPass {
         receiver1: bool,
         probes: Option<&crate::passes::compose::ProbeGpu>,
         compute: bool,
+        scale: u32,
     ) -> Self {
+        let scissor = scissor.map(|r| upsample::low_rect(r, scale));
+        let outputs = if scale > 1 { upsample::LOW_OUTPUTS } else { OUTPUTS };
         let zeroed: RadiosityUniforms = bytemuck::Zeroable::zeroed();
         let dummy;
         let gpu_probes = match probes {
@@ -650,6 +671,7 @@ impl RadiosityPass {
             .shader("radiosity", include_str!("radiosity.wgsl"))
             .constant("LAYERS", layers as f64)
             .constant("RECEIVER1", receiver1 as u32 as f64)
+            .constant("SCALE", scale as f64)
             .frame(scene)
             .uniforms(&zeroed)
             .read("zmip")
@@ -659,7 +681,7 @@ impl RadiosityPass {
             .read(if layers > 1 { b[1] } else { b[0] })
             .storage(&gpu_probes.probes)
             .storage(&gpu_probes.depth);
-        let pass = ScreenPass::build(builder, &OUTPUTS.map(|t| t.name), compute);
+        let pass = ScreenPass::build(builder, &outputs.map(|t| t.name), compute);
         Self {
             pass,
             grid: probes.map(|p| p.grid),

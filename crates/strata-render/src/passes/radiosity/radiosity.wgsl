@@ -15,6 +15,10 @@ override LAYERS: u32 = 2u;
 // 1 = also gather for layer 1's receiver (needed only to propagate bounces
 // through layer 1, §3.3 / Fig. 5)
 override RECEIVER1: u32 = 1u;
+// > 1: the gather runs at 1/SCALE resolution, texel t shading one pixel of its
+// SCALE×SCALE block (`block_pixel`); `upsample.wgsl` brings it back to full resolution
+// (`RadiositySettings::gather_scale`)
+override SCALE: u32 = 1u;
 
 // Matches `radiosity::RadiosityUniforms`.
 struct Radiosity {
@@ -446,9 +450,14 @@ fn gather(p: vec2i) -> Out {
     return o;
 }
 
+// The pixel that output texel t shades (itself at full resolution).
+fn receiver_pixel(t: vec2u) -> vec2i {
+    return vec2i(block_pixel(t, SCALE, rad.seed, textureDimensions(zmip, 0)));
+}
+
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> Out {
-    return gather(vec2i(pos.xy));
+    return gather(receiver_pixel(vec2u(pos.xy)));
 }
 
 // The same gather as a compute pass (`RadiositySettings::compute_gather`), 8×8 pixels
@@ -469,7 +478,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3u) {
     }
     var o: Out;
     if (all(id.xy >= vec2u(SCISSOR_X0, SCISSOR_Y0)) && all(id.xy < vec2u(SCISSOR_X1, SCISSOR_Y1))) {
-        o = gather(vec2i(id.xy));
+        o = gather(receiver_pixel(id.xy));
     }
     textureStore(e0_out, id.xy, o.e0);
     textureStore(e1_out, id.xy, o.e1);

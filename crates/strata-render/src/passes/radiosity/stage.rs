@@ -14,6 +14,8 @@ use crate::scene_gpu::GpuScene;
 pub(crate) struct RadiosityStage {
     pub(crate) propagate: Option<crate::passes::radiosity::PropagatePass>,
     pub(crate) gather: RadiosityPass,
+    /// With [`RadiositySettings::gather_scale`] > 1: the low-resolution gather's upsampling.
+    pub(crate) upsample: Option<crate::passes::radiosity::upsample::UpsamplePass>,
     pub(crate) temporal: Option<TemporalPass>,
     pub(crate) blur_h: BilateralPass,
     pub(crate) blur_v: BilateralPass,
@@ -42,6 +44,13 @@ impl RadiosityStage {
         };
         for t in crate::passes::radiosity::OUTPUTS {
             targets.create_with_usage(gpu, t, [targets.width, targets.height], usage);
+        }
+        let scale = s.gather_scale;
+        if scale > 1 {
+            let size = crate::passes::radiosity::upsample::low_size(targets.width, targets.height, scale);
+            for t in crate::passes::radiosity::upsample::LOW_OUTPUTS {
+                targets.create_with_usage(gpu, t, size, usage);
+            }
         }
         let mut filtered = "indirect-raw";
         if s.temporal.is_some() {
@@ -108,7 +117,19 @@ impl RadiosityStage {
             // the compose pass's buffers (the detail term reads them; otherwise unread)
             probe_gpu.as_ref(),
             compute,
+            scale,
         );
+        let upsample = (scale > 1).then(|| {
+            crate::passes::radiosity::upsample::UpsamplePass::new(
+                gpu,
+                scene,
+                targets,
+                deep.layers,
+                crate::passes::radiosity::upsample::UpsampleUniforms::new(scale, &s.blur),
+                region,
+                compute,
+            )
+        });
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
                 gpu,
@@ -166,10 +187,19 @@ impl RadiosityStage {
         Self {
             propagate,
             gather,
+            upsample,
             temporal,
             blur_h,
             blur_v,
             compose,
+        }
+    }
+
+    /// This frame's gather uniforms, and the upsampling's seed from them.
+    pub(crate) fn set_frame(&self, gpu: &GpuContext, u: crate::passes::radiosity::RadiosityUniforms) {
+        self.gather.set_frame(gpu, u);
+        if let Some(up) = &self.upsample {
+            up.set_frame(gpu, u.seed);
         }
     }
 
@@ -179,6 +209,9 @@ impl RadiosityStage {
             v.push(p);
         }
         v.push(&self.gather);
+        if let Some(u) = &self.upsample {
+            v.push(u);
+        }
         if let Some(t) = &self.temporal {
             v.push(t);
         }

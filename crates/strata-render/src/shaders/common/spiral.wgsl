@@ -18,6 +18,15 @@ fn pixel_angle(p: vec2u, seed: u32) -> f32 {
     return f32(h >> 8u) * (1.0 / 16777216.0) * SPIRAL_TWO_PI;
 }
 
+// The full-resolution pixel that texel t of a gather run at 1/s resolution shades
+// (`RadiositySettings::gather_scale`): one pixel of t's s×s block, the block's own hashed
+// phase plus `seed` (the frame index with temporal noise) stepping through all s² pixels
+// in s² frames, clamped into the image of `size` pixels. s = 1: t itself.
+fn block_pixel(t: vec2u, s: u32, seed: u32, size: vec2u) -> vec2u {
+    let k = (pcg_hash(t.x + pcg_hash(t.y ^ 0x68e31da4u)) + seed) % (s * s);
+    return min(t * s + vec2u(k % s, k / s), size - 1u);
+}
+
 struct SpiralTap {
     // screen offset in pixels
     offset: vec2f,
