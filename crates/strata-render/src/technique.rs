@@ -1233,6 +1233,9 @@ pub struct Technique {
     /// The passes it adds to the frame, in frame order (what `strata bench technique`
     /// times; a test checks each runs in its frame).
     pub passes: &'static [&'static str],
+    /// Passes that some of its settings add (e.g. `gather-scale`'s upsampling): `strata
+    /// bench technique` times those the frame has, in frame order.
+    pub optional_passes: &'static [&'static str],
     /// Its numeric settings, in groups (e.g. `full` = direct's + AO's + its own).
     pub settings: &'static [&'static [SettingInfo]],
     /// Turns `s` into this technique's settings with `preset` (`None`: the default
@@ -1485,6 +1488,8 @@ pub const RADIOSITY_PASSES: &[&str] = &[
     "depth-mip",
     "propagate",
     "radiosity",
+    // only with `gather-scale` > 1
+    "radiosity-upsample",
     "indirect-temporal",
     "indirect-blur-h",
     "indirect-blur-v",
@@ -1511,6 +1516,10 @@ const FULL_PASSES: &[&str] = &[
     "tonemap",
 ];
 
+/// Passes `full`'s settings may add: the reduced-resolution gather's upsampling
+/// (`gather-scale` > 1).
+const FULL_OPTIONAL_PASSES: &[&str] = &["radiosity-upsample"];
+
 /// Preset names of the DGB radiosity (Table 2), default first.
 const FULL_PRESETS: &[&str] = &["balanced", "high-performance", "high-quality"];
 
@@ -1523,6 +1532,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::None,
         presets: &[],
         passes: DIRECT_PASSES,
+        optional_passes: &[],
         settings: &[&DIRECT_SETTINGS],
         configure: configure_direct,
     },
@@ -1534,6 +1544,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::AmbientVisibility,
         presets: &[],
         passes: AO_PASSES,
+        optional_passes: &[],
         settings: &[&AO_SETTINGS],
         configure: configure_ao,
     },
@@ -1545,6 +1556,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::Radiance,
         presets: FULL_PRESETS,
         passes: FULL_PASSES,
+        optional_passes: FULL_OPTIONAL_PASSES,
         settings: &[&DIRECT_SETTINGS, &AO_SETTINGS, &RADIOSITY_SETTINGS],
         configure: configure_full,
     },
@@ -1558,6 +1570,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::VplRadiance,
         presets: &crate::passes::ils::PRESETS,
         passes: ILS_PASSES,
+        optional_passes: &[],
         settings: &[&DIRECT_SETTINGS, &ILS_SETTINGS],
         configure: configure_ils,
     },
@@ -1569,6 +1582,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::Composite,
         presets: &[],
         passes: OIT_PASSES,
+        optional_passes: &[],
         settings: &[&ABUFFER_SETTINGS],
         configure: configure_oit,
     },
@@ -1580,6 +1594,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::AmbientVisibility,
         presets: &[],
         passes: ABA_AO_PASSES,
+        optional_passes: &[],
         settings: &[&ABUFFER_SETTINGS, &ABA_AO_SETTINGS],
         configure: configure_aba_ao,
     },
@@ -1591,6 +1606,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::AmbientVisibility,
         presets: &[],
         passes: BZB_AO_PASSES,
+        optional_passes: &[],
         settings: &[&BZB_SETTINGS],
         configure: configure_bzb_ao,
     },
@@ -1602,6 +1618,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::Radiance,
         presets: &[],
         passes: BZB_GI_PASSES,
+        optional_passes: &[],
         settings: &[&DIRECT_SETTINGS, &BZB_GI_SETTINGS],
         configure: configure_bzb_gi,
     },

@@ -63,6 +63,8 @@ pub fn run(
             (None, None) => technique.passes.to_vec(),
         },
     };
+    // passes its settings add; the frame times those it has, in frame order
+    let passes: Vec<&str> = passes.into_iter().chain(technique.optional_passes.iter().copied()).collect();
     let extra = json!({
         "technique": technique.name,
         "preset": preset.or(technique.presets.first().copied()),

@@ -3,7 +3,8 @@
 //! DGB). At scale s the gather writes `indirect-raw-low` / `indirect1-raw-low`, one texel
 //! per s×s block, each shading one pixel of its block ([`crate::spiral::block_pixel`]:
 //! every pixel of the block in turn over s² frames). [`UpsamplePass`] writes the
-//! full-resolution `indirect-raw` / `indirect1-raw` from them (`upsample.wgsl`), which the
+//! full-resolution `indirect-raw` / `indirect1-raw` from them (`upsample.wgsl`: 2×2 texels
+//! per pixel), which the
 //! temporal and bilateral filters then read as before.
 
 use glam::Vec3;
@@ -101,9 +102,11 @@ pub fn upsample_cpu(
             let (x, n) = (at(px, py, zp), n_of(px, py));
             let (mut sum, mut weight, mut spatial) = ([0.0f32; 4], 0.0f32, 0.0f32);
             let (mut nearest, mut nearest_dz) = ([0.0f32; 4], f32::INFINITY);
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let (tx, ty) = (px / s + dx, py / s + dy);
+            // the texel whose block centre is the last at or before the pixel, per axis
+            let home = |q: i32| (2 * q + s + 1) / (2 * s) - 1;
+            for dy in 0..=1 {
+                for dx in 0..=1 {
+                    let (tx, ty) = (home(px) + dx, home(py) + dy);
                     if tx < 0 || ty < 0 || tx >= low.width as i32 || ty >= low.height as i32 {
                         continue;
                     }
@@ -115,7 +118,7 @@ pub fn upsample_cpu(
                     }
                     let v = low.pixel(tx as u32, ty as u32);
                     let (ddx, ddy) = ((rx - px) as f32, (ry - py) as f32);
-                    let ws = (1.0 - (ddx * ddx + ddy * ddy) / (4 * s * s) as f32).max(0.0);
+                    let ws = (1.0 - (ddx * ddx + ddy * ddy) / (5 * s * s) as f32).max(0.0);
                     let y = at(rx, ry, zr);
                     let plane = (1.0 - u.plane_sharpness * n.dot(y - x).abs() / zp).max(0.0);
                     let c = n.dot(n_of(rx, ry)).max(0.0);

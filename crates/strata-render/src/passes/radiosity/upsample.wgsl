@@ -1,10 +1,10 @@
 // Joint bilateral upsampling (Kopf et al. 2007) of a gather run at 1/s resolution
 // (`RadiositySettings::gather_scale`; not in DGB): each full-resolution pixel averages
-// the 3×3 low-resolution texels around its own, each standing at the pixel it shaded
-// (`block_pixel`), weighted by screen distance × the bilateral filter's plane and
-// normal weights (bilateral.wgsl's, on the pixel's own layer). Where no texel holds the
-// pixel's surface (all weights ≈ 0: thin features), the texel whose depth is nearest
-// the pixel's (relative) stands in. CPU twin: `radiosity::upsample::upsample_cpu`.
+// the 2×2 low-resolution texels whose blocks' centres surround it, each standing at the
+// pixel it shaded (`block_pixel`), weighted by screen distance × the bilateral filter's
+// plane and normal weights (bilateral.wgsl's, on the pixel's own layer). Where no texel
+// holds the pixel's surface (all weights ≈ 0: thin features), the texel whose depth is
+// nearest the pixel's stands in. CPU twin: `radiosity::upsample::upsample_cpu`.
 #import "common/fullscreen.wgsl"
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
@@ -36,78 +36,99 @@ struct Out {
 // Below this share of the spatial weights the joint weights count as none.
 const MIN_WEIGHT: f32 = 1e-3;
 
-fn layer_normal(p: vec2i, j: u32) -> vec3f {
-    let n = textureLoad(npack, p, 0);
-    return oct_decode(select(n.ba, n.rg, j == 0u));
+// One layer's running sums over the texels (`accumulate`).
+struct Acc {
+    sum: vec4f,
+    weight: f32,
+    spatial: f32,
+    nearest: vec4f,
+    nearest_dz: f32,
 }
 
-fn low_value(t: vec2i, j: u32) -> vec4f {
-    if (j == 0u) {
-        return textureLoad(low0, t, 0);
-    }
-    return textureLoad(low1, t, 0);
+fn new_acc() -> Acc {
+    return Acc(vec4f(0.0), 0.0, 0.0, vec4f(0.0), 1e30);
 }
 
-// Layer j's upsampled value at pixel p, whose layer-j depth is zp > 0.
-fn upsampled_layer(p: vec2i, j: u32, zp: f32) -> vec4f {
-    let size = textureDimensions(zmip, 0);
-    let low = vec2i(textureDimensions(low0));
-    let s = i32(up.scale);
-    let x = world_from_csz(frame, vec2f(p) + 0.5, zp);
-    let n = layer_normal(p, j);
-    let home = p / s;
-    var sum = vec4f(0.0);
-    var weight = 0.0;
-    var spatial = 0.0;
-    var nearest = vec4f(0.0);
-    var nearest_dz = 1e30;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let t = home + vec2i(dx, dy);
-            if (any(t < vec2i(0)) || any(t >= low)) {
-                continue;
-            }
-            let r = vec2i(block_pixel(vec2u(t), up.scale, up.seed, size));
-            let zr = textureLoad(zmip, r, 0)[j];
-            if (zr <= 0.0) {
-                continue;
-            }
-            let v = low_value(t, j);
-            // screen distance: 1 at the pixel, 0 at 2s pixels
-            let d = vec2f(r - p);
-            let ws = max(0.0, 1.0 - dot(d, d) / f32(4 * s * s));
-            let y = world_from_csz(frame, vec2f(r) + 0.5, zr);
-            let plane = max(0.0, 1.0 - up.plane_sharpness * abs(dot(n, y - x)) / zp);
-            let c = max(0.0, dot(n, layer_normal(r, j)));
-            var normal = 1.0;
-            for (var e = 0u; e < up.normal_power; e++) {
-                normal *= c;
-            }
-            let w = ws * plane * normal;
-            sum += w * v;
-            weight += w;
-            spatial += ws;
-            let dz = abs(zr - zp);
-            if (dz < nearest_dz) {
-                nearest_dz = dz;
-                nearest = v;
-            }
-        }
+// Adds texel value v, which stands at pixel r (depth zr, normal nr on this layer), to
+// the sums of the receiver at pixel p (position x, normal n, depth zp).
+fn accumulate(acc: ptr<function, Acc>, p: vec2i, x: vec3f, n: vec3f, zp: f32, r: vec2i, zr: f32, nr: vec3f, v: vec4f) {
+    if (zr <= 0.0) {
+        return;
     }
-    if (weight > MIN_WEIGHT * spatial && weight > 0.0) {
-        return sum / weight;
+    // screen distance: 1 at the pixel, above 0.1 anywhere in the 2×2 blocks
+    let s = f32(up.scale);
+    let d = vec2f(r - p);
+    let ws = max(0.0, 1.0 - dot(d, d) / (5.0 * s * s));
+    let y = world_from_csz(frame, vec2f(r) + 0.5, zr);
+    let plane = max(0.0, 1.0 - up.plane_sharpness * abs(dot(n, y - x)) / zp);
+    let c = max(0.0, dot(n, nr));
+    var normal = 1.0;
+    for (var e = 0u; e < up.normal_power; e++) {
+        normal *= c;
     }
-    return nearest;
+    let w = ws * plane * normal;
+    (*acc).sum += w * v;
+    (*acc).weight += w;
+    (*acc).spatial += ws;
+    let dz = abs(zr - zp);
+    if (dz < (*acc).nearest_dz) {
+        (*acc).nearest_dz = dz;
+        (*acc).nearest = v;
+    }
+}
+
+fn resolve(acc: Acc) -> vec4f {
+    if (acc.weight > MIN_WEIGHT * acc.spatial && acc.weight > 0.0) {
+        return acc.sum / acc.weight;
+    }
+    return acc.nearest;
 }
 
 fn upsampled(p: vec2i) -> Out {
     var o: Out;
     let z = textureLoad(zmip, p, 0);
-    if (z.x > 0.0) {
-        o.e0 = upsampled_layer(p, 0u, z.x);
+    if (z.x <= 0.0) {
+        return o;
     }
-    if (LAYERS > 1u && z.y > 0.0) {
-        o.e1 = upsampled_layer(p, 1u, z.y);
+    let has1 = LAYERS > 1u && z.y > 0.0;
+    let np = textureLoad(npack, p, 0);
+    let x0 = world_from_csz(frame, vec2f(p) + 0.5, z.x);
+    let n0 = oct_decode(np.rg);
+    var x1 = x0;
+    var n1 = n0;
+    if (has1) {
+        x1 = world_from_csz(frame, vec2f(p) + 0.5, z.y);
+        n1 = oct_decode(np.ba);
+    }
+    let size = textureDimensions(zmip, 0);
+    let low = vec2i(textureDimensions(low0));
+    let s = i32(up.scale);
+    // the texel whose block centre s·t + (s − 1)/2 is the last at or before p, per axis
+    // (⌊(2p − s + 1) / 2s⌋, kept positive for the integer division)
+    let home = (2 * p + s + 1) / (2 * s) - 1;
+    var a0 = new_acc();
+    var a1 = new_acc();
+    for (var dy = 0; dy <= 1; dy++) {
+        for (var dx = 0; dx <= 1; dx++) {
+            let t = home + vec2i(dx, dy);
+            if (any(t < vec2i(0)) || any(t >= low)) {
+                continue;
+            }
+            let r = vec2i(block_pixel(vec2u(t), up.scale, up.seed, size));
+            let zr = textureLoad(zmip, r, 0);
+            if (zr.x <= 0.0) {
+                continue;
+            }
+            let nr = textureLoad(npack, r, 0);
+            accumulate(&a0, p, x0, n0, z.x, r, zr.x, oct_decode(nr.rg), textureLoad(low0, t, 0));
+            if (has1 && zr.y > 0.0) {
+                accumulate(&a1, p, x1, n1, z.y, r, zr.y, oct_decode(nr.ba), textureLoad(low1, t, 0));
+            }
+        }
+    }
+    o.e0 = resolve(a0);
+    if (has1) {
+        o.e1 = resolve(a1);
     }
     return o;
 }
