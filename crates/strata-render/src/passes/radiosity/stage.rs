@@ -130,6 +130,12 @@ impl RadiosityStage {
                 compute,
             )
         });
+        // the reduced gather's noise is correlated over s×s blocks: the blur's taps step
+        // over blocks, s pixels apart, so that as many independent samples are averaged
+        let blur = crate::passes::bilateral::BilateralSettings {
+            step: s.blur.step * scale,
+            ..s.blur
+        };
         let temporal = s.temporal.as_ref().map(|t: &TemporalSettings| {
             TemporalPass::new(
                 gpu,
@@ -148,7 +154,7 @@ impl RadiosityStage {
             gpu,
             scene,
             targets,
-            &s.blur,
+            &blur,
             "indirect-blur-h",
             filtered,
             "indirect-blur-h",
@@ -159,7 +165,7 @@ impl RadiosityStage {
             gpu,
             scene,
             targets,
-            &s.blur,
+            &blur,
             "indirect-blur-v",
             "indirect-blur-h",
             "indirect",
