@@ -175,6 +175,8 @@ fn algorithm_switching_settings_render_cleanly() {
         ("aba-ao", &[("kernel", "hbao-compute"), ("multilayer", "off")]),
         ("ils", &[("split", "compute")]),
         ("ils", &[("split", "blocks"), ("shadows", "vpl")]),
+        ("full", &[("gather-scale", "2")]),
+        ("full", &[("gather-scale", "3"), ("indirect-kernel", "compute")]),
     ];
     let gpu = common::gpu();
     let mut images = 0;

@@ -714,14 +714,15 @@ fn per_frame_rotation_lets_the_temporal_filter_remove_the_pattern_noise() {
 /// Table 2's "fraction of guard band shaded": outside it the gather leaves
 /// E = 0 and confidence 0; inside (and in the whole image) it runs. Both as the
 /// fragment pass (a scissor) and as its compute twin (`indirect-kernel=compute`, which
-/// stores zero outside).
+/// stores zero outside), at full resolution and as the reduced gather (`gather-scale=2`,
+/// whose upsampling keeps the same rectangle).
 #[test]
 fn gather_shades_only_the_requested_fraction_of_the_guard_band() {
     let gpu = common::gpu();
     let scene = frozen("cornell");
     let (w, h, g) = (64, 64, 16);
     // the fragment pass (scissor) and its compute twin (`indirect-kernel=compute`: zero outside)
-    for compute_gather in [false, true] {
+    for (compute_gather, gather_scale) in [(false, 1), (true, 1), (false, 2), (true, 2)] {
         let mut r = Renderer::new(
             &gpu,
             &scene,
@@ -736,6 +737,7 @@ fn gather_shades_only_the_requested_fraction_of_the_guard_band() {
                 },
                 radiosity: Some(RadiositySettings {
                     guard_band_shaded: 0.5,
+                    gather_scale,
                     kernel: if compute_gather {
                         Kernel::Compute
                     } else {
@@ -765,11 +767,11 @@ fn gather_shades_only_the_requested_fraction_of_the_guard_band() {
         }
         assert_eq!(
             outside_nonzero, 0,
-            "compute {compute_gather}: the unshaded guard band was written"
+            "compute {compute_gather}, scale {gather_scale}: the unshaded guard band was written"
         );
         assert!(
             inside_conf > (w * h) / 2,
-            "compute {compute_gather}: the shaded region has too few gathered pixels ({inside_conf})"
+            "compute {compute_gather}, scale {gather_scale}: the shaded region has too few gathered pixels ({inside_conf})"
         );
     }
 }
