@@ -18,6 +18,7 @@ const COMMON: &[(&str, &str)] = &[
     ("common/shadow.wgsl", include_str!("shaders/common/shadow.wgsl")),
     ("common/probes.wgsl", include_str!("shaders/common/probes.wgsl")),
     ("common/obscurance.wgsl", include_str!("shaders/common/obscurance.wgsl")),
+    ("common/scissor.wgsl", include_str!("shaders/common/scissor.wgsl")),
     (
         "common/bzb_geometry.wgsl",
         include_str!("shaders/common/bzb_geometry.wgsl"),

@@ -64,7 +64,10 @@ pub fn run(
         },
     };
     // passes its settings add; the frame times those it has, in frame order
-    let passes: Vec<&str> = passes.into_iter().chain(technique.optional_passes.iter().copied()).collect();
+    let passes: Vec<&str> = passes
+        .into_iter()
+        .chain(technique.optional_passes.iter().copied())
+        .collect();
     let extra = json!({
         "technique": technique.name,
         "preset": preset.or(technique.presets.first().copied()),

@@ -188,6 +188,24 @@ impl<'a> PassBuilder<'a> {
         self
     }
 
+    /// The form `compute` asks for of a screen pass limited to `scissor` ([x, y, w, h] in
+    /// output texels; `None`: everywhere). The fragment form takes the scissor when it is
+    /// built ([`ScreenPass::build_in`]); the compute form (entry `cs_main`) gets it as the
+    /// override constants of `common/scissor.wgsl`, whose `in_scissor` its shader tests.
+    /// Call it before declaring any binding.
+    pub fn kernel_in(self, compute: bool, scissor: Option<[u32; 4]>) -> Self {
+        if !compute {
+            return self;
+        }
+        let [x0, y0, x1, y1] = scissor.map_or([0, 0, u32::MAX, u32::MAX], |[x, y, w, h]| [x, y, x + w, y + h]);
+        self.compute()
+            .entry("cs_main")
+            .constant("SCISSOR_X0", x0 as f64)
+            .constant("SCISSOR_Y0", y0 as f64)
+            .constant("SCISSOR_X1", x1 as f64)
+            .constant("SCISSOR_Y1", y1 as f64)
+    }
+
     /// The WGSL (with `#import`s) and its label.
     pub fn shader(mut self, label: &'static str, source: &'static str) -> Self {
         self.shader = Some((label, source));
@@ -532,7 +550,8 @@ impl ComputePass {
 /// A screen pass built in either form ([`Kernel`]): a fullscreen fragment pass or its
 /// compute twin, 8×8 pixels per workgroup over its first output.
 pub(crate) enum ScreenPass {
-    Fragment(FullscreenPass),
+    /// The fragment form, and the scissor rectangle it draws in (`None`: everywhere).
+    Fragment(FullscreenPass, Option<[u32; 4]>),
     Compute(ComputePass),
 }
 
@@ -540,7 +559,19 @@ impl ScreenPass {
     /// Declares the outputs (colour attachments or storage textures) and builds the
     /// form `compute` asks for; a compute builder must have been made with
     /// [`PassBuilder::compute`] and a compute `entry`.
-    pub fn build(mut builder: PassBuilder<'_>, outputs: &[&'static str], compute: bool) -> Self {
+    pub fn build(builder: PassBuilder<'_>, outputs: &[&'static str], compute: bool) -> Self {
+        Self::build_in(builder, outputs, compute, None)
+    }
+
+    /// [`ScreenPass::build`] limited to `scissor` ([x, y, w, h] in output texels): the
+    /// fragment form draws only there; the compute form, whose builder must come from
+    /// [`PassBuilder::kernel_in`] with the same scissor, stores zero outside it.
+    pub fn build_in(
+        mut builder: PassBuilder<'_>,
+        outputs: &[&'static str],
+        compute: bool,
+        scissor: Option<[u32; 4]>,
+    ) -> Self {
         for &t in outputs {
             builder = if compute {
                 builder.write_storage(t)
@@ -551,39 +582,28 @@ impl ScreenPass {
         if compute {
             ScreenPass::Compute(builder.build_compute())
         } else {
-            ScreenPass::Fragment(builder.build())
+            ScreenPass::Fragment(builder.build(), scissor)
         }
     }
 
     pub fn set_uniforms<T: bytemuck::Pod>(&self, gpu: &GpuContext, value: &T) {
         match self {
-            ScreenPass::Fragment(p) => p.set_uniforms(gpu, value),
+            ScreenPass::Fragment(p, _) => p.set_uniforms(gpu, value),
             ScreenPass::Compute(p) => p.set_uniforms(gpu, value),
         }
     }
 
     pub fn info(&self) -> PassInfo {
         match self {
-            ScreenPass::Fragment(p) => p.info(),
+            ScreenPass::Fragment(p, _) => p.info(),
             ScreenPass::Compute(p) => p.info(),
         }
     }
 
+    /// Records the pass (the compute form over its whole first output).
     pub fn encode(&self, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.encode_in(scene, targets, encoder, None)
-    }
-
-    /// Records the pass; `scissor` limits the fragment form (the compute form covers its
-    /// whole first output, and its shader stores what the scissor would have left).
-    pub fn encode_in(
-        &self,
-        scene: &GpuScene,
-        targets: &Targets,
-        encoder: &mut wgpu::CommandEncoder,
-        scissor: Option<[u32; 4]>,
-    ) {
         match self {
-            ScreenPass::Fragment(p) => p.encode_in(scene, targets, encoder, scissor),
+            ScreenPass::Fragment(p, scissor) => p.encode_in(scene, targets, encoder, *scissor),
             ScreenPass::Compute(p) => {
                 let t = &targets.get(p.bound.outputs[0]).texture;
                 p.encode_grid(scene, encoder, [t.width(), t.height()], [8, 8]);
@@ -598,6 +618,6 @@ impl crate::frame::Pass for ScreenPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.encode_in(scene, targets, encoder, None)
+        ScreenPass::encode(self, scene, targets, encoder)
     }
 }

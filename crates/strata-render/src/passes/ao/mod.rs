@@ -329,7 +329,7 @@ impl AoPass {
             .write(DEINT_RAW_TILED.name)
             .build();
         Self {
-            pass: ScreenPass::Fragment(pass),
+            pass: ScreenPass::Fragment(pass, None),
             last: std::cell::Cell::new(zeroed),
             ils: Some(ils),
         }

@@ -16,7 +16,7 @@ use crate::passes::builder::{FullscreenPass, Kernel, PassBuilder, ScreenPass};
 use glam::Vec3;
 use strata_scene::ImageBuf;
 
-use crate::frame::{FrameUniforms, Pass, PassInfo, TargetDesc, Targets};
+use crate::frame::{FrameUniforms, TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::passes::bilateral::BilateralSettings;
 use crate::passes::depth_mip::DepthMipSettings;
@@ -619,8 +619,6 @@ pub struct RadiosityPass {
     pass: ScreenPass,
     /// The probes' grid, when the gather has probes for the detail term.
     grid: Option<crate::passes::compose::ProbeGridUniform>,
-    /// Shaded region (the image plus the shaded part of the guard band).
-    scissor: Option<[u32; 4]>,
     last: std::cell::Cell<RadiosityUniforms>,
 }
 
@@ -656,18 +654,8 @@ impl RadiosityPass {
                 &dummy
             }
         };
-        let mut builder = PassBuilder::new(gpu, targets, "radiosity");
-        if compute {
-            let [x0, y0, x1, y1] = scissor.map_or([0, 0, u32::MAX, u32::MAX], |[x, y, w, h]| [x, y, x + w, y + h]);
-            builder = builder
-                .compute()
-                .entry("cs_main")
-                .constant("SCISSOR_X0", x0 as f64)
-                .constant("SCISSOR_Y0", y0 as f64)
-                .constant("SCISSOR_X1", x1 as f64)
-                .constant("SCISSOR_Y1", y1 as f64);
-        }
-        builder = builder
+        let builder = PassBuilder::new(gpu, targets, "radiosity")
+            .kernel_in(compute, scissor)
             .shader("radiosity", include_str!("radiosity.wgsl"))
             .constant("LAYERS", layers as f64)
             .constant("RECEIVER1", receiver1 as u32 as f64)
@@ -681,11 +669,10 @@ impl RadiosityPass {
             .read(if layers > 1 { b[1] } else { b[0] })
             .storage(&gpu_probes.probes)
             .storage(&gpu_probes.depth);
-        let pass = ScreenPass::build(builder, &outputs.map(|t| t.name), compute);
+        let pass = ScreenPass::build_in(builder, &outputs.map(|t| t.name), compute, scissor);
         Self {
             pass,
             grid: probes.map(|p| p.grid),
-            scissor,
             last: std::cell::Cell::new(zeroed),
         }
     }
@@ -704,15 +691,7 @@ impl RadiosityPass {
     }
 }
 
-impl Pass for RadiosityPass {
-    fn info(&self) -> PassInfo {
-        self.pass.info()
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode_in(scene, targets, encoder, self.scissor);
-    }
-}
+crate::passes::builder::delegate_pass!(RadiosityPass);
 
 /// Mirrors `Propagate` in `propagate.wgsl`.
 #[repr(C)]

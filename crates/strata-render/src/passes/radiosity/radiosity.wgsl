@@ -10,6 +10,7 @@
 #import "common/spiral.wgsl"
 #import "common/color.wgsl"
 #import "common/probes.wgsl"
+#import "common/scissor.wgsl"
 
 override LAYERS: u32 = 2u;
 // 1 = also gather for layer 1's receiver (needed only to propagate bounces
@@ -460,14 +461,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     return gather(receiver_pixel(vec2u(pos.xy)));
 }
 
-// The same gather as a compute pass (`RadiositySettings::compute_gather`), 8×8 pixels
-// per workgroup, into storage textures. Outside the shaded rectangle [SCISSOR_X0,
-// SCISSOR_X1) × [SCISSOR_Y0, SCISSOR_Y1) it stores zero, as the fragment pass's clear
-// leaves there.
-override SCISSOR_X0: u32 = 0u;
-override SCISSOR_Y0: u32 = 0u;
-override SCISSOR_X1: u32 = 0xffffffffu;
-override SCISSOR_Y1: u32 = 0xffffffffu;
+// The same gather as a compute pass (`RadiositySettings::kernel`), 8×8 texels per
+// workgroup, into storage textures; zero outside the shaded rectangle (`in_scissor`).
 @group(1) @binding(7) var e0_out: texture_storage_2d<rgba16float, write>;
 @group(1) @binding(8) var e1_out: texture_storage_2d<rgba16float, write>;
 
@@ -477,7 +472,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     var o: Out;
-    if (all(id.xy >= vec2u(SCISSOR_X0, SCISSOR_Y0)) && all(id.xy < vec2u(SCISSOR_X1, SCISSOR_Y1))) {
+    if (in_scissor(id.xy)) {
         o = gather(receiver_pixel(id.xy));
     }
     textureStore(e0_out, id.xy, o.e0);

@@ -10,7 +10,7 @@
 use glam::Vec3;
 use strata_scene::ImageBuf;
 
-use crate::frame::{FrameUniforms, Pass, PassInfo, TargetDesc, Targets};
+use crate::frame::{FrameUniforms, TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::passes::ao::world_from_csz;
 use crate::passes::bilateral::BilateralSettings;
@@ -152,7 +152,6 @@ pub fn upsample_cpu(
 pub struct UpsamplePass {
     pass: ScreenPass,
     uniforms: std::cell::Cell<UpsampleUniforms>,
-    scissor: Option<[u32; 4]>,
 }
 
 impl UpsamplePass {
@@ -167,18 +166,8 @@ impl UpsamplePass {
         scissor: Option<[u32; 4]>,
         compute: bool,
     ) -> Self {
-        let mut builder = PassBuilder::new(gpu, targets, "radiosity-upsample");
-        if compute {
-            let [x0, y0, x1, y1] = scissor.map_or([0, 0, u32::MAX, u32::MAX], |[x, y, w, h]| [x, y, x + w, y + h]);
-            builder = builder
-                .compute()
-                .entry("cs_main")
-                .constant("SCISSOR_X0", x0 as f64)
-                .constant("SCISSOR_Y0", y0 as f64)
-                .constant("SCISSOR_X1", x1 as f64)
-                .constant("SCISSOR_Y1", y1 as f64);
-        }
-        let builder = builder
+        let builder = PassBuilder::new(gpu, targets, "radiosity-upsample")
+            .kernel_in(compute, scissor)
             .shader("radiosity-upsample", include_str!("upsample.wgsl"))
             .constant("LAYERS", layers as f64)
             .frame(scene)
@@ -187,11 +176,10 @@ impl UpsamplePass {
             .read(LOW_OUTPUTS[1].name)
             .read("zmip")
             .read("npack");
-        let pass = ScreenPass::build(builder, &super::OUTPUTS.map(|t| t.name), compute);
+        let pass = ScreenPass::build_in(builder, &super::OUTPUTS.map(|t| t.name), compute, scissor);
         Self {
             pass,
             uniforms: std::cell::Cell::new(u),
-            scissor,
         }
     }
 
@@ -210,15 +198,7 @@ impl UpsamplePass {
     }
 }
 
-impl Pass for UpsamplePass {
-    fn info(&self) -> PassInfo {
-        self.pass.info()
-    }
-
-    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        self.pass.encode_in(scene, targets, encoder, self.scissor);
-    }
-}
+crate::passes::builder::delegate_pass!(UpsamplePass);
 
 #[cfg(test)]
 mod tests {

@@ -10,6 +10,7 @@
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
 #import "common/spiral.wgsl"
+#import "common/scissor.wgsl"
 
 override LAYERS: u32 = 2u;
 
@@ -138,13 +139,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     return upsampled(vec2i(pos.xy));
 }
 
-// The same pass as compute (`Kernel`), 8×8 pixels per workgroup. Outside the shaded
-// rectangle [SCISSOR_X0, SCISSOR_X1) × [SCISSOR_Y0, SCISSOR_Y1) it stores zero, as the
-// fragment pass's clear leaves there.
-override SCISSOR_X0: u32 = 0u;
-override SCISSOR_Y0: u32 = 0u;
-override SCISSOR_X1: u32 = 0xffffffffu;
-override SCISSOR_Y1: u32 = 0xffffffffu;
+// The same pass as compute (`Kernel`), 8×8 pixels per workgroup; zero outside the
+// shaded rectangle (`in_scissor`).
 @group(1) @binding(5) var e0_out: texture_storage_2d<rgba16float, write>;
 @group(1) @binding(6) var e1_out: texture_storage_2d<rgba16float, write>;
 
@@ -154,7 +150,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     var o: Out;
-    if (all(id.xy >= vec2u(SCISSOR_X0, SCISSOR_Y0)) && all(id.xy < vec2u(SCISSOR_X1, SCISSOR_Y1))) {
+    if (in_scissor(id.xy)) {
         o = upsampled(vec2i(id.xy));
     }
     textureStore(e0_out, id.xy, o.e0);
