@@ -853,7 +853,7 @@ impl Renderer {
         let max_mip = self.targets.try_get("zmip").map_or(0, |t| t.desc.mips - 1);
         if let (Some(stage), Some(s)) = (&self.ao, &self.settings.ao) {
             let au = AoUniforms::new(s, scene, &u, max_mip, self.frames_rendered);
-            stage.ao.set_frame(gpu, au);
+            stage.set_frame(gpu, au);
             if let Some(t) = &stage.temporal {
                 t.set_frame(gpu, temporal_history);
             }
@@ -972,6 +972,12 @@ impl Renderer {
     /// (`RadiositySettings::gather_scale` > 1), for its CPU twin.
     pub fn upsample_uniforms(&self) -> Option<crate::passes::radiosity::upsample::UpsampleUniforms> {
         self.radiosity.as_ref()?.upsample.as_ref().map(|u| u.uniforms())
+    }
+
+    /// The reduced-resolution AO's upsampling uniforms this frame (`AoSettings::scale` >
+    /// 1), for its CPU twin.
+    pub fn ao_upsample_uniforms(&self) -> Option<crate::passes::radiosity::upsample::UpsampleUniforms> {
+        self.ao.as_ref()?.upsample.as_ref().map(|u| u.uniforms())
     }
 
     /// The AO pass's uniforms of the last rendered frame.

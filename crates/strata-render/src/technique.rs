@@ -301,7 +301,7 @@ static DIRECT_SETTINGS: [SettingInfo; 3] = [
     },
 ];
 
-static AO_SETTINGS: [SettingInfo; 16] = [
+static AO_SETTINGS: [SettingInfo; 17] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
@@ -411,6 +411,14 @@ static AO_SETTINGS: [SettingInfo; 16] = [
         set: |s, v| ao_mut(s).deinterleave = (v >= 1.0).then(|| [v as u32 + 1; 2]),
         values: &["off", "2x2", "3x3", "4x4"],
     },
+    setting!(
+        "ao-scale",
+        "the AO pass's resolution divisor s: at s > 1 it shades one pixel of each s x s block (a different one each frame), a joint bilateral upsampling fills the rest (1 = every pixel, as the paper; not with deinterleave; not in the paper, docs/ao.md)",
+        Range::Closed(1.0, crate::passes::radiosity::upsample::MAX_GATHER_SCALE as f64),
+        true,
+        |s| Some(ao_of(s).scale as f64),
+        |s, v| ao_mut(s).scale = v as u32
+    ),
     enum_setting!(
         "ao-kernel",
         "the AO pass (Eq. 1-2, not the deinterleaved one) as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/ao.md)",
@@ -1516,9 +1524,12 @@ const FULL_PASSES: &[&str] = &[
     "tonemap",
 ];
 
-/// Passes `full`'s settings may add: the reduced-resolution gather's upsampling
-/// (`gather-scale` > 1).
-const FULL_OPTIONAL_PASSES: &[&str] = &["radiosity-upsample"];
+/// Passes `full`'s settings may add: the reduced-resolution AO's and gather's upsampling
+/// (`ao-scale`, `gather-scale` > 1).
+const FULL_OPTIONAL_PASSES: &[&str] = &["ao-upsample", "radiosity-upsample"];
+
+/// Passes `ao`'s settings may add: the reduced-resolution AO's upsampling (`ao-scale` > 1).
+pub const AO_OPTIONAL_PASSES: &[&str] = &["ao-upsample"];
 
 /// Preset names of the DGB radiosity (Table 2), default first.
 const FULL_PRESETS: &[&str] = &["balanced", "high-performance", "high-quality"];
@@ -1544,7 +1555,7 @@ static REGISTRY: [Technique; 8] = [
         eval: EvalKind::AmbientVisibility,
         presets: &[],
         passes: AO_PASSES,
-        optional_passes: &[],
+        optional_passes: AO_OPTIONAL_PASSES,
         settings: &[&AO_SETTINGS],
         configure: configure_ao,
     },

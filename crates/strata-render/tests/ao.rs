@@ -168,6 +168,100 @@ fn gpu_ao_equals_cpu_eq1_eq2_over_the_same_buffers() {
     }
 }
 
+/// Reduced-resolution AO (`ao-scale`, not in the paper), on the second frame (seed 1):
+/// each texel of `ao-raw-low` equals Eq. 1–2 on the CPU at the pixel it shades
+/// (`block_pixel`), and `ao-raw` equals the CPU twin of the joint bilateral upsampling of
+/// the read-back `ao-raw-low`, at scales 2 and 3, one and two layers, the AO pass as a
+/// fragment and as a compute pass.
+#[test]
+fn reduced_resolution_ao_and_upsampling_match_their_cpu_twins() {
+    use strata_render::passes::radiosity::upsample::upsample_cpu;
+    use strata_render::passes::Kernel;
+    let gpu = common::gpu();
+    for (name, layers, scale, kernel) in [
+        ("atrium", 2u32, 2u32, Kernel::Fragment),
+        ("column-wall", 1, 3, Kernel::Fragment),
+        ("cornell", 2, 2, Kernel::Compute),
+    ] {
+        let scene = frozen(name);
+        let (w, h) = (96u32, 64u32);
+        let settings = AoSettings {
+            filter_obscurance: false,
+            scale,
+            kernel,
+            ..AoSettings::default()
+        };
+        let mut r = ao_renderer(&gpu, &scene, w, h, layers, settings);
+        for _ in 0..2 {
+            r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+                .expect("frame renders without validation errors");
+        }
+        let u = r.ao_uniforms().unwrap();
+        let up = r.ao_upsample_uniforms().expect("an upsampling pass at scale > 1");
+        assert_eq!(
+            (up.scale, up.seed, u.seed),
+            (scale, 1, 1),
+            "{name}: the second frame's seed"
+        );
+        let zmip: Vec<ImageBuf> = (0..=u.max_mip)
+            .map(|m| r.read_target_mip(&gpu, "zmip", m).unwrap())
+            .collect();
+        let normals = common::npack_normals(&r.read_target_full(&gpu, "npack", 0).unwrap(), 0);
+        let f = r.frame_uniforms();
+        let low = r.read_target_full(&gpu, "ao-raw-low", 0).unwrap();
+        assert_eq!((low.width, low.height), (w.div_ceil(scale), h.div_ceil(scale)));
+        let (mut close, mut occluded) = (0usize, 0usize);
+        for ty in 0..low.height {
+            for tx in 0..low.width {
+                let p = strata_render::spiral::block_pixel([tx, ty], scale, u.seed, [w, h]);
+                let cpu = ambient_visibility_cpu(&zmip, &normals, &f, &u, layers, p[0], p[1]);
+                close += ((cpu - low.pixel(tx, ty)[0]).abs() < 1e-4) as usize;
+                occluded += (cpu < 0.99) as usize;
+            }
+        }
+        let m = (low.width * low.height) as usize;
+        eprintln!("{name} s={scale}: {close}/{m} texels match, {occluded} occluded");
+        assert!(close as f32 >= 0.995 * m as f32, "{name} s={scale}: {close}/{m} texels");
+        assert!(occluded > m / 10, "{name}: weak test, {occluded} occluded texels");
+
+        let want = upsample_cpu(&low, &zmip[0], &normals, &f, &up, 0);
+        let got = r.read_target_full(&gpu, "ao-raw", 0).unwrap();
+        let n = (w * h) as usize;
+        let close = (0..n).filter(|&i| (got.data[i] - want.data[i]).abs() < 1e-4).count();
+        let varied = (0..n).filter(|&i| want.data[i] < 0.99).count();
+        eprintln!("{name} s={scale}: {close}/{n} upsampled pixels match, {varied} occluded");
+        assert!(close as f32 >= 0.995 * n as f32, "{name} s={scale}: {close}/{n} pixels");
+        assert!(varied > n / 10, "{name}: weak test, {varied} occluded pixels");
+    }
+}
+
+/// `ao-scale` outside 1..=4, or above 1 with the deinterleaved AO (which shades every
+/// pixel), is a one-line error naming the setting and what is valid.
+#[test]
+fn ao_scale_out_of_range_or_with_deinterleave_is_refused() {
+    for (scale, deinterleave, want) in [
+        (0, None, "AO scale 0 is out of range: must be in 1..=4"),
+        (5, None, "AO scale 5 is out of range: must be in 1..=4"),
+        (2, Some([2, 2]), "AO scale 2 needs deinterleave off"),
+    ] {
+        let e = AoSettings {
+            scale,
+            deinterleave,
+            ..AoSettings::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert!(e.contains(want) && !e.contains('\n'), "{e}");
+    }
+    for scale in 1..=4 {
+        let ok = AoSettings {
+            scale,
+            ..AoSettings::default()
+        };
+        assert_eq!(ok.validate(), Ok(()), "scale {scale}");
+    }
+}
+
 fn reference_av(scene: &Scene, w: u32, h: u32, ao: &AoSettings) -> ImageBuf {
     let (radius, beta, epsilon) = ao.resolve(scene);
     let s = ObscuranceSettings {

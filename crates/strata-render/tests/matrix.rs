@@ -176,6 +176,8 @@ fn algorithm_switching_settings_render_cleanly() {
         ("ils", &[("split", "compute")]),
         ("ils", &[("split", "blocks"), ("shadows", "vpl")]),
         ("full", &[("gather-scale", "2")]),
+        ("ao", &[("ao-scale", "2")]),
+        ("full", &[("ao-scale", "3"), ("ao-kernel", "compute")]),
         ("full", &[("gather-scale", "3"), ("indirect-kernel", "compute")]),
     ];
     let gpu = common::gpu();

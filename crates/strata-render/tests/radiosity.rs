@@ -252,6 +252,30 @@ fn reduced_resolution_gather_and_upsampling_match_their_cpu_twins() {
     }
 }
 
+/// `gather-scale` outside 1..=4 is a one-line error naming the setting and its range.
+#[test]
+fn gather_scale_out_of_range_is_refused() {
+    for scale in [0, 5] {
+        let e = RadiositySettings {
+            gather_scale: scale,
+            ..Default::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(
+            e,
+            format!("radiosity gather-scale {scale} is out of range: must be in 1..=4")
+        );
+    }
+    for scale in 1..=4 {
+        let ok = RadiositySettings {
+            gather_scale: scale,
+            ..Default::default()
+        };
+        assert_eq!(ok.validate(), Ok(()), "scale {scale}");
+    }
+}
+
 /// A scene of `parts` (one object and material each) with no light source, a black
 /// sky and no ambient light (min separation 0.5 m): only emissive parts send light.
 fn emitter_only_scene(name: &str, parts: Vec<(MeshBuilder, Material)>, camera: Camera) -> Scene {

@@ -16,10 +16,12 @@ pub fn run(stage: &StageSettings, ao: &AoSettings) -> Result<StageBench> {
         "temporal_alpha": ao.temporal.map_or(0.0, |t| t.alpha), "variant": stage.variant.to_string(),
         "deinterleave": ao.deinterleave.map_or("off".to_string(), |[n, m]| format!("{n}x{m}")),
         "filter_obscurance": ao.filter_obscurance});
-    // the deinterleaved frame replaces `ao` by its split, `ao-deint` and gather passes
+    // the deinterleaved frame replaces `ao` by its split, `ao-deint` and gather passes; at
+    // `ao-scale` > 1 the upsampling follows `ao`
     let passes: Vec<&str> = AO_PASSES
         .iter()
         .chain(strata_render::passes::ao::DEINTERLEAVED_PASSES)
+        .chain(strata_render::technique::AO_OPTIONAL_PASSES)
         .copied()
         .collect();
     stage::run(Stage {

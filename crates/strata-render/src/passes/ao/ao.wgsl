@@ -8,6 +8,9 @@
 #import "common/obscurance.wgsl"
 
 override LAYERS: u32 = 2u;
+// > 1: the pass runs at 1/SCALE resolution, texel t shading one pixel of its SCALE×SCALE
+// block (`block_pixel`); `radiosity/upsample.wgsl` brings it back (`AoSettings::scale`)
+override SCALE: u32 = 1u;
 
 #import "ao/uniforms.wgsl"
 
@@ -68,9 +71,14 @@ fn ambient(p: vec2i) -> vec4f {
     return vec4f(av);
 }
 
+// The pixel that output texel t shades (itself at full resolution).
+fn receiver_pixel(t: vec2u) -> vec2i {
+    return vec2i(block_pixel(t, SCALE, ao.seed, textureDimensions(zmip, 0)));
+}
+
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
-    return ambient(vec2i(pos.xy));
+    return ambient(receiver_pixel(vec2u(pos.xy)));
 }
 
 // The same pass as compute (`AoSettings::kernel`), 8×8 pixels per workgroup.
@@ -81,5 +89,5 @@ fn cs_main(@builtin(global_invocation_id) id: vec3u) {
     if (any(id.xy >= textureDimensions(ao_out))) {
         return;
     }
-    textureStore(ao_out, id.xy, ambient(vec2i(id.xy)));
+    textureStore(ao_out, id.xy, ambient(receiver_pixel(id.xy)));
 }

@@ -91,6 +91,12 @@ pub struct AoSettings {
     /// shader code and values. Not in the paper (default [`Kernel::Auto`]: compute on
     /// GPUs, fragment on CPU adapters; docs/ao.md § "The AO pass as compute").
     pub kernel: Kernel,
+    /// The AO pass's resolution divisor s, 1..=[`MAX_GATHER_SCALE`](crate::passes::radiosity::upsample::MAX_GATHER_SCALE):
+    /// at s > 1 it shades one pixel of each s×s block (a different one each frame with
+    /// `temporal_noise`) and a joint bilateral upsampling fills the rest (as the radiosity
+    /// gather's `gather_scale`, whose blur steps s times as far; AO's does not: docs/ao.md
+    /// § "Reduced-resolution AO"). Not with `deinterleave`. Not in the paper (default 1).
+    pub scale: u32,
 }
 
 impl Default for AoSettings {
@@ -120,6 +126,7 @@ impl Default for AoSettings {
             filter_obscurance: true,
             distance_weight: true,
             kernel: Kernel::Auto,
+            scale: 1,
         }
     }
 }
@@ -161,6 +168,19 @@ impl AoSettings {
                     self.samples
                 ));
             }
+        }
+        let max_scale = crate::passes::radiosity::upsample::MAX_GATHER_SCALE;
+        if !(1..=max_scale).contains(&self.scale) {
+            return Err(format!(
+                "AO scale {} is out of range: must be in 1..={max_scale}",
+                self.scale
+            ));
+        }
+        if self.scale > 1 && self.deinterleave.is_some() {
+            return Err(format!(
+                "AO scale {} needs deinterleave off: the deinterleaved AO shades every pixel",
+                self.scale
+            ));
         }
         self.mips.validate()?;
         self.blur.validate()?;
@@ -241,6 +261,15 @@ pub const OUTPUT: TargetDesc = TargetDesc::new(
     "DGB Eq. 1 ambient visibility before reconstruction (1 = unoccluded)",
 );
 
+/// The AO pass's output at [`AoSettings::scale`] > 1 (⌈w/s⌉ × ⌈h/s⌉), before its upsampling
+/// into [`OUTPUT`].
+pub const OUTPUT_LOW: TargetDesc = TargetDesc::new(
+    "ao-raw-low",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "DGB Eq. 1 at 1/s resolution: one pixel per s×s block (AoSettings::scale)",
+);
+
 pub struct AoPass {
     pass: ScreenPass,
     last: std::cell::Cell<AoUniforms>,
@@ -284,8 +313,9 @@ pub const DEINT_RAW_TILED: TargetDesc = TargetDesc::new(
 );
 
 impl AoPass {
-    /// `compute`: [`AoSettings::kernel`] resolved (the output must then allow storage binding).
-    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32, compute: bool) -> Self {
+    /// `compute`: [`AoSettings::kernel`] resolved (the output must then allow storage
+    /// binding); `scale`: [`AoSettings::scale`] (> 1: into [`OUTPUT_LOW`]).
+    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, layers: u32, compute: bool, scale: u32) -> Self {
         let zeroed = AoUniforms::zeroed();
         let mut builder = PassBuilder::new(gpu, targets, "ao");
         if compute {
@@ -294,11 +324,13 @@ impl AoPass {
         let builder = builder
             .shader("ao", include_str!("ao.wgsl"))
             .constant("LAYERS", layers as f64)
+            .constant("SCALE", scale as f64)
             .frame(scene)
             .uniforms(&zeroed)
             .read("zmip")
             .read("npack");
-        let pass = ScreenPass::build(builder, &[OUTPUT.name], compute);
+        let output = if scale > 1 { OUTPUT_LOW } else { OUTPUT };
+        let pass = ScreenPass::build(builder, &[output.name], compute);
         Self {
             pass,
             last: std::cell::Cell::new(zeroed),

@@ -76,9 +76,9 @@ impl UpsampleUniforms {
 const MIN_WEIGHT: f32 = 1e-3;
 
 /// CPU twin of `upsample.wgsl` for layer `j`: `low` = the gather's low-resolution output
-/// of that layer (4 channels), `csz` = `zmip` level 0 (channel j = layer j's depth; ≤ 0:
-/// none), `normals` = layer j's unit normals (3 channels). Returns the full-resolution
-/// image (4 channels; zero where layer j is empty).
+/// of that layer (any channel count), `csz` = `zmip` level 0 (channel j = layer j's
+/// depth; ≤ 0: none), `normals` = layer j's unit normals (3 channels). Returns the
+/// full-resolution image (as many channels; zero where layer j is empty).
 pub fn upsample_cpu(
     low: &ImageBuf,
     csz: &ImageBuf,
@@ -92,7 +92,8 @@ pub fn upsample_cpu(
     let z_of = |x: i32, y: i32| csz.pixel(x as u32, y as u32)[j];
     let n_of = |x: i32, y: i32| Vec3::from_slice(&normals.pixel(x as u32, y as u32)[..3]);
     let at = |x: i32, y: i32, z: f32| world_from_csz(frame, [x as f32 + 0.5, y as f32 + 0.5], z);
-    let mut out = ImageBuf::new(w, h, 4);
+    let ch = low.channels as usize;
+    let mut out = ImageBuf::new(w, h, low.channels);
     for py in 0..h as i32 {
         for px in 0..w as i32 {
             let zp = z_of(px, py);
@@ -100,8 +101,8 @@ pub fn upsample_cpu(
                 continue;
             }
             let (x, n) = (at(px, py, zp), n_of(px, py));
-            let (mut sum, mut weight, mut spatial) = ([0.0f32; 4], 0.0f32, 0.0f32);
-            let (mut nearest, mut nearest_dz) = ([0.0f32; 4], f32::INFINITY);
+            let (mut sum, mut weight, mut spatial) = (vec![0.0f32; ch], 0.0f32, 0.0f32);
+            let (mut nearest, mut nearest_dz) = (vec![0.0f32; ch], f32::INFINITY);
             // the texel whose block centre is the last at or before the pixel, per axis
             let home = |q: i32| (2 * q + s + 1) / (2 * s) - 1;
             for dy in 0..=1 {
@@ -130,13 +131,13 @@ pub fn upsample_cpu(
                     spatial += ws;
                     if (zr - zp).abs() < nearest_dz {
                         nearest_dz = (zr - zp).abs();
-                        nearest.copy_from_slice(&v[..4]);
+                        nearest.copy_from_slice(v);
                     }
                 }
             }
             let o = out.pixel_mut(px as u32, py as u32);
             if weight > MIN_WEIGHT * spatial && weight > 0.0 {
-                for (a, b) in o.iter_mut().zip(sum) {
+                for (a, b) in o.iter_mut().zip(&sum) {
                     *a = b / weight;
                 }
             } else {
@@ -155,6 +156,7 @@ pub struct UpsamplePass {
 }
 
 impl UpsamplePass {
+    /// The radiosity gather's upsampling, `LOW_OUTPUTS` into `OUTPUTS` (both receivers).
     /// `scissor`: the shaded full-resolution rectangle (zero outside it); `compute`: the
     /// compute form (outputs with storage binding).
     pub fn new(
@@ -166,12 +168,7 @@ impl UpsamplePass {
         scissor: Option<[u32; 4]>,
         compute: bool,
     ) -> Self {
-        let builder = PassBuilder::new(gpu, targets, "radiosity-upsample")
-            .kernel_in(compute, scissor)
-            .shader("radiosity-upsample", include_str!("upsample.wgsl"))
-            .constant("LAYERS", layers as f64)
-            .frame(scene)
-            .uniforms(&u)
+        let builder = Self::builder(gpu, scene, targets, "radiosity-upsample", layers, &u, compute, scissor)
             .read(LOW_OUTPUTS[0].name)
             .read(LOW_OUTPUTS[1].name)
             .read("zmip")
@@ -181,6 +178,49 @@ impl UpsamplePass {
             pass,
             uniforms: std::cell::Cell::new(u),
         }
+    }
+
+    /// Layer 0's upsampling of `low` into `output` (one channel used), as a fragment pass
+    /// named `name` (the AO pass at [`AoSettings::scale`](crate::passes::ao::AoSettings::scale)).
+    pub fn layer0(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        name: &'static str,
+        u: UpsampleUniforms,
+        low: &'static str,
+        output: &'static str,
+    ) -> Self {
+        let builder = Self::builder(gpu, scene, targets, name, 1, &u, false, None)
+            .entry("fs_layer0")
+            .read(low)
+            .read(low)
+            .read("zmip")
+            .read("npack");
+        let pass = ScreenPass::build(builder, &[output], false);
+        Self {
+            pass,
+            uniforms: std::cell::Cell::new(u),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn builder<'a>(
+        gpu: &'a GpuContext,
+        scene: &'a GpuScene,
+        targets: &'a Targets,
+        name: &'static str,
+        layers: u32,
+        u: &UpsampleUniforms,
+        compute: bool,
+        scissor: Option<[u32; 4]>,
+    ) -> PassBuilder<'a> {
+        PassBuilder::new(gpu, targets, name)
+            .kernel_in(compute, scissor)
+            .shader("radiosity-upsample", include_str!("upsample.wgsl"))
+            .constant("LAYERS", layers as f64)
+            .frame(scene)
+            .uniforms(u)
     }
 
     /// This frame's gather seed.

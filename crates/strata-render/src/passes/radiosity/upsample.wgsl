@@ -1,5 +1,5 @@
 // Joint bilateral upsampling (Kopf et al. 2007) of a gather run at 1/s resolution
-// (`RadiositySettings::gather_scale`; not in DGB): each full-resolution pixel averages
+// (`RadiositySettings::gather_scale`, `AoSettings::scale`; not in DGB): each full-resolution pixel averages
 // the 2×2 low-resolution texels whose blocks' centres surround it, each standing at the
 // pixel it shaded (`block_pixel`), weighted by screen distance × the bilateral filter's
 // plane and normal weights (bilateral.wgsl's, on the pixel's own layer). Where no texel
@@ -137,6 +137,12 @@ fn upsampled(p: vec2i) -> Out {
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> Out {
     return upsampled(vec2i(pos.xy));
+}
+
+// Layer 0 only, into one target (AO: `AoSettings::scale`; LAYERS = 1, `low1` = `low0`).
+@fragment
+fn fs_layer0(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    return upsampled(vec2i(pos.xy)).e0;
 }
 
 // The same pass as compute (`Kernel`), 8×8 pixels per workgroup; zero outside the
