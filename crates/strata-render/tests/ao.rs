@@ -229,6 +229,10 @@ fn reduced_resolution_ao_and_upsampling_match_their_cpu_twins() {
         let n = (w * h) as usize;
         let close = (0..n).filter(|&i| (got.data[i] - want.data[i]).abs() < 1e-4).count();
         let varied = (0..n).filter(|&i| want.data[i] < 0.99).count();
+        // no surface: unoccluded (AV 1), as at full resolution
+        let z0 = &zmip[0];
+        let empty: Vec<usize> = (0..n).filter(|&i| z0.data[i * z0.channels as usize] <= 0.0).collect();
+        assert!(empty.iter().all(|&i| got.data[i] == 1.0), "{name}: AV of empty pixels");
         eprintln!("{name} s={scale}: {close}/{n} upsampled pixels match, {varied} occluded");
         assert!(close as f32 >= 0.995 * n as f32, "{name} s={scale}: {close}/{n} pixels");
         assert!(varied > n / 10, "{name}: weak test, {varied} occluded pixels");

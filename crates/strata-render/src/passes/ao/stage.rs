@@ -72,7 +72,11 @@ impl AoStage {
                 scene,
                 targets,
                 "ao-upsample",
-                crate::passes::radiosity::upsample::UpsampleUniforms::new(scale, &s.reconstruction(radius)),
+                crate::passes::radiosity::upsample::UpsampleUniforms {
+                    // the AO pass's value where there is no surface: AV 1, or S 0
+                    empty: (!s.filter_obscurance) as u32 as f32,
+                    ..crate::passes::radiosity::upsample::UpsampleUniforms::new(scale, &s.reconstruction(radius))
+                },
                 crate::passes::ao::OUTPUT_LOW.name,
                 crate::passes::ao::OUTPUT.name,
             )

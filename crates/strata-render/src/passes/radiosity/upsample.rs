@@ -3,9 +3,10 @@
 //! DGB). At scale s the gather writes `indirect-raw-low` / `indirect1-raw-low`, one texel
 //! per s×s block, each shading one pixel of its block ([`crate::spiral::block_pixel`]:
 //! every pixel of the block in turn over s² frames). [`UpsamplePass`] writes the
-//! full-resolution `indirect-raw` / `indirect1-raw` from them (`upsample.wgsl`: 2×2 texels
-//! per pixel), which the
-//! temporal and bilateral filters then read as before.
+//! full-resolution `indirect-raw` / `indirect1-raw` from them (`upsample.wgsl`: 2×2
+//! texels per pixel), which the temporal and bilateral filters then read as before. The
+//! AO pass at [`AoSettings::scale`](crate::passes::ao::AoSettings::scale) uses the same
+//! upsampling for layer 0 ([`UpsamplePass::layer0`]).
 
 use glam::Vec3;
 use strata_scene::ImageBuf;
@@ -57,16 +58,23 @@ pub struct UpsampleUniforms {
     pub seed: u32,
     pub plane_sharpness: f32,
     pub normal_power: u32,
+    /// Layer 0's value where it has no surface, in every channel (what the low-resolution
+    /// pass writes there: 0 for E, 1 for AV).
+    pub empty: f32,
+    pub _pad: [u32; 3],
 }
 
 impl UpsampleUniforms {
-    /// The indirect light's bilateral weights `blur` at scale `s`.
+    /// Scale `s`, with the plane and normal weights of the bilateral filter `blur` that
+    /// follows the upsampling; 0 where layer 0 is empty.
     pub fn new(s: u32, blur: &BilateralSettings) -> Self {
         Self {
             scale: s,
             seed: 0,
             plane_sharpness: blur.plane_sharpness,
             normal_power: blur.normal_power,
+            empty: 0.0,
+            _pad: [0; 3],
         }
     }
 }
@@ -78,7 +86,8 @@ const MIN_WEIGHT: f32 = 1e-3;
 /// CPU twin of `upsample.wgsl` for layer `j`: `low` = the gather's low-resolution output
 /// of that layer (any channel count), `csz` = `zmip` level 0 (channel j = layer j's
 /// depth; ≤ 0: none), `normals` = layer j's unit normals (3 channels). Returns the
-/// full-resolution image (as many channels; zero where layer j is empty).
+/// full-resolution image (as many channels; where layer j is empty, `u.empty` for layer 0
+/// and zero for layer 1).
 pub fn upsample_cpu(
     low: &ImageBuf,
     csz: &ImageBuf,
@@ -98,6 +107,9 @@ pub fn upsample_cpu(
         for px in 0..w as i32 {
             let zp = z_of(px, py);
             if zp <= 0.0 {
+                if j == 0 {
+                    out.pixel_mut(px as u32, py as u32).fill(u.empty);
+                }
                 continue;
             }
             let (x, n) = (at(px, py, zp), n_of(px, py));

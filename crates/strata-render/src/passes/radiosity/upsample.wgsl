@@ -20,6 +20,8 @@ struct Upsample {
     seed: u32,
     plane_sharpness: f32,
     normal_power: u32,
+    // layer 0's value where it has no surface (0 for E, 1 for AV)
+    empty: f32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -89,6 +91,7 @@ fn upsampled(p: vec2i) -> Out {
     var o: Out;
     let z = textureLoad(zmip, p, 0);
     if (z.x <= 0.0) {
+        o.e0 = vec4f(up.empty);
         return o;
     }
     let has1 = LAYERS > 1u && z.y > 0.0;
