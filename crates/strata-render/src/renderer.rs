@@ -970,13 +970,13 @@ impl Renderer {
 
     /// The reduced-resolution gather's upsampling uniforms this frame
     /// (`RadiositySettings::gather_scale` > 1), for its CPU twin.
-    pub fn upsample_uniforms(&self) -> Option<crate::passes::radiosity::upsample::UpsampleUniforms> {
+    pub fn upsample_uniforms(&self) -> Option<crate::passes::upsample::UpsampleUniforms> {
         self.radiosity.as_ref()?.upsample.as_ref().map(|u| u.uniforms())
     }
 
     /// The reduced-resolution AO's upsampling uniforms this frame (`AoSettings::scale` >
     /// 1), for its CPU twin.
-    pub fn ao_upsample_uniforms(&self) -> Option<crate::passes::radiosity::upsample::UpsampleUniforms> {
+    pub fn ao_upsample_uniforms(&self) -> Option<crate::passes::upsample::UpsampleUniforms> {
         self.ao.as_ref()?.upsample.as_ref().map(|u| u.uniforms())
     }
 

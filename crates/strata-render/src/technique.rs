@@ -414,7 +414,7 @@ static AO_SETTINGS: [SettingInfo; 17] = [
     setting!(
         "ao-scale",
         "the AO pass's resolution divisor s: at s > 1 it shades one pixel of each s x s block (a different one each frame), a joint bilateral upsampling fills the rest (1 = every pixel, as the paper; not with deinterleave; not in the paper, docs/ao.md)",
-        Range::Closed(1.0, crate::passes::radiosity::upsample::MAX_GATHER_SCALE as f64),
+        Range::Closed(1.0, crate::passes::upsample::MAX_SCALE as f64),
         true,
         |s| Some(ao_of(s).scale as f64),
         |s, v| ao_mut(s).scale = v as u32
@@ -558,7 +558,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 24] = [
     setting!(
         "gather-scale",
         "the radiosity gather's resolution divisor s: at s > 1 it shades one pixel of each s x s block (a different one each frame) and a joint bilateral upsampling fills the rest (1 = every pixel, as the paper; not in the paper, docs/radiosity.md)",
-        Range::Closed(1.0, radiosity::upsample::MAX_GATHER_SCALE as f64),
+        Range::Closed(1.0, crate::passes::upsample::MAX_SCALE as f64),
         true,
         |s| Some(radiosity_of(s).gather_scale as f64),
         |s, v| radiosity_mut(s).gather_scale = v as u32

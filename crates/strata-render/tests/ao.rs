@@ -175,7 +175,7 @@ fn gpu_ao_equals_cpu_eq1_eq2_over_the_same_buffers() {
 /// fragment and as a compute pass.
 #[test]
 fn reduced_resolution_ao_and_upsampling_match_their_cpu_twins() {
-    use strata_render::passes::radiosity::upsample::upsample_cpu;
+    use strata_render::passes::upsample::upsample_cpu;
     use strata_render::passes::Kernel;
     let gpu = common::gpu();
     for (name, layers, scale, kernel) in [

@@ -167,7 +167,7 @@ fn gpu_gather_equals_cpu_eq4_eq5_over_the_same_buffers() {
 /// at scales 2 and 3, as fragment and as compute passes.
 #[test]
 fn reduced_resolution_gather_and_upsampling_match_their_cpu_twins() {
-    use strata_render::passes::radiosity::upsample::upsample_cpu;
+    use strata_render::passes::upsample::upsample_cpu;
     let gpu = common::gpu();
     for (name, scale, kernel) in [
         ("atrium", 2u32, Kernel::Fragment),

@@ -17,6 +17,7 @@ pub mod reflections;
 pub mod shadow;
 pub mod temporal;
 pub mod tonemap;
+pub mod upsample;
 
 /// A full-screen-triangle pipeline (vertex entry `vs_fullscreen` from
 /// `common/fullscreen.wgsl`, fragment entry `fs_main`).

@@ -9,7 +9,7 @@
 
 override LAYERS: u32 = 2u;
 // > 1: the pass runs at 1/SCALE resolution, texel t shading one pixel of its SCALE×SCALE
-// block (`block_pixel`); `radiosity/upsample.wgsl` brings it back (`AoSettings::scale`)
+// block (`block_pixel`); `upsample/upsample.wgsl` brings it back (`AoSettings::scale`)
 override SCALE: u32 = 1u;
 
 #import "ao/uniforms.wgsl"

@@ -91,7 +91,7 @@ pub struct AoSettings {
     /// shader code and values. Not in the paper (default [`Kernel::Auto`]: compute on
     /// GPUs, fragment on CPU adapters; docs/ao.md § "The AO pass as compute").
     pub kernel: Kernel,
-    /// The AO pass's resolution divisor s, 1..=[`MAX_GATHER_SCALE`](crate::passes::radiosity::upsample::MAX_GATHER_SCALE):
+    /// The AO pass's resolution divisor s, 1..=[`MAX_SCALE`](crate::passes::upsample::MAX_SCALE):
     /// at s > 1 it shades one pixel of each s×s block (a different one each frame with
     /// `temporal_noise`) and a joint bilateral upsampling fills the rest (as the radiosity
     /// gather's `gather_scale`, whose blur steps s times as far; AO's does not: docs/ao.md
@@ -169,7 +169,7 @@ impl AoSettings {
                 ));
             }
         }
-        let max_scale = crate::passes::radiosity::upsample::MAX_GATHER_SCALE;
+        let max_scale = crate::passes::upsample::MAX_SCALE;
         if !(1..=max_scale).contains(&self.scale) {
             return Err(format!(
                 "AO scale {} is out of range: must be in 1..={max_scale}",

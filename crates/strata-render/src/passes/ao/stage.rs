@@ -22,7 +22,7 @@ pub(crate) struct AoStage {
     pub(crate) deint_before: Vec<Box<dyn Pass>>,
     pub(crate) ao: AoPass,
     /// With [`AoSettings::scale`] > 1: `ao-raw-low`'s upsampling into `ao-raw`.
-    pub(crate) upsample: Option<crate::passes::radiosity::upsample::UpsamplePass>,
+    pub(crate) upsample: Option<crate::passes::upsample::UpsamplePass>,
     /// Deinterleaved: the gather of `ao-raw-tiled` into `ao-raw`.
     pub(crate) deint_gather: Option<InterleavePass>,
     pub(crate) temporal: Option<TemporalPass>,
@@ -52,7 +52,7 @@ impl AoStage {
         targets.create_with_usage(gpu, crate::passes::ao::OUTPUT, [targets.width, targets.height], usage);
         let scale = s.scale;
         if scale > 1 {
-            let size = crate::passes::radiosity::upsample::low_size(targets.width, targets.height, scale);
+            let size = crate::passes::upsample::low_size(targets.width, targets.height, scale);
             targets.create_with_usage(gpu, crate::passes::ao::OUTPUT_LOW, size, usage);
         }
         let (ao, deint_before, deint_gather) = match s.deinterleave {
@@ -67,15 +67,15 @@ impl AoStage {
             }
         };
         let upsample = (scale > 1).then(|| {
-            crate::passes::radiosity::upsample::UpsamplePass::layer0(
+            crate::passes::upsample::UpsamplePass::layer0(
                 gpu,
                 scene,
                 targets,
                 "ao-upsample",
-                crate::passes::radiosity::upsample::UpsampleUniforms {
+                crate::passes::upsample::UpsampleUniforms {
                     // the AO pass's value where there is no surface: AV 1, or S 0
                     empty: (!s.filter_obscurance) as u32 as f32,
-                    ..crate::passes::radiosity::upsample::UpsampleUniforms::new(scale, &s.reconstruction(radius))
+                    ..crate::passes::upsample::UpsampleUniforms::new(scale, &s.reconstruction(radius))
                 },
                 crate::passes::ao::OUTPUT_LOW.name,
                 crate::passes::ao::OUTPUT.name,

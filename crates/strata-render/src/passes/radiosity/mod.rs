@@ -10,7 +10,6 @@
 //! (Eq. 6 with the Lambertian 1/π made explicit).
 
 pub(crate) mod stage;
-pub mod upsample;
 
 use crate::passes::builder::{FullscreenPass, Kernel, PassBuilder, ScreenPass};
 use glam::Vec3;
@@ -134,7 +133,7 @@ pub struct RadiositySettings {
     /// shader code and values (docs/radiosity.md § "The gather as a compute pass"). Not in
     /// the paper (default [`Kernel::Auto`]: compute on GPUs, fragment on CPU adapters).
     pub kernel: Kernel,
-    /// The gather's resolution divisor s, 1..=[`upsample::MAX_GATHER_SCALE`]: at s > 1 the
+    /// The gather's resolution divisor s, 1..=[`crate::passes::upsample::MAX_SCALE`]: at s > 1 the
     /// gather shades one pixel of each s×s block (a different one each frame with
     /// `temporal_noise`, all s² in s² frames) and a joint bilateral upsampling (the
     /// indirect blur's plane and normal weights) fills the rest before the temporal
@@ -488,11 +487,11 @@ impl RadiositySettings {
                 self.delta
             ));
         }
-        if !(1..=upsample::MAX_GATHER_SCALE).contains(&self.gather_scale) {
+        if !(1..=crate::passes::upsample::MAX_SCALE).contains(&self.gather_scale) {
             return Err(format!(
                 "radiosity gather-scale {} is out of range: must be in 1..={}",
                 self.gather_scale,
-                upsample::MAX_GATHER_SCALE
+                crate::passes::upsample::MAX_SCALE
             ));
         }
         self.mips.validate()?;
@@ -615,6 +614,22 @@ pub const OUTPUTS: [TargetDesc; 2] = [
     ),
 ];
 
+/// The reduced-resolution gather's outputs (same formats as [`OUTPUTS`]).
+pub const LOW_OUTPUTS: [TargetDesc; 2] = [
+    TargetDesc::new(
+        "indirect-raw-low",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "the gather at 1/s resolution: layer 0's E (rgb) and confidence (a) of one pixel per s×s block",
+    ),
+    TargetDesc::new(
+        "indirect1-raw-low",
+        wgpu::TextureFormat::Rgba16Float,
+        1,
+        "the gather at 1/s resolution: layer 1's E (rgb) and confidence (a) of one pixel per s×s block",
+    ),
+];
+
 pub struct RadiosityPass {
     pass: ScreenPass,
     /// The probes' grid, when the gather has probes for the detail term.
@@ -628,7 +643,7 @@ impl RadiosityPass {
     /// for layer 1's surfaces (only multi-bounce propagation reads them); `probes`: for
     /// [`RadiositySettings::probe_detail`]; `compute`: [`RadiositySettings::kernel`] resolved
     /// (the outputs must then allow storage binding); `scale`:
-    /// [`RadiositySettings::gather_scale`] (> 1: into [`upsample::LOW_OUTPUTS`], `scissor` in
+    /// [`RadiositySettings::gather_scale`] (> 1: into [`LOW_OUTPUTS`], `scissor` in
     /// full-resolution pixels).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -643,8 +658,8 @@ impl RadiosityPass {
         compute: bool,
         scale: u32,
     ) -> Self {
-        let scissor = scissor.map(|r| upsample::low_rect(r, scale));
-        let outputs = if scale > 1 { upsample::LOW_OUTPUTS } else { OUTPUTS };
+        let scissor = scissor.map(|r| crate::passes::upsample::low_rect(r, scale));
+        let outputs = if scale > 1 { LOW_OUTPUTS } else { OUTPUTS };
         let zeroed: RadiosityUniforms = bytemuck::Zeroable::zeroed();
         let dummy;
         let gpu_probes = match probes {

@@ -15,7 +15,7 @@ pub(crate) struct RadiosityStage {
     pub(crate) propagate: Option<crate::passes::radiosity::PropagatePass>,
     pub(crate) gather: RadiosityPass,
     /// With [`RadiositySettings::gather_scale`] > 1: the low-resolution gather's upsampling.
-    pub(crate) upsample: Option<crate::passes::radiosity::upsample::UpsamplePass>,
+    pub(crate) upsample: Option<crate::passes::upsample::UpsamplePass>,
     pub(crate) temporal: Option<TemporalPass>,
     pub(crate) blur_h: BilateralPass,
     pub(crate) blur_v: BilateralPass,
@@ -47,8 +47,8 @@ impl RadiosityStage {
         }
         let scale = s.gather_scale;
         if scale > 1 {
-            let size = crate::passes::radiosity::upsample::low_size(targets.width, targets.height, scale);
-            for t in crate::passes::radiosity::upsample::LOW_OUTPUTS {
+            let size = crate::passes::upsample::low_size(targets.width, targets.height, scale);
+            for t in crate::passes::radiosity::LOW_OUTPUTS {
                 targets.create_with_usage(gpu, t, size, usage);
             }
         }
@@ -120,12 +120,15 @@ impl RadiosityStage {
             scale,
         );
         let upsample = (scale > 1).then(|| {
-            crate::passes::radiosity::upsample::UpsamplePass::new(
+            crate::passes::upsample::UpsamplePass::new(
                 gpu,
                 scene,
                 targets,
+                "radiosity-upsample",
                 deep.layers,
-                crate::passes::radiosity::upsample::UpsampleUniforms::new(scale, &s.blur),
+                crate::passes::upsample::UpsampleUniforms::new(scale, &s.blur),
+                crate::passes::radiosity::LOW_OUTPUTS.map(|t| t.name),
+                crate::passes::radiosity::OUTPUTS.map(|t| t.name),
                 region,
                 compute,
             )

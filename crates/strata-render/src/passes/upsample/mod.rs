@@ -1,41 +1,24 @@
-//! A reduced-resolution gather and its joint bilateral upsampling
-//! ([`RadiositySettings::gather_scale`](super::RadiositySettings::gather_scale); not in
-//! DGB). At scale s the gather writes `indirect-raw-low` / `indirect1-raw-low`, one texel
-//! per s×s block, each shading one pixel of its block ([`crate::spiral::block_pixel`]:
-//! every pixel of the block in turn over s² frames). [`UpsamplePass`] writes the
-//! full-resolution `indirect-raw` / `indirect1-raw` from them (`upsample.wgsl`: 2×2
-//! texels per pixel), which the temporal and bilateral filters then read as before. The
-//! AO pass at [`AoSettings::scale`](crate::passes::ao::AoSettings::scale) uses the same
-//! upsampling for layer 0 ([`UpsamplePass::layer0`]).
+//! Joint bilateral upsampling (Kopf et al. 2007) of a screen pass run at reduced
+//! resolution; not in DGB. At scale s a pass shades one pixel of each s×s block
+//! ([`crate::spiral::block_pixel`]: every pixel of the block in turn over s² frames) into
+//! a ⌈w/s⌉ × ⌈h/s⌉ target, and [`UpsamplePass`] writes the full-resolution target from it
+//! (`upsample.wgsl`: 2×2 texels per pixel). Used by the radiosity gather
+//! ([`RadiositySettings::gather_scale`](crate::passes::radiosity::RadiositySettings::gather_scale),
+//! both receivers) and by AO ([`AoSettings::scale`](crate::passes::ao::AoSettings::scale),
+//! layer 0).
 
 use glam::Vec3;
 use strata_scene::ImageBuf;
 
-use crate::frame::{FrameUniforms, TargetDesc, Targets};
+use crate::frame::{FrameUniforms, Targets};
 use crate::gpu::GpuContext;
 use crate::passes::ao::world_from_csz;
 use crate::passes::bilateral::BilateralSettings;
 use crate::passes::builder::{PassBuilder, ScreenPass};
 use crate::scene_gpu::GpuScene;
 
-/// The most a gather's resolution may be divided by, per axis.
-pub const MAX_GATHER_SCALE: u32 = 4;
-
-/// The reduced-resolution gather's outputs (same formats as [`super::OUTPUTS`]).
-pub const LOW_OUTPUTS: [TargetDesc; 2] = [
-    TargetDesc::new(
-        "indirect-raw-low",
-        wgpu::TextureFormat::Rgba16Float,
-        1,
-        "the gather at 1/s resolution: layer 0's E (rgb) and confidence (a) of one pixel per s×s block",
-    ),
-    TargetDesc::new(
-        "indirect1-raw-low",
-        wgpu::TextureFormat::Rgba16Float,
-        1,
-        "the gather at 1/s resolution: layer 1's E (rgb) and confidence (a) of one pixel per s×s block",
-    ),
-];
+/// The most a pass's resolution may be divided by, per axis.
+pub const MAX_SCALE: u32 = 4;
 
 /// The low-resolution size of a `w` × `h` image gathered at scale `s`: ⌈w/s⌉ × ⌈h/s⌉.
 pub fn low_size(w: u32, h: u32, s: u32) -> [u32; 2] {
@@ -54,7 +37,7 @@ pub fn low_rect([x, y, w, h]: [u32; 4], s: u32) -> [u32; 4] {
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct UpsampleUniforms {
     pub scale: u32,
-    /// The gather's seed this frame (which pixel of its block each texel shaded).
+    /// The reduced pass's seed this frame (which pixel of its block each texel shaded).
     pub seed: u32,
     pub plane_sharpness: f32,
     pub normal_power: u32,
@@ -83,7 +66,7 @@ impl UpsampleUniforms {
 /// in upsample.wgsl).
 const MIN_WEIGHT: f32 = 1e-3;
 
-/// CPU twin of `upsample.wgsl` for layer `j`: `low` = the gather's low-resolution output
+/// CPU twin of `upsample.wgsl` for layer `j`: `low` = the reduced pass's output
 /// of that layer (any channel count), `csz` = `zmip` level 0 (channel j = layer j's
 /// depth; ≤ 0: none), `normals` = layer j's unit normals (3 channels). Returns the
 /// full-resolution image (as many channels; where layer j is empty, `u.empty` for layer 0
@@ -160,32 +143,35 @@ pub fn upsample_cpu(
     out
 }
 
-/// Joint bilateral upsampling of the reduced-resolution gather into `indirect-raw` /
-/// `indirect1-raw` (`upsample.wgsl`).
+/// Joint bilateral upsampling of a reduced-resolution pass (`upsample.wgsl`).
 pub struct UpsamplePass {
     pass: ScreenPass,
     uniforms: std::cell::Cell<UpsampleUniforms>,
 }
 
 impl UpsamplePass {
-    /// The radiosity gather's upsampling, `LOW_OUTPUTS` into `OUTPUTS` (both receivers).
-    /// `scissor`: the shaded full-resolution rectangle (zero outside it); `compute`: the
-    /// compute form (outputs with storage binding).
+    /// Both layers' upsampling (pass `name`), `low` (layer 0, layer 1) into `outputs`
+    /// (RGBA16F). `scissor`: the shaded full-resolution rectangle (zero outside it);
+    /// `compute`: the compute form (outputs with storage binding).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
         targets: &Targets,
+        name: &'static str,
         layers: u32,
         u: UpsampleUniforms,
+        low: [&'static str; 2],
+        outputs: [&'static str; 2],
         scissor: Option<[u32; 4]>,
         compute: bool,
     ) -> Self {
-        let builder = Self::builder(gpu, scene, targets, "radiosity-upsample", layers, &u, compute, scissor)
-            .read(LOW_OUTPUTS[0].name)
-            .read(LOW_OUTPUTS[1].name)
+        let builder = Self::builder(gpu, scene, targets, name, layers, &u, compute, scissor)
+            .read(low[0])
+            .read(low[1])
             .read("zmip")
             .read("npack");
-        let pass = ScreenPass::build_in(builder, &super::OUTPUTS.map(|t| t.name), compute, scissor);
+        let pass = ScreenPass::build_in(builder, &outputs, compute, scissor);
         Self {
             pass,
             uniforms: std::cell::Cell::new(u),
@@ -193,7 +179,7 @@ impl UpsamplePass {
     }
 
     /// Layer 0's upsampling of `low` into `output` (one channel used), as a fragment pass
-    /// named `name` (the AO pass at [`AoSettings::scale`](crate::passes::ao::AoSettings::scale)).
+    /// named `name` (AO at [`AoSettings::scale`](crate::passes::ao::AoSettings::scale)).
     pub fn layer0(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -229,13 +215,13 @@ impl UpsamplePass {
     ) -> PassBuilder<'a> {
         PassBuilder::new(gpu, targets, name)
             .kernel_in(compute, scissor)
-            .shader("radiosity-upsample", include_str!("upsample.wgsl"))
+            .shader("upsample", include_str!("upsample.wgsl"))
             .constant("LAYERS", layers as f64)
             .frame(scene)
             .uniforms(u)
     }
 
-    /// This frame's gather seed.
+    /// This frame's seed of the reduced pass (which pixel of its block each texel shaded).
     pub fn set_frame(&self, gpu: &GpuContext, seed: u32) {
         let u = UpsampleUniforms {
             seed,

@@ -1,10 +1,10 @@
-// Joint bilateral upsampling (Kopf et al. 2007) of a gather run at 1/s resolution
+// Joint bilateral upsampling (Kopf et al. 2007) of a pass run at 1/s resolution
 // (`RadiositySettings::gather_scale`, `AoSettings::scale`; not in DGB): each full-resolution pixel averages
 // the 2×2 low-resolution texels whose blocks' centres surround it, each standing at the
 // pixel it shaded (`block_pixel`), weighted by screen distance × the bilateral filter's
 // plane and normal weights (bilateral.wgsl's, on the pixel's own layer). Where no texel
 // holds the pixel's surface (all weights ≈ 0: thin features), the texel whose depth is
-// nearest the pixel's stands in. CPU twin: `radiosity::upsample::upsample_cpu`.
+// nearest the pixel's stands in. CPU twin: `passes::upsample::upsample_cpu`.
 #import "common/fullscreen.wgsl"
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
