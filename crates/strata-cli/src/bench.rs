@@ -211,6 +211,19 @@ fn print_stage(name: &str, s: &StageBench) {
     if !forms.is_empty() {
         println!("({}; --set ao-kernel / indirect-kernel choose)", forms.join(", "));
     }
+    let reduced: Vec<String> = [("ao_scale", "AO pass"), ("gather_scale", "radiosity gather")]
+        .iter()
+        .filter_map(|(key, what)| {
+            let s = s.settings.get(*key)?.as_u64().filter(|&v| v > 1)?;
+            Some(format!("{what} at 1/{s}"))
+        })
+        .collect();
+    if !reduced.is_empty() {
+        println!(
+            "({} resolution, upsampled; --set ao-scale / gather-scale choose)",
+            reduced.join(", ")
+        );
+    }
     if s.settings.get("vpl_shadow_maps_cached") == Some(&serde_json::Value::Bool(true)) {
         println!("(the VPLs and the scene hold still: the VPL shadow maps are drawn in the warm-up frame and kept, so `ils-vpl-shadows` is ~0; --set vpl-shadow-cache=0 times their redraw)");
     }

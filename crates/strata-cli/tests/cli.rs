@@ -577,6 +577,7 @@ fn bench_ao_splits_first_layer_and_increment() {
     let cpu = v["device"].as_str().is_some_and(|d| d.contains("llvmpipe"));
     assert_eq!(v["ao_kernel"], if cpu { "fragment" } else { "compute" }, "{v}");
     assert!(v.get("indirect_kernel").is_none(), "no radiosity in bench ao: {v}");
+    assert_eq!(v["ao_scale"], 1, "{v}");
     // and what --set chooses
     let o = strata(&[
         "bench",
@@ -596,6 +597,29 @@ fn bench_ao_splits_first_layer_and_increment() {
         "--json",
     ]);
     assert_eq!(json_of(&o)["ao_kernel"], "compute");
+    // a reduced AO pass: its upsampling is timed right after it, and the scale is reported
+    let o = strata(&[
+        "bench",
+        "technique",
+        "--technique",
+        "ao",
+        "--scene",
+        "column-wall",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "1",
+        "--set",
+        "ao-scale=2",
+        "--json",
+    ]);
+    let v = json_of(&o);
+    assert_eq!(v["ao_scale"], 2, "{v}");
+    let names = pass_names(&v);
+    let at = names.iter().position(|&n| n == "ao").expect("ao timed");
+    assert_eq!(names[at + 1], "ao-upsample", "{names:?}");
 }
 
 /// `--deinterleave 2x2 --filter-obscurance`: the copy, both splits, `ao-deint`,

@@ -82,11 +82,14 @@ pub(crate) fn run(b: Stage) -> Result<StageBench> {
     let mut settings = b.extra.as_object().cloned().unwrap_or_default();
     let rs = (b.settings)(s.layers);
     let form = |compute: bool| if compute { "compute" } else { "fragment" };
+    // and the resolution divisor of the passes that may run reduced (1: every pixel)
     if let Some(ao) = &rs.ao {
         settings.insert("ao_kernel".into(), form(ao.kernel.compute_on(&gpu)).into());
+        settings.insert("ao_scale".into(), ao.scale.into());
     }
     if let Some(rad) = &rs.radiosity {
         settings.insert("indirect_kernel".into(), form(rad.kernel.compute_on(&gpu)).into());
+        settings.insert("gather_scale".into(), rad.gather_scale.into());
     }
     Ok(StageBench {
         run: bench_run(&s.scene, s.frames, &scene, &gpu),
