@@ -579,43 +579,28 @@ fn bench_ao_splits_first_layer_and_increment() {
     assert!(v.get("indirect_kernel").is_none(), "no radiosity in bench ao: {v}");
     assert_eq!(v["ao_scale"], 1, "{v}");
     // and what --set chooses
-    let o = strata(&[
-        "bench",
-        "technique",
-        "--technique",
-        "ao",
-        "--scene",
-        "column-wall",
-        "--width",
-        "64",
-        "--height",
-        "48",
-        "--frames",
-        "1",
-        "--set",
-        "ao-kernel=compute",
-        "--json",
-    ]);
-    assert_eq!(json_of(&o)["ao_kernel"], "compute");
+    let bench_with = |set: &str| {
+        json_of(&strata(&[
+            "bench",
+            "technique",
+            "--technique",
+            "ao",
+            "--scene",
+            "column-wall",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--frames",
+            "1",
+            "--set",
+            set,
+            "--json",
+        ]))
+    };
+    assert_eq!(bench_with("ao-kernel=compute")["ao_kernel"], "compute");
     // a reduced AO pass: its upsampling is timed right after it, and the scale is reported
-    let o = strata(&[
-        "bench",
-        "technique",
-        "--technique",
-        "ao",
-        "--scene",
-        "column-wall",
-        "--width",
-        "64",
-        "--height",
-        "48",
-        "--frames",
-        "1",
-        "--set",
-        "ao-scale=2",
-        "--json",
-    ]);
-    let v = json_of(&o);
+    let v = bench_with("ao-scale=2");
     assert_eq!(v["ao_scale"], 2, "{v}");
     let names = pass_names(&v);
     let at = names.iter().position(|&n| n == "ao").expect("ao timed");
