@@ -246,7 +246,7 @@ fn ao_scale_out_of_range_or_with_deinterleave_is_refused() {
     for (scale, deinterleave, want) in [
         (0, None, "AO scale 0 is out of range: must be in 1..=4"),
         (5, None, "AO scale 5 is out of range: must be in 1..=4"),
-        (2, Some([2, 2]), "AO scale 2 needs deinterleave off"),
+        (2, Some([2, 2]), "AO scale (ao-scale) 2 needs deinterleave off"),
     ] {
         let e = AoSettings {
             scale,

@@ -178,7 +178,7 @@ impl AoSettings {
         }
         if self.scale > 1 && self.deinterleave.is_some() {
             return Err(format!(
-                "AO scale {} needs deinterleave off: the deinterleaved AO shades every pixel",
+                "AO scale (ao-scale) {} needs deinterleave off: the deinterleaved AO shades every pixel",
                 self.scale
             ));
         }
