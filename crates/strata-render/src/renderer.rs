@@ -496,6 +496,10 @@ pub struct Renderer {
     /// Frames rendered so far: the seed of per-frame rotated sampling patterns
     /// (independent of the animation frame, so a static view also varies).
     frames_rendered: u32,
+    /// The animation frame the objects were last drawn at (`None` before the first frame
+    /// and after a cut): their "previous" transforms, so re-rendering a frame (a still
+    /// image's warm-up) gives zero motion.
+    last_object_frame: Option<f32>,
     profiler: Profiler,
     lights: Vec<GpuLight>,
     animated: bool,
@@ -743,6 +747,7 @@ impl Renderer {
             has_history: false,
             history_layers_valid: false,
             frames_rendered: 0,
+            last_object_frame: None,
             profiler,
             lights,
             animated,
@@ -818,6 +823,7 @@ impl Renderer {
     /// layers have no oracle.
     pub fn reset_history(&mut self) {
         self.has_history = false;
+        self.last_object_frame = None;
     }
 
     /// Renders one frame at (fractional) frame index `frame`, seen by
@@ -877,7 +883,10 @@ impl Renderer {
                 t.set_frame(gpu, temporal_history);
             }
         }
-        self.scene_gpu.update_objects(gpu, frame, variant.next_transforms());
+        // the frame before on the first frame (PREDICT's extrapolation; no history reads it)
+        let previous = self.last_object_frame.unwrap_or(frame - 1.0);
+        self.scene_gpu
+            .update_objects(gpu, frame, previous, variant.next_transforms());
         for g in &self.geometry {
             g.set_frame(gpu, dz, self.has_history);
         }
@@ -927,6 +936,7 @@ impl Renderer {
         gpu.check_errors()?;
         self.history_layers_valid = !self.settings.deep.uses_history() || self.has_history;
         self.frames_rendered = self.frames_rendered.wrapping_add(1);
+        self.last_object_frame = Some(frame);
         self.has_history = self.history.is_some();
         self.profiler.read(gpu)
     }
@@ -1247,7 +1257,7 @@ impl Renderer {
                 Ok(pad_channels(&z, 3))
             }
             // Colours without their alpha: an empty pixel shows black, not transparent.
-            "albedo" | "emission" => Ok(pad_channels(&self.read_target_layer(gpu, base, layer)?, 3)),
+            "albedo" | "emission" | "motion" => Ok(pad_channels(&self.read_target_layer(gpu, base, layer)?, 3)),
             _ => self.read_target_layer(gpu, base, layer),
         }
     }
@@ -1368,7 +1378,16 @@ impl Renderer {
 }
 
 /// Per-layer debug views (`layerJ-NAME`).
-const PER_LAYER_VIEWS: [&str; 7] = ["csz", "depth", "normal", "albedo", "emission", "roughness", "metallic"];
+const PER_LAYER_VIEWS: [&str; 8] = [
+    "csz",
+    "depth",
+    "normal",
+    "albedo",
+    "emission",
+    "motion",
+    "roughness",
+    "metallic",
+];
 
 /// The `w`×`h` window of `img` starting at (`x0`, `y0`).
 /// The `abuffer-layer{k}` debug views (and at most this many `abuffer-node{j}-*`).

@@ -280,13 +280,14 @@ impl GpuScene {
         }
     }
 
-    /// Writes the object transforms for `frame`, `frame − 1` ("previous") and
-    /// `frame + 1` ("next", exact or extrapolated).
-    pub fn update_objects(&self, gpu: &GpuContext, frame: f32, next: NextTransforms) {
+    /// Writes the object transforms for `frame`, the frame last drawn, `previous` (its
+    /// transforms: reverse reprojection, the G-buffer's motion), and `frame + 1` ("next",
+    /// exact or extrapolated from `previous`).
+    pub fn update_objects(&self, gpu: &GpuContext, frame: f32, previous: f32, next: NextTransforms) {
         let mut bytes = vec![0u8; OBJECT_STRIDE as usize * self.objects_cpu.len().max(1)];
         for (i, o) in self.objects_cpu.iter().enumerate() {
             let m: Mat4 = o.transform_at(frame);
-            let prev = o.transform_at(frame - 1.0);
+            let prev = o.transform_at(previous);
             let next = match next {
                 NextTransforms::Exact => o.transform_at(frame + 1.0),
                 NextTransforms::Extrapolated if prev == m => m,

@@ -301,7 +301,7 @@ static DIRECT_SETTINGS: [SettingInfo; 3] = [
     },
 ];
 
-static AO_SETTINGS: [SettingInfo; 17] = [
+static AO_SETTINGS: [SettingInfo; 18] = [
     setting!(
         "ao-radius",
         "world-space AO radius r (DGB Eq. 1; default: the scene's ao_radius)",
@@ -355,6 +355,13 @@ static AO_SETTINGS: [SettingInfo; 17] = [
         ao_of,
         ao_mut,
         ramp
+    ),
+    temporal_flag!(
+        "temporal-motion",
+        "on: the AO's temporal filter reprojects with per-object velocities (the deep G-buffer's motion target), so moving objects keep their history (DGB 3.3); off: the camera's motion only",
+        ao_of,
+        ao_mut,
+        object_motion
     ),
     setting!(
         "temporal-distance",
@@ -449,7 +456,7 @@ static AO_SETTINGS: [SettingInfo; 17] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 24] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 25] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -612,6 +619,13 @@ static RADIOSITY_SETTINGS: [SettingInfo; 24] = [
         radiosity_of,
         radiosity_mut,
         ramp
+    ),
+    temporal_flag!(
+        "indirect-temporal-motion",
+        "on: the indirect light's temporal filter and the multi-bounce propagation reproject with per-object velocities (the deep G-buffer's motion target), so moving objects keep their history and bounces (DGB 3.3); off: the camera's motion only",
+        radiosity_of,
+        radiosity_mut,
+        object_motion
     ),
     setting!(
         "delta",

@@ -498,6 +498,114 @@ fn temporal_ramp_restarts_per_pixel_after_a_failed_reprojection() {
     assert!(covered.iter().all(|&i| frames(&r)[i] == 2.0), "two accepted frames");
 }
 
+/// Per-object velocities (DGB §3.3 reprojects "to account for motion"): the whole Cornell
+/// box slides 6 cm towards the still camera between two frames.
+/// - The deep G-buffer's `motion` holds that displacement on every surface pixel, and 0
+///   when the same frame is drawn again.
+/// - With `object_motion` each pixel moves its point back by `motion`, reprojects it, and
+///   blends the history read there wherever last frame's layers hold the point: the CPU
+///   twin of reproject.wgsl (`temporal::reproject`, `matching_layer`, `bilinear_at`).
+/// - With the camera's motion only, the walls facing the camera fail the 1 cm test.
+#[test]
+fn temporal_filter_follows_moving_objects_with_their_motion() {
+    use strata_render::passes::temporal::{bilinear_at, matching_layer, reproject};
+    let gpu = common::gpu();
+    let mut scene = frozen("cornell");
+    let cam = scene.camera;
+    let slide = (cam.target - cam.eye).normalize() * -0.06;
+    for o in &mut scene.objects {
+        // offset = slide · sin(2π frame / 4): 0 at frame 0, the whole slide at frame 1
+        o.animation = Some(strata_scene::Animation::Slide {
+            amplitude: slide,
+            period_frames: 4.0,
+        });
+    }
+    let (w, h) = (64, 64);
+    let alpha = 0.85;
+    let still = FrameCameras::fixed(cam);
+    let mut accepted_by_mode = Vec::new();
+    for object_motion in [true, false] {
+        let mut settings = temporal_settings(alpha);
+        let t = settings.temporal.as_mut().unwrap();
+        (t.clamp_history, t.ramp, t.object_motion) = (false, false, object_motion);
+        let mut r = ao_renderer(&gpu, &scene, w, h, 2, settings);
+        r.render(&gpu, &scene, &still, 0.0).unwrap();
+        let e0 = r.read_target(&gpu, "ao-temporal").unwrap();
+        let csz0: Vec<ImageBuf> = (0..2).map(|j| r.read_target_layer(&gpu, "csz", j).unwrap()).collect();
+        r.render(&gpu, &scene, &still, 1.0).unwrap();
+        let f = r.frame_uniforms();
+        let (e1, out) = (
+            r.read_target(&gpu, "ao-raw").unwrap(),
+            r.read_target(&gpu, "ao-temporal").unwrap(),
+        );
+        let (csz, motion) = (
+            r.read_target_layer(&gpu, "csz", 0).unwrap(),
+            r.read_target_layer(&gpu, "motion", 0).unwrap(),
+        );
+        let (mut covered, mut accepted, mut mismatched, mut moved_history) = (0, 0, 0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let z = csz.pixel(x, y)[0];
+                if z <= 0.0 {
+                    continue;
+                }
+                covered += 1;
+                let m = glam::Vec3::from_slice(&motion.pixel(x, y)[..3]);
+                assert!(
+                    (m - slide).length() < 1e-4,
+                    "pixel ({x}, {y}): motion {m} for a slide of {slide}"
+                );
+                let mut p = strata_render::passes::ao::world_from_csz(&f, [x as f32 + 0.5, y as f32 + 0.5], z);
+                if object_motion {
+                    p -= m;
+                }
+                let rp = reproject(&f, p);
+                let (cur, got) = (e1.pixel(x, y)[0], out.pixel(x, y)[0]);
+                let want = match matching_layer(&csz0, rp, 0.01) {
+                    Some(_) => {
+                        accepted += 1;
+                        let (c, _) = rp.unwrap();
+                        let h = bilinear_at(&e0, c, 0);
+                        moved_history += ((h - e0.pixel(x, y)[0]).abs() > 1e-3) as usize;
+                        (1.0 - alpha) * cur + alpha * h
+                    }
+                    None => cur,
+                };
+                mismatched += ((got - want).abs() > 1e-4) as usize;
+            }
+        }
+        eprintln!(
+            "object motion {object_motion}: {accepted} of {covered} pixels accepted, {mismatched} differ from the twin, {moved_history} read a moved history"
+        );
+        assert!(covered > 3000, "weak test: {covered} pixels");
+        // reprojection at a 1 cm threshold: a handful may fall on the other side in f32
+        assert!(
+            mismatched * 200 <= covered,
+            "{mismatched} of {covered} pixels differ from the CPU twin"
+        );
+        if object_motion {
+            assert!(
+                moved_history > 300,
+                "weak test: {moved_history} histories read elsewhere"
+            );
+        }
+        accepted_by_mode.push(accepted as f32 / covered as f32);
+        // the same frame again: nothing moved since the last one drawn
+        r.render(&gpu, &scene, &still, 1.0).unwrap();
+        let motion = r.read_target_layer(&gpu, "motion", 0).unwrap();
+        assert!(motion.data.iter().all(|&v| v == 0.0), "motion without movement");
+    }
+    let (on, off) = (accepted_by_mode[0], accepted_by_mode[1]);
+    assert!(
+        on > 0.95,
+        "with object motion only {on} of the pixels keep their history"
+    );
+    assert!(
+        off < on - 0.3,
+        "the camera's motion alone accepts {off} (with object motion {on})"
+    );
+}
+
 /// A single-pass variant's first frame has no oracle, so its layer 1 (and the
 /// AO computed from it) is wrong; the next frame must not average it in.
 #[test]

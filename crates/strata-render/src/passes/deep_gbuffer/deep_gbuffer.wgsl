@@ -49,6 +49,8 @@ struct VsOut {
     @location(2) cam_z: f32,
     // REPROJECT: the vertex at t − 1 in t − 1's clip space (reverse reprojection)
     @location(3) prev_clip: vec4f,
+    // the vertex's world-space motion since t − 1, model·p − prev_model·p (0 when static)
+    @location(4) motion: vec3f,
 }
 
 fn is_predicted_view(view: u32) -> bool {
@@ -65,6 +67,9 @@ fn vertex(view: u32, position: vec3f, normal: vec3f, uv: vec2f) -> VsOut {
         o.clip = frame.view_proj * (object.model * p);
     }
     o.cam_z = o.clip.w;
+    // exact across the triangle: both transforms are affine, and world-space varyings
+    // interpolate perspective-correctly
+    o.motion = (object.model * p - object.prev_model * p).xyz;
     o.normal = (object.normal_matrix * vec4f(normal, 0.0)).xyz;
     o.uv = uv;
     if (ORACLE == ORACLE_REPROJECT) {
@@ -152,6 +157,9 @@ struct GBufferOut {
     @location(2) albedo: vec4f,
     // rgb = emitted radiance, a = 1 (2: glossy material)
     @location(3) emission: vec4f,
+    // rgb = world-space motion of the surface point since frame t − 1 (per-object
+    // velocities for the temporal filters' reverse reprojection, DGB §3.3)
+    @location(4) motion: vec4f,
 }
 
 // The shading function S of Listings 1–2: material properties. Double-sided:
@@ -178,6 +186,7 @@ fn shade(in: VsOut, front: bool) -> GBufferOut {
     o.albedo = vec4f(base.rgb, base.a);
     // a = 1, or 2 for a glossy material (ILS shades those with GGX)
     o.emission = vec4f(material.emission.rgb, 1.0 + material.flags.x);
+    o.motion = vec4f(in.motion, 0.0);
     return o;
 }
 

@@ -250,6 +250,12 @@ impl DeepGBufferSettings {
             desc("albedo", F::Rgba8UnormSrgb, l, "base colour, a = opacity"),
             desc("emission", F::Rgba16Float, l, "emitted radiance"),
             desc(
+                "motion",
+                F::Rgba16Float,
+                l,
+                "world-space motion of the surface since last frame (rgb; 0 = static): the temporal filters' per-object velocities",
+            ),
+            desc(
                 "zpack",
                 F::Rg32Float,
                 1,
@@ -426,7 +432,7 @@ pub fn geometry_passes(
             constants: &constants,
             ..Default::default()
         };
-        let color_targets = crate::passes::color_targets(&settings.outputs()[1..5]);
+        let color_targets = crate::passes::color_targets(&settings.outputs()[1..6]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(name),
             layout: Some(&layout),
@@ -563,14 +569,14 @@ impl Pass for GeometryPass {
         PassInfo {
             name: self.name,
             inputs: self.inputs.clone(),
-            outputs: vec!["depth", "csz", "normal", "albedo", "emission"],
+            outputs: vec!["depth", "csz", "normal", "albedo", "emission", "motion"],
         }
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         // Multiview: exactly layers first..first + views (a mask narrower than the
         // attachment would need SELECTIVE_MULTIVIEW).
-        let names = ["csz", "normal", "albedo", "emission", "depth"];
+        let names = ["csz", "normal", "albedo", "emission", "motion", "depth"];
         let owned: Vec<Option<wgpu::TextureView>> = names
             .iter()
             .map(|n| {
@@ -597,7 +603,13 @@ impl Pass for GeometryPass {
         let color = |name: &str| crate::passes::clear_attachment(view(name));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(self.name),
-            color_attachments: &[color("csz"), color("normal"), color("albedo"), color("emission")],
+            color_attachments: &[
+                color("csz"),
+                color("normal"),
+                color("albedo"),
+                color("emission"),
+                color("motion"),
+            ],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: view("depth"),
                 depth_ops: Some(wgpu::Operations {

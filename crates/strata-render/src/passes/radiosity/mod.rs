@@ -716,6 +716,9 @@ pub struct PropagateUniforms {
     pub max_distance: f32,
     pub has_history: u32,
     pub boost: u32,
+    /// 1 = [`TemporalSettings::object_motion`].
+    pub motion: u32,
+    pub _pad: [u32; 3],
 }
 
 /// The radiosity inputs of this frame's gather (§3.3): `bounce0`/`bounce1` =
@@ -747,13 +750,15 @@ impl PropagatePass {
         targets: &Targets,
         layers: u32,
         s: &RadiositySettings,
-        max_distance: f32,
+        temporal: &TemporalSettings,
     ) -> Self {
         let settings = PropagateUniforms {
             delta: s.delta,
-            max_distance,
+            max_distance: temporal.max_distance,
             has_history: 0,
             boost: s.boost as u32,
+            motion: temporal.object_motion as u32,
+            _pad: [0; 3],
         };
         // one layer: layer 0's buffers fill layer 1's bindings
         let (direct1, e1) = if layers > 1 {
@@ -773,7 +778,8 @@ impl PropagatePass {
             .read(direct1)
             .read_array("csz-history")
             .read("indirect-history")
-            .read(e1);
+            .read(e1)
+            .read_array("motion");
         for t in &BOUNCE_OUTPUTS {
             b = b.write(t.name);
         }

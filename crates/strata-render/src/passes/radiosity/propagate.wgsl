@@ -17,6 +17,11 @@ struct Propagate {
     max_distance: f32,
     has_history: u32,
     boost: u32,
+    // 1 = per-object velocities (`TemporalSettings::object_motion`)
+    motion: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -30,6 +35,8 @@ struct Propagate {
 // last frame's final E of layer 0 and E of layer 1
 @group(1) @binding(7) var e0_history: texture_2d<f32>;
 @group(1) @binding(8) var e1_history: texture_2d<f32>;
+// each layer's world-space motion since last frame (the deep G-buffer's `motion`)
+@group(1) @binding(9) var motion: texture_2d_array<f32>;
 
 struct Out {
     @location(0) b0: vec4f,
@@ -41,7 +48,11 @@ fn bounce_input(p: vec2i, j: i32, direct: vec3f) -> vec3f {
     if (z <= 0.0 || prop.has_history == 0u || prop.delta <= 0.0) {
         return direct;
     }
-    let r = reproject(frame, world_from_csz(frame, vec2f(p) + 0.5, z));
+    var x = world_from_csz(frame, vec2f(p) + 0.5, z);
+    if (prop.motion != 0u) {
+        x -= textureLoad(motion, p, j, 0).xyz;
+    }
+    let r = reproject(frame, x);
     let l = matching_layer(csz_history, r, LAYERS, prop.max_distance);
     if (l < 0) {
         return direct;

@@ -82,8 +82,9 @@ impl RadiosityStage {
             ] {
                 targets.create(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc));
             }
-            let d = s.temporal.unwrap_or_default().max_distance;
-            crate::passes::radiosity::PropagatePass::new(gpu, scene, targets, deep.layers, s, d)
+            // the indirect filter's reprojection rule (its default when the filter is off)
+            let t = s.temporal.unwrap_or_default();
+            crate::passes::radiosity::PropagatePass::new(gpu, scene, targets, deep.layers, s, &t)
         });
         let b = if propagate.is_some() {
             ["bounce0", "bounce1"]

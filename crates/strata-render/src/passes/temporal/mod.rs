@@ -3,10 +3,12 @@
 //! rejection of failed reprojections. The pass's output is kept as
 //! `<output>-history` by a [`HistoryPass`](crate::passes::HistoryPass).
 
-use crate::frame::Targets;
+use crate::frame::{FrameUniforms, Targets};
 use crate::gpu::GpuContext;
 use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
+use glam::{Mat4, Vec3};
+use strata_scene::ImageBuf;
 
 /// Defaults: α = 0.85 (the paper's recommendation); reprojection accepted when
 /// the point lies within 0.01 scene units of either layer (the paper's 1 cm, with
@@ -33,6 +35,13 @@ pub struct TemporalSettings {
     /// over. Off: α from the first frame, so the oldest frame keeps weight α^n (not in
     /// the paper).
     pub ramp: bool,
+    /// Reproject with per-object velocities: the surface point moves back by the deep
+    /// G-buffer's `motion` (x_t − x_{t−1} of its object) before the camera's reverse
+    /// reprojection, so a moving object finds its own history (DGB §3.3 reprojects "to
+    /// account for motion" and reads a failed test as "an incorrect velocity estimate").
+    /// Off: the camera's motion only, and a moving object's pixels fail the test (or,
+    /// moving within their own plane, read another point's history).
+    pub object_motion: bool,
 }
 
 impl Default for TemporalSettings {
@@ -42,6 +51,7 @@ impl Default for TemporalSettings {
             max_distance: 0.01,
             clamp_history: true,
             ramp: true,
+            object_motion: true,
         }
     }
 }
@@ -90,6 +100,9 @@ pub struct TemporalUniforms {
     pub has_history: u32,
     /// 1 = [`TemporalSettings::ramp`].
     pub ramp: u32,
+    /// 1 = [`TemporalSettings::object_motion`].
+    pub motion: u32,
+    pub _pad: u32,
 }
 
 /// Filters target `input` with `history` (last frame's `output`) into `output`.
@@ -125,6 +138,7 @@ impl TemporalPass {
             .read("zpack")
             .read_array("csz-history")
             .read(frames[1])
+            .read_layer("motion", 0)
             .write(output)
             .write(frames[0])
             .build();
@@ -139,6 +153,8 @@ impl TemporalPass {
             clamp: s.clamp_history as u32,
             has_history: has_history as u32,
             ramp: s.ramp as u32,
+            motion: s.object_motion as u32,
+            _pad: 0,
         }
     }
 
@@ -164,6 +180,67 @@ pub fn frames_targets(names: [&'static str; 2]) -> [crate::frame::TargetDesc; 2]
 }
 
 crate::passes::builder::delegate_pass!(TemporalPass);
+
+/// `reproject` in common/reproject.wgsl on the CPU: where world point `x` was seen in
+/// frame t − 1, as (pixel position, camera-space depth); `None` behind the old camera or
+/// outside its image.
+pub fn reproject(f: &FrameUniforms, x: Vec3) -> Option<([f32; 2], f32)> {
+    let clip = Mat4::from_cols_array_2d(&f.prev_view_proj) * x.extend(1.0);
+    if clip.w <= 0.0 {
+        return None;
+    }
+    let ndc = [clip.x / clip.w, clip.y / clip.w];
+    let c = [(ndc[0] * 0.5 + 0.5) * f.size[0], (0.5 - 0.5 * ndc[1]) * f.size[1]];
+    (c[0] >= 0.0 && c[1] >= 0.0 && c[0] < f.size[0] && c[1] < f.size[1]).then_some((c, clip.w))
+}
+
+/// The four texels around sub-pixel position `c` (clamped to `img`) and the bilinear
+/// weights' fractions, as reproject.wgsl's `depth_at` and `bilinear_at` take them.
+fn bilinear_taps(img: &ImageBuf, c: [f32; 2]) -> ([[u32; 2]; 4], [f32; 2]) {
+    let f = [c[0] - 0.5, c[1] - 0.5];
+    let i0 = [f[0].floor() as i64, f[1].floor() as i64];
+    let at = |dx: i64, dy: i64| {
+        [
+            (i0[0] + dx).clamp(0, img.width as i64 - 1) as u32,
+            (i0[1] + dy).clamp(0, img.height as i64 - 1) as u32,
+        ]
+    };
+    (
+        [at(0, 0), at(1, 0), at(0, 1), at(1, 1)],
+        [f[0] - f[0].floor(), f[1] - f[1].floor()],
+    )
+}
+
+/// `bilinear_at` in common/reproject.wgsl on the CPU: channel `ch` of `img` at sub-pixel
+/// position `c`, bilinear between texel centres.
+pub fn bilinear_at(img: &ImageBuf, c: [f32; 2], ch: usize) -> f32 {
+    let (q, t) = bilinear_taps(img, c);
+    let v = |i: usize| img.pixel(q[i][0], q[i][1])[ch];
+    let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
+    lerp(lerp(v(0), v(1), t[0]), lerp(v(2), v(3), t[0]), t[1])
+}
+
+/// `matching_layer` in common/reproject.wgsl on the CPU: which of last frame's layer
+/// depths `csz` (one image per layer) holds the reprojected point `r` within
+/// `max_distance` (1/z bilinear, the nearest texel where one of the four is empty).
+pub fn matching_layer(csz: &[ImageBuf], r: Option<([f32; 2], f32)>, max_distance: f32) -> Option<usize> {
+    let (c, z) = r?;
+    csz.iter().take(2).position(|img| {
+        let (q, t) = bilinear_taps(img, c);
+        let d = |i: usize| img.pixel(q[i][0], q[i][1])[0];
+        let zj = if (0..4).any(|i| d(i) <= 0.0) {
+            img.pixel(c[0].floor() as u32, c[1].floor() as u32)[0]
+        } else {
+            let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
+            1.0 / lerp(
+                lerp(1.0 / d(0), 1.0 / d(1), t[0]),
+                lerp(1.0 / d(2), 1.0 / d(3), t[0]),
+                t[1],
+            )
+        };
+        zj > 0.0 && (zj - z).abs() < max_distance
+    })
+}
 
 #[cfg(test)]
 mod tests {

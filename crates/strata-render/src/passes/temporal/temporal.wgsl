@@ -19,6 +19,9 @@ struct Temporal {
     // 1 = the start-up ramp: the history's weight is min(α, n/(n + 1)) where it has
     // been accepted n frames in a row (`TemporalSettings::history_weight`)
     ramp: u32,
+    // 1 = per-object velocities: move the point back by `motion` before reprojecting
+    motion: u32,
+    pad: u32,
 }
 
 struct Out {
@@ -38,6 +41,8 @@ const MAX_FRAMES: f32 = 1024.0;
 @group(1) @binding(4) var csz_history: texture_2d_array<f32>;
 // last frame's per-pixel count (`frames` output)
 @group(1) @binding(5) var frames_history: texture_2d<f32>;
+// layer 0's world-space motion since last frame (the deep G-buffer's `motion`)
+@group(1) @binding(6) var motion: texture_2d<f32>;
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> Out {
@@ -48,9 +53,14 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     if (temporal.has_history == 0u || z <= 0.0) {
         return o;
     }
-    // reverse reprojection of X = layer 0's surface into frame t − 1; accept
-    // when it lies on either layer of last frame
-    let r = reproject(frame, world_from_csz(frame, vec2f(p) + 0.5, z));
+    // reverse reprojection of X = layer 0's surface into frame t − 1 (where its object
+    // held it then, with per-object motion); accept when it lies on either layer of last
+    // frame
+    var x = world_from_csz(frame, vec2f(p) + 0.5, z);
+    if (temporal.motion != 0u) {
+        x -= textureLoad(motion, p, 0).xyz;
+    }
+    let r = reproject(frame, x);
     if (matching_layer(csz_history, r, temporal.layers, temporal.max_distance) < 0) {
         return o;
     }
