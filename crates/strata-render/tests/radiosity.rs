@@ -530,6 +530,103 @@ fn mean_indirect_per_frame(gpu: &GpuContext, scene: &Scene, rs: RadiositySetting
         .collect()
 }
 
+/// The progressive bounce (§3.3) reprojects with per-object velocities: the whole Cornell
+/// box slides 6 cm towards the still camera between two frames. Each layer's bounce input
+/// must equal direct + δ·ρ/π·E_{t−1} read where the point, moved back by its `motion`,
+/// lands on last frame's layers (the CPU twin of reproject.wgsl), and the direct light
+/// alone where it does not. With the camera's motion only, the walls facing the camera
+/// lose their bounce for that frame.
+#[test]
+fn propagation_follows_moving_objects_with_their_motion() {
+    use strata_render::passes::temporal::{bilinear_at, matching_layer, reproject};
+    let gpu = common::gpu();
+    let mut scene = frozen("cornell");
+    let cam = scene.camera;
+    let slide = (cam.target - cam.eye).normalize() * -0.06;
+    for o in &mut scene.objects {
+        o.animation = Some(strata_scene::Animation::Slide {
+            amplitude: slide,
+            period_frames: 4.0,
+        });
+    }
+    let (w, h) = (64, 64);
+    let delta = 0.9;
+    let still = FrameCameras::fixed(cam);
+    let mut kept = Vec::new();
+    for object_motion in [true, false] {
+        let mut rs = box_settings(delta);
+        rs.temporal = Some(strata_render::passes::temporal::TemporalSettings {
+            object_motion,
+            ..strata_render::passes::radiosity::indirect_temporal()
+        });
+        let mut r = renderer(&gpu, &scene, w, h, 2, rs);
+        r.render(&gpu, &scene, &still, 0.0).unwrap();
+        let e_prev = [
+            r.read_target(&gpu, "indirect-history").unwrap(),
+            r.read_target(&gpu, "indirect1-history").unwrap(),
+        ];
+        let csz0: Vec<ImageBuf> = (0..2).map(|j| r.read_target_layer(&gpu, "csz", j).unwrap()).collect();
+        r.render(&gpu, &scene, &still, 1.0).unwrap();
+        let f = r.frame_uniforms();
+        let (mut covered, mut accepted, mut mismatched) = (0, 0, 0);
+        for (layer, (direct, bounce)) in [("radiosity0", "bounce0"), ("radiosity1", "bounce1")]
+            .into_iter()
+            .enumerate()
+        {
+            let read = |name: &str| r.read_target_layer(&gpu, name, layer as u32).unwrap();
+            let (csz, motion, albedo, normal) = (read("csz"), read("motion"), read("albedo"), read("normal"));
+            let (direct, bounce) = (
+                r.read_target(&gpu, direct).unwrap(),
+                r.read_target(&gpu, bounce).unwrap(),
+            );
+            for y in 0..h {
+                for x in 0..w {
+                    let z = csz.pixel(x, y)[0];
+                    if z <= 0.0 {
+                        continue;
+                    }
+                    covered += 1;
+                    let m = Vec3::from_slice(&motion.pixel(x, y)[..3]);
+                    assert!((m - slide).length() < 1e-4, "layer {layer} ({x}, {y}): motion {m}");
+                    let mut p = strata_render::passes::ao::world_from_csz(&f, [x as f32 + 0.5, y as f32 + 0.5], z);
+                    if object_motion {
+                        p -= m;
+                    }
+                    let rp = reproject(&f, p);
+                    let rho = 1.0 - normal.pixel(x, y)[3];
+                    for c in 0..3 {
+                        let mut want = direct.pixel(x, y)[c];
+                        if let Some(l) = matching_layer(&csz0, rp, 0.01) {
+                            let e = bilinear_at(&e_prev[l], rp.unwrap().0, c);
+                            want += delta * albedo.pixel(x, y)[c] * rho / std::f32::consts::PI * e;
+                            accepted += (c == 0) as usize;
+                        }
+                        // bounce and direct are R11G11B10F: 6 mantissa bits
+                        let got = bounce.pixel(x, y)[c];
+                        mismatched += ((got - want).abs() > 0.02 * want.abs() + 1e-4) as usize;
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "object motion {object_motion}: {accepted} of {covered} receivers kept their bounce, {mismatched} channels differ from the twin"
+        );
+        assert!(covered > 4000, "weak test: {covered} receivers");
+        assert!(
+            mismatched * 200 <= 3 * covered,
+            "{mismatched} channels differ from the CPU twin"
+        );
+        kept.push(accepted as f32 / covered as f32);
+    }
+    assert!(kept[0] > 0.9, "with object motion only {} keep their bounce", kept[0]);
+    assert!(
+        kept[1] < kept[0] - 0.3,
+        "the camera's motion alone keeps {} ({})",
+        kept[1],
+        kept[0]
+    );
+}
+
 /// §3.3 progressive bounces with boost = 1 and δ = 1 in a closed box: each
 /// frame adds one bounce. The bounce operator is linear, so the per-bounce
 /// ratio must equal ρ · g, where g = E/(πL) is the gather's response to a
