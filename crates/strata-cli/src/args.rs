@@ -507,7 +507,7 @@ pub struct EvalArgs {
     pub radiosity: RadiosityArgs,
     /// Cap on the CPU reference's samples per pixel, 2..=65536 (default 32768). The reference
     /// integrates until --ref-noise is met or this cap is reached.
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=65536))]
     pub ref_spp: Option<u32>,
     /// Noise target of the CPU reference, in [0, 1): ꟻLIP between its two independent halves
     /// (0: integrate to the --ref-spp cap). Converged references are cached.
@@ -647,6 +647,64 @@ pub struct FrameArgs {
     pub no_probes: bool,
     #[command(flatten)]
     pub set: SetArgs,
+    /// The ids of the flags given on the command line (not defaulted), filled after parsing:
+    /// `render` refuses those its technique does not read ([`FrameArgs::refuse_unread`]).
+    #[arg(skip)]
+    pub given: Vec<String>,
+}
+
+impl FrameArgs {
+    /// A one-line error for the first flag given on the command line that `settings` (the
+    /// technique's, resolved) does not read: the AO flags without the deep-G-buffer AO (the
+    /// radius, bias and intensity carry over to `aba-ao` and the radius and bias to `bzb-ao`),
+    /// the radiosity flags and `--no-probes` without the radiosity, and `--variant` without a
+    /// second layer. `eval` refuses its own in the same way.
+    pub fn refuse_unread(&self, settings: &strata_render::RenderSettings) -> anyhow::Result<()> {
+        let longs = |c: clap::Command| -> Vec<(String, String)> {
+            c.get_arguments()
+                .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?.to_string())))
+                .collect()
+        };
+        let aba_ao = settings.abuffer.as_ref().is_some_and(|a| a.ao.is_some());
+        let dgb_ao = settings.ao.is_some();
+        let radiosity = settings.radiosity.is_some();
+        // (flag id, its long name, whether the technique reads it, what it belongs to)
+        let mut flags: Vec<(String, String, bool, &str)> = Vec::new();
+        for (id, long) in longs(<AoArgs as Args>::augment_args(clap::Command::new("ao"))) {
+            let read = match id.as_str() {
+                "ao_radius" | "ao_bias" => dgb_ao || aba_ao || settings.bzb.is_some(),
+                "ao_intensity" => dgb_ao || aba_ao,
+                _ => dgb_ao,
+            };
+            flags.push((id, long, read, "the deep-G-buffer AO"));
+        }
+        for (id, long) in longs(<RadiosityArgs as Args>::augment_args(clap::Command::new("radiosity"))) {
+            // --preset is checked against the technique's presets (`Technique::settings`)
+            if id != "preset" {
+                flags.push((id, long, radiosity, "the deep-G-buffer radiosity"));
+            }
+        }
+        flags.push((
+            "no_probes".into(),
+            "no-probes".into(),
+            radiosity,
+            "the deep-G-buffer radiosity",
+        ));
+        flags.push((
+            "variant".into(),
+            "variant".into(),
+            settings.deep.layers >= 2,
+            "a second deep-G-buffer layer (--layers 2 or more)",
+        ));
+        let given = |id: &str| self.given.iter().any(|g| g == id);
+        if let Some((_, long, _, what)) = flags.iter().find(|f| !f.2 && given(&f.0)) {
+            anyhow::bail!(
+                "--{long} is not read by --technique {}: it runs without {what} (`strata techniques` lists what each technique runs)",
+                self.technique.name
+            );
+        }
+        Ok(())
+    }
 }
 
 #[derive(Args)]
@@ -708,7 +766,7 @@ pub struct ReferenceArgs {
     #[arg(long)]
     pub ao_radius: Option<f32>,
     /// Samples per pixel, 1..=65536.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub spp: u32,
     /// Indirect bounces for gi/indirect, 0..=64.
     #[arg(long, default_value_t = 3)]

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use serde_json::json;
-use strata_eval::files::check_output;
+use strata_eval::files::check_output_for;
 use strata_eval::metrics::{compare, compare_radiance};
 use strata_scene::ImageBuf;
 
@@ -62,7 +62,7 @@ pub fn run(a: &CompareArgs) -> Result<()> {
         }
     }
     if let Some(m) = &a.map {
-        check_output(m, a.force)?;
+        check_output_for("--map", m, a.force)?;
     }
     let reference = load_rgb(&a.reference)?;
     let test = load_rgb(&a.test)?;

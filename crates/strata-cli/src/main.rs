@@ -15,7 +15,7 @@ mod soak;
 mod techniques;
 mod view;
 
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 
 fn main() {
     // Output piped into `head` and closed early: end quietly like other command-line
@@ -39,17 +39,24 @@ fn main() {
         eprintln!("strata: interrupted: no output was written");
         std::process::exit(130);
     });
-    let cli = match args::Cli::try_parse() {
-        Ok(c) => c,
+    let parsed = args::Cli::command()
+        .try_get_matches()
+        .and_then(|m| args::Cli::from_arg_matches(&m).map(|c| (c, m)));
+    let cli = match parsed {
+        Ok((mut c, m)) => {
+            // which flags `render` was given, not defaulted (`FrameArgs::refuse_unread`)
+            if let (args::Command::Render(a), Some((_, sub))) = (&mut c.command, m.subcommand()) {
+                a.frame.given = sub
+                    .ids()
+                    .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
+                    .map(|id| id.to_string())
+                    .collect();
+            }
+            c
+        }
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version
         Err(e) => {
-            // One line like every other error: clap's first line names the flag and the valid values.
-            let text = e.render().to_string();
-            let first = text
-                .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("invalid arguments");
-            eprintln!("strata: {}", first.trim_start_matches("error: ").trim());
+            eprintln!("strata: {}", one_line(&e.render().to_string()));
             std::process::exit(2);
         }
     };
@@ -71,5 +78,47 @@ fn main() {
         let msg = format!("{e:#}").replace('\n', " ");
         eprintln!("strata: error: {msg}");
         std::process::exit(1);
+    }
+}
+
+/// A clap error on one line, like every other error: its first line, then what follows it
+/// up to the usage (the missing flags, `[possible values: …]`, a tip naming a similar flag).
+fn one_line(text: &str) -> String {
+    let mut lines = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .map(str::trim)
+        .filter(|l| !l.is_empty());
+    let first = lines
+        .next()
+        .unwrap_or("invalid arguments")
+        .trim_start_matches("error: ")
+        .to_string();
+    let rest: Vec<&str> = lines.collect();
+    match (rest.is_empty(), first.ends_with(':')) {
+        (true, _) => first,
+        // a list: "the following required arguments were not provided: --kind <KIND>, --out <OUT>"
+        (false, true) => format!("{first} {}", rest.join(", ")),
+        (false, false) => format!("{first}; {}", rest.join("; ")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::one_line;
+
+    #[test]
+    fn clap_errors_keep_the_flags_and_values_on_one_line() {
+        let missing = "error: the following required arguments were not provided:\n  --kind <KIND>\n  --out <OUT>\n\nUsage: strata reference --kind <KIND> --out <OUT>\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            one_line(missing),
+            "the following required arguments were not provided: --kind <KIND>, --out <OUT>"
+        );
+        let value = "error: invalid value 'foo' for '--kind <KIND>'\n  [possible values: ao, gi]\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            one_line(value),
+            "invalid value 'foo' for '--kind <KIND>'; [possible values: ao, gi]"
+        );
+        assert_eq!(one_line(""), "invalid arguments");
     }
 }

@@ -17,9 +17,6 @@ pub fn run(a: &ReferenceArgs) -> Result<()> {
     let (scene, cams) = scene_and_camera(&a.scene)?;
     let camera = cams.current;
     let (w, h) = (a.scene.width, a.scene.height);
-    if !(1..=65536).contains(&a.spp) {
-        bail!("--spp {} is out of range: must be in 1..=65536", a.spp);
-    }
     if a.bounces > 64 {
         bail!("--bounces {} is out of range: must be in 0..=64", a.bounces);
     }

@@ -66,6 +66,7 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
 pub fn run(a: &RenderArgs) -> Result<()> {
     let f = &a.frame;
     let (scene, cams, settings) = prepare(f)?;
+    f.refuse_unread(&settings)?;
     if a.list_lights {
         print_lights(&scene, &settings.shadow);
         return Ok(());
@@ -129,11 +130,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if let Some(a) = r.abuffer() {
         let lists = a.read_lists(&gpu)?;
         if lists.overflow > 0 {
+            let room = match a.settings().slots() {
+                0 => format!("pool {} nodes", a.pool()),
+                k => format!("{k} slots per pixel"),
+            };
             eprintln!(
-                "A-buffer: dropped {} of {} fragments (pool {} nodes; raise --set pool=N or max-layers=K)",
+                "A-buffer: dropped {} of {} fragments ({room}; {})",
                 lists.overflow,
                 lists.total,
-                a.pool()
+                a.settings().overflow_hint()
             );
         }
     }

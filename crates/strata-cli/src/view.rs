@@ -95,7 +95,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
             if !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")) {
                 bail!("{flag} {}: use a .png file name", p.display());
             }
-            strata_eval::files::check_output(p, a.force).map_err(|e| anyhow::anyhow!("{flag}: {e:#}"))?;
+            strata_eval::files::check_output_for(flag, p, a.force)?;
         }
     }
     let script = match &a.script {

@@ -94,6 +94,94 @@ fn out_of_range_width_names_flag_and_range() {
     assert!(!out.exists());
 }
 
+/// Flags the chosen technique does not read are refused, not ignored (the CLI sweep of
+/// 2026-11-29 found `render` accepting them silently), while the same flags with a technique
+/// that reads them render.
+#[test]
+fn render_refuses_flags_its_technique_does_not_read() {
+    let out = scratch("unread.png");
+    let o = out.to_str().unwrap();
+    let base = [
+        "render", "--scene", "plane", "--width", "32", "--height", "18", "--out", o, "--force",
+    ];
+    for (extra, needles) in [
+        (
+            &["--technique", "direct", "--samples", "5"][..],
+            &["--samples", "direct", "AO"][..],
+        ),
+        (
+            &["--technique", "ao", "--indirect-samples", "5"][..],
+            &["--indirect-samples", "ao", "radiosity"][..],
+        ),
+        (
+            &["--technique", "direct", "--no-probes"][..],
+            &["--no-probes", "direct"][..],
+        ),
+        (
+            &["--technique", "ao", "--variant", "peel"][..],
+            &["--variant", "ao"][..],
+        ),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra).copied().collect();
+        assert_one_line_error(&strata(&args), needles);
+        assert!(!out.exists(), "{extra:?} wrote an image");
+    }
+    let args: Vec<&str> = base
+        .iter()
+        .chain(&[
+            "--technique",
+            "ao",
+            "--samples",
+            "5",
+            "--layers",
+            "2",
+            "--variant",
+            "peel",
+        ])
+        .copied()
+        .collect();
+    let o = strata(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// clap's own errors keep, on their one line, the flags they miss and the values they accept;
+/// a folder where the output file goes is refused before anything is rendered.
+#[test]
+fn argument_errors_name_flags_values_and_folders_on_one_line() {
+    let o = strata(&["reference", "--scene", "plane"]);
+    assert_one_line_error(&o, &["--kind", "--out"]);
+    let o = strata(&["reference", "--scene", "plane", "--kind", "foo", "--out", "x.exr"]);
+    assert_one_line_error(&o, &["--kind", "obscurance"]);
+    let o = strata(&[
+        "reference",
+        "--scene",
+        "plane",
+        "--kind",
+        "ao",
+        "--spp",
+        "99999999999",
+        "--out",
+        "x.exr",
+    ]);
+    assert_one_line_error(&o, &["--spp", "1..=65536"]);
+    let dir = scratch("a-folder.png");
+    std::fs::create_dir_all(&dir).unwrap();
+    let o = strata(&[
+        "render",
+        "--scene",
+        "plane",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--out",
+        dir.to_str().unwrap(),
+        "--force",
+    ]);
+    assert_one_line_error(&o, &["--out", "folder"]);
+    assert!(dir.is_dir());
+}
+
 #[test]
 fn out_of_range_fov_names_flag_and_range() {
     let out = scratch("fov.png");

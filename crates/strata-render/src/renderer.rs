@@ -247,6 +247,17 @@ impl RenderSettings {
                     "guard band {g} px is out of range: must be at most {} px",
                     (MAX_SIZE - 8) / 2
                 )
+            } else if let GuardBand::Fraction(f) = self.guard_band {
+                // the band grows with the height: the tallest image whose band still fits
+                let h_max = (8..=MAX_SIZE)
+                    .rev()
+                    .find(|&h| h + 2 * self.guard_band.pixels(h) <= MAX_SIZE)
+                    .unwrap_or(8);
+                format!(
+                    "guard band {g} px ({}% of the height) makes the rendered size {w}x{h}: must stay within {MAX_SIZE} (with this guard band the height must be in 8..={h_max} and, at height {}, the width in 8..={fits}; or set the guard band to 0)",
+                    f * 100.0,
+                    self.height
+                )
             } else {
                 format!(
                     "guard band {g} px makes the rendered size {w}x{h}: must stay within {MAX_SIZE} (with this guard band width and height must be in 8..={fits}, or set the guard band to 0)"

@@ -12,7 +12,7 @@ use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::ImageBuf;
 
 use super::{bench_run, check_frames, timing_gpu};
-use crate::files::{check_output, save};
+use crate::files::{check_output_for, save};
 use crate::results::{DeepBench, DeepRow};
 use crate::scene::SceneSpec;
 use crate::stats::median_min;
@@ -56,9 +56,9 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
     let (scene, _) = a.scene.load()?;
     if let Some(dir) = &a.images {
         for m in Variant::ALL {
-            check_output(&dir.join(format!("{m}-layer1.png")), a.force)?;
+            check_output_for("--images", &dir.join(format!("{m}-layer1.png")), a.force)?;
             if m != Variant::Peel {
-                check_output(&dir.join(format!("{m}-diff.png")), a.force)?;
+                check_output_for("--images", &dir.join(format!("{m}-diff.png")), a.force)?;
             }
         }
     }

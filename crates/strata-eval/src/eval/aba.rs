@@ -69,13 +69,12 @@ pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Resu
     let refs = (&ref_obscurance, &ref_binary);
     // dropped fragments, if any: the lists were too small for the scene
     let dropped = |r: &strata_render::Renderer| -> Result<String> {
-        let overflow = r
-            .abuffer()
-            .map(|a| a.read_lists(&gpu))
-            .transpose()?
-            .map_or(0, |l| l.overflow);
+        let Some(a) = r.abuffer() else {
+            return Ok(String::new());
+        };
+        let overflow = a.read_lists(&gpu)?.overflow;
         Ok(if overflow > 0 {
-            format!(" ({overflow} fragments dropped: raise --set pool=N)")
+            format!(" ({overflow} fragments dropped: {})", a.settings().overflow_hint())
         } else {
             String::new()
         })

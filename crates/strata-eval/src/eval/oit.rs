@@ -59,8 +59,10 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<OitEval> {
     let mut warnings = Vec::new();
     if lists.overflow > 0 {
         let w = format!(
-            "the A-buffer dropped {} of {} fragments (raise --set pool=N or max-layers=K): the error includes them",
-            lists.overflow, lists.total
+            "the A-buffer dropped {} of {} fragments ({}): the error includes them",
+            lists.overflow,
+            lists.total,
+            a.overflow_hint()
         );
         eprintln!("warning: {w}");
         warnings.push(w);

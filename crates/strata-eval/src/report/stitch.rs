@@ -56,9 +56,7 @@ pub fn stitch(s: &StitchSettings) -> Result<PathBuf> {
     if !s.from.is_dir() {
         bail!("--from {}: not a folder", s.from.display());
     }
-    if s.out.exists() && !s.force {
-        bail!("--out {}: file exists; pass --force to overwrite it", s.out.display());
-    }
+    crate::files::refuse_existing("--out", &s.out, s.force)?;
     let out_dir = s
         .out
         .parent()

@@ -236,6 +236,16 @@ impl ABufferSettings {
             .unwrap_or_else(|| (w as u64 * h as u64 * DEFAULT_POOL_PER_PIXEL as u64).min(MAX_POOL as u64) as u32)
     }
 
+    /// What to raise when fragments were dropped: the pool (and the per-pixel cap) of the
+    /// pooled methods, the per-pixel slots of the fixed ones.
+    pub fn overflow_hint(&self) -> &'static str {
+        if self.slots() > 0 {
+            "raise --set max-layers=K"
+        } else {
+            "raise --set pool=N or max-layers=K"
+        }
+    }
+
     /// Node slots per pixel: K (fixed array), 2·⌈L/2⌉ (dual peel), 0 (pooled methods).
     pub fn slots(&self) -> u32 {
         match self.method {
