@@ -648,18 +648,20 @@ pub struct FrameArgs {
     #[command(flatten)]
     pub set: SetArgs,
     /// The ids of the flags given on the command line (not defaulted), filled after parsing:
-    /// `render` refuses those its technique does not read ([`FrameArgs::refuse_unread`]).
+    /// `render` warns of those its technique does not read ([`FrameArgs::unread_flags`]).
     #[arg(skip)]
     pub given: Vec<String>,
 }
 
 impl FrameArgs {
-    /// A one-line error for the first flag given on the command line that `settings` (the
-    /// technique's, resolved) does not read: the AO flags without the deep-G-buffer AO (the
+    /// One line per flag given on the command line that `settings` (the technique's,
+    /// resolved) does not read: the AO flags without the deep-G-buffer AO (the
     /// radius, bias and intensity carry over to `aba-ao` and the radius and bias to `bzb-ao`),
     /// the radiosity flags and `--no-probes` without the radiosity, and `--variant` without a
-    /// second layer. `eval` refuses its own in the same way.
-    pub fn refuse_unread(&self, settings: &strata_render::RenderSettings) -> anyhow::Result<()> {
+    /// second layer. `render` prints them as warnings and renders: the command `strata view`
+    /// prints for a frame keeps the flags given to it across technique switches. (`eval`
+    /// refuses the flags of its own that a comparison does not read.)
+    pub fn unread_flags(&self, settings: &strata_render::RenderSettings) -> Vec<String> {
         let longs = |c: clap::Command| -> Vec<(String, String)> {
             c.get_arguments()
                 .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?.to_string())))
@@ -697,13 +699,16 @@ impl FrameArgs {
             "a second deep-G-buffer layer (--layers 2 or more)",
         ));
         let given = |id: &str| self.given.iter().any(|g| g == id);
-        if let Some((_, long, _, what)) = flags.iter().find(|f| !f.2 && given(&f.0)) {
-            anyhow::bail!(
-                "--{long} is not read by --technique {}: it runs without {what} (`strata techniques` lists what each technique runs)",
-                self.technique.name
-            );
-        }
-        Ok(())
+        flags
+            .iter()
+            .filter(|f| !f.2 && given(&f.0))
+            .map(|(_, long, _, what)| {
+                format!(
+                    "--{long} is not read by --technique {}: it runs without {what}",
+                    self.technique.name
+                )
+            })
+            .collect()
     }
 }
 

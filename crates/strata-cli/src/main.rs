@@ -44,7 +44,7 @@ fn main() {
         .and_then(|m| args::Cli::from_arg_matches(&m).map(|c| (c, m)));
     let cli = match parsed {
         Ok((mut c, m)) => {
-            // which flags `render` was given, not defaulted (`FrameArgs::refuse_unread`)
+            // which flags `render` was given, not defaulted (`FrameArgs::unread_flags`)
             if let (args::Command::Render(a), Some((_, sub))) = (&mut c.command, m.subcommand()) {
                 a.frame.given = sub
                     .ids()
@@ -83,7 +83,7 @@ fn main() {
 
 /// A clap error on one line, like every other error: its first line, then what follows it
 /// up to the usage (the missing flags, `[possible values: …]`, a tip naming a similar flag).
-fn one_line(text: &str) -> String {
+pub(crate) fn one_line(text: &str) -> String {
     let mut lines = text
         .lines()
         .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))

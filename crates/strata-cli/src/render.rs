@@ -66,7 +66,9 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
 pub fn run(a: &RenderArgs) -> Result<()> {
     let f = &a.frame;
     let (scene, cams, settings) = prepare(f)?;
-    f.refuse_unread(&settings)?;
+    for w in f.unread_flags(&settings) {
+        eprintln!("strata: warning: {w}");
+    }
     if a.list_lights {
         print_lights(&scene, &settings.shadow);
         return Ok(());

@@ -73,13 +73,7 @@ fn passthrough(argv: &[String]) -> (Vec<String>, Option<String>) {
 }
 
 fn clap_line(e: clap::Error) -> String {
-    let text = e.render().to_string();
-    text.lines()
-        .find(|l| !l.trim().is_empty())
-        .unwrap_or("invalid arguments")
-        .trim_start_matches("error: ")
-        .trim()
-        .to_string()
+    crate::one_line(&e.render().to_string())
 }
 
 pub fn run(a: &ViewArgs) -> Result<()> {

@@ -53,14 +53,12 @@ impl RenderSpec {
         if let Some(p) = &self.preset {
             a.extend(["--preset".to_string(), p.clone()]);
         }
-        a.extend([
-            "--layers".to_string(),
-            self.layers.to_string(),
-            "--variant".to_string(),
-            self.variant.clone(),
-            "--guard-band".to_string(),
-            self.guard_band.clone(),
-        ]);
+        a.extend(["--layers".to_string(), self.layers.to_string()]);
+        // one layer has no second layer to build
+        if self.layers >= 2 {
+            a.extend(["--variant".to_string(), self.variant.clone()]);
+        }
+        a.extend(["--guard-band".to_string(), self.guard_band.clone()]);
         a.extend(self.extra.iter().cloned());
         for (n, v) in &self.sets {
             a.extend(["--set".to_string(), format!("{n}={v}")]);

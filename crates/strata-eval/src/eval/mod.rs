@@ -282,8 +282,9 @@ fn reproject(csz: &ImageBuf, av: &ImageBuf, px: f32, py: f32) -> Option<(f32, f3
 
 /// Temporal instability of channel 0 of target `target` rendered with `settings` along the
 /// camera path from `spec.frame` over `frames` frames: mean |v_t(p) − v_{t−1}(p′)| over pixels
-/// whose surface reprojects (p′ in frame t − 1, interpolated) onto the same surface within
-/// `threshold`, averaged over consecutive frame pairs.
+/// whose surface reprojects (p′ in frame t − 1, interpolated; moved back by its object's
+/// `motion` first) onto the same surface within `threshold`, averaged over consecutive frame
+/// pairs.
 pub fn flicker(
     gpu: &GpuContext,
     scene: &Scene,
@@ -307,6 +308,7 @@ pub fn flicker(
         r.render(gpu, scene, &cams, f)?;
         let av = r.read_target(gpu, target)?.channel(0);
         let csz = r.read_target(gpu, "csz")?;
+        let motion = r.read_target(gpu, "motion")?;
         if let Some((pcam, pav, pcsz)) = &prev {
             let vp = pcam.view_projection(w as f32 / h as f32);
             let (mut d, mut n) = (0.0f64, 0u64);
@@ -317,7 +319,10 @@ pub fn flicker(
                         continue;
                     }
                     counted += 1;
-                    let p = cams.current.eye + cams.current.pixel_dir(x, y, w, h) * z;
+                    // where the surface point was at t − 1 (a moving object's too)
+                    let m = motion.pixel(x, y);
+                    let p =
+                        cams.current.eye + cams.current.pixel_dir(x, y, w, h) * z - glam::Vec3::new(m[0], m[1], m[2]);
                     let clip = vp * p.extend(1.0);
                     if clip.w <= 0.0 {
                         continue;
