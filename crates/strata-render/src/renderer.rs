@@ -345,6 +345,9 @@ impl RenderSettings {
         let px = w as u64 * h as u64;
         let sum = |ds: &[TargetDesc]| ds.iter().map(|d| desc_bytes(d, w, h)).sum::<u64>();
         let mut bytes = sum(&self.deep.outputs());
+        if self.needs_motion() {
+            bytes += sum(&[self.deep.motion_target()]);
+        }
         if !self.deep.uses_history() {
             // csz-history, when only a temporal filter keeps it
             bytes += px * self.deep.array_layers() as u64 * 4;
@@ -469,6 +472,17 @@ impl RenderSettings {
     }
 
     /// Guard-band pixels per side.
+    /// Whether a pass reprojects last frame's values (a temporal filter, the multi-bounce
+    /// propagation), so the deep G-buffer writes its `motion` target.
+    pub fn needs_motion(&self) -> bool {
+        self.ao.as_ref().is_some_and(|a| a.temporal.is_some())
+            || self
+                .radiosity
+                .as_ref()
+                .is_some_and(|r| r.temporal.is_some() || r.delta > 0.0)
+            || self.bzb_gi.as_ref().is_some_and(|b| b.temporal.is_some())
+    }
+
     pub fn guard_pixels(&self) -> u32 {
         self.guard_band.pixels(self.height)
     }
@@ -531,6 +545,9 @@ impl Renderer {
         let mut targets = Targets::new(w, h);
         for d in settings.deep.outputs() {
             targets.create(gpu, d);
+        }
+        if settings.needs_motion() {
+            targets.create(gpu, settings.deep.motion_target());
         }
         if settings.shade {
             for d in lighting::OUTPUTS.iter().chain(tonemap::OUTPUTS) {
@@ -1141,7 +1158,9 @@ impl Renderer {
         v.extend(["roughness", "metallic"].iter().map(|s| s.to_string()));
         for j in 0..self.settings.deep.layers {
             for n in PER_LAYER_VIEWS {
-                v.push(format!("layer{j}-{n}"));
+                if n != "motion" || self.targets.try_get("motion").is_some() {
+                    v.push(format!("layer{j}-{n}"));
+                }
             }
         }
         if self.settings.deep.array_layers() > self.settings.deep.layers {

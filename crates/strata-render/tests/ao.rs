@@ -510,16 +510,8 @@ fn temporal_ramp_restarts_per_pixel_after_a_failed_reprojection() {
 fn temporal_filter_follows_moving_objects_with_their_motion() {
     use strata_render::passes::temporal::{bilinear_at, matching_layer, reproject};
     let gpu = common::gpu();
-    let mut scene = frozen("cornell");
+    let (scene, slide) = common::sliding_cornell(0.06);
     let cam = scene.camera;
-    let slide = (cam.target - cam.eye).normalize() * -0.06;
-    for o in &mut scene.objects {
-        // offset = slide · sin(2π frame / 4): 0 at frame 0, the whole slide at frame 1
-        o.animation = Some(strata_scene::Animation::Slide {
-            amplitude: slide,
-            period_frames: 4.0,
-        });
-    }
     let (w, h) = (64, 64);
     let alpha = 0.85;
     let still = FrameCameras::fixed(cam);

@@ -540,15 +540,8 @@ fn mean_indirect_per_frame(gpu: &GpuContext, scene: &Scene, rs: RadiositySetting
 fn propagation_follows_moving_objects_with_their_motion() {
     use strata_render::passes::temporal::{bilinear_at, matching_layer, reproject};
     let gpu = common::gpu();
-    let mut scene = frozen("cornell");
+    let (scene, slide) = common::sliding_cornell(0.06);
     let cam = scene.camera;
-    let slide = (cam.target - cam.eye).normalize() * -0.06;
-    for o in &mut scene.objects {
-        o.animation = Some(strata_scene::Animation::Slide {
-            amplitude: slide,
-            period_frames: 4.0,
-        });
-    }
     let (w, h) = (64, 64);
     let delta = 0.9;
     let still = FrameCameras::fixed(cam);

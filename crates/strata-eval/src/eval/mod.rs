@@ -308,7 +308,8 @@ pub fn flicker(
         r.render(gpu, scene, &cams, f)?;
         let av = r.read_target(gpu, target)?.channel(0);
         let csz = r.read_target(gpu, "csz")?;
-        let motion = r.read_target(gpu, "motion")?;
+        // without a reprojecting pass the G-buffer writes no motion: pixels pair by the camera alone
+        let motion = r.read_target(gpu, "motion").ok();
         if let Some((pcam, pav, pcsz)) = &prev {
             let vp = pcam.view_projection(w as f32 / h as f32);
             let (mut d, mut n) = (0.0f64, 0u64);
@@ -320,9 +321,10 @@ pub fn flicker(
                     }
                     counted += 1;
                     // where the surface point was at t − 1 (a moving object's too)
-                    let m = motion.pixel(x, y);
-                    let p =
-                        cams.current.eye + cams.current.pixel_dir(x, y, w, h) * z - glam::Vec3::new(m[0], m[1], m[2]);
+                    let m = motion
+                        .as_ref()
+                        .map_or(glam::Vec3::ZERO, |m| glam::Vec3::from_slice(&m.pixel(x, y)[..3]));
+                    let p = cams.current.eye + cams.current.pixel_dir(x, y, w, h) * z - m;
                     let clip = vp * p.extend(1.0);
                     if clip.w <= 0.0 {
                         continue;

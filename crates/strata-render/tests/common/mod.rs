@@ -56,6 +56,23 @@ use strata_render::frame::FrameCameras;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, Scene};
 
+/// The Cornell box without its camera path, sliding as a whole by `length` towards its
+/// still camera between frames 0 and 1 (offset = slide · sin(2π frame / 4)): every surface
+/// moves, and the walls facing the camera change depth. Returns the scene and the slide
+/// (per-object motion: `tests/ao.rs`, `tests/radiosity.rs`).
+pub fn sliding_cornell(length: f32) -> (Scene, glam::Vec3) {
+    let mut scene = strata_scene::procedural::builtin("cornell").unwrap();
+    scene.camera_path = None;
+    let slide = (scene.camera.target - scene.camera.eye).normalize() * -length;
+    for o in &mut scene.objects {
+        o.animation = Some(strata_scene::Animation::Slide {
+            amplitude: slide,
+            period_frames: 4.0,
+        });
+    }
+    (scene, slide)
+}
+
 /// Opens the GPU. Tests fail (never skip) without one: `scripts/test.sh` installs lavapipe.
 pub fn gpu() -> GpuContext {
     GpuContext::new(&GpuOptions::default()).expect("a Vulkan adapter (scripts/test.sh installs Mesa lavapipe)")

@@ -228,7 +228,19 @@ impl DeepGBufferSettings {
         self.layers >= 2 && self.variant.is_single_pass()
     }
 
-    /// The targets the deep G-buffer passes write.
+    /// The world-space motion of each layer's surface since the frame last drawn, which the
+    /// geometry passes also write where the renderer creates it (a temporal filter or the
+    /// multi-bounce propagation reprojects: `RenderSettings::needs_motion`).
+    pub fn motion_target(&self) -> TargetDesc {
+        TargetDesc::new(
+            "motion",
+            wgpu::TextureFormat::Rgba16Float,
+            self.array_layers(),
+            "world-space motion of the surface since last frame (rgb; 0 = static): the temporal filters' per-object velocities",
+        )
+    }
+
+    /// The targets the deep G-buffer passes write (and [`Self::motion_target`] where it exists).
     pub fn outputs(&self) -> Vec<TargetDesc> {
         let l = self.array_layers();
         let desc = TargetDesc::new;
@@ -249,12 +261,6 @@ impl DeepGBufferSettings {
             ),
             desc("albedo", F::Rgba8UnormSrgb, l, "base colour, a = opacity"),
             desc("emission", F::Rgba16Float, l, "emitted radiance"),
-            desc(
-                "motion",
-                F::Rgba16Float,
-                l,
-                "world-space motion of the surface since last frame (rgb; 0 = static): the temporal filters' per-object velocities",
-            ),
             desc(
                 "zpack",
                 F::Rg32Float,
@@ -327,6 +333,8 @@ pub struct GeometryPass {
     group: wgpu::BindGroup,
     params: wgpu::Buffer,
     inputs: Vec<&'static str>,
+    /// The `motion` target exists and this pass writes it.
+    motion: bool,
 }
 
 const PEEL_NAMES: [&str; 4] = ["gbuffer", "peel1", "peel2", "peel3"];
@@ -382,6 +390,7 @@ pub fn geometry_passes(
             ..Default::default()
         });
     let csz = targets.get("csz");
+    let motion = targets.try_get("motion").is_some();
     let make = |name: &'static str,
                 oracle: u32,
                 first_layer: u32,
@@ -432,7 +441,9 @@ pub fn geometry_passes(
             constants: &constants,
             ..Default::default()
         };
-        let color_targets = crate::passes::color_targets(&settings.outputs()[1..6]);
+        let mut color_targets = crate::passes::color_targets(&settings.outputs()[1..5]);
+        // location 4 (motion) is written only where the target exists
+        color_targets.push(motion.then(|| wgpu::ColorTargetState::from(settings.motion_target().format)));
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(name),
             layout: Some(&layout),
@@ -476,6 +487,7 @@ pub fn geometry_passes(
             group,
             params,
             inputs,
+            motion,
         }
     };
 
@@ -569,14 +581,22 @@ impl Pass for GeometryPass {
         PassInfo {
             name: self.name,
             inputs: self.inputs.clone(),
-            outputs: vec!["depth", "csz", "normal", "albedo", "emission", "motion"],
+            outputs: if self.motion {
+                vec!["depth", "csz", "normal", "albedo", "emission", "motion"]
+            } else {
+                vec!["depth", "csz", "normal", "albedo", "emission"]
+            },
         }
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         // Multiview: exactly layers first..first + views (a mask narrower than the
         // attachment would need SELECTIVE_MULTIVIEW).
-        let names = ["csz", "normal", "albedo", "emission", "motion", "depth"];
+        let names: &[&str] = if self.motion {
+            &["csz", "normal", "albedo", "emission", "motion", "depth"]
+        } else {
+            &["csz", "normal", "albedo", "emission", "depth"]
+        };
         let owned: Vec<Option<wgpu::TextureView>> = names
             .iter()
             .map(|n| {
@@ -608,7 +628,7 @@ impl Pass for GeometryPass {
                 color("normal"),
                 color("albedo"),
                 color("emission"),
-                color("motion"),
+                self.motion.then(|| color("motion")).flatten(),
             ],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: view("depth"),

@@ -124,7 +124,7 @@ impl VplShadowPass {
         let max_layers = device.limits().max_texture_array_layers;
         if layers > max_layers {
             return Err(RenderError::Parameter(format!(
-                "shadows vpl needs one shadow-map layer per VPL: {layers} VPLs, this device holds at most {max_layers} (set vpls to at most {max_layers}, or shadows to another method)"
+                "shadows vpl needs one shadow-map layer per VPL ({layers} VPLs): vpls must be in 1..={max_layers} on this device, or shadows another method"
             )));
         }
         let (w, h) = (3 * resolution, 2 * resolution);
