@@ -42,6 +42,7 @@ impl From<&EvalArgs> for EvalSettings {
             ref_spp: a.ref_spp,
             ref_noise: a.ref_noise,
             warmup: a.warmup,
+            moving: a.moving,
             cache: a.cache.clone().unwrap_or_else(RefCache::default_dir),
             no_cache: a.no_cache,
             frames: a.frames,

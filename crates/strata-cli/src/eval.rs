@@ -25,11 +25,16 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             ("--fig10", a.fig10),
             ("--no-probes", a.no_probes),
             ("--probes-from", a.probes_from.is_some() && !a.views),
-            ("--moving", a.moving),
         ];
         if let Some((flag, _)) = gi_only.iter().find(|f| f.1) {
             anyhow::bail!("{flag} is only read by eval --technique gi or full (the deep-G-buffer radiosity against the path tracer, without --views)");
         }
+    }
+    // the warm-up along the camera path: the deep-G-buffer comparisons with a temporal filter
+    let dgb_ao = a.technique.eval == EvalKind::AmbientVisibility && !is_bzb && !is_aba;
+    let dgb_gi = a.technique.eval == EvalKind::Radiance && !is_bzb_gi;
+    if a.moving && (a.views || !(dgb_ao || dgb_gi)) {
+        anyhow::bail!("--moving is only read by eval --technique gi, full or ao (the deep-G-buffer radiosity or AO along the camera path, without --views)");
     }
     if a.views {
         return views(a, &s);
@@ -115,7 +120,6 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 probes: !a.no_probes,
                 probes_from: a.probes_from.clone(),
                 probe_bake: a.radiosity.probe_bake(),
-                moving: a.moving,
             };
             EvalResult::Gi(gi::run(&s, &rs, &g)?)
         }

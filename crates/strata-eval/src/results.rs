@@ -346,6 +346,9 @@ pub struct EvalRun {
     /// What the reference computes, in words.
     pub reference: String,
     pub device: String,
+    /// The warm-up followed the camera path, objects moving (`--moving`: gi, ao).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub moving: bool,
     #[serde(flatten)]
     pub flicker: Option<Flicker>,
     /// Things the reader of the numbers must know (a reference that did not converge, an error
@@ -446,9 +449,6 @@ pub struct GiEval {
     /// Paths per probe of the bake (`--probe-rays`), when blended with probes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub probe_rays: Option<u32>,
-    /// The warm-up followed the camera path (`--moving`).
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub moving: bool,
     #[serde(flatten)]
     pub errors: GiErrors,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -661,6 +661,7 @@ mod tests {
             ref_spp: 16,
             reference: "obscurance".into(),
             device: "lavapipe".into(),
+            moving: false,
             flicker: None,
             warnings: vec![],
         }

@@ -276,6 +276,11 @@ pub(crate) fn render_frame(
     s: &EvalSettings,
     f: f32,
 ) -> Result<ImageBuf> {
+    if s.moving {
+        // camera and objects move through the warm-up: the temporal filter reprojects
+        super::render_along_path(r, gpu, scene, s, f)?;
+        return Ok(r.read_target(gpu, "ao")?);
+    }
     if r.settings.ao.as_ref().is_some_and(|a| a.temporal_noise) {
         // per-frame spiral rotations: `warmup` static frames at the evaluated camera first, so
         // the temporal filter averages different tap patterns as in `render --warmup N` (with the

@@ -38,8 +38,6 @@ pub struct GiEvalSettings {
     pub probes_from: Option<String>,
     /// The probes' grid, probes per axis (`cache::probes::GRID` by default).
     pub probe_bake: crate::cache::probes::ProbeBake,
-    /// Warm up along the camera path (frames f − warmup … f) instead of at a still camera.
-    pub moving: bool,
 }
 
 /// GPU images of one configuration and their errors.
@@ -145,16 +143,11 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         let mut r = Renderer::new(&gpu, &scene, settings)?;
         // warm-up at the evaluated camera (bounces and temporal history), or along the
         // camera path up to it (--moving)
-        let renders = s.warmup.max(1) + 1;
-        let (full, indirect) = if g.moving {
-            let f = s.scene.frame;
-            for k in (0..renders).rev() {
-                let fk = (f - k as f32).max(0.0);
-                r.render(&gpu, &scene, &s.scene.cameras_at(&scene, fk), fk)?;
-            }
+        let (full, indirect) = if s.moving {
+            super::render_along_path(&mut r, &gpu, &scene, s, s.scene.frame)?;
             read_indirect(&r, &gpu)?
         } else {
-            render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, renders)?
+            render_indirect(&mut r, &gpu, &scene, camera, s.scene.frame, s.warmup.max(1) + 1)?
         };
         // RMSE / MAE on linear radiance, FLIP on the tonemapped images
         let (full_stats, full_map) = compare_radiance(&ref_total.image, &full, exposure)?;
@@ -217,7 +210,6 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         probes_from: g.probes_from.clone(),
         probe_grid: g.probes.then_some(g.probe_bake.grid),
         probe_rays: g.probes.then_some(g.probe_bake.rays),
-        moving: g.moving,
         errors: main.errors,
         layers_1: results.first().map(|o| o.errors),
         fig10,

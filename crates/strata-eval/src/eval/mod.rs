@@ -46,6 +46,9 @@ pub struct EvalSettings {
     pub ref_noise: f64,
     /// Static frames rendered before the evaluated one (gi), 0..=1000.
     pub warmup: u32,
+    /// The warm-up frames follow the camera path up to the evaluated frame (f − warmup … f:
+    /// camera and objects moving) instead of holding the evaluated camera still (gi, ao).
+    pub moving: bool,
     /// Folder of cached reference images.
     pub cache: PathBuf,
     /// Recompute the reference even when cached.
@@ -129,6 +132,7 @@ impl EvalSettings {
             ref_spp,
             reference: reference.into(),
             device,
+            moving: self.moving,
             flicker,
             warnings,
         }
@@ -278,6 +282,22 @@ fn reproject(csz: &ImageBuf, av: &ImageBuf, px: f32, py: f32) -> Option<(f32, f3
         value += w * av.pixel(x, y)[0];
     }
     Some((1.0 / inv, value))
+}
+
+/// Renders the warm-up frames f − warmup … f − 1 along the camera path (clamped at frame 0;
+/// at least one), then frame `f`: `EvalSettings::moving`.
+pub(crate) fn render_along_path(
+    r: &mut Renderer,
+    gpu: &GpuContext,
+    scene: &Scene,
+    s: &EvalSettings,
+    f: f32,
+) -> Result<()> {
+    for k in (0..=s.warmup.max(1)).rev() {
+        let fk = (f - k as f32).max(0.0);
+        r.render(gpu, scene, &s.scene.cameras_at(scene, fk), fk)?;
+    }
+    Ok(())
 }
 
 /// Temporal instability of channel 0 of target `target` rendered with `settings` along the
