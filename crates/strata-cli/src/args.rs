@@ -144,6 +144,10 @@ pub struct DeepArgs {
     /// Minimum separation Δz between layers in scene units, >= 0 (default: the scene's; the paper uses 0.5 m).
     #[arg(long, allow_negative_numbers = true)]
     pub min_separation: Option<f32>,
+    /// Resolution divisor s of layers >= 1, 1..=4 (DGB Fig. 11): each is rasterised at 1/s of the
+    /// size and upsampled keeping the minimum separation (1 = full resolution, as the paper's results).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub layer_scale: u32,
     /// Guard band rendered around the image and cropped: pixels per side (e.g. 32), percent of the height (e.g. 10%), or auto (the technique's default: 10% for ao and full, else 0).
     #[arg(long, default_value = "auto", value_parser = parse_guard_band)]
     pub guard_band: GuardBand,
@@ -155,6 +159,7 @@ impl DeepArgs {
             layers: self.layers,
             variant: self.variant,
             min_separation: self.min_separation,
+            layer_scale: self.layer_scale,
             ..Default::default()
         }
     }
@@ -972,6 +977,10 @@ pub struct BenchDeepArgs {
     /// Minimum separation Δz in scene units (default: the scene's).
     #[arg(long, allow_negative_numbers = true)]
     pub min_separation: Option<f32>,
+    /// Resolution divisor s of the second and later layers for every method, 1..=4 (DGB Fig. 11:
+    /// layer j >= 1 rasterised at 1/s of the size, then upsampled; 1 = full resolution).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub layer_scale: u32,
     /// Write Fig. 3-style images (each method's layer 1 and its differences from the peel) into this folder.
     #[arg(long)]
     pub images: Option<PathBuf>,

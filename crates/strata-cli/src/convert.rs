@@ -85,6 +85,7 @@ impl From<&BenchDeepArgs> for DeepSettings {
             frames: a.frames,
             layers: a.layers,
             min_separation: a.min_separation,
+            layer_scale: a.layer_scale,
             images: a.images.clone(),
             force: a.force,
         }

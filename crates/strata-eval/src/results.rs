@@ -122,7 +122,14 @@ pub struct DeepBench {
     #[serde(flatten)]
     pub run: BenchRun,
     pub layers: u32,
+    /// Resolution divisor of layers ≥ 1 (DGB Fig. 11; 1 = full resolution).
+    #[serde(default = "one")]
+    pub layer_scale: u32,
     pub rows: Vec<DeepRow>,
+}
+
+fn one() -> u32 {
+    1
 }
 
 /// `strata bench reference`: CPU ray throughput.

@@ -348,6 +348,13 @@ impl RenderSettings {
         if self.needs_motion() {
             bytes += sum(&[self.deep.motion_target()]);
         }
+        let [rw, rh] = self.deep.reduced_size(w, h);
+        bytes += self
+            .deep
+            .reduced_outputs(self.needs_motion())
+            .iter()
+            .map(|d| desc_bytes(d, rw, rh))
+            .sum::<u64>();
         if !self.deep.uses_history() {
             // csz-history, when only a temporal filter keeps it
             bytes += px * self.deep.array_layers() as u64 * 4;
@@ -499,7 +506,7 @@ pub struct Renderer {
     pub scene_gpu: GpuScene,
     pub targets: Targets,
     shadow: Option<shadow::ShadowPass>,
-    geometry: Vec<deep_gbuffer::GeometryPass>,
+    geometry: Vec<deep_gbuffer::GeometryStep>,
     pack: deep_gbuffer::PackPass,
     lighting: Option<lighting::LightingPass>,
     tonemap: Option<tonemap::TonemapPass>,
@@ -548,6 +555,10 @@ impl Renderer {
         }
         if settings.needs_motion() {
             targets.create(gpu, settings.deep.motion_target());
+        }
+        let reduced = settings.deep.reduced_size(w, h);
+        for d in settings.deep.reduced_outputs(settings.needs_motion()) {
+            targets.create_sized(gpu, d, reduced);
         }
         if settings.shade {
             for d in lighting::OUTPUTS.iter().chain(tonemap::OUTPUTS) {

@@ -28,6 +28,8 @@ pub struct DeepSettings {
     pub layers: u32,
     /// Minimum separation Δz in scene units (default: the scene's).
     pub min_separation: Option<f32>,
+    /// Resolution divisor s of layers ≥ 1 for every method (DGB Fig. 11), 1..=4.
+    pub layer_scale: u32,
     /// Write Fig. 3-style images into this folder.
     pub images: Option<PathBuf>,
     /// Overwrite existing images.
@@ -71,6 +73,7 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
             variant,
             min_separation: a.min_separation,
             submission,
+            layer_scale: if layers >= 2 { a.layer_scale } else { 1 },
         },
         shade: false,
         ..Default::default()
@@ -89,7 +92,10 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
             continue;
         }
         let default = Renderer::new(&gpu, &scene, settings(a.layers, v, Submission::Auto))?;
-        let multiview = (v.is_single_pass() && default.settings.deep.submission.resolve(&gpu) != Submission::Multiview)
+        // a reduced layer needs per-layer submission: no multiview twin
+        let multiview = (v.is_single_pass()
+            && a.layer_scale == 1
+            && default.settings.deep.submission_on(&gpu) != Submission::Multiview)
             .then(|| Renderer::new(&gpu, &scene, settings(a.layers, v, Submission::Multiview)))
             .transpose()?;
         methods.push(Method {
@@ -185,6 +191,7 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
     Ok(DeepBench {
         run: bench_run(&a.scene, a.frames, &scene, &gpu),
         layers: a.layers,
+        layer_scale: a.layer_scale,
         rows: rows
             .iter()
             .map(|&(m, l1, l2, t, mm, mv)| DeepRow {

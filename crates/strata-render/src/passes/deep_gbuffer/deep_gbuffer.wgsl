@@ -27,8 +27,10 @@ struct DeepParams {
     min_separation: f32,
     // 0 on a single-pass variant's first frame: no oracle yet, accept every fragment
     has_history: u32,
+    // full-resolution pixels per pixel of this pass's targets (> 1: a reduced layer,
+    // DeepGBufferSettings::layer_scale)
+    scale: f32,
     pad0: u32,
-    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -126,7 +128,8 @@ fn passes_min_separation(in: VsOut, layer: u32) -> bool {
     if (ORACLE != ORACLE_PEEL && deep.has_history == 0u) {
         return true;
     }
-    var c = in.clip.xy;
+    // the fragment's position in the oracle's full-resolution pixels
+    var c = in.clip.xy * deep.scale;
     var z = in.cam_z;
     if (ORACLE == ORACLE_REPROJECT) {
         // C = (x_{t−1}, y_{t−1}, z_{t−1}): where this point was last frame.
@@ -136,6 +139,12 @@ fn passes_min_separation(in: VsOut, layer: u32) -> bool {
         let ndc = in.prev_clip.xy / in.prev_clip.w;
         c = vec2f((ndc.x * 0.5 + 0.5) * frame.size.x, (0.5 - 0.5 * ndc.y) * frame.size.y);
         z = in.prev_clip.w;
+    }
+    if (deep.scale > 1.0) {
+        // A reduced pixel's centre lies on a corner of four full-resolution pixels at even
+        // scales; a quarter pixel up-left picks one of them for every fragment, where the
+        // rounding of the reprojected position would flip between two from row to row.
+        c -= vec2f(0.25);
     }
     if (c.x < 0.0 || c.y < 0.0 || c.x >= frame.size.x || c.y >= frame.size.y) {
         return true;

@@ -48,6 +48,9 @@ use crate::gpu::GpuContext;
 use crate::scene_gpu::{GpuScene, NextTransforms, VERTEX_LAYOUT};
 use crate::RenderError;
 
+mod layer_upsample;
+pub use layer_upsample::{upsample_pick, LayerUpsamplePass};
+
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Most layers a deep G-buffer can have (DGB §5 generalises to k layers).
 pub const MAX_LAYERS: u32 = 4;
@@ -151,7 +154,16 @@ pub struct DeepGBufferSettings {
     pub min_separation: Option<f32>,
     /// How the single-pass variants submit their layers (default [`Submission::Auto`]).
     pub submission: Submission,
+    /// Resolution divisor s of layers ≥ 1, 1..=[`MAX_LAYER_SCALE`] (DGB Fig. 11: the second
+    /// layer at a lower resolution than the first). 1 = every layer at full resolution, as in
+    /// the paper's results. At s > 1 each layer j ≥ 1 is rasterised at ⌈w/s⌉ × ⌈h/s⌉ and a
+    /// depth-aware upsampling ([`LayerUpsamplePass`]) writes it into the full-resolution
+    /// arrays, so every later pass reads the same targets; it needs per-layer submission.
+    pub layer_scale: u32,
 }
+
+/// Largest [`DeepGBufferSettings::layer_scale`].
+pub const MAX_LAYER_SCALE: u32 = 4;
 
 /// Geometry submissions of the single-pass variants (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -182,6 +194,7 @@ impl Default for DeepGBufferSettings {
             variant: Variant::Reproject,
             min_separation: None,
             submission: Submission::Auto,
+            layer_scale: 1,
         }
     }
 }
@@ -208,6 +221,18 @@ impl DeepGBufferSettings {
                 self.variant, self.layers
             )));
         }
+        if !(1..=MAX_LAYER_SCALE).contains(&self.layer_scale) {
+            return Err(RenderError::Parameter(format!(
+                "layer-scale {} is out of range: must be in 1..={MAX_LAYER_SCALE}",
+                self.layer_scale
+            )));
+        }
+        if self.is_reduced() && self.submission == Submission::Multiview {
+            return Err(RenderError::Parameter(format!(
+                "layer-scale {} needs one submission per layer: a multiview pass renders every layer at one size",
+                self.layer_scale
+            )));
+        }
         if let Some(dz) = self.min_separation {
             if !(dz >= 0.0 && dz.is_finite()) {
                 return Err(RenderError::Parameter(format!(
@@ -216,6 +241,54 @@ impl DeepGBufferSettings {
             }
         }
         Ok(())
+    }
+
+    /// Are layers ≥ 1 built at a reduced resolution (k ≥ 2 and `layer_scale` > 1)?
+    pub fn is_reduced(&self) -> bool {
+        self.layers >= 2 && self.layer_scale > 1
+    }
+
+    /// How the layers are submitted on `gpu`: [`Submission::Auto`] resolved, and one
+    /// submission per layer when they are built at a reduced resolution.
+    pub fn submission_on(&self, gpu: &GpuContext) -> Submission {
+        if self.is_reduced() {
+            Submission::PerLayer
+        } else {
+            self.submission.resolve(gpu)
+        }
+    }
+
+    /// Size of the reduced layers' targets for a `width` × `height` G-buffer.
+    pub fn reduced_size(&self, width: u32, height: u32) -> [u32; 2] {
+        [width.div_ceil(self.layer_scale), height.div_ceil(self.layer_scale)]
+    }
+
+    /// The reduced-resolution targets that layers ≥ 1 are rasterised into before their
+    /// upsampling (one layer each, reused by every layer ≥ 1; empty unless [`Self::is_reduced`]).
+    /// `motion` adds its reduced twin.
+    pub fn reduced_outputs(&self, motion: bool) -> Vec<TargetDesc> {
+        if !self.is_reduced() {
+            return Vec::new();
+        }
+        let full = self.outputs();
+        let mut v: Vec<TargetDesc> = REDUCED
+            .iter()
+            .take(5)
+            .map(|&(name, of)| {
+                let d = full.iter().find(|d| d.name == of).expect("a G-buffer target");
+                TargetDesc::new(name, d.format, 1, "a layer >= 1 at the reduced resolution (layer-scale)")
+            })
+            .collect();
+        if motion {
+            let (name, _) = REDUCED[5];
+            v.push(TargetDesc::new(
+                name,
+                self.motion_target().format,
+                1,
+                "a layer >= 1's motion at the reduced resolution (layer-scale)",
+            ));
+        }
+        v
     }
 
     /// Layers of the per-layer arrays: k, plus the predicted layer for DELAY/PREDICT.
@@ -312,13 +385,25 @@ impl DeepGBufferSettings {
     }
 }
 
+/// The reduced-resolution targets and the full-resolution arrays they are upsampled into.
+const REDUCED: [(&str, &str); 6] = [
+    ("reduced-depth", "depth"),
+    ("reduced-csz", "csz"),
+    ("reduced-normal", "normal"),
+    ("reduced-albedo", "albedo"),
+    ("reduced-emission", "emission"),
+    ("reduced-motion", "motion"),
+];
+
 /// Per-frame constants of a geometry pass (`DeepParams` in WGSL).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct DeepParams {
     min_separation: f32,
     has_history: u32,
-    _pad: [u32; 2],
+    /// Full-resolution pixels per pixel of this pass's targets (the peel's oracle lookup).
+    scale: f32,
+    _pad: u32,
 }
 
 /// One geometry submission of the deep G-buffer: the single-layer pass, one
@@ -335,19 +420,57 @@ pub struct GeometryPass {
     inputs: Vec<&'static str>,
     /// The `motion` target exists and this pass writes it.
     motion: bool,
+    /// Renders into the reduced-resolution targets (`layer_scale` > 1, a layer ≥ 1).
+    reduced: bool,
+    /// Full-resolution pixels per pixel of this pass's targets.
+    scale: f32,
 }
 
 const PEEL_NAMES: [&str; 4] = ["gbuffer", "peel1", "peel2", "peel3"];
 /// Per-layer submissions of the single-pass variants ([`Submission::PerLayer`]).
 const LAYER_NAMES: [&str; 4] = ["gbuffer", "layer1", "layer2", "layer3"];
 
-/// The geometry passes for `settings`, in order.
+/// One step of the deep G-buffer's construction: a geometry submission, or the
+/// upsampling of a reduced-resolution layer into the full-resolution arrays.
+pub enum GeometryStep {
+    Geometry(GeometryPass),
+    Upsample(LayerUpsamplePass),
+}
+
+impl GeometryStep {
+    /// Sets Δz and whether last frame's oracle exists, before encoding a frame.
+    pub fn set_frame(&self, gpu: &GpuContext, min_separation: f32, has_history: bool) {
+        match self {
+            GeometryStep::Geometry(g) => g.set_frame(gpu, min_separation, has_history),
+            GeometryStep::Upsample(u) => u.set_frame(gpu, min_separation),
+        }
+    }
+}
+
+impl Pass for GeometryStep {
+    fn info(&self) -> PassInfo {
+        match self {
+            GeometryStep::Geometry(g) => g.info(),
+            GeometryStep::Upsample(u) => u.info(),
+        }
+    }
+
+    fn encode(&self, gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        match self {
+            GeometryStep::Geometry(g) => g.encode(gpu, scene, targets, encoder),
+            GeometryStep::Upsample(u) => u.encode(gpu, scene, targets, encoder),
+        }
+    }
+}
+
+/// The geometry passes for `settings`, in order (with [`DeepGBufferSettings::layer_scale`]
+/// > 1, each reduced layer's pass is followed by its upsampling).
 pub fn geometry_passes(
     gpu: &GpuContext,
     scene: &GpuScene,
     targets: &Targets,
     settings: &DeepGBufferSettings,
-) -> Result<Vec<GeometryPass>, RenderError> {
+) -> Result<Vec<GeometryStep>, RenderError> {
     settings.validate()?;
     let k = settings.layers;
     let device = &gpu.device;
@@ -396,13 +519,16 @@ pub fn geometry_passes(
                 first_layer: u32,
                 views: u32,
                 oracle_view: &wgpu::TextureView,
-                entry: Entry| {
+                entry: Entry,
+                reduced: bool| {
+        let scale = if reduced { settings.layer_scale as f32 } else { 1.0 };
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(name),
             contents: bytemuck::bytes_of(&DeepParams {
                 min_separation: 0.0,
                 has_history: 0,
-                _pad: [0; 2],
+                scale,
+                _pad: 0,
             }),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
@@ -479,7 +605,7 @@ pub fn geometry_passes(
             (1, _) => vec!["scene", "csz"],
             _ => vec!["scene", "csz-history"],
         };
-        GeometryPass {
+        GeometryStep::Geometry(GeometryPass {
             name,
             pipeline,
             first_layer,
@@ -488,11 +614,21 @@ pub fn geometry_passes(
             params,
             inputs,
             motion,
+            reduced,
+            scale,
+        })
+    };
+    let reduced = settings.is_reduced();
+    // A reduced layer j's pass and then its upsampling (before layer j + 1's peel reads it).
+    let layer = |v: &mut Vec<GeometryStep>, pass: GeometryStep, j: u32| {
+        v.push(pass);
+        if reduced {
+            v.push(GeometryStep::Upsample(LayerUpsamplePass::new(gpu, targets, settings, j)));
         }
     };
 
     if multiview_needed(settings)
-        && settings.submission.resolve(gpu) == Submission::Multiview
+        && settings.submission_on(gpu) == Submission::Multiview
         && !gpu.features.contains(wgpu::Features::MULTIVIEW)
     {
         return Err(RenderError::MissingFeature {
@@ -501,9 +637,9 @@ pub fn geometry_passes(
         });
     }
     let passes = if k == 1 {
-        vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single)]
+        vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single, false)]
     } else if settings.variant == Variant::Peel {
-        let mut v = vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single)];
+        let mut v = vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single, false)];
         for j in 1..k {
             // This frame's layer j − 1 only: rendering into layer j while reading it.
             let prev_layer = csz.texture.create_view(&wgpu::TextureViewDescriptor {
@@ -512,27 +648,30 @@ pub fn geometry_passes(
                 array_layer_count: Some(1),
                 ..Default::default()
             });
-            v.push(make(
+            let pass = make(
                 PEEL_NAMES[j as usize],
                 settings.variant.oracle(),
                 j,
                 1,
                 &prev_layer,
                 Entry::Single,
-            ));
+                reduced,
+            );
+            layer(&mut v, pass, j);
         }
         v
     } else {
         let history = &targets.get("csz-history").array_view;
         let oracle = settings.variant.oracle();
-        match settings.submission.resolve(gpu) {
+        match settings.submission_on(gpu) {
             Submission::PerLayer => {
-                let mut v = vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single)];
+                let mut v = vec![make("gbuffer", 0, 0, 1, &no_oracle, Entry::Single, false)];
                 for j in 1..k {
-                    v.push(make(LAYER_NAMES[j as usize], oracle, j, 1, history, Entry::Single));
+                    let pass = make(LAYER_NAMES[j as usize], oracle, j, 1, history, Entry::Single, reduced);
+                    layer(&mut v, pass, j);
                 }
                 if settings.variant.has_predicted_view() {
-                    v.push(make("oracle", oracle, 0, 1, &no_oracle, Entry::Oracle));
+                    v.push(make("oracle", oracle, 0, 1, &no_oracle, Entry::Oracle, false));
                 }
                 v
             }
@@ -543,6 +682,7 @@ pub fn geometry_passes(
                 settings.array_layers(),
                 history,
                 Entry::Multiview,
+                false,
             )],
         }
     };
@@ -570,7 +710,8 @@ impl GeometryPass {
         let p = DeepParams {
             min_separation,
             has_history: has_history as u32,
-            _pad: [0; 2],
+            scale: self.scale,
+            _pad: 0,
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
     }
@@ -581,10 +722,10 @@ impl Pass for GeometryPass {
         PassInfo {
             name: self.name,
             inputs: self.inputs.clone(),
-            outputs: if self.motion {
-                vec!["depth", "csz", "normal", "albedo", "emission", "motion"]
-            } else {
-                vec!["depth", "csz", "normal", "albedo", "emission"]
+            outputs: match (self.reduced, self.motion) {
+                (false, true) => vec!["depth", "csz", "normal", "albedo", "emission", "motion"],
+                (false, false) => vec!["depth", "csz", "normal", "albedo", "emission"],
+                (true, m) => REDUCED.iter().take(5 + m as usize).map(|r| r.0).collect(),
             },
         }
     }
@@ -613,6 +754,10 @@ impl Pass for GeometryPass {
             .collect();
         let view = |name: &str| {
             let i = names.iter().position(|n| *n == name).expect("a G-buffer attachment");
+            if self.reduced {
+                let (reduced, _) = REDUCED.iter().find(|r| r.1 == name).expect("a reduced twin");
+                return &targets.get(reduced).view;
+            }
             let t = targets.get(name);
             match (&owned[i], self.views > 1) {
                 (Some(v), _) => v,
@@ -642,6 +787,18 @@ impl Pass for GeometryPass {
             occlusion_query_set: None,
             multiview_mask: (self.views > 1).then(|| NonZeroU32::new((1u32 << self.views) - 1).expect("views > 0")),
         });
+        if self.reduced {
+            // exactly 1/s of the full image, so that reduced pixel i's centre is full-resolution
+            // (i + 1/2)·s for any size (a last partial column or row stays empty)
+            pass.set_viewport(
+                0.0,
+                0.0,
+                targets.width as f32 / self.scale,
+                targets.height as f32 / self.scale,
+                0.0,
+                1.0,
+            );
+        }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.frame_bind_group, &[]);
         pass.set_bind_group(3, &self.group, &[]);

@@ -1,0 +1,267 @@
+//! A reduced-resolution layer into the full-resolution arrays (DGB Fig. 11; see
+//! [`DeepGBufferSettings::layer_scale`] and `layer_upsample.wgsl`).
+
+use wgpu::util::DeviceExt;
+
+use super::{DeepGBufferSettings, DEPTH_FORMAT, REDUCED, SURFACE_TOLERANCE};
+use crate::frame::{Pass, PassInfo, Targets};
+use crate::gpu::GpuContext;
+use crate::scene_gpu::GpuScene;
+
+/// `UpsampleParams` in WGSL.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct UpsampleParams {
+    min_separation: f32,
+    scale: u32,
+    _pad: [u32; 2],
+}
+
+/// Writes reduced layer `layer` (≥ 1) into its slice of `depth`, `csz`, `normal`,
+/// `albedo`, `emission` (and `motion`), keeping the layer's minimum separation from
+/// this frame's layer `layer` − 1 at every full-resolution pixel ([`upsample_pick`]).
+pub struct LayerUpsamplePass {
+    name: &'static str,
+    layer: u32,
+    scale: u32,
+    pipeline: wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    motion: bool,
+}
+
+const NAMES: [&str; 4] = ["", "layer1-upsample", "layer2-upsample", "layer3-upsample"];
+
+impl LayerUpsamplePass {
+    pub fn new(gpu: &GpuContext, targets: &Targets, settings: &DeepGBufferSettings, layer: u32) -> Self {
+        let device = &gpu.device;
+        let motion = targets.try_get("motion").is_some();
+        let module = crate::shader::module(device, "layer_upsample", include_str!("layer_upsample.wgsl"));
+        let mut entries = vec![crate::passes::uniform_entry(0)];
+        for b in 1..=5 {
+            entries.push(crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, false));
+        }
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 6,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Depth,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        });
+        entries.push(crate::passes::texture_entry(7, wgpu::TextureViewDimension::D2, false));
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("layer_upsample"),
+            entries: &entries,
+        });
+        let scale = settings.layer_scale;
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("layer_upsample"),
+            contents: bytemuck::bytes_of(&UpsampleParams {
+                min_separation: 0.0,
+                scale,
+                _pad: [0; 2],
+            }),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let reduced = |name: &str| &targets.get(name).view;
+        // without a motion target the shader's motion output has no attachment; any
+        // float texture stands in for its input
+        let motion_input = if motion { REDUCED[5].0 } else { REDUCED[1].0 };
+        let views = [
+            reduced(REDUCED[1].0),
+            reduced(REDUCED[2].0),
+            reduced(REDUCED[3].0),
+            reduced(REDUCED[4].0),
+            reduced(motion_input),
+            reduced(REDUCED[0].0),
+            targets.get("csz").layer(layer - 1),
+        ];
+        let mut group_entries = vec![wgpu::BindGroupEntry {
+            binding: 0,
+            resource: params.as_entire_binding(),
+        }];
+        for (i, v) in views.into_iter().enumerate() {
+            group_entries.push(wgpu::BindGroupEntry {
+                binding: i as u32 + 1,
+                resource: wgpu::BindingResource::TextureView(v),
+            });
+        }
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("layer_upsample"),
+            layout: &group_layout,
+            entries: &group_entries,
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("layer_upsample"),
+            bind_group_layouts: &[Some(&group_layout)],
+            immediate_size: 0,
+        });
+        let mut color_targets = crate::passes::color_targets(&settings.outputs()[1..5]);
+        color_targets.push(motion.then(|| wgpu::ColorTargetState::from(settings.motion_target().format)));
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(NAMES[layer as usize]),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_fullscreen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_upsample"),
+                compilation_options: Default::default(),
+                targets: &color_targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self {
+            name: NAMES[layer as usize],
+            layer,
+            scale,
+            pipeline,
+            group,
+            params,
+            motion,
+        }
+    }
+
+    pub fn set_frame(&self, gpu: &GpuContext, min_separation: f32) {
+        let p = UpsampleParams {
+            min_separation,
+            scale: self.scale,
+            _pad: [0; 2],
+        };
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+    }
+}
+
+impl Pass for LayerUpsamplePass {
+    fn info(&self) -> PassInfo {
+        let n = 5 + self.motion as usize;
+        let mut inputs: Vec<&'static str> = REDUCED.iter().take(n).map(|r| r.0).collect();
+        inputs.push("csz");
+        PassInfo {
+            name: self.name,
+            inputs,
+            outputs: REDUCED.iter().take(n).map(|r| r.1).collect(),
+        }
+    }
+
+    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        let view = |name: &str| targets.get(name).layer(self.layer);
+        let color = |name: &str| crate::passes::clear_attachment(view(name));
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(self.name),
+            color_attachments: &[
+                color("csz"),
+                color("normal"),
+                color("albedo"),
+                color("emission"),
+                self.motion.then(|| color("motion")).flatten(),
+            ],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: view("depth"),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// CPU twin of `pick` in `layer_upsample.wgsl`: the reduced texel that full-resolution
+/// pixel `p` of layer j takes, or `None` for no surface. `reduced` holds the reduced
+/// layer's camera-space depths (`size` = [w, h], row-major), `z_front` layer j − 1's
+/// depth at `p` this frame, `scale` the divisor s.
+pub fn upsample_pick(
+    reduced: &[f32],
+    size: [u32; 2],
+    p: [u32; 2],
+    z_front: f32,
+    scale: u32,
+    min_separation: f32,
+) -> Option<[u32; 2]> {
+    if z_front <= 0.0 {
+        return None;
+    }
+    let behind = |z: f32| z > 0.0 && z > z_front + min_separation + SURFACE_TOLERANCE * z_front;
+    let last = [size[0] as i64 - 1, size[1] as i64 - 1];
+    let q = [
+        (p[0] / scale).min(size[0] - 1) as i64,
+        (p[1] / scale).min(size[1] - 1) as i64,
+    ];
+    let at = |t: [i64; 2]| reduced[(t[1] * size[0] as i64 + t[0]) as usize];
+    if behind(at(q)) {
+        return Some([q[0] as u32, q[1] as u32]);
+    }
+    let mut best: Option<([i64; 2], f32)> = None;
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let t = [q[0] + dx, q[1] + dy];
+            if (dx == 0 && dy == 0) || t[0] < 0 || t[1] < 0 || t[0] > last[0] || t[1] > last[1] {
+                continue;
+            }
+            let z = at(t);
+            if behind(z) && best.is_none_or(|(_, bz)| z < bz) {
+                best = Some((t, z));
+            }
+        }
+    }
+    best.map(|(t, _)| [t[0] as u32, t[1] as u32])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::upsample_pick;
+
+    #[test]
+    fn the_covering_texel_wins_when_it_keeps_the_separation() {
+        // 2×2 reduced layer; full pixel (3, 1) at s = 2 lies in texel (1, 0)
+        let z = [5.0, 6.0, 7.0, 8.0];
+        assert_eq!(upsample_pick(&z, [2, 2], [3, 1], 1.0, 2, 0.5), Some([1, 0]));
+    }
+
+    #[test]
+    fn otherwise_the_nearest_separated_neighbour_and_else_nothing() {
+        // texel (1, 0) is within Δz of the front layer (z 6 vs 5.8 + 0.5): its neighbours
+        // (0, 0) = 5 is too close as well, (0, 1) = 9 and (1, 1) = 7 lie behind: 7 wins
+        let z = [5.0, 6.0, 9.0, 7.0];
+        assert_eq!(upsample_pick(&z, [2, 2], [2, 0], 5.8, 2, 0.5), Some([1, 1]));
+        // nothing lies behind 10
+        assert_eq!(upsample_pick(&z, [2, 2], [2, 0], 10.0, 2, 0.5), None);
+        // an empty front layer has nothing behind it
+        assert_eq!(upsample_pick(&z, [2, 2], [0, 0], 0.0, 2, 0.5), None);
+        // empty texels (z = 0) never count
+        let z = [0.0, 0.0, 0.0, 0.0];
+        assert_eq!(upsample_pick(&z, [2, 2], [1, 1], 1.0, 2, 0.0), None);
+    }
+
+    #[test]
+    fn the_last_reduced_column_covers_an_odd_width() {
+        // a 5-pixel-wide image at s = 2 has ⌈5/2⌉ = 3 reduced columns; pixel 4 is column 2
+        let z = [2.0, 2.0, 3.0];
+        assert_eq!(upsample_pick(&z, [3, 1], [4, 0], 1.0, 2, 0.5), Some([2, 0]));
+    }
+}
