@@ -663,8 +663,8 @@ impl FrameArgs {
     /// One line per flag given on the command line that `settings` (the technique's,
     /// resolved) does not read: the AO flags without the deep-G-buffer AO (the
     /// radius, bias and intensity carry over to `aba-ao` and the radius and bias to `bzb-ao`),
-    /// the radiosity flags and `--no-probes` without the radiosity, and `--variant` without a
-    /// second layer. `render` prints them as warnings and renders: the command `strata view`
+    /// the radiosity flags and `--no-probes` without the radiosity, and `--variant` and
+    /// `--layer-scale` without a second layer. `render` prints them as warnings and renders: the command `strata view`
     /// prints for a frame keeps the flags given to it across technique switches. (`eval`
     /// refuses the flags of its own that a comparison does not read.)
     pub fn unread_flags(&self, settings: &strata_render::RenderSettings) -> Vec<String> {
@@ -698,12 +698,14 @@ impl FrameArgs {
             radiosity,
             "the deep-G-buffer radiosity",
         ));
-        flags.push((
-            "variant".into(),
-            "variant".into(),
-            settings.deep.layers >= 2,
-            "a second deep-G-buffer layer (--layers 2 or more)",
-        ));
+        for (id, long) in [("variant", "variant"), ("layer_scale", "layer-scale")] {
+            flags.push((
+                id.into(),
+                long.into(),
+                settings.deep.layers >= 2,
+                "a second deep-G-buffer layer (--layers 2 or more)",
+            ));
+        }
         let given = |id: &str| self.given.iter().any(|g| g == id);
         flags
             .iter()

@@ -231,30 +231,36 @@ fn print_stage(name: &str, s: &StageBench) {
 
 fn print_deep(d: &DeepBench, f0: f32) {
     let r = &d.run;
+    let scale = match d.layer_scale {
+        1 => String::new(),
+        s => format!(" (layers >= 1 at 1/{s} resolution)"),
+    };
     println!(
-        "{} at {}x{}, {} layers, {} triangles, {} frames from frame {} on {}",
+        "{} at {}x{}, {} layers{scale}, {} triangles, {} frames from frame {} on {}",
         r.scene, r.width, r.height, d.layers, r.triangles, r.frames, f0, r.device
     );
     println!(
-        "{:<13} {:>10} {:>10} {:>10} {:>8} {:>10} {:>14}",
-        "method", "layer1 ms", "layer2 ms", "total ms", "l2/l1", "mismatch %", "multiview ms"
+        "{:<13} {:>10} {:>10} {:>12} {:>10} {:>8} {:>10} {:>14}",
+        "method", "layer1 ms", "layer2 ms", "upsample ms", "total ms", "l2/l1", "mismatch %", "multiview ms"
     );
+    let or_dash = |v: Option<f64>| v.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     for row in &d.rows {
-        let mv = row
-            .multiview_total_ms
-            .map(|v| format!("{v:.3}"))
-            .unwrap_or_else(|| "-".into());
         println!(
-            "{:<13} {:>10.3} {:>10.3} {:>10.3} {:>8.2} {:>10.3} {mv:>14}",
+            "{:<13} {:>10.3} {:>10.3} {:>12} {:>10.3} {:>8.2} {:>10.3} {:>14}",
             row.method,
             row.layer1_ms,
             row.layer2_ms,
+            or_dash(row.upsample_ms),
             row.total_ms,
             row.layer2_ms / row.layer1_ms,
-            row.mismatch_pct
+            row.mismatch_pct,
+            or_dash(row.multiview_total_ms)
         );
     }
     println!("(peel, and single-pass methods with a multiview column, ran one submission per layer)");
+    if d.layer_scale > 1 {
+        println!("(layer2 ms includes the upsampling of the reduced layers into the full-resolution arrays)");
+    }
 }
 
 fn print_reference(r: &ReferenceBench) {

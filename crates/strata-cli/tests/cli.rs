@@ -133,6 +133,10 @@ fn render_warns_of_flags_its_technique_does_not_read() {
             &["--technique", "ao", "--variant", "peel"][..],
             &["--variant", "ao"][..],
         ),
+        (
+            &["--technique", "ao", "--layer-scale", "2"][..],
+            &["--layer-scale", "second"][..],
+        ),
     ] {
         let w = warnings(extra);
         assert_eq!(w.len(), 1, "{extra:?}: {w:?}");
@@ -149,6 +153,8 @@ fn render_warns_of_flags_its_technique_does_not_read() {
         "2",
         "--variant",
         "peel",
+        "--layer-scale",
+        "2",
     ]);
     assert!(w.is_empty(), "{w:?}");
 }
@@ -173,6 +179,8 @@ fn argument_errors_name_flags_values_and_folders_on_one_line() {
         "x.exr",
     ]);
     assert_one_line_error(&o, &["--spp", "1..=65536"]);
+    let o = strata(&["render", "--scene", "plane", "--layers", "2", "--layer-scale", "5"]);
+    assert_one_line_error(&o, &["--layer-scale", "1..=4"]);
     let dir = scratch("a-folder.png");
     std::fs::create_dir_all(&dir).unwrap();
     let o = strata(&[

@@ -114,6 +114,10 @@ pub struct DeepRow {
     pub multiview_total_ms: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub multiview_layer2_ms: Option<f64>,
+    /// With `layer_scale` > 1: the part of `layer2_ms` that upsamples the reduced layers
+    /// into the full-resolution arrays (the rest rasterises them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upsample_ms: Option<f64>,
 }
 
 /// `strata bench deep-gbuffer`.
@@ -130,6 +134,10 @@ pub struct DeepBench {
 
 fn one() -> u32 {
     1
+}
+
+fn is_one(v: &u32) -> bool {
+    *v == 1
 }
 
 /// `strata bench reference`: CPU ray throughput.
@@ -346,6 +354,9 @@ pub struct EvalRun {
     pub scene: String,
     pub layers: u32,
     pub variant: String,
+    /// Resolution divisor of layers ≥ 1 (`--layer-scale`, DGB Fig. 11); absent = 1.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub layer_scale: u32,
     pub width: u32,
     pub height: u32,
     pub frame: f32,
@@ -662,6 +673,7 @@ mod tests {
             scene: "atrium".into(),
             layers: 2,
             variant: "reproject".into(),
+            layer_scale: 1,
             width: 32,
             height: 16,
             frame: 0.0,

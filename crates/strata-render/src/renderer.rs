@@ -927,7 +927,7 @@ impl Renderer {
         self.scene_gpu
             .update_objects(gpu, frame, previous, variant.next_transforms());
         for g in &self.geometry {
-            g.set_frame(gpu, dz, self.has_history);
+            g.set_frame(gpu, dz, self.has_history, cams.current.near);
         }
         if let Some(r) = &self.reflections {
             r.set_frame(gpu, dz);

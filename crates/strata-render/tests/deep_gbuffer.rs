@@ -710,6 +710,13 @@ fn reduced_layers_keep_the_separation_and_equal_their_cpu_twin() {
             }
         }
         assert!(taken > (w * h / 10) as usize, "{what}: layer {j} nearly empty ({taken} px)");
+        // its hardware depth is that of the same point: reversed-Z infinite, near / z
+        let depth = layer("depth", j as u32).data;
+        let near = atrium.camera.near;
+        for (i, (&d, &z)) in depth.iter().zip(&csz[j]).enumerate() {
+            let want = if z > 0.0 { near / z } else { 0.0 };
+            assert!((d - want).abs() <= 1e-6 * want, "{what}: depth of pixel {i}: {d} vs {want}");
+        }
         // the peel's oracle at a reduced fragment: layer j − 1 at the full-resolution pixel a
         // quarter pixel up-left of its centre (i + 1/2)·s; past the 1/s viewport nothing is drawn
         if v == Variant::Peel {

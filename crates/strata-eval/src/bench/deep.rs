@@ -46,6 +46,8 @@ struct Method {
     multiview_totals: Vec<f64>,
     /// Per frame: (first layer ms, whole construction ms).
     times: Vec<(f64, f64)>,
+    /// Per frame: the reduced layers' upsampling ms (`layer_scale` > 1).
+    upsample: Vec<f64>,
     mismatched: u64,
     counted: u64,
 }
@@ -84,6 +86,7 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
         multiview: None,
         multiview_totals: Vec::new(),
         times: Vec::new(),
+        upsample: Vec::new(),
         mismatched: 0,
         counted: 0,
     }];
@@ -104,6 +107,7 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
             multiview,
             multiview_totals: Vec::new(),
             times: Vec::new(),
+            upsample: Vec::new(),
             mismatched: 0,
             counted: 0,
         });
@@ -127,6 +131,13 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
             }
             let first = t.get("gbuffer").unwrap_or(f64::NAN);
             m.times.push((first, geometry_ms(&t)));
+            m.upsample.push(
+                t.passes
+                    .iter()
+                    .filter(|(n, _)| n.ends_with("-upsample"))
+                    .map(|(_, ms)| ms)
+                    .sum(),
+            );
             if let Some(mv) = mv {
                 m.multiview_totals.push(geometry_ms(&mv));
             }
@@ -178,15 +189,20 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
         };
         let mut mv: Vec<f64> = m.multiview_totals.clone();
         let multiview_total = (!mv.is_empty()).then(|| median_min(&mut mv).0);
-        rows.push((m.name, layer1, layer2, total, mismatch, multiview_total));
+        let mut up = m.upsample.clone();
+        let upsample = (m.renderer.settings.deep.is_reduced()).then(|| median_min(&mut up).0);
+        let submission = match m.renderer.settings.deep.layers {
+            1 => Submission::PerLayer,
+            _ if m.renderer.settings.deep.variant == Variant::Peel => Submission::PerLayer,
+            _ => m.renderer.settings.deep.submission_on(&gpu),
+        };
+        let submission = if submission == Submission::Multiview {
+            "multiview"
+        } else {
+            "per-layer"
+        };
+        rows.push((m.name, layer1, layer2, total, mismatch, multiview_total, upsample, submission));
     }
-    let submission = |name: &str| match name {
-        "single-layer" | "peel" => "per-layer",
-        _ => match rows.iter().find(|r| r.0 == name).and_then(|r| r.5) {
-            Some(_) => "per-layer",
-            None => "multiview",
-        },
-    };
 
     Ok(DeepBench {
         run: bench_run(&a.scene, a.frames, &scene, &gpu),
@@ -194,15 +210,16 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
         layer_scale: a.layer_scale,
         rows: rows
             .iter()
-            .map(|&(m, l1, l2, t, mm, mv)| DeepRow {
+            .map(|&(m, l1, l2, t, mm, mv, up, sub)| DeepRow {
                 method: m.into(),
                 layer1_ms: l1,
                 layer2_ms: l2,
                 total_ms: t,
                 mismatch_pct: mm,
-                submission: submission(m).into(),
+                submission: sub.into(),
                 multiview_total_ms: mv,
                 multiview_layer2_ms: mv.map(|mv| mv - l1),
+                upsample_ms: up,
             })
             .collect(),
     })

@@ -126,6 +126,7 @@ impl EvalSettings {
             scene: self.scene.scene.clone(),
             layers: self.deep.layers,
             variant: self.deep.variant.to_string(),
+            layer_scale: self.deep.layer_scale,
             width: self.scene.width,
             height: self.scene.height,
             frame: self.scene.frame,

@@ -14,7 +14,8 @@ use crate::scene_gpu::GpuScene;
 struct UpsampleParams {
     min_separation: f32,
     scale: u32,
-    _pad: [u32; 2],
+    near: f32,
+    _pad: u32,
 }
 
 /// Writes reduced layer `layer` (≥ 1) into its slice of `depth`, `csz`, `normal`,
@@ -38,20 +39,9 @@ impl LayerUpsamplePass {
         let motion = targets.try_get("motion").is_some();
         let module = crate::shader::module(device, "layer_upsample", include_str!("layer_upsample.wgsl"));
         let mut entries = vec![crate::passes::uniform_entry(0)];
-        for b in 1..=5 {
+        for b in 1..=6 {
             entries.push(crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, false));
         }
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: 6,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Depth,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        });
-        entries.push(crate::passes::texture_entry(7, wgpu::TextureViewDimension::D2, false));
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("layer_upsample"),
             entries: &entries,
@@ -62,7 +52,8 @@ impl LayerUpsamplePass {
             contents: bytemuck::bytes_of(&UpsampleParams {
                 min_separation: 0.0,
                 scale,
-                _pad: [0; 2],
+                near: 1.0,
+                _pad: 0,
             }),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
@@ -76,7 +67,6 @@ impl LayerUpsamplePass {
             reduced(REDUCED[3].0),
             reduced(REDUCED[4].0),
             reduced(motion_input),
-            reduced(REDUCED[0].0),
             targets.get("csz").layer(layer - 1),
         ];
         let mut group_entries = vec![wgpu::BindGroupEntry {
@@ -139,11 +129,13 @@ impl LayerUpsamplePass {
         }
     }
 
-    pub fn set_frame(&self, gpu: &GpuContext, min_separation: f32) {
+    /// This frame's Δz and the camera's near plane.
+    pub fn set_frame(&self, gpu: &GpuContext, min_separation: f32, near: f32) {
         let p = UpsampleParams {
             min_separation,
             scale: self.scale,
-            _pad: [0; 2],
+            near,
+            _pad: 0,
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
     }
@@ -152,7 +144,8 @@ impl LayerUpsamplePass {
 impl Pass for LayerUpsamplePass {
     fn info(&self) -> PassInfo {
         let n = 5 + self.motion as usize;
-        let mut inputs: Vec<&'static str> = REDUCED.iter().take(n).map(|r| r.0).collect();
+        // not the reduced depth: the layer's depth is near / z
+        let mut inputs: Vec<&'static str> = REDUCED.iter().take(n).skip(1).map(|r| r.0).collect();
         inputs.push("csz");
         PassInfo {
             name: self.name,

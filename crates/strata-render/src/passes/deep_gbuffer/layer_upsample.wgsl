@@ -18,8 +18,9 @@ struct UpsampleParams {
     min_separation: f32,
     // the reduced targets' divisor s
     scale: u32,
+    // the camera's near plane: reversed-Z infinite depth is near / z
+    near: f32,
     pad0: u32,
-    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: UpsampleParams;
@@ -29,9 +30,8 @@ struct UpsampleParams {
 @group(0) @binding(4) var reduced_emission: texture_2d<f32>;
 // the reduced motion where the motion target exists (else a stand-in, never stored)
 @group(0) @binding(5) var reduced_motion: texture_2d<f32>;
-@group(0) @binding(6) var reduced_depth: texture_depth_2d;
 // this frame's layer j − 1 at full resolution
-@group(0) @binding(7) var front_csz: texture_2d<f32>;
+@group(0) @binding(6) var front_csz: texture_2d<f32>;
 
 // deep_gbuffer::SURFACE_TOLERANCE
 const SURFACE_TOLERANCE: f32 = 1e-4;
@@ -93,6 +93,7 @@ fn fs_upsample(@builtin(position) pos: vec4f) -> LayerOut {
     o.albedo = textureLoad(reduced_albedo, t, 0);
     o.emission = textureLoad(reduced_emission, t, 0);
     o.motion = textureLoad(reduced_motion, t, 0);
-    o.depth = textureLoad(reduced_depth, t, 0);
+    // the hardware depth of the same point (Camera::projection), without a depth-texture read
+    o.depth = params.near / o.csz;
     return o;
 }

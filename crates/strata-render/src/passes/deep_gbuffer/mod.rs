@@ -438,11 +438,12 @@ pub enum GeometryStep {
 }
 
 impl GeometryStep {
-    /// Sets Δz and whether last frame's oracle exists, before encoding a frame.
-    pub fn set_frame(&self, gpu: &GpuContext, min_separation: f32, has_history: bool) {
+    /// Sets Δz, whether last frame's oracle exists and the camera's near plane, before
+    /// encoding a frame.
+    pub fn set_frame(&self, gpu: &GpuContext, min_separation: f32, has_history: bool, near: f32) {
         match self {
             GeometryStep::Geometry(g) => g.set_frame(gpu, min_separation, has_history),
-            GeometryStep::Upsample(u) => u.set_frame(gpu, min_separation),
+            GeometryStep::Upsample(u) => u.set_frame(gpu, min_separation, near),
         }
     }
 }
