@@ -244,6 +244,28 @@ macro_rules! temporal_flag {
     };
 }
 
+/// The n×m patterns of the `deinterleave` setting, value v ≥ 1 = pattern v − 1: the square
+/// ones first (the values 1..=3 that were its only ones), then every other pattern
+/// `--deinterleave NxM` takes (n, m in 1..=4), so both accept the same patterns.
+const DEINTERLEAVE_PATTERNS: [[u32; 2]; 16] = [
+    [2, 2],
+    [3, 3],
+    [4, 4],
+    [1, 1],
+    [1, 2],
+    [1, 3],
+    [1, 4],
+    [2, 1],
+    [2, 3],
+    [2, 4],
+    [3, 1],
+    [3, 2],
+    [3, 4],
+    [4, 1],
+    [4, 2],
+    [4, 3],
+];
+
 fn ao_mut(s: &mut RenderSettings) -> &mut AoSettings {
     s.ao.get_or_insert_with(AoSettings::default)
 }
@@ -411,12 +433,18 @@ static AO_SETTINGS: [SettingInfo; 18] = [
     SettingInfo {
         name: "deinterleave",
         doc: "deinterleaved AO (issue 11 item 8): ILS split into n x n sub-buffers, sub-buffer s = i + n*j evaluates the spiral taps k with k mod n*n = s, then gather + the same temporal/bilateral (off = one full-resolution pass)",
-        range: Range::Closed(0.0, 3.0),
+        range: Range::Closed(0.0, DEINTERLEAVE_PATTERNS.len() as f64),
         integer: true,
-        get: |s| Some(ao_of(s).deinterleave.map_or(0.0, |[n, _]| n as f64 - 1.0)),
-        // value v >= 1 is the (v+1)x(v+1) pattern
-        set: |s, v| ao_mut(s).deinterleave = (v >= 1.0).then(|| [v as u32 + 1; 2]),
-        values: &["off", "2x2", "3x3", "4x4"],
+        get: |s| {
+            Some(ao_of(s).deinterleave.map_or(0.0, |p| {
+                DEINTERLEAVE_PATTERNS.iter().position(|&q| q == p).map_or(f64::NAN, |i| i as f64 + 1.0)
+            }))
+        },
+        set: |s, v| ao_mut(s).deinterleave = (v >= 1.0).then(|| DEINTERLEAVE_PATTERNS[v as usize - 1]),
+        values: &[
+            "off", "2x2", "3x3", "4x4", "1x1", "1x2", "1x3", "1x4", "2x1", "2x3", "2x4", "3x1", "3x2", "3x4", "4x1",
+            "4x2", "4x3",
+        ],
     },
     setting!(
         "ao-scale",
@@ -1668,6 +1696,34 @@ pub fn find(name: &str) -> Result<&'static Technique, RenderError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `--set deinterleave=NxM` takes every pattern `--deinterleave NxM` takes, and reads back
+    /// the pattern it set (it used to know the square ones only and read n×m back as n×n).
+    #[test]
+    fn every_deinterleave_pattern_round_trips_through_its_setting() {
+        let ao = find("ao").unwrap();
+        let info = ao.setting_list().find(|i| i.name == "deinterleave").unwrap();
+        assert_eq!(info.values.len(), DEINTERLEAVE_PATTERNS.len() + 1);
+        let mut seen = Vec::new();
+        for n in 1..=crate::passes::ao::MAX_DEINTERLEAVE {
+            for m in 1..=crate::passes::ao::MAX_DEINTERLEAVE {
+                let text = format!("{n}x{m}");
+                let v = named_value("deinterleave", &text).unwrap_or_else(|| panic!("{text} is not a value"));
+                let mut s = ao.settings(&RenderSettings::default(), None).unwrap();
+                ao.set(&mut s, "deinterleave", v).unwrap();
+                assert_eq!(s.ao.as_ref().unwrap().deinterleave, Some([n, m]), "{text}");
+                assert_eq!((info.get)(&s), Some(v), "{text}");
+                seen.push(v);
+            }
+        }
+        seen.sort_by(f64::total_cmp);
+        seen.dedup();
+        assert_eq!(seen.len(), 16);
+        // the values that were the only ones keep their meaning
+        for (v, text) in [(0.0, "off"), (1.0, "2x2"), (2.0, "3x3"), (3.0, "4x4")] {
+            assert_eq!(named_value("deinterleave", text), Some(v));
+        }
+    }
 
     #[test]
     fn auto_guard_band_is_the_techniques_default_and_an_explicit_one_wins() {

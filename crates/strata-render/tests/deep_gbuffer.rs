@@ -420,7 +420,10 @@ fn invalid_settings_are_errors_naming_the_parameter() {
             },
             GuardBand::default(),
         );
-        assert!(e.contains(&format!("layer-scale {scale}")) && e.contains("1..=4"), "{e}");
+        assert!(
+            e.contains(&format!("layer-scale {scale}")) && e.contains("1..=4"),
+            "{e}"
+        );
     }
     let e = try_new(
         DeepGBufferSettings {
@@ -662,7 +665,7 @@ fn reduced_renderer(gpu: &GpuContext, scene: &Scene, k: u32, v: Variant, scale: 
 
 #[test]
 fn reduced_layers_keep_the_separation_and_equal_their_cpu_twin() {
-    use strata_render::passes::deep_gbuffer::{upsample_pick, SURFACE_TOLERANCE};
+    use strata_render::passes::deep_gbuffer::{texel_plane_depth, upsample_depth, upsample_pick, SURFACE_TOLERANCE};
     let gpu = common::gpu();
     let atrium = static_scenes().pop().unwrap();
     let dz = atrium.settings.min_separation;
@@ -690,17 +693,42 @@ fn reduced_layers_keep_the_separation_and_equal_their_cpu_twin() {
             "{what}: reduced size"
         );
         let (albedo, reduced_albedo) = (layer("albedo", j as u32), layer("reduced-albedo", 0));
-        let mut taken = 0;
+        let reduced_normal = layer("reduced-normal", 0);
+        let f = r.frame_uniforms();
+        let (mut taken, mut planar, mut edges) = (0, 0, 0);
         for y in 0..h {
             for x in 0..w {
                 let i = (y * w + x) as usize;
-                let pick = upsample_pick(&reduced.data, [reduced.width, reduced.height], [x, y], csz[j - 1][i], s, dz);
+                let pick = upsample_pick(
+                    &reduced.data,
+                    [reduced.width, reduced.height],
+                    [x, y],
+                    csz[j - 1][i],
+                    s,
+                    dz,
+                );
                 match pick {
                     None => assert_eq!(csz[j][i], 0.0, "{what}: pixel ({x}, {y}) should be empty"),
                     Some([qx, qy]) => {
                         taken += 1;
                         let q = (qy * reduced.width + qx) as usize;
-                        assert_eq!(csz[j][i], reduced.data[q], "{what}: pixel ({x}, {y}) takes texel ({qx}, {qy})");
+                        let nq = &reduced_normal.data[q * 4..q * 4 + 2];
+                        let n = strata_render::packing::oct_decode(glam::Vec2::new(nq[0], nq[1]));
+                        let (zt, front) = (reduced.data[q], csz[j - 1][i]);
+                        let want = upsample_depth(&f, [qx, qy], s, zt, n, [x, y], front, dz);
+                        let got = csz[j][i];
+                        let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * b.abs();
+                        // where the plane's depth lies on a threshold (the separation, or the
+                        // largest change), GPU and CPU rounding may decide either way
+                        let plane = texel_plane_depth(&f, [qx, qy], s, zt, n, [x, y]);
+                        let knife_edge = close(plane, front + dz + SURFACE_TOLERANCE * front)
+                            || close((plane - zt).abs(), 0.25 * zt);
+                        assert!(
+                            close(got, want) || (knife_edge && (close(got, plane) || got == zt)),
+                            "{what}: pixel ({x}, {y}) takes texel ({qx}, {qy}): depth {got} vs {want}"
+                        );
+                        edges += (!close(got, want)) as usize;
+                        planar += (want != reduced.data[q]) as usize;
                         for c in 0..4 {
                             let (a, b) = (albedo.data[i * 4 + c], reduced_albedo.data[q * 4 + c]);
                             assert!((a - b).abs() <= 0.5 / 255.0, "{what}: albedo of ({x}, {y}): {a} vs {b}");
@@ -709,13 +737,28 @@ fn reduced_layers_keep_the_separation_and_equal_their_cpu_twin() {
                 }
             }
         }
-        assert!(taken > (w * h / 10) as usize, "{what}: layer {j} nearly empty ({taken} px)");
+        assert!(
+            taken > (w * h / 10) as usize,
+            "{what}: layer {j} nearly empty ({taken} px)"
+        );
+        assert!(
+            edges * 1000 < taken,
+            "{what}: {edges} of {taken} pixels decided differently"
+        );
+        // most pixels take their depth from the texel's plane, not its centre
+        assert!(
+            planar * 2 > taken,
+            "{what}: {planar} of {taken} pixels on their texel's plane"
+        );
         // its hardware depth is that of the same point: reversed-Z infinite, near / z
         let depth = layer("depth", j as u32).data;
         let near = atrium.camera.near;
         for (i, (&d, &z)) in depth.iter().zip(&csz[j]).enumerate() {
             let want = if z > 0.0 { near / z } else { 0.0 };
-            assert!((d - want).abs() <= 1e-6 * want, "{what}: depth of pixel {i}: {d} vs {want}");
+            assert!(
+                (d - want).abs() <= 1e-6 * want,
+                "{what}: depth of pixel {i}: {d} vs {want}"
+            );
         }
         // the peel's oracle at a reduced fragment: layer j − 1 at the full-resolution pixel a
         // quarter pixel up-left of its centre (i + 1/2)·s; past the 1/s viewport nothing is drawn
@@ -753,7 +796,7 @@ fn reduced_layers_keep_the_separation_and_equal_their_cpu_twin() {
         let pct = 100.0 * differ as f64 / counted as f64;
         println!("{what}: {pct:.1} % of layer {j}'s pixels hold another surface than at full resolution");
         // 640×360 (2026-11-29): 6.6 % at s = 2, 8.4 % at s = 3, 12.3 % at s = 4 (k = 2)
-        assert!(pct < 5.0 * s as f64, "{what}: {pct:.1} % of layer {j} lost");
+        assert!(pct < 6.0 * s as f64, "{what}: {pct:.1} % of layer {j} lost");
         lost.push(pct);
     }
     // a coarser layer loses more: peel k = 2 at s = 2 against s = 3

@@ -201,7 +201,16 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
         } else {
             "per-layer"
         };
-        rows.push((m.name, layer1, layer2, total, mismatch, multiview_total, upsample, submission));
+        rows.push((
+            m.name,
+            layer1,
+            layer2,
+            total,
+            mismatch,
+            multiview_total,
+            upsample,
+            submission,
+        ));
     }
 
     Ok(DeepBench {

@@ -3,8 +3,10 @@
 
 use wgpu::util::DeviceExt;
 
+use glam::Vec3;
+
 use super::{DeepGBufferSettings, DEPTH_FORMAT, REDUCED, SURFACE_TOLERANCE};
-use crate::frame::{Pass, PassInfo, Targets};
+use crate::frame::{FrameUniforms, Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
 use crate::scene_gpu::GpuScene;
 
@@ -34,7 +36,13 @@ pub struct LayerUpsamplePass {
 const NAMES: [&str; 4] = ["", "layer1-upsample", "layer2-upsample", "layer3-upsample"];
 
 impl LayerUpsamplePass {
-    pub fn new(gpu: &GpuContext, targets: &Targets, settings: &DeepGBufferSettings, layer: u32) -> Self {
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        settings: &DeepGBufferSettings,
+        layer: u32,
+    ) -> Self {
         let device = &gpu.device;
         let motion = targets.try_get("motion").is_some();
         let module = crate::shader::module(device, "layer_upsample", include_str!("layer_upsample.wgsl"));
@@ -86,7 +94,7 @@ impl LayerUpsamplePass {
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("layer_upsample"),
-            bind_group_layouts: &[Some(&group_layout)],
+            bind_group_layouts: &[Some(&group_layout), Some(&scene.frame_layout)],
             immediate_size: 0,
         });
         let mut color_targets = crate::passes::color_targets(&settings.outputs()[1..5]);
@@ -154,7 +162,7 @@ impl Pass for LayerUpsamplePass {
         }
     }
 
-    fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+    fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         let view = |name: &str| targets.get(name).layer(self.layer);
         let color = |name: &str| crate::passes::clear_attachment(view(name));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -180,6 +188,7 @@ impl Pass for LayerUpsamplePass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.group, &[]);
+        pass.set_bind_group(1, &scene.frame_bind_group, &[]);
         pass.draw(0..3, 0..1);
     }
 }
@@ -223,6 +232,42 @@ pub fn upsample_pick(
         }
     }
     best.map(|(t, _)| [t[0] as u32, t[1] as u32])
+}
+
+/// The depth at full-resolution pixel `p` of the plane through reduced texel `t`'s point
+/// (depth `z_t`) with world normal `n`, before [`upsample_depth`]'s checks.
+pub fn texel_plane_depth(f: &FrameUniforms, t: [u32; 2], scale: u32, z_t: f32, n: Vec3, p: [u32; 2]) -> f32 {
+    let dir = |pix: [f32; 2]| crate::passes::ao::world_from_csz(f, pix, 1.0) - Vec3::new(f.eye[0], f.eye[1], f.eye[2]);
+    let s = scale as f32;
+    let d_t = dir([(t[0] as f32 + 0.5) * s, (t[1] as f32 + 0.5) * s]);
+    let d_p = dir([p[0] as f32 + 0.5, p[1] as f32 + 0.5]);
+    z_t * n.dot(d_t) / n.dot(d_p)
+}
+
+/// `MAX_PLANE_CHANGE` in `layer_upsample.wgsl`.
+const MAX_PLANE_CHANGE: f32 = 0.25;
+
+/// CPU twin of `plane_depth` in `layer_upsample.wgsl`: the depth full-resolution pixel `p`
+/// of layer j takes from reduced texel `t` (depth `z_t` at its centre, world normal `n`):
+/// where p's ray meets the plane through the texel's point with its normal, or `z_t` where
+/// that changes the depth by more than a quarter or breaks the separation from `z_front`.
+#[allow(clippy::too_many_arguments)]
+pub fn upsample_depth(
+    f: &FrameUniforms,
+    t: [u32; 2],
+    scale: u32,
+    z_t: f32,
+    n: Vec3,
+    p: [u32; 2],
+    z_front: f32,
+    min_separation: f32,
+) -> f32 {
+    let z = texel_plane_depth(f, t, scale, z_t, n, p);
+    let behind = z > 0.0 && z > z_front + min_separation + SURFACE_TOLERANCE * z_front;
+    if !((z - z_t).abs() <= MAX_PLANE_CHANGE * z_t) || !behind {
+        return z_t;
+    }
+    z
 }
 
 #[cfg(test)]

@@ -10,8 +10,15 @@
 // - else the nearest such surface among q's 8 neighbours (the layer is the
 //   nearest surface beyond the separation), first in row order on ties;
 // - else no surface (also where layer j − 1 has none).
-// Rust twin: deep_gbuffer::upsample_pick.
+// Its depth at p is not the texel's own: that belongs to the texel's centre, up to
+// 1.5·s pixels away, and on p's ray it would put the point off its surface (a
+// staircase, which AO taps read as occluders). It is where p's ray meets the plane
+// through the texel's point with the texel's normal, unless that plane is seen too
+// obliquely or breaks the separation (then the texel's depth).
+// Rust twins: deep_gbuffer::upsample_pick, deep_gbuffer::upsample_depth.
 #import "common/fullscreen.wgsl"
+#import "common/camera.wgsl"
+#import "common/packing.wgsl"
 
 struct UpsampleParams {
     // minimum separation Δz, scene units
@@ -32,6 +39,7 @@ struct UpsampleParams {
 @group(0) @binding(5) var reduced_motion: texture_2d<f32>;
 // this frame's layer j − 1 at full resolution
 @group(0) @binding(6) var front_csz: texture_2d<f32>;
+@group(1) @binding(0) var<uniform> frame: Frame;
 
 // deep_gbuffer::SURFACE_TOLERANCE
 const SURFACE_TOLERANCE: f32 = 1e-4;
@@ -70,6 +78,22 @@ fn pick(p: vec2i) -> vec2i {
     return best;
 }
 
+// Largest relative change of a texel's depth the plane may make (beyond: seen too obliquely).
+const MAX_PLANE_CHANGE: f32 = 0.25;
+
+// Camera-space depth at full-resolution pixel position `p` of the plane through reduced
+// texel t's surface point (depth z_t at its centre) with world normal n.
+fn plane_depth(t: vec2i, z_t: f32, n: vec3f, p: vec2f, z_front: f32) -> f32 {
+    let d_t = pixel_dir(frame, (vec2f(t) + 0.5) * f32(params.scale));
+    let d_p = pixel_dir(frame, p);
+    let z = z_t * dot(n, d_t) / dot(n, d_p);
+    // (NaN, infinite or negative depths fail the first test)
+    if (!(abs(z - z_t) <= MAX_PLANE_CHANGE * z_t) || !is_behind(z, z_front)) {
+        return z_t;
+    }
+    return z;
+}
+
 struct LayerOut {
     @location(0) csz: f32,
     @location(1) normal: vec4f,
@@ -81,15 +105,17 @@ struct LayerOut {
 
 @fragment
 fn fs_upsample(@builtin(position) pos: vec4f) -> LayerOut {
-    let t = pick(vec2i(floor(pos.xy)));
+    let p = vec2i(floor(pos.xy));
+    let t = pick(p);
     // no surface: the values a geometry pass clears to
     var o: LayerOut;
     o.depth = 0.0;
     if (t.x < 0) {
         return o;
     }
-    o.csz = textureLoad(reduced_csz, t, 0).r;
     o.normal = textureLoad(reduced_normal, t, 0);
+    let z_front = textureLoad(front_csz, p, 0).r;
+    o.csz = plane_depth(t, textureLoad(reduced_csz, t, 0).r, oct_decode(o.normal.xy), pos.xy, z_front);
     o.albedo = textureLoad(reduced_albedo, t, 0);
     o.emission = textureLoad(reduced_emission, t, 0);
     o.motion = textureLoad(reduced_motion, t, 0);

@@ -49,7 +49,7 @@ use crate::scene_gpu::{GpuScene, NextTransforms, VERTEX_LAYOUT};
 use crate::RenderError;
 
 mod layer_upsample;
-pub use layer_upsample::{upsample_pick, LayerUpsamplePass};
+pub use layer_upsample::{texel_plane_depth, upsample_depth, upsample_pick, LayerUpsamplePass};
 
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Most layers a deep G-buffer can have (DGB §5 generalises to k layers).
@@ -276,7 +276,12 @@ impl DeepGBufferSettings {
             .take(5)
             .map(|&(name, of)| {
                 let d = full.iter().find(|d| d.name == of).expect("a G-buffer target");
-                TargetDesc::new(name, d.format, 1, "a layer >= 1 at the reduced resolution (layer-scale)")
+                TargetDesc::new(
+                    name,
+                    d.format,
+                    1,
+                    "a layer >= 1 at the reduced resolution (layer-scale)",
+                )
             })
             .collect();
         if motion {
@@ -624,7 +629,9 @@ pub fn geometry_passes(
     let layer = |v: &mut Vec<GeometryStep>, pass: GeometryStep, j: u32| {
         v.push(pass);
         if reduced {
-            v.push(GeometryStep::Upsample(LayerUpsamplePass::new(gpu, targets, settings, j)));
+            v.push(GeometryStep::Upsample(LayerUpsamplePass::new(
+                gpu, scene, targets, settings, j,
+            )));
         }
     };
 
