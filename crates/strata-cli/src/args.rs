@@ -663,11 +663,13 @@ impl FrameArgs {
     /// One line per flag given on the command line that `settings` (the technique's,
     /// resolved) does not read: the AO flags without the deep-G-buffer AO (the
     /// radius, bias and intensity carry over to `aba-ao` and the radius and bias to `bzb-ao`),
-    /// the radiosity flags and `--no-probes` without the radiosity, and `--variant` and
-    /// `--layer-scale` without a second layer. `render` prints them as warnings and renders: the command `strata view`
-    /// prints for a frame keeps the flags given to it across technique switches. (`eval`
+    /// the radiosity flags and `--no-probes` without the radiosity, `--variant` and
+    /// `--layer-scale` without a second layer, and `--layers` above 1 where no pass reads a
+    /// second layer (ILS, the A-buffer techniques, `bzb-ao`, `direct`) and no debug view
+    /// (`debug_view`) may show one. `render` prints them as warnings and renders: the command
+    /// `strata view` prints for a frame keeps the flags given to it across technique switches. (`eval`
     /// refuses the flags of its own that a comparison does not read.)
-    pub fn unread_flags(&self, settings: &strata_render::RenderSettings) -> Vec<String> {
+    pub fn unread_flags(&self, settings: &strata_render::RenderSettings, debug_view: bool) -> Vec<String> {
         let longs = |c: clap::Command| -> Vec<(String, String)> {
             c.get_arguments()
                 .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?.to_string())))
@@ -697,6 +699,16 @@ impl FrameArgs {
             "no-probes".into(),
             radiosity,
             "the deep-G-buffer radiosity",
+        ));
+        // the stages that read layers >= 1 (the deep-G-buffer AO, radiosity, mirror reflections
+        // and bzb-gi's visibility)
+        let reads_layers =
+            dgb_ao || radiosity || settings.reflections.is_some() || settings.bzb_gi.is_some() || debug_view;
+        flags.push((
+            "layers".into(),
+            "layers".into(),
+            reads_layers || settings.deep.layers < 2,
+            "a pass that reads a second deep-G-buffer layer",
         ));
         for (id, long) in [("variant", "variant"), ("layer_scale", "layer-scale")] {
             flags.push((

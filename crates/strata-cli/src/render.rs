@@ -66,7 +66,7 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
 pub fn run(a: &RenderArgs) -> Result<()> {
     let f = &a.frame;
     let (scene, cams, settings) = prepare(f)?;
-    for w in f.unread_flags(&settings) {
+    for w in f.unread_flags(&settings, a.debug_view.is_some()) {
         eprintln!("strata: warning: {w}");
     }
     if a.list_lights {

@@ -137,6 +137,10 @@ fn render_warns_of_flags_its_technique_does_not_read() {
             &["--technique", "ao", "--layer-scale", "2"][..],
             &["--layer-scale", "second"][..],
         ),
+        (
+            &["--technique", "ils", "--layers", "2"][..],
+            &["--layers", "ils", "second"][..],
+        ),
     ] {
         let w = warnings(extra);
         assert_eq!(w.len(), 1, "{extra:?}: {w:?}");

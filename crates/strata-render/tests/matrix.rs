@@ -217,6 +217,45 @@ fn algorithm_switching_settings_render_cleanly() {
     );
 }
 
+/// Reduced-resolution layers (`DeepGBufferSettings::layer_scale`, DGB Fig. 11) under every
+/// registered technique: the reduced targets, their upsampling and every pass that reads
+/// the layers render cleanly, at an odd scale that does not divide the size (64 = 3·21 + 1).
+#[test]
+fn every_technique_renders_cleanly_with_reduced_layers() {
+    let gpu = common::gpu();
+    let mut runs = 0;
+    for scene_name in ["cornell", "atrium"] {
+        let scene = procedural::builtin(scene_name).expect("built-in scene");
+        let vpls = scene_vpls(&scene);
+        for t in registry() {
+            for (layers, variant, layer_scale) in [(2, Variant::Reproject, 3), (3, Variant::Peel, 2)] {
+                let base = RenderSettings {
+                    width: 64,
+                    height: 64,
+                    deep: DeepGBufferSettings {
+                        layers,
+                        variant,
+                        layer_scale,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let mut s = t.settings(&base, None).expect("default settings");
+                if s.radiosity.is_some() {
+                    s.probes = Some(probes(&scene));
+                }
+                if let Some(ils) = &mut s.ils {
+                    ils.vpls = vpls.clone();
+                }
+                let what = format!("{scene_name} {} k={layers} {variant} layer-scale {layer_scale}", t.name);
+                check(&gpu, &scene, s, t.passes, &what);
+                runs += 1;
+            }
+        }
+    }
+    assert_eq!(runs, 2 * 2 * registry().len());
+}
+
 /// The values at the ends of a declared range that a user can type (`Range::ends`),
 /// and for an unbounded range a large one too (10³ × the lower end, at least 10³).
 fn range_ends(range: Range, integer: bool) -> Vec<f64> {

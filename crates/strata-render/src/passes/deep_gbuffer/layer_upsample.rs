@@ -264,7 +264,9 @@ pub fn upsample_depth(
 ) -> f32 {
     let z = texel_plane_depth(f, t, scale, z_t, n, p);
     let behind = z > 0.0 && z > z_front + min_separation + SURFACE_TOLERANCE * z_front;
-    if !((z - z_t).abs() <= MAX_PLANE_CHANGE * z_t) || !behind {
+    // (false for NaN, as the WGSL test)
+    let small_change = (z - z_t).abs() <= MAX_PLANE_CHANGE * z_t;
+    if !small_change || !behind {
         return z_t;
     }
     z
