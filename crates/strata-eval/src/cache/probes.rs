@@ -75,15 +75,64 @@ pub fn scene_probes(scene: &Scene, bake: ProbeBake, cache: &RefCache, quiet: boo
         bounces: BOUNCES,
         ..Default::default()
     };
+    // a large scene spends minutes in the BVH build before the first path: say so
+    let triangles = scene.triangle_count();
+    let step = Step::start(quiet, format!("building the BVH of {triangles} triangles"));
     let reference = Reference::new(scene, 0.0);
+    step.finish();
+    let step = Step::start(
+        quiet,
+        format!("tracing {} probes × {rays} paths", grid.iter().product::<u32>()),
+    );
     let probes = match scene.settings.probe_bounds {
         Some([lo, hi]) => reference.bake_grid(IrradianceProbes::grid(lo.into(), hi.into(), grid), rays, &settings),
         None => reference.bake_probes(grid, rays, &settings),
     };
+    step.finish();
     if let Err(e) = cache.store(&key, &encode(&probes), &description) {
         tracing::warn!("could not cache the light probes: {e:#}");
     }
     Ok(probes)
+}
+
+/// One step of a bake shown while it runs: a spinner with the elapsed time on a terminal;
+/// elsewhere (logs, pipes) one line when it ends, if it took 5 s or more.
+struct Step {
+    bar: indicatif::ProgressBar,
+    what: String,
+    start: std::time::Instant,
+    quiet: bool,
+}
+
+impl Step {
+    fn start(quiet: bool, what: String) -> Self {
+        use std::io::IsTerminal;
+        let bar = if quiet || !std::io::stderr().is_terminal() {
+            indicatif::ProgressBar::hidden()
+        } else {
+            let bar = indicatif::ProgressBar::new_spinner();
+            if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg}… {elapsed}") {
+                bar.set_style(style);
+            }
+            bar.set_message(what.clone());
+            bar.enable_steady_tick(std::time::Duration::from_millis(200));
+            bar
+        };
+        Self {
+            bar,
+            what,
+            start: std::time::Instant::now(),
+            quiet,
+        }
+    }
+
+    fn finish(self) {
+        self.bar.finish_and_clear();
+        let s = self.start.elapsed().as_secs_f64();
+        if !self.quiet && self.bar.is_hidden() && s >= 5.0 {
+            eprintln!("{}: {s:.0} s", self.what);
+        }
+    }
 }
 
 /// Floats per row: 27 coefficients, the validity, the distance map's moments, the
