@@ -257,9 +257,10 @@ fn print_deep(d: &DeepBench, f0: f32) {
             or_dash(row.multiview_total_ms)
         );
     }
-    println!("(peel, and single-pass methods with a multiview column, ran one submission per layer)");
     if d.layer_scale > 1 {
-        println!("(layer2 ms includes the upsampling of the reduced layers into the full-resolution arrays)");
+        println!("(every method ran one submission per layer, as a reduced layer needs; layer2 ms includes the upsampling of the reduced layers into the full-resolution arrays, which also checks every method's layer against this frame's layer 0 as the peel does)");
+    } else {
+        println!("(peel, and single-pass methods with a multiview column, ran one submission per layer)");
     }
 }
 

@@ -757,7 +757,8 @@ impl Renderer {
             }
         }
         let history = (!copies.is_empty()).then_some(HistoryPass { copies });
-        let profiler = Profiler::new(gpu, 32);
+        // (a technique's passes, up to 4 geometry passes and 3 reduced layers' upsampling)
+        let profiler = Profiler::new(gpu, 48);
         let animated = scene.animated();
         // nothing moves: the shadow maps of frame 0 serve every frame (an animated
         // scene's `update` re-renders them each frame)

@@ -432,7 +432,7 @@ static AO_SETTINGS: [SettingInfo; 18] = [
     ),
     SettingInfo {
         name: "deinterleave",
-        doc: "deinterleaved AO (issue 11 item 8): ILS split into n x n sub-buffers, sub-buffer s = i + n*j evaluates the spiral taps k with k mod n*n = s, then gather + the same temporal/bilateral (off = one full-resolution pass)",
+        doc: "deinterleaved AO (issue 11 item 8): ILS split into n x m sub-buffers, sub-buffer s = i + n*j evaluates the spiral taps k with k mod n*m = s, then gather + the same temporal/bilateral (off = one full-resolution pass)",
         range: Range::Closed(0.0, DEINTERLEAVE_PATTERNS.len() as f64),
         integer: true,
         get: |s| {
@@ -440,7 +440,15 @@ static AO_SETTINGS: [SettingInfo; 18] = [
                 DEINTERLEAVE_PATTERNS.iter().position(|&q| q == p).map_or(f64::NAN, |i| i as f64 + 1.0)
             }))
         },
-        set: |s, v| ao_mut(s).deinterleave = (v >= 1.0).then(|| DEINTERLEAVE_PATTERNS[v as usize - 1]),
+        // (a value past the table, which `set` refuses, gives a pattern validation refuses)
+        set: |s, v| {
+            ao_mut(s).deinterleave = (v >= 1.0).then(|| {
+                DEINTERLEAVE_PATTERNS
+                    .get(v as usize - 1)
+                    .copied()
+                    .unwrap_or([v as u32 + 1; 2])
+            })
+        },
         values: &[
             "off", "2x2", "3x3", "4x4", "1x1", "1x2", "1x3", "1x4", "2x1", "2x3", "2x4", "3x1", "3x2", "3x4", "4x1",
             "4x2", "4x3",

@@ -848,9 +848,9 @@ fn bad_deinterleave_settings_are_one_line_errors() {
         .unwrap();
     t.set(&mut s, "deinterleave", v).unwrap();
     assert_eq!(s.ao.as_ref().unwrap().deinterleave, Some([4, 4]));
-    let e = t.set(&mut s, "deinterleave", 4.0).unwrap_err().to_string();
+    let e = t.set(&mut s, "deinterleave", 17.0).unwrap_err().to_string();
     assert!(
-        e.contains("deinterleave") && e.contains("0..=3") && !e.contains('\n'),
+        e.contains("deinterleave") && e.contains("0..=16") && !e.contains('\n'),
         "{e}"
     );
 }

@@ -126,7 +126,12 @@ impl EvalSettings {
             scene: self.scene.scene.clone(),
             layers: self.deep.layers,
             variant: self.deep.variant.to_string(),
-            layer_scale: self.deep.layer_scale,
+            // as run: one layer is never reduced
+            layer_scale: if self.deep.is_reduced() {
+                self.deep.layer_scale
+            } else {
+                1
+            },
             width: self.scene.width,
             height: self.scene.height,
             frame: self.scene.frame,

@@ -534,10 +534,15 @@ pub fn pixel_of_world(f: &FrameUniforms, q: Vec3) -> Option<[f32; 2]> {
     Some([(ndc[0] * 0.5 + 0.5) * f.size[0], (0.5 - ndc[1] * 0.5) * f.size[1]])
 }
 
-/// `camera.wgsl`'s `world_from_csz` on the CPU.
-pub fn world_from_csz(f: &FrameUniforms, pix: [f32; 2], z: f32) -> Vec3 {
+/// `camera.wgsl`'s `pixel_dir` on the CPU: the world direction through a pixel position,
+/// scaled so its forward component is 1.
+pub fn pixel_dir(f: &FrameUniforms, pix: [f32; 2]) -> Vec3 {
     let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
     let ndc = [pix[0] * f.size[2] * 2.0 - 1.0, 1.0 - pix[1] * f.size[3] * 2.0];
-    let dir = v(f.cam_forward) + v(f.cam_right) * ndc[0] + v(f.cam_up) * ndc[1];
-    v(f.eye) + dir * z
+    v(f.cam_forward) + v(f.cam_right) * ndc[0] + v(f.cam_up) * ndc[1]
+}
+
+/// `camera.wgsl`'s `world_from_csz` on the CPU.
+pub fn world_from_csz(f: &FrameUniforms, pix: [f32; 2], z: f32) -> Vec3 {
+    Vec3::new(f.eye[0], f.eye[1], f.eye[2]) + pixel_dir(f, pix) * z
 }

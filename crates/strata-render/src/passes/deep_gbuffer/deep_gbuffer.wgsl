@@ -143,8 +143,10 @@ fn passes_min_separation(in: VsOut, layer: u32) -> bool {
     if (deep.scale > 1.0) {
         // A reduced pixel's centre lies on a corner of four full-resolution pixels at even
         // scales; a quarter pixel up-left picks one of them for every fragment, where the
-        // rounding of the reprojected position would flip between two from row to row.
-        c -= vec2f(0.25);
+        // rounding of the reprojected position would flip between two from row to row (at
+        // odd scales it stays in the centre's own pixel). Kept on screen at the left and
+        // top edges.
+        c = max(c - vec2f(0.25), vec2f(0.0));
     }
     if (c.x < 0.0 || c.y < 0.0 || c.x >= frame.size.x || c.y >= frame.size.y) {
         return true;

@@ -237,7 +237,7 @@ pub fn upsample_pick(
 /// The depth at full-resolution pixel `p` of the plane through reduced texel `t`'s point
 /// (depth `z_t`) with world normal `n`, before [`upsample_depth`]'s checks.
 pub fn texel_plane_depth(f: &FrameUniforms, t: [u32; 2], scale: u32, z_t: f32, n: Vec3, p: [u32; 2]) -> f32 {
-    let dir = |pix: [f32; 2]| crate::passes::ao::world_from_csz(f, pix, 1.0) - Vec3::new(f.eye[0], f.eye[1], f.eye[2]);
+    let dir = |pix: [f32; 2]| crate::passes::ao::pixel_dir(f, pix);
     let s = scale as f32;
     let d_t = dir([(t[0] as f32 + 0.5) * s, (t[1] as f32 + 0.5) * s]);
     let d_p = dir([p[0] as f32 + 0.5, p[1] as f32 + 0.5]);
@@ -299,9 +299,13 @@ mod tests {
     }
 
     #[test]
-    fn the_last_reduced_column_covers_an_odd_width() {
-        // a 5-pixel-wide image at s = 2 has ⌈5/2⌉ = 3 reduced columns; pixel 4 is column 2
-        let z = [2.0, 2.0, 3.0];
+    fn an_edge_pixel_takes_its_neighbour_where_the_partial_column_is_empty() {
+        // a 5-pixel-wide image at s = 2 has ⌈5/2⌉ = 3 reduced columns; pixel 4 lies in column
+        // 2, which the geometry pass leaves empty (scissored): column 1 stands in
+        let z = [2.0, 2.5, 0.0];
+        assert_eq!(upsample_pick(&z, [3, 1], [4, 0], 1.0, 2, 0.5), Some([1, 0]));
+        // and where column 2 holds a surface, it is taken
+        let z = [2.0, 2.5, 3.0];
         assert_eq!(upsample_pick(&z, [3, 1], [4, 0], 1.0, 2, 0.5), Some([2, 0]));
     }
 }

@@ -260,7 +260,8 @@ impl DeepGBufferSettings {
 
     /// Size of the reduced layers' targets for a `width` × `height` G-buffer.
     pub fn reduced_size(&self, width: u32, height: u32) -> [u32; 2] {
-        [width.div_ceil(self.layer_scale), height.div_ceil(self.layer_scale)]
+        let s = self.layer_scale.max(1);
+        [width.div_ceil(s), height.div_ceil(s)]
     }
 
     /// The reduced-resolution targets that layers ≥ 1 are rasterised into before their
@@ -797,15 +798,12 @@ impl Pass for GeometryPass {
         });
         if self.reduced {
             // exactly 1/s of the full image, so that reduced pixel i's centre is full-resolution
-            // (i + 1/2)·s for any size (a last partial column or row stays empty)
-            pass.set_viewport(
-                0.0,
-                0.0,
-                targets.width as f32 / self.scale,
-                targets.height as f32 / self.scale,
-                0.0,
-                1.0,
-            );
+            // (i + 1/2)·s for any size; a last partial column or row, whose centre lies on or
+            // past the viewport's edge, is scissored off so that it stays empty on every
+            // rasteriser (the upsampling takes its neighbours)
+            let (w, h) = (targets.width as f32 / self.scale, targets.height as f32 / self.scale);
+            pass.set_viewport(0.0, 0.0, w, h, 0.0, 1.0);
+            pass.set_scissor_rect(0, 0, (w.floor() as u32).max(1), (h.floor() as u32).max(1));
         }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &scene.frame_bind_group, &[]);
