@@ -711,6 +711,16 @@ fn scripted_technique_and_debug_view_switch_match_render() {
     // normals as colours: not grey
     let (_, _, p) = rgb(&normal);
     assert!(p.chunks_exact(3).filter(|c| c[0] != c[1] || c[1] != c[2]).count() > p.len() / 3 / 4);
+    // a reduced second layer (DGB Fig. 11) from the script, as the panel's 1/s sets it
+    let script = "layers 2\nlayer-scale 2\ndebug-view layer1-normal\nwait 2\n";
+    let (o, reduced) = view(&x, &dir, "reduced", 4, Some(script), &base);
+    ok(&o);
+    let line = run_cmd_txt(&reduced, &dir.join("reduced-render.png"));
+    assert!(
+        line.contains("--layers 2") && line.contains("--layer-scale 2"),
+        "{line}"
+    );
+    assert!(flip(&reduced, &dir.join("reduced-render.png")) < FLIP_BOUND);
 }
 
 #[test]

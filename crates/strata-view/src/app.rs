@@ -339,6 +339,11 @@ impl App {
                     s.variant = v;
                     self.apply_spec(s, None);
                 }
+                Action::LayerScale(n) => {
+                    let mut s = self.spec.clone();
+                    s.layer_scale = n;
+                    self.apply_spec(s, None);
+                }
                 Action::GuardBand(g) => {
                     let mut s = self.spec.clone();
                     s.guard_band = g;

@@ -39,6 +39,8 @@ pub struct RenderSpec {
     pub preset: Option<String>,
     pub layers: u32,
     pub variant: String,
+    /// `--layer-scale`: resolution divisor of layers ≥ 1 (DGB Fig. 11; 1 = full resolution).
+    pub layer_scale: u32,
     pub guard_band: String,
     /// `--set NAME=VALUE` in order (a later one wins).
     pub sets: Vec<(String, String)>,
@@ -57,6 +59,9 @@ impl RenderSpec {
         // one layer has no second layer to build
         if self.layers >= 2 {
             a.extend(["--variant".to_string(), self.variant.clone()]);
+            if self.layer_scale > 1 {
+                a.extend(["--layer-scale".to_string(), self.layer_scale.to_string()]);
+            }
         }
         a.extend(["--guard-band".to_string(), self.guard_band.clone()]);
         a.extend(self.extra.iter().cloned());
@@ -95,6 +100,7 @@ pub enum Action {
     Preset(String),
     Layers(u32),
     Variant(String),
+    LayerScale(u32),
     GuardBand(String),
     /// A technique setting by name, value as typed (a number or a named value).
     Set(String, String),

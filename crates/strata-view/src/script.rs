@@ -8,7 +8,7 @@
 //! wheel 2              wheel notches (fly: speed; orbit: distance)
 //! mode orbit           fly | orbit
 //! technique ao         any registered technique
-//! preset balanced | layers 2 | variant peel | guard-band 10% | set samples 32
+//! preset balanced | layers 2 | variant peel | layer-scale 2 | guard-band 10% | set samples 32
 //! debug-view layer0-normal   (final = the technique's output)
 //! open PATH            load a glTF/GLB/OBJ/TOML scene (errors keep the current one)
 //! screenshot PATH      save the viewport PNG and PATH.cmd.txt (as F12 does) of the state up
@@ -98,6 +98,7 @@ impl Script {
                 "preset" => act(Action::Preset(arg(0)?.to_string())),
                 "layers" => act(Action::Layers(frames(0)?)),
                 "variant" => act(Action::Variant(arg(0)?.to_string())),
+                "layer-scale" => act(Action::LayerScale(frames(0)?)),
                 "guard-band" => act(Action::GuardBand(arg(0)?.to_string())),
                 "set" => act(Action::Set(arg(0)?.to_string(), arg(1)?.to_string())),
                 "debug-view" => act(Action::DebugView(match arg(0)? {
@@ -150,5 +151,16 @@ mod tests {
         assert!(e.starts_with("line 2:"), "{e}");
         assert!(Script::parse("jump 3").unwrap_err().contains("unknown command"));
         assert!(Script::parse("wait x").unwrap_err().contains("not a frame count"));
+        // the construction's controls, as the panel has them
+        let s = Script::parse("layers 2\nvariant peel\nlayer-scale 2\n").unwrap();
+        let acts: Vec<_> = s.at(0).cloned().collect();
+        assert_eq!(
+            acts,
+            [
+                Event::Action(Action::Layers(2)),
+                Event::Action(Action::Variant("peel".into())),
+                Event::Action(Action::LayerScale(2)),
+            ]
+        );
     }
 }

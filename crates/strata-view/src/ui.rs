@@ -193,6 +193,16 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
                     }
                 }
             });
+        // DGB Fig. 11: layers >= 1 at 1/s resolution
+        let mut s = app.spec.layer_scale;
+        ui.label("1/");
+        if ui
+            .add(egui::DragValue::new(&mut s).range(1..=strata_render::passes::deep_gbuffer::MAX_LAYER_SCALE))
+            .on_hover_text("layer scale: layers >= 1 at 1/s of the resolution (DGB Fig. 11)")
+            .changed()
+        {
+            app.actions.push(Action::LayerScale(s));
+        }
     });
     ui.horizontal(|ui| {
         ui.label("guard band");
