@@ -164,28 +164,7 @@ impl Pass for LayerUpsamplePass {
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         let view = |name: &str| targets.get(name).layer(self.layer);
-        let color = |name: &str| crate::passes::clear_attachment(view(name));
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(self.name),
-            color_attachments: &[
-                color("csz"),
-                color("normal"),
-                color("albedo"),
-                color("emission"),
-                self.motion.then(|| color("motion")).flatten(),
-            ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: view("depth"),
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = super::begin_layer_pass(encoder, self.name, view, self.motion, None);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.group, &[]);
         pass.set_bind_group(1, &scene.frame_bind_group, &[]);

@@ -774,28 +774,8 @@ impl Pass for GeometryPass {
                 (None, false) => t.layer(self.first_layer),
             }
         };
-        let color = |name: &str| crate::passes::clear_attachment(view(name));
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(self.name),
-            color_attachments: &[
-                color("csz"),
-                color("normal"),
-                color("albedo"),
-                color("emission"),
-                self.motion.then(|| color("motion")).flatten(),
-            ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: view("depth"),
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: (self.views > 1).then(|| NonZeroU32::new((1u32 << self.views) - 1).expect("views > 0")),
-        });
+        let mask = (self.views > 1).then(|| NonZeroU32::new((1u32 << self.views) - 1).expect("views > 0"));
+        let mut pass = begin_layer_pass(encoder, self.name, view, self.motion, mask);
         if self.reduced {
             // exactly 1/s of the full image, so that reduced pixel i's centre is full-resolution
             // (i + 1/2)·s for any size; a last partial column or row, whose centre lies on or
@@ -810,6 +790,40 @@ impl Pass for GeometryPass {
         pass.set_bind_group(3, &self.group, &[]);
         scene.draw_all(&mut pass, 1, Some(2));
     }
+}
+
+/// A render pass that clears and writes a layer's G-buffer attachments (`csz`, `normal`,
+/// `albedo`, `emission`, `motion` where it exists, and `depth`), each named view from `view`:
+/// the geometry passes and the reduced layers' upsampling.
+pub(crate) fn begin_layer_pass<'a, 'v>(
+    encoder: &'a mut wgpu::CommandEncoder,
+    label: &str,
+    view: impl Fn(&str) -> &'v wgpu::TextureView,
+    motion: bool,
+    multiview_mask: Option<NonZeroU32>,
+) -> wgpu::RenderPass<'a> {
+    let color = |name: &str| crate::passes::clear_attachment(view(name));
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[
+            color("csz"),
+            color("normal"),
+            color("albedo"),
+            color("emission"),
+            motion.then(|| color("motion")).flatten(),
+        ],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: view("depth"),
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(0.0),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask,
+    })
 }
 
 /// Packs the per-layer arrays into DGB Table 1's layout (`zpack`, `npack`, and
