@@ -31,6 +31,10 @@
 //! DELAY and PREDICT are implemented for k = 2 (the paper's
 //! 2k − 1-view generalisation of PREDICT is not).
 //!
+//! **Reduced layers** (DGB Fig. 11, [`DeepGBufferSettings::layer_scale`]): layers ≥ 1 drawn
+//! at 1/s of the resolution into `reduced-*` targets, then written into the full-resolution
+//! arrays by [`LayerUpsamplePass`], one submission per layer.
+//!
 //! Outputs: per-layer arrays (`csz`, `normal`, `albedo`, `emission`, `depth`;
 //! Delay/Predict add the depth-only predicted layer at index k) and the packed
 //! layout of DGB Table 1 (`zpack` = RG32F camera-space z of layers 0 and 1,
