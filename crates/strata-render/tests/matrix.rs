@@ -111,6 +111,31 @@ fn scene_vpls(scene: &Scene) -> std::sync::Arc<[GpuVpl]> {
         .collect()
 }
 
+/// Technique `t`'s settings with `preset` at 64×64 over the deep G-buffer `deep`, with the
+/// caller's light probes and VPLs (generated once per scene) where it reads them.
+fn configured(
+    t: &strata_render::technique::Technique,
+    preset: Option<&str>,
+    deep: DeepGBufferSettings,
+    scene: &Scene,
+    vpls: &std::sync::Arc<[GpuVpl]>,
+) -> RenderSettings {
+    let base = RenderSettings {
+        width: 64,
+        height: 64,
+        deep,
+        ..Default::default()
+    };
+    let mut s = t.settings(&base, preset).expect("registered presets configure");
+    if s.radiosity.is_some() {
+        s.probes = Some(probes(scene));
+    }
+    if let Some(ils) = &mut s.ils {
+        ils.vpls = vpls.clone();
+    }
+    s
+}
+
 #[test]
 fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
     let gpu = common::gpu();
@@ -129,24 +154,12 @@ fn every_technique_preset_layer_count_and_variant_renders_cleanly() {
             };
             for preset in presets {
                 for &(layers, variant) in &configs {
-                    let base = RenderSettings {
-                        width: 64,
-                        height: 64,
-                        deep: DeepGBufferSettings {
-                            layers,
-                            variant,
-                            ..Default::default()
-                        },
+                    let deep = DeepGBufferSettings {
+                        layers,
+                        variant,
                         ..Default::default()
                     };
-                    let mut s = t.settings(&base, preset).expect("registered presets configure");
-                    if s.radiosity.is_some() {
-                        s.probes = Some(probes(&scene));
-                    }
-                    if let Some(ils) = &mut s.ils {
-                        // the caller's VPLs, as the probes are (generated once per scene)
-                        ils.vpls = vpls.clone();
-                    }
+                    let s = configured(t, preset, deep, &scene, &vpls);
                     let what = format!("{scene_name} {} {} k={layers} {variant}", t.name, preset.unwrap_or("-"));
                     images += check(&gpu, &scene, s, t.passes, &what);
                     runs += 1;
@@ -229,24 +242,13 @@ fn every_technique_renders_cleanly_with_reduced_layers() {
         let vpls = scene_vpls(&scene);
         for t in registry() {
             for (layers, variant, layer_scale) in [(2, Variant::Reproject, 3), (3, Variant::Peel, 2)] {
-                let base = RenderSettings {
-                    width: 64,
-                    height: 64,
-                    deep: DeepGBufferSettings {
-                        layers,
-                        variant,
-                        layer_scale,
-                        ..Default::default()
-                    },
+                let deep = DeepGBufferSettings {
+                    layers,
+                    variant,
+                    layer_scale,
                     ..Default::default()
                 };
-                let mut s = t.settings(&base, None).expect("default settings");
-                if s.radiosity.is_some() {
-                    s.probes = Some(probes(&scene));
-                }
-                if let Some(ils) = &mut s.ils {
-                    ils.vpls = vpls.clone();
-                }
+                let s = configured(t, None, deep, &scene, &vpls);
                 let what = format!("{scene_name} {} k={layers} {variant} layer-scale {layer_scale}", t.name);
                 check(&gpu, &scene, s, t.passes, &what);
                 runs += 1;
