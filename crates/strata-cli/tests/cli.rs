@@ -2673,3 +2673,63 @@ fn probe_grid_and_rays_reach_the_bake_and_are_range_checked() {
     let e = run("3,2,2", "512");
     assert!(e.contains("baking 12 light probes (3×2×2, 512 paths each)"), "{e}");
 }
+
+/// `bench deep-gbuffer` (DGB Table 5, Fig. 3) and, with `--layer-scale`, Fig. 11: every method
+/// builds its layers one submission per layer, the upsampling is part of layer 2's time, and
+/// the JSON and the report say the scale.
+#[test]
+fn bench_deep_gbuffer_with_a_reduced_second_layer() {
+    let bench = |scale: &str| {
+        json_of(&strata(&[
+            "bench",
+            "deep-gbuffer",
+            "--scene",
+            "atrium",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--frames",
+            "2",
+            "--layer-scale",
+            scale,
+            "--json",
+        ]))
+    };
+    let full = bench("1");
+    let reduced = bench("2");
+    assert_eq!(full["layer_scale"].as_u64(), Some(1), "{full}");
+    assert_eq!(reduced["layer_scale"].as_u64(), Some(2), "{reduced}");
+    let rows = |v: &serde_json::Value| v["rows"].as_array().unwrap().clone();
+    assert_eq!(rows(&full).len(), 6, "single layer and the five variants");
+    for r in rows(&reduced) {
+        let method = r["method"].as_str().unwrap();
+        assert_eq!(r["submission"], "per-layer", "{r}");
+        assert!(r["multiview_total_ms"].is_null(), "{r}");
+        if method == "single-layer" {
+            assert!(r["upsample_ms"].is_null(), "{r}");
+            continue;
+        }
+        let up = r["upsample_ms"].as_f64().unwrap_or_else(|| panic!("{method}: no upsampling time: {r}"));
+        assert!(up > 0.0 && up < r["layer2_ms"].as_f64().unwrap(), "{r}");
+    }
+    // at full resolution there is no upsampling
+    assert!(rows(&full).iter().all(|r| r["upsample_ms"].is_null()), "{full}");
+    // the report names the scale
+    let dir = scratch("deep-report");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("bench-deep.json"), reduced.to_string()).unwrap();
+    let page = dir.join("report.html");
+    let o = strata(&[
+        "report",
+        "--from",
+        dir.to_str().unwrap(),
+        "--out",
+        page.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("layers ≥ 1 at 1/2 resolution") && html.contains("of which upsampling"));
+}

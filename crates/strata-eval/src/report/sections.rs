@@ -532,12 +532,20 @@ fn stage_section(section: Section, name: &str, s: &StageBench, dir: &Path, prefi
 }
 
 fn deep_section(section: Section, d: &DeepBench, dir: &Path, prefix: &str) -> Result<Section> {
+    let title = match d.layer_scale {
+        1 => format!("Deep G-buffer construction, k = {} (DGB Table 5)", d.layers),
+        sc => format!(
+            "Deep G-buffer construction, k = {}, layers ≥ 1 at 1/{sc} resolution (DGB Table 5, Fig. 11)",
+            d.layers
+        ),
+    };
     let mut t = Table::new(
-        format!("Deep G-buffer construction, k = {} (DGB Table 5)", d.layers),
+        title,
         &[
             "method",
             "layer1 ms",
             "layer2 ms",
+            "of which upsampling ms",
             "total ms",
             "l2/l1",
             "mismatch %",
@@ -550,6 +558,7 @@ fn deep_section(section: Section, d: &DeepBench, dir: &Path, prefix: &str) -> Re
             r.method.clone().into(),
             r.layer1_ms.into(),
             r.layer2_ms.into(),
+            r.upsample_ms.into(),
             r.total_ms.into(),
             (r.layer2_ms / r.layer1_ms).into(),
             r.mismatch_pct.into(),
