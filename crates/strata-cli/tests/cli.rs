@@ -2710,7 +2710,9 @@ fn bench_deep_gbuffer_with_a_reduced_second_layer() {
             assert!(r["upsample_ms"].is_null(), "{r}");
             continue;
         }
-        let up = r["upsample_ms"].as_f64().unwrap_or_else(|| panic!("{method}: no upsampling time: {r}"));
+        let up = r["upsample_ms"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{method}: no upsampling time: {r}"));
         assert!(up > 0.0 && up < r["layer2_ms"].as_f64().unwrap(), "{r}");
     }
     // at full resolution there is no upsampling
