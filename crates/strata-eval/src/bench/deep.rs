@@ -191,12 +191,7 @@ pub fn run(a: &DeepSettings) -> Result<DeepBench> {
         let multiview_total = (!mv.is_empty()).then(|| median_min(&mut mv).0);
         let mut up = m.upsample.clone();
         let upsample = (m.renderer.settings.deep.is_reduced()).then(|| median_min(&mut up).0);
-        let submission = match m.renderer.settings.deep.layers {
-            1 => Submission::PerLayer,
-            _ if m.renderer.settings.deep.variant == Variant::Peel => Submission::PerLayer,
-            _ => m.renderer.settings.deep.submission_on(&gpu),
-        };
-        let submission = if submission == Submission::Multiview {
+        let submission = if m.renderer.settings.deep.submission_on(&gpu) == Submission::Multiview {
             "multiview"
         } else {
             "per-layer"

@@ -97,8 +97,7 @@ impl LayerUpsamplePass {
             bind_group_layouts: &[Some(&group_layout), Some(&scene.frame_layout)],
             immediate_size: 0,
         });
-        let mut color_targets = crate::passes::color_targets(&settings.outputs()[1..5]);
-        color_targets.push(motion.then(|| wgpu::ColorTargetState::from(settings.motion_target().format)));
+        let color_targets = settings.layer_color_targets(motion);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(NAMES[layer as usize]),
             layout: Some(&layout),

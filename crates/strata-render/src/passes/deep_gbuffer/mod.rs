@@ -253,9 +253,10 @@ impl DeepGBufferSettings {
     }
 
     /// How the layers are submitted on `gpu`: [`Submission::Auto`] resolved, and one
-    /// submission per layer when they are built at a reduced resolution.
+    /// submission per layer where there is nothing to share a pass (one layer, the peel) or
+    /// the layers are built at a reduced resolution.
     pub fn submission_on(&self, gpu: &GpuContext) -> Submission {
-        if self.is_reduced() {
+        if !multiview_needed(self) || self.is_reduced() {
             Submission::PerLayer
         } else {
             self.submission.resolve(gpu)
@@ -321,6 +322,14 @@ impl DeepGBufferSettings {
             self.array_layers(),
             "world-space motion of the surface since last frame (rgb; 0 = static): the temporal filters' per-object velocities",
         )
+    }
+
+    /// The colour targets of a pass that writes a layer (`csz`, `normal`, `albedo`, `emission`
+    /// at locations 0–3; location 4, `motion`, only where the target exists).
+    pub(crate) fn layer_color_targets(&self, motion: bool) -> Vec<Option<wgpu::ColorTargetState>> {
+        let mut v = crate::passes::color_targets(&self.outputs()[1..5]);
+        v.push(motion.then(|| wgpu::ColorTargetState::from(self.motion_target().format)));
+        v
     }
 
     /// The targets the deep G-buffer passes write (and [`Self::motion_target`] where it exists).
@@ -578,9 +587,7 @@ pub fn geometry_passes(
             constants: &constants,
             ..Default::default()
         };
-        let mut color_targets = crate::passes::color_targets(&settings.outputs()[1..5]);
-        // location 4 (motion) is written only where the target exists
-        color_targets.push(motion.then(|| wgpu::ColorTargetState::from(settings.motion_target().format)));
+        let color_targets = settings.layer_color_targets(motion);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(name),
             layout: Some(&layout),
