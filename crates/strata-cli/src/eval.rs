@@ -36,6 +36,21 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     if a.moving && (a.views || !(dgb_ao || dgb_gi)) {
         anyhow::bail!("--moving is only read by eval --technique gi, full or ao (the deep-G-buffer radiosity or AO along the camera path, without --views)");
     }
+    // --layer-scale reduces layers >= 1: an error where no configuration builds one (ILS and
+    // the OIT composite shade layer 0 alone; bzb-ao, aba-ao and bzb-gi compare against DGB
+    // with 2 layers)
+    let builds_second_layer = match a.technique.eval {
+        EvalKind::VplRadiance | EvalKind::Composite => false,
+        _ => is_bzb || is_aba || is_bzb_gi || a.deep.layers >= 2,
+    };
+    if a.deep.layer_scale > 1 && !builds_second_layer {
+        anyhow::bail!(
+            "--layer-scale {}: eval --technique {} with --layers {} builds no second layer to reduce (it needs --layers 2..=4, or a technique compared against DGB with 2 layers: bzb-ao, aba-ao, bzb-gi)",
+            a.deep.layer_scale,
+            a.technique.name,
+            a.deep.layers
+        );
+    }
     if a.views {
         return views(a, &s);
     }

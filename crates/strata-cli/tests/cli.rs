@@ -654,6 +654,28 @@ fn eval_rejects_out_of_range_parameters() {
     assert_one_line_error(&o, &["--ref-spp", "2..=65536"]);
 }
 
+/// `eval --layer-scale` where no compared configuration builds a second layer (one layer, ILS,
+/// the OIT composite) is an error naming the flag, not a number measured without it.
+#[test]
+fn eval_refuses_a_layer_scale_without_a_second_layer() {
+    for technique in ["ao", "gi", "ils", "oit"] {
+        let o = strata(&[
+            "eval",
+            "--scene",
+            "plane",
+            "--technique",
+            technique,
+            "--layer-scale",
+            "2",
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ]);
+        assert_one_line_error(&o, &["--layer-scale 2", technique, "--layers 2..=4"]);
+    }
+}
+
 #[test]
 fn bench_ao_splits_first_layer_and_increment() {
     let o = strata(&[
