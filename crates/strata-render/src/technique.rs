@@ -700,7 +700,7 @@ fn ils_of(s: &RenderSettings) -> IlsSettings {
     s.ils.clone().unwrap_or_default()
 }
 
-static ILS_SETTINGS: [SettingInfo; 20] = [
+static ILS_SETTINGS: [SettingInfo; 21] = [
     SettingInfo {
         name: "shadows",
         doc: "VPL visibility: none (SNSM, ILS §6.2) or vpl (SSM: a cube shadow map per VPL, §4.3, §6.3)",
@@ -873,6 +873,14 @@ static ILS_SETTINGS: [SettingInfo; 20] = [
         false,
         |s| Some(ils_of(s).refine_roughness as f64),
         |s, v| ils_mut(s).refine_roughness = v as f32
+    ),
+    setting!(
+        "refine-peak",
+        "ils-refine also shades Lambert pixels whose blur window holds a gathered texel that outshines its own VPL subset one period away by more than this share of the blurred irradiance (a VPL near the receivers: n*m blocks under the blur; 0 = off; not in ILS)",
+        Range::Closed(0.0, 1.0),
+        false,
+        |s| Some(ils_of(s).refine_peak as f64),
+        |s, v| ils_mut(s).refine_peak = v as f32
     ),
     setting!(
         "depth-threshold",

@@ -539,32 +539,40 @@ fn kept_vpl_shadow_maps_match_a_fresh_frame_and_follow_new_vpls() {
 /// radiance, and every other pixel keeps its blurred value, bit for bit. On still-life
 /// (glossy and Lambert receivers, 8×6): t = 0.5 refines pixels of each kind; r = 0.3
 /// alone refines the gold sphere (0.25) and the vase (0.15) and no Lambert pixel. With
-/// SSM the refined pixels test the VPLs' shadow maps as the brute force does.
+/// SSM the refined pixels test the VPLs' shadow maps as the brute force does. With
+/// `refine-peak` = 0.2 the refined pixels are exactly the Lambert receivers [`peaked`] picks
+/// from the read-back gathered and blurred irradiance (VPLs close to the receivers), and
+/// the passes' own window maxima (`ils-peak`) equal the twin's.
 #[test]
 fn refined_pixels_hold_the_brute_force_and_the_others_the_blur() {
     use strata_render::passes::ils::VplShadows;
     let gpu = common::gpu();
     let scene = procedural::builtin("still-life").unwrap();
-    let v = vpls(&scene, 96);
+    let v = vpls(&scene, 480);
     let read = |r: &Renderer, name: &str| {
         let img = r.read_target(&gpu, name).unwrap();
         gpu.check_errors().unwrap();
         img
     };
     for shadows in [VplShadows::None, VplShadows::ShadowMaps] {
-        let settings = |brute_force: bool, refine: f32, refine_roughness: f32| IlsSettings {
+        let settings = |brute_force: bool, refine: f32, refine_roughness: f32, refine_peak: f32| IlsSettings {
             vpls: gpu_vpls(&v),
             brute_force,
             refine,
             refine_roughness,
+            refine_peak,
             shadows,
             vpl_shadow_resolution: 32,
             ..Default::default()
         };
-        let brute = render(&gpu, &scene, settings(true, 0.0, 0.0));
+        let brute = render(&gpu, &scene, settings(true, 0.0, 0.0, 0.0));
         let (bf, bf_glossy) = (read(&brute, "ils-irradiance"), read(&brute, "ils-glossy"));
-        for (t, r) in [(0.5f32, 0.0f32), (0.0, 0.3)] {
-            let refined = render(&gpu, &scene, settings(false, t, r));
+        for (t, r, peak) in [(0.5f32, 0.0f32, 0.0f32), (0.0, 0.3, 0.0), (0.0, 0.0, 0.2)] {
+            let s = settings(false, t, r, peak);
+            let (radius, pattern) = (s.blur_radius(), s.pattern);
+            let refined = render(&gpu, &scene, s);
+            let gathered = read(&refined, "ils-irradiance");
+            let spikes = (peak > 0.0).then(|| read(&refined, "ils-peak"));
             let (blurred, blurred_glossy) = (read(&refined, "indirect"), read(&refined, "ils-glossy-blurred"));
             let (out, out_glossy) = (read(&refined, "ils-refined"), read(&refined, "ils-glossy-refined"));
             let (csz, emission, normal) = (
@@ -572,14 +580,31 @@ fn refined_pixels_hold_the_brute_force_and_the_others_the_blur() {
                 read(&refined, "emission"),
                 read(&refined, "normal"),
             );
-            let (mut kept, mut lambert, mut glossy) = (0, 0, 0);
+            let (mut kept, mut lambert, mut glossy, mut near) = (0, 0, 0, 0);
             let csz_stride = csz.data.len() / (W * H) as usize;
             for i in 0..(W * H) as usize {
                 let px = |img: &ImageBuf| Vec3::from_slice(&img.data[i * 4..i * 4 + 3]);
                 let is_glossy = emission.data[i * 4 + 3] > 1.5;
                 let sharp = is_glossy && normal.data[i * 4 + 2] < r;
-                let case = format!("{shadows:?}, refine {t}, refine-roughness {r}: pixel {i}");
-                if csz.data[i * csz_stride] <= 0.0 || (blurred.data[i * 4 + 3] >= t && !sharp) {
+                let case = format!("{shadows:?}, refine {t}, refine-roughness {r}, refine-peak {peak}: pixel {i}");
+                let p = [i as u32 % W, i as u32 / W];
+                let peak_test = if peak > 0.0 {
+                    let largest = largest_spike(&gathered, p, pattern, radius);
+                    let spikes = spikes.as_ref().unwrap();
+                    assert_eq!(spikes.data[i * spikes.channels as usize], largest, "{case}: ils-peak");
+                    if is_glossy {
+                        Some(false)
+                    } else {
+                        peaked(largest, px(&blurred), peak, pattern)
+                    }
+                } else {
+                    Some(false)
+                };
+                let Some(is_peaked) = peak_test else {
+                    near += 1;
+                    continue;
+                };
+                if csz.data[i * csz_stride] <= 0.0 || (blurred.data[i * 4 + 3] >= t && !sharp && !is_peaked) {
                     assert_eq!(px(&out), px(&blurred), "{case} keeps the blur");
                     assert_eq!(px(&out_glossy), px(&blurred_glossy), "{case} keeps the blur (glossy)");
                     kept += 1;
@@ -594,8 +619,16 @@ fn refined_pixels_hold_the_brute_force_and_the_others_the_blur() {
                 }
             }
             eprintln!(
-                "{shadows:?}, refine {t}, refine-roughness {r}: {lambert} Lambert and {glossy} glossy pixels refined, {kept} kept"
+                "{shadows:?}, refine {t}, refine-roughness {r}, refine-peak {peak}: {lambert} Lambert and {glossy} glossy pixels refined, {kept} kept, {near} on the threshold"
             );
+            if peak > 0.0 {
+                // VPLs close to the receivers: some pixels of each kind, few of them
+                assert!(
+                    lambert > 5 && kept > 3000 && near < 5,
+                    "{lambert} / {glossy} / {kept} / {near}"
+                );
+                continue;
+            }
             let lambert_ok = if t > 0.0 { lambert > 20 } else { lambert == 0 };
             assert!(lambert_ok && glossy > 5 && kept > 1000, "{lambert} / {glossy} / {kept}");
         }
@@ -689,4 +722,45 @@ fn refine_list_may_be_empty_and_changes_only_the_listed_pixels() {
     assert!(refined > 100 && kept > 1000, "{refined} refined, {kept} kept");
     r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
     assert_eq!(read(&r, "ils-refined").data, first.data, "the second frame");
+}
+
+/// CPU twin of `refine-peak`'s spikes (ils_peak.wgsl): the largest, over the texels of
+/// `gathered` within `radius` of pixel `p` (clipped to the image), of a texel's channel sum
+/// over the least of its four neighbours one `pattern` period away (those inside).
+fn largest_spike(gathered: &ImageBuf, p: [u32; 2], pattern: [u32; 2], radius: [u32; 2]) -> f32 {
+    let (w, h) = (gathered.width as i32, gathered.height as i32);
+    let sum = |x: i32, y: i32| {
+        let j = ((y * w + x) * 4) as usize;
+        gathered.data[j] + gathered.data[j + 1] + gathered.data[j + 2]
+    };
+    let (n, m) = (pattern[0] as i32, pattern[1] as i32);
+    let spike = |x: i32, y: i32| {
+        let mut least = sum(x, y);
+        for [dx, dy] in [[-n, 0], [n, 0], [0, -m], [0, m]] {
+            let (tx, ty) = (x + dx, y + dy);
+            if tx >= 0 && ty >= 0 && tx < w && ty < h {
+                least = least.min(sum(tx, ty));
+            }
+        }
+        sum(x, y) - least
+    };
+    let (p, r) = ([p[0] as i32, p[1] as i32], [radius[0] as i32, radius[1] as i32]);
+    let mut largest = f32::NEG_INFINITY;
+    for y in (p[1] - r[1]).max(0)..=(p[1] + r[1]).min(h - 1) {
+        for x in (p[0] - r[0]).max(0)..=(p[0] + r[0]).min(w - 1) {
+            largest = largest.max(spike(x, y));
+        }
+    }
+    largest
+}
+
+/// CPU twin of `refine-peak`'s test (ils_refine.wgsl): whether `largest` (the window's
+/// largest spike) exceeds `peak` · n·m · the blurred value in channel sums; `None` when it
+/// lies within 10⁻⁵ of that limit (either rounding may win).
+fn peaked(largest: f32, blurred: Vec3, peak: f32, pattern: [u32; 2]) -> Option<bool> {
+    let limit = peak * (pattern[0] * pattern[1]) as f32 * (blurred.x + blurred.y + blurred.z);
+    if limit > 0.0 && (largest - limit).abs() <= 1e-5 * limit {
+        return None;
+    }
+    Some(largest > limit)
 }

@@ -4,7 +4,10 @@
 // along silhouettes. The blur's alpha says which share of the subsets each pixel
 // averaged (`coverage` in ils_filter.wgsl); pixels below `shade.refine` are shaded
 // again with all N VPLs (the brute force at that pixel), and so are glossy receivers
-// smoother than `shade.refine_roughness` (sharp lobes: n×m blocks); the others keep the
+// smoother than `shade.refine_roughness` (sharp lobes: n×m blocks), and Lambert receivers
+// whose blur window holds a gathered texel that outshines its own VPL subset one period
+// away by more than `shade.refine_peak` of the blurred irradiance (a VPL close to the
+// receivers: ils_peak.wgsl); the others keep the
 // blurred values. Appended to ils_vpl_shading.wgsl.
 //
 // Two steps, so that the few refined pixels do not hold up the many kept ones (a
@@ -40,13 +43,16 @@ struct RefineList {
     pixels: array<u32>,
 }
 @group(1) @binding(8) var<storage, read_write> refine_list: RefineList;
+// the largest spike of a gathered texel over its own VPL subset one period away within
+// the blur's window (ils_peak.wgsl; with refine_peak > 0, else unread)
+@group(1) @binding(9) var peak_tex: texture_2d<f32>;
 // cs_refine's outputs (fs_refine_select writes them as colour attachments)
-@group(1) @binding(9) var refined_out: texture_storage_2d<rgba16float, write>;
-@group(1) @binding(10) var glossy_refined_out: texture_storage_2d<rgba16float, write>;
+@group(1) @binding(10) var refined_out: texture_storage_2d<rgba16float, write>;
+@group(1) @binding(11) var glossy_refined_out: texture_storage_2d<rgba16float, write>;
 // SSM only (as in ils_snsm.wgsl)
-@group(1) @binding(11) var vpl_shadow_maps: texture_depth_2d_array;
-@group(1) @binding(12) var vpl_shadow_sampler: sampler_comparison;
-@group(1) @binding(13) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
+@group(1) @binding(12) var vpl_shadow_maps: texture_depth_2d_array;
+@group(1) @binding(13) var vpl_shadow_sampler: sampler_comparison;
+@group(1) @binding(14) var<storage, read> vpl_shadow_mats: array<mat4x4f>;
 
 const REFINE_GROUP: u32 = 64u;
 
@@ -64,8 +70,15 @@ fn refined_at(p: vec2u) -> Refined {
     r.keep.glossy = textureLoad(blurred_glossy, vec2i(p), 0);
     r.g = textureLoad(gbuffer, vec2i(p), 0);
     let p_i = vec2i(p);
-    let sharp = textureLoad(emission_tex, p_i, 0).a > 1.5 && textureLoad(normal_tex, p_i, 0).z < shade.refine_roughness;
-    r.refined = r.g.w > 0.0 && (r.keep.irradiance.a < shade.refine || sharp);
+    let glossy = textureLoad(emission_tex, p_i, 0).a > 1.5;
+    let sharp = glossy && textureLoad(normal_tex, p_i, 0).z < shade.refine_roughness;
+    // a glossy receiver's irradiance is 0 (its light is in the glossy target)
+    // refine-peak: the window's largest spike against the pixel's blurred irradiance B,
+    // spike > refine_peak · n·m · B in channel sums
+    let b = r.keep.irradiance.rgb;
+    let limit = shade.refine_peak * f32(shade.sub_buffers) * (b.r + b.g + b.b);
+    let peak = shade.refine_peak > 0.0 && !glossy && textureLoad(peak_tex, p_i, 0).r > limit;
+    r.refined = r.g.w > 0.0 && (r.keep.irradiance.a < shade.refine || sharp || peak);
     return r;
 }
 

@@ -12,7 +12,8 @@
 //! | `ils-db` | §4.5 DB | discontinuity buffer (depth and normal vs the three positive neighbours) |
 //! | `ils-blur-h`, `ils-blur-v` | §4.5 B | separable Gaussian blur stopping at discontinuities (Fig. 4 a or b) |
 //! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers"); only in scenes with glossy materials |
-//! | `ils-refine` | – | only with [`IlsSettings::refine`] or [`IlsSettings::refine_roughness`]: pixels the blur averaged too few VPL subsets for, and sharp glossy receivers, shaded with all N VPLs (not in the paper) |
+//! | `ils-spike`, `ils-peak-h`, `ils-peak-v` | – | only with [`IlsSettings::refine_peak`]: each gathered texel's spike over its own VPL subset one pattern period away, and the largest within the blur's window (not in the paper) |
+//! | `ils-refine` | – | only with [`IlsSettings::refine`], [`IlsSettings::refine_roughness`] or [`IlsSettings::refine_peak`]: pixels the blur averaged too few VPL subsets for, sharp glossy receivers, and pixels whose window holds a spike (a VPL close to the receivers), shaded with all N VPLs (not in the paper) |
 //! | `compose` | Fig. 3 g | final = direct + ρ/π · blurred irradiance + blurred glossy radiance (the shared compose pass) |
 //!
 //! With [`IlsSettings::brute_force`] the three middle passes are replaced by
@@ -181,6 +182,16 @@ pub struct IlsSettings {
     /// so the blur cannot rebuild it from their subsets and it stays as n×m blocks.
     /// 0..=1; 0 = off.
     pub refine_roughness: f32,
+    /// Not in the paper: `ils-refine` also shades the Lambert receivers whose blur window
+    /// holds a gathered texel q that outshines its own VPL subset one pattern period away,
+    /// in channel sums G(q) − min G(q ± (n, 0), q ± (0, m)) > `refine_peak` · n·m · B(p),
+    /// B the pixel's blurred irradiance (ils_peak.wgsl). A texel holds one VPL subset
+    /// ×n·m, so a VPL close to the receivers lights its subset's texel in one n×m block
+    /// and not in the next, and the blur spreads that spike over the block: the bright
+    /// squares where the brute force has a round VPL blob. A subset bright over several
+    /// blocks (a far VPL) is left to the blur. 0..=1; 0 = off (docs/ils.md § "VPLs close
+    /// to the receivers").
+    pub refine_peak: f32,
 }
 
 impl Default for IlsSettings {
@@ -205,6 +216,7 @@ impl Default for IlsSettings {
             vpl_shadow_cache: true,
             refine: 0.0,
             refine_roughness: 0.0,
+            refine_peak: 0.0,
         }
     }
 }
@@ -265,6 +277,12 @@ impl IlsSettings {
         }
         if !(0.0..=1.0).contains(&self.refine) {
             return Err(format!("refine {} is out of range: must be in 0..=1", self.refine));
+        }
+        if !(0.0..=1.0).contains(&self.refine_peak) {
+            return Err(format!(
+                "refine-peak {} is out of range: must be in 0..=1",
+                self.refine_peak
+            ));
         }
         if !(0.0..=1.0).contains(&self.refine_roughness) {
             return Err(format!(
@@ -332,7 +350,7 @@ impl IlsSettings {
 
     /// Whether `ils-refine` runs (after a blur of the interleaved frame).
     pub fn refines(&self) -> bool {
-        (self.refine > 0.0 || self.refine_roughness > 0.0) && self.blurs()
+        (self.refine > 0.0 || self.refine_roughness > 0.0 || self.refine_peak > 0.0) && self.blurs()
     }
 
     /// The frame's passes for these settings in `scene`, in order. A scene without
@@ -355,6 +373,9 @@ impl IlsSettings {
                 v.extend(["ils-blur-glossy-h", "ils-blur-glossy-v"]);
             }
             if self.refines() {
+                if self.refine_peak > 0.0 {
+                    v.extend(PEAK_PASSES);
+                }
                 v.push(REFINE_PASS);
             }
         }
@@ -486,7 +507,88 @@ pub const GLOSSY_REFINED: TargetDesc = TargetDesc::new(
     1,
     "ils-glossy-blurred after ils-refine",
 );
-/// The refinement pass (`IlsSettings::refine`, `IlsSettings::refine_roughness`).
+/// `refine-peak` (ils_peak.wgsl): each gathered texel's spike over its own VPL subset one
+/// pattern period away, then the largest within the blur's radius along x and along y.
+pub const SPIKE: TargetDesc = TargetDesc::new(
+    "ils-spike",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "refine-peak: a gathered texel's channel sum over the least of its VPL subset's one pattern period away",
+);
+pub const PEAK_H: TargetDesc = TargetDesc::new(
+    "ils-peak-h",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "refine-peak: the largest ils-spike within the blur's radius along x",
+);
+pub const PEAK: TargetDesc = TargetDesc::new(
+    "ils-peak",
+    wgpu::TextureFormat::R32Float,
+    1,
+    "refine-peak: the largest ils-spike within the blur's window, which ils-refine compares with the blurred irradiance",
+);
+/// The passes of `refine-peak`, in order.
+pub const PEAK_PASSES: [&str; 3] = ["ils-spike", "ils-peak-h", "ils-peak-v"];
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct PeakUniforms {
+    pattern: [i32; 2],
+    dir: [i32; 2],
+    radius: i32,
+    _pad: [u32; 3],
+}
+
+/// `refine-peak`'s passes (ils_peak.wgsl): `IRRADIANCE` → `SPIKE` → `PEAK_H` → `PEAK`.
+fn peak_passes(gpu: &GpuContext, targets: &mut Targets, s: &IlsSettings) -> [FullscreenPass; 3] {
+    for t in [SPIKE, PEAK_H, PEAK] {
+        targets.create(gpu, t);
+    }
+    let [n, m] = s.pattern.map(|p| p as i32);
+    let [rx, ry] = s.blur_radius().map(|r| r as i32);
+    let uniforms = |dir: [i32; 2], radius: i32| PeakUniforms {
+        pattern: [n, m],
+        dir,
+        radius,
+        _pad: [0; 3],
+    };
+    let targets = &*targets;
+    let pass = |name: &'static str, entry: &'static str, u: PeakUniforms, src: &'static str, dst: &'static str| {
+        PassBuilder::new(gpu, targets, name)
+            .shader("ils-peak", include_str!("ils_peak.wgsl"))
+            .entry(entry)
+            .uniforms(&u)
+            .read(src)
+            .write(dst)
+            .build()
+    };
+    [
+        pass(
+            PEAK_PASSES[0],
+            "fs_spike",
+            uniforms([0, 0], 0),
+            IRRADIANCE.name,
+            SPIKE.name,
+        ),
+        pass(
+            PEAK_PASSES[1],
+            "fs_spread",
+            uniforms([1, 0], rx),
+            SPIKE.name,
+            PEAK_H.name,
+        ),
+        pass(
+            PEAK_PASSES[2],
+            "fs_spread",
+            uniforms([0, 1], ry),
+            PEAK_H.name,
+            PEAK.name,
+        ),
+    ]
+}
+
+/// The refinement pass (`IlsSettings::refine`, `IlsSettings::refine_roughness`,
+/// `IlsSettings::refine_peak`).
 pub const REFINE_PASS: &str = "ils-refine";
 
 #[repr(C)]
@@ -503,7 +605,9 @@ struct ShadeUniforms {
     ssm: [f32; 3],
     /// `IlsSettings::refine_roughness`
     refine_roughness: f32,
-    _pad: [u32; 3],
+    /// `IlsSettings::refine_peak`
+    refine_peak: f32,
+    _pad: [u32; 2],
 }
 
 #[repr(C)]
@@ -715,8 +819,11 @@ pub(crate) struct IlsStage {
     blur_v: Option<FullscreenPass>,
     glossy_h: Option<FullscreenPass>,
     glossy_v: Option<FullscreenPass>,
-    /// `IlsSettings::refine`, `refine_roughness`: the pixels the blur averaged too few
-    /// VPL subsets for, and sharp glossy receivers
+    /// `IlsSettings::refine_peak`: the spikes `refine` compares (ils_peak.wgsl)
+    peak: Option<[FullscreenPass; 3]>,
+    /// `IlsSettings::refine`, `refine_roughness`, `refine_peak`: the pixels the blur
+    /// averaged too few VPL subsets for, sharp glossy receivers and VPLs close to the
+    /// receivers
     refine: Option<RefinePass>,
     compose: crate::passes::compose::ComposePass,
     vpl_buffer: wgpu::Buffer,
@@ -814,6 +921,7 @@ impl RefinePass {
             blurred: [&'static str; 2],
             list: &'a wgpu::Buffer,
         ) -> PassBuilder<'a> {
+            let peak = uniforms.refine_peak > 0.0;
             b.shader("ils-refine", shading_shader!("ils_refine.wgsl"))
                 .frame(scene_gpu)
                 .uniforms(uniforms)
@@ -825,6 +933,8 @@ impl RefinePass {
                 .read(blurred[0])
                 .read(blurred[1])
                 .storage_rw(list)
+                // refine-peak's window maxima; without it any texture stands in (unread)
+                .read(if peak { PEAK.name } else { IRRADIANCE.name })
         }
         let targets = &*targets;
         let select = common(
@@ -980,7 +1090,8 @@ impl IlsStage {
             max_geometry: s.max_geometry(scene),
             ssm: ssm_uniforms,
             refine_roughness: s.refine_roughness,
-            _pad: [0; 3],
+            refine_peak: s.refine_peak,
+            _pad: [0; 2],
         };
         let shade = {
             let traced = vpl_shadows.is_some();
@@ -1045,8 +1156,11 @@ impl IlsStage {
         } else {
             (IRRADIANCE.name, GLOSSY.name)
         };
-        let mut refine = None;
+        let (mut refine, mut peak) = (None, None);
         let (shown, glossy_shown) = if s.refines() {
+            if s.refine_peak > 0.0 {
+                peak = Some(peak_passes(gpu, targets, s));
+            }
             refine = Some(RefinePass::new(
                 gpu,
                 scene_gpu,
@@ -1084,6 +1198,7 @@ impl IlsStage {
             blur_v,
             glossy_h,
             glossy_v,
+            peak,
             refine,
             compose,
             vpl_capacity: capacity,
@@ -1144,6 +1259,9 @@ impl IlsStage {
         .into_iter()
         .flatten()
         {
+            v.push(p);
+        }
+        for p in self.peak.iter().flatten() {
             v.push(p);
         }
         if let Some(p) = &self.refine {
