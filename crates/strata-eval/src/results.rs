@@ -537,6 +537,14 @@ pub struct IlsEval {
     /// `ils-refine`'s coverage threshold (0 = off; `IlsSettings::refine`).
     #[serde(default)]
     pub refine: f32,
+    /// `ils-refine`'s roughness below which glossy receivers are refined (0 = off;
+    /// `IlsSettings::refine_roughness`).
+    #[serde(default)]
+    pub refine_roughness: f32,
+    /// `ils-refine`'s spike share for VPLs close to the receivers (0 = off;
+    /// `IlsSettings::refine_peak`).
+    #[serde(default)]
+    pub refine_peak: f32,
     /// Whether windows an edge cuts slide and are re-weighted (`IlsSettings::slide_window`).
     #[serde(default)]
     pub blur_slide: bool,
@@ -547,8 +555,9 @@ pub struct IlsEval {
     /// The technique's preset (`--preset`; `standard` unless set), before `--set`.
     #[serde(default)]
     pub preset: String,
-    /// With `refine` or `refine-roughness`: the share of the pixels `ils-refine` shaded
-    /// again with all VPLs (their refined value differs from the blurred one).
+    /// With `refine`, `refine-roughness` or `refine-peak`: the share of the pixels
+    /// `ils-refine` shaded again with all VPLs (their refined value differs from the
+    /// blurred one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub refined_share: Option<f32>,
     /// `none` (SNSM: VPL visibility ignored) or `vpl` (SSM: per-VPL shadow maps, §4.3).

@@ -150,6 +150,8 @@ pub fn run(
         blur: ils.blur,
         bilinear: ils.bilinear,
         refine: ils.refine,
+        refine_roughness: ils.refine_roughness,
+        refine_peak: ils.refine_peak,
         blur_slide: ils.slide_window,
         per_axis_db: ils.per_axis_discontinuities,
         refined_share,
@@ -174,7 +176,7 @@ pub fn run(
     Ok(out)
 }
 
-/// With `refine` or `refine-roughness`: the share of the pixels `ils-refine` shaded again,
+/// With `refine`, `refine-roughness` or `refine-peak`: the share of the pixels `ils-refine` shaded again,
 /// those whose refined irradiance or glossy radiance differs from the blurred one.
 fn refined_share(r: &Renderer, gpu: &GpuContext) -> Result<Option<f32>> {
     let names = r.target_names();
