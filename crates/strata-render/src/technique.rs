@@ -796,7 +796,7 @@ static ILS_SETTINGS: [SettingInfo; 21] = [
     },
     setting!(
         "clamp-distance",
-        "geometry term clamped to 1/d^2 below this distance (default: 2% of the scene diagonal)",
+        "geometry term clamped to 1/d^2 below this distance (default: 4% of the scene diagonal)",
         Range::Above(0.0),
         false,
         |s| ils_of(s).clamp_distance.map(f64::from),
