@@ -537,6 +537,10 @@ pub struct IlsEval {
     /// `ils-refine`'s coverage threshold (0 = off; `IlsSettings::refine`).
     #[serde(default)]
     pub refine: f32,
+    /// d_c, the distance below which the geometry term is clamped (scene units; the
+    /// default is `passes::ils::DEFAULT_CLAMP_SHARE` of the scene's diagonal).
+    #[serde(default)]
+    pub clamp_distance: f32,
     /// `ils-refine`'s roughness below which glossy receivers are refined (0 = off;
     /// `IlsSettings::refine_roughness`).
     #[serde(default)]
