@@ -188,6 +188,8 @@ fn algorithm_switching_settings_render_cleanly() {
         ("aba-ao", &[("kernel", "hbao-compute"), ("multilayer", "off")]),
         ("ils", &[("split", "compute")]),
         ("ils", &[("split", "blocks"), ("shadows", "vpl")]),
+        ("ils", &[("refine-peak", "0.2")]),
+        ("ils", &[("refine-peak", "0.2"), ("shadows", "vpl"), ("refine", "0.5")]),
         ("full", &[("gather-scale", "2")]),
         ("ao", &[("ao-scale", "2")]),
         ("full", &[("ao-scale", "3"), ("ao-kernel", "compute")]),
