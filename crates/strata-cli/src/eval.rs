@@ -44,8 +44,15 @@ pub fn run(a: &EvalArgs) -> Result<()> {
         _ => is_bzb || is_aba || is_bzb_gi || a.deep.layers >= 2,
     };
     if a.deep.layer_scale > 1 && !builds_second_layer {
+        if matches!(a.technique.eval, EvalKind::VplRadiance | EvalKind::Composite) {
+            anyhow::bail!(
+                "--layer-scale {}: eval --technique {} shades one layer and builds no second layer to reduce (--layer-scale must be 1)",
+                a.deep.layer_scale,
+                a.technique.name
+            );
+        }
         anyhow::bail!(
-            "--layer-scale {}: eval --technique {} with --layers {} builds no second layer to reduce (it needs --layers 2..=4, or a technique compared against DGB with 2 layers: bzb-ao, aba-ao, bzb-gi)",
+            "--layer-scale {}: eval --technique {} with --layers {} builds no second layer to reduce (it needs --layers 2..=4)",
             a.deep.layer_scale,
             a.technique.name,
             a.deep.layers
@@ -266,9 +273,11 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             );
             if let Some(r) = e.refined_share {
                 println!(
-                    "  ils-refine shaded {:.1} % of the pixels again (refine {})",
+                    "  ils-refine shaded {:.1} % of the pixels again (refine {}, refine-roughness {}, refine-peak {})",
                     100.0 * r,
-                    e.refine
+                    e.refine,
+                    e.refine_roughness,
+                    e.refine_peak
                 );
             }
             if let Some(p) = &e.progressive {

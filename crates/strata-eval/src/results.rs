@@ -538,9 +538,10 @@ pub struct IlsEval {
     #[serde(default)]
     pub refine: f32,
     /// d_c, the distance below which the geometry term is clamped (scene units; the
-    /// default is `passes::ils::DEFAULT_CLAMP_SHARE` of the scene's diagonal).
-    #[serde(default)]
-    pub clamp_distance: f32,
+    /// default is `passes::ils::DEFAULT_CLAMP_SHARE` of the scene's diagonal); absent in
+    /// results written before 2026-11-29.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clamp_distance: Option<f32>,
     /// `ils-refine`'s roughness below which glossy receivers are refined (0 = off;
     /// `IlsSettings::refine_roughness`).
     #[serde(default)]

@@ -876,7 +876,7 @@ static ILS_SETTINGS: [SettingInfo; 21] = [
     ),
     setting!(
         "refine-peak",
-        "ils-refine also shades Lambert pixels whose blur window holds a gathered texel that outshines its own VPL subset one period away by more than this share of the blurred irradiance (a VPL near the receivers: n*m blocks under the blur; 0 = off; not in ILS)",
+        "ils-refine also shades Lambert pixels whose blur window holds a gathered texel that outshines its own VPL subset one period away by more than this times n*m times the blurred irradiance (channel sums; a VPL near the receivers: n*m blocks under the blur; 0 = off; not in ILS)",
         Range::Closed(0.0, 1.0),
         false,
         |s| Some(ils_of(s).refine_peak as f64),

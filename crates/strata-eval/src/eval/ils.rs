@@ -150,7 +150,7 @@ pub fn run(
         blur: ils.blur,
         bilinear: ils.bilinear,
         refine: ils.refine,
-        clamp_distance: ils.clamp_distance_for(&scene),
+        clamp_distance: Some(ils.clamp_distance_for(&scene)),
         refine_roughness: ils.refine_roughness,
         refine_peak: ils.refine_peak,
         blur_slide: ils.slide_window,

@@ -126,8 +126,9 @@ impl EvalSettings {
             scene: self.scene.scene.clone(),
             layers: self.deep.layers,
             variant: self.deep.variant.to_string(),
-            // as run: one layer is never reduced
-            layer_scale: if self.deep.is_reduced() {
+            // as run: one layer is never reduced, except in the 2-layer DGB baseline of
+            // bzb-ao, aba-ao and bzb-gi (`eval` refuses the scale where nothing reads it)
+            layer_scale: if self.deep.layer_scale > 1 {
                 self.deep.layer_scale
             } else {
                 1

@@ -6,8 +6,8 @@
 // again with all N VPLs (the brute force at that pixel), and so are glossy receivers
 // smoother than `shade.refine_roughness` (sharp lobes: n×m blocks), and Lambert receivers
 // whose blur window holds a gathered texel that outshines its own VPL subset one period
-// away by more than `shade.refine_peak` of the blurred irradiance (a VPL close to the
-// receivers: ils_peak.wgsl); the others keep the
+// away by more than `shade.refine_peak` · n·m · the blurred irradiance (a VPL close to
+// the receivers: ils_peak.wgsl); the others keep the
 // blurred values. Appended to ils_vpl_shading.wgsl.
 //
 // Two steps, so that the few refined pixels do not hold up the many kept ones (a

@@ -38,8 +38,8 @@ struct Shade {
     // ils-refine: glossy receivers rougher than this keep the blur (0 = every one does)
     refine_roughness: f32,
     // ils-refine: pixels whose blur window holds a gathered texel that outshines its
-    // own VPL subset one period away by more than this share of the blurred irradiance
-    // (ils_peak.wgsl; 0 = off)
+    // own VPL subset one period away by more than this · n·m · the blurred irradiance
+    // (channel sums; ils_peak.wgsl; 0 = off)
     refine_peak: f32,
     _pad0: u32,
     _pad1: u32,

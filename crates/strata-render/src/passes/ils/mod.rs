@@ -432,10 +432,15 @@ impl IlsSettings {
         let tiled = (w.div_ceil(n.max(1)) * n.max(1)) as u64 * (h.div_ceil(m.max(1)) * m.max(1)) as u64;
         let px = w as u64 * h as u64;
         // gbuffer 16 + irradiance 8 + glossy 8 + DB 8 + blur-h 8 + indirect 8 + compose 24
-        // (+ refined 8 + 8 + the refine list's 4); tiled: 16 + 8 + 8; the Blocks
-        // intermediates ≤ 2 more tiled-size buffers
+        // (+ refined 8 + 8 + the refine list's 4; + refine-peak's spike, peak-h and peak
+        // 4 + 4 + 4); tiled: 16 + 8 + 8; the Blocks intermediates ≤ 2 more tiled-size buffers
         let refined = if self.refines() { 20 } else { 0 };
-        px * (80 + refined)
+        let peak = if self.refines() && self.refine_peak > 0.0 {
+            12
+        } else {
+            0
+        };
+        px * (80 + refined + peak)
             + tiled * (32 + 24)
             + self.vpls.len().max(self.vpl_count as usize) as u64 * 48
             + self.shadow_map_bytes()
