@@ -1776,6 +1776,39 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
     assert_eq!(v["ref_spp"], 4);
     assert_eq!(v["preset"], "standard", "{v}");
     assert!(v.get("refined_share").is_none(), "no ils-refine without refine: {v}");
+    // --report: the path tracer, the interleaved frame and the brute force beside their
+    // ꟻLIP maps, and the interleaved frame's ꟻLIP against the brute force
+    let report = scratch("ils-report");
+    let _ = std::fs::remove_dir_all(&report);
+    let v = json_of(&run(&["--set", "vpls=96", "--report", report.to_str().unwrap()]));
+    let html = std::fs::read_to_string(report.join("index.html")).unwrap();
+    for f in [
+        "reference-indirect.png",
+        "reference-full.png",
+        "flip-indirect-vs-brute-force.png",
+    ] {
+        assert!(
+            html.contains(f) && report.join(f).exists(),
+            "{f} missing from the report"
+        );
+    }
+    let indirect: Vec<_> = std::fs::read_dir(&report)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with("indirect-") && html.contains(n.as_str()))
+        .collect();
+    assert_eq!(
+        indirect.len(),
+        2,
+        "the interleaved frame and the brute force: {indirect:?}"
+    );
+    let (a, b) = (
+        std::fs::read(report.join(&indirect[0])).unwrap(),
+        std::fs::read(report.join(&indirect[1])).unwrap(),
+    );
+    assert_ne!(a, b, "the interleaved frame and the brute force wrote the same image");
+    let flip = format!("{:.4}", v["indirect_flip_vs_brute"].as_f64().unwrap());
+    assert!(html.contains(&flip), "ꟻLIP vs the brute force {flip} not on the page");
     // §4.3 SSM: per-VPL shadow maps, named value on --set; the refined preset's
     // ils-refine with them, and the share of the pixels it shaded
     let v = json_of(&run(&[

@@ -11,7 +11,7 @@ use strata_render::passes::bzb::BzbSettings;
 use strata_render::RenderSettings;
 
 use super::ao::{av_setup, evaluate_av, render_settings, write_side_by_side_report, DEFAULT_CAP};
-use super::{noise_warnings, EvalSettings};
+use super::{noise_warnings, EvalSettings, GiImages};
 use crate::results::{AoEval, EvalResult};
 
 /// `bzb` as configured (its radius and bias default to `ao`'s, then the scene's);
@@ -248,67 +248,27 @@ pub fn run_gi(
     Ok(out)
 }
 
-/// One bzb-gi evaluation's images: linear radiance of the frame and of its indirect
-/// light, and their ꟻLIP maps against the path tracer.
-struct GiImages {
-    full: strata_scene::ImageBuf,
-    indirect: strata_scene::ImageBuf,
-    full_map: strata_scene::ImageBuf,
-    indirect_map: strata_scene::ImageBuf,
-}
-
-/// `--report` of `eval --technique bzb-gi`: the result's tables, the path tracer's indirect
-/// light and frame, then each configuration's (`rows`: label, errors, images) indirect light
-/// and frame beside their ꟻLIP maps, tonemapped with the scene's exposure.
+/// `--report` of `eval --technique bzb-gi`: the result's tables, then
+/// [`super::gi_report_sections`] for the path tracer and each configuration (`rows`).
 fn write_gi_report(
     dir: &std::path::Path,
     s: &EvalSettings,
     out: &crate::results::BzbGiEval,
-    (ref_indirect, ref_total): (&strata_scene::ImageBuf, &strata_scene::ImageBuf),
+    references: (&strata_scene::ImageBuf, &strata_scene::ImageBuf),
     exposure: f32,
     rows: &[(&str, &crate::results::GiErrors, &GiImages)],
 ) -> Result<()> {
-    use super::{figure, write_report};
-    use crate::metrics::display;
-    use crate::report::Section;
-    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
-    let shown =
-        |img: &strata_scene::ImageBuf, name: &str, caption: String| figure(dir, &display(img, exposure), name, caption);
-    let map = |img: &strata_scene::ImageBuf, name: &str, caption: String| figure(dir, img, name, caption);
-    let mut sections = vec![Section::new("Path tracer, one indirect bounce")
-        .text(format!(
+    use super::write_report;
+    let sections = super::gi_report_sections(
+        dir,
+        format!(
             "{}×{} pixels, frame {}, {} spp; sky and ambient off. Tonemapped with the scene's exposure ({exposure}); indirect = the composed frame − the direct light. ꟻLIP maps use the magma scale. {} directions per pixel, d_max {:.3}.",
             s.scene.width, s.scene.height, s.scene.frame, out.run.ref_spp, out.directions, out.d_max
-        ))
-        .figures(vec![
-            shown(ref_indirect, "reference-indirect.png", "indirect light".into())?,
-            shown(ref_total, "reference-full.png", "direct + indirect".into())?,
-        ])];
-    for (label, e, img) in rows {
-        let name = super::ao::slug(label);
-        sections.push(Section::new(*label).figures(vec![
-            shown(
-                &img.indirect,
-                &format!("indirect-{name}.png"),
-                format!("indirect: ꟻLIP {:.4}, RMSE {:.4}", e.indirect.flip, e.indirect.rmse),
-            )?,
-            map(
-                &img.indirect_map,
-                &format!("flip-indirect-{name}.png"),
-                "ꟻLIP of the indirect light".into(),
-            )?,
-            shown(
-                &img.full,
-                &format!("full-{name}.png"),
-                format!("frame: ꟻLIP {:.4}", e.full.flip),
-            )?,
-            map(
-                &img.full_map,
-                &format!("flip-full-{name}.png"),
-                "ꟻLIP of the frame".into(),
-            )?,
-        ]));
-    }
+        ),
+        references,
+        exposure,
+        rows,
+    )?;
     write_report(
         dir,
         format!("strata eval: bzb-gi on {}", s.scene.scene),

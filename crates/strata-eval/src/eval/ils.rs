@@ -16,8 +16,9 @@ use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::ImageBuf;
 
 use super::gi::{indirect, render_indirect, total, DEFAULT_CAP};
-use super::{noise_warnings, write_report, EvalSettings, RefImage};
+use super::{figure, gi_report_sections, noise_warnings, write_report, EvalSettings, GiImages, RefImage};
 use crate::metrics::{compare, compare_radiance, display};
+use crate::report::Section;
 use crate::results::{EvalResult, GiErrors, IlsEval};
 
 /// `preset`: one of the `ils` technique's presets (`None`: standard); `set`: its settings
@@ -110,19 +111,28 @@ pub fn run(
     let (full, ind, refined_share) = render(is_settings)?;
     let (brute_full, brute_ind, _) = render(brute_settings)?;
 
-    let vs_reference = |full: &ImageBuf, ind: &ImageBuf| -> Result<GiErrors> {
-        let (f, _) = compare_radiance(&ref_total.image, full, exposure)?;
-        let (i, _) = compare_radiance(&ref_indirect.image, ind, exposure)?;
-        Ok(GiErrors {
-            full: ref_total.annotate(f, &display(full, exposure)),
-            indirect: ref_indirect.annotate(i, &display(ind, exposure)),
-        })
+    let vs_reference = |full: ImageBuf, indirect: ImageBuf| -> Result<(GiErrors, GiImages)> {
+        let (f, full_map) = compare_radiance(&ref_total.image, &full, exposure)?;
+        let (i, indirect_map) = compare_radiance(&ref_indirect.image, &indirect, exposure)?;
+        let errors = GiErrors {
+            full: ref_total.annotate(f, &display(&full, exposure)),
+            indirect: ref_indirect.annotate(i, &display(&indirect, exposure)),
+        };
+        Ok((
+            errors,
+            GiImages {
+                full,
+                indirect,
+                full_map,
+                indirect_map,
+            },
+        ))
     };
-    let errors = vs_reference(&full, &ind)?;
-    let brute_force = vs_reference(&brute_full, &brute_ind)?;
     // vs the brute force: ꟻLIP and RMSE of the tonemapped display values
     let (vs_brute, _) = compare(&display(&brute_full, exposure), &display(&full, exposure))?;
-    let (vs_brute_ind, _) = compare(&display(&brute_ind, exposure), &display(&ind, exposure))?;
+    let (vs_brute_ind, vs_brute_map) = compare(&display(&brute_ind, exposure), &display(&ind, exposure))?;
+    let (errors, images) = vs_reference(full, ind)?;
+    let (brute_force, brute_images) = vs_reference(brute_full, brute_ind)?;
 
     let shadows = ils.shadows.name();
     let reference_text = format!(
@@ -167,11 +177,35 @@ pub fn run(
         progressive,
     };
     if let Some(dir) = &s.report {
+        let label = format!("ILS {}, {} ({} VPLs)", out.pattern, out.preset, out.vpls);
+        let mut sections = gi_report_sections(
+            dir,
+            format!(
+                "{}×{} pixels, frame {}, {} spp; sky and ambient off. Tonemapped with the scene's exposure ({exposure}); indirect = the composed frame − the direct light. ꟻLIP maps use the magma scale. {}",
+                s.scene.width, s.scene.height, s.scene.frame, out.run.ref_spp, out.run.reference
+            ),
+            (&ref_indirect.image, &ref_total.image),
+            exposure,
+            &[
+                (label.as_str(), &out.errors, &images),
+                ("brute force (every pixel, all N VPLs)", &out.brute_force, &brute_images),
+            ],
+        )?;
+        // ILS §4's own target: the interleaved frame against the brute force
+        sections.push(Section::new("Interleaved against the brute force").figures(vec![figure(
+            dir,
+            &vs_brute_map,
+            "flip-indirect-vs-brute-force.png",
+            format!(
+                "ꟻLIP of the indirect light against the brute force: {:.4} (RMSE {:.4})",
+                out.indirect_flip_vs_brute, out.indirect_rmse_vs_brute
+            ),
+        )?]));
         write_report(
             dir,
             format!("strata eval: ILS on {}", s.scene.scene),
             &EvalResult::Ils(out.clone()),
-            Vec::new(),
+            sections,
         )?;
     }
     Ok(out)

@@ -255,6 +255,63 @@ pub(crate) fn write_report(
     Ok(())
 }
 
+/// One radiance evaluation's images: linear radiance of the frame and of its indirect
+/// light, and their ꟻLIP maps against the path tracer (`eval --technique bzb-gi`, `ils`).
+pub(crate) struct GiImages {
+    pub full: ImageBuf,
+    pub indirect: ImageBuf,
+    pub full_map: ImageBuf,
+    pub indirect_map: ImageBuf,
+}
+
+/// The image sections of a radiance evaluation's `--report`: the path tracer's indirect
+/// light and frame under `header`, then each configuration's (`rows`: label, errors,
+/// images) indirect light and frame beside their ꟻLIP maps, tonemapped with `exposure`.
+pub(crate) fn gi_report_sections(
+    dir: &std::path::Path,
+    header: String,
+    (ref_indirect, ref_total): (&ImageBuf, &ImageBuf),
+    exposure: f32,
+    rows: &[(&str, &crate::results::GiErrors, &GiImages)],
+) -> Result<Vec<Section>> {
+    use crate::metrics::display;
+    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
+    let shown = |img: &ImageBuf, name: &str, caption: String| figure(dir, &display(img, exposure), name, caption);
+    let map = |img: &ImageBuf, name: &str, caption: String| figure(dir, img, name, caption);
+    let mut sections = vec![Section::new("Path tracer, one indirect bounce")
+        .text(header)
+        .figures(vec![
+            shown(ref_indirect, "reference-indirect.png", "indirect light".into())?,
+            shown(ref_total, "reference-full.png", "direct + indirect".into())?,
+        ])];
+    for (label, e, img) in rows {
+        let name = ao::slug(label);
+        sections.push(Section::new(*label).figures(vec![
+            shown(
+                &img.indirect,
+                &format!("indirect-{name}.png"),
+                format!("indirect: ꟻLIP {:.4}, RMSE {:.4}", e.indirect.flip, e.indirect.rmse),
+            )?,
+            map(
+                &img.indirect_map,
+                &format!("flip-indirect-{name}.png"),
+                "ꟻLIP of the indirect light".into(),
+            )?,
+            shown(
+                &img.full,
+                &format!("full-{name}.png"),
+                format!("frame: ꟻLIP {:.4}", e.full.flip),
+            )?,
+            map(
+                &img.full_map,
+                &format!("flip-full-{name}.png"),
+                "ꟻLIP of the frame".into(),
+            )?,
+        ]));
+    }
+    Ok(sections)
+}
+
 /// Saves `img` as `dir/name` (display values: bytes written as is) and returns its figure.
 pub(crate) fn figure(dir: &std::path::Path, img: &ImageBuf, name: &str, caption: String) -> Result<ReportImage> {
     img.save(&dir.join(name), false).map_err(|e| anyhow::anyhow!(e))?;
