@@ -2397,6 +2397,46 @@ fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
     let (total, dropped) = (v["fragments"].as_u64().unwrap(), v["dropped"].as_u64().unwrap());
     assert_eq!(dropped, total - 500, "{v}");
     assert!(stderr(&o).contains("dropped"), "{}", stderr(&o));
+    // --report: the page and its images exist (it had printed "wrote" and written nothing)
+    let report = scratch("oit-report");
+    let _ = std::fs::remove_dir_all(&report);
+    let v = json_of(&strata(&[
+        "eval",
+        "--scene",
+        "glasshouse",
+        "--technique",
+        "oit",
+        "--width",
+        "96",
+        "--height",
+        "54",
+        "--json",
+        "--report",
+        report.to_str().unwrap(),
+    ]));
+    let html = std::fs::read_to_string(report.join("index.html")).expect("the report page");
+    for f in ["reference.png", "oit.png", "flip-oit.png"] {
+        assert!(
+            html.contains(f) && report.join(f).exists(),
+            "{f} missing from the report"
+        );
+    }
+    let flip = format!("{:.4}", v["flip"].as_f64().unwrap());
+    assert!(html.contains(&flip), "ꟻLIP {flip} not on the page");
+    let again = strata(&[
+        "eval",
+        "--scene",
+        "glasshouse",
+        "--technique",
+        "oit",
+        "--width",
+        "96",
+        "--height",
+        "54",
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&again, &["--report", "--force"]);
     let out = scratch("oit.png");
     let o = strata(&[
         "render",

@@ -68,6 +68,19 @@ pub struct EvalSettings {
 }
 
 impl EvalSettings {
+    /// `--report`: an existing report is overwritten only with `--force`.
+    pub(crate) fn check_report(&self) -> Result<()> {
+        if let Some(dir) = &self.report {
+            if dir.join("index.html").exists() && !self.force {
+                bail!(
+                    "--report {}: a report exists there; pass --force to overwrite it",
+                    dir.display()
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// Checks what every technique shares and returns the reference's convergence rule: the
     /// `ref_noise` target, the cap `ref_spp` (`default_cap` unless given), first rounds of
     /// `first_spp` samples per half.
@@ -84,14 +97,7 @@ impl EvalSettings {
                 bail!("--frames {n} is out of range: must be in 2..=1000");
             }
         }
-        if let Some(dir) = &self.report {
-            if dir.join("index.html").exists() && !self.force {
-                bail!(
-                    "--report {}: a report exists there; pass --force to overwrite it",
-                    dir.display()
-                );
-            }
-        }
+        self.check_report()?;
         Ok(ConvergeRule {
             target: self.ref_noise,
             first_spp: first_spp.min(spp / 2),

@@ -11,9 +11,10 @@ use strata_render::technique;
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 
 use super::gi::rgb;
-use super::EvalSettings;
+use super::{figure, write_report, EvalSettings};
 use crate::metrics::{compare_radiance, display, outliers, OUTLIER_THRESHOLD};
-use crate::results::OitEval;
+use crate::report::Section;
+use crate::results::{EvalResult, OitEval};
 
 /// `set`: the `oit` technique's settings (`abuffer`, `pool`, `max-layers`, `compress`, …),
 /// applied last and range-checked.
@@ -27,6 +28,7 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<OitEval> {
     if s.frames.is_some() {
         bail!("--frames is not available for --technique oit (one static frame is compared)");
     }
+    s.check_report()?;
     let t = technique::find("oit")?;
     let mut rs: RenderSettings = t.settings(&s.render_settings(1), None)?;
     for (name, value) in set {
@@ -53,7 +55,7 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<OitEval> {
     let lists = r.abuffer().expect("the oit frame has an A-buffer").read_lists(&gpu)?;
     gpu.check_errors()?;
 
-    let (mut errors, _) = compare_radiance(&ref_img, &img, exposure)?;
+    let (mut errors, map) = compare_radiance(&ref_img, &img, exposure)?;
     errors.outliers = Some(outliers(&display(&img, exposure), OUTLIER_THRESHOLD));
     errors.ref_outliers = Some(outliers(&display(&ref_img, exposure), OUTLIER_THRESHOLD));
     let mut warnings = Vec::new();
@@ -68,7 +70,7 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<OitEval> {
         warnings.push(w);
     }
     let max_layers = lists.lists.iter().map(Vec::len).max().unwrap_or(0) as u32;
-    Ok(OitEval {
+    let out = OitEval {
         run: s.run_info(
             1,
             "CPU compositing of every surface crossing along the pixel-centre ray (unshadowed fragment shading)",
@@ -82,5 +84,31 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<OitEval> {
         max_fragments_per_pixel: max_layers,
         memory_bytes: a.memory_bytes(w, h),
         errors,
-    })
+    };
+    if let Some(dir) = &s.report {
+        // the composites (tonemapped with the scene's exposure) and the ꟻLIP map
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
+        let shown = |img, name: &str, caption: String| figure(dir, &display(img, exposure), name, caption);
+        let section = Section::new("Composite")
+            .text(format!(
+                "{w}×{h} pixels, frame {}; the CPU compositing of every surface crossing along the pixel-centre ray, and the A-buffer's ({}, {} fragments, {} dropped, at most {} per pixel). Tonemapped with the scene's exposure ({exposure}); the ꟻLIP map uses the magma scale.",
+                s.scene.frame, out.method, out.fragments, out.dropped, out.max_fragments_per_pixel
+            ))
+            .figures(vec![
+                shown(&ref_img, "reference.png", "CPU compositing".into())?,
+                shown(
+                    &img,
+                    "oit.png",
+                    format!("A-buffer: ꟻLIP {:.4}, RMSE {:.4}", out.errors.flip, out.errors.rmse),
+                )?,
+                figure(dir, &map, "flip-oit.png", "ꟻLIP against the CPU compositing".into())?,
+            ]);
+        write_report(
+            dir,
+            format!("strata eval: OIT on {}", s.scene.scene),
+            &EvalResult::Oit(out.clone()),
+            vec![section],
+        )?;
+    }
+    Ok(out)
 }
