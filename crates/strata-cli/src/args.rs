@@ -584,6 +584,57 @@ pub struct EvalArgs {
     /// --technique ils: its settings (e.g. --set vpls=480 --set shadows=vpl).
     #[command(flatten)]
     pub set: SetArgs,
+    /// The ids of the flags given on the command line (not defaulted), filled after parsing:
+    /// `eval` warns of those its comparison does not read ([`EvalArgs::unread_flags`]).
+    #[arg(skip)]
+    pub given: Vec<String>,
+}
+
+impl EvalArgs {
+    /// One line per flag given on the command line that the comparison of `--technique oit`
+    /// or `ils` does not read (the A-buffer composite is exact and static; ILS renders one
+    /// static frame of layer 0 and reads `--bounces` only with `--progressive`): the AO and
+    /// radiosity flags (ILS reads `--preset`), the deep-G-buffer construction besides
+    /// `--layers`, `--warmup`, and for OIT the reference's flags. Flags a comparison refuses
+    /// outright are left to its one-line error. The other comparisons: none (not audited).
+    pub fn unread_flags(&self) -> Vec<String> {
+        use strata_render::technique::EvalKind;
+        let kind = self.technique.eval;
+        if !matches!(kind, EvalKind::Composite | EvalKind::VplRadiance) {
+            return Vec::new();
+        }
+        let ids = |c: clap::Command| -> Vec<String> { c.get_arguments().map(|a| a.get_id().to_string()).collect() };
+        let mut unread: Vec<String> = ids(<AoArgs as Args>::augment_args(clap::Command::new("ao")));
+        unread.extend(
+            ids(<RadiosityArgs as Args>::augment_args(clap::Command::new("radiosity")))
+                .into_iter()
+                .filter(|id| !(kind == EvalKind::VplRadiance && id == "preset")),
+        );
+        unread.extend(["variant", "min_separation", "warmup"].map(String::from));
+        if kind == EvalKind::Composite {
+            unread.extend(["ref_spp", "ref_noise", "cache", "no_cache", "bounces"].map(String::from));
+        } else if self.progressive.is_none() {
+            unread.push("bounces".into());
+        }
+        let eval = <EvalArgs as Args>::augment_args(clap::Command::new("eval"));
+        eval.get_arguments()
+            .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?)))
+            .filter(|(id, _)| unread.contains(id) && self.given.contains(id))
+            .map(|(id, long)| {
+                let why = match kind {
+                    EvalKind::Composite => {
+                        "it compares one static frame's A-buffer composite with the exact CPU compositing"
+                    }
+                    _ if id == "bounces" => "--bounces is read only with --progressive (the reference has one bounce)",
+                    _ => "it compares one static frame of layer 0 with the brute force and the one-bounce path tracer",
+                };
+                format!(
+                    "--{long} is not read by eval --technique {}: {why}",
+                    self.technique.name
+                )
+            })
+            .collect()
+    }
 }
 
 #[derive(Args)]

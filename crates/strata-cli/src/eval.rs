@@ -11,6 +11,9 @@ use crate::args::EvalArgs;
 
 pub fn run(a: &EvalArgs) -> Result<()> {
     let s = EvalSettings::from(a);
+    for w in a.unread_flags() {
+        eprintln!("strata: warning: {w}");
+    }
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";

@@ -44,13 +44,19 @@ fn main() {
         .and_then(|m| args::Cli::from_arg_matches(&m).map(|c| (c, m)));
     let cli = match parsed {
         Ok((mut c, m)) => {
-            // which flags `render` was given, not defaulted (`FrameArgs::unread_flags`)
-            if let (args::Command::Render(a), Some((_, sub))) = (&mut c.command, m.subcommand()) {
-                a.frame.given = sub
+            // which flags `render` and `eval` were given, not defaulted
+            // (`FrameArgs::unread_flags`, `EvalArgs::unread_flags`)
+            if let Some((_, sub)) = m.subcommand() {
+                let given: Vec<String> = sub
                     .ids()
                     .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
                     .map(|id| id.to_string())
                     .collect();
+                match &mut c.command {
+                    args::Command::Render(a) => a.frame.given = given,
+                    args::Command::Eval(a) => a.given = given,
+                    _ => {}
+                }
             }
             c
         }

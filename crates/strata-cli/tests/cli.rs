@@ -1809,6 +1809,29 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
     assert_ne!(a, b, "the interleaved frame and the brute force wrote the same image");
     let flip = format!("{:.4}", v["indirect_flip_vs_brute"].as_f64().unwrap());
     assert!(html.contains(&flip), "ꟻLIP vs the brute force {flip} not on the page");
+    // --bounces without --progressive and an AO flag are not read: a warning each;
+    // --preset is read (the ILS presets)
+    let o = run(&[
+        "--set",
+        "vpls=96",
+        "--bounces",
+        "2",
+        "--samples",
+        "5",
+        "--preset",
+        "refined",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+    assert_eq!(warned.len(), 2, "{warned:?}");
+    assert!(
+        warned
+            .iter()
+            .any(|l| l.contains("--bounces") && l.contains("--progressive")),
+        "{warned:?}"
+    );
+    assert!(warned.iter().any(|l| l.contains("--samples")), "{warned:?}");
     // §4.3 SSM: per-VPL shadow maps, named value on --set; the refined preset's
     // ils-refine with them, and the share of the pixels it shaded
     let v = json_of(&run(&[
@@ -2437,6 +2460,39 @@ fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
         report.to_str().unwrap(),
     ]);
     assert_one_line_error(&again, &["--report", "--force"]);
+    // flags the exact composite does not read: one warning line each, and it still runs;
+    // --guard-band is read (a wider frame), so no warning names it
+    let o = strata(&[
+        "eval",
+        "--scene",
+        "glasshouse",
+        "--technique",
+        "oit",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--warmup",
+        "5",
+        "--samples",
+        "5",
+        "--ref-spp",
+        "4",
+        "--guard-band",
+        "8",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning:")).collect();
+    for flag in ["--warmup", "--samples", "--ref-spp"] {
+        assert!(
+            warned
+                .iter()
+                .any(|l| l.contains(flag) && l.contains("not read by eval --technique oit")),
+            "{flag}: {warned:?}"
+        );
+    }
+    assert_eq!(warned.len(), 3, "{warned:?}");
     let out = scratch("oit.png");
     let o = strata(&[
         "render",
