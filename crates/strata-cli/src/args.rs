@@ -591,42 +591,83 @@ pub struct EvalArgs {
 }
 
 impl EvalArgs {
-    /// One line per flag given on the command line that the comparison of `--technique oit`
-    /// or `ils` does not read (the A-buffer composite is exact and static; ILS renders one
-    /// static frame of layer 0 and reads `--bounces` only with `--progressive`): the AO and
-    /// radiosity flags (ILS reads `--preset`), the deep-G-buffer construction besides
-    /// `--layers`, `--warmup`, and for OIT the reference's flags. Flags a comparison refuses
-    /// outright are left to its one-line error. The other comparisons: none (not audited).
+    /// One line per flag given on the command line that this comparison does not read:
+    /// - `oit` (one static frame's composite against the exact CPU compositing): the AO
+    ///   and radiosity flags, the deep-G-buffer construction besides `--layers`,
+    ///   `--warmup`, and the reference's flags;
+    /// - `ils` (one static frame of layer 0): the AO and radiosity flags (`--preset` is
+    ///   read), the construction besides `--layers`, `--warmup`, and `--bounces` without
+    ///   `--progressive`;
+    /// - `ao`, `bzb-ao`, `aba-ao`: the radiosity flags and `--bounces`;
+    /// - `gi`/`full` without `--views` and `bzb-gi`: the AO flags (no AO in the
+    ///   comparison), and for `bzb-gi` `--bounces` (its reference has one bounce).
+    ///
+    /// Flags a comparison refuses outright are left to its one-line error.
     pub fn unread_flags(&self) -> Vec<String> {
         use strata_render::technique::EvalKind;
         let kind = self.technique.eval;
-        if !matches!(kind, EvalKind::Composite | EvalKind::VplRadiance) {
-            return Vec::new();
-        }
         let ids = |c: clap::Command| -> Vec<String> { c.get_arguments().map(|a| a.get_id().to_string()).collect() };
-        let mut unread: Vec<String> = ids(<AoArgs as Args>::augment_args(clap::Command::new("ao")));
-        unread.extend(
-            ids(<RadiosityArgs as Args>::augment_args(clap::Command::new("radiosity")))
-                .into_iter()
-                .filter(|id| !(kind == EvalKind::VplRadiance && id == "preset")),
-        );
-        unread.extend(["variant", "min_separation", "warmup"].map(String::from));
-        if kind == EvalKind::Composite {
-            unread.extend(["ref_spp", "ref_noise", "cache", "no_cache", "bounces"].map(String::from));
-        } else if self.progressive.is_none() {
-            unread.push("bounces".into());
-        }
+        let ao = ids(<AoArgs as Args>::augment_args(clap::Command::new("ao")));
+        // --preset is checked against the technique's presets (`eval::run`)
+        let radiosity: Vec<String> = ids(<RadiosityArgs as Args>::augment_args(clap::Command::new("radiosity")))
+            .into_iter()
+            .filter(|id| id != "preset")
+            .collect();
+        let strings = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        let bzb_gi = self.technique.name == "bzb-gi";
+        let (unread, why): (Vec<String>, &str) = match kind {
+            EvalKind::Composite => (
+                [
+                    ao,
+                    radiosity,
+                    strings(&[
+                        "variant",
+                        "min_separation",
+                        "warmup",
+                        "ref_spp",
+                        "ref_noise",
+                        "cache",
+                        "no_cache",
+                        "bounces",
+                    ]),
+                ]
+                .concat(),
+                "it compares one static frame's A-buffer composite with the exact CPU compositing",
+            ),
+            EvalKind::VplRadiance => {
+                let mut v = [ao, radiosity, strings(&["variant", "min_separation", "warmup"])].concat();
+                if self.progressive.is_none() {
+                    v.push("bounces".into());
+                }
+                (
+                    v,
+                    "it compares one static frame of layer 0 with the brute force and the one-bounce path tracer",
+                )
+            }
+            EvalKind::AmbientVisibility => (
+                [radiosity, strings(&["bounces"])].concat(),
+                "it measures ambient occlusion against the ray-traced AO, with no radiosity",
+            ),
+            EvalKind::Radiance if self.views => (Vec::new(), ""),
+            EvalKind::Radiance if bzb_gi => (
+                [ao, strings(&["bounces"])].concat(),
+                "it compares the indirect light without AO against the one-bounce path tracer",
+            ),
+            EvalKind::Radiance => (
+                ao,
+                "it compares the radiosity and probes without AO (--views measures the frame with AO)",
+            ),
+            EvalKind::None => (Vec::new(), ""),
+        };
         let eval = <EvalArgs as Args>::augment_args(clap::Command::new("eval"));
         eval.get_arguments()
             .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?)))
             .filter(|(id, _)| unread.contains(id) && self.given.contains(id))
             .map(|(id, long)| {
-                let why = match kind {
-                    EvalKind::Composite => {
-                        "it compares one static frame's A-buffer composite with the exact CPU compositing"
-                    }
-                    _ if id == "bounces" => "--bounces is read only with --progressive (the reference has one bounce)",
-                    _ => "it compares one static frame of layer 0 with the brute force and the one-bounce path tracer",
+                let why = if kind == EvalKind::VplRadiance && id == "bounces" {
+                    "--bounces is read only with --progressive (the reference has one bounce)"
+                } else {
+                    why
                 };
                 format!(
                     "--{long} is not read by eval --technique {}: {why}",

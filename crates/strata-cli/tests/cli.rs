@@ -996,6 +996,44 @@ fn eval_gi_refuses_ao_settings_it_would_ignore() {
         let name = set.split('=').next().unwrap();
         assert_one_line_error(&o, &[name, "without AO", "--views"]);
     }
+    // the AO flags themselves: a one-line warning each, and the comparison runs; the
+    // radiosity flags given to the AO comparison likewise
+    for (technique, flags, warned_flag) in [
+        ("gi", &["--samples", "5"][..], "--samples"),
+        (
+            "ao",
+            &["--indirect-samples", "5", "--bounces", "2"][..],
+            "--indirect-samples",
+        ),
+    ] {
+        let mut args = vec![
+            "eval",
+            "--scene",
+            "cornell",
+            "--technique",
+            technique,
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--ref-spp",
+            "4",
+            "--quiet",
+            "--no-cache",
+        ];
+        args.extend_from_slice(flags);
+        let o = strata(&args);
+        assert!(o.status.success(), "{technique}: {}", stderr(&o));
+        let err = stderr(&o);
+        let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+        assert_eq!(warned.len(), flags.len() / 2, "{technique}: {warned:?}");
+        assert!(
+            warned
+                .iter()
+                .any(|l| l.contains(warned_flag) && l.contains("not read by eval")),
+            "{technique}: {warned:?}"
+        );
+    }
 }
 
 /// `eval --technique gi` blends with light probes by default (what `render --technique full`
