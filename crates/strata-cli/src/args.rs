@@ -760,7 +760,8 @@ impl FrameArgs {
     /// second layer (ILS, the A-buffer techniques, `bzb-ao`, `direct`) and no debug view
     /// (`debug_view`) may show one. `render` prints them as warnings and renders: the command
     /// `strata view` prints for a frame keeps the flags given to it across technique switches. (`eval`
-    /// refuses the flags of its own that a comparison does not read.)
+    /// refuses some flags of its own that a comparison does not read and warns of the rest:
+    /// [`EvalArgs::unread_flags`].)
     pub fn unread_flags(&self, settings: &strata_render::RenderSettings, debug_view: bool) -> Vec<String> {
         let longs = |c: clap::Command| -> Vec<(String, String)> {
             c.get_arguments()
