@@ -1031,6 +1031,26 @@ pub struct BenchStageArgs {
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    /// The ids of the flags given on the command line (not defaulted), filled after parsing:
+    /// the benches that time no second layer warn of `--layers` and `--variant`.
+    #[arg(skip)]
+    pub given: Vec<String>,
+}
+
+impl BenchWhat {
+    /// The shared stage flags of the benches that have them.
+    pub fn stage_mut(&mut self) -> Option<&mut BenchStageArgs> {
+        match self {
+            BenchWhat::Ao(b) => Some(&mut b.stage),
+            BenchWhat::Radiosity(b) => Some(&mut b.stage),
+            BenchWhat::Technique(b) => Some(&mut b.stage),
+            BenchWhat::Ils(b) => Some(&mut b.stage),
+            BenchWhat::Abuffer(b) => Some(&mut b.stage),
+            BenchWhat::Bzb(b) => Some(&mut b.stage),
+            BenchWhat::Reflections(b) => Some(&mut b.stage),
+            BenchWhat::Gbuffer(_) | BenchWhat::DeepGbuffer(_) | BenchWhat::Reference(_) => None,
+        }
+    }
 }
 
 #[derive(Args)]

@@ -6,9 +6,32 @@ use strata_eval::bench::{abuffer, ao, bzb, deep, gbuffer, ils, radiosity, refere
 use strata_eval::results::{to_json_string, BenchResult, DeepBench, GbufferBench, ReferenceBench, StageBench};
 use strata_render::passes::reflections::ReflectionSettings;
 
-use crate::args::{BenchArgs, BenchWhat};
+use crate::args::{BenchArgs, BenchStageArgs, BenchWhat};
+
+/// One warning line per deep-G-buffer flag given to a bench that times no second layer.
+fn warn_unread_layers(stage: &BenchStageArgs, bench: &str, why: &str) {
+    for (id, long) in [("layers", "--layers"), ("variant", "--variant")] {
+        if stage.given.iter().any(|g| g == id) {
+            eprintln!("strata: warning: {long} is not read by bench {bench}: {why}");
+        }
+    }
+}
 
 pub fn run(a: &BenchArgs) -> Result<()> {
+    match &a.what {
+        BenchWhat::Ils(b) => warn_unread_layers(&b.stage, "ils", "ILS shades layer 0 alone"),
+        BenchWhat::Abuffer(b) => warn_unread_layers(
+            &b.stage,
+            "abuffer",
+            "the A-buffer keeps every fragment, with no deep G-buffer",
+        ),
+        BenchWhat::Bzb(b) => warn_unread_layers(
+            &b.stage,
+            "bzb",
+            "it times the bounced z-buffer with one deep-G-buffer layer",
+        ),
+        _ => {}
+    }
     let (result, json) = match &a.what {
         BenchWhat::Gbuffer(b) => (BenchResult::Gbuffer(gbuffer::run(&b.into())?), b.json),
         BenchWhat::DeepGbuffer(b) => (BenchResult::DeepGbuffer(deep::run(&b.into())?), b.json),

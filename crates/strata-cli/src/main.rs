@@ -46,15 +46,22 @@ fn main() {
         Ok((mut c, m)) => {
             // which flags `render` and `eval` were given, not defaulted
             // (`FrameArgs::unread_flags`, `EvalArgs::unread_flags`)
-            if let Some((_, sub)) = m.subcommand() {
-                let given: Vec<String> = sub
-                    .ids()
+            let given = |sub: &clap::ArgMatches| -> Vec<String> {
+                sub.ids()
                     .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
                     .map(|id| id.to_string())
-                    .collect();
+                    .collect()
+            };
+            if let Some((_, sub)) = m.subcommand() {
                 match &mut c.command {
-                    args::Command::Render(a) => a.frame.given = given,
-                    args::Command::Eval(a) => a.given = given,
+                    args::Command::Render(a) => a.frame.given = given(sub),
+                    args::Command::Eval(a) => a.given = given(sub),
+                    // `bench <what>`: the stage flags of the nested command
+                    args::Command::Bench(b) => {
+                        if let (Some(stage), Some((_, what))) = (b.what.stage_mut(), sub.subcommand()) {
+                            stage.given = given(what);
+                        }
+                    }
                     _ => {}
                 }
             }

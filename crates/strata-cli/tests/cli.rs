@@ -2870,6 +2870,33 @@ fn probe_grid_and_rays_reach_the_bake_and_are_range_checked() {
     assert!(e.contains("baking 12 light probes (3×2×2, 512 paths each)"), "{e}");
 }
 
+/// `bench ils`, `abuffer` and `bzb` time no second layer: `--layers` and `--variant` given to
+/// them get a one-line warning each and the bench runs; not given, no warning.
+#[test]
+fn benches_without_a_second_layer_warn_of_layer_flags() {
+    for bench in ["ils", "abuffer", "bzb"] {
+        let args = |extra: &[&'static str]| {
+            let mut a = vec![
+                "bench", bench, "--scene", "cornell", "--frames", "1", "--width", "32", "--height", "32", "--json",
+            ];
+            a.extend_from_slice(extra);
+            strata(&a)
+        };
+        let o = args(&["--layers", "3", "--variant", "peel"]);
+        assert!(o.status.success(), "{bench}: {}", stderr(&o));
+        let err = stderr(&o);
+        let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+        assert_eq!(warned.len(), 2, "{bench}: {warned:?}");
+        for flag in ["--layers", "--variant"] {
+            let needle = format!("{flag} is not read by bench {bench}");
+            assert!(warned.iter().any(|l| l.contains(&needle)), "{bench}: {warned:?}");
+        }
+        let o = args(&[]);
+        assert!(o.status.success(), "{bench}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("strata: warning: --"), "{bench}: {}", stderr(&o));
+    }
+}
+
 /// `bench deep-gbuffer` (DGB Table 5, Fig. 3) and, with `--layer-scale`, Fig. 11: every method
 /// builds its layers one submission per layer, the upsampling is part of layer 2's time, and
 /// the JSON and the report say the scale.
