@@ -134,6 +134,21 @@ pub fn stitch(s: &StitchSettings) -> Result<PathBuf> {
             _ => benches.extend(secs),
         }
     }
+    let has_info = s.from.join("info.txt").is_file();
+    if evals.is_empty() && benches.is_empty() && links.is_empty() && s.figures.is_empty() && !has_info {
+        let hint = if s.from.join("index.html").is_file() {
+            format!(
+                " (it holds an evaluation report of its own: {})",
+                s.from.join("index.html").display()
+            )
+        } else {
+            String::new()
+        };
+        bail!(
+            "--from {}: nothing to report: no *.json from `bench`/`eval --json`, no info.txt and no subfolder with an index.html{hint}",
+            s.from.display()
+        );
+    }
     if !links.is_empty() {
         page.sections.push(Section {
             title: "Evaluation reports (images, FLIP maps)".into(),
@@ -242,6 +257,33 @@ mod tests {
             let svg = fs::read_to_string(dir.join(plot)).unwrap();
             assert!(svg.trim_end().ends_with("</svg>"));
         }
+        let _ = fs::remove_dir_all(&dir);
+    }
+
+    /// A folder with nothing to stitch (or an eval report folder itself) is a one-line error
+    /// naming it, and no page is written.
+    #[test]
+    fn an_empty_folder_is_an_error_not_an_empty_page() {
+        let dir = std::env::temp_dir().join(format!("strata-stitch-empty-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(dir.join("a.png"), b"png").unwrap();
+        let s = StitchSettings {
+            from: dir.clone(),
+            out: dir.join("report.html"),
+            title: "t".into(),
+            figures: Vec::new(),
+            force: false,
+        };
+        let e = stitch(&s).unwrap_err().to_string();
+        assert!(
+            e.contains("--from") && e.contains("nothing to report") && !e.contains('\n'),
+            "{e}"
+        );
+        assert!(!dir.join("report.html").exists());
+        fs::write(dir.join("index.html"), "<html>").unwrap();
+        let e = stitch(&s).unwrap_err().to_string();
+        assert!(e.contains("evaluation report of its own"), "{e}");
         let _ = fs::remove_dir_all(&dir);
     }
 }
