@@ -2415,22 +2415,25 @@ fn bzb_ao_dss_renders_and_range_checks_its_settings() {
 /// warns; `render --technique oit` writes the image.
 #[test]
 fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
-    for method in ["linked-list", "linear", "fixed-array", "dual-peel"] {
-        let set = format!("abuffer={method}");
-        let v = json_of(&strata(&[
+    // eval --technique oit on glasshouse at `size`, then `extra`
+    let oit = |size: [&str; 2], extra: &[&str]| {
+        let mut a = vec![
             "eval",
             "--scene",
             "glasshouse",
             "--technique",
             "oit",
             "--width",
-            "96",
+            size[0],
             "--height",
-            "54",
-            "--json",
-            "--set",
-            &set,
-        ]));
+            size[1],
+        ];
+        a.extend_from_slice(extra);
+        strata(&a)
+    };
+    for method in ["linked-list", "linear", "fixed-array", "dual-peel"] {
+        let set = format!("abuffer={method}");
+        let v = json_of(&oit(["96", "54"], &["--json", "--set", &set]));
         let flip = v["flip"].as_f64().unwrap();
         assert!(flip <= 0.02, "{method}: ꟻLIP {flip}");
         assert!(v["fragments"].as_u64().unwrap() > 96 * 54, "{method}: {v}");
@@ -2439,20 +2442,7 @@ fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
             "glasshouse has ≥ 8 layers somewhere: {v}"
         );
     }
-    let o = strata(&[
-        "eval",
-        "--scene",
-        "glasshouse",
-        "--technique",
-        "oit",
-        "--width",
-        "96",
-        "--height",
-        "54",
-        "--json",
-        "--set",
-        "pool=500",
-    ]);
+    let o = oit(["96", "54"], &["--json", "--set", "pool=500"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let (total, dropped) = (v["fragments"].as_u64().unwrap(), v["dropped"].as_u64().unwrap());
@@ -2461,20 +2451,8 @@ fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
     // --report: the page and its images exist (it had printed "wrote" and written nothing)
     let report = scratch("oit-report");
     let _ = std::fs::remove_dir_all(&report);
-    let v = json_of(&strata(&[
-        "eval",
-        "--scene",
-        "glasshouse",
-        "--technique",
-        "oit",
-        "--width",
-        "96",
-        "--height",
-        "54",
-        "--json",
-        "--report",
-        report.to_str().unwrap(),
-    ]));
+    let report_arg = report.to_str().unwrap();
+    let v = json_of(&oit(["96", "54"], &["--json", "--report", report_arg]));
     let html = std::fs::read_to_string(report.join("index.html")).expect("the report page");
     for f in ["reference.png", "oit.png", "flip-oit.png"] {
         assert!(
@@ -2484,41 +2462,13 @@ fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
     }
     let flip = format!("{:.4}", v["flip"].as_f64().unwrap());
     assert!(html.contains(&flip), "ꟻLIP {flip} not on the page");
-    let again = strata(&[
-        "eval",
-        "--scene",
-        "glasshouse",
-        "--technique",
-        "oit",
-        "--width",
-        "96",
-        "--height",
-        "54",
-        "--report",
-        report.to_str().unwrap(),
-    ]);
-    assert_one_line_error(&again, &["--report", "--force"]);
+    assert_one_line_error(&oit(["96", "54"], &["--report", report_arg]), &["--report", "--force"]);
     // flags the exact composite does not read: one warning line each, and it still runs;
     // --guard-band is read (a wider frame), so no warning names it
-    let o = strata(&[
-        "eval",
-        "--scene",
-        "glasshouse",
-        "--technique",
-        "oit",
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--warmup",
-        "5",
-        "--samples",
-        "5",
-        "--ref-spp",
-        "4",
-        "--guard-band",
-        "8",
-    ]);
+    let o = oit(
+        ["32", "24"],
+        &["--warmup", "5", "--samples", "5", "--ref-spp", "4", "--guard-band", "8"],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
     let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning:")).collect();
