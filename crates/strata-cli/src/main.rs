@@ -44,8 +44,8 @@ fn main() {
         .and_then(|m| args::Cli::from_arg_matches(&m).map(|c| (c, m)));
     let cli = match parsed {
         Ok((mut c, m)) => {
-            // which flags `render` and `eval` were given, not defaulted
-            // (`FrameArgs::unread_flags`, `EvalArgs::unread_flags`)
+            // which flags `render`, `soak`, `eval` and `bench` were given, not defaulted
+            // (`FrameArgs::unread_flags`, `EvalArgs::unread_flags`, the benches' layer flags)
             let given = |sub: &clap::ArgMatches| -> Vec<String> {
                 sub.ids()
                     .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
@@ -55,6 +55,7 @@ fn main() {
             if let Some((_, sub)) = m.subcommand() {
                 match &mut c.command {
                     args::Command::Render(a) => a.frame.given = given(sub),
+                    args::Command::Soak(a) => a.frame.given = given(sub),
                     args::Command::Eval(a) => a.given = given(sub),
                     // `bench <what>`: the stage flags of the nested command
                     args::Command::Bench(b) => {

@@ -44,6 +44,9 @@ pub fn run(a: &SoakArgs) -> Result<()> {
     }
     let f = &a.frame;
     let (scene, _, settings) = crate::render::prepare(f)?;
+    for w in f.unread_flags(&settings, false) {
+        eprintln!("strata: warning: {w}");
+    }
     let gpu = GpuContext::new(&GpuOptions {
         adapter: f.gpu.adapter.clone(),
     })?;

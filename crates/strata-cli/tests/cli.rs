@@ -1246,6 +1246,30 @@ fn soak_rejects_out_of_range_parameters() {
         "-5",
     ]);
     assert_one_line_error(&o, &["--max-growth-percent", "0..=1000"]);
+    // a flag its technique does not read: the same one-line warning as `render`, and it runs
+    let o = strata(&[
+        "soak",
+        "--scene",
+        "cornell",
+        "--frames",
+        "2",
+        "--sample-every",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--samples",
+        "5",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+    assert!(
+        warned.len() == 1 && warned[0].contains("--samples is not read by --technique direct"),
+        "{warned:?}"
+    );
 }
 
 /// Issue 9's CLI fix, needed by anyone typing a camera: negative vector values in
