@@ -2910,7 +2910,14 @@ fn bench_deep_gbuffer_with_a_reduced_second_layer() {
         let up = r["upsample_ms"]
             .as_f64()
             .unwrap_or_else(|| panic!("{method}: no upsampling time: {r}"));
-        assert!(up > 0.0 && up < r["layer2_ms"].as_f64().unwrap(), "{r}");
+        assert!(up > 0.0 && up.is_finite(), "{r}");
+        // the peel times its second layer inside each frame, upsampling included, so its
+        // median lies above the upsampling's; the single-pass methods' layer 2 is their
+        // frame minus the single-layer frame of other runs, which timing noise can push
+        // below it (a test of timings would be flaky)
+        if method == "peel" {
+            assert!(up <= r["layer2_ms"].as_f64().unwrap(), "{r}");
+        }
     }
     // at full resolution there is no upsampling
     assert!(rows(&full).iter().all(|r| r["upsample_ms"].is_null()), "{full}");
