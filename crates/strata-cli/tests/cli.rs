@@ -42,6 +42,16 @@ fn json_of(o: &Output) -> serde_json::Value {
     serde_json::from_str(stdout(o).trim()).expect("one JSON object on stdout")
 }
 
+/// The flag warnings (`strata: warning: --…`) of a successful run, one per line.
+fn flag_warnings(o: &Output) -> Vec<String> {
+    assert!(o.status.success(), "{}", stderr(o));
+    stderr(o)
+        .lines()
+        .filter(|l| l.starts_with("strata: warning: --"))
+        .map(String::from)
+        .collect()
+}
+
 /// Pass names of a `bench` JSON object.
 fn pass_names(v: &serde_json::Value) -> Vec<&str> {
     v["passes"]
@@ -1023,9 +1033,7 @@ fn eval_gi_refuses_ao_settings_it_would_ignore() {
         ];
         args.extend_from_slice(flags);
         let o = strata(&args);
-        assert!(o.status.success(), "{technique}: {}", stderr(&o));
-        let err = stderr(&o);
-        let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+        let warned = flag_warnings(&o);
         assert_eq!(warned.len(), flags.len() / 2, "{technique}: {warned:?}");
         assert!(
             warned
@@ -1263,9 +1271,7 @@ fn soak_rejects_out_of_range_parameters() {
         "5",
         "--json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
-    let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+    let warned = flag_warnings(&o);
     assert!(
         warned.len() == 1 && warned[0].contains("--samples is not read by --technique direct"),
         "{warned:?}"
@@ -1883,9 +1889,7 @@ fn eval_ils_reports_errors_vs_brute_force_and_path_tracer() {
         "--preset",
         "refined",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
-    let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+    let warned = flag_warnings(&o);
     assert_eq!(warned.len(), 2, "{warned:?}");
     assert!(
         warned
@@ -2493,9 +2497,7 @@ fn eval_oit_matches_the_cpu_compositing_and_reports_overflow() {
         ["32", "24"],
         &["--warmup", "5", "--samples", "5", "--ref-spp", "4", "--guard-band", "8"],
     );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
-    let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning:")).collect();
+    let warned = flag_warnings(&o);
     for flag in ["--warmup", "--samples", "--ref-spp"] {
         assert!(
             warned
@@ -2857,9 +2859,7 @@ fn benches_without_a_second_layer_warn_of_layer_flags() {
             strata(&a)
         };
         let o = args(&["--layers", "3", "--variant", "peel"]);
-        assert!(o.status.success(), "{bench}: {}", stderr(&o));
-        let err = stderr(&o);
-        let warned: Vec<&str> = err.lines().filter(|l| l.starts_with("strata: warning: --")).collect();
+        let warned = flag_warnings(&o);
         assert_eq!(warned.len(), 2, "{bench}: {warned:?}");
         for flag in ["--layers", "--variant"] {
             let needle = format!("{flag} is not read by bench {bench}");

@@ -261,10 +261,9 @@ fn write_gi_report(
     use super::write_report;
     let sections = super::gi_report_sections(
         dir,
-        format!(
-            "{}×{} pixels, frame {}, {} spp; sky and ambient off. Tonemapped with the scene's exposure ({exposure}); indirect = the composed frame − the direct light. ꟻLIP maps use the magma scale. {} directions per pixel, d_max {:.3}.",
-            s.scene.width, s.scene.height, s.scene.frame, out.run.ref_spp, out.directions, out.d_max
-        ),
+        s,
+        out.run.ref_spp,
+        &format!("{} directions per pixel, d_max {:.3}.", out.directions, out.d_max),
         references,
         exposure,
         rows,

@@ -180,10 +180,9 @@ pub fn run(
         let label = format!("ILS {}, {} ({} VPLs)", out.pattern, out.preset, out.vpls);
         let mut sections = gi_report_sections(
             dir,
-            format!(
-                "{}×{} pixels, frame {}, {} spp; sky and ambient off. Tonemapped with the scene's exposure ({exposure}); indirect = the composed frame − the direct light. ꟻLIP maps use the magma scale. {}",
-                s.scene.width, s.scene.height, s.scene.frame, out.run.ref_spp, out.run.reference
-            ),
+            s,
+            out.run.ref_spp,
+            &out.run.reference,
             (&ref_indirect.image, &ref_total.image),
             exposure,
             &[

@@ -271,11 +271,14 @@ pub(crate) struct GiImages {
 }
 
 /// The image sections of a radiance evaluation's `--report`: the path tracer's indirect
-/// light and frame under `header`, then each configuration's (`rows`: label, errors,
-/// images) indirect light and frame beside their ꟻLIP maps, tonemapped with `exposure`.
+/// light and frame (`ref_spp` samples; `detail` ends the caption), then each
+/// configuration's (`rows`: label, errors, images) indirect light and frame beside their
+/// ꟻLIP maps, tonemapped with `exposure`.
 pub(crate) fn gi_report_sections(
     dir: &std::path::Path,
-    header: String,
+    s: &EvalSettings,
+    ref_spp: u32,
+    detail: &str,
     (ref_indirect, ref_total): (&ImageBuf, &ImageBuf),
     exposure: f32,
     rows: &[(&str, &crate::results::GiErrors, &GiImages)],
@@ -284,6 +287,10 @@ pub(crate) fn gi_report_sections(
     std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
     let shown = |img: &ImageBuf, name: &str, caption: String| figure(dir, &display(img, exposure), name, caption);
     let map = |img: &ImageBuf, name: &str, caption: String| figure(dir, img, name, caption);
+    let header = format!(
+        "{}×{} pixels, frame {}, {ref_spp} spp; sky and ambient off. Tonemapped with the scene's exposure ({exposure}); indirect = the composed frame − the direct light. ꟻLIP maps use the magma scale. {detail}",
+        s.scene.width, s.scene.height, s.scene.frame
+    );
     let mut sections = vec![Section::new("Path tracer, one indirect bounce")
         .text(header)
         .figures(vec![
