@@ -1,10 +1,13 @@
 //! `strata compare`: two images of the same size with the metrics `eval` uses.
 //!
-//! Without `--exposure` the values are compared as they are (ambient visibility:
-//! `strata_eval::metrics::compare`, as `eval --technique ao` does); with
-//! `--exposure E` they are linear radiance, displayed as the tonemapper does
+//! Without `--exposure` the values are compared as the files store them
+//! (`strata_eval::metrics::compare`, as `eval --technique ao` does): a PNG's bytes are
+//! what `eval` hands ꟻLIP, sRGB-encoded display values or ambient visibility's raw
+//! 255·AV, so two PNGs, or an AO EXR and its PNG, compare as `eval` would. With
+//! `--exposure E` both are EXRs of linear radiance, displayed as the tonemapper does
 //! (exposure, ACES, sRGB) for FLIP, with RMSE and MAE of the linear values
-//! (`compare_radiance`, as `eval --technique gi` does).
+//! (`compare_radiance`, as `eval --technique gi` does); a PNG holds display values
+//! and is refused there.
 
 use std::path::PathBuf;
 
@@ -13,11 +16,12 @@ use clap::Args;
 use serde_json::json;
 use strata_eval::files::check_output_for;
 use strata_eval::metrics::{compare, compare_radiance};
+use strata_scene::image_buf::is_png;
 use strata_scene::ImageBuf;
 
 #[derive(Args)]
 pub struct CompareArgs {
-    /// Reference image (.exr linear, or .png).
+    /// Reference image (.exr linear, or .png display values; AO PNGs hold 255·AV).
     pub reference: PathBuf,
     /// Test image, same size.
     pub test: PathBuf,
@@ -35,12 +39,12 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
-/// RGB (alpha dropped) of an image file.
+/// RGB (alpha dropped) of an image file, the values it stores (`ImageBuf::load_stored`).
 fn load_rgb(path: &std::path::Path) -> Result<ImageBuf> {
     if !path.exists() {
         bail!("{}: no such file", path.display());
     }
-    let rgba = ImageBuf::load(path).map_err(|e| anyhow!(e))?;
+    let rgba = ImageBuf::load_stored(path).map_err(|e| anyhow!(e))?;
     let mut out = ImageBuf::new(rgba.width, rgba.height, 3);
     for (o, p) in out.data.chunks_exact_mut(3).zip(rgba.data.chunks_exact(4)) {
         o.copy_from_slice(&p[..3]);
@@ -61,11 +65,33 @@ pub fn run(a: &CompareArgs) -> Result<()> {
             bail!("--exposure {e} is out of range: must be > 0");
         }
     }
+    let pngs: Vec<&PathBuf> = [&a.reference, &a.test].into_iter().filter(|p| is_png(p)).collect();
+    if let (Some(e), Some(p)) = (a.exposure, pngs.first()) {
+        bail!(
+            "--exposure {e} compares linear radiance, but {} holds display values (tonemapped, sRGB): compare two EXRs with --exposure, or drop it",
+            p.display()
+        );
+    }
     if let Some(m) = &a.map {
         check_output_for("--map", m, a.force)?;
     }
     let reference = load_rgb(&a.reference)?;
     let test = load_rgb(&a.test)?;
+    // an EXR with values above 1 holds radiance, which a PNG's display values never match
+    if let (Some(png), 1) = (pngs.first(), pngs.len()) {
+        let (exr, img) = if is_png(&a.reference) {
+            (&a.test, &test)
+        } else {
+            (&a.reference, &reference)
+        };
+        if img.data.iter().any(|&v| v > 1.0) {
+            eprintln!(
+                "strata: warning: compare: {} holds linear radiance (values above 1) and {} display values: the two do not match whatever the renders; compare two EXRs with --exposure, or two PNGs",
+                exr.display(),
+                png.display()
+            );
+        }
+    }
     if (reference.width, reference.height) != (test.width, test.height) {
         bail!(
             "{} is {}x{} but {} is {}x{}: images must have the same size",

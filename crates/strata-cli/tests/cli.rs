@@ -2078,6 +2078,89 @@ fn compare_reports_zero_for_identical_images_and_refuses_size_mismatch() {
     assert_one_line_error(&o, &["same size"]);
 }
 
+/// `compare` reads a PNG's stored bytes, as `eval` hands them to ꟻLIP: an AO reference
+/// written as EXR and as PNG (raw 255·AV bytes) compares with ꟻLIP 0 and RMSE within the
+/// bytes' rounding (it read the PNG sRGB-decoded before: ꟻLIP 0.15 at this size).
+/// `--exposure` (linear radiance) refuses a PNG in one line, and a radiance EXR against a
+/// PNG warns.
+#[test]
+fn compare_reads_png_bytes_as_eval_does() {
+    let (exr, png) = (scratch("compare-ao.exr"), scratch("compare-ao.png"));
+    for p in [&exr, &png] {
+        let o = strata(&[
+            "reference",
+            "--scene",
+            "cornell",
+            "--kind",
+            "ao",
+            "--spp",
+            "4",
+            "--width",
+            "24",
+            "--height",
+            "16",
+            "--quiet",
+            "--force",
+            "--out",
+            p.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let v = json_of(&strata(&[
+        "compare",
+        exr.to_str().unwrap(),
+        png.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(v["flip"].as_f64(), Some(0.0), "{v}");
+    let rmse = v["rmse"].as_f64().unwrap();
+    assert!(rmse <= 0.5 / 255.0 + 1e-6, "rmse {rmse}");
+    assert!(v["mean_difference"].as_f64().unwrap().abs() <= 0.5 / 255.0, "{v}");
+
+    let o = strata(&[
+        "compare",
+        exr.to_str().unwrap(),
+        png.to_str().unwrap(),
+        "--exposure",
+        "1",
+    ]);
+    assert_one_line_error(&o, &["--exposure", "compare-ao.png", "display values"]);
+
+    let (hdr, ldr) = (scratch("compare-render.exr"), scratch("compare-render.png"));
+    for p in [&hdr, &ldr] {
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--width",
+            "24",
+            "--height",
+            "16",
+            "--force",
+            "--out",
+            p.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let o = strata(&["compare", hdr.to_str().unwrap(), ldr.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let warned: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("strata: warning: compare:"))
+        .collect();
+    assert!(
+        warned.len() == 1 && warned[0].contains("compare-render.exr") && warned[0].contains("linear radiance"),
+        "{}",
+        stderr(&o)
+    );
+    // two PNGs, or an AO EXR beside its PNG, do not warn
+    let o = strata(&["compare", ldr.to_str().unwrap(), ldr.to_str().unwrap()]);
+    assert!(o.status.success() && !stderr(&o).contains("warning"), "{}", stderr(&o));
+    let o = strata(&["compare", exr.to_str().unwrap(), png.to_str().unwrap()]);
+    assert!(o.status.success() && !stderr(&o).contains("warning"), "{}", stderr(&o));
+}
+
 /// Writes a glTF (JSON + external .bin) of a 4 × 4 floor quad at y = 0 (normal
 /// +Y) seen from above by a camera node; `extension` is inserted at the top
 /// level and `light_nodes` appended to the nodes (the scene lists nodes 0.. all).

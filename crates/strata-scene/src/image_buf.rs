@@ -111,25 +111,36 @@ impl ImageBuf {
 
     /// Reads a PNG/EXR back as linear RGBA (PNG is sRGB-decoded).
     pub fn load(path: &Path) -> Result<ImageBuf, String> {
-        let img = image::open(path).map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
-        let is_png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        let rgba = img.to_rgba32f();
-        let (w, h) = rgba.dimensions();
-        let mut data = rgba.into_raw();
-        if is_png {
-            for (i, v) in data.iter_mut().enumerate() {
+        let mut img = Self::load_stored(path)?;
+        if is_png(path) {
+            for (i, v) in img.data.iter_mut().enumerate() {
                 if i % 4 != 3 {
                     *v = crate::model::srgb_to_linear((*v * 255.0 + 0.5) as u8);
                 }
             }
         }
+        Ok(img)
+    }
+
+    /// Reads a PNG/EXR as RGBA with the values it stores: a PNG's bytes / 255 (no
+    /// transfer function: sRGB-encoded display values, or the raw 255·AV bytes of
+    /// ambient visibility), an EXR's floats.
+    pub fn load_stored(path: &Path) -> Result<ImageBuf, String> {
+        let img = image::open(path).map_err(|e| format!("{}: cannot read image: {e}", path.display()))?;
+        let rgba = img.to_rgba32f();
+        let (w, h) = rgba.dimensions();
         Ok(ImageBuf {
             width: w,
             height: h,
             channels: 4,
-            data,
+            data: rgba.into_raw(),
         })
     }
+}
+
+/// Whether `path` names a PNG (by its extension).
+pub fn is_png(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
 }
 
 pub fn linear_to_srgb(c: f32) -> f32 {
