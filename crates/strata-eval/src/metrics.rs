@@ -57,10 +57,12 @@ pub struct ErrorStats {
 
 impl ErrorStats {
     /// Whether the error is within 2× of the reference's own noise (ꟻLIP or RMSE): then the
-    /// reference cannot tell this error apart from its noise.
+    /// reference cannot tell this error apart from its noise. A metric whose noise is 0 (a
+    /// noise-free reference: nothing to converge) never flags.
     pub fn within_ref_noise(&self) -> bool {
+        let within = |err: f32, noise: f32| noise > 0.0 && err <= 2.0 * noise;
         self.ref_noise
-            .is_some_and(|n| self.flip <= 2.0 * n.flip || self.rmse <= 2.0 * n.rmse)
+            .is_some_and(|n| within(self.flip, n.flip) || within(self.rmse, n.rmse))
     }
 }
 
@@ -452,6 +454,22 @@ mod tests {
         assert!(e(0.5, 0.02).within_ref_noise());
         assert!(!e(0.041, 0.021).within_ref_noise());
         assert!(!ErrorStats::default().within_ref_noise(), "no noise measured, no flag");
+        // a noise-free reference (a scene without indirect light: both halves 0) flags
+        // nothing, not even an exact match; noise in one metric still counts
+        let exact = RefNoise {
+            flip: 0.0,
+            rmse: 0.0,
+            ..noise
+        };
+        let f = |flip, rmse, n| ErrorStats {
+            flip,
+            rmse,
+            ref_noise: Some(n),
+            ..Default::default()
+        };
+        assert!(!f(0.0, 0.0, exact).within_ref_noise());
+        assert!(!f(0.0, 0.004, exact).within_ref_noise());
+        assert!(f(0.0, 0.004, RefNoise { rmse: 0.01, ..exact }).within_ref_noise());
     }
 
     #[test]
