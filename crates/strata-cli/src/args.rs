@@ -827,6 +827,9 @@ impl FrameArgs {
 
 #[derive(Args)]
 pub struct TechniquesArgs {
+    /// Only this technique (default: every registered one).
+    #[arg(value_parser = parse_technique)]
+    pub technique: Option<&'static strata_render::technique::Technique>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,

@@ -50,24 +50,43 @@ pub fn technique_json(t: &Technique) -> Result<serde_json::Value> {
 }
 
 pub fn run(a: &TechniquesArgs) -> Result<()> {
+    let listed: Vec<&Technique> = match a.technique {
+        Some(t) => vec![t],
+        None => registry().iter().collect(),
+    };
     if a.json {
-        let all: Vec<_> = registry().iter().map(technique_json).collect::<Result<_>>()?;
+        let all: Vec<_> = listed.into_iter().map(technique_json).collect::<Result<_>>()?;
         println!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({ "techniques": all }))?
         );
         return Ok(());
     }
-    for t in registry() {
+    for t in listed {
         let defaults = t.settings(&RenderSettings::default(), None)?;
         println!("{}  —  {}", t.name, t.doc);
         println!("  output {}, eval {}", t.output, t.eval.name());
         if !t.presets.is_empty() {
-            println!("  presets {} (default {})", t.presets.join(", "), t.presets[0]);
+            println!(
+                "  presets (--preset) {} (default {})",
+                t.presets.join(", "),
+                t.presets[0]
+            );
         }
+        println!("  settings (--set NAME=VALUE): name, default, range, meaning");
         for i in t.setting_list() {
-            let d = (i.get)(&defaults).map_or("scene".to_string(), |v| format!("{}", tidy(v)));
-            println!("  --{:<22} {:>8}  {:<12} {}", i.name, d, i.range.to_string(), i.doc);
+            let value = (i.get)(&defaults);
+            // named values (`--set shadows=vpl`) by name, the rest as numbers
+            let (d, range) = if i.values.is_empty() {
+                (
+                    value.map_or("scene".to_string(), |v| format!("{}", tidy(v))),
+                    i.range.to_string(),
+                )
+            } else {
+                let named = value.and_then(|v| i.values.get(v as usize)).map_or("scene", |n| n);
+                (named.to_string(), i.values.join("|"))
+            };
+            println!("    {:<22} {:>8}  {:<12} {}", i.name, d, range, i.doc);
         }
         println!();
     }

@@ -1434,6 +1434,44 @@ fn frame_over_the_memory_budget_is_refused() {
     assert!(!out.exists());
 }
 
+/// `strata techniques NAME` lists that technique alone, naming its settings as `--set`
+/// takes them (not as flags: `--refine-peak` is no flag of `render`) and two-valued ones by
+/// their value names; an unknown name is one line listing the valid ones.
+#[test]
+fn techniques_lists_one_technique_with_set_names() {
+    let o = strata(&["techniques", "ils"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(out.starts_with("ils  —"), "{out}");
+    assert!(
+        !out.contains("\nao  —") && !out.contains("\nbzb-gi  —"),
+        "other techniques listed: {out}"
+    );
+    assert!(out.contains("--set NAME=VALUE"), "{out}");
+    let row = |name: &str| {
+        out.lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("no row {name}: {out}"))
+            .to_string()
+    };
+    assert!(!out.contains("--refine-peak"), "{out}");
+    assert!(
+        row("shadows").contains(" none ") && row("shadows").contains("none|vpl"),
+        "{}",
+        row("shadows")
+    );
+    assert!(row("refine-peak").contains("0..=1"), "{}", row("refine-peak"));
+    let v = json_of(&strata(&["techniques", "ao", "--json"]));
+    let names: Vec<&str> = v["techniques"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["ao"]);
+    assert_one_line_error(&strata(&["techniques", "foo"]), &["unknown technique 'foo'", "ils"]);
+}
+
 /// Issue 9: `strata techniques --json` lists every registered technique with its
 /// settings, defaults and ranges; every listed setting is settable with `--set`
 /// and its range is enforced there with a one-line error.
