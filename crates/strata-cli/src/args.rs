@@ -523,7 +523,7 @@ pub struct EvalArgs {
     pub bounces: u32,
     /// ils: also run §6.3's physically-based mode — up to K frames with fresh VPL sets of
     /// --bounces bounces and VPL shadow maps, accumulated until within 1 % RMS of the mean of
-    /// K independent sets, for 1x1 and 2x2 (Table 5), and that mean against the path tracer; 2..=4096.
+    /// K independent sets, for 1x1 and 2x2 (Table 5), and that mean against the path tracer; 2..=16384.
     #[arg(long)]
     pub progressive: Option<u32>,
     /// gi: also run DGB Fig. 10's error-source study — single-bounce GPU radiosity with and
