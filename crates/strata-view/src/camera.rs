@@ -57,7 +57,11 @@ const MAX_PITCH: f32 = 1.55;
 pub struct CameraControl {
     pub mode: Mode,
     pub eye: Vec3,
-    /// Around world +Y from +Z (radians); pitch above the horizon.
+    /// The world's up: the scene camera's up vector (+Y for Y-up scenes, +Z for Z-up
+    /// ones); yaw turns around it and pitch rises towards it.
+    pub up: Vec3,
+    /// Around `up` from the horizon's reference direction (+Z for a Y-up world,
+    /// [`horizon`]) (radians); pitch above the horizon.
     pub yaw: f32,
     pub pitch: f32,
     /// Distance to the look-at point (the orbit centre).
@@ -78,8 +82,28 @@ pub struct CameraControl {
     exact: Option<Camera>,
 }
 
-fn dir(yaw: f32, pitch: f32) -> Vec3 {
-    Vec3::new(pitch.cos() * yaw.sin(), pitch.sin(), pitch.cos() * yaw.cos())
+/// The horizon's axes (a, b) of a world whose up is `up` (unit): yaw 0 looks along b,
+/// yaw π/2 along a. For +Y they are +X and +Z, so a Y-up world keeps its old angles.
+fn horizon(up: Vec3) -> (Vec3, Vec3) {
+    let reference = if up.z.abs() < 0.9 { Vec3::Z } else { Vec3::X };
+    let b = (reference - reference.dot(up) * up).normalize();
+    (up.cross(b), b)
+}
+
+/// The view direction at `yaw`, `pitch` in a world whose up is `up`.
+fn dir(up: Vec3, yaw: f32, pitch: f32) -> Vec3 {
+    let (a, b) = horizon(up);
+    pitch.cos() * (yaw.sin() * a + yaw.cos() * b) + pitch.sin() * up
+}
+
+/// `v` as a world up: normalised, or +Y when it is zero or not finite.
+fn world_up(v: Vec3) -> Vec3 {
+    let n = v.normalize_or_zero();
+    if n == Vec3::ZERO || !n.is_finite() {
+        Vec3::Y
+    } else {
+        n
+    }
 }
 
 impl CameraControl {
@@ -88,6 +112,7 @@ impl CameraControl {
         let mut c = Self {
             mode: Mode::Fly,
             eye: cam.eye,
+            up: Vec3::Y,
             yaw: 0.0,
             pitch: 0.0,
             distance: 1.0,
@@ -110,10 +135,12 @@ impl CameraControl {
         let f = cam.target - cam.eye;
         let d = f.length().max(1e-6);
         let n = f / d;
+        self.up = world_up(cam.up);
+        let (a, b) = horizon(self.up);
         self.eye = cam.eye;
         self.distance = d;
-        self.pitch = n.y.clamp(-1.0, 1.0).asin();
-        self.yaw = n.x.atan2(n.z);
+        self.pitch = n.dot(self.up).clamp(-1.0, 1.0).asin();
+        self.yaw = n.dot(a).atan2(n.dot(b));
         self.fov_y_deg = cam.fov_y_deg;
         self.near = cam.near;
         self.exact = Some(cam);
@@ -123,11 +150,11 @@ impl CameraControl {
         if let Some(c) = self.exact {
             return c;
         }
-        let f = dir(self.yaw, self.pitch);
+        let f = dir(self.up, self.yaw, self.pitch);
         Camera {
             eye: self.eye,
             target: self.eye + f * self.distance,
-            up: Vec3::Y,
+            up: self.up,
             fov_y_deg: self.fov_y_deg,
             near: self.near,
         }
@@ -187,19 +214,19 @@ impl CameraControl {
                 if wheel != 0.0 {
                     self.speed = (self.speed * 1.25f32.powf(wheel)).clamp(1e-4, 1e4);
                 }
-                let f = dir(self.yaw, self.pitch);
-                let r = f.cross(Vec3::Y).normalize_or_zero();
+                let f = dir(self.up, self.yaw, self.pitch);
+                let r = f.cross(self.up).normalize_or_zero();
                 let v = self.speed * boost * dt;
-                self.eye += (f * fwd + r * side + Vec3::Y * lift) * v;
+                self.eye += (f * fwd + r * side + self.up * lift) * v;
             }
             Mode::Orbit => {
                 self.distance = self.distance.max(self.min_orbit);
-                let centre = self.eye + dir(self.yaw, self.pitch) * self.distance;
+                let centre = self.eye + dir(self.up, self.yaw, self.pitch) * self.distance;
                 self.yaw -= dx * LOOK_SENSITIVITY + side * 1.5 * dt;
                 self.pitch = (self.pitch - dy * LOOK_SENSITIVITY + lift * 1.5 * dt).clamp(-MAX_PITCH, MAX_PITCH);
                 let zoom = 0.9f32.powf(wheel) * (1.0 - fwd * dt * boost).max(0.05);
                 self.distance = (self.distance * zoom).clamp(1e-3, 1e5);
-                self.eye = centre - dir(self.yaw, self.pitch) * self.distance;
+                self.eye = centre - dir(self.up, self.yaw, self.pitch) * self.distance;
             }
         }
         self.camera() != before
@@ -234,6 +261,47 @@ mod tests {
         c.apply(Input::Key(Key::W, false));
         assert!(c.step(0.1));
         assert!(!c.step(0.1), "released: no more motion");
+    }
+
+    /// A Z-up scene camera (glTF/OBJ exports of CAD and architecture scenes) keeps +Z as
+    /// the world's up once the camera moves: a small drag turns the view a little instead
+    /// of snapping it to a +Y horizon, E lifts along +Z, D strafes in the XY plane, and
+    /// the camera handed to the renderer keeps up = +Z.
+    #[test]
+    fn a_z_up_scene_keeps_its_up_after_the_first_move() {
+        let cam = Camera::new(Vec3::new(5.0, -3.0, 1.5), Vec3::new(0.0, 0.0, 1.0), Vec3::Z, 50.0, 0.05);
+        let f0 = (cam.target - cam.eye).normalize();
+        let mut c = CameraControl::new(cam, 4.0);
+        assert_eq!(c.up, Vec3::Z);
+        c.apply(Input::Drag(1.0, 0.0));
+        assert!(c.step(1.0 / 60.0));
+        let m = c.camera();
+        assert_eq!(m.up, Vec3::Z);
+        let turned = m.forward().angle_between(f0);
+        assert!(
+            turned > 0.5 * LOOK_SENSITIVITY && turned < 2.0 * LOOK_SENSITIVITY,
+            "turned {turned} rad"
+        );
+        // a yaw turns around +Z: the height of the view direction is kept
+        assert!((m.forward().z - f0.z).abs() < 1e-5);
+        let e0 = m.eye;
+        c.apply(Input::Key(Key::E, true));
+        assert!(c.step(0.1));
+        c.apply(Input::Key(Key::E, false));
+        let d = c.camera().eye - e0;
+        assert!((d.normalize() - Vec3::Z).length() < 1e-5, "lift {d}");
+        c.apply(Input::Key(Key::D, true));
+        assert!(c.step(0.1));
+        c.apply(Input::Key(Key::D, false));
+        let d = c.camera().eye - e0 - Vec3::Z * c.speed * 0.1;
+        assert!(d.z.abs() < 1e-5 && d.length() > 0.0, "strafe {d}");
+        // a Y-up camera keeps the old angles: yaw 0 looks along +Z
+        let y = CameraControl::new(Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 60.0, 0.05), 1.0);
+        assert!(y.yaw.abs() < 1e-6 && y.pitch.abs() < 1e-6 && y.up == Vec3::Y);
+        // a degenerate up falls back to +Y
+        let mut z = CameraControl::new(cam, 1.0);
+        z.set(Camera { up: Vec3::ZERO, ..cam });
+        assert_eq!(z.up, Vec3::Y);
     }
 
     #[test]
