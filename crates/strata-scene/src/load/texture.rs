@@ -191,3 +191,62 @@ impl<K: Hash + Eq> TextureCache<K> {
         Ok(textures.len() - 1)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An EXR header (magic, version, then `dataWindow` and `tiles` attributes and the
+    /// terminating empty name) with a data window of `w`×`h` and tiles of `tw`×`th`.
+    fn exr_header(w: i32, h: i32, tiles: Option<(u32, u32)>) -> Vec<u8> {
+        let mut b = vec![0x76, 0x2f, 0x31, 0x01, 2, 2, 0, 0];
+        let mut attr = |name: &str, ty: &str, value: &[u8]| {
+            b.extend(name.bytes().chain([0]));
+            b.extend(ty.bytes().chain([0]));
+            b.extend((value.len() as i32).to_le_bytes());
+            b.extend(value);
+        };
+        let window: Vec<u8> = [0, 0, w - 1, h - 1]
+            .iter()
+            .flat_map(|v: &i32| v.to_le_bytes())
+            .collect();
+        attr("dataWindow", "box2i", &window);
+        if let Some((tw, th)) = tiles {
+            let desc: Vec<u8> = tw
+                .to_le_bytes()
+                .into_iter()
+                .chain(th.to_le_bytes())
+                .chain([0])
+                .collect();
+            attr("tiles", "tiledesc", &desc);
+        }
+        b.push(0);
+        b
+    }
+
+    /// The fuzzer's finding (docs/reliability.md, "tile-size-huge"): a tiled EXR whose
+    /// tiles are far larger than its data window is refused before decoding, in one line
+    /// naming the tile size and its range; tiles within the window (or the slack) and
+    /// scanline files pass; a data window past the side limit is refused; bytes that are
+    /// not an EXR are left to the decoders.
+    #[test]
+    fn exr_headers_with_huge_tiles_or_windows_are_refused_before_decoding() {
+        let huge = exr_header(4, 4, Some((64, 536_870_912)));
+        let e = check_exr_header(&huge).unwrap_err();
+        assert!(
+            e.contains("tile size 64×536870912") && e.contains("1 to 1024×1024") && !e.contains('\n'),
+            "{e}"
+        );
+        let e = decode_texture(&huge, "huge.exr").unwrap_err();
+        assert!(e.contains("tile size"), "{e}");
+        assert!(check_exr_header(&exr_header(4, 4, Some((4, 4)))).is_ok());
+        assert!(check_exr_header(&exr_header(4, 4, Some((EXR_TILE_SLACK as u32, 1)))).is_ok());
+        assert!(check_exr_header(&exr_header(2048, 8, Some((2048, 8)))).is_ok());
+        assert!(check_exr_header(&exr_header(2048, 8, Some((2049, 8)))).is_err());
+        assert!(check_exr_header(&exr_header(4, 4, Some((0, 4)))).is_err());
+        assert!(check_exr_header(&exr_header(64, 64, None)).is_ok());
+        let e = check_exr_header(&exr_header(MAX_TEXTURE_SIDE as i32 + 1, 1, None)).unwrap_err();
+        assert!(e.contains("data window"), "{e}");
+        assert!(check_exr_header(b"\x89PNG\r\n\x1a\n").is_ok());
+    }
+}
