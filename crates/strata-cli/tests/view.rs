@@ -455,6 +455,64 @@ fn camera_path_playback_follows_the_scene_path() {
     assert!(flip(&shot, &r) < FLIP_BOUND);
 }
 
+/// A Z-up camera (`--up 0,0,1`, as Z-up glTF/OBJ exports have) keeps +Z after the first
+/// move: a one-pixel drag turns the view by about a pixel's angle, and the command the
+/// screenshot saves names `--up 0,0,1` and reproduces the viewport. The viewer used to
+/// switch to +Y on the first move.
+#[test]
+fn a_z_up_camera_keeps_its_up_after_a_drag() {
+    let Some(x) = xvfb("view::a_z_up_camera_keeps_its_up_after_a_drag") else {
+        return;
+    };
+    let dir = scratch("z-up");
+    let small = ["--width", "64", "--height", "48"];
+    let camera = [
+        "--eye",
+        "-0.5,0.273,0.28",
+        "--target",
+        "0.28,0.273,0.28",
+        "--up",
+        "0,0,1",
+    ];
+    let (o, shot) = view(
+        &x,
+        &dir,
+        "dragged",
+        6,
+        Some("wait 1\nmouse-drag 1 0\nwait 2\n"),
+        &[&["--scene", "cornell"][..], &small, &camera].concat(),
+    );
+    ok(&o);
+    let cmd = std::fs::read_to_string(shot.with_extension("cmd.txt")).unwrap();
+    let flag = |f: &str| -> glam::Vec3 {
+        let v: Vec<f32> = cmd
+            .split(&format!(" {f} "))
+            .nth(1)
+            .unwrap_or_else(|| panic!("no {f}: {cmd}"))
+            .split(' ')
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        glam::Vec3::new(v[0], v[1], v[2])
+    };
+    assert_eq!(flag("--up"), glam::Vec3::Z, "{cmd}");
+    let (eye, target) = (flag("--eye"), flag("--target"));
+    let turned = (target - eye).normalize().angle_between(glam::Vec3::X);
+    assert!(
+        turned > 1e-4 && turned < 0.05,
+        "the drag turned the view by {turned} rad: {cmd}"
+    );
+    assert!(
+        (target - eye).normalize().z.abs() < 1e-4,
+        "a yaw keeps the view level in Z: {cmd}"
+    );
+    let r = dir.join("render.png");
+    run_cmd_txt(&shot, &r);
+    assert!(flip(&shot, &r) < FLIP_BOUND);
+}
+
 /// CPU seconds (user + system) process `pid` has used, from /proc (Linux).
 fn cpu_seconds(pid: u32) -> f64 {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
