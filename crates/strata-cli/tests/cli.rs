@@ -2079,29 +2079,35 @@ fn export_scene_writes_the_triangles_and_camera_of_the_frame() {
     assert_one_line_error(&o, &["exists", "--force"]);
 }
 
+/// Writes cornell's ray-traced AO (4 spp) at `width`×16 to `out` (overwriting it).
+fn ao_reference(out: &Path, width: &str) {
+    let o = strata(&[
+        "reference",
+        "--scene",
+        "cornell",
+        "--kind",
+        "ao",
+        "--spp",
+        "4",
+        "--width",
+        width,
+        "--height",
+        "16",
+        "--quiet",
+        "--force",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// `compare` of an image with itself is zero error; different sizes are one line.
 #[test]
 fn compare_reports_zero_for_identical_images_and_refuses_size_mismatch() {
     let a = scratch("compare-a.exr");
     let b = scratch("compare-b.exr");
     for (p, w) in [(&a, "24"), (&b, "16")] {
-        let o = strata(&[
-            "reference",
-            "--scene",
-            "cornell",
-            "--kind",
-            "ao",
-            "--spp",
-            "4",
-            "--width",
-            w,
-            "--height",
-            "16",
-            "--quiet",
-            "--out",
-            p.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        ao_reference(p, w);
     }
     let v = json_of(&strata(&[
         "compare",
@@ -2125,24 +2131,7 @@ fn compare_reports_zero_for_identical_images_and_refuses_size_mismatch() {
 fn compare_reads_png_bytes_as_eval_does() {
     let (exr, png) = (scratch("compare-ao.exr"), scratch("compare-ao.png"));
     for p in [&exr, &png] {
-        let o = strata(&[
-            "reference",
-            "--scene",
-            "cornell",
-            "--kind",
-            "ao",
-            "--spp",
-            "4",
-            "--width",
-            "24",
-            "--height",
-            "16",
-            "--quiet",
-            "--force",
-            "--out",
-            p.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
+        ao_reference(p, "24");
     }
     let v = json_of(&strata(&[
         "compare",
