@@ -10,7 +10,8 @@ mod common;
 use glam::{Mat4, Vec3};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::abuffer::{
-    blend_front_to_back, compress, far_depth, ABufferMethod, ABufferSettings, FragmentLists,
+    blend_front_to_back, compress, far_depth, ABufferMethod, ABufferSettings, FragmentLists, DEFAULT_POOL_PER_PIXEL,
+    NODE_BYTES,
 };
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::shapes::MeshBuilder;
@@ -473,6 +474,57 @@ fn bad_settings_are_one_line_errors_naming_the_parameter() {
     s.shade = true;
     let e = Renderer::new(&gpu, &scene, s).err().expect("rejected").to_string();
     assert!(e.contains("abuffer") && e.contains("shading"), "{e}");
+    gpu.check_errors().unwrap();
+}
+
+/// The default pool (8 nodes a pixel) fits the adapter: at a size where that would
+/// exceed the largest storage buffer (lavapipe: 128 MiB, 8,388,608 nodes; the
+/// paper's 1280×720 with strata's guard band needs 9.8 M), the frame renders with the
+/// pool capped to the buffer, and the stored lists stay well formed. A pool given
+/// explicitly above the limit is still refused in one line. Skips on an adapter whose
+/// buffers hold the default pool (there is nothing to cap).
+#[test]
+fn the_default_pool_fits_the_adapters_largest_buffer() {
+    let gpu = common::gpu();
+    let limits = gpu.device.limits();
+    let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let cap = (max / NODE_BYTES) as u32;
+    // the smallest square frame whose default pool exceeds the cap (plus the guard band)
+    let side = ((cap as f64 / DEFAULT_POOL_PER_PIXEL as f64).sqrt() as u32 + 1).min(8190);
+    if side as u64 * side as u64 * DEFAULT_POOL_PER_PIXEL as u64 <= cap as u64 {
+        strata_scene::skip::note_skip(
+            "abuffer::the_default_pool_fits_the_adapters_largest_buffer",
+            "the adapter's largest storage buffer holds the default pool at every allowed size",
+        );
+        return;
+    }
+    let scene = layered();
+    let t = strata_render::technique::find("oit").unwrap();
+    let base = RenderSettings {
+        width: side,
+        height: side,
+        ..Default::default()
+    };
+    let mut s = t.settings(&base, None).unwrap();
+    s.abuffer = Some(ABufferSettings::default());
+    let mut r = Renderer::new(&gpu, &scene, s.clone()).expect("the default pool is capped, not refused");
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0)
+        .expect("frame renders without validation errors");
+    let a = r.abuffer().unwrap();
+    assert_eq!(a.pool(), cap, "{side}x{side}: pool {} vs cap {cap}", a.pool());
+    let l = lists(&gpu, &r);
+    assert!(l.total > 0, "the panes are stored");
+    drop(r);
+    let mut explicit = s;
+    explicit.abuffer = Some(ABufferSettings {
+        pool: Some(cap + 1),
+        ..Default::default()
+    });
+    let e = Renderer::new(&gpu, &scene, explicit)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("largest storage buffer") && !e.contains('\n'), "{e}");
     gpu.check_errors().unwrap();
 }
 

@@ -95,22 +95,24 @@ pub fn run(stage: &StageSettings, set: &[(String, f64)]) -> Result<AbufferBench>
         let settings = configure(key)?;
         let a = settings.abuffer.clone().expect("oit has an A-buffer");
         // fragments stored and dropped, from one frame's lists
-        let (fragments, dropped) = {
+        let (fragments, dropped, pool) = {
             let mut r = Renderer::new(&gpu, &scene, settings.clone())?;
             r.render(&gpu, &scene, &FrameCameras::fixed(cams.current), stage.scene.frame)?;
-            let lists = r.abuffer().expect("A-buffer").read_lists(&gpu)?;
+            let abuffer = r.abuffer().expect("A-buffer");
+            let (lists, pool) = (abuffer.read_lists(&gpu)?, abuffer.pool());
             if key == "linked-list" || key == "compressed" {
                 ao_images.insert(key, r.read_target(&gpu, "ao")?);
             }
             gpu.check_errors()?;
-            (lists.total, lists.overflow)
+            (lists.total, lists.overflow, pool)
         };
         let mut passes = a.method.passes().to_vec();
         passes.extend(["aba-ao", "ao-blur-h", "ao-blur-v"]);
         let extra = json!({
             "technique": "aba-ao",
             "abuffer": a.method.name(),
-            "pool": a.pool_nodes(w, h),
+            // the nodes the stage allocated (the default pool fits the adapter)
+            "pool": pool,
             "max_layers": a.max_layers,
             "compress": a.compress,
             "compress_back_half": a.compress_back_half,

@@ -126,7 +126,9 @@ pub const MAX_LAYERS: u32 = 64;
 #[derive(Clone, Debug, PartialEq)]
 pub struct ABufferSettings {
     pub method: ABufferMethod,
-    /// Nodes of the linked-list / linear pool; `None`: [`DEFAULT_POOL_PER_PIXEL`] × pixels (capped at [`MAX_POOL`]).
+    /// Nodes of the linked-list / linear pool; `None`: [`DEFAULT_POOL_PER_PIXEL`] × pixels
+    /// (capped at [`MAX_POOL`], and at what the adapter's largest storage buffer holds: a
+    /// larger frame then drops fragments, reported, instead of refusing to render).
     pub pool: Option<u32>,
     /// K: fixed-array slots per pixel, dual-peel layers L (rounded up to even: two per peel).
     pub max_layers: u32,
@@ -230,10 +232,20 @@ impl ABufferSettings {
         Ok(())
     }
 
-    /// Pool nodes at `w`×`h`.
+    /// Pool nodes at `w`×`h` before the adapter's limit ([`Self::pool_nodes_within`]).
     pub fn pool_nodes(&self, w: u32, h: u32) -> u32 {
-        self.pool
-            .unwrap_or_else(|| (w as u64 * h as u64 * DEFAULT_POOL_PER_PIXEL as u64).min(MAX_POOL as u64) as u32)
+        self.pool_nodes_within(w, h, u64::MAX)
+    }
+
+    /// Pool nodes at `w`×`h` on an adapter whose largest storage buffer is `max_bytes`: a
+    /// given pool as is (refused when it does not fit), the default capped to fit.
+    pub fn pool_nodes_within(&self, w: u32, h: u32, max_bytes: u64) -> u32 {
+        self.pool.unwrap_or_else(|| {
+            (w as u64 * h as u64 * DEFAULT_POOL_PER_PIXEL as u64)
+                .min(MAX_POOL as u64)
+                .min(max_bytes / NODE_BYTES)
+                .max(1) as u32
+        })
     }
 
     /// What to raise when fragments were dropped: the pool (and the per-pixel cap) of the
@@ -560,7 +572,9 @@ impl ABufferStage {
         let (w, h) = (targets.width, targets.height);
         let px = w as u64 * h as u64;
         let method = settings.method;
-        let pool = settings.pool_nodes(w, h);
+        let limits = device.limits();
+        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let pool = settings.pool_nodes_within(w, h, max);
         let slots = settings.slots();
         let pooled = matches!(method, ABufferMethod::LinkedList | ABufferMethod::Linear);
         let node_bytes = if pooled {
@@ -568,8 +582,6 @@ impl ABufferStage {
         } else {
             px * slots as u64 * NODE_BYTES
         };
-        let limits = device.limits();
-        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if node_bytes > max {
             let what = if pooled {
                 format!("pool {pool} nodes")
