@@ -1434,6 +1434,45 @@ fn frame_over_the_memory_budget_is_refused() {
     assert!(!out.exists());
 }
 
+/// `bzb-gi` with AOV splats and d_max spanning the scene (the defaults) tests every
+/// triangle at every texel of every sub-image: above 10¹⁰ tests a frame `render` warns in
+/// one line with the count and the DSS alternative (atrium at 1280×720: 7,866 × 4 ×
+/// 921,600 = 2.9·10¹⁰), and not with DSS surfels, a shorter d_max, the additive
+/// baseline's single sub-image (7.2·10⁹) or at 640×360 (7.2·10⁹).
+#[test]
+fn render_warns_of_a_full_screen_bzb_gi_splat() {
+    let warned = |extra: &[&str]| -> Vec<String> {
+        let args = [
+            &["render", "--scene", "atrium", "--technique", "bzb-gi", "--list-passes"][..],
+            extra,
+        ]
+        .concat();
+        let o = strata(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+            .lines()
+            .filter(|l| l.starts_with("strata: warning: bzb-gi:"))
+            .map(String::from)
+            .collect()
+    };
+    let big = ["--width", "1280", "--height", "720"];
+    let w = warned(&big);
+    assert!(
+        w.len() == 1
+            && w[0].contains("7866 triangles × 4 directions × 1280x720 = 2.9e10")
+            && w[0].contains("splat=dss"),
+        "{w:?}"
+    );
+    for extra in [
+        &["--set", "splat=dss"][..],
+        &["--set", "dmax=5"],
+        &["--set", "visibility=off"],
+    ] {
+        assert!(warned(&[&big[..], extra].concat()).is_empty(), "{extra:?}");
+    }
+    assert!(warned(&["--width", "640", "--height", "360"]).is_empty());
+}
+
 /// `strata techniques NAME` lists that technique alone, naming its settings as `--set`
 /// takes them (not as flags: `--refine-peak` is no flag of `render`) and two-valued ones by
 /// their value names; an unknown name is one line listing the valid ones.

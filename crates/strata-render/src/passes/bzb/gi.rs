@@ -190,6 +190,20 @@ impl BzbGiSettings {
         (d_max, self.bias.unwrap_or(0.01 * scene.settings.ao_radius))
     }
 
+    /// Ray–triangle tests of one frame's AOV splat when every splat covers its whole
+    /// sub-image: T·S·W·H (T·W·H for the additive baseline, which splats sub-image 0
+    /// only). That is the case with d_max at least the scene's diagonal, the default: each
+    /// triangle's box grown by d_max then holds the camera. `None` for DSS surfels or a
+    /// shorter d_max, whose splats their grown boxes bound.
+    pub fn full_screen_splat_tests(&self, scene: &Scene, w: u32, h: u32) -> Option<u64> {
+        let spans = self.d_max.is_none_or(|d| d >= scene_diagonal(scene));
+        if self.splat != super::Splat::Aov || !spans {
+            return None;
+        }
+        let s = if self.visibility { self.directions } else { 1 };
+        Some(scene.triangle_count() as u64 * s as u64 * w as u64 * h as u64)
+    }
+
     /// Sub-image grid (cols, rows): cols = ⌈√S⌉.
     pub fn grid(&self) -> (u32, u32) {
         let cols = (self.directions as f32).sqrt().ceil() as u32;
