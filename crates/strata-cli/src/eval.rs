@@ -239,10 +239,14 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 )
             };
             println!(
-                "{} bzb-gi S={} d_max={:.3} {w}x{h} (reference {} spp, 1 bounce, noise FLIP {:.4}); bzb-splat {:.0} ms with visibility, {:.0} ms without:",
+                "{} bzb-gi S={} d_max={:.3}{} {w}x{h} (reference {} spp, 1 bounce, noise FLIP {:.4}); bzb-splat {:.0} ms with visibility, {:.0} ms without:",
                 run.scene,
                 e.directions,
                 e.d_max,
+                match (e.temporal_alpha, e.warmup_frames) {
+                    (Some(a), Some(n)) => format!(" temporal α={a} after {n} frames"),
+                    _ => String::new(),
+                },
                 run.ref_spp,
                 noise(&e.errors.indirect),
                 e.splat_ms,

@@ -500,6 +500,14 @@ pub struct BzbGiEval {
     pub splat_ms_no_visibility: f64,
     /// GPU milliseconds of the whole frame (bzb-gi with visibility).
     pub frame_ms: f64,
+    /// The temporal filter's α (`--set alpha`; absent: off, every frame stands alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temporal_alpha: Option<f32>,
+    /// Frames rendered on the still camera before the evaluated one, for both bzb-gi
+    /// configurations: `--warmup` with the temporal filter, else 0. Absent in results
+    /// written before 2026-11-29, which rendered one frame even with the filter on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warmup_frames: Option<u32>,
 }
 
 /// A-buffer OIT (ABA §IV) against the CPU compositing of every crossing.

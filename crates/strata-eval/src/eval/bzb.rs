@@ -113,7 +113,7 @@ pub fn run_gi(
     use crate::results::GiErrors;
 
     if s.frames.is_some() {
-        bail!("--frames is not available for --technique bzb-gi (it has no temporal filter): drop --frames");
+        bail!("--frames is not available for --technique bzb-gi (it evaluates one still frame, after --warmup frames with --set alpha): drop --frames");
     }
     let rule = s.check(super::gi::DEFAULT_CAP, 8)?;
     let t = strata_render::technique::find("bzb-gi")?;
@@ -191,8 +191,12 @@ pub fn run_gi(
         };
         Ok((errors, splat.unwrap_or(f64::NAN), timings.total(), images))
     };
-    let (errors, splat_ms, frame_ms, images) = evaluate(main.clone(), 1)?;
-    let (no_visibility, splat_ms_no_visibility, _, images_no_visibility) = evaluate(baseline, 1)?;
+    // a frame stands alone, unless the temporal filter (`--set alpha`) accumulates new
+    // directions on the still camera: then --warmup frames before the evaluated one, as
+    // the DGB configuration has
+    let renders = if gi.temporal.is_some() { s.warmup.max(1) + 1 } else { 1 };
+    let (errors, splat_ms, frame_ms, images) = evaluate(main.clone(), renders)?;
+    let (no_visibility, splat_ms_no_visibility, _, images_no_visibility) = evaluate(baseline, renders)?;
     let (dgb_2_layers, _, _, images_dgb) = evaluate(dgb, s.warmup.max(1) + 1)?;
     let (errors, no_visibility, images, images_no_visibility) = if gi.visibility {
         (errors, no_visibility, images, images_no_visibility)
@@ -226,6 +230,8 @@ pub fn run_gi(
         splat_ms,
         splat_ms_no_visibility,
         frame_ms,
+        temporal_alpha: gi.temporal.as_ref().map(|t| t.alpha),
+        warmup_frames: Some(renders - 1),
     };
     if let Some(dir) = &s.report {
         write_gi_report(
