@@ -2439,6 +2439,7 @@ fn bzb_gi_renders_with_and_without_visibility() {
 /// RMSE against the path tracer falls below the single frame's (cornell 64×64, 1024 spp:
 /// 0.0039 → 0.0028 with 8 frames). It rendered one frame before, and the two were equal.
 /// The JSON records α and the frames; without the filter a frame stands alone (0).
+/// `--set exposure` is not read by the comparison: a one-line warning, same numbers.
 #[test]
 fn eval_bzb_gi_warms_up_its_temporal_filter() {
     let cache = scratch("bzb-gi-temporal-cache");
@@ -2468,6 +2469,39 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
     };
     let single = run(&[]);
     let filtered = run(&["--set", "alpha=0.85", "--warmup", "8"]);
+    // --set exposure changes nothing here (ꟻLIP at the scene's exposure): a warning
+    let args = [
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        "bzb-gi",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--ref-spp",
+        "1024",
+        "--json",
+        "--quiet",
+        "--cache",
+        cache.to_str().unwrap(),
+        "--set",
+        "exposure=4",
+    ];
+    let o = strata(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("strata: warning: --set exposure is not read by eval --technique bzb-gi")),
+        "{err}"
+    );
+    let exposed: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        exposed["rmse"], single["rmse"],
+        "exposure leaves the comparison as it was"
+    );
     assert!(
         single["temporal_alpha"].is_null() && single["warmup_frames"] == 0,
         "{single}"
