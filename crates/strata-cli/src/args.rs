@@ -911,6 +911,45 @@ pub struct ReferenceArgs {
     /// Hide the progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// The ids of the flags given on the command line (not defaulted), filled after parsing:
+    /// `reference` warns of those its kind does not read ([`ReferenceArgs::unread_flags`]).
+    #[arg(skip)]
+    pub given: Vec<String>,
+}
+
+impl ReferenceArgs {
+    /// One warning per given flag that `--kind` does not read (it is still range-checked).
+    pub fn unread_flags(&self) -> Vec<String> {
+        use ReferenceKind::*;
+        let reads: &[&str] = match self.kind {
+            Ao | Obscurance | AoOpacity => &["ao_radius", "spp", "seed"],
+            Gi | Indirect => &["spp", "bounces", "seed"],
+            Layers => &["layers", "min_separation"],
+            Composite => &[],
+        };
+        let kind = self
+            .kind
+            .to_possible_value()
+            .map_or(String::new(), |v| v.get_name().to_string());
+        <ReferenceArgs as Args>::augment_args(clap::Command::new("reference"))
+            .get_arguments()
+            .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?)))
+            .filter(|(id, _)| {
+                ["ao_radius", "spp", "bounces", "seed", "layers", "min_separation"].contains(&id.as_str())
+                    && !reads.contains(&id.as_str())
+                    && self.given.contains(id)
+            })
+            .map(|(_, long)| {
+                let read: Vec<String> = reads.iter().map(|r| format!("--{}", r.replace('_', "-"))).collect();
+                let what = if read.is_empty() {
+                    "it takes none of the sampling flags".to_string()
+                } else {
+                    format!("it reads {}", read.join(", "))
+                };
+                format!("--{long} is not read by reference --kind {kind}: {what}")
+            })
+            .collect()
+    }
 }
 
 #[derive(Args)]

@@ -44,8 +44,9 @@ fn main() {
         .and_then(|m| args::Cli::from_arg_matches(&m).map(|c| (c, m)));
     let cli = match parsed {
         Ok((mut c, m)) => {
-            // which flags `render`, `soak`, `eval` and `bench` were given, not defaulted
-            // (`FrameArgs::unread_flags`, `EvalArgs::unread_flags`, the benches' layer flags)
+            // which flags `render`, `soak`, `eval`, `reference` and `bench` were given, not
+            // defaulted (`FrameArgs::unread_flags`, `EvalArgs::unread_flags`,
+            // `ReferenceArgs::unread_flags`, the benches' layer flags)
             let given = |sub: &clap::ArgMatches| -> Vec<String> {
                 sub.ids()
                     .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
@@ -57,6 +58,7 @@ fn main() {
                     args::Command::Render(a) => a.frame.given = given(sub),
                     args::Command::Soak(a) => a.frame.given = given(sub),
                     args::Command::Eval(a) => a.given = given(sub),
+                    args::Command::Reference(a) => a.given = given(sub),
                     // `bench <what>`: the stage flags of the nested command
                     args::Command::Bench(b) => {
                         if let (Some(stage), Some((_, what))) = (b.what.stage_mut(), sub.subcommand()) {

@@ -14,6 +14,9 @@ use crate::args::{ReferenceArgs, ReferenceKind};
 use crate::output::{check_output, save, scene_and_camera};
 
 pub fn run(a: &ReferenceArgs) -> Result<()> {
+    for w in a.unread_flags() {
+        eprintln!("strata: warning: {w}");
+    }
     let (scene, cams) = scene_and_camera(&a.scene)?;
     let camera = cams.current;
     let (w, h) = (a.scene.width, a.scene.height);

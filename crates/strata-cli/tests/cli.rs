@@ -2118,6 +2118,67 @@ fn export_scene_writes_the_triangles_and_camera_of_the_frame() {
     assert_one_line_error(&o, &["exists", "--force"]);
 }
 
+/// `reference` warns in one line of each given flag its `--kind` does not read (it used to
+/// accept `--kind ao --bounces 3` or `--kind layers --spp 64` without a word), still writes
+/// the image, and says nothing of the flags the kind reads.
+#[test]
+fn reference_warns_of_flags_its_kind_does_not_read() {
+    let out = scratch("reference-unread.exr");
+    let warned = |args: &[&str]| -> Vec<String> {
+        let base = [
+            "reference",
+            "--scene",
+            "cornell",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--quiet",
+            "--force",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let o = strata(&[&base[..], args].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(out.exists());
+        stderr(&o)
+            .lines()
+            .filter(|l| l.starts_with("strata: warning: --"))
+            .map(String::from)
+            .collect()
+    };
+    let w = warned(&[
+        "--kind",
+        "ao",
+        "--bounces",
+        "3",
+        "--layers",
+        "3",
+        "--spp",
+        "4",
+        "--ao-radius",
+        "0.1",
+    ]);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w.iter()
+            .any(|l| l.contains("--bounces is not read by reference --kind ao: it reads --ao-radius, --spp, --seed")),
+        "{w:?}"
+    );
+    assert!(w.iter().any(|l| l.contains("--layers is not read")), "{w:?}");
+    let w = warned(&["--kind", "layers", "--spp", "64", "--layers", "3"]);
+    assert!(
+        w.len() == 1 && w[0].contains("--spp is not read by reference --kind layers"),
+        "{w:?}"
+    );
+    let w = warned(&["--kind", "composite", "--seed", "3"]);
+    assert!(
+        w.len() == 1 && w[0].contains("it takes none of the sampling flags"),
+        "{w:?}"
+    );
+    assert!(warned(&["--kind", "indirect", "--bounces", "1", "--spp", "4", "--seed", "2"]).is_empty());
+}
+
 /// Writes cornell's ray-traced AO (4 spp) at `width`×16 to `out` (overwriting it).
 fn ao_reference(out: &Path, width: &str) {
     let o = strata(&[
