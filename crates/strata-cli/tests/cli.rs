@@ -2504,7 +2504,7 @@ fn bzb_gi_renders_with_and_without_visibility() {
 #[test]
 fn eval_bzb_gi_warms_up_its_temporal_filter() {
     let cache = scratch("bzb-gi-temporal-cache");
-    let run = |extra: &[&str]| {
+    let eval = |extra: &[&str]| {
         let args = [
             &[
                 "eval",
@@ -2526,31 +2526,12 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
             extra,
         ]
         .concat();
-        json_of(&strata(&args))
+        strata(&args)
     };
-    let single = run(&[]);
-    let filtered = run(&["--set", "alpha=0.85", "--warmup", "8"]);
+    let single = json_of(&eval(&[]));
+    let filtered = json_of(&eval(&["--set", "alpha=0.85", "--warmup", "8"]));
     // --set exposure changes nothing here (ꟻLIP at the scene's exposure): a warning
-    let args = [
-        "eval",
-        "--scene",
-        "cornell",
-        "--technique",
-        "bzb-gi",
-        "--width",
-        "64",
-        "--height",
-        "64",
-        "--ref-spp",
-        "1024",
-        "--json",
-        "--quiet",
-        "--cache",
-        cache.to_str().unwrap(),
-        "--set",
-        "exposure=4",
-    ];
-    let o = strata(&args);
+    let o = eval(&["--set", "exposure=4"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
