@@ -51,6 +51,7 @@ impl From<&EvalArgs> for EvalSettings {
             progress: !a.quiet,
             lighting: direct.lighting,
             shadow: direct.shadow,
+            exposure: direct.exposure,
         }
     }
 }

@@ -14,14 +14,6 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     for w in a.unread_flags() {
         eprintln!("strata: warning: {w}");
     }
-    // the comparisons display both images at the scene's exposure for ꟻLIP (RMSE and MAE
-    // compare linear values); only --views renders the frame's own tonemapping
-    if !a.views && a.set.values.iter().any(|(n, _)| n == "exposure") {
-        eprintln!(
-            "strata: warning: --set exposure is not read by eval --technique {}: ꟻLIP shows both images at the scene's exposure, and RMSE and MAE compare linear values (--views measures the frame at its own exposure)",
-            a.technique.name
-        );
-    }
     // the registry's eval kind picks the comparison
     let is_bzb = a.technique.name == "bzb-ao";
     let is_aba = a.technique.name == "aba-ao";

@@ -2500,7 +2500,8 @@ fn bzb_gi_renders_with_and_without_visibility() {
 /// RMSE against the path tracer falls below the single frame's (cornell 64×64, 1024 spp:
 /// 0.0039 → 0.0028 with 8 frames). It rendered one frame before, and the two were equal.
 /// The JSON records α and the frames; without the filter a frame stands alone (0).
-/// `--set exposure` is not read by the comparison: a one-line warning, same numbers.
+/// `--set exposure` sets the exposure ꟻLIP displays both images at (the scene's before,
+/// silently): the RMSE stays, ꟻLIP moves, and the JSON records `display_exposure`.
 #[test]
 fn eval_bzb_gi_warms_up_its_temporal_filter() {
     let cache = scratch("bzb-gi-temporal-cache");
@@ -2530,19 +2531,20 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
     };
     let single = json_of(&eval(&[]));
     let filtered = json_of(&eval(&["--set", "alpha=0.85", "--warmup", "8"]));
-    // --set exposure changes nothing here (ꟻLIP at the scene's exposure): a warning
-    let o = eval(&["--set", "exposure=4"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let err = stderr(&o);
-    assert!(
-        err.lines()
-            .any(|l| l.starts_with("strata: warning: --set exposure is not read by eval --technique bzb-gi")),
-        "{err}"
-    );
-    let exposed: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // --set exposure: ꟻLIP displays both images at it (RMSE compares linear values), and
+    // the JSON records it
+    let exposed = json_of(&eval(&["--set", "exposure=4"]));
+    assert_eq!(exposed["display_exposure"], 4.0, "{exposed}");
+    assert!(single["display_exposure"].is_null(), "{single}");
     assert_eq!(
         exposed["rmse"], single["rmse"],
-        "exposure leaves the comparison as it was"
+        "linear values are compared as they were"
+    );
+    assert!(
+        exposed["flip"].as_f64().unwrap() > single["flip"].as_f64().unwrap() * 1.2,
+        "a brighter display shows the noise: {} vs {}",
+        exposed["flip"],
+        single["flip"]
     );
     assert!(
         single["temporal_alpha"].is_null() && single["warmup_frames"] == 0,

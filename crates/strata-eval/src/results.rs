@@ -367,6 +367,10 @@ pub struct EvalRun {
     /// The warm-up followed the camera path, objects moving (`--moving`: gi, ao).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub moving: bool,
+    /// `--set exposure`: the exposure the radiance comparisons displayed both images at for
+    /// ꟻLIP; absent: the scene's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub display_exposure: Option<f32>,
     #[serde(flatten)]
     pub flicker: Option<Flicker>,
     /// Things the reader of the numbers must know (a reference that did not converge, an error
@@ -703,6 +707,7 @@ mod tests {
             reference: "obscurance".into(),
             device: "lavapipe".into(),
             moving: false,
+            display_exposure: None,
             flicker: None,
             warnings: vec![],
         }

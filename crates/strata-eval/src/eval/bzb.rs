@@ -151,7 +151,7 @@ pub fn run_gi(
     scene.settings.sky = [0.0; 3];
     let (_w, _h) = (s.scene.width, s.scene.height);
     let camera = cams.current;
-    let exposure = scene.settings.exposure;
+    let exposure = s.display_exposure(&scene);
     let shown = |img: &ImageBuf| display(img, exposure);
     let converged = super::gi::converged_gi(s, &scene, camera, 1, &rule);
     let ref_total = RefImage::of(&converged, total, shown)?;

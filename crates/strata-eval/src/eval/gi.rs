@@ -105,7 +105,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         .map_err(|e| anyhow::anyhow!("{e}"))?;
 
     let cache = RefCache::new(&s.cache);
-    let exposure = scene.settings.exposure;
+    let exposure = s.display_exposure(&scene);
     let shown = |img: &ImageBuf| display(img, exposure);
     let converged = converged_gi(s, &scene, camera, g.bounces, &rule);
     let ref_total = RefImage::of(&converged, total, shown)?;
@@ -320,7 +320,7 @@ fn write_gi_report(
     let mut sections = vec![
         Section::new(format!("Indirect diffuse light, {k} layers, against the path tracer"))
             .text(format!(
-                "Tonemapped with the scene exposure ({exposure}); GPU indirect = composed image − direct. Reference: {} spp (converged to ꟻLIP {:.4} between two independent halves), {} bounces.",
+                "Tonemapped at exposure {exposure} (the scene's unless `--set exposure`); GPU indirect = composed image − direct. Reference: {} spp (converged to ꟻLIP {:.4} between two independent halves), {} bounces.",
                 out.run.ref_spp, out.errors.indirect.ref_noise.map_or(0.0, |n| n.flip), out.ref_bounces
             ))
             .figures(vec![
@@ -388,7 +388,7 @@ fn fig10(
         );
         refs.push(cache.get_or_compute(s.no_cache, &d, || reference.one_bounce(&camera, w, h, &settings)));
     }
-    let exposure = scene.settings.exposure;
+    let exposure = s.display_exposure(scene);
     let row = |normal_test: bool| -> Result<Fig10Row> {
         let settings = RadiositySettings {
             normal_test,

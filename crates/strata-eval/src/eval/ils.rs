@@ -73,7 +73,7 @@ pub fn run(
     scene.settings.sky = [0.0; 3];
     let (_w, _h) = (s.scene.width, s.scene.height);
     let camera = cams.current;
-    let exposure = scene.settings.exposure;
+    let exposure = s.display_exposure(&scene);
 
     // One indirect bounce = one VPL bounce (§6.2); the same cache entry as `eval gi --bounces 1`.
     let shown = |img: &ImageBuf| display(img, exposure);

@@ -65,9 +65,19 @@ pub struct EvalSettings {
     pub lighting: LightingSettings,
     /// The shadow maps' (`--set shadow-resolution`).
     pub shadow: ShadowSettings,
+    /// `--set exposure`: the exposure at which the radiance comparisons display both images
+    /// for ꟻLIP (RMSE and MAE compare linear values); `None`: the scene's. The references'
+    /// convergence is measured at the scene's exposure either way, so cached references
+    /// stay valid.
+    pub exposure: Option<f32>,
 }
 
 impl EvalSettings {
+    /// The exposure the comparisons display both images at for ꟻLIP.
+    pub(crate) fn display_exposure(&self, scene: &Scene) -> f32 {
+        self.exposure.unwrap_or(scene.settings.exposure)
+    }
+
     /// `--report`: an existing report is overwritten only with `--force`.
     pub(crate) fn check_report(&self) -> Result<()> {
         if let Some(dir) = &self.report {
@@ -146,6 +156,7 @@ impl EvalSettings {
             reference: reference.into(),
             device,
             moving: self.moving,
+            display_exposure: self.exposure,
             flicker,
             warnings,
         }

@@ -41,7 +41,7 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<OitEval> {
     let (scene, cams) = s.scene.load()?;
     let (w, h) = (s.scene.width, s.scene.height);
     let camera = cams.current;
-    let exposure = scene.settings.exposure;
+    let exposure = s.display_exposure(&scene);
 
     let reference = Reference::new(&scene, s.scene.frame).with_progress(s.progress);
     let ref_img = reference.composite(&camera, w, h);
@@ -86,12 +86,12 @@ pub fn run(s: &EvalSettings, set: &[(String, f64)]) -> Result<OitEval> {
         errors,
     };
     if let Some(dir) = &s.report {
-        // the composites (tonemapped with the scene's exposure) and the ꟻLIP map
+        // the composites (tonemapped at the display exposure) and the ꟻLIP map
         std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--report {}: {e}", dir.display()))?;
         let shown = |img, name: &str, caption: String| figure(dir, &display(img, exposure), name, caption);
         let section = Section::new("Composite")
             .text(format!(
-                "{w}×{h} pixels, frame {}; the CPU compositing of every surface crossing along the pixel-centre ray, and the A-buffer's ({}, {} fragments, {} dropped, at most {} per pixel). Tonemapped with the scene's exposure ({exposure}); the ꟻLIP map uses the magma scale.",
+                "{w}×{h} pixels, frame {}; the CPU compositing of every surface crossing along the pixel-centre ray, and the A-buffer's ({}, {} fragments, {} dropped, at most {} per pixel). Tonemapped at exposure {exposure} (the scene's unless `--set exposure`); the ꟻLIP map uses the magma scale.",
                 s.scene.frame, out.method, out.fragments, out.dropped, out.max_fragments_per_pixel
             ))
             .figures(vec![
