@@ -211,7 +211,7 @@ pub fn run(
     }
     // the path tracer with B indirect bounces (cached like `eval gi`)
     let rule = s.check(super::gi::DEFAULT_CAP, 8)?;
-    let exposure = s.display_exposure(&scene);
+    let exposure = s.display_exposure(scene);
     let shown = |img: &ImageBuf| display(img, exposure);
     let traced = super::gi::converged_gi(s, scene, camera, bounces, &rule);
     let ref_total = RefImage::of(&traced, total, shown)?;
