@@ -659,10 +659,8 @@ impl EvalArgs {
             ),
             EvalKind::None => (Vec::new(), ""),
         };
-        let eval = <EvalArgs as Args>::augment_args(clap::Command::new("eval"));
-        eval.get_arguments()
-            .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?)))
-            .filter(|(id, _)| unread.contains(id) && self.given.contains(id))
+        given_among::<EvalArgs>(&self.given, &unread)
+            .into_iter()
             .map(|(id, long)| {
                 let why = if kind == EvalKind::VplRadiance && id == "bounces" {
                     "--bounces is read only with --progressive (the reference has one bounce)"
@@ -917,6 +915,16 @@ pub struct ReferenceArgs {
     pub given: Vec<String>,
 }
 
+/// (id, long name) of each flag of `A` that was `given` on the command line and is among
+/// `ids` (the unread-flag warnings of `eval` and `reference`).
+fn given_among<A: Args>(given: &[String], ids: &[String]) -> Vec<(String, String)> {
+    A::augment_args(clap::Command::new("args"))
+        .get_arguments()
+        .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?.to_string())))
+        .filter(|(id, _)| ids.contains(id) && given.contains(id))
+        .collect()
+}
+
 impl ReferenceArgs {
     /// One warning per given flag that `--kind` does not read (it is still range-checked).
     pub fn unread_flags(&self) -> Vec<String> {
@@ -931,14 +939,13 @@ impl ReferenceArgs {
             .kind
             .to_possible_value()
             .map_or(String::new(), |v| v.get_name().to_string());
-        <ReferenceArgs as Args>::augment_args(clap::Command::new("reference"))
-            .get_arguments()
-            .filter_map(|a| Some((a.get_id().to_string(), a.get_long()?)))
-            .filter(|(id, _)| {
-                ["ao_radius", "spp", "bounces", "seed", "layers", "min_separation"].contains(&id.as_str())
-                    && !reads.contains(&id.as_str())
-                    && self.given.contains(id)
-            })
+        let unread: Vec<String> = ["ao_radius", "spp", "bounces", "seed", "layers", "min_separation"]
+            .into_iter()
+            .filter(|id| !reads.contains(id))
+            .map(String::from)
+            .collect();
+        given_among::<ReferenceArgs>(&self.given, &unread)
+            .into_iter()
             .map(|(_, long)| {
                 let read: Vec<String> = reads.iter().map(|r| format!("--{}", r.replace('_', "-"))).collect();
                 let what = if read.is_empty() {
