@@ -13,29 +13,10 @@ use crate::output::{cameras_at, check_output, save, scene_and_camera};
 pub fn prepare(f: &FrameArgs) -> Result<(Scene, FrameCameras, RenderSettings)> {
     let (scene, cams) = scene_and_camera(&f.scene)?;
     let settings = settings_for(f, &scene)?;
-    if let Some(w) = cost_warning(&scene, &settings) {
+    if let Some(w) = settings.cost_warning(&scene) {
         eprintln!("strata: warning: {w}");
     }
     Ok((scene, cams, settings))
-}
-
-/// Ray–triangle tests a frame above which `bzb-gi`'s AOV splat gets a warning: about 80 s
-/// on lavapipe (2 cores), which tests about 1.3·10⁸ a second (atrium, 160×90).
-pub const SPLAT_TESTS_WARNING: u64 = 10_000_000_000;
-
-/// A one-line warning when the frame is far more expensive than its size suggests:
-/// `bzb-gi` with AOV splats that each cover the whole sub-image (T·S·W·H tests).
-pub fn cost_warning(scene: &Scene, settings: &RenderSettings) -> Option<String> {
-    let g = settings.bzb_gi.as_ref()?;
-    let (w, h) = (settings.width, settings.height);
-    let tests = g.full_screen_splat_tests(scene, w, h)?;
-    (tests > SPLAT_TESTS_WARNING).then(|| {
-        format!(
-            "bzb-gi: every AOV splat covers its whole sub-image (d_max spans the scene): {} triangles × {} directions × {w}x{h} = {tests:.1e} ray–triangle tests a frame, minutes or more on a CPU adapter; --set splat=dss splats surfels instead",
-            scene.triangle_count(),
-            if g.visibility { g.directions } else { 1 },
-        )
-    })
 }
 
 /// The render settings that `f` asks for on the loaded `scene` (validated; probes baked

@@ -1078,3 +1078,71 @@ fn script_frames(script: &str) -> u32 {
         .map(|n| n.trim().parse::<u32>().unwrap())
         .sum()
 }
+
+/// `render`'s cost warning for a `bzb-gi` frame of minutes (AOV splats over whole
+/// sub-images: atrium at 1280×720 is 2.9·10¹⁰ ray–triangle tests) reaches the viewer's
+/// stderr and status line too, and before that frame: the test reads stderr while the
+/// first frame renders (about 4 minutes on lavapipe) and stops the viewer once the line
+/// is there.
+#[test]
+fn view_warns_of_a_full_screen_bzb_gi_splat_before_its_frame() {
+    use std::io::BufRead;
+    let Some(x) = xvfb("view::view_warns_of_a_full_screen_bzb_gi_splat_before_its_frame") else {
+        return;
+    };
+    let dir = scratch("bzb-gi-cost");
+    let shot = dir.join("shot.png");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args([
+            "view",
+            "--scene",
+            "atrium",
+            "--technique",
+            "bzb-gi",
+            "--width",
+            "1280",
+            "--height",
+            "720",
+            "--frames",
+            "1",
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ])
+        .env("DISPLAY", &x.display)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stderr = child.stderr.take().unwrap();
+    std::thread::spawn(move || {
+        for line in std::io::BufReader::new(stderr).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let t0 = Instant::now();
+    let mut seen = Vec::new();
+    let warning = loop {
+        match rx.recv_timeout(Duration::from_millis(200)) {
+            Ok(l) if l.starts_with("strata view: warning: bzb-gi:") => break Some(l),
+            Ok(l) => seen.push(l),
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break None,
+            Err(_) if t0.elapsed() > Duration::from_secs(150) => break None,
+            Err(_) => {}
+        }
+    };
+    let _ = child.kill();
+    let _ = child.wait();
+    let w = warning.unwrap_or_else(|| panic!("no bzb-gi cost warning before the frame: {seen:?}"));
+    assert!(
+        w.contains("7866 triangles × 4 directions × 1280x720 = 2.9e10") && w.contains("splat=dss"),
+        "{w}"
+    );
+    assert!(
+        !shot.exists(),
+        "the frame of minutes finished before the warning was read"
+    );
+}

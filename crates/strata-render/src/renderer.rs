@@ -333,6 +333,13 @@ impl RenderSettings {
         self.deep.validate()
     }
 
+    /// A one-line warning when a frame is far more expensive than its size suggests, for
+    /// `render`, `soak` and `view` alike: `bzb-gi` with AOV splats that each cover the whole
+    /// sub-image (T·S·W·H ray–triangle tests, [`crate::passes::bzb::gi::SPLAT_TESTS_WARNING`]).
+    pub fn cost_warning(&self, scene: &Scene) -> Option<String> {
+        self.bzb_gi.as_ref()?.cost_warning(scene, self.width, self.height)
+    }
+
     /// Upper bound of the GPU memory a renderer with these settings allocates for
     /// `scene`, in bytes: every screen target (exactly where the pass declares its
     /// list, a documented bound for targets a stage creates internally: AO ≤ 24,

@@ -270,6 +270,8 @@ impl App {
                 return false;
             }
         };
+        // `render`'s cost warning (a bzb-gi frame of minutes), before the frame that takes them
+        let warning = settings.cost_warning(scene_ref);
         match Renderer::new(&gfx.gpu, scene_ref, settings.clone()) {
             Ok(r) => {
                 self.view_names = r.debug_view_names();
@@ -296,6 +298,9 @@ impl App {
                             false,
                         );
                     }
+                }
+                if let Some(w) = warning {
+                    self.say(format!("warning: {w}"), false);
                 }
                 true
             }

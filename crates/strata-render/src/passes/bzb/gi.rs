@@ -38,6 +38,10 @@ use crate::passes::builder::{FullscreenPass, PassBuilder};
 use crate::scene_gpu::GpuScene;
 use crate::spiral::pcg_hash;
 
+/// Ray–triangle tests a frame above which `bzb-gi`'s AOV splat gets a warning: about 80 s
+/// on lavapipe (2 cores), which tests about 1.3·10⁸ a second (atrium, 160×90).
+pub const SPLAT_TESTS_WARNING: u64 = 10_000_000_000;
+
 /// Bounced-z-buffer GI settings. Defaults: S = 4, visibility on, d_max = the
 /// scene's bounding-box diagonal, t_min = 0.01 × the scene's AO radius (the AO
 /// bias convention), seed 0, bilateral filter 4 taps each side, 1 px apart.
@@ -202,6 +206,18 @@ impl BzbGiSettings {
         }
         let s = if self.visibility { self.directions } else { 1 };
         Some(scene.triangle_count() as u64 * s as u64 * w as u64 * h as u64)
+    }
+
+    /// The one-line warning of a full-screen AOV splat above [`SPLAT_TESTS_WARNING`] tests.
+    pub fn cost_warning(&self, scene: &Scene, w: u32, h: u32) -> Option<String> {
+        let tests = self.full_screen_splat_tests(scene, w, h)?;
+        (tests > SPLAT_TESTS_WARNING).then(|| {
+            format!(
+                "bzb-gi: every AOV splat covers its whole sub-image (d_max spans the scene): {} triangles × {} directions × {w}x{h} = {tests:.1e} ray–triangle tests a frame, minutes or more on a CPU adapter; --set splat=dss splats surfels instead",
+                scene.triangle_count(),
+                if self.visibility { self.directions } else { 1 },
+            )
+        })
     }
 
     /// Sub-image grid (cols, rows): cols = ⌈√S⌉.
