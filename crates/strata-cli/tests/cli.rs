@@ -3215,3 +3215,52 @@ fn bench_deep_gbuffer_with_a_reduced_second_layer() {
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(html.contains("layers ≥ 1 at 1/2 resolution") && html.contains("of which upsampling"));
 }
+
+/// The main job (`scripts/demo.sh`, the README's first command) renders every registered
+/// technique, evaluates every one with an eval kind against its reference, and times
+/// every one: a technique added to the registry and not to the main job fails here.
+#[test]
+fn the_main_job_renders_evaluates_and_times_every_registered_technique() {
+    use std::collections::BTreeSet;
+    use strata_render::technique::{find, registry, EvalKind};
+    let demo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scripts/demo.sh");
+    let text = std::fs::read_to_string(&demo).unwrap();
+    let (mut rendered, mut evaluated, mut timed) = (BTreeSet::new(), BTreeSet::new(), BTreeSet::new());
+    // commands continued over lines with a backslash are one command
+    for line in text.replace("\\\n", " ").lines() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let Some(at) = words.iter().position(|w| *w == "$S") else {
+            continue;
+        };
+        // `eval` takes `gi` for `full`
+        let given = words
+            .windows(2)
+            .find(|w| w[0] == "--technique")
+            .map(|w| if w[1] == "gi" { "full" } else { w[1] });
+        let name = |default: &str| find(given.unwrap_or(default)).unwrap().name;
+        match (words.get(at + 1).copied(), words.get(at + 2).copied()) {
+            (Some("render"), _) => rendered.insert(name("direct")),
+            (Some("eval"), _) => evaluated.insert(name("ao")),
+            // what each bench subcommand times (`strata bench --help`)
+            (Some("bench"), Some(sub)) => match sub {
+                "gbuffer" => timed.insert("direct"),
+                "ao" => timed.insert("ao"),
+                "radiosity" | "reflections" => timed.insert("full"),
+                "ils" => timed.insert("ils"),
+                "abuffer" => timed.insert("oit") | timed.insert("aba-ao"),
+                "bzb" => timed.insert(name("bzb-ao")),
+                "technique" => timed.insert(name("")),
+                "deep-gbuffer" | "reference" => false,
+                other => panic!("bench {other}: say here which techniques it times"),
+            },
+            _ => false,
+        };
+    }
+    for t in registry() {
+        assert!(rendered.contains(t.name), "scripts/demo.sh renders no '{}'", t.name);
+        assert!(timed.contains(t.name), "scripts/demo.sh times no '{}'", t.name);
+        if t.eval != EvalKind::None {
+            assert!(evaluated.contains(t.name), "scripts/demo.sh evaluates no '{}'", t.name);
+        }
+    }
+}
