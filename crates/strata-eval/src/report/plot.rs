@@ -10,12 +10,18 @@ use plotters::prelude::*;
 pub const SIZE: (u32, u32) = (720, 360);
 
 /// Series colours, in order (also the bars' fill, so tests can count bars by colour).
-pub const COLOURS: [RGBColor; 4] = [
+pub const COLOURS: [RGBColor; 6] = [
     RGBColor(0x1f, 0x77, 0xb4),
     RGBColor(0xff, 0x7f, 0x0e),
     RGBColor(0x2c, 0xa0, 0x2c),
     RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0x8c, 0x56, 0x4b),
 ];
+
+/// Axis label font size, and the width of one of its characters as estimated for layout.
+const LABEL_PX: u32 = 14;
+const LABEL_CHAR_PX: f64 = 7.5;
 
 fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow!("cannot draw the plot: {e:?}")
@@ -31,20 +37,22 @@ fn top(values: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
-/// A white plot with a title, axes areas and the value range `x` × [0, `ymax`].
+/// A white plot of `size` with a title, axis label areas `areas` px (under the x axis, left
+/// of the y axis) and the ranges `x` × `y`.
 fn chart<'a, 'b>(
     root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
     title: &str,
     x: std::ops::Range<f64>,
-    ymax: f64,
+    y: std::ops::Range<f64>,
+    areas: (u32, u32),
 ) -> Result<ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>> {
     root.fill(&WHITE).map_err(err)?;
     ChartBuilder::on(root)
         .caption(title, ("sans-serif", 18))
         .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(64)
-        .build_cartesian_2d(x, 0f64..ymax)
+        .x_label_area_size(areas.0)
+        .y_label_area_size(areas.1)
+        .build_cartesian_2d(x, y)
         .map_err(err)
 }
 
@@ -63,37 +71,76 @@ fn legend<'a, 'b: 'a>(
 
 /// A grouped bar chart: one group per category, one bar per series (NaN bars are left out).
 /// `series` holds `(name, one value per category)`; with more than one series, a legend.
+/// Categories whose names do not fit under their group (many passes) are listed down the
+/// left instead, with the bars running across, first category on top.
 pub fn bars(title: &str, y_label: &str, categories: &[String], series: &[(String, Vec<f64>)]) -> Result<String> {
     let n = categories.len().max(1);
-    let ymax = top(series.iter().flat_map(|(_, v)| v.iter().copied()));
+    let mut vmax = top(series.iter().flat_map(|(_, v)| v.iter().copied()));
+    if series.len() > 1 {
+        // room beyond the bars for the legend, upper right
+        vmax *= 1.0 + 0.1 * series.len().min(6) as f64;
+    }
+    let longest = categories.iter().map(|c| c.chars().count()).max().unwrap_or(0) as f64 * LABEL_CHAR_PX;
+    let across = longest + 8.0 > (SIZE.0 - 64 - 24) as f64 / n as f64;
+    let groups = series.len().max(1) as f64;
+    let width = 0.8 / groups;
+    // category i's slot: down from the top when the bars run across
+    let slot = |i: usize| if across { (n - 1 - i) as f64 } else { i as f64 };
+    let label = |x: &f64| {
+        let i = x.round();
+        if (x - i).abs() < 1e-6 && i >= 0.0 && i < n as f64 {
+            let i = i as usize;
+            categories
+                .get(if across { n - 1 - i } else { i })
+                .cloned()
+                .unwrap_or_default()
+        } else {
+            String::new()
+        }
+    };
+    let size = if across {
+        (
+            SIZE.0,
+            SIZE.1.max(100 + n as u32 * (8 + 6 * series.len().min(4) as u32)),
+        )
+    } else {
+        SIZE
+    };
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        let mut chart = chart(&root, title, -0.5f64..(n as f64 - 0.5), ymax)?;
-        let label = |x: &f64| {
-            let i = x.round();
-            if (x - i).abs() < 1e-6 && i >= 0.0 {
-                categories.get(i as usize).cloned().unwrap_or_default()
-            } else {
-                String::new()
-            }
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        let slots = -0.5f64..(n as f64 - 0.5);
+        let mut chart = if across {
+            chart(&root, title, 0f64..vmax, slots, (40, longest as u32 + 16))?
+        } else {
+            chart(&root, title, slots, 0f64..vmax, (40, 64))?
         };
-        chart
-            .configure_mesh()
-            .disable_x_mesh()
-            .x_labels(n)
-            .x_label_formatter(&label)
-            .label_style(("sans-serif", 14))
-            .y_desc(y_label)
-            .draw()
-            .map_err(err)?;
-        let groups = series.len().max(1) as f64;
-        let width = 0.8 / groups;
+        let mut mesh = chart.configure_mesh();
+        mesh.label_style(("sans-serif", LABEL_PX));
+        if across {
+            mesh.disable_y_mesh()
+                .y_labels(n)
+                .y_label_formatter(&label)
+                .x_desc(y_label);
+        } else {
+            mesh.disable_x_mesh()
+                .x_labels(n)
+                .x_label_formatter(&label)
+                .y_desc(y_label);
+        }
+        mesh.draw().map_err(err)?;
         for (s, (name, values)) in series.iter().enumerate() {
             let colour = COLOURS[s % COLOURS.len()];
+            // series 0 on top in a group that runs across, leftmost in one that stands
+            let offset = if across { groups - 1.0 - s as f64 } else { s as f64 };
             let bars = values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(i, v)| {
-                let x0 = i as f64 - 0.4 + s as f64 * width;
-                Rectangle::new([(x0, 0.0), (x0 + width, *v)], colour.filled())
+                let c0 = slot(i) - 0.4 + offset * width;
+                let corners = if across {
+                    [(0.0, c0), (*v, c0 + width)]
+                } else {
+                    [(c0, 0.0), (c0 + width, *v)]
+                };
+                Rectangle::new(corners, colour.filled())
             });
             let drawn = chart.draw_series(bars).map_err(err)?;
             if series.len() > 1 {
@@ -127,7 +174,7 @@ pub fn lines(title: &str, x_label: &str, y_label: &str, series: &[(String, Vec<(
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        let mut chart = chart(&root, title, x0..x1, ymax)?;
+        let mut chart = chart(&root, title, x0..x1, 0f64..ymax, (40, 64))?;
         let integer_ticks = |x: &f64| {
             if (x - x.round()).abs() < 1e-6 {
                 format!("{}", x.round())
@@ -213,6 +260,35 @@ mod tests {
         assert_eq!(filled_rects(&svg, 0), 4);
         assert_eq!(filled_rects(&svg, 1), 3);
         assert!(svg.contains("k = 1") && svg.contains("k = 2"));
+    }
+
+    /// Names too long for their group (many passes) go down the left, with the bars running
+    /// across in category order from the top, each as long as its value.
+    #[test]
+    fn many_long_categories_run_across_in_order() {
+        let cats: Vec<String> = (0..12).map(|i| format!("bzb-gi-glossy-pass-{i}")).collect();
+        let values: Vec<f64> = (1..=12).map(f64::from).collect();
+        let svg = bars("t", "ms", &cats, &[("median".into(), values)]).unwrap();
+        is_svg(&svg);
+        let c = COLOURS[0];
+        let fill = format!("fill=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);
+        let attr = |l: &str, a: &str| -> f64 {
+            let at = l.find(&format!(" {a}=\"")).unwrap() + a.len() + 3;
+            l[at..].split('"').next().unwrap().parse().unwrap()
+        };
+        let rects: Vec<(f64, f64)> = svg
+            .lines()
+            .filter(|l| l.contains("<rect") && l.contains(&fill))
+            .map(|l| (attr(l, "y"), attr(l, "width")))
+            .collect();
+        assert_eq!(rects.len(), 12);
+        for w in rects.windows(2) {
+            assert!(w[1].0 > w[0].0, "category order runs down: {rects:?}");
+            assert!(w[1].1 > w[0].1, "longer bars for larger values: {rects:?}");
+        }
+        for c in &cats {
+            assert!(svg.contains(&format!("\n{c}\n")), "label {c} missing");
+        }
     }
 
     #[test]

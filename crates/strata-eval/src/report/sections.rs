@@ -408,13 +408,8 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
                 "GPU time per pass".into(),
                 &[("", &g.passes, (g.total_median_ms, g.total_min_ms))],
             ));
-            let svg = pass_bars(&format!("bench {name}: {}", g.run.scene), &g.passes, None)?;
-            section = section.figures(vec![plot_file(
-                dir,
-                format!("{prefix}passes.svg"),
-                svg,
-                "median GPU ms per pass".into(),
-            )?]);
+            let title = format!("bench {name}: {}", g.run.scene);
+            section = passes_figure(section, title, &[("median".into(), &g.passes)], dir, prefix)?;
         }
         BenchResult::Ao(s) | BenchResult::Radiosity(s) | BenchResult::Reflections(s) | BenchResult::Technique(s) => {
             section = stage_section(section, name, s, dir, prefix)?;
@@ -433,6 +428,13 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
                     &[("", &s.passes, (s.total_median_ms, s.total_min_ms))],
                 ));
             }
+            let pattern = b.interleaved.settings.get("pattern").and_then(|v| v.as_str());
+            let series = [
+                (format!("IS {}", pattern.unwrap_or_default()), &b.interleaved.passes[..]),
+                ("no IS (brute force)".to_string(), &b.brute_force.passes[..]),
+            ];
+            let title = format!("bench {name}: {}, speed-up {:.2}x", b.interleaved.run.scene, b.speedup);
+            section = passes_figure(section, title, &series, dir, prefix)?;
         }
         BenchResult::Abuffer(b) => {
             for (key, m) in &b.methods {
@@ -447,6 +449,33 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
                     &[("", &s.passes, (s.total_median_ms, s.total_min_ms))],
                 ));
             }
+            // Table I as bars: one group per stage, one bar per construction
+            let stages = ["clear", "count", "prefix sum", "draw", "resolve", "AO", "AO blur"];
+            let series: Vec<(String, Vec<f64>)> = b
+                .methods
+                .iter()
+                .map(|(key, m)| {
+                    let v = [
+                        m.clear_ms,
+                        m.count_ms,
+                        m.prefix_sum_ms,
+                        m.draw_ms,
+                        m.resolve_ms,
+                        m.ao_ms,
+                        m.ao_blur_ms,
+                    ];
+                    (key.clone(), v.iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+                })
+                .collect();
+            let scene = b.methods.values().next().map_or("", |m| m.stage.run.scene.as_str());
+            let categories: Vec<String> = stages.iter().map(|x| x.to_string()).collect();
+            let svg = plot::bars(&format!("bench {name}: {scene}"), "median GPU ms", &categories, &series)?;
+            section = section.figures(vec![plot_file(
+                dir,
+                format!("{prefix}stages.svg"),
+                svg,
+                "median GPU ms per ABA Table I stage and construction".into(),
+            )?]);
         }
         BenchResult::Bzb(b) => {
             for (what, s) in [
@@ -461,29 +490,55 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
                     &[("", &s.passes, (s.total_median_ms, s.total_min_ms))],
                 ));
             }
+            let series = [
+                ("bounced z-buffer".to_string(), &b.visibility.passes[..]),
+                ("additive baseline".to_string(), &b.no_visibility.passes[..]),
+            ];
+            let title = format!("bench {name} {}: {}", b.technique, b.visibility.run.scene);
+            section = passes_figure(section, title, &series, dir, prefix)?;
         }
         BenchResult::Reference(_) => {}
     }
     Ok(vec![section])
 }
 
-fn pass_bars(title: &str, passes: &[PassTime], layers_1: Option<(&[PassTime], u32)>) -> Result<String> {
-    let names: Vec<String> = passes.iter().map(|p| p.name.clone()).collect();
-    let medians = |ps: &[PassTime]| {
-        names
-            .iter()
-            .map(|n| ps.iter().find(|p| &p.name == n).map_or(f64::NAN, |p| p.median_ms))
-            .collect::<Vec<_>>()
-    };
-    let mut series = Vec::new();
-    match layers_1 {
-        Some((one, k)) => {
-            series.push((format!("k = {k}"), medians(passes)));
-            series.push(("k = 1".to_string(), medians(one)));
+/// Median GPU ms per pass as grouped bars: one group per pass (in first-seen order over the
+/// series), one bar per series (a configuration); a pass a series lacks has no bar.
+fn pass_bars(title: &str, series: &[(String, &[PassTime])]) -> Result<String> {
+    let mut names: Vec<String> = Vec::new();
+    for p in series.iter().flat_map(|(_, ps)| ps.iter()) {
+        if !names.contains(&p.name) {
+            names.push(p.name.clone());
         }
-        None => series.push(("median".to_string(), medians(passes))),
     }
-    plot::bars(title, "median GPU ms", &names, &series)
+    let values: Vec<(String, Vec<f64>)> = series
+        .iter()
+        .map(|(label, ps)| {
+            let v = names
+                .iter()
+                .map(|n| ps.iter().find(|p| &p.name == n).map_or(f64::NAN, |p| p.median_ms))
+                .collect();
+            (label.clone(), v)
+        })
+        .collect();
+    plot::bars(title, "median GPU ms", &names, &values)
+}
+
+/// The section's bar plot of `series` ([`pass_bars`]), written as `{prefix}passes.svg`.
+fn passes_figure(
+    section: Section,
+    title: String,
+    series: &[(String, &[PassTime])],
+    dir: &Path,
+    prefix: &str,
+) -> Result<Section> {
+    let svg = pass_bars(&title, series)?;
+    Ok(section.figures(vec![plot_file(
+        dir,
+        format!("{prefix}passes.svg"),
+        svg,
+        "median GPU ms per pass".into(),
+    )?]))
 }
 
 fn stage_section(section: Section, name: &str, s: &StageBench, dir: &Path, prefix: &str) -> Result<Section> {
@@ -521,14 +576,13 @@ fn stage_section(section: Section, name: &str, s: &StageBench, dir: &Path, prefi
         ]);
         section = section.table(t);
     }
-    let one = s.passes_layers_1.as_deref().map(|p| (p, k));
-    let svg = pass_bars(&format!("bench {name}: {}", s.run.scene), &s.passes, one)?;
-    Ok(section.figures(vec![plot_file(
-        dir,
-        format!("{prefix}passes.svg"),
-        svg,
-        "median GPU ms per pass".into(),
-    )?]))
+    let mut series = vec![(format!("k = {k}"), &s.passes[..])];
+    if let Some(one) = &s.passes_layers_1 {
+        series.push(("k = 1".into(), &one[..]));
+    } else {
+        series[0].0 = "median".into();
+    }
+    passes_figure(section, format!("bench {name}: {}", s.run.scene), &series, dir, prefix)
 }
 
 fn deep_section(section: Section, d: &DeepBench, dir: &Path, prefix: &str) -> Result<Section> {

@@ -231,6 +231,30 @@ mod tests {
             "triangles": 10, "device": "lavapipe", "rows": [
             {"method": "peel", "layer1_ms": 1.0, "layer2_ms": 1.0, "total_ms": 2.0, "mismatch_pct": 0.0, "submission": "per-layer"}]});
         fs::write(dir.join("bench-deep.json"), deep.to_string()).unwrap();
+        // the other papers' benches: ILS Table 4, ABA Table I, BZB Table 1
+        let stage = |passes: &[(&str, f64)]| {
+            let total: f64 = passes.iter().map(|p| p.1).sum();
+            serde_json::json!({"scene": "atrium", "width": 64, "height": 48, "frames": 2, "triangles": 10,
+                "device": "lavapipe", "layers": 1, "total_median_ms": total, "total_min_ms": total,
+                "layer1_ms": total, "increment_ms": 0.0, "pattern": "8x6",
+                "passes": passes.iter().map(|(n, ms)| serde_json::json!({"name": n, "median_ms": ms, "min_ms": ms})).collect::<Vec<_>>()})
+        };
+        let ils = serde_json::json!({"bench": "ils", "vpls_generated": 480, "speedup": 3.0, "shading_speedup": 20.0,
+            "interleaved": stage(&[("ils-snsm", 1.0), ("ils-blur-h", 0.5)]),
+            "brute_force": stage(&[("ils-brute-force", 4.5)])});
+        fs::write(dir.join("bench-ils.json"), ils.to_string()).unwrap();
+        let method = |draw: f64| {
+            serde_json::json!({"clear_ms": 0.1, "count_ms": null, "prefix_sum_ms": null,
+            "draw_ms": draw, "resolve_ms": 1.0, "total_ms": draw + 1.1, "memory_bytes": 1024, "fragments": 100,
+            "dropped": 0, "stage": stage(&[("aba-draw", draw)])})
+        };
+        let aba =
+            serde_json::json!({"bench": "abuffer", "methods": {"linked-list": method(2.0), "linear": method(3.0)}});
+        fs::write(dir.join("bench-abuffer.json"), aba.to_string()).unwrap();
+        let bzb = serde_json::json!({"bench": "bzb", "technique": "bzb-gi", "triangles": 10, "directions": 4,
+            "splat_ratio": 0.8, "total_ratio": 0.8, "memory_bytes": 1024,
+            "visibility": stage(&[("bzb-splat", 0.8)]), "no_visibility": stage(&[("bzb-splat", 1.0)])});
+        fs::write(dir.join("bench-bzb.json"), bzb.to_string()).unwrap();
         fs::write(dir.join("other.json"), r#"{"x": 1.5}"#).unwrap();
         let s = StitchSettings {
             from: dir.clone(),
@@ -252,10 +276,29 @@ mod tests {
         assert!(html.contains("<td>peel</td>"));
         assert!(html.contains("<td>x</td><td class=\"num\">1.500</td>"));
         assert!(!html.contains("\"median_ms\""), "no raw JSON");
-        for plot in ["report-bench-ao-passes.svg", "report-bench-deep-methods.svg"] {
+        // every bench has its plot; two-configuration plots have a legend naming both
+        for (plot, legend) in [
+            ("report-bench-ao-passes.svg", &["k = 2", "k = 1"][..]),
+            ("report-bench-deep-methods.svg", &[][..]),
+            (
+                "report-bench-ils-passes.svg",
+                &["IS 8x6", "no IS (brute force)", "ils-brute-force"][..],
+            ),
+            (
+                "report-bench-abuffer-stages.svg",
+                &["linked-list", "linear", "prefix sum"][..],
+            ),
+            (
+                "report-bench-bzb-passes.svg",
+                &["bounced z-buffer", "additive baseline", "bzb-gi"][..],
+            ),
+        ] {
             assert!(html.contains(plot), "{plot}");
             let svg = fs::read_to_string(dir.join(plot)).unwrap();
             assert!(svg.trim_end().ends_with("</svg>"));
+            for l in legend {
+                assert!(svg.contains(l), "{plot} names {l}");
+            }
         }
         let _ = fs::remove_dir_all(&dir);
     }
