@@ -57,9 +57,7 @@ fn chart<'a, 'b>(
 }
 
 /// The series' legend, upper right.
-fn legend<'a, 'b: 'a>(
-    chart: &mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
-) -> Result<()> {
+fn legend<'a, 'b: 'a, CT: CoordTranslate>(chart: &mut ChartContext<'a, SVGBackend<'b>, CT>) -> Result<()> {
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
@@ -201,6 +199,81 @@ pub fn lines(title: &str, x_label: &str, y_label: &str, series: &[(String, Vec<(
             chart
                 .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, colour.filled())))
                 .map_err(err)?;
+        }
+        legend(&mut chart)?;
+        root.present().map_err(err)?;
+    }
+    Ok(svg)
+}
+
+/// Lines on log–log axes: `series` holds `(name, points (x, y))`; points that are not
+/// positive and finite are left out. Series of up to 32 points get a marker at each.
+pub fn log_lines(title: &str, x_label: &str, y_label: &str, series: &[(String, Vec<(f64, f64)>)]) -> Result<String> {
+    let ok = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
+    let all: Vec<(f64, f64)> = series.iter().flat_map(|(_, p)| p.iter().filter(ok).copied()).collect();
+    let range = |v: Vec<f64>| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(0.0f64, f64::max);
+        if lo.is_finite() && hi > lo {
+            (lo / 1.25)..(hi * 1.25)
+        } else if lo.is_finite() {
+            (lo / 2.0)..(lo * 2.0)
+        } else {
+            1.0..10.0
+        }
+    };
+    let (xs, ys) = (
+        range(all.iter().map(|p| p.0).collect()),
+        range(all.iter().map(|p| p.1).collect()),
+    );
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d(xs.log_scale(), ys.log_scale())
+            .map_err(err)?;
+        // labels at 1, 2 and 5 × a power of ten only, in plain numbers
+        let tick = |v: &f64| {
+            let mantissa = v / 10f64.powf(v.log10().floor());
+            if ![1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6) {
+                String::new()
+            } else if *v >= 1.0 {
+                format!("{}", v.round())
+            } else {
+                super::sig4(*v).trim_end_matches('0').to_string()
+            }
+        };
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_labels(30)
+            .y_labels(30)
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .light_line_style(WHITE)
+            .label_style(("sans-serif", LABEL_PX))
+            .draw()
+            .map_err(err)?;
+        for (s, (name, points)) in series.iter().enumerate() {
+            let colour = COLOURS[s % COLOURS.len()];
+            let pts: Vec<(f64, f64)> = points.iter().filter(ok).copied().collect();
+            let marked = pts.len() <= 32;
+            chart
+                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
+                .map_err(err)?
+                .label(name.as_str())
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2)));
+            if marked {
+                chart
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 3, colour.filled())))
+                    .map_err(err)?;
+            }
         }
         legend(&mut chart)?;
         root.present().map_err(err)?;

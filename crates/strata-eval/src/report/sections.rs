@@ -10,7 +10,9 @@ use serde::Serialize;
 
 use super::{plot, write_file, Cell, ReportImage, Section, Table};
 use crate::metrics::ErrorStats;
-use crate::results::{BenchResult, DeepBench, EvalResult, EvalRun, Fig10, PassTime, StageBench};
+use crate::results::{
+    BenchResult, DeepBench, EvalResult, EvalRun, Fig10, IlsEval, IlsProgressive, PassTime, StageBench,
+};
 
 /// Writes `svg` as `dir/file` and returns the figure that shows it.
 fn plot_file(dir: &Path, file: String, svg: String, caption: String) -> Result<ReportImage> {
@@ -178,13 +180,12 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
             None,
         ),
         EvalResult::Ils(e) => (
-            "interleaved VPL shading against the one-bounce path tracer",
+            "interleaved VPL shading and its brute force against the one-bounce path tracer",
             &GI_HEADER[..],
-            vec![ErrorRow::layers(
-                1,
-                gi_cells(&e.errors),
-                (e.errors.indirect.flip, e.errors.indirect.mae),
-            )],
+            vec![
+                gi_row(&format!("ils {}", e.pattern), &e.errors),
+                gi_row("brute force (all N VPLs at every pixel)", &e.brute_force),
+            ],
             None,
         ),
     };
@@ -225,6 +226,7 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         "outliers",
         "ref_outliers",
         "warnings",
+        "progressive",
     ];
     let mut section = Section::new(format!("{} on {}: numbers", technique(r), run.scene))
         .text(
@@ -259,8 +261,89 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
         }
         section = section.table(t);
     }
-    section = section.figures(eval_plots(run, &rows, dir, prefix)?);
+    let mut figures = eval_plots(run, &rows, dir, prefix)?;
+    if let EvalResult::Ils(IlsEval {
+        progressive: Some(p), ..
+    }) = r
+    {
+        let (table, plot) = progressive_table_and_plot(p, &run.scene, dir, prefix)?;
+        section = section.table(table);
+        figures.push(plot);
+    }
+    section = section.figures(figures);
     Ok(vec![section])
+}
+
+/// ILS Table 5 (§6.3): per pattern, the per-set noise σ₁ and the frames and GPU time to 1 %
+/// relative RMS, measured and predicted; the plot shows the running mean's distance to the
+/// converged image per pattern, and the 1×1 mean's to the path tracer, on log–log axes.
+fn progressive_table_and_plot(
+    p: &IlsProgressive,
+    scene: &str,
+    dir: &Path,
+    prefix: &str,
+) -> Result<(Table, ReportImage)> {
+    let mut t = Table::new(
+        format!(
+            "ILS Table 5 (§6.3): K = {} VPL sets of {} paths, {} bounces, until {} % relative RMS of the mean of K other sets; the 1x1 converged image against the path tracer: FLIP {:.4}",
+            p.sets,
+            p.vpl_paths,
+            p.bounces,
+            p.target_rms * 100.0,
+            p.converged_vs_path_tracer.flip
+        ),
+        &[
+            "n×m",
+            "σ₁ (one set)",
+            "frames to target",
+            "GPU ms to target",
+            "predicted frames",
+            "predicted GPU ms",
+            "predicted GPU ms, static view",
+            "GPU ms / frame",
+            "VPL-dependent ms / frame",
+        ],
+    );
+    let mut series = Vec::new();
+    for q in &p.patterns {
+        let reached = q
+            .frames_to_target
+            .map_or(format!("not in {}", p.sets), |f| f.to_string());
+        t.row(vec![
+            Cell::Text(q.pattern.clone()),
+            q.per_set_rel_rms.into(),
+            Cell::Text(reached),
+            q.gpu_ms_to_target.into(),
+            Cell::Text(q.predicted_frames_to_target.to_string()),
+            q.predicted_gpu_ms_to_target.into(),
+            q.predicted_static_view_gpu_ms_to_target.into(),
+            q.gpu_ms_per_frame.into(),
+            q.vpl_dependent_ms_per_frame.into(),
+        ]);
+        let curve = q.rms_curve.iter().map(|&(k, e)| (k as f64, e)).collect();
+        series.push((format!("{} vs converged", q.pattern), curve));
+        if !q.rms_vs_path_tracer.is_empty() {
+            let curve = q.rms_vs_path_tracer.iter().map(|&(k, e)| (k as f64, e)).collect();
+            series.push((format!("{} vs path tracer", q.pattern), curve));
+        }
+    }
+    series.push((
+        format!("target {} %", p.target_rms * 100.0),
+        vec![(1.0, p.target_rms), (p.sets as f64, p.target_rms)],
+    ));
+    let svg = plot::log_lines(
+        &format!("ILS §6.3 progressive accumulation ({scene})"),
+        "frames accumulated",
+        "relative RMS",
+        &series,
+    )?;
+    let fig = plot_file(
+        dir,
+        format!("{prefix}progressive.svg"),
+        svg,
+        "relative RMS of the running mean against the frames (log–log)".into(),
+    )?;
+    Ok((t, fig))
 }
 
 /// The references' own quality: samples, whether the noise target was met, the noise between
@@ -322,8 +405,28 @@ fn eval_plots(run: &EvalRun, rows: &[ErrorRow], dir: &Path, prefix: &str) -> Res
             .filter_map(|r| Some((r.layers? as f64, f(r) as f64)))
             .collect::<Vec<_>>()
     };
+    if rows.len() >= 2 && rows.iter().all(|r| r.layers.is_none()) {
+        // configurations side by side
+        let labels: Vec<String> = rows.iter().map(|r| r.label.clone()).collect();
+        let svg = plot::bars(
+            &format!("Error by configuration ({})", run.scene),
+            "error",
+            &labels,
+            &[
+                ("FLIP".into(), rows.iter().map(|r| r.flip_mae.0 as f64).collect()),
+                ("MAE".into(), rows.iter().map(|r| r.flip_mae.1 as f64).collect()),
+            ],
+        )?;
+        figs.push(plot_file(
+            dir,
+            format!("{prefix}errors.svg"),
+            svg,
+            "FLIP and MAE of each configuration against the same reference".into(),
+        )?);
+        return flicker_plot(run, dir, prefix, figs);
+    }
     if points(|r| r.flip_mae.0).len() < 2 {
-        // one layer count, or configurations side by side: the tables say it all
+        // one layer count: the table says it all
         return flicker_plot(run, dir, prefix, figs);
     }
     let svg = plot::lines(

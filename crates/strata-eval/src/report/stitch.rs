@@ -303,6 +303,51 @@ mod tests {
         let _ = fs::remove_dir_all(&dir);
     }
 
+    /// `eval --technique ils --progressive K` (a real run: cornell 64×48, K = 16) gets ILS
+    /// Table 5 as a table and a log–log plot, and its interleaved and brute-force rows side
+    /// by side; the K-long RMS curves are not flattened into the settings table.
+    #[test]
+    fn an_ils_progressive_eval_gets_table_5_and_its_curves() {
+        let dir = std::env::temp_dir().join(format!("strata-stitch-ils-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(
+            dir.join("eval-ils.json"),
+            include_str!("testdata/eval-ils-progressive.json"),
+        )
+        .unwrap();
+        let s = StitchSettings {
+            from: dir.clone(),
+            out: dir.join("report.html"),
+            title: "ils".into(),
+            figures: Vec::new(),
+            force: false,
+        };
+        let html = fs::read_to_string(stitch(&s).unwrap()).unwrap();
+        assert!(!html.contains("<td>progressive."), "curves flattened into the settings");
+        assert!(html.contains("ILS Table 5 (§6.3): K = 16 VPL sets"), "{html}");
+        for row in [
+            "<td>1x1</td>",
+            "<td>2x2</td>",
+            "<td>ils 8x6</td>",
+            "<td>brute force (all N VPLs at every pixel)</td>",
+        ] {
+            assert!(html.contains(row), "{row}");
+        }
+        let curves = fs::read_to_string(dir.join("report-eval-ils-progressive.svg")).unwrap();
+        for name in [
+            "1x1 vs converged",
+            "2x2 vs converged",
+            "1x1 vs path tracer",
+            "target 1 %",
+        ] {
+            assert!(curves.contains(name), "{name}");
+        }
+        let bars = fs::read_to_string(dir.join("report-eval-ils-errors.svg")).unwrap();
+        assert!(bars.contains("brute force (all N VPLs at every pixel)"));
+        let _ = fs::remove_dir_all(&dir);
+    }
+
     /// A folder with nothing to stitch (or an eval report folder itself) is a one-line error
     /// naming it, and no page is written.
     #[test]
