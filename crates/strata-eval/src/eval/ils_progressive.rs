@@ -47,6 +47,74 @@ fn vpls(reference: &Reference, paths: u32, bounces: u32, seed: u64) -> Vec<GpuVp
         .collect()
 }
 
+/// Where a run of many thousand frames is: a bar on a terminal; elsewhere (logs, pipes) a
+/// line a minute and one when the phase ends. Silent with `--quiet`.
+struct Progress {
+    bar: indicatif::ProgressBar,
+    label: String,
+    len: u64,
+    show: bool,
+    start: std::time::Instant,
+    last_line: std::time::Instant,
+}
+
+impl Progress {
+    const LINE_EVERY: std::time::Duration = std::time::Duration::from_secs(60);
+
+    fn new(show: bool, label: String, len: u64) -> Self {
+        use std::io::IsTerminal;
+        let bar = if show && std::io::stderr().is_terminal() {
+            let bar = indicatif::ProgressBar::new(len);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{prefix} [{bar:40}] {pos}/{len} {msg} {elapsed_precise} eta {eta}",
+            ) {
+                bar.set_style(style.progress_chars("=> "));
+            }
+            bar.set_prefix(label.clone());
+            bar
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        let now = std::time::Instant::now();
+        Self {
+            bar,
+            label,
+            len,
+            show,
+            start: now,
+            last_line: now,
+        }
+    }
+
+    /// `pos` of `len` done; `note` says how far the run has got (e.g. the current RMS).
+    fn set(&mut self, pos: u64, note: &str) {
+        self.bar.set_position(pos);
+        self.bar.set_message(note.to_string());
+        if self.show && self.bar.is_hidden() && self.last_line.elapsed() >= Self::LINE_EVERY {
+            self.last_line = std::time::Instant::now();
+            self.line(pos, note);
+        }
+    }
+
+    fn line(&self, pos: u64, note: &str) {
+        let t = self.start.elapsed().as_secs();
+        eprintln!(
+            "strata: {}: {pos}/{} {note} ({}m{:02}s)",
+            self.label,
+            self.len,
+            t / 60,
+            t % 60
+        );
+    }
+
+    fn finish(self, pos: u64, note: &str) {
+        self.bar.finish_and_clear();
+        if self.show && self.bar.is_hidden() && self.start.elapsed() >= Self::LINE_EVERY {
+            self.line(pos, note);
+        }
+    }
+}
+
 /// A VPL set and the CPU milliseconds that generated it.
 struct VplSet {
     vpls: Vec<GpuVpl>,
@@ -190,12 +258,14 @@ pub fn run(
     let reference = Reference::new(scene, s.scene.frame).with_progress(false);
     let at = s.scene.frame;
     // every VPL set of the run: the converged image's K and the progressive K
-    let converged_sets: Vec<VplSet> = (0..sets)
-        .map(|k| vpl_set(&reference, paths, bounces, REFERENCE_SEED + k as u64))
-        .collect();
-    let progressive_sets: Vec<VplSet> = (0..sets)
-        .map(|k| vpl_set(&reference, paths, bounces, k as u64))
-        .collect();
+    let mut progress = Progress::new(s.progress, "ils §6.3: VPL sets".into(), 2 * sets as u64);
+    let mut set_of = |k: u32, seed: u64| {
+        progress.set(k as u64, "generated");
+        vpl_set(&reference, paths, bounces, seed)
+    };
+    let converged_sets: Vec<VplSet> = (0..sets).map(|k| set_of(k, REFERENCE_SEED + k as u64)).collect();
+    let progressive_sets: Vec<VplSet> = (0..sets).map(|k| set_of(sets + k, k as u64)).collect();
+    progress.finish(2 * sets as u64, "generated");
     let largest = converged_sets
         .iter()
         .chain(&progressive_sets)
@@ -229,11 +299,16 @@ pub fn run(
         // the converged image of this estimator: K independent sets
         let mut sum = ImageBuf::new(s.scene.width, s.scene.height, 3);
         let mut moments = SetMoments::new(sum.data.len());
-        for set in &converged_sets {
+        let label = |what: &str| format!("ils §6.3 {}x{}: {what}", pattern[0], pattern[1]);
+        let mut progress = Progress::new(s.progress, label("converged image"), sets as u64);
+        for (k, set) in converged_sets.iter().enumerate() {
+            progress.set(k as u64, "sets");
             let (img, _) = frame(&mut r, gpu, scene, camera, set, at)?;
             accumulate(&mut sum, &img);
             moments.add(&img);
         }
+        progress.finish(sets as u64, "sets");
+        let mut progress = Progress::new(s.progress, label("accumulation"), sets as u64);
         let converged = scaled(&sum, sets);
         // the progressive run
         let mut acc = ImageBuf::new(s.scene.width, s.scene.height, 3);
@@ -250,6 +325,7 @@ pub fn run(
             vpl_ms += set.ms;
             let mean = scaled(&acc, k);
             let e = relative_rms(&mean, &converged);
+            progress.set(k as u64, &format!("frames, relative RMS {e:.4}"));
             curve.push((k, e));
             if k.is_power_of_two() {
                 pt_curve.push((k, relative_rms(&mean, &ref_total.image)));
@@ -261,6 +337,8 @@ pub fn run(
                 break;
             }
         }
+        let last = curve.last().copied().unwrap_or((0, 1.0));
+        progress.finish(last.0 as u64, &format!("frames, relative RMS {:.4}", last.1));
         // σ₁ from every set this pattern rendered: the K of the converged image and the
         // accumulated ones (independent seeds; VPL noise is heavy-tailed, so the more sets
         // the steadier the estimate)
