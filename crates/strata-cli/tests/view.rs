@@ -276,6 +276,19 @@ fn xdotool(d: &str, args: &[&str]) -> String {
 /// id). With `frames`, a `--frames` run that writes `shot` at its end; without,
 /// interactive, in `shot`'s folder (where F12 saves `strata-view-001.png`) until the test
 /// ends it. `None` (with the skip noted) when xdotool is missing.
+/// `strata ARGS` started in the X server from `dir`, stdout and stderr piped.
+fn spawn_view(x: &XServer, args: &[&str], dir: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args(args)
+        .current_dir(dir)
+        .env("DISPLAY", &x.display)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 fn view_window(
     x: &XServer,
     test: &str,
@@ -290,15 +303,7 @@ fn view_window(
     if let Some(n) = frames {
         args.extend(["--frames", n, "--screenshot", shot.to_str().unwrap()]);
     }
-    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
-        .args([&args[..], &SIZE].concat())
-        .current_dir(shot.parent().unwrap())
-        .env("DISPLAY", &x.display)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_view(x, &[&args[..], &SIZE].concat(), shot.parent().unwrap());
     let t0 = Instant::now();
     let id = loop {
         let o = Command::new("xdotool")
@@ -1092,8 +1097,9 @@ fn view_warns_of_a_full_screen_bzb_gi_splat_before_its_frame() {
     };
     let dir = scratch("bzb-gi-cost");
     let shot = dir.join("shot.png");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_strata"))
-        .args([
+    let mut child = spawn_view(
+        &x,
+        &[
             "view",
             "--scene",
             "atrium",
@@ -1107,13 +1113,9 @@ fn view_warns_of_a_full_screen_bzb_gi_splat_before_its_frame() {
             "1",
             "--screenshot",
             shot.to_str().unwrap(),
-        ])
-        .env("DISPLAY", &x.display)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+        ],
+        &dir,
+    );
     let (tx, rx) = std::sync::mpsc::channel();
     let stderr = child.stderr.take().unwrap();
     std::thread::spawn(move || {
