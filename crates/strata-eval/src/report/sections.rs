@@ -275,8 +275,9 @@ pub fn eval_sections(r: &EvalResult, dir: &Path, prefix: &str) -> Result<Vec<Sec
 }
 
 /// ILS Table 5 (§6.3): per pattern, the per-set noise σ₁ and the frames and GPU time to 1 %
-/// relative RMS, measured and predicted; the plot shows the running mean's distance to the
-/// converged image per pattern, and the 1×1 mean's to the path tracer, on log–log axes.
+/// relative RMS, measured and predicted; the plot shows each pattern's running mean against
+/// its converged image (every frame) and against the path tracer (at 1, 2, 4, … frames), on
+/// log–log axes.
 fn progressive_table_and_plot(
     p: &IlsProgressive,
     scene: &str,
