@@ -1245,7 +1245,7 @@ fn soak_500_frames_keeps_memory_flat() {
 /// techniques have lists to build) with 2 layers, sampled every 40 frames. wgpu's
 /// allocations stay the same and resident memory grows ≤ 1 % after the first sample.
 /// Measured 2026-11-29: 0 % for each, at 64×36 and at 128×72 for 300 frames (atrium;
-/// `bzb-gi` on cornell), bar one-time steps of 0.35–0.67 % before frame 100.
+/// `bzb-gi` on cornell), bar one-time steps of 0.35–0.67 % before frame 150.
 #[test]
 fn every_technique_soaks_flat() {
     let cache = scratch("soak-every-cache");
