@@ -19,6 +19,11 @@ for v in confidence gbuffer-only probe-only blended; do
   $S render --scene atrium --technique full --preset balanced --layers 2 --frame 10 --warmup 8 \
     --width "$W" --height "$H" --debug-view "$v" --out "$OUT/atrium-$v.png" --force
 done
+# the same frame measured (issue 14): pixels clipped per view, |blended - probe-only|, ꟻLIP of each
+# composite and the banner regions' colour against the path-traced frame with sky (320x180, frame 0)
+$S eval --scene atrium --technique full --preset balanced --views --layers 2 --width 320 --height 180 \
+  --json --quiet > "$OUT/eval-views.json"
+cat "$OUT/eval-views.json"
 $S render --scene mirror --technique full --layers 2 --warmup 4 --width "$W" --height "$H" --out "$OUT/mirror-full.png" --force
 $S render --scene atrium --width "$W" --height "$H" --out "$OUT/atrium.png" --force
 $S render --scene atrium --width "$W" --height "$H" --out "$OUT/atrium.exr" --force

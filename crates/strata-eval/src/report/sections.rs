@@ -9,6 +9,7 @@ use anyhow::Result;
 use serde::Serialize;
 
 use super::{plot, write_file, Cell, ReportImage, Section, Table};
+use crate::eval::views::ViewsEval;
 use crate::metrics::ErrorStats;
 use crate::results::{
     BenchResult, DeepBench, EvalResult, EvalRun, Fig10, IlsEval, IlsProgressive, PassTime, StageBench,
@@ -345,6 +346,113 @@ fn progressive_table_and_plot(
         "relative RMS of the running mean against the frames (log–log)".into(),
     )?;
     Ok((t, fig))
+}
+
+/// Sections of `eval --technique full --views`: the frame as `render` shows it against the
+/// path-traced frame with sky. Per view: clipped pixels, mean display value, outliers; ꟻLIP
+/// of the final image and of the probe-only and G-buffer-only composites; and the fixed
+/// regions' chroma (issue 14's banner regions), with a plot of each composite's CIELAB
+/// (a*, b*) distance to the path tracer's colour per region.
+pub fn views_sections(e: &ViewsEval, dir: &Path, prefix: &str) -> Result<Vec<Section>> {
+    let skip = [
+        "views",
+        "regions",
+        "flip_blended",
+        "flip_probe_only",
+        "flip_gbuffer_only",
+        "reference_outliers",
+        "warnings",
+    ];
+    let mut views = Table::new(
+        format!(
+            "Views as `render` shows them (display bytes); the path-traced frame has {} outliers",
+            e.reference_outliers
+        ),
+        &["view", "pixels clipped", "mean (0..255)", "outliers"],
+    );
+    for v in &e.views {
+        views.row(vec![
+            Cell::Text(v.view.clone()),
+            Cell::Text(format!("{:.2} %", 100.0 * v.clip_fraction)),
+            v.mean.into(),
+            Cell::Text(v.outliers.to_string()),
+        ]);
+    }
+    let mut flips = Table::new(
+        format!(
+            "Against the path-traced frame (sky on); mean |blended − probe-only| {:.2}/255, mean confidence {:.3}",
+            e.blended_vs_probe_only, e.mean_confidence
+        ),
+        &["composite", "FLIP"],
+    );
+    for (name, f) in [
+        ("final (blend)", e.flip_blended),
+        ("probes only", e.flip_probe_only),
+        ("deep G-buffer only", e.flip_gbuffer_only),
+    ] {
+        flips.row(vec![name.into(), f.into()]);
+    }
+    let mut regions = Table::new(
+        "Regions: chroma C*ab of the mean display colour, and its (a*, b*) distance to the path tracer's",
+        &[
+            "region",
+            "pixels",
+            "confidence",
+            "C* path tracer",
+            "C* probes only",
+            "C* blend",
+            "C* G-buffer only",
+            "Δab probes only",
+            "Δab blend",
+            "Δab G-buffer only",
+            "|blend − probes| /255",
+        ],
+    );
+    for r in &e.regions {
+        regions.row(vec![
+            Cell::Text(r.name.clone()),
+            Cell::Text(r.pixels.to_string()),
+            r.confidence.into(),
+            r.chroma_reference.into(),
+            r.chroma_probe_only.into(),
+            r.chroma_blended.into(),
+            r.chroma_gbuffer_only.into(),
+            r.ab_error_probe_only.into(),
+            r.ab_error_blended.into(),
+            r.ab_error_gbuffer_only.into(),
+            r.blended_vs_probe_only.into(),
+        ]);
+    }
+    let mut section = Section::new(format!("eval full --views on {}: numbers", e.run.scene))
+        .table(settings_table("Settings", e, &skip)?)
+        .table(views)
+        .table(flips)
+        .table(regions);
+    if !e.regions.is_empty() {
+        let names: Vec<String> = e.regions.iter().map(|r| r.name.clone()).collect();
+        let series = [
+            ("probes only", e.regions.iter().map(|r| r.ab_error_probe_only).collect()),
+            ("blend", e.regions.iter().map(|r| r.ab_error_blended).collect()),
+            (
+                "deep G-buffer only",
+                e.regions.iter().map(|r| r.ab_error_gbuffer_only).collect(),
+            ),
+        ]
+        .map(|(n, v): (&str, Vec<f64>)| (n.to_string(), v));
+        let svg = plot::bars(
+            &format!("Colour error per region ({})", e.run.scene),
+            "CIELAB (a*, b*) distance to the path tracer",
+            &names,
+            &series,
+        )?;
+        section = section.figures(vec![plot_file(
+            dir,
+            format!("{prefix}regions.svg"),
+            svg,
+            "each composite's colour distance to the path-traced frame, per region".into(),
+        )?]);
+    }
+    Ok(vec![section])
 }
 
 /// The references' own quality: samples, whether the noise target was met, the noise between

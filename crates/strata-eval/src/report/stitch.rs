@@ -27,6 +27,8 @@ pub struct StitchSettings {
 /// A result file of the folder.
 enum Parsed {
     Eval(Box<EvalResult>),
+    /// `eval --technique full --views` (issue 14's final-frame measurements).
+    Views(Box<crate::eval::views::ViewsEval>),
     Bench(Box<BenchResult>),
     Other(serde_json::Value),
 }
@@ -36,6 +38,11 @@ fn parse(text: &str) -> Result<Parsed> {
     if v.get("technique").is_some() {
         if let Ok(e) = serde_json::from_value(v.clone()) {
             return Ok(Parsed::Eval(Box::new(e)));
+        }
+    }
+    if v.get("views").is_some() && v.get("regions").is_some() {
+        if let Ok(e) = serde_json::from_value(v.clone()) {
+            return Ok(Parsed::Views(Box::new(e)));
         }
     }
     if v.get("bench").is_some() || v.get("rows").is_some() {
@@ -123,6 +130,7 @@ pub fn stitch(s: &StitchSettings) -> Result<PathBuf> {
         let parsed = parse(&text).with_context(|| format!("{}: not JSON", path.display()))?;
         let mut secs = match &parsed {
             Parsed::Eval(e) => sections::eval_sections(e, out_dir, &prefix)?,
+            Parsed::Views(e) => sections::views_sections(e, out_dir, &prefix)?,
             Parsed::Bench(b) => sections::bench_sections(b, out_dir, &prefix)?,
             Parsed::Other(v) => vec![Section::new(name.clone()).table(Table::key_values("", v))],
         };
@@ -130,7 +138,7 @@ pub fn stitch(s: &StitchSettings) -> Result<PathBuf> {
             sec.title = format!("{} ({name})", sec.title);
         }
         match parsed {
-            Parsed::Eval(_) => evals.extend(secs),
+            Parsed::Eval(_) | Parsed::Views(_) => evals.extend(secs),
             _ => benches.extend(secs),
         }
     }
@@ -345,6 +353,39 @@ mod tests {
         }
         let bars = fs::read_to_string(dir.join("report-eval-ils-errors.svg")).unwrap();
         assert!(bars.contains("brute force (all N VPLs at every pixel)"));
+        let _ = fs::remove_dir_all(&dir);
+    }
+
+    /// `eval --technique full --views` (a real run: atrium 320×180) gets its views, ꟻLIP
+    /// and region tables and the regions' colour-error plot, not a flattened key list.
+    #[test]
+    fn a_views_eval_gets_its_tables_and_region_plot() {
+        let dir = std::env::temp_dir().join(format!("strata-stitch-views-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(dir.join("eval-views.json"), include_str!("testdata/eval-views.json")).unwrap();
+        let s = StitchSettings {
+            from: dir.clone(),
+            out: dir.join("report.html"),
+            title: "views".into(),
+            figures: Vec::new(),
+            force: false,
+        };
+        let html = fs::read_to_string(stitch(&s).unwrap()).unwrap();
+        assert!(html.contains("eval full --views on atrium"), "{html}");
+        assert!(!html.contains("<td>regions."), "regions flattened into the settings");
+        for row in [
+            "<td>final</td>",
+            "<td>probe-only</td>",
+            "<td>final (blend)</td>",
+            "<td>columns-blue-green</td>",
+        ] {
+            assert!(html.contains(row), "{row}");
+        }
+        let plot = fs::read_to_string(dir.join("report-eval-views-regions.svg")).unwrap();
+        for name in ["soffits-yellow-blue", "probes only", "deep G-buffer only"] {
+            assert!(plot.contains(name), "{name}");
+        }
         let _ = fs::remove_dir_all(&dir);
     }
 
