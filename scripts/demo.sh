@@ -19,8 +19,9 @@ for v in confidence gbuffer-only probe-only blended; do
   $S render --scene atrium --technique full --preset balanced --layers 2 --frame 10 --warmup 8 \
     --width "$W" --height "$H" --debug-view "$v" --out "$OUT/atrium-$v.png" --force
 done
-# the same frame measured (issue 14): pixels clipped per view, |blended - probe-only|, ꟻLIP of each
-# composite and the banner regions' colour against the path-traced frame with sky (320x180, frame 0)
+# these views measured (issue 14): pixels clipped per view, |blended - probe-only|, ꟻLIP of each
+# composite and the banner regions' colour against the path-traced frame with sky (320x180; frame 0,
+# the camera the regions are drawn for)
 $S eval --scene atrium --technique full --preset balanced --views --layers 2 --width 320 --height 180 \
   --json --quiet > "$OUT/eval-views.json"
 cat "$OUT/eval-views.json"
