@@ -311,27 +311,34 @@ mod tests {
         let _ = fs::remove_dir_all(&dir);
     }
 
+    /// A page stitched from a folder (`strata-stitch-NAME-PID`) holding one result `file`;
+    /// returns the folder and the page.
+    fn stitch_one(name: &str, file: &str, json: &str) -> (PathBuf, String) {
+        let dir = std::env::temp_dir().join(format!("strata-stitch-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        fs::write(dir.join(file), json).unwrap();
+        let s = StitchSettings {
+            from: dir.clone(),
+            out: dir.join("report.html"),
+            title: name.into(),
+            figures: Vec::new(),
+            force: false,
+        };
+        let html = fs::read_to_string(stitch(&s).unwrap()).unwrap();
+        (dir, html)
+    }
+
     /// `eval --technique ils --progressive K` (a real run: cornell 64×48, K = 16) gets ILS
     /// Table 5 as a table and a log–log plot, and its interleaved and brute-force rows side
     /// by side; the K-long RMS curves are not flattened into the settings table.
     #[test]
     fn an_ils_progressive_eval_gets_table_5_and_its_curves() {
-        let dir = std::env::temp_dir().join(format!("strata-stitch-ils-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        fs::write(
-            dir.join("eval-ils.json"),
+        let (dir, html) = stitch_one(
+            "ils",
+            "eval-ils.json",
             include_str!("testdata/eval-ils-progressive.json"),
-        )
-        .unwrap();
-        let s = StitchSettings {
-            from: dir.clone(),
-            out: dir.join("report.html"),
-            title: "ils".into(),
-            figures: Vec::new(),
-            force: false,
-        };
-        let html = fs::read_to_string(stitch(&s).unwrap()).unwrap();
+        );
         assert!(!html.contains("<td>progressive."), "curves flattened into the settings");
         assert!(html.contains("ILS Table 5 (§6.3): K = 16 VPL sets"), "{html}");
         for row in [
@@ -360,18 +367,7 @@ mod tests {
     /// and region tables and the regions' colour-error plot, not a flattened key list.
     #[test]
     fn a_views_eval_gets_its_tables_and_region_plot() {
-        let dir = std::env::temp_dir().join(format!("strata-stitch-views-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        fs::write(dir.join("eval-views.json"), include_str!("testdata/eval-views.json")).unwrap();
-        let s = StitchSettings {
-            from: dir.clone(),
-            out: dir.join("report.html"),
-            title: "views".into(),
-            figures: Vec::new(),
-            force: false,
-        };
-        let html = fs::read_to_string(stitch(&s).unwrap()).unwrap();
+        let (dir, html) = stitch_one("views", "eval-views.json", include_str!("testdata/eval-views.json"));
         assert!(html.contains("eval full --views on atrium"), "{html}");
         assert!(!html.contains("<td>regions."), "regions flattened into the settings");
         for row in [
