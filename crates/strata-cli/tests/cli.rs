@@ -1244,8 +1244,9 @@ fn soak_500_frames_keeps_memory_flat() {
 /// 120 frames of `glasshouse` (transparent and opaque surfaces, so the A-buffer
 /// techniques have lists to build) with 2 layers, sampled every 40 frames. wgpu's
 /// allocations stay the same and resident memory grows ≤ 1 % after the first sample.
-/// Measured 2026-11-29: 0 % for each, at 64×36 and at 128×72 for 300 frames (atrium;
-/// `bzb-gi` on cornell), bar one-time steps of 0.35–0.67 % before frame 150.
+/// Measured 2026-11-29: 0 % for each at 64×36, and at 128×72 for 300 frames (atrium,
+/// glasshouse for the A-buffer techniques, cornell for `bzb-gi`) 0 % but for one-time
+/// steps of 0.35–0.67 % before frame 150.
 #[test]
 fn every_technique_soaks_flat() {
     let cache = scratch("soak-every-cache");

@@ -37,8 +37,8 @@ fn top(values: impl Iterator<Item = f64>) -> f64 {
     }
 }
 
-/// A white plot of `size` with a title, axis label areas `areas` px (under the x axis, left
-/// of the y axis) and the ranges `x` × `y`.
+/// A white plot with a title, axis label areas `areas` px deep (under the x axis, left of
+/// the y axis) and the ranges `x` × `y`.
 fn chart<'a, 'b>(
     root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
     title: &str,
