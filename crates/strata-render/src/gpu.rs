@@ -63,7 +63,9 @@ pub struct GpuOptions {
 
 /// The device plus everything passes need to know about it.
 pub struct GpuContext {
-    pub instance: wgpu::Instance,
+    /// The instance the device was opened from; `None` for an application's device
+    /// ([`GpuContext::from_device`]).
+    pub instance: Option<wgpu::Instance>,
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
@@ -182,13 +184,27 @@ impl GpuContext {
                 .push(format!("the GPU device was lost ({reason:?}): {message}"));
         });
         Ok(Self {
-            instance,
+            instance: Some(instance),
             adapter,
             device,
             queue,
             features,
             errors,
         })
+    }
+
+    /// Wraps an application's device (`strata_render::embed`): its features are the ones
+    /// the application requested, and its errors go to the application's handler and
+    /// error scopes, so [`GpuContext::check_errors`] reports none.
+    pub fn from_device(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        Self {
+            instance: None,
+            adapter: adapter.clone(),
+            device: device.clone(),
+            queue: queue.clone(),
+            features: device.features(),
+            errors: Arc::new(Mutex::new(Vec::new())),
+        }
     }
 
     /// A known defect of this adapter's driver that affects strata (see [`known_driver_issue`]).

@@ -1123,6 +1123,13 @@ impl Renderer {
         decode_texels(&bytes, t.desc.format, w, h)
     }
 
+    /// Target `name`'s texture (whole, guard band included), if the frame has it: e.g. the
+    /// deep G-buffer's `depth` and `normal` as an application's G-buffer
+    /// (`strata_render::embed`'s tests).
+    pub fn target_texture(&self, name: &str) -> Option<&wgpu::Texture> {
+        self.targets.try_get(name).map(|t| &t.texture)
+    }
+
     /// The declaration of target `name` (format, layers, MIP levels), if the frame has it.
     pub fn target_desc(&self, name: &str) -> Option<crate::frame::TargetDesc> {
         self.targets.try_get(name).map(|t| t.desc)

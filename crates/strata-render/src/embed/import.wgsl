@@ -1,0 +1,109 @@
+// The application's G-buffer → strata's deep G-buffer layout (DGB Table 1): camera-space
+// z of each layer from its hardware depth and projection, Oct16 world normals, and the
+// layer-0 world motion the temporal filter follows. One pass; `embed::EmbeddedAo`.
+#import "common/fullscreen.wgsl"
+#import "common/packing.wgsl"
+
+// the normals' encoding: 0 = signed xyz, 1 = xyz·0.5 + 0.5, 2 = Oct16 rg in [0, 1]
+override NORMALS: u32 = 0u;
+// 1: the normals are in view space (rotated to world space with inv_view)
+override VIEW_SPACE: u32 = 0u;
+
+struct Import {
+    inv_proj: mat4x4f,
+    inv_view: mat4x4f,
+    // w, h, 1/w, 1/h
+    size: vec4f,
+    // the projection's w row's z factor: csz = w_sign · z_view (−1 right-handed, +1 left)
+    w_sign: f32,
+    // 1: reversed z (no surface where depth = 0), 0: standard (no surface where depth = 1)
+    reversed: u32,
+    _pad: vec2u,
+}
+
+@group(0) @binding(0) var<uniform> im: Import;
+@group(0) @binding(1) var depth0: texture_depth_2d;
+@group(0) @binding(2) var normal0: texture_2d<f32>;
+@group(0) @binding(3) var depth1: texture_depth_2d;
+@group(0) @binding(4) var normal1: texture_2d<f32>;
+@group(0) @binding(5) var motion_in: texture_2d<f32>;
+
+// camera-space z of hardware depth d at pixel p (0 = no surface): the projection inverted
+fn csz_of_depth(p: vec2i, d: f32) -> f32 {
+    let empty = select(d >= 1.0, d <= 0.0, im.reversed != 0u);
+    if (empty) {
+        return 0.0;
+    }
+    let uv = (vec2f(p) + 0.5) * im.size.zw;
+    let v = im.inv_proj * vec4f(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, d, 1.0);
+    let z = im.w_sign * v.z / v.w;
+    // behind the eye, or a projection that cannot be inverted there
+    return select(0.0, z, z > 0.0 && z < 3.0e38);
+}
+
+// Oct16 of the world normal in texel `t` of a normal texture
+fn oct_of(t: vec4f) -> vec2f {
+    if (NORMALS == 2u && VIEW_SPACE == 0u) {
+        // already strata's encoding: pass it through bit for bit
+        return t.rg;
+    }
+    var n: vec3f;
+    if (NORMALS == 0u) {
+        n = t.xyz;
+    } else if (NORMALS == 1u) {
+        n = t.xyz * 2.0 - 1.0;
+    } else {
+        n = oct_decode(t.rg);
+    }
+    if (VIEW_SPACE != 0u) {
+        n = (im.inv_view * vec4f(n, 0.0)).xyz;
+    }
+    let l = length(n);
+    return oct_encode(select(vec3f(0.0, 0.0, 1.0), n / l, l > 1e-20));
+}
+
+// the application's motion texture, or one of zeros where it gives none
+fn motion_of(p: vec2i) -> vec4f {
+    return vec4f(textureLoad(motion_in, p, 0).xyz, 0.0);
+}
+
+struct One {
+    @location(0) z01: vec2f,
+    @location(1) n01: vec4f,
+    @location(2) csz0: f32,
+    @location(3) motion: vec4f,
+}
+
+struct Two {
+    @location(0) z01: vec2f,
+    @location(1) n01: vec4f,
+    @location(2) csz0: f32,
+    @location(3) motion: vec4f,
+    @location(4) csz1: f32,
+}
+
+@fragment
+fn fs_import1(@builtin(position) pos: vec4f) -> One {
+    let p = vec2i(pos.xy);
+    let z0 = csz_of_depth(p, textureLoad(depth0, p, 0));
+    var o: One;
+    o.z01 = vec2f(z0, 0.0);
+    o.n01 = vec4f(oct_of(textureLoad(normal0, p, 0)), 0.5, 0.5);
+    o.csz0 = z0;
+    o.motion = motion_of(p);
+    return o;
+}
+
+@fragment
+fn fs_import2(@builtin(position) pos: vec4f) -> Two {
+    let p = vec2i(pos.xy);
+    let z0 = csz_of_depth(p, textureLoad(depth0, p, 0));
+    let z1 = csz_of_depth(p, textureLoad(depth1, p, 0));
+    var o: Two;
+    o.z01 = vec2f(z0, z1);
+    o.n01 = vec4f(oct_of(textureLoad(normal0, p, 0)), oct_of(textureLoad(normal1, p, 0)));
+    o.csz0 = z0;
+    o.motion = motion_of(p);
+    o.csz1 = z1;
+    return o;
+}
