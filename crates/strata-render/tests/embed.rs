@@ -6,6 +6,7 @@
 
 mod common;
 
+use glam::{Mat4, Vec3};
 use strata_render::embed::{AoInputs, EmbeddedAo, EmbeddedAoConfig, NormalEncoding, NormalSpace, TextureLayer};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::ao::AoSettings;
@@ -148,5 +149,295 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
         );
         let lo = b.data.iter().cloned().fold(1.0f32, f32::min);
         assert!(lo < 0.6, "the atrium has occlusion to compare (darkest AV {lo})");
+    }
+}
+
+#[path = "../examples/embed_ao/gbuffer.rs"]
+mod gbuffer;
+
+/// G-buffers drawn as applications draw them: the embedded AO of each matches the renderer's
+/// AO of the same camera. The left-handed case mirrors the world (z → −z) and looks at it
+/// with `look_at_lh`, which gives the same image (and the same winding on screen); AO is
+/// unchanged by the mirror.
+#[test]
+fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
+    use glam::camera::{lh, rh};
+    use wgpu::TextureFormat as F;
+    let gpu = common::gpu();
+    let scene = still_atrium();
+    let cam = scene.camera;
+    let aspect = W as f32 / H as f32;
+    let fov = cam.fov_y_deg.to_radians();
+    let mut r = renderer(&gpu, &scene, 1);
+    for _ in 0..FRAMES {
+        r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
+    }
+    let reference = r.read_target(&gpu, "ao").unwrap();
+    let tris = |mirror: Vec3| -> Vec<([Vec3; 3], [Vec3; 3])> {
+        scene
+            .world_triangles(0.0)
+            .iter()
+            .map(|t| (t.p.map(|p| p * mirror), t.n.map(|n| n * mirror)))
+            .collect()
+    };
+    let flip = Vec3::new(1.0, 1.0, -1.0);
+    struct Case {
+        name: &'static str,
+        layout: gbuffer::Layout,
+        encoding: NormalEncoding,
+        space: NormalSpace,
+        mirror: bool,
+        view: Mat4,
+        proj: Mat4,
+    }
+    let layout = |depth, normal, normals, reversed| gbuffer::Layout {
+        depth,
+        normal,
+        normals,
+        reversed,
+    };
+    let cases = [
+        Case {
+            name: "right-handed, standard depth, signed world normals",
+            layout: layout(F::Depth32Float, F::Rgba16Float, gbuffer::Normals::WorldSigned, false),
+            encoding: NormalEncoding::Signed,
+            space: NormalSpace::World,
+            mirror: false,
+            view: cam.view(),
+            proj: rh::proj::directx::perspective(fov, aspect, cam.near, 500.0),
+        },
+        Case {
+            name: "right-handed, reversed infinite depth, unsigned view-space normals",
+            layout: layout(F::Depth24Plus, F::Rgba8Unorm, gbuffer::Normals::ViewUnsigned, true),
+            encoding: NormalEncoding::Unsigned,
+            space: NormalSpace::View,
+            mirror: false,
+            view: cam.view(),
+            proj: rh::proj::directx::perspective_infinite_reverse(fov, aspect, cam.near),
+        },
+        Case {
+            name: "left-handed, standard depth, signed view-space normals",
+            layout: layout(F::Depth32Float, F::Rgba16Float, gbuffer::Normals::ViewSigned, false),
+            encoding: NormalEncoding::Signed,
+            space: NormalSpace::View,
+            mirror: true,
+            view: lh::view::look_at_mat4(cam.eye * flip, cam.target * flip, cam.up * flip),
+            proj: lh::proj::directx::perspective(fov, aspect, cam.near, 500.0),
+        },
+    ];
+    for c in cases {
+        let app = gbuffer::GBuffer::new(
+            &gpu.device,
+            [W, H],
+            c.layout,
+            &tris(if c.mirror { flip } else { Vec3::ONE }),
+        );
+        let mut ao = embedded(&gpu, &scene, 1, c.encoding, c.space);
+        for _ in 0..FRAMES {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            app.draw(&gpu.queue, &mut encoder, c.view, c.proj);
+            ao.encode(
+                &mut encoder,
+                &AoInputs::new((&app.depth).into(), (&app.normals).into(), c.view, c.proj),
+            )
+            .expect("valid inputs");
+            gpu.queue.submit([encoder.finish()]);
+            gpu.check_errors().expect("no wgpu validation errors");
+        }
+        let (za, zb) = (ao.read_target("zpack").unwrap(), r.read_target(&gpu, "zpack").unwrap());
+        let (mut worst, mut missed) = (0.0f32, 0usize);
+        for (a, b) in za.data.iter().zip(&zb.data).step_by(2) {
+            if (*a > 0.0) != (*b > 0.0) {
+                missed += 1;
+            } else if *b > 0.0 {
+                worst = worst.max((a - b).abs() / b);
+            }
+        }
+        let a = ao.read_target("ao").unwrap();
+        let (mean, over) = diff(&a, &reference, 4.0 / 255.0);
+        println!(
+            "{}: z within {worst:.1e} relative, {missed} pixels' coverage differs; mean |ΔAV| {mean:.2e}, {:.2} % over 4/255",
+            c.name,
+            100.0 * over
+        );
+        assert!(missed <= 4 && worst < 1e-3, "{}: depth import off", c.name);
+        assert!(mean < 2e-3 && over < 0.01, "{}: AO differs from the renderer's", c.name);
+    }
+}
+
+/// Bad configurations and inputs are one-line errors naming the parameter and its valid
+/// range, and record nothing: the device sees no validation error.
+#[test]
+fn bad_embedded_ao_input_is_a_one_line_error() {
+    use wgpu::TextureFormat as F;
+    let gpu = common::gpu();
+    let config = |f: &dyn Fn(&mut EmbeddedAoConfig)| {
+        let mut c = EmbeddedAoConfig {
+            width: W,
+            height: H,
+            settings: AoSettings {
+                radius: Some(0.5),
+                ..AoSettings::default()
+            },
+            ..EmbeddedAoConfig::default()
+        };
+        f(&mut c);
+        EmbeddedAo::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
+            .err()
+            .map(|e| e.to_string())
+    };
+    let one_line = |e: Option<String>, words: &[&str]| {
+        let e = e.expect("an error");
+        assert!(!e.contains('\n'), "one line: {e}");
+        for w in words {
+            assert!(e.contains(w), "'{e}' names '{w}'");
+        }
+    };
+    one_line(config(&|c| c.settings.radius = None), &["settings.radius", "> 0"]);
+    one_line(config(&|c| c.settings.radius = Some(-1.0)), &["radius", "> 0"]);
+    one_line(config(&|c| c.layers = 3), &["layers 3", "1..=2"]);
+    one_line(config(&|c| c.width = 0), &["size 0x90", "width and height"]);
+    one_line(config(&|c| c.settings.samples = 0), &["samples", "1..=256"]);
+
+    let texture = |size: [u32; 2], format, usage, samples| {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("app"),
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    };
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
+    let depth = texture([W, H], F::Depth32Float, usage, 1);
+    let normals = texture([W, H], F::Rgba16Float, usage, 1);
+    let small = texture([W / 2, H / 2], F::Depth32Float, usage, 1);
+    let unbound = texture([W, H], F::Depth32Float, wgpu::TextureUsages::RENDER_ATTACHMENT, 1);
+    let msaa = texture([W, H], F::Depth32Float, usage, 4);
+    let integer = texture([W, H], F::Rgba8Uint, usage, 1);
+    let cam = strata_scene::Camera::default();
+    let (view, proj) = (cam.view(), cam.projection(W as f32 / H as f32));
+    let mut ao = EmbeddedAo::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedAoConfig {
+            width: W,
+            height: H,
+            settings: AoSettings {
+                radius: Some(0.5),
+                ..AoSettings::default()
+            },
+            ..EmbeddedAoConfig::default()
+        },
+    )
+    .unwrap();
+    let mut encode = |i: AoInputs<'_>| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let e = ao.encode(&mut encoder, &i).err().map(|e| e.to_string());
+        gpu.queue.submit([encoder.finish()]);
+        e
+    };
+    let ok = AoInputs::new((&depth).into(), (&normals).into(), view, proj);
+    one_line(
+        encode(AoInputs {
+            depth: (&small).into(),
+            ..ok
+        }),
+        &["depth is 80x45", "160x90"],
+    );
+    one_line(
+        encode(AoInputs {
+            depth: (&unbound).into(),
+            ..ok
+        }),
+        &["depth", "TEXTURE_BINDING"],
+    );
+    one_line(
+        encode(AoInputs {
+            depth: (&msaa).into(),
+            ..ok
+        }),
+        &["depth has 4 samples", "resolve"],
+    );
+    one_line(
+        encode(AoInputs {
+            depth: (&normals).into(),
+            ..ok
+        }),
+        &["depth has format Rgba16Float", "depth format"],
+    );
+    one_line(
+        encode(AoInputs {
+            normals: (&integer).into(),
+            ..ok
+        }),
+        &["normals has format Rgba8Uint", "float, unorm or snorm"],
+    );
+    one_line(
+        encode(AoInputs {
+            normals: TextureLayer {
+                texture: &normals,
+                layer: 1,
+            },
+            ..ok
+        }),
+        &["normals layer 1", "0..1"],
+    );
+    one_line(
+        encode(AoInputs {
+            second: Some(((&depth).into(), (&normals).into())),
+            ..ok
+        }),
+        &["AoInputs::second", "1 layer"],
+    );
+    let ortho = glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0);
+    one_line(encode(AoInputs { proj: ortho, ..ok }), &["proj", "perspective"]);
+    let mut jittered = proj;
+    jittered.z_axis.x = 0.5 / W as f32;
+    one_line(encode(AoInputs { proj: jittered, ..ok }), &["proj", "jittered"]);
+    let vulkan = glam::camera::rh::proj::vulkan::perspective(1.0, 1.0, 0.1, 10.0);
+    one_line(encode(AoInputs { proj: vulkan, ..ok }), &["proj", "y up"]);
+    one_line(encode(AoInputs { view: Mat4::ZERO, ..ok }), &["view", "invertible"]);
+    // none of them recorded anything; a good frame still runs
+    assert_eq!(encode(ok), None);
+    gpu.check_errors().expect("no wgpu validation errors");
+
+    // the smallest windows build and run (one MIP level, a blur wider than the image)
+    for size in [[1, 1], [3, 2]] {
+        let mut ao = EmbeddedAo::new(
+            &gpu.adapter,
+            &gpu.device,
+            &gpu.queue,
+            EmbeddedAoConfig {
+                width: size[0],
+                height: size[1],
+                settings: AoSettings {
+                    radius: Some(0.5),
+                    ..AoSettings::default()
+                },
+                ..EmbeddedAoConfig::default()
+            },
+        )
+        .unwrap();
+        let (d, n) = (
+            texture(size, F::Depth32Float, usage, 1),
+            texture(size, F::Rgba16Float, usage, 1),
+        );
+        let proj = cam.projection(size[0] as f32 / size[1] as f32);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        ao.encode(&mut encoder, &AoInputs::new((&d).into(), (&n).into(), view, proj))
+            .unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+        // depth 0 in a reversed projection: no surface, fully visible
+        assert!(ao.read_target("ao").unwrap().data.iter().all(|v| *v == 1.0));
     }
 }

@@ -1,0 +1,242 @@
+//! An application's own G-buffer, as the `embed_ao` example draws it: hardware depth and
+//! a normal texture, from world-space triangles, with plain wgpu. Nothing here is strata's;
+//! `tests/embed.rs` draws its G-buffers with it too.
+
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+/// How the normal texture stores the normal (the shader's `mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(dead_code)] // the example draws one; tests/embed.rs draws every one
+pub enum Normals {
+    /// World-space xyz, signed.
+    WorldSigned,
+    /// View-space xyz · ½ + ½.
+    ViewUnsigned,
+    /// View-space xyz, signed.
+    ViewSigned,
+}
+
+/// The G-buffer's formats and conventions.
+#[derive(Clone, Copy, Debug)]
+pub struct Layout {
+    pub depth: wgpu::TextureFormat,
+    pub normal: wgpu::TextureFormat,
+    pub normals: Normals,
+    /// Depth cleared to 0 and tested with `Greater` (reversed z), else cleared to 1, `Less`.
+    pub reversed: bool,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Uniforms {
+    view_proj: [[f32; 4]; 4],
+    view: [[f32; 4]; 4],
+    mode: [u32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Vertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+}
+
+const SHADER: &str = r#"
+struct U { view_proj: mat4x4f, view: mat4x4f, mode: vec4u }
+@group(0) @binding(0) var<uniform> u: U;
+struct V { @builtin(position) pos: vec4f, @location(0) n: vec3f }
+@vertex fn vs(@location(0) p: vec3f, @location(1) n: vec3f) -> V {
+    return V(u.view_proj * vec4f(p, 1.0), n);
+}
+@fragment fn fs(v: V, @builtin(front_facing) front: bool) -> @location(0) vec4f {
+    // two-sided: a back face's normal points towards the viewer
+    var n = normalize(v.n) * select(-1.0, 1.0, front);
+    if (u.mode.x != 0u) {
+        n = (u.view * vec4f(n, 0.0)).xyz;
+    }
+    if (u.mode.x == 1u) {
+        return vec4f(n * 0.5 + 0.5, 1.0);
+    }
+    return vec4f(n, 1.0);
+}
+"#;
+
+/// Depth and normal textures and the pipeline that fills them.
+pub struct GBuffer {
+    pub depth: wgpu::Texture,
+    pub normals: wgpu::Texture,
+    layout: Layout,
+    pipeline: wgpu::RenderPipeline,
+    uniforms: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    vertices: wgpu::Buffer,
+    count: u32,
+}
+
+impl GBuffer {
+    /// `triangles`: world-space corners and their normals.
+    pub fn new(device: &wgpu::Device, size: [u32; 2], layout: Layout, triangles: &[([Vec3; 3], [Vec3; 3])]) -> Self {
+        let texture = |label, format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size[0],
+                    height: size[1],
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                // TEXTURE_BINDING: strata's AO reads both
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let depth = texture("app-depth", layout.depth);
+        let normals = texture("app-normals", layout.normal);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("app-gbuffer"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("app-gbuffer"),
+            size: std::mem::size_of::<Uniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("app-gbuffer"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("app-gbuffer"),
+            layout: &group_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniforms.as_entire_binding(),
+            }],
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("app-gbuffer"),
+            bind_group_layouts: &[Some(&group_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("app-gbuffer"),
+            layout: Some(&pl),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: layout.depth,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(if layout.reversed {
+                    wgpu::CompareFunction::Greater
+                } else {
+                    wgpu::CompareFunction::Less
+                }),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(layout.normal.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let verts: Vec<Vertex> = triangles
+            .iter()
+            .flat_map(|(p, n)| {
+                (0..3).map(move |k| Vertex {
+                    position: p[k].to_array(),
+                    normal: n[k].to_array(),
+                })
+            })
+            .collect();
+        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("app-triangles"),
+            contents: bytemuck::cast_slice(&verts),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        Self {
+            depth,
+            normals,
+            layout,
+            pipeline,
+            uniforms,
+            group,
+            vertices,
+            count: verts.len() as u32,
+        }
+    }
+
+    /// Draws the triangles with `view` and `proj` into the depth and normal textures.
+    pub fn draw(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, view: Mat4, proj: Mat4) {
+        let mode = match self.layout.normals {
+            Normals::WorldSigned => 0,
+            Normals::ViewUnsigned => 1,
+            Normals::ViewSigned => 2,
+        };
+        let u = Uniforms {
+            view_proj: (proj * view).to_cols_array_2d(),
+            view: view.to_cols_array_2d(),
+            mode: [mode, 0, 0, 0],
+        };
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        let normals = self.normals.create_view(&Default::default());
+        let depth = self.depth.create_view(&Default::default());
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("app-gbuffer"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &normals,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(if self.layout.reversed { 0.0 } else { 1.0 }),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.draw(0..self.count, 0..1);
+    }
+}
