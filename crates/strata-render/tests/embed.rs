@@ -147,6 +147,13 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
             mean < 2e-4 && over < 0.002,
             "k = {layers}: mean {mean}, {over} over 1/255"
         );
+        // per-pass GPU time, where the device has timestamps (lavapipe has)
+        if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
+            let t = ao.timings().unwrap();
+            let names: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
+            assert_eq!(names, ao.pass_names(), "one time per pass, in order");
+            assert!(t.passes.iter().all(|p| p.1 >= 0.0) && t.total() > 0.0, "{t:?}");
+        }
         let lo = b.data.iter().cloned().fold(1.0f32, f32::min);
         assert!(lo < 0.6, "the atrium has occlusion to compare (darkest AV {lo})");
     }
@@ -440,4 +447,76 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
         // depth 0 in a reversed projection: no surface, fully visible
         assert!(ao.read_target("ao").unwrap().data.iter().all(|v| *v == 1.0));
     }
+}
+
+/// DGB's second layer drawn by the application (a depth peel with the minimum separation,
+/// `examples/embed_ao/gbuffer.rs`): the embedded 2-layer AO matches the renderer's 2-layer
+/// AO (peeled, `Variant::Peel`), and differs from the 1-layer AO where the layer matters.
+#[test]
+fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
+    use glam::camera::rh;
+    use wgpu::TextureFormat as F;
+    let gpu = common::gpu();
+    let scene = still_atrium();
+    let cam = scene.camera;
+    let mut r2 = renderer(&gpu, &scene, 2);
+    let mut r1 = renderer(&gpu, &scene, 1);
+    for _ in 0..FRAMES {
+        r2.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
+        r1.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
+    }
+    let view = cam.view();
+    let proj = rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), W as f32 / H as f32, cam.near, 500.0);
+    let tris: Vec<_> = scene.world_triangles(0.0).iter().map(|t| (t.p, t.n)).collect();
+    let layout = gbuffer::Layout {
+        depth: F::Depth32Float,
+        normal: F::Rgba16Float,
+        normals: gbuffer::Normals::WorldSigned,
+        reversed: false,
+    };
+    let first = gbuffer::GBuffer::new(&gpu.device, [W, H], layout, &tris);
+    let second = gbuffer::GBuffer::second_layer(&gpu.device, &first, scene.settings.min_separation, &tris);
+    let mut ao = embedded(&gpu, &scene, 2, NormalEncoding::Signed, NormalSpace::World);
+    for _ in 0..FRAMES {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        first.draw(&gpu.queue, &mut encoder, view, proj);
+        second.draw(&gpu.queue, &mut encoder, view, proj);
+        let inputs = AoInputs {
+            second: Some(((&second.depth).into(), (&second.normals).into())),
+            ..AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj)
+        };
+        ao.encode(&mut encoder, &inputs).expect("valid inputs");
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+    }
+    // the second layer's coverage: the same pixels but where the peel's threshold rounds apart
+    let (za, zb) = (ao.read_target("zpack").unwrap(), r2.read_target(&gpu, "zpack").unwrap());
+    let (mut both, mut apart) = (0usize, 0usize);
+    for (a, b) in za.data.iter().zip(&zb.data).skip(1).step_by(2) {
+        match (*a > 0.0, *b > 0.0) {
+            (true, true) => both += 1,
+            (false, false) => {}
+            _ => apart += 1,
+        }
+    }
+    let (a, b2, b1) = (
+        ao.read_target("ao").unwrap(),
+        r2.read_target(&gpu, "ao").unwrap(),
+        r1.read_target(&gpu, "ao").unwrap(),
+    );
+    let (mean, over) = diff(&a, &b2, 4.0 / 255.0);
+    let (mean1, _) = diff(&b1, &b2, 4.0 / 255.0);
+    println!(
+        "second layer: {both} pixels in both, {apart} in one; mean |ΔAV| {mean:.2e} ({:.2} % over 4/255), 1 vs 2 layers {mean1:.2e}",
+        100.0 * over
+    );
+    assert!(
+        both > (W * H / 4) as usize && apart * 200 < both,
+        "layer 1 coverage: {both} vs {apart}"
+    );
+    assert!(mean < 2e-3 && over < 0.01, "2-layer AO differs from the renderer's");
+    assert!(
+        mean1 > 5.0 * mean,
+        "the second layer changes the AO ({mean1} vs {mean})"
+    );
 }

@@ -1,6 +1,7 @@
 //! An application's own G-buffer, as the `embed_ao` example draws it: hardware depth and
-//! a normal texture, from world-space triangles, with plain wgpu. Nothing here is strata's;
-//! `tests/embed.rs` draws its G-buffers with it too.
+//! a normal texture, from world-space triangles, with plain wgpu; and DGB's second layer,
+//! peeled with a minimum separation (§2). Nothing here is strata's; `tests/embed.rs` draws
+//! its G-buffers with it too.
 
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
@@ -32,7 +33,11 @@ pub struct Layout {
 struct Uniforms {
     view_proj: [[f32; 4]; 4],
     view: [[f32; 4]; 4],
+    inv_proj: [[f32; 4]; 4],
+    /// x: the normals' mode, y: 1 = reversed depth
     mode: [u32; 4],
+    /// x: the minimum separation Δz, y: 1 = peel behind the first layer
+    peel: [f32; 4],
 }
 
 #[repr(C)]
@@ -43,13 +48,30 @@ struct Vertex {
 }
 
 const SHADER: &str = r#"
-struct U { view_proj: mat4x4f, view: mat4x4f, mode: vec4u }
+struct U { view_proj: mat4x4f, view: mat4x4f, inv_proj: mat4x4f, mode: vec4u, peel: vec4f }
 @group(0) @binding(0) var<uniform> u: U;
-struct V { @builtin(position) pos: vec4f, @location(0) n: vec3f }
+@group(0) @binding(1) var first_depth: texture_depth_2d;
+// csz: the distance in front of the (right-handed) camera
+struct V { @builtin(position) pos: vec4f, @location(0) n: vec3f, @location(1) csz: f32 }
 @vertex fn vs(@location(0) p: vec3f, @location(1) n: vec3f) -> V {
-    return V(u.view_proj * vec4f(p, 1.0), n);
+    return V(u.view_proj * vec4f(p, 1.0), n, -(u.view * vec4f(p, 1.0)).z);
+}
+// the second layer (DGB §2): the nearest surface more than Δz behind the first layer's
+fn behind_first(v: V) -> bool {
+    let d0 = textureLoad(first_depth, vec2i(v.pos.xy), 0);
+    if (select(d0 >= 1.0, d0 <= 0.0, u.mode.y != 0u)) {
+        return false;
+    }
+    let uv = v.pos.xy / vec2f(textureDimensions(first_depth));
+    let q = u.inv_proj * vec4f(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, d0, 1.0);
+    let z0 = -q.z / q.w;
+    // within 1e-4·z0 of the first layer is the first layer's own surface
+    return v.csz > z0 + u.peel.x + 1e-4 * z0;
 }
 @fragment fn fs(v: V, @builtin(front_facing) front: bool) -> @location(0) vec4f {
+    if (u.peel.y != 0.0 && !behind_first(v)) {
+        discard;
+    }
     // two-sided: a back face's normal points towards the viewer
     var n = normalize(v.n) * select(-1.0, 1.0, front);
     if (u.mode.x != 0u) {
@@ -67,6 +89,8 @@ pub struct GBuffer {
     pub depth: wgpu::Texture,
     pub normals: wgpu::Texture,
     layout: Layout,
+    /// Peeling behind another G-buffer's depth: Δz.
+    min_separation: Option<f32>,
     pipeline: wgpu::RenderPipeline,
     uniforms: wgpu::Buffer,
     group: wgpu::BindGroup,
@@ -75,8 +99,36 @@ pub struct GBuffer {
 }
 
 impl GBuffer {
-    /// `triangles`: world-space corners and their normals.
+    /// The first layer of `triangles` (world-space corners and their normals).
     pub fn new(device: &wgpu::Device, size: [u32; 2], layout: Layout, triangles: &[([Vec3; 3], [Vec3; 3])]) -> Self {
+        Self::build(device, size, layout, triangles, None)
+    }
+
+    /// The second layer behind `first`: the nearest surfaces more than `min_separation`
+    /// behind it (draw `first` before it, with the same camera, each frame).
+    pub fn second_layer(
+        device: &wgpu::Device,
+        first: &GBuffer,
+        min_separation: f32,
+        triangles: &[([Vec3; 3], [Vec3; 3])],
+    ) -> Self {
+        let size = [first.depth.width(), first.depth.height()];
+        Self::build(
+            device,
+            size,
+            first.layout,
+            triangles,
+            Some((&first.depth, min_separation)),
+        )
+    }
+
+    fn build(
+        device: &wgpu::Device,
+        size: [u32; 2],
+        layout: Layout,
+        triangles: &[([Vec3; 3], [Vec3; 3])],
+        first: Option<(&wgpu::Texture, f32)>,
+    ) -> Self {
         let texture = |label, format| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -108,24 +160,49 @@ impl GBuffer {
         });
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("app-gbuffer"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
                 },
-                count: None,
-            }],
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
         });
+        // the first layer's depth, or (drawing the first layer) one it does not read
+        let unused = (first.is_none()).then(|| texture("app-unused", layout.depth));
+        let first_depth = first
+            .map(|f| f.0)
+            .or(unused.as_ref())
+            .expect("one of them")
+            .create_view(&Default::default());
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("app-gbuffer"),
             layout: &group_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniforms.as_entire_binding(),
-            }],
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&first_depth),
+                },
+            ],
         });
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("app-gbuffer"),
@@ -188,6 +265,7 @@ impl GBuffer {
             depth,
             normals,
             layout,
+            min_separation: first.map(|f| f.1),
             pipeline,
             uniforms,
             group,
@@ -206,7 +284,14 @@ impl GBuffer {
         let u = Uniforms {
             view_proj: (proj * view).to_cols_array_2d(),
             view: view.to_cols_array_2d(),
-            mode: [mode, 0, 0, 0],
+            inv_proj: proj.inverse().to_cols_array_2d(),
+            mode: [mode, self.layout.reversed as u32, 0, 0],
+            peel: [
+                self.min_separation.unwrap_or(0.0),
+                self.min_separation.is_some() as u32 as f32,
+                0.0,
+                0.0,
+            ],
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         let normals = self.normals.create_view(&Default::default());

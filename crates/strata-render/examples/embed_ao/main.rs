@@ -2,8 +2,9 @@
 //!
 //! The "application" opens its own device, draws a few boxes on a floor into its own
 //! depth and normal textures (`gbuffer.rs`, plain wgpu, standard depth, signed world
-//! normals), and asks `strata_render::embed::EmbeddedAo` for the ambient visibility. It
-//! warms the temporal filter up for 8 frames and writes the AO as a PNG:
+//! normals), peels DGB's second layer behind them (the nearest surfaces at least Δz = 0.5
+//! further), and asks `strata_render::embed::EmbeddedAo` for the ambient visibility of
+//! both layers. It warms the temporal filter up for 8 frames and writes the AO as a PNG:
 //!
 //! ```sh
 //! cargo run --release -p strata-render --example embed_ao -- out/embed-ao.png
@@ -49,7 +50,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // the application's device (any adapter: lavapipe where there is no GPU)
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
-    let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
+    // timestamps, where the adapter has them, let strata report its passes' GPU time
+    let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_features: adapter.features() & timing,
+        ..Default::default()
+    }))?;
 
     // its scene and camera (right-handed, standard depth in [0, 1])
     let mut triangles = cuboid(Vec3::new(-6.0, -0.2, -6.0), Vec3::new(6.0, 0.0, 6.0));
@@ -59,7 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     use glam::camera::rh;
     let view = rh::view::look_at_mat4(Vec3::new(1.5, 2.2, 4.0), Vec3::new(-0.3, 0.6, -1.0), Vec3::Y);
     let proj = rh::proj::directx::perspective(50f32.to_radians(), width as f32 / height as f32, 0.05, 100.0);
-    let app = gbuffer::GBuffer::new(
+    let first = gbuffer::GBuffer::new(
         &device,
         [width, height],
         gbuffer::Layout {
@@ -70,6 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
         &triangles,
     );
+    let second = gbuffer::GBuffer::second_layer(&device, &first, 0.5, &triangles);
 
     // strata's AO on that G-buffer: the radius is in the application's units (metres here)
     let mut ao = EmbeddedAo::new(
@@ -79,6 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         EmbeddedAoConfig {
             width,
             height,
+            layers: 2,
             settings: AoSettings {
                 radius: Some(0.6),
                 ..AoSettings::default()
@@ -90,12 +98,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("passes: {}", ao.pass_names().join(" → "));
     for _ in 0..8 {
         let mut encoder = device.create_command_encoder(&Default::default());
-        app.draw(&queue, &mut encoder, view, proj);
-        ao.encode(
-            &mut encoder,
-            &AoInputs::new((&app.depth).into(), (&app.normals).into(), view, proj),
-        )?;
+        first.draw(&queue, &mut encoder, view, proj);
+        second.draw(&queue, &mut encoder, view, proj);
+        let inputs = AoInputs {
+            second: Some(((&second.depth).into(), (&second.normals).into())),
+            ..AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj)
+        };
+        ao.encode(&mut encoder, &inputs)?;
         queue.submit([encoder.finish()]);
+    }
+
+    let timings = ao.timings()?;
+    if !timings.passes.is_empty() {
+        let each: Vec<String> = timings.passes.iter().map(|(n, ms)| format!("{n} {ms:.2}")).collect();
+        println!("GPU ms, last frame: {} (total {:.2})", each.join(", "), timings.total());
     }
 
     // what the application's lighting pass would sample: AV in [0, 1]

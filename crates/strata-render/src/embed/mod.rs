@@ -272,6 +272,9 @@ pub struct EmbeddedAo {
     mip: DepthMipPass,
     stage: AoStage,
     history: HistoryPass,
+    /// Per-pass GPU time where the application's device has timestamp queries inside
+    /// encoders (`TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`).
+    profiler: crate::profiler::Profiler,
     frames: u32,
     prev_view_proj: Option<Mat4>,
 }
@@ -373,6 +376,7 @@ impl EmbeddedAo {
             copies.push((n, h));
         }
         let history = HistoryPass { copies };
+        let profiler = crate::profiler::Profiler::new(&gpu, 16);
 
         let device = &gpu.device;
         let depth_entry = |binding| wgpu::BindGroupLayoutEntry {
@@ -456,6 +460,7 @@ impl EmbeddedAo {
             mip,
             stage,
             history,
+            profiler,
             frames: 0,
             prev_view_proj: None,
         })
@@ -489,11 +494,17 @@ impl EmbeddedAo {
         crate::renderer::decode_texels(&bytes, t.desc.format, t.texture.width(), t.texture.height())
     }
 
+    /// GPU milliseconds per pass of the last submitted frame (waits for it). Empty unless
+    /// the application's device has `TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`.
+    pub fn timings(&self) -> Result<crate::PassTimings, RenderError> {
+        self.profiler.read(&self.gpu)
+    }
+
     /// The pass names [`EmbeddedAo::encode`] records, in order.
     pub fn pass_names(&self) -> Vec<&'static str> {
-        let mut v = vec!["embed-import", "depth-mip"];
+        let mut v = vec!["embed-import", self.mip.info().name];
         v.extend(self.stage.passes().iter().map(|p| p.info().name));
-        v.push("history");
+        v.push(self.history.info().name);
         v
     }
 
@@ -662,12 +673,20 @@ impl EmbeddedAo {
         if self.config.layers == 2 {
             outputs.push(&t.get("csz").layer_views[1]);
         }
+        let prof = &self.profiler;
+        prof.reset();
+        let slot = prof.begin(encoder, "embed-import");
         crate::passes::fullscreen_pass(encoder, "embed-import", &self.import_pipeline, &outputs, &[&group]);
-        self.mip.encode(gpu, &self.scene_gpu, t, encoder);
-        for p in self.stage.passes() {
+        prof.end(encoder, slot);
+        let mut passes: Vec<&dyn Pass> = vec![&self.mip];
+        passes.extend(self.stage.passes());
+        passes.push(&self.history);
+        for p in passes {
+            let slot = prof.begin(encoder, p.info().name);
             p.encode(gpu, &self.scene_gpu, t, encoder);
+            prof.end(encoder, slot);
         }
-        self.history.encode(gpu, &self.scene_gpu, t, encoder);
+        prof.resolve(encoder);
         self.frames = self.frames.wrapping_add(1);
         self.prev_view_proj = Some(vp);
         Ok(())
