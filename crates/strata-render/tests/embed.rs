@@ -11,6 +11,7 @@ use strata_render::embed::{AoInputs, EmbeddedAo, EmbeddedAoConfig, NormalEncodin
 use strata_render::frame::FrameCameras;
 use strata_render::passes::ao::AoSettings;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
+use strata_render::passes::Kernel;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{ImageBuf, Scene};
 
@@ -29,7 +30,7 @@ fn still_atrium() -> Scene {
 }
 
 /// The renderer's AO of `FRAMES` still frames with `layers` peeled layers (no guard band).
-fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32) -> Renderer {
+fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32, kernel: Kernel) -> Renderer {
     Renderer::new(
         gpu,
         scene,
@@ -42,14 +43,24 @@ fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32) -> Renderer {
                 min_separation: Some(scene.settings.min_separation),
                 ..Default::default()
             },
-            ao: Some(AoSettings::default()),
+            ao: Some(AoSettings {
+                kernel,
+                ..AoSettings::default()
+            }),
             ..Default::default()
         },
     )
     .unwrap()
 }
 
-fn embedded(gpu: &GpuContext, scene: &Scene, layers: u32, normals: NormalEncoding, space: NormalSpace) -> EmbeddedAo {
+fn embedded(
+    gpu: &GpuContext,
+    scene: &Scene,
+    layers: u32,
+    kernel: Kernel,
+    normals: NormalEncoding,
+    space: NormalSpace,
+) -> EmbeddedAo {
     EmbeddedAo::new(
         &gpu.adapter,
         &gpu.device,
@@ -60,6 +71,7 @@ fn embedded(gpu: &GpuContext, scene: &Scene, layers: u32, normals: NormalEncodin
             layers,
             settings: AoSettings {
                 radius: Some(scene.settings.ao_radius),
+                kernel,
                 ..AoSettings::default()
             },
             normals,
@@ -96,9 +108,17 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
     let scene = still_atrium();
     let cams = FrameCameras::fixed(scene.camera);
     let (view, proj) = (scene.camera.view(), scene.camera.projection(W as f32 / H as f32));
-    for layers in [1, 2] {
-        let mut r = renderer(&gpu, &scene, layers);
-        let mut ao = embedded(&gpu, &scene, layers, NormalEncoding::Octahedral, NormalSpace::World);
+    // the AO pass as a fragment pass (lavapipe's Auto) and as compute (GPUs' Auto)
+    for (layers, kernel) in [(1, Kernel::Auto), (2, Kernel::Auto), (2, Kernel::Compute)] {
+        let mut r = renderer(&gpu, &scene, layers, kernel);
+        let mut ao = embedded(
+            &gpu,
+            &scene,
+            layers,
+            kernel,
+            NormalEncoding::Octahedral,
+            NormalSpace::World,
+        );
         for _ in 0..FRAMES {
             r.render(&gpu, &scene, &cams, 0.0).unwrap();
             let (depth, normal) = (r.target_texture("depth").unwrap(), r.target_texture("normal").unwrap());
@@ -140,12 +160,12 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
         let (a, b) = (ao.read_target("ao").unwrap(), r.read_target(&gpu, "ao").unwrap());
         let (mean, over) = diff(&a, &b, 1.0 / 255.0);
         println!(
-            "k = {layers}: mean |ΔAV| {mean:.2e}, {:.3} % of pixels over 1/255",
+            "k = {layers}, {kernel:?} AO pass: mean |ΔAV| {mean:.2e}, {:.3} % of pixels over 1/255",
             100.0 * over
         );
         assert!(
             mean < 2e-4 && over < 0.002,
-            "k = {layers}: mean {mean}, {over} over 1/255"
+            "k = {layers}, {kernel:?}: mean {mean}, {over} over 1/255"
         );
         // per-pass GPU time, where the device has timestamps (lavapipe has)
         if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
@@ -175,7 +195,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
     let cam = scene.camera;
     let aspect = W as f32 / H as f32;
     let fov = cam.fov_y_deg.to_radians();
-    let mut r = renderer(&gpu, &scene, 1);
+    let mut r = renderer(&gpu, &scene, 1, Kernel::Auto);
     for _ in 0..FRAMES {
         r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
     }
@@ -239,7 +259,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
             c.layout,
             &tris(if c.mirror { flip } else { Vec3::ONE }),
         );
-        let mut ao = embedded(&gpu, &scene, 1, c.encoding, c.space);
+        let mut ao = embedded(&gpu, &scene, 1, Kernel::Auto, c.encoding, c.space);
         for _ in 0..FRAMES {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             app.draw(&gpu.queue, &mut encoder, c.view, c.proj);
@@ -459,8 +479,8 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
     let gpu = common::gpu();
     let scene = still_atrium();
     let cam = scene.camera;
-    let mut r2 = renderer(&gpu, &scene, 2);
-    let mut r1 = renderer(&gpu, &scene, 1);
+    let mut r2 = renderer(&gpu, &scene, 2, Kernel::Auto);
+    let mut r1 = renderer(&gpu, &scene, 1, Kernel::Auto);
     for _ in 0..FRAMES {
         r2.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
         r1.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
@@ -476,7 +496,14 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
     };
     let first = gbuffer::GBuffer::new(&gpu.device, [W, H], layout, &tris);
     let second = gbuffer::GBuffer::second_layer(&gpu.device, &first, scene.settings.min_separation, &tris);
-    let mut ao = embedded(&gpu, &scene, 2, NormalEncoding::Signed, NormalSpace::World);
+    let mut ao = embedded(
+        &gpu,
+        &scene,
+        2,
+        Kernel::Auto,
+        NormalEncoding::Signed,
+        NormalSpace::World,
+    );
     for _ in 0..FRAMES {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         first.draw(&gpu.queue, &mut encoder, view, proj);
