@@ -381,40 +381,21 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
         texture: &normals,
         layer: 1,
     };
+    let with_depth = |t| AoInputs {
+        depth: TextureLayer::from(t),
+        ..ok
+    };
+    let with_normals = |t| AoInputs {
+        normals: TextureLayer::from(t),
+        ..ok
+    };
     let bad: [(AoInputs<'_>, &[&str]); 11] = [
+        (with_depth(&small), &["depth is 80x45", "160x90"]),
+        (with_depth(&unbound), &["depth", "TEXTURE_BINDING"]),
+        (with_depth(&msaa), &["depth has 4 samples", "resolve"]),
+        (with_depth(&normals), &["depth has format Rgba16Float", "depth format"]),
         (
-            AoInputs {
-                depth: (&small).into(),
-                ..ok
-            },
-            &["depth is 80x45", "160x90"],
-        ),
-        (
-            AoInputs {
-                depth: (&unbound).into(),
-                ..ok
-            },
-            &["depth", "TEXTURE_BINDING"],
-        ),
-        (
-            AoInputs {
-                depth: (&msaa).into(),
-                ..ok
-            },
-            &["depth has 4 samples", "resolve"],
-        ),
-        (
-            AoInputs {
-                depth: (&normals).into(),
-                ..ok
-            },
-            &["depth has format Rgba16Float", "depth format"],
-        ),
-        (
-            AoInputs {
-                normals: (&integer).into(),
-                ..ok
-            },
+            with_normals(&integer),
             &["normals has format Rgba8Uint", "float, unorm or snorm"],
         ),
         (AoInputs { normals: layer1, ..ok }, &["normals layer 1", "0..1"]),
