@@ -346,9 +346,11 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
     let depth = texture([W, H], F::Depth32Float, usage, 1);
     let normals = texture([W, H], F::Rgba16Float, usage, 1);
     let small = texture([W / 2, H / 2], F::Depth32Float, usage, 1);
+    let half_normals = texture([W / 2, H / 2], F::Rgba16Float, usage, 1);
     let unbound = texture([W, H], F::Depth32Float, wgpu::TextureUsages::RENDER_ATTACHMENT, 1);
     let msaa = texture([W, H], F::Depth32Float, usage, 4);
     let integer = texture([W, H], F::Rgba8Uint, usage, 1);
+    let srgb = texture([W, H], F::Rgba8UnormSrgb, usage, 1);
     let cam = strata_scene::Camera::default();
     let (view, proj) = (cam.view(), cam.projection(W as f32 / H as f32));
     let mut ao = EmbeddedAo::new(
@@ -389,7 +391,7 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
         normals: TextureLayer::from(t),
         ..ok
     };
-    let bad: [(AoInputs<'_>, &[&str]); 11] = [
+    let bad: [(AoInputs<'_>, &[&str]); 13] = [
         (with_depth(&small), &["depth is 80x45", "160x90"]),
         (with_depth(&unbound), &["depth", "TEXTURE_BINDING"]),
         (with_depth(&msaa), &["depth has 4 samples", "resolve"]),
@@ -409,13 +411,34 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
         (AoInputs { proj: ortho, ..ok }, &["proj", "perspective"]),
         (AoInputs { proj: jittered, ..ok }, &["proj", "jittered"]),
         (AoInputs { proj: vulkan, ..ok }, &["proj", "y up"]),
-        (AoInputs { view: Mat4::ZERO, ..ok }, &["view", "invertible"]),
+        (AoInputs { view: Mat4::ZERO, ..ok }, &["view", "rigid"]),
+        (
+            AoInputs {
+                view: Mat4::from_scale(Vec3::splat(2.0)) * view,
+                ..ok
+            },
+            &["view", "without scale"],
+        ),
+        (with_normals(&srgb), &["normals has format Rgba8UnormSrgb", "linear"]),
     ];
     for (inputs, words) in bad {
         one_line(encode(inputs), words);
     }
     // none of them recorded anything; a good frame still runs
     assert_eq!(encode(ok), None);
+    gpu.check_errors().expect("no wgpu validation errors");
+
+    // a resized window: the new size is the one checked, a bad size keeps the old one
+    ao.resize(W / 2, H / 2).unwrap();
+    let half = AoInputs::new((&small).into(), (&half_normals).into(), view, proj);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    ao.encode(&mut encoder, &half).expect("the new size");
+    let e = ao.encode(&mut encoder, &ok).unwrap_err().to_string();
+    assert!(e.contains("depth is 160x90") && e.contains("80x45"), "{e}");
+    gpu.queue.submit([encoder.finish()]);
+    let e = ao.resize(0, 10).unwrap_err().to_string();
+    assert!(e.contains("size 0x10"), "{e}");
+    assert_eq!((ao.config().width, ao.config().height), (W / 2, H / 2));
     gpu.check_errors().expect("no wgpu validation errors");
 
     // the smallest windows build and run (one MIP level, a blur wider than the image)

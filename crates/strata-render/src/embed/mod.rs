@@ -132,7 +132,7 @@ pub struct AoInputs<'a> {
     pub second: Option<(TextureLayer<'a>, TextureLayer<'a>)>,
     /// World-space motion of the visible surface since the last frame (rgb); `None`: static.
     pub motion: Option<TextureLayer<'a>>,
-    /// World → view transform and projection the depth was drawn with.
+    /// World → view transform (rigid: no scale) and projection the depth was drawn with.
     pub view: Mat4,
     pub proj: Mat4,
 }
@@ -245,6 +245,17 @@ impl CameraModel {
             ambient: [0.0; 4],
         }
     }
+}
+
+/// A rotation (or a reflection, for left-handed views) and a translation: camera-space z
+/// is then in world units, as the AO radius is.
+fn is_rigid(m: Mat4) -> bool {
+    let a = glam::Mat3::from_mat4(m);
+    let cols = [a.x_axis, a.y_axis, a.z_axis];
+    m.is_finite()
+        && m.row(3) == Vec4::W
+        && cols.iter().all(|c| (c.length() - 1.0).abs() < 1e-3)
+        && (0..3).all(|i| cols[i].dot(cols[(i + 1) % 3]).abs() < 1e-3)
 }
 
 /// Depth formats the import reads (their depth aspect).
@@ -508,6 +519,19 @@ impl EmbeddedAo {
         v
     }
 
+    /// Rebuilds the passes for a new render size (a resized window), keeping the rest of
+    /// the config; the temporal history starts afresh. On error the old size stays.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        let config = EmbeddedAoConfig {
+            width,
+            height,
+            ..self.config.clone()
+        };
+        let gpu = &self.gpu;
+        *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
+        Ok(())
+    }
+
     /// Forget the temporal history (a camera cut, a new scene): the next frame starts afresh.
     pub fn reset_history(&mut self) {
         self.prev_view_proj = None;
@@ -565,6 +589,11 @@ impl EmbeddedAo {
                     "has format {f:?}: it must be a float, unorm or snorm colour format"
                 ));
             }
+            if f.is_srgb() {
+                return bad(format!(
+                    "has format {f:?}: an sRGB format would decode the values; use its linear twin"
+                ));
+            }
         }
         Ok(())
     }
@@ -612,9 +641,9 @@ impl EmbeddedAo {
         if let Some(m) = inputs.motion {
             self.check("motion", m, false)?;
         }
-        if !inputs.view.is_finite() || inputs.view.determinant().abs() < 1e-12 {
+        if !is_rigid(inputs.view) {
             return Err(RenderError::Parameter(
-                "embedded AO: view is not an invertible rigid transform".into(),
+                "embedded AO: view is not a rigid transform (a rotation and a translation, without scale)".into(),
             ));
         }
         let cam = CameraModel::of(inputs.proj)?;
