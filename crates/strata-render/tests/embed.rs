@@ -29,8 +29,8 @@ fn still_atrium() -> Scene {
     scene
 }
 
-/// The renderer's AO of `FRAMES` still frames with `layers` peeled layers (no guard band).
-fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32, kernel: Kernel) -> Renderer {
+/// The renderer's AO with `ao` and `layers` peeled layers (no guard band).
+fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32, ao: AoSettings) -> Renderer {
     Renderer::new(
         gpu,
         scene,
@@ -43,21 +43,19 @@ fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32, kernel: Kernel) -> Ren
                 min_separation: Some(scene.settings.min_separation),
                 ..Default::default()
             },
-            ao: Some(AoSettings {
-                kernel,
-                ..AoSettings::default()
-            }),
+            ao: Some(ao),
             ..Default::default()
         },
     )
     .unwrap()
 }
 
+/// The embedded AO with `ao` and the scene's radius.
 fn embedded(
     gpu: &GpuContext,
     scene: &Scene,
     layers: u32,
-    kernel: Kernel,
+    ao: AoSettings,
     normals: NormalEncoding,
     space: NormalSpace,
 ) -> EmbeddedAo {
@@ -71,8 +69,7 @@ fn embedded(
             layers,
             settings: AoSettings {
                 radius: Some(scene.settings.ao_radius),
-                kernel,
-                ..AoSettings::default()
+                ..ao
             },
             normals,
             normal_space: space,
@@ -108,14 +105,43 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
     let scene = still_atrium();
     let cams = FrameCameras::fixed(scene.camera);
     let (view, proj) = (scene.camera.view(), scene.camera.projection(W as f32 / H as f32));
-    // the AO pass as a fragment pass (lavapipe's Auto) and as compute (GPUs' Auto)
-    for (layers, kernel) in [(1, Kernel::Auto), (2, Kernel::Auto), (2, Kernel::Compute)] {
-        let mut r = renderer(&gpu, &scene, layers, kernel);
+    // the AO pass as a fragment pass (lavapipe's Auto) and as compute (GPUs' Auto), at half
+    // resolution, and deinterleaved: every AoSettings variant runs on the imported layers
+    let cases = [
+        (1, "default", AoSettings::default()),
+        (2, "default", AoSettings::default()),
+        (
+            2,
+            "compute",
+            AoSettings {
+                kernel: Kernel::Compute,
+                ..AoSettings::default()
+            },
+        ),
+        (
+            2,
+            "ao-scale 2",
+            AoSettings {
+                scale: 2,
+                ..AoSettings::default()
+            },
+        ),
+        (
+            2,
+            "deinterleave 2x2",
+            AoSettings {
+                deinterleave: Some([2, 2]),
+                ..AoSettings::default()
+            },
+        ),
+    ];
+    for (layers, what, settings) in cases {
+        let mut r = renderer(&gpu, &scene, layers, settings.clone());
         let mut ao = embedded(
             &gpu,
             &scene,
             layers,
-            kernel,
+            settings,
             NormalEncoding::Octahedral,
             NormalSpace::World,
         );
@@ -160,12 +186,12 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
         let (a, b) = (ao.read_target("ao").unwrap(), r.read_target(&gpu, "ao").unwrap());
         let (mean, over) = diff(&a, &b, 1.0 / 255.0);
         println!(
-            "k = {layers}, {kernel:?} AO pass: mean |ΔAV| {mean:.2e}, {:.3} % of pixels over 1/255",
+            "k = {layers}, {what}: mean |ΔAV| {mean:.2e}, {:.3} % of pixels over 1/255",
             100.0 * over
         );
         assert!(
             mean < 2e-4 && over < 0.002,
-            "k = {layers}, {kernel:?}: mean {mean}, {over} over 1/255"
+            "k = {layers}, {what}: mean {mean}, {over} over 1/255"
         );
         // per-pass GPU time, where the device has timestamps (lavapipe has)
         if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
@@ -195,7 +221,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
     let cam = scene.camera;
     let aspect = W as f32 / H as f32;
     let fov = cam.fov_y_deg.to_radians();
-    let mut r = renderer(&gpu, &scene, 1, Kernel::Auto);
+    let mut r = renderer(&gpu, &scene, 1, AoSettings::default());
     for _ in 0..FRAMES {
         r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
     }
@@ -259,7 +285,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
             c.layout,
             &tris(if c.mirror { flip } else { Vec3::ONE }),
         );
-        let mut ao = embedded(&gpu, &scene, 1, Kernel::Auto, c.encoding, c.space);
+        let mut ao = embedded(&gpu, &scene, 1, AoSettings::default(), c.encoding, c.space);
         for _ in 0..FRAMES {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             app.draw(&gpu.queue, &mut encoder, c.view, c.proj);
@@ -483,8 +509,8 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
     let gpu = common::gpu();
     let scene = still_atrium();
     let cam = scene.camera;
-    let mut r2 = renderer(&gpu, &scene, 2, Kernel::Auto);
-    let mut r1 = renderer(&gpu, &scene, 1, Kernel::Auto);
+    let mut r2 = renderer(&gpu, &scene, 2, AoSettings::default());
+    let mut r1 = renderer(&gpu, &scene, 1, AoSettings::default());
     for _ in 0..FRAMES {
         r2.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
         r1.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
@@ -504,7 +530,7 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
         &gpu,
         &scene,
         2,
-        Kernel::Auto,
+        AoSettings::default(),
         NormalEncoding::Signed,
         NormalSpace::World,
     );
