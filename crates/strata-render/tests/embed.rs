@@ -402,8 +402,9 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
     };
     let ok = AoInputs::new((&depth).into(), (&normals).into(), view, proj);
     let ortho = glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0);
-    let mut jittered = proj;
-    jittered.z_axis.x = 0.5 / W as f32;
+    // 3 pixels off centre: an asymmetric frustum, not a TAA jitter
+    let mut off_centre = proj;
+    off_centre.z_axis.x = 6.0 / W as f32;
     let vulkan = glam::camera::rh::proj::vulkan::perspective(1.0, 1.0, 0.1, 10.0);
     let layer1 = TextureLayer {
         texture: &normals,
@@ -435,7 +436,10 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
             &["AoInputs::second", "1 layer"],
         ),
         (AoInputs { proj: ortho, ..ok }, &["proj", "perspective"]),
-        (AoInputs { proj: jittered, ..ok }, &["proj", "jittered"]),
+        (
+            AoInputs { proj: off_centre, ..ok },
+            &["proj", "off-centre by (3.00, 0.00) pixels"],
+        ),
         (AoInputs { proj: vulkan, ..ok }, &["proj", "y up"]),
         (AoInputs { view: Mat4::ZERO, ..ok }, &["view", "rigid"]),
         (
@@ -576,4 +580,85 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
         mean1 > 5.0 * mean,
         "the second layer changes the AO ({mean1} vs {mean})"
     );
+}
+
+/// TAA: the application draws a frame with a sub-pixel jitter and passes that projection.
+/// Each pixel's imported camera-space z is the one a ray through the jittered pixel centre
+/// meets (ray-traced on the CPU). A perspective depth depends on z alone, so the jitter
+/// changes which point a pixel sees, not how its depth inverts: the unjittered matrix gives
+/// the same z, and the AO (whose camera model drops the jitter) the same bits.
+#[test]
+fn embedded_ao_takes_a_taa_jittered_projection() {
+    use glam::camera::rh;
+    use wgpu::TextureFormat as F;
+    let gpu = common::gpu();
+    let scene = still_atrium();
+    let cam = scene.camera;
+    let view = cam.view();
+    let proj = rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), W as f32 / H as f32, cam.near, 500.0);
+    // a jitter of (jx, jy) pixels, right and down: NDC (2jx/W, −2jy/H); w = −z_view
+    let (jx, jy) = (0.37f32, -0.29f32);
+    let mut jittered = proj;
+    jittered.z_axis.x = -2.0 * jx / W as f32;
+    jittered.z_axis.y = 2.0 * jy / H as f32;
+    let tris: Vec<_> = scene.world_triangles(0.0).iter().map(|t| (t.p, t.n)).collect();
+    let layout = gbuffer::Layout {
+        depth: F::Depth32Float,
+        normal: F::Rgba16Float,
+        normals: gbuffer::Normals::WorldSigned,
+        reversed: false,
+    };
+    let app = gbuffer::GBuffer::new(&gpu.device, [W, H], layout, &tris);
+    // the oracle: pixel centre c shows the point the unjittered camera sees at c − j
+    let reference = strata_reference::Reference::new(&scene, 0.0);
+    let oracle: Vec<f32> = (0..W * H)
+        .map(|i| {
+            let (x, y) = ((i % W) as f32 + 0.5 - jx, (i / W) as f32 + 0.5 - jy);
+            let dir = cam.pixel_dir_f(x, y, W, H);
+            reference
+                .bvh()
+                .intersect(cam.eye, dir, cam.near, f32::INFINITY)
+                .map_or(0.0, |h| h.t)
+        })
+        .collect();
+    let (mut exact, mut av) = (Vec::new(), Vec::new());
+    for given in [jittered, proj] {
+        let settings = AoSettings::default();
+        let mut ao = embedded(&gpu, &scene, 1, settings, NormalEncoding::Signed, NormalSpace::World);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        app.draw(&gpu.queue, &mut encoder, view, jittered);
+        let inputs = AoInputs::new((&app.depth).into(), (&app.normals).into(), view, given);
+        ao.encode(&mut encoder, &inputs).expect("a sub-pixel jitter is taken");
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+        let z = ao.read_target("zpack").unwrap();
+        // pixels whose z is within 10⁻³ of the ray's (of those where both see a surface)
+        let (mut within, mut both) = (0usize, 0usize);
+        for (i, t) in oracle.iter().enumerate() {
+            let zi = z.data[2 * i];
+            if zi > 0.0 && *t > 0.0 {
+                both += 1;
+                within += ((zi - t).abs() <= 1e-3 * t) as usize;
+            }
+        }
+        let share = within as f64 / both as f64;
+        println!(
+            "jittered depth, {} projection given: z within 10⁻³ of the ray's at {:.2} % of {both} pixels",
+            if exact.is_empty() {
+                "the jittered"
+            } else {
+                "the unjittered"
+            },
+            100.0 * share
+        );
+        exact.push(share);
+        av.push(ao.read_target("ao").unwrap().data);
+    }
+    assert!(
+        exact[0] > 0.999,
+        "the jittered projection's z is the ray's ({})",
+        exact[0]
+    );
+    assert_eq!(exact[0], exact[1], "z does not depend on the jitter");
+    assert!(av[0] == av[1], "nor does the AO's camera model");
 }

@@ -30,10 +30,10 @@
 //! ```
 //!
 //! Conventions (the ones wgpu and glam use by default, checked where they can be):
-//! - `proj` is a perspective projection with a symmetric frustum (no jitter: pass the
-//!   unjittered matrix), right- or left-handed, standard or reversed depth, finite or
-//!   infinite far plane. No surface is where the depth buffer holds its clear value
-//!   (1, or 0 when reversed).
+//! - `proj` is a perspective projection with a symmetric frustum, or one jittered by up to
+//!   [`MAX_JITTER_PIXELS`] (TAA: pass the jittered matrix the depth was drawn with),
+//!   right- or left-handed, standard or reversed depth, finite or infinite far plane. No
+//!   surface is where the depth buffer holds its clear value (1, or 0 when reversed).
 //! - Pixel (x, y) is the texel whose centre is at (x + ½, y + ½), y down, as in wgpu.
 //! - `settings.radius` and the temporal filter's `max_distance` are in world units.
 //! - The temporal filter reprojects with the camera of the previous call. Surfaces
@@ -163,6 +163,10 @@ struct ImportUniforms {
     _pad: [u32; 2],
 }
 
+/// Largest sub-pixel jitter (TAA) [`CameraModel::of`] takes in an off-centre projection, in
+/// pixels per axis; a larger offset is an asymmetric frustum, which it refuses.
+pub const MAX_JITTER_PIXELS: f32 = 2.0;
+
 /// The camera a perspective `proj` and `view` describe, in strata's model: the frame's
 /// uniforms (eye, the basis scaled to the frustum) and the import's constants.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,11 +177,17 @@ pub struct CameraModel {
     pub reversed: bool,
     /// Camera-space z of the near plane.
     pub near: f32,
+    /// `proj` without its sub-pixel jitter (TAA): the symmetric frustum strata's camera
+    /// model describes. The import inverts the jittered `proj`, at whose pixel centres the
+    /// depth was drawn; the AO reconstructs positions at the unjittered centres, less than
+    /// [`MAX_JITTER_PIXELS`] away.
+    pub unjittered: Mat4,
 }
 
 impl CameraModel {
-    /// Checks that `proj` is a symmetric perspective projection and reads its conventions.
-    pub fn of(proj: Mat4) -> Result<Self, RenderError> {
+    /// Checks that `proj` is a perspective projection, symmetric up to a sub-pixel jitter at
+    /// `width`×`height`, and reads its conventions.
+    pub fn of(proj: Mat4, width: u32, height: u32) -> Result<Self, RenderError> {
         let bad = |why: &str| RenderError::Parameter(format!("embedded AO: proj {why}"));
         let p = proj.to_cols_array_2d();
         if !p.iter().flatten().all(|v| v.is_finite()) {
@@ -185,16 +195,28 @@ impl CameraModel {
         }
         let w_sign = p[2][3];
         // w_clip = ±z_view and nothing else: a perspective projection
-        if (w_sign.abs() - 1.0).abs() > 1e-6 || p[0][3] != 0.0 || p[1][3] != 0.0 || p[3][3] != 0.0 {
+        let translated = p[3][0] != 0.0 || p[3][1] != 0.0;
+        if (w_sign.abs() - 1.0).abs() > 1e-6 || p[0][3] != 0.0 || p[1][3] != 0.0 || p[3][3] != 0.0 || translated {
             return Err(bad(
-                "is not a perspective projection (its w row must be (0, 0, ±1, 0); an orthographic projection is not supported)",
+                "is not a perspective projection (its w row must be (0, 0, ±1, 0) and x, y must not depend on w; an orthographic projection is not supported)",
             ));
         }
-        if p[2][0] != 0.0 || p[2][1] != 0.0 || p[0][1] != 0.0 || p[1][0] != 0.0 {
+        if p[0][1] != 0.0 || p[1][0] != 0.0 {
             return Err(bad(
-                "has an off-centre (jittered) or skewed frustum: pass the unjittered, symmetric projection",
+                "has a skewed frustum (x and y mixed): strata's camera model is not skewed",
             ));
         }
+        // an off-centre frustum shifts NDC by proj[2][0..2] · w_sign: 2/size per pixel
+        let jitter = [p[2][0].abs() * width as f32 / 2.0, p[2][1].abs() * height as f32 / 2.0];
+        if jitter.iter().any(|j| *j > MAX_JITTER_PIXELS) {
+            return Err(bad(&format!(
+                "is off-centre by ({:.2}, {:.2}) pixels: a sub-pixel (TAA) jitter up to {MAX_JITTER_PIXELS} pixels is taken, an asymmetric frustum is not",
+                jitter[0], jitter[1]
+            )));
+        }
+        let mut unjittered = proj;
+        unjittered.z_axis.x = 0.0;
+        unjittered.z_axis.y = 0.0;
         if !(p[0][0] > 0.0 && p[1][1] > 0.0) {
             return Err(bad("has a non-positive x or y scale: x must map right and y up"));
         }
@@ -208,19 +230,18 @@ impl CameraModel {
         if !(near > 0.0 && near.is_finite()) {
             return Err(bad("puts its near plane at or behind the eye"));
         }
-        Ok(Self { w_sign, reversed, near })
+        Ok(Self {
+            w_sign,
+            reversed,
+            near,
+            unjittered,
+        })
     }
 
-    /// The frame's uniforms of strata's camera model for `view` and `proj` (whose
-    /// conventions `self` holds) at `width`×`height`; `prev_view_proj` reprojects.
-    pub fn frame_uniforms(
-        &self,
-        view: Mat4,
-        proj: Mat4,
-        prev_view_proj: Mat4,
-        width: u32,
-        height: u32,
-    ) -> FrameUniforms {
+    /// The frame's uniforms of strata's camera model for `view` and the unjittered
+    /// projection at `width`×`height`; `prev_view_proj` (unjittered too) reprojects.
+    pub fn frame_uniforms(&self, view: Mat4, prev_view_proj: Mat4, width: u32, height: u32) -> FrameUniforms {
+        let proj = self.unjittered;
         let inv_view = view.inverse();
         let eye = inv_view.transform_point3(Vec3::ZERO);
         let right = inv_view.transform_vector3(Vec3::X).normalize();
@@ -646,11 +667,11 @@ impl EmbeddedAo {
                 "embedded AO: view is not a rigid transform (a rotation and a translation, without scale)".into(),
             ));
         }
-        let cam = CameraModel::of(inputs.proj)?;
         let (w, h) = (self.config.width, self.config.height);
-        let vp = inputs.proj * inputs.view;
+        let cam = CameraModel::of(inputs.proj, w, h)?;
+        let vp = cam.unjittered * inputs.view;
         let has_history = self.prev_view_proj.is_some();
-        let frame = cam.frame_uniforms(inputs.view, inputs.proj, self.prev_view_proj.unwrap_or(vp), w, h);
+        let frame = cam.frame_uniforms(inputs.view, self.prev_view_proj.unwrap_or(vp), w, h);
         let gpu = &self.gpu;
         self.scene_gpu.update_frame(gpu, &frame);
         let max_mip = self.targets.get("zmip").desc.mips - 1;
