@@ -1,0 +1,89 @@
+//! `strata_render::embed` over a long run: an application that records the embedded AO every
+//! frame for hundreds of frames (two layers, a moving camera, no `poll` but its submits)
+//! holds its GPU allocations and resident memory flat. `encode` creates a bind group and
+//! views of the application's textures each frame; they must not pile up. Its own test
+//! binary: resident memory is per process, and other tests would move it.
+
+mod common;
+
+#[path = "../examples/embed_ao/gbuffer.rs"]
+mod gbuffer;
+
+use strata_render::embed::{AoInputs, EmbeddedAo, EmbeddedAoConfig, NormalEncoding};
+use strata_render::passes::ao::AoSettings;
+
+fn resident_bytes() -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").expect("Linux /proc");
+    let line = status.lines().find(|l| l.starts_with("VmRSS:")).expect("VmRSS");
+    line.split_whitespace().nth(1).unwrap().parse::<u64>().unwrap() * 1024
+}
+
+#[test]
+fn embedded_ao_soaks_flat() {
+    let gpu = common::gpu();
+    let mut scene = strata_scene::procedural::builtin("atrium").unwrap();
+    scene.camera_path = None;
+    let tris: Vec<_> = scene.world_triangles(0.0).iter().map(|t| (t.p, t.n)).collect();
+    let (w, h) = (64u32, 36u32);
+    let layout = gbuffer::Layout {
+        depth: wgpu::TextureFormat::Depth32Float,
+        normal: wgpu::TextureFormat::Rgba16Float,
+        normals: gbuffer::Normals::WorldSigned,
+        reversed: false,
+    };
+    let first = gbuffer::GBuffer::new(&gpu.device, [w, h], layout, &tris);
+    let second = gbuffer::GBuffer::second_layer(&gpu.device, &first, scene.settings.min_separation, &tris);
+    let mut ao = EmbeddedAo::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedAoConfig {
+            width: w,
+            height: h,
+            layers: 2,
+            settings: AoSettings {
+                radius: Some(scene.settings.ao_radius),
+                ..AoSettings::default()
+            },
+            normals: NormalEncoding::Signed,
+            ..EmbeddedAoConfig::default()
+        },
+    )
+    .unwrap();
+    let cam = scene.camera;
+    let proj =
+        glam::camera::rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), w as f32 / h as f32, cam.near, 500.0);
+    let (frames, first_sample) = (600u32, 200u32);
+    let mut samples = Vec::new();
+    for f in 1..=frames {
+        // the camera sways sideways, so the temporal filter reprojects every frame
+        let sway = cam.basis().0 * (0.2 * (f as f32 * 0.1).sin());
+        let view = glam::camera::rh::view::look_at_mat4(cam.eye + sway, cam.target + sway, cam.up);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        first.draw(&gpu.queue, &mut encoder, view, proj);
+        second.draw(&gpu.queue, &mut encoder, view, proj);
+        let inputs = AoInputs {
+            second: Some(((&second.depth).into(), (&second.normals).into())),
+            ..AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj)
+        };
+        ao.encode(&mut encoder, &inputs).unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        if f == first_sample || f == frames {
+            gpu.check_errors().expect("no wgpu validation errors");
+            let report = gpu.device.generate_allocator_report().map(|r| r.total_allocated_bytes);
+            samples.push((f, resident_bytes(), report));
+        }
+    }
+    let (a, b) = (&samples[0], &samples[1]);
+    let growth = 100.0 * (b.1 as f64 - a.1 as f64) / a.1 as f64;
+    println!(
+        "frames {} → {}: resident {} → {} bytes ({growth:+.2} %), wgpu allocated {:?} → {:?}",
+        a.0, b.0, a.1, b.1, a.2, b.2
+    );
+    assert_eq!(a.2, b.2, "wgpu's allocations stay the same");
+    assert!(
+        growth <= 1.0,
+        "resident memory grew {growth:.2} % over {} frames",
+        b.0 - a.0
+    );
+}
