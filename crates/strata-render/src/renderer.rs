@@ -653,6 +653,7 @@ impl Renderer {
                     .as_ref()
                     .and_then(|a| a.radius)
                     .unwrap_or(scene.settings.ao_radius),
+                true,
             )),
             None => None,
         };

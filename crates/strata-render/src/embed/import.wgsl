@@ -1,6 +1,8 @@
 // The application's G-buffer → strata's deep G-buffer layout (DGB Table 1): camera-space
 // z of each layer from its hardware depth and projection, Oct16 world normals, and the
-// layer-0 world motion the temporal filter follows. One pass; `embed::EmbeddedAo`.
+// layer-0 world motion the temporal filter follows (`fs_import*`, every embedded
+// technique); each layer's normal, albedo and radiosity B (`fs_shading*`, the embedded
+// radiosity). `embed::core`.
 #import "common/fullscreen.wgsl"
 #import "common/packing.wgsl"
 
@@ -27,6 +29,11 @@ struct Import {
 @group(0) @binding(3) var depth1: texture_depth_2d;
 @group(0) @binding(4) var normal1: texture_2d<f32>;
 @group(0) @binding(5) var motion_in: texture_2d<f32>;
+// per layer: diffuse albedo ρ (rgb, linear) and outgoing diffuse radiance B (rgb)
+@group(0) @binding(6) var albedo0: texture_2d<f32>;
+@group(0) @binding(7) var radiance0: texture_2d<f32>;
+@group(0) @binding(8) var albedo1: texture_2d<f32>;
+@group(0) @binding(9) var radiance1: texture_2d<f32>;
 
 // camera-space z of hardware depth d at pixel p (0 = no surface): the projection inverted
 fn csz_of_depth(p: vec2i, d: f32) -> f32 {
@@ -106,4 +113,50 @@ fn fs_import2(@builtin(position) pos: vec4f) -> Two {
     o.motion = motion_of(p);
     o.csz1 = z1;
     return o;
+}
+
+// the deep G-buffer's `normal` (rg = Oct16, ba = roughness, metallic: 0), `albedo` (a = 1)
+// and `radiosity<j>` of one layer
+struct Layer {
+    normal: vec4f,
+    albedo: vec4f,
+    radiosity: vec4f,
+}
+
+fn shading_of(normal: vec4f, albedo: vec4f, radiance: vec4f) -> Layer {
+    return Layer(
+        vec4f(oct_of(normal), 0.0, 0.0),
+        vec4f(clamp(albedo.rgb, vec3f(0.0), vec3f(1.0)), 1.0),
+        vec4f(max(radiance.rgb, vec3f(0.0)), 1.0),
+    );
+}
+
+struct Shading1 {
+    @location(0) normal0: vec4f,
+    @location(1) albedo0: vec4f,
+    @location(2) radiosity0: vec4f,
+}
+
+struct Shading2 {
+    @location(0) normal0: vec4f,
+    @location(1) albedo0: vec4f,
+    @location(2) radiosity0: vec4f,
+    @location(3) normal1: vec4f,
+    @location(4) albedo1: vec4f,
+    @location(5) radiosity1: vec4f,
+}
+
+@fragment
+fn fs_shading1(@builtin(position) pos: vec4f) -> Shading1 {
+    let p = vec2i(pos.xy);
+    let l0 = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
+    return Shading1(l0.normal, l0.albedo, l0.radiosity);
+}
+
+@fragment
+fn fs_shading2(@builtin(position) pos: vec4f) -> Shading2 {
+    let p = vec2i(pos.xy);
+    let l0 = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
+    let l1 = shading_of(textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
+    return Shading2(l0.normal, l0.albedo, l0.radiosity, l1.normal, l1.albedo, l1.radiosity);
 }

@@ -43,14 +43,16 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::frame::{FrameUniforms, Pass, TargetDesc, Targets};
-use crate::gpu::GpuContext;
+mod core;
+mod radiosity;
+
+pub use radiosity::{EmbeddedRadiosity, EmbeddedRadiosityConfig, RadiosityInputs};
+
+use self::core::{Core, CoreConfig};
+use crate::frame::{FrameUniforms, Pass};
 use crate::passes::ao::stage::AoStage;
 use crate::passes::ao::{AoSettings, AoUniforms};
 use crate::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
-use crate::passes::depth_mip::{DepthMipPass, DepthMipSettings};
-use crate::passes::HistoryPass;
-use crate::scene_gpu::GpuScene;
 use crate::RenderError;
 
 /// How the application's normal texture stores a unit normal.
@@ -151,18 +153,6 @@ impl<'a> AoInputs<'a> {
     }
 }
 
-/// Mirrors `Import` in `import.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ImportUniforms {
-    inv_proj: [[f32; 4]; 4],
-    inv_view: [[f32; 4]; 4],
-    size: [f32; 4],
-    w_sign: f32,
-    reversed: u32,
-    _pad: [u32; 2],
-}
-
 /// Largest sub-pixel jitter (TAA) [`CameraModel::of`] takes in an off-centre projection, in
 /// pixels per axis; a larger offset is an asymmetric frustum, which it refuses.
 pub const MAX_JITTER_PIXELS: f32 = 2.0;
@@ -188,7 +178,7 @@ impl CameraModel {
     /// Checks that `proj` is a perspective projection, symmetric up to a sub-pixel jitter at
     /// `width`×`height`, and reads its conventions.
     pub fn of(proj: Mat4, width: u32, height: u32) -> Result<Self, RenderError> {
-        let bad = |why: &str| RenderError::Parameter(format!("embedded AO: proj {why}"));
+        let bad = |why: &str| RenderError::Parameter(format!("proj {why}"));
         let p = proj.to_cols_array_2d();
         if !p.iter().flatten().all(|v| v.is_finite()) {
             return Err(bad("has a non-finite entry"));
@@ -290,25 +280,9 @@ fn is_depth(format: wgpu::TextureFormat) -> bool {
 
 /// The AO passes of `strata render --technique ao` on an application's G-buffer.
 pub struct EmbeddedAo {
-    gpu: GpuContext,
-    /// A scene without geometry: the AO's radius, and the frame uniforms' buffer.
-    scene: strata_scene::Scene,
-    scene_gpu: GpuScene,
-    targets: Targets,
+    core: Core,
     config: EmbeddedAoConfig,
-    import_pipeline: wgpu::RenderPipeline,
-    import_layout: wgpu::BindGroupLayout,
-    import_uniforms: wgpu::Buffer,
-    /// Zeros, bound where the application gives no motion texture.
-    no_motion: wgpu::TextureView,
-    mip: DepthMipPass,
     stage: AoStage,
-    history: HistoryPass,
-    /// Per-pass GPU time where the application's device has timestamp queries inside
-    /// encoders (`TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`).
-    profiler: crate::profiler::Profiler,
-    frames: u32,
-    prev_view_proj: Option<Mat4>,
 }
 
 impl EmbeddedAo {
@@ -327,217 +301,81 @@ impl EmbeddedAo {
             )
         })?;
         s.validate().map_err(RenderError::Parameter)?;
-        if !(1..=MAX_LAYERS).contains(&config.layers) {
-            return Err(RenderError::Parameter(format!(
-                "embedded AO: layers {} is out of range: must be in 1..={MAX_LAYERS}",
-                config.layers
-            )));
-        }
-        let max = device.limits().max_texture_dimension_2d;
-        if !(1..=max).contains(&config.width) || !(1..=max).contains(&config.height) {
-            return Err(RenderError::Parameter(format!(
-                "embedded AO: size {}x{} is out of range: width and height must be in 1..={max}",
-                config.width, config.height
-            )));
-        }
-        let gpu = GpuContext::from_device(adapter, device, queue);
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let built = Self::build(gpu, config, radius);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Validation(e.to_string()));
-        }
-        built
-    }
-
-    fn build(gpu: GpuContext, config: EmbeddedAoConfig, radius: f32) -> Result<Self, RenderError> {
-        use wgpu::TextureFormat as F;
-        let (w, h, layers) = (config.width, config.height, config.layers);
         let mut scene = strata_scene::Scene::default();
         scene.settings.ao_radius = radius;
-        let scene_gpu = GpuScene::new(&gpu, &scene);
-        let mut targets = Targets::new(w, h);
-        let imported = [
-            TargetDesc::new(
-                "zpack",
-                F::Rg32Float,
-                1,
-                "DGB Table 1: camera-space z of layers 0 (r) and 1 (g)",
-            ),
-            TargetDesc::new(
-                "npack",
-                F::Rgba8Unorm,
-                1,
-                "DGB Table 1: Oct16 normals of layers 0 (rg) and 1 (ba)",
-            ),
-            TargetDesc::new(
-                "csz",
-                F::R32Float,
-                layers,
-                "camera-space depth z per layer (0 = no surface)",
-            ),
-            TargetDesc::new(
-                "motion",
-                F::Rgba16Float,
-                1,
-                "world-space motion of layer 0 since last frame",
-            ),
-        ];
-        for d in imported {
-            targets.create(&gpu, d);
-        }
-        let deep = DeepGBufferSettings {
-            layers,
-            variant: Variant::Peel,
-            ..DeepGBufferSettings::default()
+        let core = CoreConfig {
+            what: "embedded AO",
+            width: config.width,
+            height: config.height,
+            layers: config.layers,
+            normals: config.normals,
+            normal_space: config.normal_space,
+            mip_levels: s.mips.levels,
+            shading: false,
         };
-        let s = &config.settings;
-        targets.create(&gpu, DepthMipSettings { levels: s.mips.levels }.output(layers, w, h));
-        let mip = DepthMipPass::new(&gpu, &targets, layers);
-        if s.temporal.is_some() {
-            targets.create(
-                &gpu,
-                TargetDesc::new("csz-history", F::R32Float, layers, "last frame's csz"),
-            );
-        }
-        let stage = AoStage::new(&gpu, &scene_gpu, &mut targets, &deep, s, radius)?;
-        let mut copies = Vec::new();
-        if stage.temporal.is_some() {
-            copies.push(("csz", "csz-history"));
-            copies.push(("ao-temporal", "ao-temporal-history"));
-            let [n, h] = crate::passes::ao::stage::AO_FRAMES;
-            copies.push((n, h));
-        }
-        let history = HistoryPass { copies };
-        let profiler = crate::profiler::Profiler::new(&gpu, 16);
-
-        let device = &gpu.device;
-        let depth_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Depth,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let colour = |b| crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, false);
-        let import_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("embed-import"),
-            entries: &[
-                crate::passes::uniform_entry(0),
-                depth_entry(1),
-                colour(2),
-                depth_entry(3),
-                colour(4),
-                colour(5),
-            ],
-        });
-        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("embed-import"),
-            bind_group_layouts: &[Some(&import_layout)],
-            immediate_size: 0,
-        });
-        let module = crate::shader::module(device, "embed-import", include_str!("import.wgsl"));
-        let mut formats = vec![F::Rg32Float, F::Rgba8Unorm, F::R32Float, F::Rgba16Float];
-        if layers == 2 {
-            formats.push(F::R32Float);
-        }
-        let color: Vec<_> = formats.iter().map(|f| Some(wgpu::ColorTargetState::from(*f))).collect();
-        let normals = match config.normals {
-            NormalEncoding::Signed => 0.0,
-            NormalEncoding::Unsigned => 1.0,
-            NormalEncoding::Octahedral => 2.0,
-        };
-        let constants = [
-            ("NORMALS", normals),
-            ("VIEW_SPACE", (config.normal_space == NormalSpace::View) as u32 as f64),
-        ];
-        let entry = if layers == 2 { "fs_import2" } else { "fs_import1" };
-        let import_pipeline =
-            crate::passes::fullscreen_pipeline_with(device, "embed-import", &pl, &module, entry, &constants, &color);
-        let import_uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("embed-import"),
-            size: std::mem::size_of::<ImportUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        // zero-initialised by wgpu
-        let no_motion = device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("embed-no-motion"),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: F::Rgba16Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
+        Core::scoped(device, || {
+            let mut core = Core::new(adapter, device, queue, core, scene)?;
+            let deep = DeepGBufferSettings {
+                layers: config.layers,
+                variant: Variant::Peel,
+                ..DeepGBufferSettings::default()
+            };
+            if s.temporal.is_some() {
+                core.targets.create(
+                    &core.gpu,
+                    crate::frame::TargetDesc::new(
+                        "csz-history",
+                        wgpu::TextureFormat::R32Float,
+                        config.layers,
+                        "last frame's csz",
+                    ),
+                );
+            }
+            let stage = AoStage::new(&core.gpu, &core.scene_gpu, &mut core.targets, &deep, s, radius)?;
+            if stage.temporal.is_some() {
+                let [n, h] = crate::passes::ao::stage::AO_FRAMES;
+                core.history.copies = vec![("csz", "csz-history"), ("ao-temporal", "ao-temporal-history"), (n, h)];
+            }
+            Ok(Self {
+                core,
+                config: config.clone(),
+                stage,
             })
-            .create_view(&Default::default());
-        Ok(Self {
-            gpu,
-            scene,
-            scene_gpu,
-            targets,
-            config,
-            import_pipeline,
-            import_layout,
-            import_uniforms,
-            no_motion,
-            mip,
-            stage,
-            history,
-            profiler,
-            frames: 0,
-            prev_view_proj: None,
         })
     }
 
     /// The ambient visibility AV (`R16Float`, 1 = unoccluded), written by the last
     /// [`EmbeddedAo::encode`] once its encoder is submitted.
     pub fn output(&self) -> &wgpu::Texture {
-        &self.targets.get("ao").texture
+        &self.core.targets.get("ao").texture
     }
 
     /// A view of [`EmbeddedAo::output`] to bind in the application's lighting pass.
     pub fn output_view(&self) -> &wgpu::TextureView {
-        &self.targets.get("ao").view
+        &self.core.targets.get("ao").view
     }
 
     /// Any intermediate target by its `strata render --list-passes` name (`zpack`,
     /// `npack`, `zmip`, `ao-raw`, …), for debugging.
     pub fn target(&self, name: &str) -> Option<&wgpu::Texture> {
-        self.targets.try_get(name).map(|t| &t.texture)
+        self.core.targets.try_get(name).map(|t| &t.texture)
     }
 
     /// Reads layer 0 of target `name` back as floats (after the submitted frames), for
     /// tests and debugging: `ao`, `zpack`, `npack`, `ao-raw`, ….
     pub fn read_target(&self, name: &str) -> Result<strata_scene::ImageBuf, RenderError> {
-        let t = self
-            .targets
-            .try_get(name)
-            .ok_or_else(|| RenderError::Parameter(format!("embedded AO: unknown target '{name}'")))?;
-        let bytes = self.gpu.read_texture(&t.texture, 0)?;
-        crate::renderer::decode_texels(&bytes, t.desc.format, t.texture.width(), t.texture.height())
+        self.core.read_target(name)
     }
 
     /// GPU milliseconds per pass of the last submitted frame (waits for it). Empty unless
     /// the application's device has `TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`.
     pub fn timings(&self) -> Result<crate::PassTimings, RenderError> {
-        self.profiler.read(&self.gpu)
+        self.core.timings()
     }
 
     /// The pass names [`EmbeddedAo::encode`] records, in order.
     pub fn pass_names(&self) -> Vec<&'static str> {
-        let mut v = vec!["embed-import", self.mip.info().name];
-        v.extend(self.stage.passes().iter().map(|p| p.info().name));
-        v.push(self.history.info().name);
-        v
+        self.core.pass_names(self.stage.passes())
     }
 
     /// Rebuilds the passes for a new render size (a resized window), keeping the rest of
@@ -548,14 +386,14 @@ impl EmbeddedAo {
             height,
             ..self.config.clone()
         };
-        let gpu = &self.gpu;
+        let gpu = &self.core.gpu;
         *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
         Ok(())
     }
 
     /// Forget the temporal history (a camera cut, a new scene): the next frame starts afresh.
     pub fn reset_history(&mut self) {
-        self.prev_view_proj = None;
+        self.core.reset_history();
     }
 
     /// The application's config.
@@ -563,182 +401,26 @@ impl EmbeddedAo {
         &self.config
     }
 
-    /// Checks one input texture: size, usage, sampling, format kind and layer.
-    fn check(&self, what: &str, t: TextureLayer<'_>, depth: bool) -> Result<(), RenderError> {
-        let bad = |why: String| Err(RenderError::Parameter(format!("embedded AO: {what} {why}")));
-        let tex = t.texture;
-        let (w, h) = (self.config.width, self.config.height);
-        if tex.width() != w || tex.height() != h {
-            return bad(format!(
-                "is {}x{}: it must be the configured {w}x{h} (EmbeddedAoConfig::width/height)",
-                tex.width(),
-                tex.height()
-            ));
-        }
-        if tex.dimension() != wgpu::TextureDimension::D2 {
-            return bad("must be a 2D texture".into());
-        }
-        if t.layer >= tex.depth_or_array_layers() {
-            return bad(format!(
-                "layer {} is out of range: must be in 0..{}",
-                t.layer,
-                tex.depth_or_array_layers()
-            ));
-        }
-        if !tex.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
-            return bad("lacks TextureUsages::TEXTURE_BINDING".into());
-        }
-        if tex.sample_count() != 1 {
-            return bad(format!(
-                "has {} samples: resolve it to a single-sampled texture first",
-                tex.sample_count()
-            ));
-        }
-        let f = tex.format();
-        if depth && !is_depth(f) {
-            return bad(format!(
-                "has format {f:?}: it must be a depth format (Depth16Unorm, Depth24Plus[Stencil8], Depth32Float[Stencil8])"
-            ));
-        }
-        if !depth {
-            let float = matches!(
-                f.sample_type(None, Some(self.gpu.features)),
-                Some(wgpu::TextureSampleType::Float { .. })
-            );
-            if !float || f.is_depth_stencil_format() {
-                return bad(format!(
-                    "has format {f:?}: it must be a float, unorm or snorm colour format"
-                ));
-            }
-            if f.is_srgb() {
-                return bad(format!(
-                    "has format {f:?}: an sRGB format would decode the values; use its linear twin"
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    fn layer_view(t: TextureLayer<'_>, depth: bool) -> wgpu::TextureView {
-        t.texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("embed-input"),
-            dimension: Some(wgpu::TextureViewDimension::D2),
-            aspect: if depth {
-                wgpu::TextureAspect::DepthOnly
-            } else {
-                wgpu::TextureAspect::All
-            },
-            base_array_layer: t.layer,
-            array_layer_count: Some(1),
-            mip_level_count: Some(1),
-            ..Default::default()
-        })
-    }
-
     /// Records this frame's AO into `encoder` and writes its uniforms with the queue: submit
     /// `encoder` before the next call. Inputs are checked first; a bad one is a one-line
     /// error and nothing is recorded.
     pub fn encode(&mut self, encoder: &mut wgpu::CommandEncoder, inputs: &AoInputs<'_>) -> Result<(), RenderError> {
-        self.check("depth", inputs.depth, true)?;
-        self.check("normals", inputs.normals, false)?;
-        match (self.config.layers, &inputs.second) {
-            (2, Some((d, n))) => {
-                self.check("second depth", *d, true)?;
-                self.check("second normals", *n, false)?;
-            }
-            (2, None) => {
-                return Err(RenderError::Parameter(
-                    "embedded AO: 2 layers need AoInputs::second (the second layer's depth and normals)".into(),
-                ))
-            }
-            (_, Some(_)) => {
-                return Err(RenderError::Parameter(
-                    "embedded AO: AoInputs::second is given but the config has 1 layer (EmbeddedAoConfig::layers = 2 uses it)"
-                        .into(),
-                ))
-            }
-            _ => {}
-        }
-        if let Some(m) = inputs.motion {
-            self.check("motion", m, false)?;
-        }
-        if !is_rigid(inputs.view) {
-            return Err(RenderError::Parameter(
-                "embedded AO: view is not a rigid transform (a rotation and a translation, without scale)".into(),
-            ));
-        }
-        let (w, h) = (self.config.width, self.config.height);
-        let cam = CameraModel::of(inputs.proj, w, h)?;
-        let vp = cam.unjittered * inputs.view;
-        let has_history = self.prev_view_proj.is_some();
-        let frame = cam.frame_uniforms(inputs.view, self.prev_view_proj.unwrap_or(vp), w, h);
-        let gpu = &self.gpu;
-        self.scene_gpu.update_frame(gpu, &frame);
-        let max_mip = self.targets.get("zmip").desc.mips - 1;
-        self.stage.set_frame(
-            gpu,
-            AoUniforms::new(&self.config.settings, &self.scene, &frame, max_mip, self.frames),
+        let cam = self.core.check_inputs(inputs, &[])?;
+        let (frame, has_history): (FrameUniforms, bool) = self.core.begin(inputs, &cam);
+        let gpu = &self.core.gpu;
+        let u = AoUniforms::new(
+            &self.config.settings,
+            &self.core.scene,
+            &frame,
+            self.core.max_mip(),
+            self.core.frames,
         );
+        self.stage.set_frame(gpu, u);
         if let Some(t) = &self.stage.temporal {
             t.set_frame(gpu, has_history);
         }
-        let u = ImportUniforms {
-            inv_proj: inputs.proj.inverse().to_cols_array_2d(),
-            inv_view: inputs.view.inverse().to_cols_array_2d(),
-            size: frame.size,
-            w_sign: cam.w_sign,
-            reversed: cam.reversed as u32,
-            _pad: [0; 2],
-        };
-        gpu.queue.write_buffer(&self.import_uniforms, 0, bytemuck::bytes_of(&u));
-
-        let depth0 = Self::layer_view(inputs.depth, true);
-        let normal0 = Self::layer_view(inputs.normals, false);
-        let (depth1, normal1) = match inputs.second {
-            Some((d, n)) => (Self::layer_view(d, true), Self::layer_view(n, false)),
-            None => (depth0.clone(), normal0.clone()),
-        };
-        let motion = inputs.motion.map(|m| Self::layer_view(m, false));
-        use wgpu::BindingResource as R;
-        let group = crate::passes::bind_group(
-            &gpu.device,
-            "embed-import",
-            &self.import_layout,
-            &[
-                self.import_uniforms.as_entire_binding(),
-                R::TextureView(&depth0),
-                R::TextureView(&normal0),
-                R::TextureView(&depth1),
-                R::TextureView(&normal1),
-                R::TextureView(motion.as_ref().unwrap_or(&self.no_motion)),
-            ],
-        );
-        let t = &self.targets;
-        let mut outputs = vec![
-            &t.get("zpack").view,
-            &t.get("npack").view,
-            &t.get("csz").layer_views[0],
-            &t.get("motion").view,
-        ];
-        if self.config.layers == 2 {
-            outputs.push(&t.get("csz").layer_views[1]);
-        }
-        let prof = &self.profiler;
-        prof.reset();
-        let slot = prof.begin(encoder, "embed-import");
-        crate::passes::fullscreen_pass(encoder, "embed-import", &self.import_pipeline, &outputs, &[&group]);
-        prof.end(encoder, slot);
-        let mut passes: Vec<&dyn Pass> = vec![&self.mip];
-        passes.extend(self.stage.passes());
-        passes.push(&self.history);
-        for p in passes {
-            let slot = prof.begin(encoder, p.info().name);
-            p.encode(gpu, &self.scene_gpu, t, encoder);
-            prof.end(encoder, slot);
-        }
-        prof.resolve(encoder);
-        self.frames = self.frames.wrapping_add(1);
-        self.prev_view_proj = Some(vp);
+        let passes: Vec<&dyn Pass> = self.stage.passes();
+        self.core.record(encoder, inputs, &[], passes);
         Ok(())
     }
 }

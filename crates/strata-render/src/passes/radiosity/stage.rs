@@ -19,7 +19,8 @@ pub(crate) struct RadiosityStage {
     pub(crate) temporal: Option<TemporalPass>,
     pub(crate) blur_h: BilateralPass,
     pub(crate) blur_v: BilateralPass,
-    pub(crate) compose: crate::passes::compose::ComposePass,
+    /// `None` where the frame's composite is someone else's (`embed::EmbeddedRadiosity`).
+    pub(crate) compose: Option<crate::passes::compose::ComposePass>,
 }
 
 impl RadiosityStage {
@@ -33,6 +34,7 @@ impl RadiosityStage {
         guard: u32,
         probes: Option<&strata_scene::probes::IrradianceProbes>,
         ao_radius: f32,
+        compose: bool,
     ) -> Self {
         use wgpu::TextureFormat as F;
         // the compute gather and blurs write their outputs as storage textures
@@ -176,24 +178,26 @@ impl RadiosityStage {
             true,
             compute,
         );
-        for t in crate::passes::compose::OUTPUTS {
-            targets.create_with_usage(gpu, t, [targets.width, targets.height], usage);
-        }
-        let compose = crate::passes::compose::ComposePass::new(
-            gpu,
-            scene,
-            targets,
-            s.boost,
-            probe_gpu.as_ref().map(|p| crate::passes::compose::ComposeProbes {
-                probes: p,
-                ao: s.probe_ao,
-                detail,
-                one_sided: s.one_sided_confidence,
-            }),
-            "indirect",
-            None,
-            compute,
-        );
+        let compose = compose.then(|| {
+            for t in crate::passes::compose::OUTPUTS {
+                targets.create_with_usage(gpu, t, [targets.width, targets.height], usage);
+            }
+            crate::passes::compose::ComposePass::new(
+                gpu,
+                scene,
+                targets,
+                s.boost,
+                probe_gpu.as_ref().map(|p| crate::passes::compose::ComposeProbes {
+                    probes: p,
+                    ao: s.probe_ao,
+                    detail,
+                    one_sided: s.one_sided_confidence,
+                }),
+                "indirect",
+                None,
+                compute,
+            )
+        });
         Self {
             propagate,
             gather,
@@ -227,7 +231,9 @@ impl RadiosityStage {
         }
         v.push(&self.blur_h);
         v.push(&self.blur_v);
-        v.push(&self.compose);
+        if let Some(c) = &self.compose {
+            v.push(c);
+        }
         v
     }
 }
