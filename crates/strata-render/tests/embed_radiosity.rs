@@ -120,3 +120,114 @@ fn embedded_radiosity_on_the_renderers_layers_is_the_renderers_indirect_light() 
         }
     }
 }
+
+/// Bad configurations and inputs are one-line errors naming the parameter; an sRGB albedo
+/// (decoded to linear, as albedo should be) is taken.
+#[test]
+fn bad_embedded_radiosity_input_is_a_one_line_error() {
+    use wgpu::TextureFormat as F;
+    let gpu = common::gpu();
+    let new = |f: &dyn Fn(&mut EmbeddedRadiosityConfig)| {
+        let mut c = EmbeddedRadiosityConfig {
+            width: W,
+            height: H,
+            settings: RadiositySettings {
+                radius: Some(2.0),
+                ..RadiositySettings::default()
+            },
+            ..EmbeddedRadiosityConfig::default()
+        };
+        f(&mut c);
+        EmbeddedRadiosity::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
+    };
+    let one_line = |e: String, words: &[&str]| {
+        assert!(!e.contains('\n'), "one line: {e}");
+        for w in words {
+            assert!(e.contains(w), "'{e}' names '{w}'");
+        }
+    };
+    let err = |f: &dyn Fn(&mut EmbeddedRadiosityConfig)| new(f).err().expect("an error").to_string();
+    one_line(
+        err(&|c| c.settings.radius = None),
+        &["embedded radiosity", "settings.radius", "> 0"],
+    );
+    one_line(err(&|c| c.min_separation = -1.0), &["min_separation -1", ">= 0"]);
+    one_line(err(&|c| c.layers = 0), &["layers 0", "1..=2"]);
+    one_line(err(&|c| c.settings.samples = 0), &["samples"]);
+
+    let texture = |format| {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("app"),
+            size: wgpu::Extent3d {
+                width: W,
+                height: H,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+    };
+    let (depth, normals) = (texture(F::Depth32Float), texture(F::Rgba16Float));
+    let (srgb, hdr, integer) = (texture(F::Rgba8UnormSrgb), texture(F::Rgba16Float), texture(F::R32Uint));
+    let cam = strata_scene::Camera::default();
+    let gbuffer = AoInputs::new(
+        (&depth).into(),
+        (&normals).into(),
+        cam.view(),
+        cam.projection(W as f32 / H as f32),
+    );
+    let ok = strata_render::embed::RadiosityInputs {
+        gbuffer,
+        albedo: (&srgb).into(),
+        radiance: (&hdr).into(),
+        second: None,
+    };
+    let mut gi = new(&|_| {}).unwrap();
+    let mut encode = |i: strata_render::embed::RadiosityInputs<'_>| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let e = gi.encode(&mut encoder, &i).err().map(|e| e.to_string());
+        gpu.queue.submit([encoder.finish()]);
+        e
+    };
+    one_line(
+        encode(strata_render::embed::RadiosityInputs {
+            radiance: (&integer).into(),
+            ..ok
+        })
+        .expect("an error"),
+        &[
+            "embedded radiosity: radiance has format R32Uint",
+            "float, unorm or snorm",
+        ],
+    );
+    one_line(
+        encode(strata_render::embed::RadiosityInputs {
+            second: Some(((&srgb).into(), (&hdr).into())),
+            ..ok
+        })
+        .expect("an error"),
+        &["RadiosityInputs::second", "1 layer"],
+    );
+    one_line(
+        encode(strata_render::embed::RadiosityInputs {
+            gbuffer: AoInputs {
+                normals: (&srgb).into(),
+                ..gbuffer
+            },
+            ..ok
+        })
+        .expect("an error"),
+        &["embedded radiosity: normals has format Rgba8UnormSrgb"],
+    );
+    // the sRGB albedo is taken, and nothing above reached the device
+    assert_eq!(encode(ok), None);
+    gpu.check_errors().expect("no wgpu validation errors");
+    let mut two = new(&|c| c.layers = 2).unwrap();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let e = two.encode(&mut encoder, &ok).unwrap_err().to_string();
+    one_line(e, &["2 layers need RadiosityInputs::second"]);
+}

@@ -1,6 +1,6 @@
-//! `strata_render::embed` over a long run: an application that records the embedded AO every
-//! frame for hundreds of frames (two layers, a moving camera, no `poll` but its submits)
-//! holds its GPU allocations and resident memory flat. `encode` creates a bind group and
+//! `strata_render::embed` over a long run: an application that records the embedded AO and
+//! radiosity every frame for hundreds of frames (two layers, a moving camera, no `poll` but
+//! its submits) holds its GPU allocations and resident memory flat. `encode` creates a bind group and
 //! views of the application's textures each frame; they must not pile up. Its own test
 //! binary: resident memory is per process, and other tests would move it.
 
@@ -9,8 +9,11 @@ mod common;
 #[path = "../examples/embed_ao/gbuffer.rs"]
 mod gbuffer;
 
-use strata_render::embed::{AoInputs, EmbeddedAo, EmbeddedAoConfig, NormalEncoding};
+use strata_render::embed::{
+    AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding, RadiosityInputs,
+};
 use strata_render::passes::ao::AoSettings;
+use strata_render::passes::radiosity::RadiositySettings;
 
 fn resident_bytes() -> u64 {
     let status = std::fs::read_to_string("/proc/self/status").expect("Linux /proc");
@@ -19,7 +22,7 @@ fn resident_bytes() -> u64 {
 }
 
 #[test]
-fn embedded_ao_soaks_flat() {
+fn embedded_ao_and_radiosity_soak_flat() {
     let gpu = common::gpu();
     let mut scene = strata_scene::procedural::builtin("atrium").unwrap();
     scene.camera_path = None;
@@ -50,6 +53,22 @@ fn embedded_ao_soaks_flat() {
         },
     )
     .unwrap();
+    let mut gi = EmbeddedRadiosity::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedRadiosityConfig {
+            width: w,
+            height: h,
+            layers: 2,
+            settings: RadiositySettings {
+                radius: Some(scene.settings.radiosity_radius),
+                ..RadiositySettings::default()
+            },
+            ..EmbeddedRadiosityConfig::default()
+        },
+    )
+    .unwrap();
     let cam = scene.camera;
     let proj =
         glam::camera::rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), w as f32 / h as f32, cam.near, 500.0);
@@ -67,6 +86,14 @@ fn embedded_ao_soaks_flat() {
             ..AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj)
         };
         ao.encode(&mut encoder, &inputs).unwrap();
+        // (the normals stand in for albedo and radiance: any values do for memory)
+        let shading = RadiosityInputs {
+            gbuffer: inputs,
+            albedo: (&first.normals).into(),
+            radiance: (&first.normals).into(),
+            second: Some(((&second.normals).into(), (&second.normals).into())),
+        };
+        gi.encode(&mut encoder, &shading).unwrap();
         gpu.queue.submit([encoder.finish()]);
         if f == first_sample || f == frames {
             gpu.check_errors().expect("no wgpu validation errors");
