@@ -1,4 +1,5 @@
-//! Deep-G-buffer ambient occlusion (DGB §3.1) inside an application's own wgpu renderer.
+//! Deep-G-buffer ambient occlusion (DGB §3.1) and screen-space radiosity (§3.2–3.3,
+//! [`EmbeddedRadiosity`]) inside an application's own wgpu renderer (`docs/embed.md`).
 //!
 //! The application draws its scene as usual, into a depth texture and a normal texture
 //! (and, for DGB's second layer, a second pair). Each frame, [`EmbeddedAo::encode`] records
