@@ -226,6 +226,22 @@ fn bad_embedded_radiosity_input_is_a_one_line_error() {
     // the sRGB albedo is taken, and nothing above reached the device
     assert_eq!(encode(ok), None);
     gpu.check_errors().expect("no wgpu validation errors");
+    // a device opened without R11G11B10 render targets (DGB Table 1's radiosity format)
+    let (plain, plain_queue) = pollster::block_on(gpu.adapter.request_device(&Default::default())).unwrap();
+    let config = EmbeddedRadiosityConfig {
+        width: W,
+        height: H,
+        settings: RadiositySettings {
+            radius: Some(2.0),
+            ..RadiositySettings::default()
+        },
+        ..EmbeddedRadiosityConfig::default()
+    };
+    let e = EmbeddedRadiosity::new(&gpu.adapter, &plain, &plain_queue, config)
+        .err()
+        .expect("an error");
+    one_line(e.to_string(), &["RG11B10UFLOAT_RENDERABLE", "request it"]);
+
     let mut two = new(&|c| c.layers = 2).unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let e = two.encode(&mut encoder, &ok).unwrap_err().to_string();

@@ -1,14 +1,16 @@
-//! An application's own G-buffer, as the `embed_ao` example draws it: hardware depth and
-//! a normal texture, from world-space triangles, with plain wgpu; and DGB's second layer,
-//! peeled with a minimum separation (§2). Nothing here is strata's; `tests/embed.rs` draws
-//! its G-buffers with it too.
+//! An application's own G-buffer, as the `embed_ao` and `embed_gi` examples draw it:
+//! hardware depth and a normal texture, from world-space triangles, with plain wgpu; DGB's
+//! second layer, peeled with a minimum separation (§2); and, lit by a sun without shadows,
+//! each layer's albedo and outgoing diffuse radiance. Nothing here is strata's;
+//! `tests/embed.rs` draws its G-buffers with it too.
+// two examples and three tests share this file, each using part of it
+#![allow(dead_code)]
 
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 /// How the normal texture stores the normal (the shader's `mode`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[allow(dead_code)] // the example draws one; tests/embed.rs draws every one
 pub enum Normals {
     /// World-space xyz, signed.
     WorldSigned,
@@ -28,6 +30,18 @@ pub struct Layout {
     pub reversed: bool,
 }
 
+/// A directional light without shadows: the application's whole direct lighting here.
+#[derive(Clone, Copy, Debug)]
+pub struct Sun {
+    /// Towards the light.
+    pub direction: Vec3,
+    /// Irradiance on a surface facing it (rgb).
+    pub irradiance: Vec3,
+}
+
+/// A triangle: world-space corners, their normals, and its diffuse albedo.
+pub type Triangle = ([Vec3; 3], [Vec3; 3], Vec3);
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Uniforms {
@@ -38,6 +52,10 @@ struct Uniforms {
     mode: [u32; 4],
     /// x: the minimum separation Δz, y: 1 = peel behind the first layer
     peel: [f32; 4],
+    /// xyz: towards the sun
+    sun_direction: [f32; 4],
+    /// rgb: the sun's irradiance
+    sun: [f32; 4],
 }
 
 #[repr(C)]
@@ -45,16 +63,23 @@ struct Uniforms {
 struct Vertex {
     position: [f32; 3],
     normal: [f32; 3],
+    albedo: [f32; 3],
 }
 
 const SHADER: &str = r#"
-struct U { view_proj: mat4x4f, view: mat4x4f, inv_proj: mat4x4f, mode: vec4u, peel: vec4f }
+struct U {
+    view_proj: mat4x4f, view: mat4x4f, inv_proj: mat4x4f, mode: vec4u, peel: vec4f,
+    sun_direction: vec4f, sun: vec4f,
+}
 @group(0) @binding(0) var<uniform> u: U;
 @group(0) @binding(1) var first_depth: texture_depth_2d;
 // csz: the distance in front of the (right-handed) camera
-struct V { @builtin(position) pos: vec4f, @location(0) n: vec3f, @location(1) csz: f32 }
-@vertex fn vs(@location(0) p: vec3f, @location(1) n: vec3f) -> V {
-    return V(u.view_proj * vec4f(p, 1.0), n, -(u.view * vec4f(p, 1.0)).z);
+struct V {
+    @builtin(position) pos: vec4f, @location(0) n: vec3f, @location(1) csz: f32,
+    @location(2) albedo: vec3f,
+}
+@vertex fn vs(@location(0) p: vec3f, @location(1) n: vec3f, @location(2) albedo: vec3f) -> V {
+    return V(u.view_proj * vec4f(p, 1.0), n, -(u.view * vec4f(p, 1.0)).z, albedo);
 }
 // the second layer (DGB §2): the nearest surface more than Δz behind the first layer's
 fn behind_first(v: V) -> bool {
@@ -68,12 +93,28 @@ fn behind_first(v: V) -> bool {
     // within 1e-4·z0 of the first layer is the first layer's own surface
     return v.csz > z0 + u.peel.x + 1e-4 * z0;
 }
+// two-sided: a back face's normal points towards the viewer
+fn world_normal(v: V, front: bool) -> vec3f {
+    return normalize(v.n) * select(-1.0, 1.0, front);
+}
 @fragment fn fs(v: V, @builtin(front_facing) front: bool) -> @location(0) vec4f {
     if (u.peel.y != 0.0 && !behind_first(v)) {
         discard;
     }
-    // two-sided: a back face's normal points towards the viewer
-    var n = normalize(v.n) * select(-1.0, 1.0, front);
+    return encoded(world_normal(v, front));
+}
+struct Lit { @location(0) normal: vec4f, @location(1) albedo: vec4f, @location(2) radiance: vec4f }
+// the G-buffer and the sun's Lambertian outgoing radiance B = ρ/π · E · max(0, n·l)
+@fragment fn fs_lit(v: V, @builtin(front_facing) front: bool) -> Lit {
+    if (u.peel.y != 0.0 && !behind_first(v)) {
+        discard;
+    }
+    let n = world_normal(v, front);
+    let b = v.albedo / 3.14159265 * u.sun.rgb * max(dot(n, u.sun_direction.xyz), 0.0);
+    return Lit(encoded(n), vec4f(v.albedo, 1.0), vec4f(b, 1.0));
+}
+fn encoded(world: vec3f) -> vec4f {
+    var n = world;
     if (u.mode.x != 0u) {
         n = (u.view * vec4f(n, 0.0)).xyz;
     }
@@ -84,10 +125,14 @@ fn behind_first(v: V) -> bool {
 }
 "#;
 
-/// Depth and normal textures and the pipeline that fills them.
+/// Depth and normal textures (and, lit, albedo and radiance) and the pipeline that fills them.
 pub struct GBuffer {
     pub depth: wgpu::Texture,
     pub normals: wgpu::Texture,
+    /// Lit G-buffers: diffuse albedo (`Rgba8UnormSrgb`) and outgoing diffuse radiance
+    /// (`Rgba16Float`).
+    pub shading: Option<(wgpu::Texture, wgpu::Texture)>,
+    sun: Option<Sun>,
     layout: Layout,
     /// Peeling behind another G-buffer's depth: Δz.
     min_separation: Option<f32>,
@@ -101,7 +146,24 @@ pub struct GBuffer {
 impl GBuffer {
     /// The first layer of `triangles` (world-space corners and their normals).
     pub fn new(device: &wgpu::Device, size: [u32; 2], layout: Layout, triangles: &[([Vec3; 3], [Vec3; 3])]) -> Self {
-        Self::build(device, size, layout, triangles, None)
+        Self::build(device, size, layout, &grey(triangles), None, None)
+    }
+
+    /// The first layer of `triangles`, lit by `sun`: also albedo and radiance.
+    pub fn lit(device: &wgpu::Device, size: [u32; 2], layout: Layout, triangles: &[Triangle], sun: Sun) -> Self {
+        Self::build(device, size, layout, triangles, None, Some(sun))
+    }
+
+    /// The second layer behind `first`, lit as `first` is.
+    pub fn second_layer_lit(
+        device: &wgpu::Device,
+        first: &GBuffer,
+        min_separation: f32,
+        triangles: &[Triangle],
+    ) -> Self {
+        let size = [first.depth.width(), first.depth.height()];
+        let behind = Some((&first.depth, min_separation));
+        Self::build(device, size, first.layout, triangles, behind, first.sun)
     }
 
     /// The second layer behind `first`: the nearest surfaces more than `min_separation`
@@ -113,21 +175,17 @@ impl GBuffer {
         triangles: &[([Vec3; 3], [Vec3; 3])],
     ) -> Self {
         let size = [first.depth.width(), first.depth.height()];
-        Self::build(
-            device,
-            size,
-            first.layout,
-            triangles,
-            Some((&first.depth, min_separation)),
-        )
+        let behind = Some((&first.depth, min_separation));
+        Self::build(device, size, first.layout, &grey(triangles), behind, None)
     }
 
     fn build(
         device: &wgpu::Device,
         size: [u32; 2],
         layout: Layout,
-        triangles: &[([Vec3; 3], [Vec3; 3])],
+        triangles: &[Triangle],
         first: Option<(&wgpu::Texture, f32)>,
+        sun: Option<Sun>,
     ) -> Self {
         let texture = |label, format| {
             device.create_texture(&wgpu::TextureDescriptor {
@@ -209,6 +267,11 @@ impl GBuffer {
             bind_group_layouts: &[Some(&group_layout)],
             immediate_size: 0,
         });
+        let mut targets = vec![Some(layout.normal.into())];
+        if sun.is_some() {
+            targets.push(Some(wgpu::TextureFormat::Rgba8UnormSrgb.into()));
+            targets.push(Some(wgpu::TextureFormat::Rgba16Float.into()));
+        }
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("app-gbuffer"),
             layout: Some(&pl),
@@ -219,7 +282,7 @@ impl GBuffer {
                 buffers: &[Some(wgpu::VertexBufferLayout {
                     array_stride: std::mem::size_of::<Vertex>() as u64,
                     step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3],
                 })],
             },
             primitive: wgpu::PrimitiveState {
@@ -240,22 +303,29 @@ impl GBuffer {
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
-                entry_point: Some("fs"),
+                entry_point: Some(if sun.is_some() { "fs_lit" } else { "fs" }),
                 compilation_options: Default::default(),
-                targets: &[Some(layout.normal.into())],
+                targets: &targets,
             }),
             multiview_mask: None,
             cache: None,
         });
         let verts: Vec<Vertex> = triangles
             .iter()
-            .flat_map(|(p, n)| {
+            .flat_map(|(p, n, albedo)| {
                 (0..3).map(move |k| Vertex {
                     position: p[k].to_array(),
                     normal: n[k].to_array(),
+                    albedo: albedo.to_array(),
                 })
             })
             .collect();
+        let shading = sun.map(|_| {
+            (
+                texture("app-albedo", wgpu::TextureFormat::Rgba8UnormSrgb),
+                texture("app-radiance", wgpu::TextureFormat::Rgba16Float),
+            )
+        });
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("app-triangles"),
             contents: bytemuck::cast_slice(&verts),
@@ -264,6 +334,8 @@ impl GBuffer {
         Self {
             depth,
             normals,
+            shading,
+            sun,
             layout,
             min_separation: first.map(|f| f.1),
             pipeline,
@@ -292,21 +364,37 @@ impl GBuffer {
                 0.0,
                 0.0,
             ],
+            sun_direction: self
+                .sun
+                .map_or(Vec3::ZERO, |s| s.direction.normalize())
+                .extend(0.0)
+                .to_array(),
+            sun: self.sun.map_or(Vec3::ZERO, |s| s.irradiance).extend(0.0).to_array(),
         };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-        let normals = self.normals.create_view(&Default::default());
+        let mut views = vec![self.normals.create_view(&Default::default())];
+        if let Some((albedo, radiance)) = &self.shading {
+            views.push(albedo.create_view(&Default::default()));
+            views.push(radiance.create_view(&Default::default()));
+        }
+        let attachments: Vec<_> = views
+            .iter()
+            .map(|view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
         let depth = self.depth.create_view(&Default::default());
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("app-gbuffer"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &normals,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
+            color_attachments: &attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &depth,
                 depth_ops: Some(wgpu::Operations {
@@ -324,4 +412,9 @@ impl GBuffer {
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.draw(0..self.count, 0..1);
     }
+}
+
+/// `triangles` with a mid-grey albedo (unlit G-buffers do not read it).
+fn grey(triangles: &[([Vec3; 3], [Vec3; 3])]) -> Vec<Triangle> {
+    triangles.iter().map(|(p, n)| (*p, *n, Vec3::splat(0.5))).collect()
 }

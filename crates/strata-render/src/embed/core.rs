@@ -63,7 +63,8 @@ pub(crate) struct Core {
     pub layers: u32,
     what: &'static str,
     geometry: wgpu::RenderPipeline,
-    shading: Option<wgpu::RenderPipeline>,
+    /// One per layer (empty without shading).
+    shading: Vec<wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     /// Zeros at the render size: bound where the application gives no motion texture, and
@@ -217,15 +218,17 @@ impl Core {
             formats.push(F::R32Float);
         }
         let geometry = pipeline(if layers == 2 { "fs_import2" } else { "fs_import1" }, &formats);
-        let shading = c.shading.then(|| {
-            let per_layer = [
-                F::Rgba8Unorm,
-                F::Rgba8UnormSrgb,
-                crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
-            ];
-            let formats: Vec<F> = (0..layers).flat_map(|_| per_layer).collect();
-            pipeline(if layers == 2 { "fs_shading2" } else { "fs_shading1" }, &formats)
-        });
+        let per_layer = [
+            F::Rgba8Unorm,
+            F::Rgba8UnormSrgb,
+            crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+        ];
+        let shading = match c.shading {
+            true => (0..layers)
+                .map(|j| pipeline(&format!("fs_shading{j}"), &per_layer))
+                .collect(),
+            false => Vec::new(),
+        };
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("embed-import"),
             size: std::mem::size_of::<ImportUniforms>() as u64,
@@ -476,18 +479,16 @@ impl Core {
         let slot = prof.begin(encoder, "embed-import");
         crate::passes::fullscreen_pass(encoder, "embed-import", &self.geometry, &outputs, &[&group]);
         prof.end(encoder, slot);
-        if let Some(shading) = &self.shading {
-            let outputs: Vec<&wgpu::TextureView> = (0..self.layers as usize)
-                .flat_map(|j| {
-                    [
-                        &t.get("normal").layer_views[j],
-                        &t.get("albedo").layer_views[j],
-                        &t.get(crate::passes::lighting::RADIOSITY[j]).view,
-                    ]
-                })
-                .collect();
+        if !self.shading.is_empty() {
             let slot = prof.begin(encoder, "embed-import-shading");
-            crate::passes::fullscreen_pass(encoder, "embed-import-shading", shading, &outputs, &[&group]);
+            for (j, pipeline) in self.shading.iter().enumerate() {
+                let outputs = [
+                    &t.get("normal").layer_views[j],
+                    &t.get("albedo").layer_views[j],
+                    &t.get(crate::passes::lighting::RADIOSITY[j]).view,
+                ];
+                crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &outputs, &[&group]);
+            }
             prof.end(encoder, slot);
         }
         let mut passes: Vec<&dyn Pass> = vec![&self.mip];
@@ -505,7 +506,7 @@ impl Core {
     /// The pass names [`Core::record`] records around `stage`'s, in order.
     pub fn pass_names(&self, stage: Vec<&dyn Pass>) -> Vec<&'static str> {
         let mut v = vec!["embed-import"];
-        if self.shading.is_some() {
+        if !self.shading.is_empty() {
             v.push("embed-import-shading");
         }
         v.push(self.mip.info().name);

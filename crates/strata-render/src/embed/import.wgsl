@@ -1,7 +1,7 @@
 // The application's G-buffer → strata's deep G-buffer layout (DGB Table 1): camera-space
 // z of each layer from its hardware depth and projection, Oct16 world normals, and the
 // layer-0 world motion the temporal filter follows (`fs_import*`, every embedded
-// technique); each layer's normal, albedo and radiosity B (`fs_shading*`, the embedded
+// technique); each layer's normal, albedo and radiosity B (`fs_shading<j>`, the embedded
 // radiosity). `embed::core`.
 #import "common/fullscreen.wgsl"
 #import "common/packing.wgsl"
@@ -131,32 +131,23 @@ fn shading_of(normal: vec4f, albedo: vec4f, radiance: vec4f) -> Layer {
     );
 }
 
-struct Shading1 {
-    @location(0) normal0: vec4f,
-    @location(1) albedo0: vec4f,
-    @location(2) radiosity0: vec4f,
-}
-
-struct Shading2 {
-    @location(0) normal0: vec4f,
-    @location(1) albedo0: vec4f,
-    @location(2) radiosity0: vec4f,
-    @location(3) normal1: vec4f,
-    @location(4) albedo1: vec4f,
-    @location(5) radiosity1: vec4f,
+// one pass per layer: three targets each stay within WebGPU's default 32 bytes per sample
+struct Shading {
+    @location(0) normal: vec4f,
+    @location(1) albedo: vec4f,
+    @location(2) radiosity: vec4f,
 }
 
 @fragment
-fn fs_shading1(@builtin(position) pos: vec4f) -> Shading1 {
+fn fs_shading0(@builtin(position) pos: vec4f) -> Shading {
     let p = vec2i(pos.xy);
-    let l0 = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
-    return Shading1(l0.normal, l0.albedo, l0.radiosity);
+    let l = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
+    return Shading(l.normal, l.albedo, l.radiosity);
 }
 
 @fragment
-fn fs_shading2(@builtin(position) pos: vec4f) -> Shading2 {
+fn fs_shading1(@builtin(position) pos: vec4f) -> Shading {
     let p = vec2i(pos.xy);
-    let l0 = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
-    let l1 = shading_of(textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
-    return Shading2(l0.normal, l0.albedo, l0.radiosity, l1.normal, l1.albedo, l1.radiosity);
+    let l = shading_of(textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
+    return Shading(l.normal, l.albedo, l.radiosity);
 }

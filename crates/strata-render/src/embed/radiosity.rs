@@ -90,6 +90,12 @@ impl EmbeddedRadiosity {
             ))
         })?;
         s.validate().map_err(RenderError::Parameter)?;
+        let needed = wgpu::Features::RG11B10UFLOAT_RENDERABLE;
+        if !device.features().contains(needed) {
+            return Err(RenderError::Parameter(format!(
+                "{what}: the device lacks {needed:?}, which DGB Table 1's radiosity buffers need: request it when opening the device"
+            )));
+        }
         let dz = config.min_separation;
         if !(dz >= 0.0 && dz.is_finite()) {
             return Err(RenderError::Parameter(format!(
