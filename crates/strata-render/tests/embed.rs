@@ -10,7 +10,6 @@ use glam::{Mat4, Vec3};
 use strata_render::embed::{AoInputs, EmbeddedAo, EmbeddedAoConfig, NormalEncoding, NormalSpace, TextureLayer};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::ao::AoSettings;
-use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::Kernel;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{ImageBuf, Scene};
@@ -31,23 +30,11 @@ fn still_atrium() -> Scene {
 
 /// The renderer's AO with `ao` and `layers` peeled layers (no guard band).
 fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32, ao: AoSettings) -> Renderer {
-    Renderer::new(
-        gpu,
-        scene,
-        RenderSettings {
-            width: W,
-            height: H,
-            deep: DeepGBufferSettings {
-                layers,
-                variant: Variant::Peel,
-                min_separation: Some(scene.settings.min_separation),
-                ..Default::default()
-            },
-            ao: Some(ao),
-            ..Default::default()
-        },
-    )
-    .unwrap()
+    let settings = RenderSettings {
+        ao: Some(ao),
+        ..common::peeled_layers(scene, W, H, layers)
+    };
+    Renderer::new(gpu, scene, settings).unwrap()
 }
 
 /// The embedded AO with `ao` and the scene's radius.
@@ -205,8 +192,8 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
     }
 }
 
-#[path = "../examples/embed_ao/gbuffer.rs"]
-mod gbuffer;
+#[path = "../examples/embed_ao/app.rs"]
+mod app;
 
 /// G-buffers drawn as applications draw them: the embedded AO of each matches the renderer's
 /// AO of the same camera. The left-handed case mirrors the world (z → −z) and looks at it
@@ -226,24 +213,23 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
         r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
     }
     let reference = r.read_target(&gpu, "ao").unwrap();
-    let tris = |mirror: Vec3| -> Vec<([Vec3; 3], [Vec3; 3])> {
-        scene
-            .world_triangles(0.0)
-            .iter()
-            .map(|t| (t.p.map(|p| p * mirror), t.n.map(|n| n * mirror)))
+    let tris = |mirror: Vec3| -> Vec<app::Triangle> {
+        app::scene_triangles(&scene)
+            .into_iter()
+            .map(|(p, n, albedo)| (p.map(|p| p * mirror), n.map(|n| n * mirror), albedo))
             .collect()
     };
     let flip = Vec3::new(1.0, 1.0, -1.0);
     struct Case {
         name: &'static str,
-        layout: gbuffer::Layout,
+        layout: app::Layout,
         encoding: NormalEncoding,
         space: NormalSpace,
         mirror: bool,
         view: Mat4,
         proj: Mat4,
     }
-    let layout = |depth, normal, normals, reversed| gbuffer::Layout {
+    let layout = |depth, normal, normals, reversed| app::Layout {
         depth,
         normal,
         normals,
@@ -252,7 +238,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
     let cases = [
         Case {
             name: "right-handed, standard depth, signed world normals",
-            layout: layout(F::Depth32Float, F::Rgba16Float, gbuffer::Normals::WorldSigned, false),
+            layout: layout(F::Depth32Float, F::Rgba16Float, app::Normals::WorldSigned, false),
             encoding: NormalEncoding::Signed,
             space: NormalSpace::World,
             mirror: false,
@@ -261,7 +247,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
         },
         Case {
             name: "right-handed, reversed infinite depth, unsigned view-space normals",
-            layout: layout(F::Depth24Plus, F::Rgba8Unorm, gbuffer::Normals::ViewUnsigned, true),
+            layout: layout(F::Depth24Plus, F::Rgba8Unorm, app::Normals::ViewUnsigned, true),
             encoding: NormalEncoding::Unsigned,
             space: NormalSpace::View,
             mirror: false,
@@ -270,7 +256,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
         },
         Case {
             name: "left-handed, standard depth, signed view-space normals",
-            layout: layout(F::Depth32Float, F::Rgba16Float, gbuffer::Normals::ViewSigned, false),
+            layout: layout(F::Depth32Float, F::Rgba16Float, app::Normals::ViewSigned, false),
             encoding: NormalEncoding::Signed,
             space: NormalSpace::View,
             mirror: true,
@@ -279,7 +265,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
         },
     ];
     for c in cases {
-        let app = gbuffer::GBuffer::new(
+        let app = app::GBuffer::new(
             &gpu.device,
             [W, H],
             c.layout,
@@ -504,12 +490,11 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
 }
 
 /// DGB's second layer drawn by the application (a depth peel with the minimum separation,
-/// `examples/embed_ao/gbuffer.rs`): the embedded 2-layer AO matches the renderer's 2-layer
+/// `examples/embed_ao/app.rs`): the embedded 2-layer AO matches the renderer's 2-layer
 /// AO (peeled, `Variant::Peel`), and differs from the 1-layer AO where the layer matters.
 #[test]
 fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
     use glam::camera::rh;
-    use wgpu::TextureFormat as F;
     let gpu = common::gpu();
     let scene = still_atrium();
     let cam = scene.camera;
@@ -521,15 +506,10 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
     }
     let view = cam.view();
     let proj = rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), W as f32 / H as f32, cam.near, 500.0);
-    let tris: Vec<_> = scene.world_triangles(0.0).iter().map(|t| (t.p, t.n)).collect();
-    let layout = gbuffer::Layout {
-        depth: F::Depth32Float,
-        normal: F::Rgba16Float,
-        normals: gbuffer::Normals::WorldSigned,
-        reversed: false,
-    };
-    let first = gbuffer::GBuffer::new(&gpu.device, [W, H], layout, &tris);
-    let second = gbuffer::GBuffer::second_layer(&gpu.device, &first, scene.settings.min_separation, &tris);
+    let tris = app::scene_triangles(&scene);
+    let layout = app::Layout::standard();
+    let first = app::GBuffer::new(&gpu.device, [W, H], layout, &tris);
+    let second = app::GBuffer::second_layer(&gpu.device, &first, scene.settings.min_separation, &tris);
     let mut ao = embedded(
         &gpu,
         &scene,
@@ -590,7 +570,6 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
 #[test]
 fn embedded_ao_takes_a_taa_jittered_projection() {
     use glam::camera::rh;
-    use wgpu::TextureFormat as F;
     let gpu = common::gpu();
     let scene = still_atrium();
     let cam = scene.camera;
@@ -601,14 +580,9 @@ fn embedded_ao_takes_a_taa_jittered_projection() {
     let mut jittered = proj;
     jittered.z_axis.x = -2.0 * jx / W as f32;
     jittered.z_axis.y = 2.0 * jy / H as f32;
-    let tris: Vec<_> = scene.world_triangles(0.0).iter().map(|t| (t.p, t.n)).collect();
-    let layout = gbuffer::Layout {
-        depth: F::Depth32Float,
-        normal: F::Rgba16Float,
-        normals: gbuffer::Normals::WorldSigned,
-        reversed: false,
-    };
-    let app = gbuffer::GBuffer::new(&gpu.device, [W, H], layout, &tris);
+    let tris = app::scene_triangles(&scene);
+    let layout = app::Layout::standard();
+    let app = app::GBuffer::new(&gpu.device, [W, H], layout, &tris);
     // the oracle: pixel centre c shows the point the unjittered camera sees at c − j
     let reference = strata_reference::Reference::new(&scene, 0.0);
     let oracle: Vec<f32> = (0..W * H)

@@ -7,7 +7,6 @@ mod common;
 
 use strata_render::embed::{AoInputs, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding, TextureLayer};
 use strata_render::frame::FrameCameras;
-use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::radiosity::RadiositySettings;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::Scene;
@@ -29,23 +28,11 @@ fn still(name: &str) -> Scene {
 }
 
 fn renderer(gpu: &GpuContext, scene: &Scene, layers: u32, rs: RadiositySettings) -> Renderer {
-    Renderer::new(
-        gpu,
-        scene,
-        RenderSettings {
-            width: W,
-            height: H,
-            deep: DeepGBufferSettings {
-                layers,
-                variant: Variant::Peel,
-                min_separation: Some(scene.settings.min_separation),
-                ..Default::default()
-            },
-            radiosity: Some(rs),
-            ..Default::default()
-        },
-    )
-    .unwrap()
+    let settings = RenderSettings {
+        radiosity: Some(rs),
+        ..common::peeled_layers(scene, W, H, layers)
+    };
+    Renderer::new(gpu, scene, settings).unwrap()
 }
 
 fn embedded(gpu: &GpuContext, scene: &Scene, layers: u32, rs: RadiositySettings) -> EmbeddedRadiosity {
@@ -127,16 +114,17 @@ fn embedded_radiosity_on_the_renderers_layers_is_the_renderers_indirect_light() 
 fn bad_embedded_radiosity_input_is_a_one_line_error() {
     use wgpu::TextureFormat as F;
     let gpu = common::gpu();
+    let config = EmbeddedRadiosityConfig {
+        width: W,
+        height: H,
+        settings: RadiositySettings {
+            radius: Some(2.0),
+            ..RadiositySettings::default()
+        },
+        ..EmbeddedRadiosityConfig::default()
+    };
     let new = |f: &dyn Fn(&mut EmbeddedRadiosityConfig)| {
-        let mut c = EmbeddedRadiosityConfig {
-            width: W,
-            height: H,
-            settings: RadiositySettings {
-                radius: Some(2.0),
-                ..RadiositySettings::default()
-            },
-            ..EmbeddedRadiosityConfig::default()
-        };
+        let mut c = config.clone();
         f(&mut c);
         EmbeddedRadiosity::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
     };
@@ -228,16 +216,7 @@ fn bad_embedded_radiosity_input_is_a_one_line_error() {
     gpu.check_errors().expect("no wgpu validation errors");
     // a device opened without R11G11B10 render targets (DGB Table 1's radiosity format)
     let (plain, plain_queue) = pollster::block_on(gpu.adapter.request_device(&Default::default())).unwrap();
-    let config = EmbeddedRadiosityConfig {
-        width: W,
-        height: H,
-        settings: RadiositySettings {
-            radius: Some(2.0),
-            ..RadiositySettings::default()
-        },
-        ..EmbeddedRadiosityConfig::default()
-    };
-    let e = EmbeddedRadiosity::new(&gpu.adapter, &plain, &plain_queue, config)
+    let e = EmbeddedRadiosity::new(&gpu.adapter, &plain, &plain_queue, config.clone())
         .err()
         .expect("an error");
     one_line(e.to_string(), &["RG11B10UFLOAT_RENDERABLE", "request it"]);

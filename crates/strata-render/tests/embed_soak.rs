@@ -6,8 +6,8 @@
 
 mod common;
 
-#[path = "../examples/embed_ao/gbuffer.rs"]
-mod gbuffer;
+#[path = "../examples/embed_ao/app.rs"]
+mod app;
 
 use strata_render::embed::{
     AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding, RadiosityInputs,
@@ -26,16 +26,11 @@ fn embedded_ao_and_radiosity_soak_flat() {
     let gpu = common::gpu();
     let mut scene = strata_scene::procedural::builtin("atrium").unwrap();
     scene.camera_path = None;
-    let tris: Vec<_> = scene.world_triangles(0.0).iter().map(|t| (t.p, t.n)).collect();
+    let tris = app::scene_triangles(&scene);
     let (w, h) = (64u32, 36u32);
-    let layout = gbuffer::Layout {
-        depth: wgpu::TextureFormat::Depth32Float,
-        normal: wgpu::TextureFormat::Rgba16Float,
-        normals: gbuffer::Normals::WorldSigned,
-        reversed: false,
-    };
-    let first = gbuffer::GBuffer::new(&gpu.device, [w, h], layout, &tris);
-    let second = gbuffer::GBuffer::second_layer(&gpu.device, &first, scene.settings.min_separation, &tris);
+    let layout = app::Layout::standard();
+    let first = app::GBuffer::new(&gpu.device, [w, h], layout, &tris);
+    let second = app::GBuffer::second_layer(&gpu.device, &first, scene.settings.min_separation, &tris);
     let mut ao = EmbeddedAo::new(
         &gpu.adapter,
         &gpu.device,

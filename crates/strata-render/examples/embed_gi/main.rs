@@ -3,7 +3,7 @@
 //! The "application" draws an open box (a red wall on the left, a green one on the right, a
 //! white floor and back wall) around two white blocks. Its lighting is a sun without
 //! shadows, which gives each pixel's albedo and outgoing diffuse radiance
-//! (`../embed_ao/gbuffer.rs`). It peels DGB's second layer and lights that too, and asks
+//! (`../embed_ao/app.rs`). It peels DGB's second layer and lights that too, and asks
 //! `strata_render::embed::EmbeddedRadiosity` for the indirect irradiance E of 16 frames
 //! (the progressive bounces build up). It then composes `B + ρ/π · E` on the CPU and writes
 //! the direct light and the composite side by side as a PNG:
@@ -12,41 +12,12 @@
 //! cargo run --release -p strata-render --example embed_gi -- out/embed-gi.png
 //! ```
 
-#[path = "../embed_ao/gbuffer.rs"]
-mod gbuffer;
+#[path = "../embed_ao/app.rs"]
+mod app;
 
 use glam::Vec3;
 use strata_render::embed::{AoInputs, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding, RadiosityInputs};
 use strata_render::passes::radiosity::RadiositySettings;
-
-/// A box's 12 triangles of one albedo (outward normals, counter-clockwise from outside).
-fn cuboid(lo: Vec3, hi: Vec3, albedo: Vec3) -> Vec<gbuffer::Triangle> {
-    let c = |i: usize| {
-        Vec3::new(
-            if i & 1 != 0 { hi.x } else { lo.x },
-            if i & 2 != 0 { hi.y } else { lo.y },
-            if i & 4 != 0 { hi.z } else { lo.z },
-        )
-    };
-    let faces = [
-        ([0, 4, 6, 2], -Vec3::X),
-        ([1, 3, 7, 5], Vec3::X),
-        ([0, 1, 5, 4], -Vec3::Y),
-        ([2, 6, 7, 3], Vec3::Y),
-        ([0, 2, 3, 1], -Vec3::Z),
-        ([4, 5, 7, 6], Vec3::Z),
-    ];
-    faces
-        .iter()
-        .flat_map(|(q, n)| {
-            let p = q.map(c);
-            [
-                ([p[0], p[1], p[2]], [*n; 3], albedo),
-                ([p[0], p[2], p[3]], [*n; 3], albedo),
-            ]
-        })
-        .collect()
-}
 
 /// Linear → 8-bit sRGB of a tone-mapped value.
 fn display(v: f32) -> u8 {
@@ -62,43 +33,39 @@ fn display(v: f32) -> u8 {
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "embed-gi.png".into());
     let (width, height) = (480u32, 320u32);
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
-    // the radiosity buffers are R11G11B10 render targets (DGB Table 1); timestamps, where
-    // the adapter has them, let strata report its passes' GPU time
-    let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-        required_features: wgpu::Features::RG11B10UFLOAT_RENDERABLE | (adapter.features() & timing),
-        ..Default::default()
-    }))?;
+    // the radiosity buffers are R11G11B10 render targets (DGB Table 1)
+    let (adapter, device, queue) = app::open_device(wgpu::Features::RG11B10UFLOAT_RENDERABLE)?;
 
     let (white, red, green) = (
         Vec3::splat(0.75),
         Vec3::new(0.75, 0.08, 0.06),
         Vec3::new(0.1, 0.6, 0.12),
     );
-    let mut triangles = cuboid(Vec3::new(-2.0, -0.1, -2.0), Vec3::new(2.0, 0.0, 2.0), white);
-    triangles.extend(cuboid(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(-1.9, 2.0, 2.0), red));
-    triangles.extend(cuboid(Vec3::new(1.9, 0.0, -2.0), Vec3::new(2.0, 2.0, 2.0), green));
-    triangles.extend(cuboid(Vec3::new(-1.9, 0.0, -2.0), Vec3::new(1.9, 2.0, -1.9), white));
-    triangles.extend(cuboid(Vec3::new(-1.2, 0.0, -1.0), Vec3::new(-0.4, 0.8, -0.2), white));
-    triangles.extend(cuboid(Vec3::new(0.4, 0.0, -1.3), Vec3::new(1.0, 1.4, -0.7), white));
+    let mut triangles = app::cuboid(Vec3::new(-2.0, -0.1, -2.0), Vec3::new(2.0, 0.0, 2.0), white);
+    triangles.extend(app::cuboid(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(-1.9, 2.0, 2.0), red));
+    triangles.extend(app::cuboid(Vec3::new(1.9, 0.0, -2.0), Vec3::new(2.0, 2.0, 2.0), green));
+    triangles.extend(app::cuboid(
+        Vec3::new(-1.9, 0.0, -2.0),
+        Vec3::new(1.9, 2.0, -1.9),
+        white,
+    ));
+    triangles.extend(app::cuboid(
+        Vec3::new(-1.2, 0.0, -1.0),
+        Vec3::new(-0.4, 0.8, -0.2),
+        white,
+    ));
+    triangles.extend(app::cuboid(Vec3::new(0.4, 0.0, -1.3), Vec3::new(1.0, 1.4, -0.7), white));
     // from the right and above: it lights the red wall, the floor and the blocks' right faces
-    let sun = gbuffer::Sun {
+    let sun = app::Sun {
         direction: Vec3::new(1.0, 0.8, 0.2),
         irradiance: Vec3::splat(4.0),
     };
     use glam::camera::rh;
     let view = rh::view::look_at_mat4(Vec3::new(0.0, 1.4, 4.2), Vec3::new(0.0, 0.7, -0.5), Vec3::Y);
     let proj = rh::proj::directx::perspective(45f32.to_radians(), width as f32 / height as f32, 0.05, 50.0);
-    let layout = gbuffer::Layout {
-        depth: wgpu::TextureFormat::Depth32Float,
-        normal: wgpu::TextureFormat::Rgba16Float,
-        normals: gbuffer::Normals::WorldSigned,
-        reversed: false,
-    };
-    let first = gbuffer::GBuffer::lit(&device, [width, height], layout, &triangles, sun);
-    let second = gbuffer::GBuffer::second_layer_lit(&device, &first, 0.3, &triangles);
+    let layout = app::Layout::standard();
+    let first = app::GBuffer::lit(&device, [width, height], layout, &triangles, sun);
+    let second = app::GBuffer::second_layer_lit(&device, &first, 0.3, &triangles);
 
     let mut gi = EmbeddedRadiosity::new(
         &adapter,
@@ -136,11 +103,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gi.encode(&mut encoder, &inputs)?;
         queue.submit([encoder.finish()]);
     }
-    let timings = gi.timings()?;
-    if !timings.passes.is_empty() {
-        let each: Vec<String> = timings.passes.iter().map(|(n, ms)| format!("{n} {ms:.2}")).collect();
-        println!("GPU ms, last frame: {} (total {:.2})", each.join(", "), timings.total());
-    }
+    app::print_timings(&gi.timings()?);
 
     // the application's composite, here on the CPU from strata's imported copies of its
     // buffers: direct B on the left, B + ρ/π · E on the right

@@ -209,24 +209,23 @@ impl Core {
             ("NORMALS", normals),
             ("VIEW_SPACE", (c.normal_space == NormalSpace::View) as u32 as f64),
         ];
-        let pipeline = |entry: &str, formats: &[F]| {
+        let pipeline = |entry: &str, layer: u32, formats: &[F]| {
             let color: Vec<_> = formats.iter().map(|f| Some(wgpu::ColorTargetState::from(*f))).collect();
+            let constants = [constants[0], constants[1], ("LAYER", layer as f64)];
             crate::passes::fullscreen_pipeline_with(device, "embed-import", &pl, &module, entry, &constants, &color)
         };
         let mut formats = vec![F::Rg32Float, F::Rgba8Unorm, F::R32Float, F::Rgba16Float];
         if layers == 2 {
             formats.push(F::R32Float);
         }
-        let geometry = pipeline(if layers == 2 { "fs_import2" } else { "fs_import1" }, &formats);
+        let geometry = pipeline(if layers == 2 { "fs_import2" } else { "fs_import1" }, 0, &formats);
         let per_layer = [
             F::Rgba8Unorm,
             F::Rgba8UnormSrgb,
             crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
         ];
         let shading = match c.shading {
-            true => (0..layers)
-                .map(|j| pipeline(&format!("fs_shading{j}"), &per_layer))
-                .collect(),
+            true => (0..layers).map(|j| pipeline("fs_shading", j, &per_layer)).collect(),
             false => Vec::new(),
         };
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {

@@ -1,7 +1,7 @@
 // The application's G-buffer → strata's deep G-buffer layout (DGB Table 1): camera-space
 // z of each layer from its hardware depth and projection, Oct16 world normals, and the
 // layer-0 world motion the temporal filter follows (`fs_import*`, every embedded
-// technique); each layer's normal, albedo and radiosity B (`fs_shading<j>`, the embedded
+// technique); each layer's normal, albedo and radiosity B (`fs_shading`, the embedded
 // radiosity). `embed::core`.
 #import "common/fullscreen.wgsl"
 #import "common/packing.wgsl"
@@ -132,6 +132,8 @@ fn shading_of(normal: vec4f, albedo: vec4f, radiance: vec4f) -> Layer {
 }
 
 // one pass per layer: three targets each stay within WebGPU's default 32 bytes per sample
+override LAYER: u32 = 0u;
+
 struct Shading {
     @location(0) normal: vec4f,
     @location(1) albedo: vec4f,
@@ -139,15 +141,13 @@ struct Shading {
 }
 
 @fragment
-fn fs_shading0(@builtin(position) pos: vec4f) -> Shading {
+fn fs_shading(@builtin(position) pos: vec4f) -> Shading {
     let p = vec2i(pos.xy);
-    let l = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
-    return Shading(l.normal, l.albedo, l.radiosity);
-}
-
-@fragment
-fn fs_shading1(@builtin(position) pos: vec4f) -> Shading {
-    let p = vec2i(pos.xy);
-    let l = shading_of(textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
+    var l: Layer;
+    if (LAYER == 0u) {
+        l = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
+    } else {
+        l = shading_of(textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
+    }
     return Shading(l.normal, l.albedo, l.radiosity);
 }

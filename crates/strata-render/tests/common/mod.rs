@@ -99,11 +99,17 @@ pub fn render(gpu: &GpuContext, scene: &Scene, camera: &Camera, w: u32, h: u32) 
 /// (the rest default).
 #[allow(dead_code)]
 pub fn two_peeled_layers(scene: &Scene, w: u32, h: u32) -> RenderSettings {
+    peeled_layers(scene, w, h, 2)
+}
+
+/// `layers` deep-G-buffer layers, each peeled exactly (`Variant::Peel`) with the scene's
+/// minimum separation, at `w`×`h` without a guard band.
+pub fn peeled_layers(scene: &Scene, w: u32, h: u32, layers: u32) -> RenderSettings {
     RenderSettings {
         width: w,
         height: h,
         deep: strata_render::passes::deep_gbuffer::DeepGBufferSettings {
-            layers: 2,
+            layers,
             variant: strata_render::passes::deep_gbuffer::Variant::Peel,
             min_separation: Some(scene.settings.min_separation),
             ..Default::default()

@@ -1,8 +1,8 @@
-//! An application's own G-buffer, as the `embed_ao` and `embed_gi` examples draw it:
-//! hardware depth and a normal texture, from world-space triangles, with plain wgpu; DGB's
-//! second layer, peeled with a minimum separation (§2); and, lit by a sun without shadows,
-//! each layer's albedo and outgoing diffuse radiance. Nothing here is strata's;
-//! `tests/embed.rs` draws its G-buffers with it too.
+//! The examples' "application": its device, its boxes, and its own G-buffer, drawn with plain
+//! wgpu: hardware depth and a normal texture from world-space triangles; DGB's second
+//! layer, peeled with a minimum separation (§2); and, lit by a sun without shadows, each
+//! layer's albedo and outgoing diffuse radiance. Nothing here is strata's; the `embed_ao`
+//! and `embed_gi` examples and `tests/embed*.rs` draw their G-buffers with it.
 // two examples and three tests share this file, each using part of it
 #![allow(dead_code)]
 
@@ -28,6 +28,72 @@ pub struct Layout {
     pub normals: Normals,
     /// Depth cleared to 0 and tested with `Greater` (reversed z), else cleared to 1, `Less`.
     pub reversed: bool,
+}
+
+impl Layout {
+    /// `Depth32Float` with standard depth, signed world normals in `Rgba16Float`.
+    pub fn standard() -> Self {
+        Self {
+            depth: wgpu::TextureFormat::Depth32Float,
+            normal: wgpu::TextureFormat::Rgba16Float,
+            normals: Normals::WorldSigned,
+            reversed: false,
+        }
+    }
+}
+
+/// The application's device on the first adapter wgpu finds (lavapipe where there is no
+/// GPU), with `features` and, where the adapter has them, timestamps inside encoders (so
+/// that strata can report its passes' GPU time).
+pub fn open_device(
+    features: wgpu::Features,
+) -> Result<(wgpu::Adapter, wgpu::Device, wgpu::Queue), Box<dyn std::error::Error>> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
+    let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_features: features | (adapter.features() & timing),
+        ..Default::default()
+    }))?;
+    Ok((adapter, device, queue))
+}
+
+/// A box's 12 triangles of one albedo (outward normals, counter-clockwise from outside).
+pub fn cuboid(lo: Vec3, hi: Vec3, albedo: Vec3) -> Vec<Triangle> {
+    let c = |i: usize| {
+        Vec3::new(
+            if i & 1 != 0 { hi.x } else { lo.x },
+            if i & 2 != 0 { hi.y } else { lo.y },
+            if i & 4 != 0 { hi.z } else { lo.z },
+        )
+    };
+    // each face: four corners counter-clockwise from outside, and its normal
+    let faces = [
+        ([0, 4, 6, 2], -Vec3::X),
+        ([1, 3, 7, 5], Vec3::X),
+        ([0, 1, 5, 4], -Vec3::Y),
+        ([2, 6, 7, 3], Vec3::Y),
+        ([0, 2, 3, 1], -Vec3::Z),
+        ([4, 5, 7, 6], Vec3::Z),
+    ];
+    faces
+        .iter()
+        .flat_map(|(q, n)| {
+            let p = q.map(c);
+            [
+                ([p[0], p[1], p[2]], [*n; 3], albedo),
+                ([p[0], p[2], p[3]], [*n; 3], albedo),
+            ]
+        })
+        .collect()
+}
+
+/// Prints strata's per-pass GPU times, where the device measured them.
+pub fn print_timings(t: &strata_render::PassTimings) {
+    if !t.passes.is_empty() {
+        let each: Vec<String> = t.passes.iter().map(|(n, ms)| format!("{n} {ms:.2}")).collect();
+        println!("GPU ms, last frame: {} (total {:.2})", each.join(", "), t.total());
+    }
 }
 
 /// A directional light without shadows: the application's whole direct lighting here.
@@ -144,9 +210,9 @@ pub struct GBuffer {
 }
 
 impl GBuffer {
-    /// The first layer of `triangles` (world-space corners and their normals).
-    pub fn new(device: &wgpu::Device, size: [u32; 2], layout: Layout, triangles: &[([Vec3; 3], [Vec3; 3])]) -> Self {
-        Self::build(device, size, layout, &grey(triangles), None, None)
+    /// The first layer of `triangles` (their albedo is not read).
+    pub fn new(device: &wgpu::Device, size: [u32; 2], layout: Layout, triangles: &[Triangle]) -> Self {
+        Self::build(device, size, layout, triangles, None, None)
     }
 
     /// The first layer of `triangles`, lit by `sun`: also albedo and radiance.
@@ -168,15 +234,10 @@ impl GBuffer {
 
     /// The second layer behind `first`: the nearest surfaces more than `min_separation`
     /// behind it (draw `first` before it, with the same camera, each frame).
-    pub fn second_layer(
-        device: &wgpu::Device,
-        first: &GBuffer,
-        min_separation: f32,
-        triangles: &[([Vec3; 3], [Vec3; 3])],
-    ) -> Self {
+    pub fn second_layer(device: &wgpu::Device, first: &GBuffer, min_separation: f32, triangles: &[Triangle]) -> Self {
         let size = [first.depth.width(), first.depth.height()];
         let behind = Some((&first.depth, min_separation));
-        Self::build(device, size, first.layout, &grey(triangles), behind, None)
+        Self::build(device, size, first.layout, triangles, behind, None)
     }
 
     fn build(
@@ -414,7 +475,12 @@ impl GBuffer {
     }
 }
 
-/// `triangles` with a mid-grey albedo (unlit G-buffers do not read it).
-fn grey(triangles: &[([Vec3; 3], [Vec3; 3])]) -> Vec<Triangle> {
-    triangles.iter().map(|(p, n)| (*p, *n, Vec3::splat(0.5))).collect()
+/// A strata scene's triangles at frame 0 with their materials' albedo: the tests draw
+/// strata's scenes as an application would.
+pub fn scene_triangles(scene: &strata_scene::Scene) -> Vec<Triangle> {
+    scene
+        .world_triangles(0.0)
+        .iter()
+        .map(|t| (t.p, t.n, Vec3::from(scene.materials[t.material as usize].base_color)))
+        .collect()
 }
