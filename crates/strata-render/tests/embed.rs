@@ -310,7 +310,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
 fn bad_embedded_ao_input_is_a_one_line_error() {
     use wgpu::TextureFormat as F;
     let gpu = common::gpu();
-    let config = |f: &dyn Fn(&mut EmbeddedAoConfig)| {
+    let build = |f: &dyn Fn(&mut EmbeddedAoConfig)| {
         let mut c = EmbeddedAoConfig {
             width: W,
             height: H,
@@ -322,9 +322,8 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
         };
         f(&mut c);
         EmbeddedAo::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
-            .err()
-            .map(|e| e.to_string())
     };
+    let config = |f: &dyn Fn(&mut EmbeddedAoConfig)| build(f).err().map(|e| e.to_string());
     let one_line = |e: Option<String>, words: &[&str]| {
         let e = e.expect("an error");
         assert!(!e.contains('\n'), "one line: {e}");
@@ -365,21 +364,7 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
     let srgb = texture([W, H], F::Rgba8UnormSrgb, usage, 1);
     let cam = strata_scene::Camera::default();
     let (view, proj) = (cam.view(), cam.projection(W as f32 / H as f32));
-    let mut ao = EmbeddedAo::new(
-        &gpu.adapter,
-        &gpu.device,
-        &gpu.queue,
-        EmbeddedAoConfig {
-            width: W,
-            height: H,
-            settings: AoSettings {
-                radius: Some(0.5),
-                ..AoSettings::default()
-            },
-            ..EmbeddedAoConfig::default()
-        },
-    )
-    .unwrap();
+    let mut ao = build(&|_| {}).unwrap();
     let mut encode = |i: AoInputs<'_>| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let e = ao.encode(&mut encoder, &i).err().map(|e| e.to_string());
@@ -459,21 +444,7 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
 
     // the smallest windows build and run (one MIP level, a blur wider than the image)
     for size in [[1, 1], [3, 2]] {
-        let mut ao = EmbeddedAo::new(
-            &gpu.adapter,
-            &gpu.device,
-            &gpu.queue,
-            EmbeddedAoConfig {
-                width: size[0],
-                height: size[1],
-                settings: AoSettings {
-                    radius: Some(0.5),
-                    ..AoSettings::default()
-                },
-                ..EmbeddedAoConfig::default()
-            },
-        )
-        .unwrap();
+        let mut ao = build(&|c| [c.width, c.height] = size).unwrap();
         let (d, n) = (
             texture(size, F::Depth32Float, usage, 1),
             texture(size, F::Rgba16Float, usage, 1),

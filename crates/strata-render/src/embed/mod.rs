@@ -279,12 +279,51 @@ fn is_depth(format: wgpu::TextureFormat) -> bool {
     )
 }
 
+/// The methods every embedded technique has, over its `core`, `stage` and `config`.
+macro_rules! embedded_common {
+    ($t:ty, $config:ty) => {
+        impl $t {
+            /// Reads layer 0 of target `name` back as floats (after the submitted frames),
+            /// for tests and debugging: the output, `zpack`, `npack`, `zmip`, ….
+            pub fn read_target(&self, name: &str) -> Result<strata_scene::ImageBuf, RenderError> {
+                self.core.read_target(name)
+            }
+
+            /// GPU milliseconds per pass of the last submitted frame (waits for it). Empty
+            /// unless the application's device has `TIMESTAMP_QUERY |
+            /// TIMESTAMP_QUERY_INSIDE_ENCODERS`.
+            pub fn timings(&self) -> Result<crate::PassTimings, RenderError> {
+                self.core.timings()
+            }
+
+            /// The pass names `encode` records, in order.
+            pub fn pass_names(&self) -> Vec<&'static str> {
+                self.core.pass_names(self.stage.passes())
+            }
+
+            /// Forget the temporal history (a camera cut, a new scene): the next frame
+            /// starts afresh, and so do the radiosity's progressive bounces.
+            pub fn reset_history(&mut self) {
+                self.core.reset_history();
+            }
+
+            /// The application's config.
+            pub fn config(&self) -> &$config {
+                &self.config
+            }
+        }
+    };
+}
+pub(crate) use embedded_common;
+
 /// The AO passes of `strata render --technique ao` on an application's G-buffer.
 pub struct EmbeddedAo {
     core: Core,
     config: EmbeddedAoConfig,
     stage: AoStage,
 }
+
+embedded_common!(EmbeddedAo, EmbeddedAoConfig);
 
 impl EmbeddedAo {
     /// Builds the passes for `config` on the application's device. Errors name the
@@ -362,23 +401,6 @@ impl EmbeddedAo {
         self.core.targets.try_get(name).map(|t| &t.texture)
     }
 
-    /// Reads layer 0 of target `name` back as floats (after the submitted frames), for
-    /// tests and debugging: `ao`, `zpack`, `npack`, `ao-raw`, ….
-    pub fn read_target(&self, name: &str) -> Result<strata_scene::ImageBuf, RenderError> {
-        self.core.read_target(name)
-    }
-
-    /// GPU milliseconds per pass of the last submitted frame (waits for it). Empty unless
-    /// the application's device has `TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`.
-    pub fn timings(&self) -> Result<crate::PassTimings, RenderError> {
-        self.core.timings()
-    }
-
-    /// The pass names [`EmbeddedAo::encode`] records, in order.
-    pub fn pass_names(&self) -> Vec<&'static str> {
-        self.core.pass_names(self.stage.passes())
-    }
-
     /// Rebuilds the passes for a new render size (a resized window), keeping the rest of
     /// the config; the temporal history starts afresh. On error the old size stays.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
@@ -390,16 +412,6 @@ impl EmbeddedAo {
         let gpu = &self.core.gpu;
         *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
         Ok(())
-    }
-
-    /// Forget the temporal history (a camera cut, a new scene): the next frame starts afresh.
-    pub fn reset_history(&mut self) {
-        self.core.reset_history();
-    }
-
-    /// The application's config.
-    pub fn config(&self) -> &EmbeddedAoConfig {
-        &self.config
     }
 
     /// Records this frame's AO into `encoder` and writes its uniforms with the queue: submit

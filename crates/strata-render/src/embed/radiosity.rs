@@ -73,6 +73,8 @@ pub struct EmbeddedRadiosity {
     stage: RadiosityStage,
 }
 
+super::embedded_common!(EmbeddedRadiosity, EmbeddedRadiosityConfig);
+
 impl EmbeddedRadiosity {
     /// Builds the passes for `config` on the application's device. Errors name the
     /// parameter and its valid range.
@@ -175,32 +177,6 @@ impl EmbeddedRadiosity {
     /// A view of [`EmbeddedRadiosity::output`] to bind in the application's composite.
     pub fn output_view(&self) -> &wgpu::TextureView {
         &self.core.targets.get("indirect").view
-    }
-
-    /// Reads layer 0 of target `name` back as floats (after the submitted frames), for
-    /// tests and debugging: `indirect`, `indirect-raw`, `radiosity0`, `zpack`, ….
-    pub fn read_target(&self, name: &str) -> Result<strata_scene::ImageBuf, RenderError> {
-        self.core.read_target(name)
-    }
-
-    /// GPU milliseconds per pass of the last submitted frame (as [`super::EmbeddedAo::timings`]).
-    pub fn timings(&self) -> Result<crate::PassTimings, RenderError> {
-        self.core.timings()
-    }
-
-    /// The pass names [`EmbeddedRadiosity::encode`] records, in order.
-    pub fn pass_names(&self) -> Vec<&'static str> {
-        self.core.pass_names(self.stage.passes())
-    }
-
-    /// Forget the temporal history and the progressive bounces (a camera cut).
-    pub fn reset_history(&mut self) {
-        self.core.reset_history();
-    }
-
-    /// The application's config.
-    pub fn config(&self) -> &EmbeddedRadiosityConfig {
-        &self.config
     }
 
     /// Records this frame's radiosity into `encoder` and writes its uniforms with the
