@@ -283,6 +283,12 @@ fn is_depth(format: wgpu::TextureFormat) -> bool {
 macro_rules! embedded_common {
     ($t:ty, $config:ty) => {
         impl $t {
+            /// Any intermediate target by its `strata render --list-passes` name (`zpack`,
+            /// `npack`, `zmip`, `ao-raw`, `indirect-raw`, …), for debugging.
+            pub fn target(&self, name: &str) -> Option<&wgpu::Texture> {
+                self.core.targets.try_get(name).map(|t| &t.texture)
+            }
+
             /// Reads layer 0 of target `name` back as floats (after the submitted frames),
             /// for tests and debugging: the output, `zpack`, `npack`, `zmip`, ….
             pub fn read_target(&self, name: &str) -> Result<strata_scene::ImageBuf, RenderError> {
@@ -393,12 +399,6 @@ impl EmbeddedAo {
     /// A view of [`EmbeddedAo::output`] to bind in the application's lighting pass.
     pub fn output_view(&self) -> &wgpu::TextureView {
         &self.core.targets.get("ao").view
-    }
-
-    /// Any intermediate target by its `strata render --list-passes` name (`zpack`,
-    /// `npack`, `zmip`, `ao-raw`, …), for debugging.
-    pub fn target(&self, name: &str) -> Option<&wgpu::Texture> {
-        self.core.targets.try_get(name).map(|t| &t.texture)
     }
 
     /// Rebuilds the passes for a new render size (a resized window), keeping the rest of
