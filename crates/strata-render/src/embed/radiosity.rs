@@ -27,7 +27,8 @@ pub struct EmbeddedRadiosityConfig {
     /// Deep G-buffer layers k: 1, or 2 with a second layer's inputs each frame.
     pub layers: u32,
     /// The radiosity settings of `strata render --technique full`; `radius` (the
-    /// world-space gather radius) is required. Probe settings are not read.
+    /// world-space gather radius) is required. Probe settings are not read, nor is
+    /// `boost`: Eq. 7 acts in the composite, which is the application's.
     pub settings: RadiositySettings,
     /// Δz of the application's second layer, world units (DGB §2's minimum separation;
     /// the gather's `tap-visibility` test takes it as the layers' thickness). Default 0.5,
