@@ -1241,12 +1241,14 @@ fn soak_500_frames_keeps_memory_flat() {
 }
 
 /// Every other registered technique soaks flat too (`full` has the 500-frame test above):
-/// 120 frames of `glasshouse` (transparent and opaque surfaces, so the A-buffer
+/// 160 frames of `glasshouse` (transparent and opaque surfaces, so the A-buffer
 /// techniques have lists to build) with 2 layers, sampled every 40 frames. wgpu's
-/// allocations stay the same and resident memory grows ≤ 1 % after the first sample.
-/// Measured 2026-11-29: 0 % for each at 64×36, and at 128×72 for 300 frames (atrium,
-/// glasshouse for the A-buffer techniques, cornell for `bzb-gi`) 0 % but for one-time
-/// steps of 0.35–0.67 % before frame 150.
+/// allocations stay the same. Resident memory grows ≤ 2 % after the first sample, and not
+/// in every interval: a leak grows each interval, while the process's allocator takes a
+/// one-time step now and then (measured 2026-11-29: 0 % for each at 64×36; at 128×72 for
+/// 300 frames, one-time steps of 0.35–0.67 % before frame 150; and one clean-clone CI run
+/// failed the earlier "≤ 1 % over 120 frames" rule on `ao` with a single 1.1 MiB step,
+/// 1.004 %, at frame 120).
 #[test]
 fn every_technique_soaks_flat() {
     let cache = scratch("soak-every-cache");
@@ -1265,7 +1267,7 @@ fn every_technique_soaks_flat() {
                 "--height",
                 "36",
                 "--frames",
-                "120",
+                "160",
                 "--sample-every",
                 "40",
                 "--json",
@@ -1273,14 +1275,21 @@ fn every_technique_soaks_flat() {
             &cache,
         ));
         let samples = v["samples"].as_array().expect("samples");
-        assert_eq!(samples.len(), 3, "{} {v}", t.name);
+        assert_eq!(samples.len(), 4, "{} {v}", t.name);
         let gpu: Vec<u64> = samples
             .iter()
             .map(|s| s["gpu_allocated_bytes"].as_u64().expect("wgpu's allocator report"))
             .collect();
         assert!(gpu.iter().all(|&b| b == gpu[0]), "{}: wgpu allocations {gpu:?}", t.name);
         let growth = v["rss_growth_percent"].as_f64().unwrap();
-        assert!(growth <= 1.0, "{}: resident memory grew {growth:.2} %: {v}", t.name);
+        assert!(growth <= 2.0, "{}: resident memory grew {growth:.2} %: {v}", t.name);
+        let rss: Vec<u64> = samples
+            .iter()
+            .map(|s| s["rss_bytes"].as_u64().expect("VmRSS"))
+            .collect();
+        // a leak of 1.6 KB a frame or more grows each 40-frame interval by 64 KiB or more
+        let flat = rss.windows(2).any(|w| w[1] <= w[0] + 64 * 1024);
+        assert!(flat, "{}: resident memory grew in every interval {rss:?}: {v}", t.name);
     }
 }
 
