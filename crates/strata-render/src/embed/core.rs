@@ -24,8 +24,22 @@ struct ImportUniforms {
     _pad: [u32; 2],
 }
 
-/// The shading inputs of one layer: albedo and outgoing radiance (`EmbeddedRadiosity`).
-pub(crate) type Shading<'a> = (TextureLayer<'a>, TextureLayer<'a>);
+/// The shading inputs of one layer: its albedo (`EmbeddedRadiosity`; `None` where the
+/// technique does not read it) and its outgoing radiance.
+pub(crate) type Shading<'a> = (Option<TextureLayer<'a>>, TextureLayer<'a>);
+
+/// Which per-layer shading inputs [`Core`] imports besides depth, normals and motion.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ShadingImport {
+    /// Depth and normals only (AO).
+    None,
+    /// Each layer's normal, albedo ρ and radiosity B (`normal`, `albedo`, `radiosity0/1`).
+    Radiosity,
+    /// Each layer's normal and outgoing radiance (layer 0's in `hdr`, layer 1's in
+    /// `radiosity1`), and layer 0's roughness and metallic from channels `roughness` and
+    /// `metallic` of a material texture (into `normal`'s b, a).
+    Reflections { roughness: u32, metallic: u32 },
+}
 
 /// What an input texture holds, for [`Core::check`].
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -46,10 +60,11 @@ pub(crate) struct CoreConfig {
     pub layers: u32,
     pub normals: NormalEncoding,
     pub normal_space: NormalSpace,
-    pub mip_levels: u32,
-    /// Also import each layer's normal, albedo and radiance (`normal`, `albedo`,
-    /// `radiosity0/1`), and keep motion for every layer.
-    pub shading: bool,
+    /// Levels of the depth MIP chain `zmip`; `None`: no chain (a technique that reads
+    /// full-resolution depth only).
+    pub mip_levels: Option<u32>,
+    /// The shading inputs imported per layer; with any, motion is kept for every layer.
+    pub shading: ShadingImport,
 }
 
 pub(crate) struct Core {
@@ -65,12 +80,14 @@ pub(crate) struct Core {
     geometry: wgpu::RenderPipeline,
     /// One per layer (empty without shading).
     shading: Vec<wgpu::RenderPipeline>,
+    /// The target each layer's radiance goes to.
+    radiance_targets: Vec<&'static str>,
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     /// Zeros at the render size: bound where the application gives no motion texture, and
     /// for the shading inputs a technique does not read.
     zeros: wgpu::TextureView,
-    mip: DepthMipPass,
+    mip: Option<DepthMipPass>,
     pub history: HistoryPass,
     /// Per-pass GPU time where the application's device has timestamp queries inside
     /// encoders (`TIMESTAMP_QUERY | TIMESTAMP_QUERY_INSIDE_ENCODERS`).
@@ -111,6 +128,17 @@ impl Core {
     fn build(gpu: GpuContext, c: CoreConfig, scene: strata_scene::Scene) -> Self {
         use wgpu::TextureFormat as F;
         let (w, h, layers) = (c.width, c.height, c.layers);
+        let shading = c.shading != ShadingImport::None;
+        let radiance_targets: Vec<&'static str> = match c.shading {
+            ShadingImport::None => Vec::new(),
+            ShadingImport::Radiosity => crate::passes::lighting::RADIOSITY.to_vec(),
+            ShadingImport::Reflections { .. } => vec!["hdr", crate::passes::lighting::RADIOSITY[1]],
+        };
+        let radiance_targets: Vec<_> = radiance_targets.into_iter().take(layers as usize).collect();
+        let radiance_format = |name: &str| match name {
+            "hdr" => F::Rgba16Float,
+            _ => crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+        };
         let scene_gpu = GpuScene::new(&gpu, &scene);
         let mut targets = Targets::new(w, h);
         let mut imported = vec![
@@ -135,16 +163,16 @@ impl Core {
             TargetDesc::new(
                 "motion",
                 F::Rgba16Float,
-                if c.shading { layers } else { 1 },
+                if shading { layers } else { 1 },
                 "world-space motion since last frame (layer 0's from the application, others 0)",
             ),
         ];
-        if c.shading {
+        if shading {
             imported.push(TargetDesc::new(
                 "normal",
                 F::Rgba8Unorm,
                 layers,
-                "rg = Oct16 world normal per layer",
+                "rg = Oct16 world normal, b = roughness, a = metallic per layer",
             ));
             imported.push(TargetDesc::new(
                 "albedo",
@@ -152,20 +180,22 @@ impl Core {
                 layers,
                 "diffuse albedo ρ per layer",
             ));
-            for name in crate::passes::lighting::RADIOSITY.iter().take(layers as usize) {
+            for name in &radiance_targets {
                 imported.push(TargetDesc::new(
                     name,
-                    crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+                    radiance_format(name),
                     1,
-                    "DGB Table 1: the layer's radiosity B (the application's outgoing diffuse radiance)",
+                    "the layer's outgoing radiance from the application (DGB Table 1's radiosity B)",
                 ));
             }
         }
         for d in imported {
             targets.create(&gpu, d);
         }
-        targets.create(&gpu, DepthMipSettings { levels: c.mip_levels }.output(layers, w, h));
-        let mip = DepthMipPass::new(&gpu, &targets, layers);
+        let mip = c.mip_levels.map(|levels| {
+            targets.create(&gpu, DepthMipSettings { levels }.output(layers, w, h));
+            DepthMipPass::new(&gpu, &targets, layers)
+        });
 
         let device = &gpu.device;
         let depth_entry = |binding| wgpu::BindGroupLayoutEntry {
@@ -192,6 +222,7 @@ impl Core {
                 colour(7),
                 colour(8),
                 colour(9),
+                colour(10),
             ],
         });
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -205,13 +236,20 @@ impl Core {
             NormalEncoding::Unsigned => 1.0,
             NormalEncoding::Octahedral => 2.0,
         };
-        let constants = [
-            ("NORMALS", normals),
-            ("VIEW_SPACE", (c.normal_space == NormalSpace::View) as u32 as f64),
-        ];
+        let (material, roughness, metallic) = match c.shading {
+            ShadingImport::Reflections { roughness, metallic } => (1.0, roughness as f64, metallic as f64),
+            _ => (0.0, 1.0, 2.0),
+        };
         let pipeline = |entry: &str, layer: u32, formats: &[F]| {
             let color: Vec<_> = formats.iter().map(|f| Some(wgpu::ColorTargetState::from(*f))).collect();
-            let constants = [constants[0], constants[1], ("LAYER", layer as f64)];
+            let constants = [
+                ("NORMALS", normals),
+                ("VIEW_SPACE", (c.normal_space == NormalSpace::View) as u32 as f64),
+                ("LAYER", layer as f64),
+                ("MATERIAL", if layer == 0 { material } else { 0.0 }),
+                ("ROUGHNESS", roughness),
+                ("METALLIC", metallic),
+            ];
             crate::passes::fullscreen_pipeline_with(device, "embed-import", &pl, &module, entry, &constants, &color)
         };
         let mut formats = vec![F::Rg32Float, F::Rgba8Unorm, F::R32Float, F::Rgba16Float];
@@ -219,15 +257,14 @@ impl Core {
             formats.push(F::R32Float);
         }
         let geometry = pipeline(if layers == 2 { "fs_import2" } else { "fs_import1" }, 0, &formats);
-        let per_layer = [
-            F::Rgba8Unorm,
-            F::Rgba8UnormSrgb,
-            crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
-        ];
-        let shading = match c.shading {
-            true => (0..layers).map(|j| pipeline("fs_shading", j, &per_layer)).collect(),
-            false => Vec::new(),
-        };
+        let shading_pipelines = radiance_targets
+            .iter()
+            .enumerate()
+            .map(|(j, name)| {
+                let per_layer = [F::Rgba8Unorm, F::Rgba8UnormSrgb, radiance_format(name)];
+                pipeline("fs_shading", j as u32, &per_layer)
+            })
+            .collect();
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("embed-import"),
             size: std::mem::size_of::<ImportUniforms>() as u64,
@@ -262,7 +299,8 @@ impl Core {
             layers,
             what: c.what,
             geometry,
-            shading,
+            shading: shading_pipelines,
+            radiance_targets,
             layout,
             uniforms,
             zeros,
@@ -342,9 +380,14 @@ impl Core {
         Ok(())
     }
 
-    /// Checks the G-buffer inputs and the shading inputs (one pair per layer where the
-    /// technique reads them), and reads the camera.
-    pub fn check_inputs(&self, inputs: &AoInputs<'_>, shading: &[Shading<'_>]) -> Result<CameraModel, RenderError> {
+    /// Checks the G-buffer inputs, the shading inputs (one pair per layer where the
+    /// technique reads them) and the material texture, and reads the camera.
+    pub fn check_inputs(
+        &self,
+        inputs: &AoInputs<'_>,
+        shading: &[Shading<'_>],
+        material: Option<TextureLayer<'_>>,
+    ) -> Result<CameraModel, RenderError> {
         let what = self.what;
         self.check("depth", inputs.depth, Kind::Depth)?;
         self.check("normals", inputs.normals, Kind::Vector)?;
@@ -367,8 +410,13 @@ impl Core {
         }
         for (j, (albedo, radiance)) in shading.iter().enumerate() {
             let layer = if j == 0 { "" } else { "second " };
-            self.check(&format!("{layer}albedo"), *albedo, Kind::Colour)?;
+            if let Some(albedo) = albedo {
+                self.check(&format!("{layer}albedo"), *albedo, Kind::Colour)?;
+            }
             self.check(&format!("{layer}radiance"), *radiance, Kind::Colour)?;
+        }
+        if let Some(m) = material {
+            self.check("material", m, Kind::Vector)?;
         }
         if let Some(m) = inputs.motion {
             self.check("motion", m, Kind::Vector)?;
@@ -431,6 +479,7 @@ impl Core {
         encoder: &mut wgpu::CommandEncoder,
         inputs: &AoInputs<'_>,
         shading: &[Shading<'_>],
+        material: Option<TextureLayer<'_>>,
         stage: Vec<&dyn Pass>,
     ) {
         let depth0 = Self::view(inputs.depth, true);
@@ -440,11 +489,12 @@ impl Core {
             None => (depth0.clone(), normal0.clone()),
         };
         let motion = inputs.motion.map(|m| Self::view(m, false));
-        let shade: Vec<wgpu::TextureView> = shading
+        let shade: Vec<Option<wgpu::TextureView>> = shading
             .iter()
-            .flat_map(|(a, r)| [Self::view(*a, false), Self::view(*r, false)])
+            .flat_map(|(a, r)| [a.map(|a| Self::view(a, false)), Some(Self::view(*r, false))])
             .collect();
-        let shade_at = |i: usize| shade.get(i).unwrap_or(&self.zeros);
+        let shade_at = |i: usize| shade.get(i).and_then(|v| v.as_ref()).unwrap_or(&self.zeros);
+        let material = material.map(|m| Self::view(m, false));
         use wgpu::BindingResource as R;
         let group = crate::passes::bind_group(
             &self.gpu.device,
@@ -461,6 +511,7 @@ impl Core {
                 R::TextureView(shade_at(1)),
                 R::TextureView(shade_at(2)),
                 R::TextureView(shade_at(3)),
+                R::TextureView(material.as_ref().unwrap_or(&self.zeros)),
             ],
         );
         let t = &self.targets;
@@ -484,13 +535,13 @@ impl Core {
                 let outputs = [
                     &t.get("normal").layer_views[j],
                     &t.get("albedo").layer_views[j],
-                    &t.get(crate::passes::lighting::RADIOSITY[j]).view,
+                    &t.get(self.radiance_targets[j]).view,
                 ];
                 crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &outputs, &[&group]);
             }
             prof.end(encoder, slot);
         }
-        let mut passes: Vec<&dyn Pass> = vec![&self.mip];
+        let mut passes: Vec<&dyn Pass> = self.mip.iter().map(|m| m as &dyn Pass).collect();
         passes.extend(stage);
         passes.push(&self.history);
         for p in passes {
@@ -508,7 +559,7 @@ impl Core {
         if !self.shading.is_empty() {
             v.push("embed-import-shading");
         }
-        v.push(self.mip.info().name);
+        v.extend(self.mip.iter().map(|m| m.info().name));
         v.extend(stage.iter().map(|p| p.info().name));
         v.push(self.history.info().name);
         v

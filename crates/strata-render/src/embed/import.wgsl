@@ -1,8 +1,9 @@
 // The application's G-buffer → strata's deep G-buffer layout (DGB Table 1): camera-space
 // z of each layer from its hardware depth and projection, Oct16 world normals, and the
 // layer-0 world motion the temporal filter follows (`fs_import*`, every embedded
-// technique); each layer's normal, albedo and radiosity B (`fs_shading`, the embedded
-// radiosity). `embed::core`.
+// technique); each layer's normal, albedo and radiance (`fs_shading`: the radiosity B of
+// the embedded radiosity, the outgoing radiance of the embedded reflections, which also
+// take layer 0's roughness and metallic from a material texture). `embed::core`.
 #import "common/fullscreen.wgsl"
 #import "common/packing.wgsl"
 
@@ -34,6 +35,13 @@ struct Import {
 @group(0) @binding(7) var radiance0: texture_2d<f32>;
 @group(0) @binding(8) var albedo1: texture_2d<f32>;
 @group(0) @binding(9) var radiance1: texture_2d<f32>;
+// layer 0's material (roughness and metallic in channels ROUGHNESS and METALLIC)
+@group(0) @binding(10) var material0: texture_2d<f32>;
+
+// 1: this layer's roughness and metallic come from `material0` (0: both 0)
+override MATERIAL: u32 = 0u;
+override ROUGHNESS: u32 = 1u;
+override METALLIC: u32 = 2u;
 
 // camera-space z of hardware depth d at pixel p (0 = no surface): the projection inverted
 fn csz_of_depth(p: vec2i, d: f32) -> f32 {
@@ -115,17 +123,22 @@ fn fs_import2(@builtin(position) pos: vec4f) -> Two {
     return o;
 }
 
-// the deep G-buffer's `normal` (rg = Oct16, ba = roughness, metallic: 0), `albedo` (a = 1)
-// and `radiosity<j>` of one layer
+// the deep G-buffer's `normal` (rg = Oct16, ba = roughness, metallic), `albedo` (a = 1)
+// and radiance of one layer
 struct Layer {
     normal: vec4f,
     albedo: vec4f,
     radiosity: vec4f,
 }
 
-fn shading_of(normal: vec4f, albedo: vec4f, radiance: vec4f) -> Layer {
+fn shading_of(p: vec2i, normal: vec4f, albedo: vec4f, radiance: vec4f) -> Layer {
+    var rm = vec2f(0.0);
+    if (MATERIAL == 1u) {
+        let m = textureLoad(material0, p, 0);
+        rm = clamp(vec2f(m[ROUGHNESS], m[METALLIC]), vec2f(0.0), vec2f(1.0));
+    }
     return Layer(
-        vec4f(oct_of(normal), 0.0, 0.0),
+        vec4f(oct_of(normal), rm),
         vec4f(clamp(albedo.rgb, vec3f(0.0), vec3f(1.0)), 1.0),
         vec4f(max(radiance.rgb, vec3f(0.0)), 1.0),
     );
@@ -145,9 +158,9 @@ fn fs_shading(@builtin(position) pos: vec4f) -> Shading {
     let p = vec2i(pos.xy);
     var l: Layer;
     if (LAYER == 0u) {
-        l = shading_of(textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
+        l = shading_of(p, textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
     } else {
-        l = shading_of(textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
+        l = shading_of(p, textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
     }
     return Shading(l.normal, l.albedo, l.radiosity);
 }

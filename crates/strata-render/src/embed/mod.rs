@@ -46,8 +46,10 @@ use glam::{Mat4, Vec3, Vec4};
 
 mod core;
 mod radiosity;
+mod reflections;
 
 pub use radiosity::{EmbeddedRadiosity, EmbeddedRadiosityConfig, RadiosityInputs};
+pub use reflections::{EmbeddedReflections, EmbeddedReflectionsConfig, MaterialChannels, ReflectionInputs};
 
 use self::core::{Core, CoreConfig};
 use crate::frame::{FrameUniforms, Pass};
@@ -317,6 +319,18 @@ macro_rules! embedded_common {
             pub fn config(&self) -> &$config {
                 &self.config
             }
+
+            /// Rebuilds the passes for a new render size (a resized window), keeping the
+            /// rest of the config; the temporal history starts afresh. On error the old
+            /// size stays.
+            pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+                let mut config = self.config.clone();
+                config.width = width;
+                config.height = height;
+                let gpu = &self.core.gpu;
+                *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
+                Ok(())
+            }
         }
     };
 }
@@ -356,8 +370,8 @@ impl EmbeddedAo {
             layers: config.layers,
             normals: config.normals,
             normal_space: config.normal_space,
-            mip_levels: s.mips.levels,
-            shading: false,
+            mip_levels: Some(s.mips.levels),
+            shading: self::core::ShadingImport::None,
         };
         Core::scoped(device, || {
             let mut core = Core::new(adapter, device, queue, core, scene)?;
@@ -401,24 +415,11 @@ impl EmbeddedAo {
         &self.core.targets.get("ao").view
     }
 
-    /// Rebuilds the passes for a new render size (a resized window), keeping the rest of
-    /// the config; the temporal history starts afresh. On error the old size stays.
-    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
-        let config = EmbeddedAoConfig {
-            width,
-            height,
-            ..self.config.clone()
-        };
-        let gpu = &self.core.gpu;
-        *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
-        Ok(())
-    }
-
     /// Records this frame's AO into `encoder` and writes its uniforms with the queue: submit
     /// `encoder` before the next call. Inputs are checked first; a bad one is a one-line
     /// error and nothing is recorded.
     pub fn encode(&mut self, encoder: &mut wgpu::CommandEncoder, inputs: &AoInputs<'_>) -> Result<(), RenderError> {
-        let cam = self.core.check_inputs(inputs, &[])?;
+        let cam = self.core.check_inputs(inputs, &[], None)?;
         let (frame, has_history): (FrameUniforms, bool) = self.core.begin(inputs, &cam);
         let gpu = &self.core.gpu;
         let u = AoUniforms::new(
@@ -433,7 +434,7 @@ impl EmbeddedAo {
             t.set_frame(gpu, has_history);
         }
         let passes: Vec<&dyn Pass> = self.stage.passes();
-        self.core.record(encoder, inputs, &[], passes);
+        self.core.record(encoder, inputs, &[], None, passes);
         Ok(())
     }
 }

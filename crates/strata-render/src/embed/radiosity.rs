@@ -115,8 +115,8 @@ impl EmbeddedRadiosity {
             layers: config.layers,
             normals: config.normals,
             normal_space: config.normal_space,
-            mip_levels: s.mips.levels,
-            shading: true,
+            mip_levels: Some(s.mips.levels),
+            shading: super::core::ShadingImport::Radiosity,
         };
         Core::scoped(device, || {
             let mut core = Core::new(adapter, device, queue, core, scene)?;
@@ -188,9 +188,9 @@ impl EmbeddedRadiosity {
         encoder: &mut wgpu::CommandEncoder,
         inputs: &RadiosityInputs<'_>,
     ) -> Result<(), RenderError> {
-        let mut shading: Vec<Shading<'_>> = vec![(inputs.albedo, inputs.radiance)];
+        let mut shading: Vec<Shading<'_>> = vec![(Some(inputs.albedo), inputs.radiance)];
         match (self.config.layers, inputs.second) {
-            (2, Some(second)) => shading.push(second),
+            (2, Some((albedo, radiance))) => shading.push((Some(albedo), radiance)),
             (2, None) => return Err(RenderError::Parameter(
                 "embedded radiosity: 2 layers need RadiosityInputs::second (the second layer's albedo and radiance)"
                     .into(),
@@ -202,7 +202,7 @@ impl EmbeddedRadiosity {
             }
             _ => {}
         }
-        let cam = self.core.check_inputs(&inputs.gbuffer, &shading)?;
+        let cam = self.core.check_inputs(&inputs.gbuffer, &shading, None)?;
         let (frame, has_history): (FrameUniforms, bool) = self.core.begin(&inputs.gbuffer, &cam);
         let gpu = &self.core.gpu;
         let u = RadiosityUniforms::new(
@@ -221,7 +221,7 @@ impl EmbeddedRadiosity {
             t.set_frame(gpu, has_history);
         }
         let passes: Vec<&dyn Pass> = self.stage.passes();
-        self.core.record(encoder, &inputs.gbuffer, &shading, passes);
+        self.core.record(encoder, &inputs.gbuffer, &shading, None, passes);
         Ok(())
     }
 }

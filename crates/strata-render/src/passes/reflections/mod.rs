@@ -49,6 +49,12 @@ impl ReflectionSettings {
                 self.steps
             ));
         }
+        if !(0.0..=1.0).contains(&self.max_roughness) {
+            return Err(format!(
+                "reflection max_roughness {} is out of range: must be in 0..=1",
+                self.max_roughness
+            ));
+        }
         if let Some(t) = self.thickness {
             if !(t > 0.0 && t.is_finite()) {
                 return Err(format!("reflection thickness {t} is out of range: must be > 0"));
@@ -98,11 +104,11 @@ impl ReflectionPass {
         input: &'static str,
         settings: &ReflectionSettings,
     ) -> Self {
-        // one layer: the binding holds layer 0's radiosity, never read
+        // one layer: the binding holds the input, never read
         let (layer1, declared) = if layers > 1 {
             ("radiosity1", "radiosity1")
         } else {
-            ("radiosity0", "")
+            (input, "")
         };
         let mut b = PassBuilder::new(gpu, targets, "reflections")
             .shader("reflections", include_str!("reflections.wgsl"))

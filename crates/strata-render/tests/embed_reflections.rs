@@ -1,0 +1,262 @@
+//! `strata_render::embed::EmbeddedReflections`: DGB §3.6's mirror reflections on an
+//! application's G-buffer. Fed the renderer's own layers (hardware depth, Oct16 normals,
+//! the material in the normal target's b and a, the shaded image and the second layer's
+//! radiance), it finds what the renderer's pass finds; bad inputs are one-line errors.
+
+mod common;
+
+use strata_render::embed::{
+    AoInputs, EmbeddedReflections, EmbeddedReflectionsConfig, MaterialChannels, NormalEncoding, ReflectionInputs,
+    TextureLayer,
+};
+use strata_render::frame::FrameCameras;
+use strata_render::passes::reflections::ReflectionSettings;
+use strata_render::{GpuContext, RenderSettings, Renderer};
+use strata_scene::{ImageBuf, Scene};
+
+const W: u32 = 160;
+const H: u32 = 120;
+
+/// The `mirror` scene without its sky: the embedded pass leaves the environment to the
+/// application (rgb 0 where a ray finds nothing).
+fn mirror_scene() -> Scene {
+    let mut scene = strata_scene::procedural::builtin("mirror").unwrap();
+    scene.camera_path = None;
+    for o in &mut scene.objects {
+        o.animation = None;
+    }
+    scene.settings.sky = [0.0; 3];
+    scene
+}
+
+fn embedded(gpu: &GpuContext, scene: &Scene, layers: u32) -> EmbeddedReflections {
+    EmbeddedReflections::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedReflectionsConfig {
+            width: W,
+            height: H,
+            layers,
+            min_separation: scene.settings.min_separation,
+            normals: NormalEncoding::Octahedral,
+            // the renderer's `normal` target: rg = Oct16, b = roughness, a = metallic
+            material: MaterialChannels {
+                roughness: 2,
+                metallic: 3,
+            },
+            ..EmbeddedReflectionsConfig::default()
+        },
+    )
+    .expect("the embedded reflections build without validation errors")
+}
+
+/// Per code (a), how many pixels; and pixels whose codes differ.
+fn codes(img: &ImageBuf) -> [usize; 4] {
+    let mut n = [0; 4];
+    for p in img.data.chunks_exact(4) {
+        n[p[3] as usize] += 1;
+    }
+    n
+}
+
+#[test]
+fn embedded_reflections_on_the_renderers_layers_are_the_renderers() {
+    let gpu = common::gpu();
+    let scene = mirror_scene();
+    let cams = FrameCameras::fixed(scene.camera);
+    let (view, proj) = (scene.camera.view(), scene.camera.projection(W as f32 / H as f32));
+    let mut hidden = Vec::new();
+    for layers in [1, 2] {
+        let settings = RenderSettings {
+            reflections: Some(ReflectionSettings::default()),
+            ..common::peeled_layers(&scene, W, H, layers)
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+        let mut refl = embedded(&gpu, &scene, layers);
+        r.render(&gpu, &scene, &cams, 0.0).unwrap();
+        let t = |n| r.target_texture(n).unwrap();
+        let layer = |n, layer| TextureLayer { texture: t(n), layer };
+        let inputs = ReflectionInputs {
+            gbuffer: AoInputs {
+                second: (layers == 2).then(|| (layer("depth", 1), layer("normal", 1))),
+                ..AoInputs::new(layer("depth", 0), layer("normal", 0), view, proj)
+            },
+            material: layer("normal", 0),
+            radiance: layer("hdr", 0),
+            second_radiance: (layers == 2).then(|| layer("radiosity1", 0)),
+        };
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        refl.encode(&mut encoder, &inputs).expect("valid inputs");
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+
+        let (a, b) = (
+            refl.read_target("reflection").unwrap(),
+            r.read_target(&gpu, "reflection").unwrap(),
+        );
+        let (ca, cb) = (codes(&a), codes(&b));
+        let mirrors = cb[1] + cb[2] + cb[3];
+        let (mut other_code, mut sum, mut ref_sum) = (0usize, 0.0f64, 0.0f64);
+        for (pa, pb) in a.data.chunks(4).zip(b.data.chunks(4)) {
+            if pa[3] != pb[3] {
+                other_code += 1;
+                continue;
+            }
+            for k in 0..3 {
+                sum += (pa[k] - pb[k]).abs() as f64;
+                ref_sum += pb[k].abs() as f64;
+            }
+        }
+        let rel = sum / ref_sum.max(1e-9);
+        println!(
+            "k = {layers}: codes (none, env, layer 0, layer 1) embedded {ca:?}, renderer {cb:?}; {other_code} px differ in code, mean |Δ| / mean = {rel:.2e}"
+        );
+        assert!(mirrors > (W * H) as usize / 5, "the mirror floor covers {mirrors} px");
+        assert_eq!(ca[0], cb[0], "the same pixels are mirrors (material import)");
+        assert!(cb[2] > mirrors / 4, "rays hit layer 0 ({} of {mirrors})", cb[2]);
+        // the imported z is within ~1e-5 of the renderer's: a ray grazing an edge may flip
+        assert!(
+            other_code * 500 <= mirrors,
+            "k = {layers}: {other_code} of {mirrors} mirror pixels found something else"
+        );
+        assert!(rel < 2e-3, "k = {layers}: reflected radiance differs ({rel})");
+        if layers == 1 {
+            assert_eq!(ca[3], 0, "one layer cannot hit layer 1");
+        }
+        hidden.push(ca[3]);
+    }
+    assert!(
+        hidden[1] > 20,
+        "2 layers reflect the panel hidden behind the board ({} px)",
+        hidden[1]
+    );
+}
+
+/// Bad configurations and inputs are one-line errors naming the parameter.
+#[test]
+fn bad_embedded_reflections_input_is_a_one_line_error() {
+    use wgpu::TextureFormat as F;
+    let gpu = common::gpu();
+    let config = EmbeddedReflectionsConfig {
+        width: W,
+        height: H,
+        ..EmbeddedReflectionsConfig::default()
+    };
+    let new = |f: &dyn Fn(&mut EmbeddedReflectionsConfig)| {
+        let mut c = config.clone();
+        f(&mut c);
+        EmbeddedReflections::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
+    };
+    let one_line = |e: String, words: &[&str]| {
+        assert!(!e.contains('\n'), "one line: {e}");
+        for w in words {
+            assert!(e.contains(w), "'{e}' names '{w}'");
+        }
+    };
+    let err = |f: &dyn Fn(&mut EmbeddedReflectionsConfig)| new(f).err().expect("an error").to_string();
+    one_line(
+        err(&|c| c.material.metallic = 4),
+        &["embedded reflections", "material.metallic channel 4", "0..=3"],
+    );
+    one_line(err(&|c| c.min_separation = 0.0), &["min_separation 0", "> 0"]);
+    one_line(err(&|c| c.settings.steps = 0), &["embedded reflections", "steps 0", "1..=1024"]);
+    one_line(err(&|c| c.settings.max_roughness = 2.0), &["max_roughness 2", "0..=1"]);
+    one_line(err(&|c| c.layers = 3), &["layers 3", "1..=2"]);
+    one_line(err(&|c| c.width = 0), &["size 0x120"]);
+
+    let texture = |format| {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("app"),
+            size: wgpu::Extent3d {
+                width: W,
+                height: H,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+    };
+    let (depth, normals) = (texture(F::Depth32Float), texture(F::Rgba16Float));
+    let (material, srgb, hdr) = (texture(F::Rgba8Unorm), texture(F::Rgba8UnormSrgb), texture(F::Rgba16Float));
+    let cam = strata_scene::Camera::default();
+    let gbuffer = AoInputs::new(
+        (&depth).into(),
+        (&normals).into(),
+        cam.view(),
+        cam.projection(W as f32 / H as f32),
+    );
+    let ok = ReflectionInputs {
+        gbuffer,
+        material: (&material).into(),
+        radiance: (&hdr).into(),
+        second_radiance: None,
+    };
+    let mut refl = new(&|_| {}).unwrap();
+    let mut encode = |i: ReflectionInputs<'_>| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let e = refl.encode(&mut encoder, &i).err().map(|e| e.to_string());
+        gpu.queue.submit([encoder.finish()]);
+        e
+    };
+    one_line(
+        encode(ReflectionInputs {
+            material: (&srgb).into(),
+            ..ok
+        })
+        .expect("an error"),
+        &["embedded reflections: material has format Rgba8UnormSrgb", "linear twin"],
+    );
+    one_line(
+        encode(ReflectionInputs {
+            second_radiance: Some((&hdr).into()),
+            ..ok
+        })
+        .expect("an error"),
+        &["ReflectionInputs::second_radiance", "1 layer"],
+    );
+    one_line(
+        encode(ReflectionInputs {
+            radiance: (&depth).into(),
+            ..ok
+        })
+        .expect("an error"),
+        &["embedded reflections: radiance has format Depth32Float"],
+    );
+    // an sRGB radiance (a display-referred image) is decoded and taken
+    assert_eq!(
+        encode(ReflectionInputs {
+            radiance: (&srgb).into(),
+            ..ok
+        }),
+        None
+    );
+    assert_eq!(encode(ok), None);
+    gpu.check_errors().expect("no wgpu validation errors");
+
+    let mut two = new(&|c| c.layers = 2).unwrap();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let e = two
+        .encode(
+            &mut encoder,
+            &ReflectionInputs {
+                gbuffer: AoInputs {
+                    second: Some(((&depth).into(), (&normals).into())),
+                    ..gbuffer
+                },
+                ..ok
+            },
+        )
+        .unwrap_err()
+        .to_string();
+    one_line(e, &["2 layers need ReflectionInputs::second_radiance"]);
+    // resizing keeps the config and checks the new size
+    two.resize(64, 48).unwrap();
+    assert_eq!((two.config().width, two.config().height, two.config().layers), (64, 48, 2));
+    one_line(two.resize(0, 48).unwrap_err().to_string(), &["size 0x48"]);
+    assert_eq!(two.config().width, 64, "the old size stays on error");
+}
