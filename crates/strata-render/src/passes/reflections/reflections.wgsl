@@ -59,23 +59,26 @@ fn layer_depths(s: vec4f) -> vec2f {
     return z;
 }
 
-// The first layer whose surface the ray sample `s` lies behind by at most the
-// allowance: Δz, or — when the previous sample (depth prev_z, surface depths
-// prev_zl) was in front of that layer — the depth the ray and the surface
-// moved apart over the step, so no step jumps over a layer. -1: none.
-fn hit_layer(s: vec4f, prev_z: f32, prev_zl: vec2f) -> i32 {
-    let zl = layer_depths(s);
-    for (var j = 0u; j < min(LAYERS, 2u); j++) {
-        let zj = zl[j];
-        var allowance = refl.thickness;
-        if (prev_z < prev_zl[j]) {
-            allowance = max(allowance, abs(s.z - prev_z) + abs(zj - prev_zl[j]));
-        }
-        if (zj > 0.0 && s.z >= zj && s.z <= zj + allowance) {
-            return i32(j);
-        }
+// Whether ray sample `s` lies behind layer j's surface by at most the allowance: Δz, or —
+// when the previous sample (depth prev_z, surface depths prev_zl) was in front of that
+// layer — the depth the ray and the surface moved apart over the step, so no step jumps
+// over a layer. A candidate only: `confirmed` applies the paper's test.
+fn behind_layer(j: u32, s: vec4f, prev_z: f32, prev_zl: vec2f) -> bool {
+    let zj = layer_depths(s)[j];
+    var allowance = refl.thickness;
+    if (prev_z < prev_zl[j]) {
+        allowance = max(allowance, abs(s.z - prev_z) + abs(zj - prev_zl[j]));
     }
-    return -1;
+    return zj > 0.0 && s.z >= zj && s.z <= zj + allowance;
+}
+
+// DGB §3.6's hit test at the refined point `sh`, `slack` the ray's depth change over
+// the bisection's last interval: within [z, z + Δz] of layer j. A candidate that fails
+// it crossed a silhouette more than Δz behind the surface (the ray passes behind an
+// edge, where the second layer may hold what it sees): the march goes on.
+fn confirmed(j: u32, sh: vec4f, slack: f32) -> bool {
+    let zj = layer_depths(sh)[j];
+    return zj > 0.0 && sh.z >= zj && sh.z <= zj + refl.thickness + slack;
 }
 
 @fragment
@@ -123,29 +126,39 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
                 break;
             }
         }
-        let hit = hit_layer(s, prev_z, prev_zl);
-        if (hit >= 0) {
+        var hit = -1;
+        for (var j = 0u; j < min(LAYERS, 2u) && hit < 0; j++) {
+            if (!behind_layer(j, s, prev_z, prev_zl)) {
+                continue;
+            }
             // refine between the previous and this step: the first point behind
             var lo = step * f32(i - 1u);
             var hi = length(q - x);
-            for (var k = 0; k < 5; k++) {
+            for (var k = 0; k < 6; k++) {
                 let mid = 0.5 * (lo + hi);
                 let sm = project(x + r * mid);
-                if (sm.w >= 0.0 && hit_layer(sm, prev_z, prev_zl) == hit) {
+                if (sm.w >= 0.0 && behind_layer(j, sm, prev_z, prev_zl)) {
                     hi = mid;
                 } else {
                     lo = mid;
                 }
             }
             let sh = project(x + r * hi);
+            let slack = abs(sh.z - dot(x + r * lo - frame.eye.xyz, frame.cam_forward.xyz));
+            if (!confirmed(j, sh, slack)) {
+                continue;
+            }
+            hit = i32(j);
             let t = vec2i(sh.xy);
-            if (hit == 0) {
+            if (j == 0u) {
                 l = textureLoad(radiance0, t, 0).rgb;
                 code = 2.0;
             } else {
                 l = textureLoad(radiance1, t, 0).rgb;
                 code = 3.0;
             }
+        }
+        if (hit >= 0) {
             break;
         }
         if (leaving) {
