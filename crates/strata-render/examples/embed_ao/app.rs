@@ -1,9 +1,10 @@
 //! The examples' "application": its device, its boxes, and its own G-buffer, drawn with plain
 //! wgpu: hardware depth and a normal texture from world-space triangles; DGB's second
 //! layer, peeled with a minimum separation (§2); and, lit by a sun without shadows, each
-//! layer's albedo and outgoing diffuse radiance. Nothing here is strata's; the `embed_ao`
-//! and `embed_gi` examples and `tests/embed*.rs` draw their G-buffers with it.
-// two examples and three tests share this file, each using part of it
+//! layer's albedo, material (glTF's roughness in g, metallic in b) and outgoing diffuse
+//! radiance. Nothing here is strata's; the `embed_*` examples and `tests/embed*.rs` draw
+//! their G-buffers with it.
+// three examples and three tests share this file, each using part of it
 #![allow(dead_code)]
 
 use glam::{Mat4, Vec3};
@@ -58,8 +59,39 @@ pub fn open_device(
     Ok((adapter, device, queue))
 }
 
-/// A box's 12 triangles of one albedo (outward normals, counter-clockwise from outside).
-pub fn cuboid(lo: Vec3, hi: Vec3, albedo: Vec3) -> Vec<Triangle> {
+/// A surface's material: diffuse albedo (a metal's F0), roughness and metallic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surface {
+    pub albedo: Vec3,
+    pub roughness: f32,
+    pub metallic: f32,
+}
+
+impl Surface {
+    /// A polished metal: metallic 1, roughness 0, F0 = `albedo`.
+    pub fn mirror(albedo: Vec3) -> Self {
+        Self {
+            albedo,
+            roughness: 0.0,
+            metallic: 1.0,
+        }
+    }
+}
+
+impl From<Vec3> for Surface {
+    /// A rough dielectric of diffuse albedo `albedo`.
+    fn from(albedo: Vec3) -> Self {
+        Self {
+            albedo,
+            roughness: 1.0,
+            metallic: 0.0,
+        }
+    }
+}
+
+/// A box's 12 triangles of one surface (outward normals, counter-clockwise from outside).
+pub fn cuboid(lo: Vec3, hi: Vec3, surface: impl Into<Surface>) -> Vec<Triangle> {
+    let surface = surface.into();
     let c = |i: usize| {
         Vec3::new(
             if i & 1 != 0 { hi.x } else { lo.x },
@@ -81,8 +113,8 @@ pub fn cuboid(lo: Vec3, hi: Vec3, albedo: Vec3) -> Vec<Triangle> {
         .flat_map(|(q, n)| {
             let p = q.map(c);
             [
-                ([p[0], p[1], p[2]], [*n; 3], albedo),
-                ([p[0], p[2], p[3]], [*n; 3], albedo),
+                ([p[0], p[1], p[2]], [*n; 3], surface),
+                ([p[0], p[2], p[3]], [*n; 3], surface),
             ]
         })
         .collect()
@@ -105,8 +137,8 @@ pub struct Sun {
     pub irradiance: Vec3,
 }
 
-/// A triangle: world-space corners, their normals, and its diffuse albedo.
-pub type Triangle = ([Vec3; 3], [Vec3; 3], Vec3);
+/// A triangle: world-space corners, their normals, and its surface.
+pub type Triangle = ([Vec3; 3], [Vec3; 3], Surface);
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -130,6 +162,8 @@ struct Vertex {
     position: [f32; 3],
     normal: [f32; 3],
     albedo: [f32; 3],
+    /// roughness, metallic
+    material: [f32; 2],
 }
 
 const SHADER: &str = r#"
@@ -142,10 +176,12 @@ struct U {
 // csz: the distance in front of the (right-handed) camera
 struct V {
     @builtin(position) pos: vec4f, @location(0) n: vec3f, @location(1) csz: f32,
-    @location(2) albedo: vec3f,
+    @location(2) albedo: vec3f, @location(3) material: vec2f,
 }
-@vertex fn vs(@location(0) p: vec3f, @location(1) n: vec3f, @location(2) albedo: vec3f) -> V {
-    return V(u.view_proj * vec4f(p, 1.0), n, -(u.view * vec4f(p, 1.0)).z, albedo);
+@vertex fn vs(
+    @location(0) p: vec3f, @location(1) n: vec3f, @location(2) albedo: vec3f, @location(3) material: vec2f,
+) -> V {
+    return V(u.view_proj * vec4f(p, 1.0), n, -(u.view * vec4f(p, 1.0)).z, albedo, material);
 }
 // the second layer (DGB §2): the nearest surface more than Δz behind the first layer's
 fn behind_first(v: V) -> bool {
@@ -169,15 +205,21 @@ fn world_normal(v: V, front: bool) -> vec3f {
     }
     return encoded(world_normal(v, front));
 }
-struct Lit { @location(0) normal: vec4f, @location(1) albedo: vec4f, @location(2) radiance: vec4f }
-// the G-buffer and the sun's Lambertian outgoing radiance B = ρ/π · E · max(0, n·l)
+struct Lit {
+    @location(0) normal: vec4f, @location(1) albedo: vec4f, @location(2) radiance: vec4f,
+    @location(3) material: vec4f,
+}
+// the G-buffer and the sun's Lambertian outgoing radiance B = (1 − metallic) ρ/π · E ·
+// max(0, n·l) (a metal reflects only specularly); the material as glTF's (1, roughness,
+// metallic)
 @fragment fn fs_lit(v: V, @builtin(front_facing) front: bool) -> Lit {
     if (u.peel.y != 0.0 && !behind_first(v)) {
         discard;
     }
     let n = world_normal(v, front);
-    let b = v.albedo / 3.14159265 * u.sun.rgb * max(dot(n, u.sun_direction.xyz), 0.0);
-    return Lit(encoded(n), vec4f(v.albedo, 1.0), vec4f(b, 1.0));
+    let diffuse = v.albedo * (1.0 - v.material.y);
+    let b = diffuse / 3.14159265 * u.sun.rgb * max(dot(n, u.sun_direction.xyz), 0.0);
+    return Lit(encoded(n), vec4f(v.albedo, 1.0), vec4f(b, 1.0), vec4f(1.0, v.material, 1.0));
 }
 fn encoded(world: vec3f) -> vec4f {
     var n = world;
@@ -198,6 +240,8 @@ pub struct GBuffer {
     /// Lit G-buffers: diffuse albedo (`Rgba8UnormSrgb`) and outgoing diffuse radiance
     /// (`Rgba16Float`).
     pub shading: Option<(wgpu::Texture, wgpu::Texture)>,
+    /// Lit G-buffers: the material (`Rgba8Unorm`; g = roughness, b = metallic, as glTF).
+    pub material: Option<wgpu::Texture>,
     sun: Option<Sun>,
     layout: Layout,
     /// Peeling behind another G-buffer's depth: Δz.
@@ -332,6 +376,7 @@ impl GBuffer {
         if sun.is_some() {
             targets.push(Some(wgpu::TextureFormat::Rgba8UnormSrgb.into()));
             targets.push(Some(wgpu::TextureFormat::Rgba16Float.into()));
+            targets.push(Some(wgpu::TextureFormat::Rgba8Unorm.into()));
         }
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("app-gbuffer"),
@@ -343,7 +388,9 @@ impl GBuffer {
                 buffers: &[Some(wgpu::VertexBufferLayout {
                     array_stride: std::mem::size_of::<Vertex>() as u64,
                     step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3],
+                    attributes: &wgpu::vertex_attr_array![
+                        0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x2
+                    ],
                 })],
             },
             primitive: wgpu::PrimitiveState {
@@ -373,11 +420,12 @@ impl GBuffer {
         });
         let verts: Vec<Vertex> = triangles
             .iter()
-            .flat_map(|(p, n, albedo)| {
+            .flat_map(|(p, n, surface)| {
                 (0..3).map(move |k| Vertex {
                     position: p[k].to_array(),
                     normal: n[k].to_array(),
-                    albedo: albedo.to_array(),
+                    albedo: surface.albedo.to_array(),
+                    material: [surface.roughness, surface.metallic],
                 })
             })
             .collect();
@@ -387,6 +435,7 @@ impl GBuffer {
                 texture("app-radiance", wgpu::TextureFormat::Rgba16Float),
             )
         });
+        let material = sun.map(|_| texture("app-material", wgpu::TextureFormat::Rgba8Unorm));
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("app-triangles"),
             contents: bytemuck::cast_slice(&verts),
@@ -396,6 +445,7 @@ impl GBuffer {
             depth,
             normals,
             shading,
+            material,
             sun,
             layout,
             min_separation: first.map(|f| f.1),
@@ -438,6 +488,9 @@ impl GBuffer {
             views.push(albedo.create_view(&Default::default()));
             views.push(radiance.create_view(&Default::default()));
         }
+        if let Some(material) = &self.material {
+            views.push(material.create_view(&Default::default()));
+        }
         let attachments: Vec<_> = views
             .iter()
             .map(|view| {
@@ -475,12 +528,20 @@ impl GBuffer {
     }
 }
 
-/// A strata scene's triangles at frame 0 with their materials' albedo: the tests draw
-/// strata's scenes as an application would.
+/// A strata scene's triangles at frame 0 with their materials: the tests draw strata's
+/// scenes as an application would.
 pub fn scene_triangles(scene: &strata_scene::Scene) -> Vec<Triangle> {
     scene
         .world_triangles(0.0)
         .iter()
-        .map(|t| (t.p, t.n, Vec3::from(scene.materials[t.material as usize].base_color)))
+        .map(|t| {
+            let m = &scene.materials[t.material as usize];
+            let surface = Surface {
+                albedo: Vec3::from(m.base_color),
+                roughness: m.roughness,
+                metallic: m.metallic,
+            };
+            (t.p, t.n, surface)
+        })
         .collect()
 }

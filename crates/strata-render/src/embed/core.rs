@@ -36,7 +36,7 @@ pub(crate) enum ShadingImport {
     /// Each layer's normal, albedo ρ and radiosity B (`normal`, `albedo`, `radiosity0/1`).
     Radiosity,
     /// Each layer's normal and outgoing radiance (layer 0's in `hdr`, layer 1's in
-    /// `radiosity1`), and layer 0's roughness and metallic from channels `roughness` and
+    /// `radiosity1`, both `Rgba16Float`), and layer 0's roughness and metallic from channels `roughness` and
     /// `metallic` of a material texture (into `normal`'s b, a).
     Reflections { roughness: u32, metallic: u32 },
 }
@@ -135,9 +135,11 @@ impl Core {
             ShadingImport::Reflections { .. } => vec!["hdr", crate::passes::lighting::RADIOSITY[1]],
         };
         let radiance_targets: Vec<_> = radiance_targets.into_iter().take(layers as usize).collect();
-        let radiance_format = |name: &str| match name {
-            "hdr" => F::Rgba16Float,
-            _ => crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+        // the radiosity's B in DGB Table 1's format; the reflections' radiance in one every
+        // device renders to (RG11B10 needs a feature) and that holds it exactly
+        let radiance_format = |_: &str| match c.shading {
+            ShadingImport::Radiosity => crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
+            _ => F::Rgba16Float,
         };
         let scene_gpu = GpuScene::new(&gpu, &scene);
         let mut targets = Targets::new(w, h);
