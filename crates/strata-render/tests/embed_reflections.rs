@@ -4,6 +4,8 @@
 //! radiance), it finds what the renderer's pass finds; bad inputs are one-line errors.
 
 mod common;
+#[path = "../examples/embed_ao/app.rs"]
+mod app;
 
 use strata_render::embed::{
     AoInputs, EmbeddedReflections, EmbeddedReflectionsConfig, MaterialChannels, NormalEncoding, ReflectionInputs,
@@ -131,6 +133,89 @@ fn embedded_reflections_on_the_renderers_layers_are_the_renderers() {
         "2 layers reflect the panel hidden behind the board ({} px)",
         hidden[1]
     );
+}
+
+/// An application's own G-buffer of the `mirror` scene (its pipeline and peel, signed world
+/// normals, glTF's material texture) finds what the renderer's pass finds at ≥ 99 % of the
+/// mirror pixels, the hidden panel with 2 layers included. Its lighting is its own, so only
+/// what each ray found (a) is compared.
+#[test]
+fn embedded_reflections_on_an_applications_gbuffer_find_the_renderers_hits() {
+    let gpu = common::gpu();
+    let scene = mirror_scene();
+    let cams = FrameCameras::fixed(scene.camera);
+    let (view, proj) = (scene.camera.view(), scene.camera.projection(W as f32 / H as f32));
+    let tris = app::scene_triangles(&scene);
+    let sun = app::Sun {
+        direction: glam::Vec3::new(0.3, 1.0, 0.8),
+        irradiance: glam::Vec3::splat(3.0),
+    };
+    let dz = scene.settings.min_separation;
+    // strata's camera: a reversed, infinite projection
+    let layout = app::Layout {
+        reversed: true,
+        ..app::Layout::standard()
+    };
+    let first = app::GBuffer::lit(&gpu.device, [W, H], layout, &tris, sun);
+    let second = app::GBuffer::second_layer_lit(&gpu.device, &first, dz, &tris);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    first.draw(&gpu.queue, &mut encoder, view, proj);
+    second.draw(&gpu.queue, &mut encoder, view, proj);
+    gpu.queue.submit([encoder.finish()]);
+    let ((_, b0), (_, b1)) = (first.shading.as_ref().unwrap(), second.shading.as_ref().unwrap());
+    for layers in [1, 2] {
+        let settings = RenderSettings {
+            reflections: Some(ReflectionSettings::default()),
+            ..common::peeled_layers(&scene, W, H, layers)
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+        r.render(&gpu, &scene, &cams, 0.0).unwrap();
+        let reference = r.read_target(&gpu, "reflection").unwrap();
+        let mut refl = EmbeddedReflections::new(
+            &gpu.adapter,
+            &gpu.device,
+            &gpu.queue,
+            EmbeddedReflectionsConfig {
+                width: W,
+                height: H,
+                layers,
+                min_separation: dz,
+                ..EmbeddedReflectionsConfig::default()
+            },
+        )
+        .unwrap();
+        let inputs = ReflectionInputs {
+            gbuffer: AoInputs {
+                second: (layers == 2).then(|| ((&second.depth).into(), (&second.normals).into())),
+                ..AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj)
+            },
+            material: first.material.as_ref().unwrap().into(),
+            radiance: b0.into(),
+            second_radiance: (layers == 2).then(|| b1.into()),
+        };
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        refl.encode(&mut encoder, &inputs).expect("valid inputs");
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+        let ours = refl.read_target("reflection").unwrap();
+        let (ca, cb) = (codes(&ours), codes(&reference));
+        let mirrors = cb[1] + cb[2] + cb[3];
+        let same = ours
+            .data
+            .chunks(4)
+            .zip(reference.data.chunks(4))
+            .filter(|(a, b)| b[3] > 0.0 && a[3] == b[3])
+            .count();
+        println!("k = {layers}: codes application {ca:?}, renderer {cb:?}; {same} of {mirrors} mirror px agree");
+        assert!(mirrors > (W * H) as usize / 5);
+        assert!(
+            same as f64 >= 0.99 * mirrors as f64,
+            "k = {layers}: {same} of {mirrors} agree"
+        );
+        if layers == 2 {
+            assert!(ca[3] > 20, "the hidden panel is reflected ({} px)", ca[3]);
+        }
+    }
 }
 
 /// Bad configurations and inputs are one-line errors naming the parameter.

@@ -137,7 +137,7 @@ impl Core {
         let radiance_targets: Vec<_> = radiance_targets.into_iter().take(layers as usize).collect();
         // the radiosity's B in DGB Table 1's format; the reflections' radiance in one every
         // device renders to (RG11B10 needs a feature) and that holds it exactly
-        let radiance_format = |_: &str| match c.shading {
+        let radiance_format = match c.shading {
             ShadingImport::Radiosity => crate::passes::deep_gbuffer::RADIOSITY_FORMAT,
             _ => F::Rgba16Float,
         };
@@ -185,7 +185,7 @@ impl Core {
             for name in &radiance_targets {
                 imported.push(TargetDesc::new(
                     name,
-                    radiance_format(name),
+                    radiance_format,
                     1,
                     "the layer's outgoing radiance from the application (DGB Table 1's radiosity B)",
                 ));
@@ -259,13 +259,9 @@ impl Core {
             formats.push(F::R32Float);
         }
         let geometry = pipeline(if layers == 2 { "fs_import2" } else { "fs_import1" }, 0, &formats);
-        let shading_pipelines = radiance_targets
-            .iter()
-            .enumerate()
-            .map(|(j, name)| {
-                let per_layer = [F::Rgba8Unorm, F::Rgba8UnormSrgb, radiance_format(name)];
-                pipeline("fs_shading", j as u32, &per_layer)
-            })
+        let per_layer = [F::Rgba8Unorm, F::Rgba8UnormSrgb, radiance_format];
+        let shading_pipelines = (0..radiance_targets.len() as u32)
+            .map(|j| pipeline("fs_shading", j, &per_layer))
             .collect();
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("embed-import"),
