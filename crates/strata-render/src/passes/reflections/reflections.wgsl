@@ -63,8 +63,9 @@ fn layer_depths(s: vec4f) -> vec2f {
 // when the previous sample (depth prev_z, surface depths prev_zl) was in front of that
 // layer — the depth the ray and the surface moved apart over the step, so no step jumps
 // over a layer. A candidate only: `confirmed` applies the paper's test.
-fn behind_layer(j: u32, s: vec4f, prev_z: f32, prev_zl: vec2f) -> bool {
-    let zj = layer_depths(s)[j];
+// `zl`: the layers' depths at the sample's pixel.
+fn behind_layer(j: u32, s: vec4f, zl: vec2f, prev_z: f32, prev_zl: vec2f) -> bool {
+    let zj = zl[j];
     var allowance = refl.thickness;
     if (prev_z < prev_zl[j]) {
         allowance = max(allowance, abs(s.z - prev_z) + abs(zj - prev_zl[j]));
@@ -127,8 +128,9 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             }
         }
         var hit = -1;
+        let zl = layer_depths(s);
         for (var j = 0u; j < min(LAYERS, 2u) && hit < 0; j++) {
-            if (!behind_layer(j, s, prev_z, prev_zl)) {
+            if (!behind_layer(j, s, zl, prev_z, prev_zl)) {
                 continue;
             }
             // refine between the previous and this step: the first point behind
@@ -137,7 +139,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             for (var k = 0; k < 6; k++) {
                 let mid = 0.5 * (lo + hi);
                 let sm = project(x + r * mid);
-                if (sm.w >= 0.0 && behind_layer(j, sm, prev_z, prev_zl)) {
+                if (sm.w >= 0.0 && behind_layer(j, sm, layer_depths(sm), prev_z, prev_zl)) {
                     hi = mid;
                 } else {
                     lo = mid;
@@ -165,7 +167,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
             break;
         }
         prev_z = s.z;
-        prev_zl = layer_depths(s);
+        prev_zl = zl;
     }
     // Fresnel at normal incidence: the metal's albedo (F0)
     let f0 = mix(vec3f(0.04), textureLoad(albedo, p, 0, 0).rgb, nrm.a);
