@@ -3,9 +3,9 @@
 //! the material in the normal target's b and a, the shaded image and the second layer's
 //! radiance), it finds what the renderer's pass finds; bad inputs are one-line errors.
 
-mod common;
 #[path = "../examples/embed_ao/app.rs"]
 mod app;
+mod common;
 
 use strata_render::embed::{
     AoInputs, EmbeddedReflections, EmbeddedReflectionsConfig, MaterialChannels, NormalEncoding, ReflectionInputs,
@@ -245,7 +245,10 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
         &["embedded reflections", "material.metallic channel 4", "0..=3"],
     );
     one_line(err(&|c| c.min_separation = 0.0), &["min_separation 0", "> 0"]);
-    one_line(err(&|c| c.settings.steps = 0), &["embedded reflections", "steps 0", "1..=1024"]);
+    one_line(
+        err(&|c| c.settings.steps = 0),
+        &["embedded reflections", "steps 0", "1..=1024"],
+    );
     one_line(err(&|c| c.settings.max_roughness = 2.0), &["max_roughness 2", "0..=1"]);
     one_line(err(&|c| c.layers = 3), &["layers 3", "1..=2"]);
     one_line(err(&|c| c.width = 0), &["size 0x120"]);
@@ -267,7 +270,11 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
         })
     };
     let (depth, normals) = (texture(F::Depth32Float), texture(F::Rgba16Float));
-    let (material, srgb, hdr) = (texture(F::Rgba8Unorm), texture(F::Rgba8UnormSrgb), texture(F::Rgba16Float));
+    let (material, srgb, hdr) = (
+        texture(F::Rgba8Unorm),
+        texture(F::Rgba8UnormSrgb),
+        texture(F::Rgba16Float),
+    );
     let cam = strata_scene::Camera::default();
     let gbuffer = AoInputs::new(
         (&depth).into(),
@@ -294,7 +301,10 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
             ..ok
         })
         .expect("an error"),
-        &["embedded reflections: material has format Rgba8UnormSrgb", "linear twin"],
+        &[
+            "embedded reflections: material has format Rgba8UnormSrgb",
+            "linear twin",
+        ],
     );
     one_line(
         encode(ReflectionInputs {
@@ -341,7 +351,10 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
     one_line(e, &["2 layers need ReflectionInputs::second_radiance"]);
     // resizing keeps the config and checks the new size
     two.resize(64, 48).unwrap();
-    assert_eq!((two.config().width, two.config().height, two.config().layers), (64, 48, 2));
+    assert_eq!(
+        (two.config().width, two.config().height, two.config().layers),
+        (64, 48, 2)
+    );
     one_line(two.resize(0, 48).unwrap_err().to_string(), &["size 0x48"]);
     assert_eq!(two.config().width, 64, "the old size stays on error");
 }

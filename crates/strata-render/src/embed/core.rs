@@ -541,7 +541,9 @@ impl Core {
         }
         let mut passes: Vec<&dyn Pass> = self.mip.iter().map(|m| m as &dyn Pass).collect();
         passes.extend(stage);
-        passes.push(&self.history);
+        if !self.history.copies.is_empty() {
+            passes.push(&self.history);
+        }
         for p in passes {
             let slot = prof.begin(encoder, p.info().name);
             p.encode(&self.gpu, &self.scene_gpu, t, encoder);
@@ -559,7 +561,9 @@ impl Core {
         }
         v.extend(self.mip.iter().map(|m| m.info().name));
         v.extend(stage.iter().map(|p| p.info().name));
-        v.push(self.history.info().name);
+        if !self.history.copies.is_empty() {
+            v.push(self.history.info().name);
+        }
         v
     }
 

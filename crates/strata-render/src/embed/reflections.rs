@@ -114,7 +114,8 @@ impl EmbeddedReflections {
     ) -> Result<Self, RenderError> {
         let what = "embedded reflections";
         let s = &config.settings;
-        s.validate().map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
+        s.validate()
+            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
         let dz = config.min_separation;
         if !(dz > 0.0 && dz.is_finite()) {
             return Err(RenderError::Parameter(format!(
@@ -206,4 +207,3 @@ impl EmbeddedReflections {
         Ok(())
     }
 }
-
