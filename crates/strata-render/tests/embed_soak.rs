@@ -1,5 +1,5 @@
-//! `strata_render::embed` over a long run: an application that records the embedded AO and
-//! radiosity every frame for hundreds of frames (two layers, a moving camera, no `poll` but
+//! `strata_render::embed` over a long run: an application that records the embedded AO,
+//! radiosity and reflections every frame for hundreds of frames (two layers, a moving camera, no `poll` but
 //! its submits) holds its GPU allocations and resident memory flat. `encode` creates a bind group and
 //! views of the application's textures each frame; they must not pile up. Its own test
 //! binary: resident memory is per process, and other tests would move it.
@@ -10,7 +10,8 @@ mod common;
 mod app;
 
 use strata_render::embed::{
-    AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding, RadiosityInputs,
+    AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedRadiosity, EmbeddedRadiosityConfig, EmbeddedReflections,
+    EmbeddedReflectionsConfig, NormalEncoding, RadiosityInputs, ReflectionInputs,
 };
 use strata_render::passes::ao::AoSettings;
 use strata_render::passes::radiosity::RadiositySettings;
@@ -22,7 +23,7 @@ fn resident_bytes() -> u64 {
 }
 
 #[test]
-fn embedded_ao_and_radiosity_soak_flat() {
+fn embedded_ao_radiosity_and_reflections_soak_flat() {
     let gpu = common::gpu();
     let mut scene = strata_scene::procedural::builtin("atrium").unwrap();
     scene.camera_path = None;
@@ -64,6 +65,18 @@ fn embedded_ao_and_radiosity_soak_flat() {
         },
     )
     .unwrap();
+    let mut refl = EmbeddedReflections::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedReflectionsConfig {
+            width: w,
+            height: h,
+            layers: 2,
+            ..EmbeddedReflectionsConfig::default()
+        },
+    )
+    .unwrap();
     let cam = scene.camera;
     let proj =
         glam::camera::rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), w as f32 / h as f32, cam.near, 500.0);
@@ -89,6 +102,15 @@ fn embedded_ao_and_radiosity_soak_flat() {
             second: Some(((&second.normals).into(), (&second.normals).into())),
         };
         gi.encode(&mut encoder, &shading).unwrap();
+        // (the normals as the material: roughness = n.y, metallic = n.z, so the walls that
+        // face +z are mirrors and their rays march)
+        let mirrors = ReflectionInputs {
+            gbuffer: inputs,
+            material: (&first.normals).into(),
+            radiance: (&first.normals).into(),
+            second_radiance: Some((&second.normals).into()),
+        };
+        refl.encode(&mut encoder, &mirrors).unwrap();
         gpu.queue.submit([encoder.finish()]);
         if f == first_sample || f == frames {
             gpu.check_errors().expect("no wgpu validation errors");
@@ -102,6 +124,14 @@ fn embedded_ao_and_radiosity_soak_flat() {
         "frames {} → {}: resident {} → {} bytes ({growth:+.2} %), wgpu allocated {:?} → {:?}",
         a.0, b.0, a.1, b.1, a.2, b.2
     );
+    let marched = refl
+        .read_target("reflection")
+        .unwrap()
+        .data
+        .chunks(4)
+        .filter(|p| p[3] > 0.0)
+        .count();
+    assert!(marched > 0, "some pixels are mirrors, so the reflections march");
     assert_eq!(a.2, b.2, "wgpu's allocations stay the same");
     assert!(
         growth <= 1.0,
