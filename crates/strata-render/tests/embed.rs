@@ -324,35 +324,17 @@ fn bad_embedded_ao_input_is_a_one_line_error() {
         EmbeddedAo::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
     };
     let config = |f: &dyn Fn(&mut EmbeddedAoConfig)| build(f).err().map(|e| e.to_string());
-    let one_line = |e: Option<String>, words: &[&str]| {
-        let e = e.expect("an error");
-        assert!(!e.contains('\n'), "one line: {e}");
-        for w in words {
-            assert!(e.contains(w), "'{e}' names '{w}'");
-        }
-    };
+    let one_line = |e: Option<String>, words: &[&str]| common::assert_one_line(&e.expect("an error"), words);
     one_line(config(&|c| c.settings.radius = None), &["settings.radius", "> 0"]);
     one_line(config(&|c| c.settings.radius = Some(-1.0)), &["radius", "> 0"]);
     one_line(config(&|c| c.layers = 3), &["layers 3", "1..=2"]);
     one_line(config(&|c| c.width = 0), &["size 0x90", "width and height"]);
-    one_line(config(&|c| c.settings.samples = 0), &["samples", "1..=256"]);
+    one_line(
+        config(&|c| c.settings.samples = 0),
+        &["embedded AO: ", "samples", "1..=256"],
+    );
 
-    let texture = |size: [u32; 2], format, usage, samples| {
-        gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("app"),
-            size: wgpu::Extent3d {
-                width: size[0],
-                height: size[1],
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: samples,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-    };
+    let texture = |size, format, usage, samples| common::app_texture(&gpu, size, format, usage, samples);
     let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
     let depth = texture([W, H], F::Depth32Float, usage, 1);
     let normals = texture([W, H], F::Rgba16Float, usage, 1);

@@ -128,12 +128,7 @@ fn bad_embedded_radiosity_input_is_a_one_line_error() {
         f(&mut c);
         EmbeddedRadiosity::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
     };
-    let one_line = |e: String, words: &[&str]| {
-        assert!(!e.contains('\n'), "one line: {e}");
-        for w in words {
-            assert!(e.contains(w), "'{e}' names '{w}'");
-        }
-    };
+    let one_line = |e: String, words: &[&str]| common::assert_one_line(&e, words);
     let err = |f: &dyn Fn(&mut EmbeddedRadiosityConfig)| new(f).err().expect("an error").to_string();
     one_line(
         err(&|c| c.settings.radius = None),
@@ -141,24 +136,9 @@ fn bad_embedded_radiosity_input_is_a_one_line_error() {
     );
     one_line(err(&|c| c.min_separation = -1.0), &["min_separation -1", ">= 0"]);
     one_line(err(&|c| c.layers = 0), &["layers 0", "1..=2"]);
-    one_line(err(&|c| c.settings.samples = 0), &["samples"]);
+    one_line(err(&|c| c.settings.samples = 0), &["embedded radiosity: ", "samples"]);
 
-    let texture = |format| {
-        gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("app"),
-            size: wgpu::Extent3d {
-                width: W,
-                height: H,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        })
-    };
+    let texture = |format| common::app_texture(&gpu, [W, H], format, wgpu::TextureUsages::TEXTURE_BINDING, 1);
     let (depth, normals) = (texture(F::Depth32Float), texture(F::Rgba16Float));
     let (srgb, hdr, integer) = (texture(F::Rgba8UnormSrgb), texture(F::Rgba16Float), texture(F::R32Uint));
     let cam = strata_scene::Camera::default();

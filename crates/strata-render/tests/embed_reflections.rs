@@ -31,7 +31,21 @@ fn mirror_scene() -> Scene {
     scene
 }
 
-fn embedded(gpu: &GpuContext, scene: &Scene, layers: u32) -> EmbeddedReflections {
+/// The embedded reflections for `scene` at W×H with `layers`, reading the renderer's
+/// G-buffer (Oct16 normals; its `normal` target as the material: b = roughness,
+/// a = metallic) or, `application`, the example application's (signed world normals,
+/// glTF's material channels).
+fn embedded(gpu: &GpuContext, scene: &Scene, layers: u32, application: bool) -> EmbeddedReflections {
+    let (normals, material) = match application {
+        false => (
+            NormalEncoding::Octahedral,
+            MaterialChannels {
+                roughness: 2,
+                metallic: 3,
+            },
+        ),
+        true => (NormalEncoding::Signed, MaterialChannels::default()),
+    };
     EmbeddedReflections::new(
         &gpu.adapter,
         &gpu.device,
@@ -41,12 +55,8 @@ fn embedded(gpu: &GpuContext, scene: &Scene, layers: u32) -> EmbeddedReflections
             height: H,
             layers,
             min_separation: scene.settings.min_separation,
-            normals: NormalEncoding::Octahedral,
-            // the renderer's `normal` target: rg = Oct16, b = roughness, a = metallic
-            material: MaterialChannels {
-                roughness: 2,
-                metallic: 3,
-            },
+            normals,
+            material,
             ..EmbeddedReflectionsConfig::default()
         },
     )
@@ -75,7 +85,7 @@ fn embedded_reflections_on_the_renderers_layers_are_the_renderers() {
             ..common::peeled_layers(&scene, W, H, layers)
         };
         let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
-        let mut refl = embedded(&gpu, &scene, layers);
+        let mut refl = embedded(&gpu, &scene, layers, false);
         r.render(&gpu, &scene, &cams, 0.0).unwrap();
         let t = |n| r.target_texture(n).unwrap();
         let layer = |n, layer| TextureLayer { texture: t(n), layer };
@@ -171,19 +181,7 @@ fn embedded_reflections_on_an_applications_gbuffer_find_the_renderers_hits() {
         let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
         r.render(&gpu, &scene, &cams, 0.0).unwrap();
         let reference = r.read_target(&gpu, "reflection").unwrap();
-        let mut refl = EmbeddedReflections::new(
-            &gpu.adapter,
-            &gpu.device,
-            &gpu.queue,
-            EmbeddedReflectionsConfig {
-                width: W,
-                height: H,
-                layers,
-                min_separation: dz,
-                ..EmbeddedReflectionsConfig::default()
-            },
-        )
-        .unwrap();
+        let mut refl = embedded(&gpu, &scene, layers, true);
         let inputs = ReflectionInputs {
             gbuffer: AoInputs {
                 second: (layers == 2).then(|| ((&second.depth).into(), (&second.normals).into())),
@@ -233,12 +231,7 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
         f(&mut c);
         EmbeddedReflections::new(&gpu.adapter, &gpu.device, &gpu.queue, c)
     };
-    let one_line = |e: String, words: &[&str]| {
-        assert!(!e.contains('\n'), "one line: {e}");
-        for w in words {
-            assert!(e.contains(w), "'{e}' names '{w}'");
-        }
-    };
+    let one_line = |e: String, words: &[&str]| common::assert_one_line(&e, words);
     let err = |f: &dyn Fn(&mut EmbeddedReflectionsConfig)| new(f).err().expect("an error").to_string();
     one_line(
         err(&|c| c.material.metallic = 4),
@@ -253,22 +246,7 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
     one_line(err(&|c| c.layers = 3), &["layers 3", "1..=2"]);
     one_line(err(&|c| c.width = 0), &["size 0x120"]);
 
-    let texture = |format| {
-        gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("app"),
-            size: wgpu::Extent3d {
-                width: W,
-                height: H,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        })
-    };
+    let texture = |format| common::app_texture(&gpu, [W, H], format, wgpu::TextureUsages::TEXTURE_BINDING, 1);
     let (depth, normals) = (texture(F::Depth32Float), texture(F::Rgba16Float));
     let (material, srgb, hdr) = (
         texture(F::Rgba8Unorm),

@@ -120,6 +120,17 @@ pub fn cuboid(lo: Vec3, hi: Vec3, surface: impl Into<Surface>) -> Vec<Triangle> 
         .collect()
 }
 
+/// Linear → 8-bit sRGB of a value tone-mapped by v / (1 + v): the examples' PNGs.
+pub fn display(v: f32) -> u8 {
+    let x = (v / (1.0 + v)).clamp(0.0, 1.0);
+    let s = if x <= 0.0031308 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
+
 /// Prints strata's per-pass GPU times, where the device measured them.
 pub fn print_timings(t: &strata_render::PassTimings) {
     if !t.passes.is_empty() {

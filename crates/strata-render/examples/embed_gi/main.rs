@@ -19,17 +19,6 @@ use glam::Vec3;
 use strata_render::embed::{AoInputs, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding, RadiosityInputs};
 use strata_render::passes::radiosity::RadiositySettings;
 
-/// Linear → 8-bit sRGB of a tone-mapped value.
-fn display(v: f32) -> u8 {
-    let x = (v / (1.0 + v)).clamp(0.0, 1.0);
-    let s = if x <= 0.0031308 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u8
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "embed-gi.png".into());
     let (width, height) = (480u32, 320u32);
@@ -120,8 +109,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             confidence += pe[3] as f64;
             for k in 0..3 {
                 let indirect = pa[k] / std::f32::consts::PI * pe[k];
-                img.get_pixel_mut(x, y)[k] = display(pb[k]);
-                img.get_pixel_mut(width + x, y)[k] = display(pb[k] + indirect);
+                img.get_pixel_mut(x, y)[k] = app::display(pb[k]);
+                img.get_pixel_mut(width + x, y)[k] = app::display(pb[k] + indirect);
             }
         }
     }

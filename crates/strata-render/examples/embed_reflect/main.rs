@@ -31,17 +31,6 @@ const SKY: Vec3 = Vec3::new(0.4, 0.5, 0.7);
 /// Δz of the application's second layer.
 const MIN_SEPARATION: f32 = 0.2;
 
-/// Linear → 8-bit sRGB of a tone-mapped value.
-fn display(v: f32) -> u8 {
-    let x = (v / (1.0 + v)).clamp(0.0, 1.0);
-    let s = if x <= 0.0031308 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u8
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "embed-reflect.png".into());
     let (width, height) = (320u32, 240u32);
@@ -142,8 +131,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 let f = if r[3] > 0.0 { MIRROR_F0 * l } else { Vec3::ZERO };
                 for k in 0..3 {
-                    img.get_pixel_mut(x, y)[k] = display(b[k]);
-                    img.get_pixel_mut(panel * width + x, y)[k] = display(b[k] + f[k]);
+                    img.get_pixel_mut(x, y)[k] = app::display(b[k]);
+                    img.get_pixel_mut(panel * width + x, y)[k] = app::display(b[k] + f[k]);
                 }
             }
         }

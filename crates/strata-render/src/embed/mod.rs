@@ -354,17 +354,19 @@ impl EmbeddedAo {
         queue: &wgpu::Queue,
         config: EmbeddedAoConfig,
     ) -> Result<Self, RenderError> {
+        let what = "embedded AO";
         let s = &config.settings;
         let radius = s.radius.ok_or_else(|| {
-            RenderError::Parameter(
-                "embedded AO: settings.radius is required: the world-space AO radius r (> 0, in the application's units)".into(),
-            )
+            RenderError::Parameter(format!(
+                "{what}: settings.radius is required: the world-space AO radius r (> 0, in the application's units)"
+            ))
         })?;
-        s.validate().map_err(RenderError::Parameter)?;
+        s.validate()
+            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
         let mut scene = strata_scene::Scene::default();
         scene.settings.ao_radius = radius;
         let core = CoreConfig {
-            what: "embedded AO",
+            what,
             width: config.width,
             height: config.height,
             layers: config.layers,

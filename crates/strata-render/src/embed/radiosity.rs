@@ -92,7 +92,8 @@ impl EmbeddedRadiosity {
                 "{what}: settings.radius is required: the world-space gather radius (> 0, in the application's units)"
             ))
         })?;
-        s.validate().map_err(RenderError::Parameter)?;
+        s.validate()
+            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
         let needed = wgpu::Features::RG11B10UFLOAT_RENDERABLE;
         if !device.features().contains(needed) {
             return Err(RenderError::Parameter(format!(

@@ -355,3 +355,38 @@ impl GatherBuffers {
         }
     }
 }
+
+/// A 2D texture of the application's, `size` texels of `format` with `usage` and `samples`:
+/// the embedded techniques' bad-input tests make their inputs with it.
+#[allow(dead_code)]
+pub fn app_texture(
+    gpu: &GpuContext,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    samples: u32,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("app"),
+        size: wgpu::Extent3d {
+            width: size[0],
+            height: size[1],
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// Asserts that error `e` is one line naming each of `words`.
+#[allow(dead_code)]
+pub fn assert_one_line(e: &str, words: &[&str]) {
+    assert!(!e.contains('\n'), "one line: {e}");
+    for w in words {
+        assert!(e.contains(w), "'{e}' names '{w}'");
+    }
+}
