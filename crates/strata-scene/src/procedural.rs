@@ -32,6 +32,7 @@ pub const BUILTIN_NAMES: &[&str] = &[
     "column-wall",
     "dense",
     "mirror",
+    "mirror-sign",
     "glasshouse",
     "still-life",
     "dominoes",
@@ -48,6 +49,7 @@ pub fn builtin(name: &str) -> Option<Scene> {
         "column-wall" => Some(column_wall()),
         "dense" => Some(dense()),
         "mirror" => Some(mirror()),
+        "mirror-sign" => Some(mirror_sign()),
         "glasshouse" => Some(glasshouse()),
         "still-life" => Some(still_life()),
         "dominoes" => Some(dominoes()),
@@ -785,6 +787,47 @@ pub fn mirror() -> Scene {
         exposure: 1.0,
         sky: [0.4, 0.5, 0.7],
         ambient: [0.03; 3],
+        probe_bounds: None,
+    };
+    b.finish(camera, vec![sun], settings)
+}
+
+/// DGB Fig. 13's situation: a foreground object between the camera and what a mirror
+/// reflects. A mirror floor (metallic 1, roughness 0) reflects a red wall 2 m behind a
+/// grey sign that hangs 0.55–1.2 m above the floor. From the camera the sign hides most
+/// of the wall's lower part; the floor's reflection rays reach that part under the sign.
+/// Only a second deep-G-buffer layer holds it. The sign is its own object (`sign`), so a
+/// test can slide it sideways. A blue back wall, a sun, a sky; no ambient light, so a
+/// diffuse surface's shaded radiance is its radiosity B in either layer.
+pub fn mirror_sign() -> Scene {
+    let mut b = SceneBuilder::new("mirror-sign");
+    let floor = b.material(Material {
+        roughness: 0.0,
+        metallic: 1.0,
+        ..Material::diffuse("mirror_floor", [0.9, 0.9, 0.9])
+    });
+    let wall = b.material(Material::diffuse("red_wall", [0.8, 0.1, 0.05]));
+    let back = b.material(Material::diffuse("back_wall", [0.3, 0.4, 0.7]));
+    let sign = b.material(Material::diffuse("sign", [0.5, 0.5, 0.5]));
+    b.geo(floor).rect(v(0.0, 0.0, 0.5), v(0.0, 0.0, 3.5), v(2.5, 0.0, 0.0));
+    b.geo(wall).cuboid(v(-1.5, 0.0, -2.1), v(1.5, 1.5, -2.0));
+    b.geo(back).rect(v(0.0, 1.5, -3.0), v(2.5, 0.0, 0.0), v(0.0, 1.5, 0.0));
+    let mut board = MeshBuilder::new();
+    board.cuboid(v(-0.6, 0.55, -0.05), v(0.6, 1.2, 0.0));
+    b.object("sign", board, sign, Mat4::IDENTITY, None);
+    let sun = Light::Sun {
+        direction: v(0.2, -1.0, -0.4).normalize(),
+        color: [1.0, 1.0, 1.0],
+        illuminance: 2.0,
+    };
+    let camera = Camera::new(v(0.0, 1.4, 4.0), v(0.0, 0.4, -1.0), Vec3::Y, 50.0, 0.05);
+    let settings = SceneSettings {
+        ao_radius: 0.5,
+        min_separation: 0.2,
+        radiosity_radius: 4.0,
+        exposure: 1.0,
+        sky: [0.4, 0.5, 0.7],
+        ambient: [0.0; 3],
         probe_bounds: None,
     };
     b.finish(camera, vec![sun], settings)
