@@ -11,6 +11,30 @@
 //! buffer or went `max_distance`: the application's environment goes there), 2 a layer-0
 //! surface, 3 a second-layer surface. The application weights it by its own Fresnel term
 //! and adds it to its image.
+//!
+//! ```no_run
+//! # fn frame(adapter: &wgpu::Adapter, device: &wgpu::Device, queue: &wgpu::Queue,
+//! #          depth: &wgpu::Texture, normals: &wgpu::Texture, material: &wgpu::Texture,
+//! #          hdr: &wgpu::Texture, view: glam::Mat4, proj: glam::Mat4)
+//! #          -> Result<(), strata_render::RenderError> {
+//! use strata_render::embed::{AoInputs, EmbeddedReflections, EmbeddedReflectionsConfig, ReflectionInputs};
+//! let mut refl = EmbeddedReflections::new(adapter, device, queue, EmbeddedReflectionsConfig {
+//!     width: 1280,
+//!     height: 720,
+//!     ..EmbeddedReflectionsConfig::default()
+//! })?;
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! // ... the application's geometry and lighting passes write its G-buffer and `hdr` ...
+//! refl.encode(&mut encoder, &ReflectionInputs {
+//!     gbuffer: AoInputs::new(depth.into(), normals.into(), view, proj),
+//!     material: material.into(),
+//!     radiance: hdr.into(),
+//!     second_radiance: None,
+//! })?;
+//! queue.submit([encoder.finish()]);
+//! // add F · refl.output() to the image where its alpha is 2 or 3, F · environment where 1
+//! # Ok(()) }
+//! ```
 
 use super::core::{Core, CoreConfig, Shading, ShadingImport};
 use super::{AoInputs, NormalEncoding, NormalSpace, TextureLayer};
