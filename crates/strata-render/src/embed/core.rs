@@ -36,8 +36,8 @@ pub(crate) enum ShadingImport {
     /// Each layer's normal, albedo ρ and radiosity B (`normal`, `albedo`, `radiosity0/1`).
     Radiosity,
     /// Each layer's normal and outgoing radiance (layer 0's in `hdr`, layer 1's in
-    /// `radiosity1`, both `Rgba16Float`), and layer 0's roughness and metallic from channels `roughness` and
-    /// `metallic` of a material texture (into `normal`'s b, a).
+    /// `radiosity1`, both `Rgba16Float`), and layer 0's roughness and metallic from
+    /// channels `roughness` and `metallic` of a material texture (into `normal`'s b, a).
     Reflections { roughness: u32, metallic: u32 },
 }
 

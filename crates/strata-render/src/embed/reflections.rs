@@ -1,5 +1,5 @@
 //! Deep-G-buffer mirror reflections (DGB §3.6) on an application's G-buffer: the pass of
-//! `strata render --set reflections=on`, a camera-space ray march tested against every
+//! `strata render --technique full`, a camera-space ray march tested against every
 //! layer, without strata's environment or composite.
 //!
 //! The application gives, per layer, depth and normals (as for [`super::EmbeddedAo`]) and
@@ -68,7 +68,7 @@ pub struct EmbeddedReflectionsConfig {
     pub height: u32,
     /// Deep G-buffer layers k: 1, or 2 with a second layer's inputs each frame.
     pub layers: u32,
-    /// The settings of `strata render --set reflections=on`. `max_distance` and
+    /// The settings of `strata render --technique full`. `max_distance` and
     /// `thickness` are in world units; `thickness: None` takes `min_separation`.
     pub settings: ReflectionSettings,
     /// Δz of the application's second layer, world units (DGB §2's minimum separation):
@@ -110,7 +110,7 @@ pub struct ReflectionInputs<'a> {
     pub second_radiance: Option<TextureLayer<'a>>,
 }
 
-/// The reflection pass of `strata render --set reflections=on` on an application's
+/// The reflection pass of `strata render --technique full` on an application's
 /// G-buffer.
 pub struct EmbeddedReflections {
     core: Core,
