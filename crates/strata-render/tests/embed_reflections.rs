@@ -137,6 +137,36 @@ fn embedded_reflections_on_the_renderers_layers_are_the_renderers() {
             assert_eq!(ca[3], 0, "one layer cannot hit layer 1");
         }
         hidden.push(ca[3]);
+
+        // an application without normals: each layer's normal from its depth
+        let config = EmbeddedReflectionsConfig {
+            normals: NormalEncoding::FromDepth,
+            ..refl.config().clone()
+        };
+        let mut from_depth = EmbeddedReflections::new(&gpu.adapter, &gpu.device, &gpu.queue, config).unwrap();
+        let depth_only = ReflectionInputs {
+            gbuffer: AoInputs {
+                second: (layers == 2).then(|| (layer("depth", 1), layer("depth", 1))),
+                ..AoInputs::depth_only(layer("depth", 0), view, proj)
+            },
+            ..inputs
+        };
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        from_depth.encode(&mut encoder, &depth_only).expect("valid inputs");
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+        let c = from_depth.read_target("reflection").unwrap();
+        let same = c
+            .data
+            .chunks(4)
+            .zip(b.data.chunks(4))
+            .filter(|(x, y)| y[3] > 0.0 && x[3] == y[3])
+            .count();
+        println!("k = {layers}, normals from depth: {same} of {mirrors} mirror px find what the renderer finds");
+        assert!(
+            same as f64 >= 0.99 * mirrors as f64,
+            "k = {layers}: {same} of {mirrors}"
+        );
     }
     assert!(
         hidden[1] > 20,

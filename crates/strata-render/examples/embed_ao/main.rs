@@ -8,6 +8,8 @@
 //!
 //! ```sh
 //! cargo run --release -p strata-render --example embed_ao -- out/embed-ao.png
+//! # an application without a normal buffer: strata reconstructs the normals from depth
+//! cargo run --release -p strata-render --example embed_ao -- out/embed-ao-depth.png --normals-from-depth
 //! ```
 
 mod app;
@@ -18,6 +20,7 @@ use strata_render::passes::ao::AoSettings;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "embed-ao.png".into());
+    let from_depth = std::env::args().any(|a| a == "--normals-from-depth");
     let (width, height) = (640u32, 360u32);
 
     // the application's device (any adapter: lavapipe where there is no GPU)
@@ -48,7 +51,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 radius: Some(0.6),
                 ..AoSettings::default()
             },
-            normals: NormalEncoding::Signed,
+            normals: if from_depth {
+                NormalEncoding::FromDepth
+            } else {
+                NormalEncoding::Signed
+            },
             ..EmbeddedAoConfig::default()
         },
     )?;
@@ -57,9 +64,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut encoder = device.create_command_encoder(&Default::default());
         first.draw(&queue, &mut encoder, view, proj);
         second.draw(&queue, &mut encoder, view, proj);
-        let inputs = AoInputs {
-            second: Some(((&second.depth).into(), (&second.normals).into())),
-            ..AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj)
+        let inputs = match from_depth {
+            false => AoInputs {
+                second: Some(((&second.depth).into(), (&second.normals).into())),
+                ..AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj)
+            },
+            true => AoInputs {
+                second: Some(((&second.depth).into(), (&second.depth).into())),
+                ..AoInputs::depth_only((&first.depth).into(), view, proj)
+            },
         };
         ao.encode(&mut encoder, &inputs)?;
         queue.submit([encoder.finish()]);

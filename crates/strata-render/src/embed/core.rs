@@ -77,6 +77,8 @@ pub(crate) struct Core {
     pub height: u32,
     pub layers: u32,
     what: &'static str,
+    /// [`NormalEncoding::FromDepth`]: the normals come from the depth.
+    normals_from_depth: bool,
     geometry: wgpu::RenderPipeline,
     /// One per layer (empty without shading).
     shading: Vec<wgpu::RenderPipeline>,
@@ -237,6 +239,7 @@ impl Core {
             NormalEncoding::Signed => 0.0,
             NormalEncoding::Unsigned => 1.0,
             NormalEncoding::Octahedral => 2.0,
+            NormalEncoding::FromDepth => 3.0,
         };
         let (material, roughness, metallic) = match c.shading {
             ShadingImport::Reflections { roughness, metallic } => (1.0, roughness as f64, metallic as f64),
@@ -296,6 +299,7 @@ impl Core {
             height: h,
             layers,
             what: c.what,
+            normals_from_depth: c.normals == NormalEncoding::FromDepth,
             geometry,
             shading: shading_pipelines,
             radiance_targets,
@@ -387,12 +391,18 @@ impl Core {
         material: Option<TextureLayer<'_>>,
     ) -> Result<CameraModel, RenderError> {
         let what = self.what;
+        // NormalEncoding::FromDepth reads no normal texture
+        let normals = !self.normals_from_depth;
         self.check("depth", inputs.depth, Kind::Depth)?;
-        self.check("normals", inputs.normals, Kind::Vector)?;
+        if normals {
+            self.check("normals", inputs.normals, Kind::Vector)?;
+        }
         match (self.layers, &inputs.second) {
             (2, Some((d, n))) => {
                 self.check("second depth", *d, Kind::Depth)?;
-                self.check("second normals", *n, Kind::Vector)?;
+                if normals {
+                    self.check("second normals", *n, Kind::Vector)?;
+                }
             }
             (2, None) => {
                 return Err(RenderError::Parameter(format!(
@@ -481,9 +491,14 @@ impl Core {
         stage: Vec<&dyn Pass>,
     ) {
         let depth0 = Self::view(inputs.depth, true);
-        let normal0 = Self::view(inputs.normals, false);
+        // NormalEncoding::FromDepth: the shader reads no normal texture
+        let normal = |n| match self.normals_from_depth {
+            true => self.zeros.clone(),
+            false => Self::view(n, false),
+        };
+        let normal0 = normal(inputs.normals);
         let (depth1, normal1) = match inputs.second {
-            Some((d, n)) => (Self::view(d, true), Self::view(n, false)),
+            Some((d, n)) => (Self::view(d, true), normal(n)),
             None => (depth0.clone(), normal0.clone()),
         };
         let motion = inputs.motion.map(|m| Self::view(m, false));

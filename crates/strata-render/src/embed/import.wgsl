@@ -7,7 +7,8 @@
 #import "common/fullscreen.wgsl"
 #import "common/packing.wgsl"
 
-// the normals' encoding: 0 = signed xyz, 1 = xyz·0.5 + 0.5, 2 = Oct16 rg in [0, 1]
+// the normals' encoding: 0 = signed xyz, 1 = xyz·0.5 + 0.5, 2 = Oct16 rg in [0, 1],
+// 3 = none: reconstructed from the layer's depth (`normal_from_depth`)
 override NORMALS: u32 = 0u;
 // 1: the normals are in view space (rotated to world space with inv_view)
 override VIEW_SPACE: u32 = 0u;
@@ -77,6 +78,75 @@ fn oct_of(t: vec4f) -> vec2f {
     return oct_encode(select(vec3f(0.0, 0.0, 1.0), n / l, l > 1e-20));
 }
 
+// View-space position of the surface in texel q of a depth texture (w = 1), or w = 0
+// where q is outside the image or holds no surface.
+fn view_position(depth: texture_depth_2d, q: vec2i) -> vec4f {
+    let size = vec2i(im.size.xy);
+    let c = clamp(q, vec2i(0), size - 1);
+    let d = textureLoad(depth, c, 0);
+    let empty = select(d >= 1.0, d <= 0.0, im.reversed != 0u);
+    let uv = (vec2f(c) + 0.5) * im.size.zw;
+    let v = im.inv_proj * vec4f(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, d, 1.0);
+    let ok = !empty && all(q == c) && abs(v.w) > 0.0;
+    return vec4f(v.xyz / select(1.0, v.w, ok), select(0.0, 1.0, ok));
+}
+
+// Hardware depth in texel q, or a value no surface extrapolates to outside the image.
+fn raw_depth(depth: texture_depth_2d, q: vec2i) -> f32 {
+    let size = vec2i(im.size.xy);
+    if (any(q < vec2i(0)) || any(q >= size)) {
+        return 1.0e30;
+    }
+    return textureLoad(depth, q, 0);
+}
+
+// The tangent along screen axis `axis` at pixel p (view position c): towards the side
+// whose two samples lie on the centre's plane. Hardware depth is affine in screen space
+// on a plane, so the side whose linear extrapolation 2·d(±1) − d(±2) lands nearer the
+// centre's depth is on the centre's surface; the difference does not cross an edge
+// (Turánszki's choice of neighbours for depth-reconstructed normals).
+fn tangent(depth: texture_depth_2d, p: vec2i, c: vec4f, axis: vec2i) -> vec3f {
+    let d0 = raw_depth(depth, p);
+    let before = abs(2.0 * raw_depth(depth, p - axis) - raw_depth(depth, p - 2 * axis) - d0);
+    let after = abs(2.0 * raw_depth(depth, p + axis) - raw_depth(depth, p + 2 * axis) - d0);
+    let a = view_position(depth, p - axis);
+    let b = view_position(depth, p + axis);
+    if (a.w == 0.0 && b.w == 0.0) {
+        return vec3f(0.0);
+    }
+    let use_b = a.w == 0.0 || (b.w != 0.0 && after < before);
+    return select(c.xyz - a.xyz, b.xyz - c.xyz, use_b);
+}
+
+// The world normal of the surface in pixel p of a depth texture (NORMALS = 3, an
+// application without a normal buffer): the cross product of the screen-space tangents,
+// facing the viewer.
+fn normal_from_depth(depth: texture_depth_2d, p: vec2i) -> vec3f {
+    let c = view_position(depth, p);
+    let tx = tangent(depth, p, c, vec2i(1, 0));
+    let ty = tangent(depth, p, c, vec2i(0, 1));
+    var n = cross(tx, ty);
+    // the eye is at the view-space origin: face it
+    n = select(n, -n, dot(n, c.xyz) > 0.0);
+    let w = (im.inv_view * vec4f(n, 0.0)).xyz;
+    let l = length(w);
+    return select(vec3f(0.0, 0.0, 1.0), w / l, c.w != 0.0 && l > 1e-20);
+}
+
+// Oct16 of layer j's world normal at p: from its normal texture, or its depth (NORMALS = 3)
+fn layer_oct(j: u32, p: vec2i) -> vec2f {
+    if (NORMALS == 3u) {
+        if (j == 0u) {
+            return oct_encode(normal_from_depth(depth0, p));
+        }
+        return oct_encode(normal_from_depth(depth1, p));
+    }
+    if (j == 0u) {
+        return oct_of(textureLoad(normal0, p, 0));
+    }
+    return oct_of(textureLoad(normal1, p, 0));
+}
+
 // the application's motion texture, or one of zeros where it gives none
 fn motion_of(p: vec2i) -> vec4f {
     return vec4f(textureLoad(motion_in, p, 0).xyz, 0.0);
@@ -103,7 +173,7 @@ fn fs_import1(@builtin(position) pos: vec4f) -> One {
     let z0 = csz_of_depth(p, textureLoad(depth0, p, 0));
     var o: One;
     o.z01 = vec2f(z0, 0.0);
-    o.n01 = vec4f(oct_of(textureLoad(normal0, p, 0)), 0.5, 0.5);
+    o.n01 = vec4f(layer_oct(0u, p), 0.5, 0.5);
     o.csz0 = z0;
     o.motion = motion_of(p);
     return o;
@@ -116,7 +186,7 @@ fn fs_import2(@builtin(position) pos: vec4f) -> Two {
     let z1 = csz_of_depth(p, textureLoad(depth1, p, 0));
     var o: Two;
     o.z01 = vec2f(z0, z1);
-    o.n01 = vec4f(oct_of(textureLoad(normal0, p, 0)), oct_of(textureLoad(normal1, p, 0)));
+    o.n01 = vec4f(layer_oct(0u, p), layer_oct(1u, p));
     o.csz0 = z0;
     o.motion = motion_of(p);
     o.csz1 = z1;
@@ -131,14 +201,14 @@ struct Layer {
     radiosity: vec4f,
 }
 
-fn shading_of(p: vec2i, normal: vec4f, albedo: vec4f, radiance: vec4f) -> Layer {
+fn shading_of(p: vec2i, oct: vec2f, albedo: vec4f, radiance: vec4f) -> Layer {
     var rm = vec2f(0.0);
     if (MATERIAL == 1u) {
         let m = textureLoad(material0, p, 0);
         rm = clamp(vec2f(m[ROUGHNESS], m[METALLIC]), vec2f(0.0), vec2f(1.0));
     }
     return Layer(
-        vec4f(oct_of(normal), rm),
+        vec4f(oct, rm),
         vec4f(clamp(albedo.rgb, vec3f(0.0), vec3f(1.0)), 1.0),
         vec4f(max(radiance.rgb, vec3f(0.0)), 1.0),
     );
@@ -158,9 +228,9 @@ fn fs_shading(@builtin(position) pos: vec4f) -> Shading {
     let p = vec2i(pos.xy);
     var l: Layer;
     if (LAYER == 0u) {
-        l = shading_of(p, textureLoad(normal0, p, 0), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
+        l = shading_of(p, layer_oct(0u, p), textureLoad(albedo0, p, 0), textureLoad(radiance0, p, 0));
     } else {
-        l = shading_of(p, textureLoad(normal1, p, 0), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
+        l = shading_of(p, layer_oct(1u, p), textureLoad(albedo1, p, 0), textureLoad(radiance1, p, 0));
     }
     return Shading(l.normal, l.albedo, l.radiosity);
 }

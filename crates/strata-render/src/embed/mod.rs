@@ -37,6 +37,8 @@
 //!   right- or left-handed, standard or reversed depth, finite or infinite far plane. No
 //!   surface is where the depth buffer holds its clear value (1, or 0 when reversed).
 //! - Pixel (x, y) is the texel whose centre is at (x + ½, y + ½), y down, as in wgpu.
+//! - Without a normal buffer, [`NormalEncoding::FromDepth`] reconstructs each layer's
+//!   normal from its depth ([`AoInputs::depth_only`]).
 //! - `settings.radius` and the temporal filter's `max_distance` are in world units.
 //! - The temporal filter reprojects with the camera of the previous call. Surfaces
 //!   that move on their own follow the optional motion texture (world-space motion since
@@ -69,6 +71,11 @@ pub enum NormalEncoding {
     Unsigned,
     /// rg = the octahedral map in [0, 1] (Cigolle et al. 2014; strata's own G-buffer).
     Octahedral,
+    /// No normal texture (a forward renderer with only a depth prepass): each layer's
+    /// normal is reconstructed from its depth, as the cross product of the screen-space
+    /// tangents towards the neighbours nearer in depth. The normal textures of the inputs
+    /// are not read ([`AoInputs::depth_only`]).
+    FromDepth,
 }
 
 /// The space the application's normals are in.
@@ -154,6 +161,12 @@ impl<'a> AoInputs<'a> {
             view,
             proj,
         }
+    }
+
+    /// One layer of depth alone, for [`NormalEncoding::FromDepth`]: `normals` holds the
+    /// depth texture too, and is not read. (A second layer is `Some((depth1, depth1))`.)
+    pub fn depth_only(depth: TextureLayer<'a>, view: Mat4, proj: Mat4) -> Self {
+        Self::new(depth, depth, view, proj)
     }
 }
 
