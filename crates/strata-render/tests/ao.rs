@@ -4,6 +4,7 @@
 
 mod common;
 
+use common::frozen;
 use strata_reference::ao::{DiskSampling, ObscuranceSettings};
 use strata_reference::Reference;
 use strata_render::frame::FrameCameras;
@@ -15,7 +16,7 @@ use strata_render::passes::bilateral::BilateralSettings;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::temporal::TemporalSettings;
 use strata_render::{GpuContext, RenderSettings, Renderer};
-use strata_scene::{procedural, ImageBuf, Scene};
+use strata_scene::{ImageBuf, Scene};
 
 fn ao_renderer(gpu: &GpuContext, scene: &Scene, w: u32, h: u32, layers: u32, ao: AoSettings) -> Renderer {
     Renderer::new(
@@ -43,15 +44,6 @@ fn render_ao(gpu: &GpuContext, scene: &Scene, w: u32, h: u32, layers: u32, ao: A
     r.render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0)
         .expect("frame renders without validation errors");
     r.read_target(gpu, "ao").unwrap()
-}
-
-fn frozen(name: &str) -> Scene {
-    let mut s = procedural::builtin(name).unwrap();
-    s.camera_path = None;
-    for o in &mut s.objects {
-        o.animation = None;
-    }
-    s
 }
 
 fn mean(v: &[f32]) -> f32 {

@@ -20,12 +20,7 @@ const FRAMES: u32 = 4;
 
 /// The atrium held still: no camera path, no animation.
 fn still_atrium() -> Scene {
-    let mut scene = strata_scene::procedural::builtin("atrium").unwrap();
-    scene.camera_path = None;
-    for o in &mut scene.objects {
-        o.animation = None;
-    }
-    scene
+    common::frozen("atrium")
 }
 
 /// The renderer's AO with `ao` and `layers` peeled layers (no guard band).
@@ -605,11 +600,7 @@ fn embedded_ao_from_depth_alone_reconstructs_the_normals() {
     let gpu = common::gpu();
     let settings = AoSettings::default();
     for name in ["cornell", "atrium"] {
-        let mut scene = strata_scene::procedural::builtin(name).unwrap();
-        scene.camera_path = None;
-        for o in &mut scene.objects {
-            o.animation = None;
-        }
+        let scene = common::frozen(name);
         let cams = FrameCameras::fixed(scene.camera);
         let (view, proj) = (scene.camera.view(), scene.camera.projection(W as f32 / H as f32));
         let mut results = Vec::new();

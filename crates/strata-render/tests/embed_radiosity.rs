@@ -17,11 +17,7 @@ const H: u32 = 90;
 /// A built-in scene held still, without sky or ambient light (the embedded radiosity has
 /// neither: the application's radiance carries all light).
 fn still(name: &str) -> Scene {
-    let mut scene = strata_scene::procedural::builtin(name).unwrap();
-    scene.camera_path = None;
-    for o in &mut scene.objects {
-        o.animation = None;
-    }
+    let mut scene = common::frozen(name);
     scene.settings.sky = [0.0; 3];
     scene.settings.ambient = [0.0; 3];
     scene

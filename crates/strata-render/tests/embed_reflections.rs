@@ -22,11 +22,7 @@ const H: u32 = 120;
 /// The `mirror` scene without its sky: the embedded pass leaves the environment to the
 /// application (rgb 0 where a ray finds nothing).
 fn mirror_scene() -> Scene {
-    let mut scene = strata_scene::procedural::builtin("mirror").unwrap();
-    scene.camera_path = None;
-    for o in &mut scene.objects {
-        o.animation = None;
-    }
+    let mut scene = common::frozen("mirror");
     scene.settings.sky = [0.0; 3];
     scene
 }

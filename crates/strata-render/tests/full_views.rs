@@ -4,21 +4,13 @@
 
 mod common;
 
+use common::frozen;
 use strata_render::frame::FrameCameras;
 use strata_render::passes::radiosity::{irradiance_cpu, RadiositySettings};
 use strata_render::passes::tonemap::tonemap;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::probes::IrradianceProbes;
-use strata_scene::{procedural, ImageBuf, Scene};
-
-fn frozen(name: &str) -> Scene {
-    let mut s = procedural::builtin(name).unwrap();
-    s.camera_path = None;
-    for o in &mut s.objects {
-        o.animation = None;
-    }
-    s
-}
+use strata_scene::{ImageBuf, Scene};
 
 /// A 2×2×2 probe grid whose irradiance is `e` for every normal (only the constant SH band).
 fn constant_probes(e: [f32; 3]) -> IrradianceProbes {

@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::frozen;
 use glam::{Mat4, Vec3};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
@@ -10,7 +11,7 @@ use strata_render::passes::radiosity::{irradiance_cpu, Normalisation, RadiosityS
 use strata_render::passes::Kernel;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::shapes::MeshBuilder;
-use strata_scene::{procedural, Camera, ImageBuf, Material, Object, Scene};
+use strata_scene::{Camera, ImageBuf, Material, Object, Scene};
 
 fn renderer(gpu: &GpuContext, scene: &Scene, w: u32, h: u32, layers: u32, rs: RadiositySettings) -> Renderer {
     Renderer::new(
@@ -30,15 +31,6 @@ fn renderer(gpu: &GpuContext, scene: &Scene, w: u32, h: u32, layers: u32, rs: Ra
         },
     )
     .unwrap_or_else(|e| panic!("{} k={layers}: {e}", scene.name))
-}
-
-fn frozen(name: &str) -> Scene {
-    let mut s = procedural::builtin(name).unwrap();
-    s.camera_path = None;
-    for o in &mut s.objects {
-        o.animation = None;
-    }
-    s
 }
 
 /// One bounce on the GPU equals Eq. 4–5 evaluated on the CPU over the read-back

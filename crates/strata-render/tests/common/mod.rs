@@ -390,3 +390,14 @@ pub fn assert_one_line(e: &str, words: &[&str]) {
         assert!(e.contains(w), "'{e}' names '{w}'");
     }
 }
+
+/// Built-in scene `name` held still: no camera path, no animation.
+#[allow(dead_code)]
+pub fn frozen(name: &str) -> Scene {
+    let mut s = strata_scene::procedural::builtin(name).unwrap();
+    s.camera_path = None;
+    for o in &mut s.objects {
+        o.animation = None;
+    }
+    s
+}
