@@ -185,16 +185,18 @@ fn agreement_with_the_tracer(gpu: &GpuContext, scene: &Scene, layers: u32, w: u3
 #[test]
 fn mirror_rays_find_the_surface_the_tracer_hits() {
     let gpu = common::gpu();
-    let scene = procedural::builtin("mirror").unwrap();
-    let shares: Vec<f64> = [1, 2]
-        .map(|layers| {
-            let (mirrors, agree, false_hits) = agreement_with_the_tracer(&gpu, &scene, layers, 160, 120);
-            let share = agree as f64 / mirrors as f64;
-            eprintln!("k = {layers}: {agree} of {mirrors} mirror px agree with the tracer ({share:.4}); {false_hits} hit a surface the ray does not reach first");
-            share
-        })
-        .to_vec();
-    assert!(shares.iter().all(|s| *s >= 0.95), "agreement {shares:?}");
+    for name in ["mirror", "mirror-sign"] {
+        let scene = procedural::builtin(name).unwrap();
+        let shares: Vec<f64> = [1, 2]
+            .map(|layers| {
+                let (mirrors, agree, false_hits) = agreement_with_the_tracer(&gpu, &scene, layers, 160, 120);
+                let share = agree as f64 / mirrors as f64;
+                eprintln!("{name}, k = {layers}: {agree} of {mirrors} mirror px agree with the tracer ({share:.4}); {false_hits} hit a surface the ray does not reach first");
+                share
+            })
+            .to_vec();
+        assert!(shares.iter().all(|s| *s >= 0.95), "{name}: agreement {shares:?}");
+    }
 }
 
 /// DGB Fig. 13: "a second layer makes the red containers' reflection more stable to passing
