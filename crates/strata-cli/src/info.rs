@@ -36,9 +36,22 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         println!("warning      {w}");
     }
     println!();
-    println!("{:<34} {:<8} used for", "feature", "present");
+    println!("{:<40} {:<8} used for", "feature", "present");
     for (name, f, why) in STRATA_FEATURES {
-        println!("{:<34} {:<8} {}", name, if gpu.has(*f) { "yes" } else { "no" }, why);
+        println!("{:<40} {:<8} {}", name, if gpu.has(*f) { "yes" } else { "no" }, why);
+    }
+    println!();
+    println!("{:<40} {:<8} used for", "storage texture format", "present");
+    for f in strata_render::passes::SCREEN_FORMATS {
+        println!(
+            "{:<40} {:<8} compute forms of the screen passes (`*-kernel` settings)",
+            format!("{f:?}"),
+            if strata_render::passes::storable(&gpu, *f) {
+                "yes"
+            } else {
+                "no"
+            }
+        );
     }
     Ok(())
 }

@@ -188,6 +188,16 @@ impl Targets {
         self.create_sized(gpu, desc, [self.width, self.height]);
     }
 
+    /// [`Targets::create`], with `STORAGE_BINDING` when `storage` (a compute pass writes it).
+    pub fn create_storable(&mut self, gpu: &GpuContext, desc: TargetDesc, storage: bool) {
+        let usage = if storage {
+            wgpu::TextureUsages::STORAGE_BINDING
+        } else {
+            wgpu::TextureUsages::empty()
+        };
+        self.create_with_usage(gpu, desc, [self.width, self.height], usage);
+    }
+
     /// A target of its own size (e.g. the tiled sub-buffers of interleaved
     /// shading, which can be a few texels larger than the frame); read-back and
     /// debug views show it whole (no guard-band crop).

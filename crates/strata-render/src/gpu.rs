@@ -52,6 +52,11 @@ pub const STRATA_FEATURES: &[(&str, wgpu::Features, &str)] = &[
         wgpu::Features::FLOAT32_FILTERABLE,
         "filtered camera-space depth",
     ),
+    (
+        "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES",
+        wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES,
+        "compute passes writing R16F / RG11B10 targets (storage textures)",
+    ),
 ];
 
 /// Options for [`GpuContext::new`].

@@ -557,8 +557,12 @@ impl Renderer {
         let scene_gpu = GpuScene::new(gpu, scene);
         let (w, h) = settings.internal_size();
         let mut targets = Targets::new(w, h);
+        // the lighting pass's compute form writes layer 0's outputs and the deeper layers'
+        // radiosity as storage textures
+        let lighting_compute = settings.shade && lighting::LightingPass::compute_on(gpu, &settings.lighting);
         for d in settings.deep.outputs() {
-            targets.create(gpu, d);
+            let storage = lighting_compute && lighting::RADIOSITY.contains(&d.name);
+            targets.create_storable(gpu, d, storage);
         }
         if settings.needs_motion() {
             targets.create(gpu, settings.deep.motion_target());
@@ -568,7 +572,10 @@ impl Renderer {
             targets.create_sized(gpu, d, reduced);
         }
         if settings.shade {
-            for d in lighting::OUTPUTS.iter().chain(tonemap::OUTPUTS) {
+            for d in lighting::OUTPUTS {
+                targets.create_storable(gpu, *d, lighting_compute);
+            }
+            for d in tonemap::OUTPUTS {
                 targets.create(gpu, *d);
             }
         }
@@ -587,6 +594,7 @@ impl Renderer {
                 settings.shadow.resolution,
                 &settings.lighting,
                 settings.deep.layers,
+                lighting_compute,
             );
             let tonemap = tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, "hdr");
             (Some(shadow), Some(lighting), Some(tonemap))
@@ -691,10 +699,14 @@ impl Renderer {
             "hdr"
         };
         let reflections = settings.reflections.as_ref().map(|rs| {
-            for t in crate::passes::reflections::OUTPUTS {
-                targets.create(gpu, t);
-            }
-            crate::passes::reflections::ReflectionPass::new(gpu, &scene_gpu, &targets, settings.deep.layers, shaded, rs)
+            crate::passes::reflections::ReflectionPass::new(
+                gpu,
+                &scene_gpu,
+                &mut targets,
+                settings.deep.layers,
+                shaded,
+                rs,
+            )
         });
         let shown = if reflections.is_some() { "hdr-reflected" } else { shaded };
         let abuffer = match &settings.abuffer {

@@ -295,7 +295,7 @@ fn radiosity_of(s: &RenderSettings) -> radiosity::RadiositySettings {
     s.radiosity.clone().unwrap_or_default()
 }
 
-static DIRECT_SETTINGS: [SettingInfo; 3] = [
+static DIRECT_SETTINGS: [SettingInfo; 4] = [
     setting!(
         "shadow-resolution",
         "shadow map resolution per light",
@@ -321,7 +321,27 @@ static DIRECT_SETTINGS: [SettingInfo; 3] = [
         set: |s, v| s.lighting.area_penumbrae = v != 0.0,
         values: &["hard", "soft"],
     },
+    enum_setting!(
+        "lighting-kernel",
+        "the deferred direct lighting as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup); auto: compute on GPUs whose storage textures take R16F and RG11B10, fragment on CPU adapters (the same shader code and values; not in a paper)",
+        lighting_of,
+        lighting_mut,
+        kernel,
+        [
+            crate::passes::Kernel::Auto => "auto",
+            crate::passes::Kernel::Fragment => "fragment",
+            crate::passes::Kernel::Compute => "compute",
+        ]
+    ),
 ];
+
+fn lighting_of(s: &RenderSettings) -> crate::passes::lighting::LightingSettings {
+    s.lighting.clone()
+}
+
+fn lighting_mut(s: &mut RenderSettings) -> &mut crate::passes::lighting::LightingSettings {
+    &mut s.lighting
+}
 
 static AO_SETTINGS: [SettingInfo; 18] = [
     setting!(
@@ -492,7 +512,7 @@ static AO_SETTINGS: [SettingInfo; 18] = [
     ),
 ];
 
-static RADIOSITY_SETTINGS: [SettingInfo; 25] = [
+static RADIOSITY_SETTINGS: [SettingInfo; 26] = [
     enum_setting!(
         "irradiance-normalisation",
         "the gather's normaliser (docs/radiosity.md): hemisphere (DGB Eq. 4: 2pi/sum w; over-estimates E where screen-space taps cluster near the normal), cosine (pi/sum w*cos: exact for a uniform surround, over-fills where only grazing taps hit) or bounded (pi/max(sum w*cos, sum w/2): the smaller of the two; not in the paper)",
@@ -690,7 +710,27 @@ static RADIOSITY_SETTINGS: [SettingInfo; 25] = [
         |s| Some(s.reflections.unwrap_or_default().steps as f64),
         |s, v| s.reflections.get_or_insert_with(ReflectionSettings::default).steps = v as u32
     ),
+    enum_setting!(
+        "reflection-kernel",
+        "the mirror ray march as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/radiosity.md)",
+        reflections_of,
+        reflections_mut,
+        kernel,
+        [
+            crate::passes::Kernel::Auto => "auto",
+            crate::passes::Kernel::Fragment => "fragment",
+            crate::passes::Kernel::Compute => "compute",
+        ]
+    ),
 ];
+
+fn reflections_mut(s: &mut RenderSettings) -> &mut ReflectionSettings {
+    s.reflections.get_or_insert_with(ReflectionSettings::default)
+}
+
+fn reflections_of(s: &RenderSettings) -> ReflectionSettings {
+    s.reflections.unwrap_or_default()
+}
 
 fn ils_mut(s: &mut RenderSettings) -> &mut IlsSettings {
     s.ils.get_or_insert_with(Default::default)

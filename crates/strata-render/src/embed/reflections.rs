@@ -171,10 +171,7 @@ impl EmbeddedReflections {
         scene.settings.min_separation = dz;
         Core::scoped(device, || {
             let mut core = Core::new(adapter, device, queue, core, scene)?;
-            for t in OUTPUTS {
-                core.targets.create(&core.gpu, t);
-            }
-            let stage = ReflectionPass::new(&core.gpu, &core.scene_gpu, &core.targets, config.layers, "hdr", s);
+            let stage = ReflectionPass::new(&core.gpu, &core.scene_gpu, &mut core.targets, config.layers, "hdr", s);
             Ok(Self {
                 core,
                 config: config.clone(),

@@ -45,6 +45,75 @@ impl Kernel {
     }
 }
 
+impl Kernel {
+    /// [`Kernel::compute_on`] for a pass writing `formats`: compute only where `gpu` can
+    /// write each of them as a storage texture ([`storable`]); R16F and RG11B10 need the
+    /// adapter's own format features. Elsewhere the pass stays a fragment pass.
+    pub fn compute_for(self, gpu: &GpuContext, formats: &[wgpu::TextureFormat]) -> bool {
+        self.compute_on(gpu) && formats.iter().all(|&f| storable(gpu, f))
+    }
+}
+
+/// The formats of the screen passes' targets with a compute form (`strata info` lists
+/// which of them this adapter can write as storage textures).
+pub const SCREEN_FORMATS: &[wgpu::TextureFormat] = &[
+    wgpu::TextureFormat::Rgba16Float,
+    wgpu::TextureFormat::R32Float,
+    wgpu::TextureFormat::R16Float,
+    wgpu::TextureFormat::Rg11b10Ufloat,
+];
+
+/// Whether a compute pass on `gpu` can write `format` as a write-only storage texture: the
+/// adapter's own format features where the device has
+/// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` (NVIDIA's and lavapipe's Vulkan drivers write
+/// R16F and RG11B10), WebGPU's guaranteed ones elsewhere (RGBA16F and R32F).
+pub fn storable(gpu: &GpuContext, format: wgpu::TextureFormat) -> bool {
+    let features = gpu.device.features();
+    let f = if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+        gpu.adapter.get_texture_format_features(format)
+    } else {
+        format.guaranteed_format_features(features)
+    };
+    f.allowed_usages.contains(wgpu::TextureUsages::STORAGE_BINDING)
+        && f.flags.contains(wgpu::TextureFormatFeatureFlags::STORAGE_WRITE_ONLY)
+}
+
+/// WGSL's name of a storage texture format, for the `STORAGE_FORMAT_i` placeholders
+/// ([`PassBuilder`]); `None` for a format no storage texture takes.
+fn wgsl_storage_format(format: wgpu::TextureFormat) -> Option<&'static str> {
+    use wgpu::TextureFormat as F;
+    Some(match format {
+        F::Rgba16Float => "rgba16float",
+        F::R32Float => "r32float",
+        F::R16Float => "r16float",
+        F::Rg11b10Ufloat => "rg11b10ufloat",
+        F::Rgba32Float => "rgba32float",
+        F::Rgba8Unorm => "rgba8unorm",
+        F::R32Uint => "r32uint",
+        _ => return None,
+    })
+}
+
+/// The shader module of a screen pass whose outputs have `formats`: `STORAGE_FORMAT_i` in
+/// its WGSL becomes the WGSL name of `formats[i]`, so one compute entry writes whatever
+/// format its target has. In the fragment form the storage textures are declared but
+/// unused, so any format does for one that no storage texture takes.
+pub(crate) fn module_writing(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+    formats: &[wgpu::TextureFormat],
+) -> wgpu::ShaderModule {
+    let mut text = crate::shader::compose(source);
+    for (i, &f) in formats.iter().enumerate().rev() {
+        text = text.replace(
+            &format!("STORAGE_FORMAT_{i}"),
+            wgsl_storage_format(f).unwrap_or("rgba16float"),
+        );
+    }
+    crate::shader::module(device, label, &text)
+}
+
 /// What a built pass holds besides its pipeline, in either form.
 struct Bound {
     name: &'static str,
@@ -186,6 +255,16 @@ impl<'a> PassBuilder<'a> {
     pub fn compute(mut self) -> Self {
         self.stage = wgpu::ShaderStages::COMPUTE;
         self
+    }
+
+    /// The form `compute` asks for of a screen pass: the compute form's entry is `cs_main`.
+    /// Call it before declaring any binding.
+    pub fn kernel(self, compute: bool) -> Self {
+        if compute {
+            self.compute().entry("cs_main")
+        } else {
+            self
+        }
     }
 
     /// The form `compute` asks for of a screen pass limited to `scissor` ([x, y, w, h] in
@@ -419,7 +498,8 @@ impl<'a> PassBuilder<'a> {
             bind_group_layouts: &layouts,
             immediate_size: 0,
         });
-        let module = crate::shader::module(device, label, source);
+        let formats: Vec<wgpu::TextureFormat> = self.outputs.iter().map(|n| self.targets.get(n).desc.format).collect();
+        let module = module_writing(device, label, source, &formats);
         (group, uniforms, pipeline_layout, module)
     }
 

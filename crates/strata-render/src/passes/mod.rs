@@ -4,7 +4,7 @@ pub mod abuffer;
 pub mod ao;
 pub mod bilateral;
 pub(crate) mod builder;
-pub use builder::Kernel;
+pub use builder::{storable, Kernel, SCREEN_FORMATS};
 pub mod bzb;
 pub mod compose;
 pub mod deep_gbuffer;

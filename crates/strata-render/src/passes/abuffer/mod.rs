@@ -899,6 +899,7 @@ impl ABufferStage {
                 &a.blur,
                 AO_RAW.name,
                 "ao",
+                false,
             ));
             let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("aba-ao-lists"),

@@ -82,15 +82,18 @@ impl AoStage {
             )
         });
         let mut filtered = crate::passes::ao::OUTPUT.name;
+        // the filters write R16F (the temporal filter's count, the blurs' outputs): compute
+        // where the adapter writes that format (`Kernel::compute_for`)
+        let filters_compute = s.kernel.compute_for(gpu, &[F::R32Float, F::R16Float]);
         if s.temporal.is_some() {
             for (name, doc) in [
                 ("ao-temporal", "AO after the temporal filter (DGB §3.3)"),
                 ("ao-temporal-history", "last frame's ao-temporal"),
             ] {
-                targets.create(gpu, TargetDesc::new(name, F::R32Float, 1, doc));
+                targets.create_storable(gpu, TargetDesc::new(name, F::R32Float, 1, doc), filters_compute);
             }
             for t in crate::passes::temporal::frames_targets(AO_FRAMES) {
-                targets.create(gpu, t);
+                targets.create_storable(gpu, t, filters_compute);
             }
             filtered = "ao-temporal";
         }
@@ -106,10 +109,11 @@ impl AoStage {
                 "ao-temporal",
                 AO_FRAMES,
                 deep.layers,
+                filters_compute,
             )
         });
         let blurred = if s.filter_obscurance {
-            targets.create(
+            targets.create_storable(
                 gpu,
                 TargetDesc::new(
                     "ao-obscurance",
@@ -117,6 +121,7 @@ impl AoStage {
                     1,
                     "filtered obscurance mean S (Eq. 1 before the square root; filter_obscurance)",
                 ),
+                filters_compute,
             );
             "ao-obscurance"
         } else {
@@ -124,7 +129,15 @@ impl AoStage {
         };
         // unlike the radiosity gather's, the blur keeps its step at any scale: stepping over
         // s×s blocks blurred AO's contact shadows (atrium ꟻLIP 0.0495 → 0.0602 at s = 2)
-        let [blur_h, blur_v] = reconstruction(gpu, scene, targets, &s.reconstruction(radius), filtered, blurred);
+        let [blur_h, blur_v] = reconstruction(
+            gpu,
+            scene,
+            targets,
+            &s.reconstruction(radius),
+            filtered,
+            blurred,
+            filters_compute,
+        );
         let resolve = s.filter_obscurance.then(|| {
             crate::passes::builder::PassBuilder::new(gpu, targets, "ao-resolve")
                 .shader("ao-resolve", include_str!("ao_resolve.wgsl"))
@@ -182,20 +195,42 @@ pub(crate) fn reconstruction(
     blur: &crate::passes::bilateral::BilateralSettings,
     input: &'static str,
     output: &'static str,
+    compute: bool,
 ) -> [BilateralPass; 2] {
     use wgpu::TextureFormat as F;
-    targets.create(
+    targets.create_storable(
         gpu,
         TargetDesc::new("ao-blur-h", F::R16Float, 1, "AO after the horizontal bilateral pass"),
+        compute,
     );
-    targets.create(
+    targets.create_storable(
         gpu,
         TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
+        compute,
     );
     [
-        // R16F outputs, which storage textures do not take: fragment passes only
-        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-h", input, "ao-blur-h", false, false),
-        BilateralPass::new(gpu, scene, targets, blur, "ao-blur-v", "ao-blur-h", output, true, false),
+        BilateralPass::new(
+            gpu,
+            scene,
+            targets,
+            blur,
+            "ao-blur-h",
+            input,
+            "ao-blur-h",
+            false,
+            compute,
+        ),
+        BilateralPass::new(
+            gpu,
+            scene,
+            targets,
+            blur,
+            "ao-blur-v",
+            "ao-blur-h",
+            output,
+            true,
+            compute,
+        ),
     ]
 }
 

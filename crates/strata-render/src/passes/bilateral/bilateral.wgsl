@@ -83,13 +83,13 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
     return filtered(vec2i(pos.xy));
 }
 
-// The same pass as compute (`Kernel`), 8×8 pixels per workgroup, for RGBA16F outputs.
-@group(1) @binding(4) var out_rgba16f: texture_storage_2d<rgba16float, write>;
+// The same pass as compute (`Kernel`), 8×8 pixels per workgroup.
+@group(1) @binding(4) var out: texture_storage_2d<STORAGE_FORMAT_0, write>;
 
 @compute @workgroup_size(8, 8)
 fn cs_main(@builtin(global_invocation_id) id: vec3u) {
-    if (any(id.xy >= textureDimensions(out_rgba16f))) {
+    if (any(id.xy >= textureDimensions(out))) {
         return;
     }
-    textureStore(out_rgba16f, id.xy, filtered(vec2i(id.xy)));
+    textureStore(out, id.xy, filtered(vec2i(id.xy)));
 }

@@ -183,8 +183,7 @@ pub struct BilateralPass {
 
 impl BilateralPass {
     /// `vertical` picks the direction; `output` must already exist in `targets`; `compute`:
-    /// the compute form ([`crate::passes::Kernel`]), for an RGBA16F `output` with storage
-    /// binding.
+    /// the compute form ([`crate::passes::Kernel`]), for an `output` with storage binding.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
@@ -197,16 +196,8 @@ impl BilateralPass {
         vertical: bool,
         compute: bool,
     ) -> Self {
-        let mut builder = PassBuilder::new(gpu, targets, name);
-        if compute {
-            assert_eq!(
-                targets.get(output).desc.format,
-                wgpu::TextureFormat::Rgba16Float,
-                "the compute bilateral pass writes RGBA16F"
-            );
-            builder = builder.compute().entry("cs_main");
-        }
-        let builder = builder
+        let builder = PassBuilder::new(gpu, targets, name)
+            .kernel(compute)
             .shader("bilateral", include_str!("bilateral.wgsl"))
             .constant("DIRECTION", vertical as u32 as f64)
             .frame(scene)

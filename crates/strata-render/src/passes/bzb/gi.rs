@@ -983,6 +983,7 @@ impl BzbGiStage {
                     TEMPORAL[2 * k].name,
                     TEMPORAL_FRAMES[k],
                     layers,
+                    false,
                 )
             };
             [

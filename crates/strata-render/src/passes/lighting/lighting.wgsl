@@ -159,9 +159,8 @@ fn direct_light(px: vec2i, frag: vec2f, z: f32) -> Direct {
     return d;
 }
 
-@fragment
-fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
-    let px = vec2i(frag.xy);
+// Layer 0's outputs at pixel px, whose centre is `centre`.
+fn lit(px: vec2i, centre: vec2f) -> LightingOut {
     let z = textureLoad(csz_tex, px, 0).r;
     var o: LightingOut;
     if (z <= 0.0) {
@@ -171,7 +170,7 @@ fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
         o.radiosity = vec4f(0.0);
         return o;
     }
-    let d = direct_light(px, frag.xy, z);
+    let d = direct_light(px, centre, z);
     var total = d.lambert + d.emission + frame.ambient.rgb * d.diffuse_albedo;
     if (params.specular == 1u) {
         total += d.spec;
@@ -185,13 +184,49 @@ fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
 
 // DGB §3.2: the initial radiosity B of a deeper layer (bound instead of layer
 // 0) = its Lambertian direct light + emission (unless emitters are Rect lights).
-@fragment
-fn fs_layer_radiosity(@builtin(position) frag: vec4f) -> @location(0) vec4f {
-    let px = vec2i(frag.xy);
+fn layer_radiosity(px: vec2i, centre: vec2f) -> vec4f {
     let z = textureLoad(csz_tex, px, 0).r;
     if (z <= 0.0) {
         return vec4f(0.0);
     }
-    let d = direct_light(px, frag.xy, z);
+    let d = direct_light(px, centre, z);
     return vec4f(d.lambert + d.emission * f32(params.emission_in_radiosity), 1.0);
+}
+
+@fragment
+fn fs_main(@builtin(position) frag: vec4f) -> LightingOut {
+    return lit(vec2i(frag.xy), frag.xy);
+}
+
+@fragment
+fn fs_layer_radiosity(@builtin(position) frag: vec4f) -> @location(0) vec4f {
+    return layer_radiosity(vec2i(frag.xy), frag.xy);
+}
+
+// The same passes as compute (`Kernel`), 8×8 pixels per workgroup: layer 0's four
+// outputs, and a deeper layer's radiosity.
+@group(1) @binding(9) var hdr_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
+@group(1) @binding(10) var direct_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
+@group(1) @binding(11) var shadow_out: texture_storage_2d<STORAGE_FORMAT_2, write>;
+@group(1) @binding(12) var radiosity_out: texture_storage_2d<STORAGE_FORMAT_3, write>;
+@group(1) @binding(13) var layer_out: texture_storage_2d<STORAGE_FORMAT_3, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(hdr_out))) {
+        return;
+    }
+    let o = lit(vec2i(id.xy), vec2f(id.xy) + 0.5);
+    textureStore(hdr_out, id.xy, o.hdr);
+    textureStore(direct_out, id.xy, o.direct_diffuse);
+    textureStore(shadow_out, id.xy, o.shadow);
+    textureStore(radiosity_out, id.xy, o.radiosity);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_layer_radiosity(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(layer_out))) {
+        return;
+    }
+    textureStore(layer_out, id.xy, layer_radiosity(vec2i(id.xy), vec2f(id.xy) + 0.5));
 }

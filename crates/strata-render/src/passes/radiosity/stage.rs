@@ -55,15 +55,17 @@ impl RadiosityStage {
             }
         }
         let mut filtered = "indirect-raw";
+        // the temporal filter's count is R16F: compute where the adapter writes it
+        let temporal_compute = s.kernel.compute_for(gpu, &[F::Rgba16Float, F::R16Float]);
         if s.temporal.is_some() {
             for (name, doc) in [
                 ("indirect-temporal", "indirect E after the temporal filter (DGB §3.3)"),
                 ("indirect-temporal-history", "last frame's indirect-temporal"),
             ] {
-                targets.create(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc));
+                targets.create_storable(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc), temporal_compute);
             }
             for t in crate::passes::temporal::frames_targets(INDIRECT_FRAMES) {
-                targets.create(gpu, t);
+                targets.create_storable(gpu, t, temporal_compute);
             }
             filtered = "indirect-temporal";
         }
@@ -154,6 +156,7 @@ impl RadiosityStage {
                 "indirect-temporal",
                 INDIRECT_FRAMES,
                 deep.layers,
+                temporal_compute,
             )
         });
         let blur_h = BilateralPass::new(

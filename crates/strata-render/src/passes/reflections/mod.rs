@@ -9,12 +9,13 @@
 
 use crate::frame::{TargetDesc, Targets};
 use crate::gpu::GpuContext;
-use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::passes::builder::{PassBuilder, ScreenPass};
+use crate::passes::Kernel;
 use crate::scene_gpu::GpuScene;
 
 /// Defaults: 64 steps over 16 scene units, surface thickness Δz = the deep
 /// G-buffer's minimum separation (as the paper), mirrors = metallic ≥ 0.5 and
-/// roughness ≤ 0.1.
+/// roughness ≤ 0.1, the march as compute on GPUs ([`Kernel::Auto`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReflectionSettings {
     pub max_distance: f32,
@@ -22,6 +23,10 @@ pub struct ReflectionSettings {
     /// Thickness of a layer's surface for the hit test; `None` = the scene's Δz.
     pub thickness: Option<f32>,
     pub max_roughness: f32,
+    /// The march as a fullscreen fragment pass or its compute twin (the same values). Not
+    /// in the paper: an H200 ran the fragment form of this pass at 1080p in 9.9 ms
+    /// (docs/benchmarks.md, 2026-11-29).
+    pub kernel: Kernel,
 }
 
 impl Default for ReflectionSettings {
@@ -31,6 +36,7 @@ impl Default for ReflectionSettings {
             steps: 64,
             thickness: None,
             max_roughness: 0.1,
+            kernel: Kernel::Auto,
         }
     }
 }
@@ -90,27 +96,33 @@ pub const OUTPUTS: [TargetDesc; 2] = [
 ];
 
 pub struct ReflectionPass {
-    pass: FullscreenPass,
+    pass: ScreenPass,
     settings: ReflectionSettings,
 }
 
 impl ReflectionPass {
-    /// Reflects `input` (the shaded layer 0) and layer 1's radiosity.
+    /// Reflects `input` (the shaded layer 0) and layer 1's radiosity; creates [`OUTPUTS`].
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
-        targets: &Targets,
+        targets: &mut Targets,
         layers: u32,
         input: &'static str,
         settings: &ReflectionSettings,
     ) -> Self {
+        let compute = settings.kernel.compute_for(gpu, &OUTPUTS.map(|t| t.format));
+        for t in OUTPUTS {
+            targets.create_storable(gpu, t, compute);
+        }
+        let targets = &*targets;
         // one layer: the binding holds the input, never read
         let (layer1, declared) = if layers > 1 {
             ("radiosity1", "radiosity1")
         } else {
             (input, "")
         };
-        let mut b = PassBuilder::new(gpu, targets, "reflections")
+        let b = PassBuilder::new(gpu, targets, "reflections")
+            .kernel(compute)
             .shader("reflections", include_str!("reflections.wgsl"))
             .constant("LAYERS", layers as f64)
             .frame(scene)
@@ -125,11 +137,8 @@ impl ReflectionPass {
                 wgpu::TextureViewDimension::D2,
                 false,
             );
-        for t in &OUTPUTS {
-            b = b.write(t.name);
-        }
         Self {
-            pass: b.build(),
+            pass: ScreenPass::build(b, &OUTPUTS.map(|t| t.name), compute),
             settings: *settings,
         }
     }

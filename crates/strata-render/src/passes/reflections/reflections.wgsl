@@ -82,9 +82,8 @@ fn confirmed(j: u32, sh: vec4f, slack: f32) -> bool {
     return zj > 0.0 && sh.z >= zj && sh.z <= zj + refl.thickness + slack;
 }
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> Out {
-    let p = vec2i(pos.xy);
+// The reflection at pixel p.
+fn reflected(p: vec2i) -> Out {
     var o: Out;
     let base = textureLoad(radiance0, p, 0);
     o.hdr = base;
@@ -174,4 +173,23 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     o.reflection = vec4f(l, code);
     o.hdr = vec4f(base.rgb + f0 * l, base.a);
     return o;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
+    return reflected(vec2i(pos.xy));
+}
+
+// The same pass as compute (`Kernel`), 8×8 pixels per workgroup.
+@group(1) @binding(6) var reflection_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
+@group(1) @binding(7) var hdr_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(reflection_out))) {
+        return;
+    }
+    let o = reflected(vec2i(id.xy));
+    textureStore(reflection_out, id.xy, o.reflection);
+    textureStore(hdr_out, id.xy, o.hdr);
 }

@@ -5,7 +5,7 @@
 
 use crate::frame::{FrameUniforms, Targets};
 use crate::gpu::GpuContext;
-use crate::passes::builder::{FullscreenPass, PassBuilder};
+use crate::passes::builder::{PassBuilder, ScreenPass};
 use crate::scene_gpu::GpuScene;
 use glam::{Mat4, Vec3};
 use strata_scene::ImageBuf;
@@ -109,12 +109,14 @@ pub struct TemporalUniforms {
 pub struct TemporalPass {
     settings: TemporalSettings,
     layers: u32,
-    pass: FullscreenPass,
+    pass: ScreenPass,
 }
 
 impl TemporalPass {
     /// `frames`: the per-pixel count of accepted histories and its copy from last frame
-    /// (`<output>-frames`, `<output>-frames-history`; [`frames_targets`]).
+    /// (`<output>-frames`, `<output>-frames-history`; [`frames_targets`]). `compute`: the
+    /// compute form ([`crate::passes::Kernel`]), for `output` and `frames[0]` with storage
+    /// binding.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
@@ -127,9 +129,11 @@ impl TemporalPass {
         output: &'static str,
         frames: [&'static str; 2],
         layers: u32,
+        compute: bool,
     ) -> Self {
         let settings = *settings;
-        let pass = PassBuilder::new(gpu, targets, name)
+        let builder = PassBuilder::new(gpu, targets, name).kernel(compute);
+        let builder = builder
             .shader("temporal", include_str!("temporal.wgsl"))
             .frame(scene)
             .uniforms(&Self::uniforms(&settings, layers, false))
@@ -138,10 +142,8 @@ impl TemporalPass {
             .read("zpack")
             .read_array("csz-history")
             .read(frames[1])
-            .read_layer("motion", 0)
-            .write(output)
-            .write(frames[0])
-            .build();
+            .read_layer("motion", 0);
+        let pass = ScreenPass::build(builder, &[output, frames[0]], compute);
         Self { settings, layers, pass }
     }
 

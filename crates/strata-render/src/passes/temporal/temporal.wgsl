@@ -44,9 +44,8 @@ const MAX_FRAMES: f32 = 1024.0;
 // layer 0's world-space motion since last frame (the deep G-buffer's `motion`)
 @group(1) @binding(6) var motion: texture_2d<f32>;
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> Out {
-    let p = vec2i(pos.xy);
+// The filtered estimate and count at pixel p.
+fn filtered(p: vec2i) -> Out {
     let e = textureLoad(current, p, 0);
     var o = Out(e, vec4f(0.0));
     let z = textureLoad(zpack, p, 0).r;
@@ -90,4 +89,23 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
     }
     o.e = mix(e, h, alpha);
     return o;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
+    return filtered(vec2i(pos.xy));
+}
+
+// The same pass as compute (`Kernel`), 8×8 pixels per workgroup.
+@group(1) @binding(7) var e_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
+@group(1) @binding(8) var frames_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(e_out))) {
+        return;
+    }
+    let o = filtered(vec2i(id.xy));
+    textureStore(e_out, id.xy, o.e);
+    textureStore(frames_out, id.xy, o.frames);
 }
