@@ -610,8 +610,17 @@ impl Renderer {
         .flatten()
         .max();
         let mip = mip_levels.map(|levels| {
-            targets.create(gpu, DepthMipSettings { levels }.output(settings.deep.layers, w, h));
-            DepthMipPass::new(gpu, &targets, settings.deep.layers)
+            let zmip = DepthMipSettings { levels }.output(settings.deep.layers, w, h);
+            // compute when a technique that reads the chain runs its passes as compute
+            let compute = [
+                settings.ao.as_ref().map(|a| a.kernel),
+                settings.radiosity.as_ref().map(|r| r.kernel),
+            ]
+            .into_iter()
+            .flatten()
+            .any(|k| DepthMipPass::compute_on(gpu, k, zmip.format));
+            targets.create_storable(gpu, zmip, compute);
+            DepthMipPass::new(gpu, &targets, settings.deep.layers, compute)
         });
         let temporal_on = settings.ao.as_ref().is_some_and(|a| a.temporal.is_some())
             || settings

@@ -484,7 +484,7 @@ static AO_SETTINGS: [SettingInfo; 18] = [
     ),
     enum_setting!(
         "ao-kernel",
-        "the AO pass (Eq. 1-2, not the deinterleaved one) as a fullscreen fragment pass or as a compute pass (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/ao.md)",
+        "the AO pass (Eq. 1-2, not the deinterleaved one) and its temporal and bilateral filters as fullscreen fragment passes or as compute passes (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (R16F outputs: where the adapter's storage textures take them) (the same shader code and values; not in the paper; docs/ao.md)",
         ao_of,
         ao_mut,
         kernel,
@@ -588,7 +588,7 @@ static RADIOSITY_SETTINGS: [SettingInfo; 26] = [
     ),
     enum_setting!(
         "indirect-kernel",
-        "the radiosity gather, the indirect light's bilateral passes and compose as fullscreen fragment passes or as compute passes (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (the same shader code and values; not in the paper; docs/radiosity.md)",
+        "the radiosity gather, the multi-bounce propagation, the indirect light's temporal and bilateral filters and compose as fullscreen fragment passes or as compute passes (8x8 pixels per workgroup); auto: compute on GPUs, fragment on CPU adapters (R16F/RG11B10 outputs: where the adapter's storage textures take them) (the same shader code and values; not in the paper; docs/radiosity.md)",
         radiosity_of,
         radiosity_mut,
         kernel,

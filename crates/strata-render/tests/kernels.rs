@@ -90,8 +90,8 @@ fn lighting_and_reflection_compute_forms_write_the_fragment_forms_bits() {
     assert!(mirrors > 100, "the rays hit something on screen ({mirrors} pixels)");
 }
 
-/// The AO and indirect light's filters (temporal, bilateral h and v). The AO's input is
-/// the same in both forms, so the filtered AO is the same bits. The indirect light's
+/// The depth MIP chain, and the AO and indirect light's filters (temporal, bilateral h and
+/// v) and the multi-bounce propagation. The AO's input is the same in both forms, so the filtered AO is the same bits. The indirect light's
 /// input is not: lavapipe's compute gather rounds some values differently from its
 /// fragment twin (that predates these filters' compute forms), so the filters must not
 /// move the two further apart than their input is. Both filters average (convex weights
@@ -104,7 +104,15 @@ fn ao_and_indirect_filter_compute_forms_match_the_fragment_forms() {
     let kernels = ["ao-kernel", "indirect-kernel"];
     let fragment = render(&gpu, &scene, &kernels, &[], FRAGMENT);
     let compute = render(&gpu, &scene, &kernels, &[], COMPUTE);
-    for name in ["ao-temporal", "ao-blur-h", "ao", "indirect-temporal", "indirect"] {
+    for name in [
+        "zmip",
+        "ao-temporal",
+        "ao-blur-h",
+        "ao",
+        "bounce0",
+        "indirect-temporal",
+        "indirect",
+    ] {
         assert!(
             !storage(&fragment, name),
             "{name}: the fragment form has no storage binding"
@@ -127,9 +135,20 @@ fn ao_and_indirect_filter_compute_forms_match_the_fragment_forms() {
         eprintln!("{name}: mean |difference| {:.2e}, max {max:.4}", sum / n as f64);
         (sum / n as f64, max)
     };
+    // the depth MIP chain: copies, the same bits at every level
+    let mips = fragment.target_desc("zmip").unwrap().mips;
+    assert!(mips >= 4, "a chain of {mips} levels");
+    for m in 0..mips {
+        let a = fragment.read_target_mip(&gpu, "zmip", m).unwrap();
+        let b = compute.read_target_mip(&gpu, "zmip", m).unwrap();
+        assert!(a.data.iter().any(|&z| z > 0.0), "level {m} holds depths");
+        assert_eq!(a.data, b.data, "zmip level {m}: the forms differ");
+    }
     for name in ["ao-raw", "ao-temporal", "ao-blur-h", "ao"] {
         assert_eq!(difference(name, 1), (0.0, 0.0), "{name}: the forms differ");
     }
+    // the propagation reads last frame's E, which differs as the gathers do; on its
+    // first frame (no history) it is B = direct, here the same bits
     // (on a device whose two gathers agree, both bounds are 0: the same bits)
     let (raw_mean, raw_max) = difference("indirect-raw", 3);
     for name in ["indirect-temporal", "indirect"] {

@@ -63,6 +63,8 @@ pub(crate) struct CoreConfig {
     /// Levels of the depth MIP chain `zmip`; `None`: no chain (a technique that reads
     /// full-resolution depth only).
     pub mip_levels: Option<u32>,
+    /// The technique's kernel: the depth MIP chain's passes take the same form.
+    pub kernel: crate::passes::Kernel,
     /// The shading inputs imported per layer; with any, motion is kept for every layer.
     pub shading: ShadingImport,
 }
@@ -197,8 +199,10 @@ impl Core {
             targets.create(&gpu, d);
         }
         let mip = c.mip_levels.map(|levels| {
-            targets.create(&gpu, DepthMipSettings { levels }.output(layers, w, h));
-            DepthMipPass::new(&gpu, &targets, layers)
+            let zmip = DepthMipSettings { levels }.output(layers, w, h);
+            let compute = DepthMipPass::compute_on(&gpu, c.kernel, zmip.format);
+            targets.create_storable(&gpu, zmip, compute);
+            DepthMipPass::new(&gpu, &targets, layers, compute)
         });
 
         let device = &gpu.device;

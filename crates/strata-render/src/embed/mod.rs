@@ -387,6 +387,7 @@ impl EmbeddedAo {
             normals: config.normals,
             normal_space: config.normal_space,
             mip_levels: Some(s.mips.levels),
+            kernel: s.kernel,
             shading: self::core::ShadingImport::None,
         };
         Core::scoped(device, || {

@@ -117,6 +117,7 @@ impl EmbeddedRadiosity {
             normals: config.normals,
             normal_space: config.normal_space,
             mip_levels: Some(s.mips.levels),
+            kernel: s.kernel,
             shading: super::core::ShadingImport::Radiosity,
         };
         Core::scoped(device, || {

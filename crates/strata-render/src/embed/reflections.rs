@@ -162,6 +162,7 @@ impl EmbeddedReflections {
             normals: config.normals,
             normal_space: config.normal_space,
             mip_levels: None,
+            kernel: s.kernel,
             shading: ShadingImport::Reflections {
                 roughness: m.roughness,
                 metallic: m.metallic,

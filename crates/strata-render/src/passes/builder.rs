@@ -61,6 +61,7 @@ pub const SCREEN_FORMATS: &[wgpu::TextureFormat] = &[
     wgpu::TextureFormat::R32Float,
     wgpu::TextureFormat::R16Float,
     wgpu::TextureFormat::Rg11b10Ufloat,
+    wgpu::TextureFormat::Rg32Float,
 ];
 
 /// Whether a compute pass on `gpu` can write `format` as a write-only storage texture: the
@@ -88,6 +89,7 @@ fn wgsl_storage_format(format: wgpu::TextureFormat) -> Option<&'static str> {
         F::R16Float => "r16float",
         F::Rg11b10Ufloat => "rg11b10ufloat",
         F::Rgba32Float => "rgba32float",
+        F::Rg32Float => "rg32float",
         F::Rgba8Unorm => "rgba8unorm",
         F::R32Uint => "r32uint",
         _ => return None,

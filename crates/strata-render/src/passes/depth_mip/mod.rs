@@ -56,19 +56,49 @@ impl DepthMipSettings {
     }
 }
 
+/// A pipeline of either form ([`crate::passes::Kernel`]).
+enum Pipeline {
+    Fragment(wgpu::RenderPipeline),
+    Compute(wgpu::ComputePipeline),
+}
+
 pub struct DepthMipPass {
-    level0: wgpu::RenderPipeline,
-    downsample: wgpu::RenderPipeline,
+    level0: Pipeline,
+    downsample: Pipeline,
     groups: Vec<wgpu::BindGroup>,
     inputs: Vec<&'static str>,
 }
 
 impl DepthMipPass {
-    /// Builds the chain into `zmip` (created beforehand from [`DepthMipSettings::output`]).
-    pub fn new(gpu: &GpuContext, targets: &Targets, layers: u32) -> Self {
+    /// Whether the chain is built by compute passes on `gpu` for a consumer whose kernel
+    /// is `kernel`, into `zmip` of `format` ([`DepthMipSettings::output`]).
+    pub fn compute_on(gpu: &GpuContext, kernel: crate::passes::Kernel, format: wgpu::TextureFormat) -> bool {
+        kernel.compute_for(gpu, &[format])
+    }
+
+    /// Builds the chain into `zmip` (created beforehand from [`DepthMipSettings::output`],
+    /// with storage binding when `compute`: each level is then a compute pass).
+    pub fn new(gpu: &GpuContext, targets: &Targets, layers: u32, compute: bool) -> Self {
         let device = &gpu.device;
         let zmip = targets.get("zmip");
-        let entries = [0, 1].map(|b| crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, false));
+        let mut entries: Vec<wgpu::BindGroupLayoutEntry> = [0, 1]
+            .map(|b| crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, false))
+            .to_vec();
+        if compute {
+            for e in &mut entries {
+                e.visibility = wgpu::ShaderStages::COMPUTE;
+            }
+            entries.push(wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: zmip.desc.format,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            });
+        }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth-mip"),
             entries: &entries,
@@ -78,49 +108,51 @@ impl DepthMipPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = crate::shader::module(device, "depth-mip", include_str!("depth_mip.wgsl"));
+        let module = crate::passes::builder::module_writing(
+            device,
+            "depth-mip",
+            include_str!("depth_mip.wgsl"),
+            &[zmip.desc.format],
+        );
         let target = [Some(wgpu::ColorTargetState::from(zmip.desc.format))];
         let constants = [("LAYERS", layers as f64)];
-        let level0 = crate::passes::fullscreen_pipeline_with(
-            device,
-            "depth-mip level 0",
-            &pl,
-            &module,
-            "fs_level0",
-            &constants,
-            &target,
-        );
-        let downsample = crate::passes::fullscreen_pipeline_with(
-            device,
-            "depth-mip downsample",
-            &pl,
-            &module,
-            "fs_downsample",
-            &constants,
-            &target,
-        );
+        let pipeline = |label: &str, entry: &str| {
+            if compute {
+                Pipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(&pl),
+                    module: &module,
+                    entry_point: Some(&entry.replace("fs_", "cs_")),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    cache: None,
+                }))
+            } else {
+                Pipeline::Fragment(crate::passes::fullscreen_pipeline_with(
+                    device, label, &pl, &module, entry, &constants, &target,
+                ))
+            }
+        };
+        let level0 = pipeline("depth-mip level 0", "fs_level0");
+        let downsample = pipeline("depth-mip downsample", "fs_downsample");
         let z01 = &targets.get("zpack").view;
         let z23 = if layers > 2 { &targets.get("zpack23").view } else { z01 };
-        let mut groups = vec![crate::passes::bind_group(
-            device,
-            "depth-mip level 0",
-            &layout,
-            &[
-                wgpu::BindingResource::TextureView(z01),
-                wgpu::BindingResource::TextureView(z23),
-            ],
-        )];
-        for m in 1..zmip.desc.mips {
-            let prev = &zmip.mip_views[m as usize - 1];
-            groups.push(crate::passes::bind_group(
-                device,
-                "depth-mip downsample",
-                &layout,
-                &[
-                    wgpu::BindingResource::TextureView(prev),
-                    wgpu::BindingResource::TextureView(prev),
-                ],
-            ));
+        let group = |label: &str, a: &wgpu::TextureView, b: &wgpu::TextureView, m: usize| {
+            let mut resources = vec![
+                wgpu::BindingResource::TextureView(a),
+                wgpu::BindingResource::TextureView(b),
+            ];
+            if compute {
+                resources.push(wgpu::BindingResource::TextureView(&zmip.mip_views[m]));
+            }
+            crate::passes::bind_group(device, label, &layout, &resources)
+        };
+        let mut groups = vec![group("depth-mip level 0", z01, z23, 0)];
+        for m in 1..zmip.desc.mips as usize {
+            let prev = &zmip.mip_views[m - 1];
+            groups.push(group("depth-mip downsample", prev, prev, m));
         }
         let mut inputs = vec!["zpack"];
         if layers > 2 {
@@ -147,8 +179,21 @@ impl Pass for DepthMipPass {
     fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         let zmip = targets.get("zmip");
         for (m, group) in self.groups.iter().enumerate() {
-            let pipeline = if m == 0 { &self.level0 } else { &self.downsample };
-            crate::passes::fullscreen_pass(encoder, "depth-mip", pipeline, &[&zmip.mip_views[m]], &[group]);
+            match if m == 0 { &self.level0 } else { &self.downsample } {
+                Pipeline::Fragment(p) => {
+                    crate::passes::fullscreen_pass(encoder, "depth-mip", p, &[&zmip.mip_views[m]], &[group])
+                }
+                Pipeline::Compute(p) => {
+                    let (w, h) = ((zmip.texture.width() >> m).max(1), (zmip.texture.height() >> m).max(1));
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("depth-mip"),
+                        timestamp_writes: None,
+                    });
+                    pass.set_pipeline(p);
+                    pass.set_bind_group(0, group, &[]);
+                    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+                }
+            }
         }
     }
 }

@@ -11,7 +11,7 @@
 
 pub(crate) mod stage;
 
-use crate::passes::builder::{FullscreenPass, Kernel, PassBuilder, ScreenPass};
+use crate::passes::builder::{Kernel, PassBuilder, ScreenPass};
 use glam::Vec3;
 use strata_scene::ImageBuf;
 
@@ -739,11 +739,12 @@ pub const BOUNCE_OUTPUTS: [TargetDesc; 2] = [
 ];
 
 pub struct PropagatePass {
-    pass: FullscreenPass,
+    pass: ScreenPass,
     settings: PropagateUniforms,
 }
 
 impl PropagatePass {
+    /// `compute`: the compute form ([`Kernel`]), for [`BOUNCE_OUTPUTS`] with storage binding.
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -751,6 +752,7 @@ impl PropagatePass {
         layers: u32,
         s: &RadiositySettings,
         temporal: &TemporalSettings,
+        compute: bool,
     ) -> Self {
         let settings = PropagateUniforms {
             delta: s.delta,
@@ -766,7 +768,8 @@ impl PropagatePass {
         } else {
             ("radiosity0", "indirect-history")
         };
-        let mut b = PassBuilder::new(gpu, targets, "propagate")
+        let b = PassBuilder::new(gpu, targets, "propagate")
+            .kernel(compute)
             .shader("propagate", include_str!("propagate.wgsl"))
             .constant("LAYERS", layers as f64)
             .frame(scene)
@@ -780,11 +783,8 @@ impl PropagatePass {
             .read("indirect-history")
             .read(e1)
             .read_array("motion");
-        for t in &BOUNCE_OUTPUTS {
-            b = b.write(t.name);
-        }
         Self {
-            pass: b.build(),
+            pass: ScreenPass::build(b, &BOUNCE_OUTPUTS.map(|t| t.name), compute),
             settings,
         }
     }

@@ -69,13 +69,31 @@ fn bounce_input(p: vec2i, j: i32, direct: vec3f) -> vec3f {
     return direct + prop.delta * rho / 3.14159265358979 * k * e;
 }
 
-@fragment
-fn fs_main(@builtin(position) pos: vec4f) -> Out {
-    let p = vec2i(pos.xy);
+// Both layers' B at pixel p.
+fn propagated(p: vec2i) -> Out {
     var o: Out;
     o.b0 = vec4f(bounce_input(p, 0, textureLoad(direct0, p, 0).rgb), 1.0);
     if (LAYERS > 1u) {
         o.b1 = vec4f(bounce_input(p, 1, textureLoad(direct1, p, 0).rgb), 1.0);
     }
     return o;
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4f) -> Out {
+    return propagated(vec2i(pos.xy));
+}
+
+// The same pass as compute (`Kernel`), 8×8 pixels per workgroup.
+@group(1) @binding(10) var b0_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
+@group(1) @binding(11) var b1_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3u) {
+    if (any(id.xy >= textureDimensions(b0_out))) {
+        return;
+    }
+    let o = propagated(vec2i(id.xy));
+    textureStore(b0_out, id.xy, o.b0);
+    textureStore(b1_out, id.xy, o.b1);
 }

@@ -77,8 +77,10 @@ impl RadiosityStage {
             targets.create_with_usage(gpu, TargetDesc::new(name, F::Rgba16Float, 1, doc), size, usage);
         }
         let propagate = (s.delta > 0.0).then(|| {
-            for t in crate::passes::radiosity::BOUNCE_OUTPUTS {
-                targets.create(gpu, t);
+            let bounce = crate::passes::radiosity::BOUNCE_OUTPUTS;
+            let compute = s.kernel.compute_for(gpu, &bounce.map(|t| t.format));
+            for t in bounce {
+                targets.create_storable(gpu, t, compute);
             }
             for (name, doc) in [
                 ("indirect-history", "last frame's final indirect E of layer 0"),
@@ -88,7 +90,7 @@ impl RadiosityStage {
             }
             // the indirect filter's reprojection rule (its default when the filter is off)
             let t = s.temporal.unwrap_or_default();
-            crate::passes::radiosity::PropagatePass::new(gpu, scene, targets, deep.layers, s, &t)
+            crate::passes::radiosity::PropagatePass::new(gpu, scene, targets, deep.layers, s, &t, compute)
         });
         let b = if propagate.is_some() {
             ["bounce0", "bounce1"]
