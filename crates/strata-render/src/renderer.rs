@@ -715,6 +715,7 @@ impl Renderer {
                 settings.deep.layers,
                 shaded,
                 rs,
+                true,
             )
         });
         let shown = if reflections.is_some() { "hdr-reflected" } else { shaded };

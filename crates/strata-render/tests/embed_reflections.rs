@@ -24,6 +24,9 @@ const H: u32 = 120;
 fn mirror_scene() -> Scene {
     let mut scene = common::frozen("mirror");
     scene.settings.sky = [0.0; 3];
+    // the renderer reflects layer 1 as B + ambient × diffuse albedo; with no ambient that
+    // is its `radiosity1`, which the tests hand over as the second layer's radiance
+    scene.settings.ambient = [0.0; 3];
     scene
 }
 

@@ -172,7 +172,15 @@ impl EmbeddedReflections {
         scene.settings.min_separation = dz;
         Core::scoped(device, || {
             let mut core = Core::new(adapter, device, queue, core, scene)?;
-            let stage = ReflectionPass::new(&core.gpu, &core.scene_gpu, &mut core.targets, config.layers, "hdr", s);
+            let stage = ReflectionPass::new(
+                &core.gpu,
+                &core.scene_gpu,
+                &mut core.targets,
+                config.layers,
+                "hdr",
+                s,
+                false,
+            );
             Ok(Self {
                 core,
                 config: config.clone(),

@@ -116,6 +116,55 @@ pub(crate) fn module_writing(
     crate::shader::module(device, label, &text)
 }
 
+/// A hand-built screen pass's pipeline in either form ([`Kernel`]), for passes whose
+/// bindings the [`PassBuilder`] does not make (the lighting, the depth MIP chain).
+pub(crate) enum ScreenPipeline {
+    Fragment(wgpu::RenderPipeline),
+    Compute(wgpu::ComputePipeline),
+}
+
+impl ScreenPipeline {
+    /// Records the pass: a fullscreen pass into `outputs`, or the compute form over `size`
+    /// texels, 8×8 per workgroup (its outputs are storage textures in `groups`).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        outputs: &[&wgpu::TextureView],
+        groups: &[&wgpu::BindGroup],
+        size: [u32; 2],
+    ) {
+        match self {
+            ScreenPipeline::Fragment(p) => super::fullscreen_pass(encoder, label, p, outputs, groups),
+            ScreenPipeline::Compute(p) => {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(label),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(p);
+                for (i, g) in groups.iter().enumerate() {
+                    pass.set_bind_group(i as u32, *g, &[]);
+                }
+                pass.dispatch_workgroups(size[0].div_ceil(8), size[1].div_ceil(8), 1);
+            }
+        }
+    }
+}
+
+/// A write-only storage texture of `format` at `binding`, for compute passes.
+pub(crate) fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
 /// What a built pass holds besides its pipeline, in either form.
 struct Bound {
     name: &'static str,
@@ -440,14 +489,8 @@ impl<'a> PassBuilder<'a> {
     pub fn write_storage(mut self, name: &'static str) -> Self {
         let t = self.targets.get(name);
         self.outputs.push(name);
-        self.push(
-            wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: t.desc.format,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            Some(wgpu::BindingResource::TextureView(t.layer(0))),
-        )
+        let ty = storage_texture_entry(0, t.desc.format).ty;
+        self.push(ty, Some(wgpu::BindingResource::TextureView(t.layer(0))))
     }
 
     /// The bind group, its uniform buffer, the pipeline layout and the shader module.

@@ -4,6 +4,7 @@
 
 use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
 use crate::gpu::GpuContext;
+use crate::passes::builder::{storage_texture_entry, ScreenPipeline};
 use crate::scene_gpu::GpuScene;
 
 /// Settings of the MIP chain.
@@ -56,15 +57,9 @@ impl DepthMipSettings {
     }
 }
 
-/// A pipeline of either form ([`crate::passes::Kernel`]).
-enum Pipeline {
-    Fragment(wgpu::RenderPipeline),
-    Compute(wgpu::ComputePipeline),
-}
-
 pub struct DepthMipPass {
-    level0: Pipeline,
-    downsample: Pipeline,
+    level0: ScreenPipeline,
+    downsample: ScreenPipeline,
     groups: Vec<wgpu::BindGroup>,
     inputs: Vec<&'static str>,
 }
@@ -88,16 +83,7 @@ impl DepthMipPass {
             for e in &mut entries {
                 e.visibility = wgpu::ShaderStages::COMPUTE;
             }
-            entries.push(wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: zmip.desc.format,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            });
+            entries.push(storage_texture_entry(2, zmip.desc.format));
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("depth-mip"),
@@ -118,7 +104,7 @@ impl DepthMipPass {
         let constants = [("LAYERS", layers as f64)];
         let pipeline = |label: &str, entry: &str| {
             if compute {
-                Pipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                ScreenPipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(label),
                     layout: Some(&pl),
                     module: &module,
@@ -130,7 +116,7 @@ impl DepthMipPass {
                     cache: None,
                 }))
             } else {
-                Pipeline::Fragment(crate::passes::fullscreen_pipeline_with(
+                ScreenPipeline::Fragment(crate::passes::fullscreen_pipeline_with(
                     device, label, &pl, &module, entry, &constants, &target,
                 ))
             }
@@ -179,21 +165,9 @@ impl Pass for DepthMipPass {
     fn encode(&self, _gpu: &GpuContext, _scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         let zmip = targets.get("zmip");
         for (m, group) in self.groups.iter().enumerate() {
-            match if m == 0 { &self.level0 } else { &self.downsample } {
-                Pipeline::Fragment(p) => {
-                    crate::passes::fullscreen_pass(encoder, "depth-mip", p, &[&zmip.mip_views[m]], &[group])
-                }
-                Pipeline::Compute(p) => {
-                    let (w, h) = ((zmip.texture.width() >> m).max(1), (zmip.texture.height() >> m).max(1));
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("depth-mip"),
-                        timestamp_writes: None,
-                    });
-                    pass.set_pipeline(p);
-                    pass.set_bind_group(0, group, &[]);
-                    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-                }
-            }
+            let pipeline = if m == 0 { &self.level0 } else { &self.downsample };
+            let size = [(zmip.texture.width() >> m).max(1), (zmip.texture.height() >> m).max(1)];
+            pipeline.record(encoder, "depth-mip", &[&zmip.mip_views[m]], &[group], size);
         }
     }
 }

@@ -4,6 +4,7 @@
 use crate::frame::{Pass, PassInfo, TargetDesc, Targets};
 use crate::gpu::GpuContext;
 use crate::lights::GpuLight;
+use crate::passes::builder::{storage_texture_entry, ScreenPipeline};
 use crate::passes::shadow::ShadowPass;
 use crate::passes::Kernel;
 use crate::scene_gpu::GpuScene;
@@ -71,18 +72,12 @@ struct Params {
     _pad: [u32; 2],
 }
 
-/// A pipeline of either form ([`Kernel`]).
-enum Pipeline {
-    Fragment(wgpu::RenderPipeline),
-    Compute(wgpu::ComputePipeline),
-}
-
 pub struct LightingPass {
-    pipeline: Pipeline,
+    pipeline: ScreenPipeline,
     group: wgpu::BindGroup,
     lights: wgpu::Buffer,
     /// Layers 1.. of the deep G-buffer: their initial radiosity B (DGB §3.2).
-    layer_pipeline: Pipeline,
+    layer_pipeline: ScreenPipeline,
     layer_groups: Vec<(&'static str, wgpu::BindGroup)>,
 }
 
@@ -140,24 +135,19 @@ impl LightingPass {
             crate::passes::uniform_entry(7),
             crate::passes::storage_entry(8),
         ];
-        let storage = |binding: u32, format: wgpu::TextureFormat| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        };
         // the compute form's layer 0 writes bindings 9..=12 (OUTPUTS), a deeper layer 13
         let mut layer_entries = entries.clone();
         if compute {
             for e in entries.iter_mut().chain(layer_entries.iter_mut()) {
                 e.visibility = wgpu::ShaderStages::COMPUTE;
             }
-            entries.extend(OUTPUTS.iter().enumerate().map(|(i, t)| storage(9 + i as u32, t.format)));
-            layer_entries.push(storage(13, crate::passes::deep_gbuffer::RADIOSITY_FORMAT));
+            entries.extend(
+                OUTPUTS
+                    .iter()
+                    .enumerate()
+                    .map(|(i, t)| storage_texture_entry(9 + i as u32, t.format)),
+            );
+            layer_entries.push(storage_texture_entry(13, crate::passes::deep_gbuffer::RADIOSITY_FORMAT));
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lighting"),
@@ -265,7 +255,7 @@ impl LightingPass {
         };
         let pl = pipeline_layout(&layout);
         let compute_pipeline = |label: &str, layout: &wgpu::PipelineLayout, entry: &str| {
-            Pipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            ScreenPipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
                 layout: Some(layout),
                 module: &module,
@@ -286,14 +276,14 @@ impl LightingPass {
         } else {
             let targets_fmt = crate::passes::color_targets(OUTPUTS);
             (
-                Pipeline::Fragment(crate::passes::fullscreen_pipeline(
+                ScreenPipeline::Fragment(crate::passes::fullscreen_pipeline(
                     device,
                     "lighting",
                     &pl,
                     &module,
                     &targets_fmt,
                 )),
-                Pipeline::Fragment(crate::passes::fullscreen_pipeline_with(
+                ScreenPipeline::Fragment(crate::passes::fullscreen_pipeline_with(
                     device,
                     "lighting layer radiosity",
                     &pl,
@@ -336,35 +326,15 @@ impl Pass for LightingPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
-        let run = |encoder: &mut wgpu::CommandEncoder,
-                   label: &str,
-                   pipeline: &Pipeline,
-                   outputs: &[&wgpu::TextureView],
-                   group: &wgpu::BindGroup| match pipeline {
-            Pipeline::Fragment(p) => {
-                crate::passes::fullscreen_pass(encoder, label, p, outputs, &[&scene.frame_bind_group, group])
-            }
-            Pipeline::Compute(p) => {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(label),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(p);
-                pass.set_bind_group(0, &scene.frame_bind_group, &[]);
-                pass.set_bind_group(1, group, &[]);
-                pass.dispatch_workgroups(targets.width.div_ceil(8), targets.height.div_ceil(8), 1);
-            }
-        };
+        let size = [targets.width, targets.height];
         let outputs = crate::passes::output_views(targets, OUTPUTS);
-        run(encoder, "lighting", &self.pipeline, &outputs, &self.group);
+        let groups = [&scene.frame_bind_group, &self.group];
+        self.pipeline.record(encoder, "lighting", &outputs, &groups, size);
         for (name, group) in &self.layer_groups {
-            run(
-                encoder,
-                "lighting layer radiosity",
-                &self.layer_pipeline,
-                &[&targets.get(name).view],
-                group,
-            );
+            let groups = [&scene.frame_bind_group, group];
+            let outputs = [&targets.get(name).view];
+            self.layer_pipeline
+                .record(encoder, "lighting layer radiosity", &outputs, &groups, size);
         }
     }
 }

@@ -102,6 +102,8 @@ pub struct ReflectionPass {
 
 impl ReflectionPass {
     /// Reflects `input` (the shaded layer 0) and layer 1's radiosity; creates [`OUTPUTS`].
+    /// `layer1_ambient`: layer 1's radiance is the renderer's `radiosity1` (B, without the
+    /// ambient term that `input` holds), so a hit there adds ambient × diffuse albedo.
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -109,6 +111,7 @@ impl ReflectionPass {
         layers: u32,
         input: &'static str,
         settings: &ReflectionSettings,
+        layer1_ambient: bool,
     ) -> Self {
         let compute = settings.kernel.compute_for(gpu, &OUTPUTS.map(|t| t.format));
         for t in OUTPUTS {
@@ -125,6 +128,7 @@ impl ReflectionPass {
             .kernel(compute)
             .shader("reflections", include_str!("reflections.wgsl"))
             .constant("LAYERS", layers as f64)
+            .constant("LAYER1_AMBIENT", layer1_ambient as u32 as f64)
             .frame(scene)
             .uniforms(&<ReflectionUniforms as bytemuck::Zeroable>::zeroed())
             .read_array("csz")

@@ -9,6 +9,9 @@
 #import "common/packing.wgsl"
 
 override LAYERS: u32 = 2u;
+// 1: layer 1's radiance is the renderer's B (Lambertian direct + emission), and a hit
+// there adds the ambient term that layer 0's shaded image holds (ambient × diffuse albedo)
+override LAYER1_AMBIENT: u32 = 0u;
 
 // Matches `reflections::ReflectionUniforms`.
 struct Reflections {
@@ -156,6 +159,10 @@ fn reflected(p: vec2i) -> Out {
                 code = 2.0;
             } else {
                 l = textureLoad(radiance1, t, 0).rgb;
+                if (LAYER1_AMBIENT != 0u) {
+                    let rho = textureLoad(albedo, t, 1, 0).rgb * (1.0 - textureLoad(normal, t, 1, 0).a);
+                    l += frame.ambient.rgb * rho;
+                }
                 code = 3.0;
             }
         }

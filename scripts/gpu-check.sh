@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The checks for a machine with a real GPU, in one run: every GPU test binary, an A/B of
+# two strata builds on the frame passes, and the bench suite (scripts/bench-gpu.sh).
+#
+#   BIN=dir OUT=dir bash scripts/gpu-check.sh
+#
+# BIN holds binaries built elsewhere (`cargo test --release --no-run` and
+# `cargo build --release`): `strata`, optionally `strata-old` (the build to compare
+# with), the examples `embed_ao`, `embed_gi`, `embed_reflect` (and `*-old`), and the test
+# binaries under `t/`, named after their test targets. The CLI's tests find the `strata`
+# binary where cargo built it, so copy BIN/strata there first. Tests that need
+# ../shared skip where it is absent. Each part is bounded (TEST_S, SUITE_S seconds) and
+# logs rather than stops on a failure. Results: OUT/tests/*.txt, OUT/ab-*.json,
+# OUT/suite/*.json, renders OUT/*.png.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+BIN="${BIN:?BIN: the folder of prebuilt binaries}"
+OUT="${OUT:-out/gpu-check}"
+mkdir -p "$OUT/tests"
+T0=$(date +%s)
+"$BIN/strata" info >"$OUT/info.txt" 2>&1
+tail -n 8 "$OUT/info.txt"
+
+# every test binary, four at a time (4 threads each)
+if [ -d "$BIN/t" ]; then
+  ls "$BIN/t" | timeout "${TEST_S:-300}" xargs -P 4 -I{} sh -c \
+    "'$BIN/t/{}' --test-threads=4 > '$OUT/tests/{}.txt' 2>&1; echo \"{} rc=\$?\" >> '$OUT/tests/_rc.txt'"
+  sort "$OUT/tests/_rc.txt" | tr '\n' ' '
+  echo
+  grep -h "^test result" "$OUT"/tests/*.txt | awk '{p+=$4; f+=$6; i+=$8} END {print "tests: passed", p, "failed", f, "ignored", i}'
+  grep -h -E "^test .* FAILED|panicked" "$OUT"/tests/*.txt | head -n 20
+fi
+echo "tests done $(($(date +%s) - T0)) s"
+
+# A/B: the two builds alternated, two rounds, at 1080p (AB_SIZE: other --width/--height)
+HD="${AB_SIZE:---width 1920 --height 1080}"
+builds=new
+[ -x "$BIN/strata-old" ] && builds="old new"
+for rep in 1 2; do
+  for v in $builds; do
+    S="$BIN/strata"
+    [ "$v" = old ] && S="$BIN/strata-old"
+    ab() { timeout 60 "$S" "$@" --json >"$OUT/ab-$v-$rep-$name.json" 2>/dev/null; }
+    name=full-atrium ab bench technique --technique full --scene atrium $HD --frames 5
+    name=full-mirror ab bench technique --technique full --scene mirror $HD --frames 5
+    name=ao-atrium ab bench ao --scene atrium $HD --layers 2 --frames 8
+    name=radiosity-atrium ab bench radiosity --scene atrium $HD --layers 2 --frames 5 --preset balanced
+    name=reflections-mirror ab bench reflections --scene mirror $HD --layers 2 --frames 5
+    for e in embed_ao embed_gi embed_reflect; do
+      X="$BIN/$e"
+      [ "$v" = old ] && X="$BIN/$e-old"
+      [ -x "$X" ] && timeout 30 "$X" "$OUT/$e-$v.png" >"$OUT/ab-$v-$rep-$e.txt" 2>&1
+    done
+  done
+done
+echo "A/B done $(($(date +%s) - T0)) s"
+
+STRATA="$BIN/strata" OUT="$OUT/suite" LIMIT=40 timeout "${SUITE_S:-200}" bash scripts/bench-gpu.sh >/dev/null 2>&1
+tail -n 28 "$OUT/suite/log.txt"
+for v in $builds; do
+  S="$BIN/strata"
+  [ "$v" = old ] && S="$BIN/strata-old"
+  "$S" render --scene atrium --technique full --preset balanced --layers 2 --width 640 --height 360 --warmup 8 \
+    --out "$OUT/atrium-full-$v.png" >/dev/null 2>&1
+  "$S" render --scene mirror-sign --technique full --layers 2 --width 640 --height 360 --warmup 4 \
+    --out "$OUT/mirror-sign-$v.png" >/dev/null 2>&1
+done
+echo "total $(($(date +%s) - T0)) s"
