@@ -992,15 +992,7 @@ impl ABufferStage {
                     entries: &[
                         ao_entries[0],
                         ao_entries[1],
-                        layout_entry(
-                            2,
-                            wgpu::ShaderStages::COMPUTE,
-                            wgpu::BindingType::StorageTexture {
-                                access: wgpu::StorageTextureAccess::WriteOnly,
-                                format: AO_RAW.format,
-                                view_dimension: wgpu::TextureViewDimension::D2,
-                            },
-                        ),
+                        crate::passes::builder::storage_texture_entry(2, AO_RAW.format),
                     ],
                 });
                 let group = crate::passes::bind_group(

@@ -208,29 +208,12 @@ pub(crate) fn reconstruction(
         TargetDesc::new("ao", F::R16Float, 1, "ambient visibility AV (1 = unoccluded)"),
         compute,
     );
+    let pass = |name, input, output, vertical| {
+        BilateralPass::new(gpu, scene, targets, blur, name, input, output, vertical, compute)
+    };
     [
-        BilateralPass::new(
-            gpu,
-            scene,
-            targets,
-            blur,
-            "ao-blur-h",
-            input,
-            "ao-blur-h",
-            false,
-            compute,
-        ),
-        BilateralPass::new(
-            gpu,
-            scene,
-            targets,
-            blur,
-            "ao-blur-v",
-            "ao-blur-h",
-            output,
-            true,
-            compute,
-        ),
+        pass("ao-blur-h", input, "ao-blur-h", false),
+        pass("ao-blur-v", "ao-blur-h", output, true),
     ]
 }
 

@@ -969,6 +969,7 @@ impl DssStage {
             count: None,
         };
         let ro = wgpu::BufferBindingType::Storage { read_only: true };
+        let [shadow_texture, shadow_sampler] = crate::passes::shadow_map_entries(4, comp);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dss-gi-shade"),
             entries: &[
@@ -976,22 +977,8 @@ impl DssStage {
                 buf(1, ro),
                 buf(2, ro),
                 buf(3, ro),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: comp,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: comp,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
+                shadow_texture,
+                shadow_sampler,
                 buf(6, ro),
                 buf(7, ro),
                 buf(8, ro),

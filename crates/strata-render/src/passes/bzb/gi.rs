@@ -813,6 +813,7 @@ impl BzbGiStage {
             },
             count: None,
         };
+        let [shadow_texture, shadow_sampler] = crate::passes::shadow_map_entries(3, frag);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bzb-gi-senders"),
             entries: &[
@@ -828,22 +829,8 @@ impl BzbGiStage {
                 },
                 storage_ro(1),
                 storage_ro(2),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: frag,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: frag,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
+                shadow_texture,
+                shadow_sampler,
                 storage_ro(5),
                 tex(6),
                 tex(7),
@@ -1146,6 +1133,7 @@ impl SenderPass {
             },
             count: None,
         };
+        let [shadow_texture, shadow_sampler] = crate::passes::shadow_map_entries(4, comp);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bzb-gi-senders"),
             entries: &[
@@ -1153,22 +1141,8 @@ impl SenderPass {
                 buf(1, true),
                 buf(2, true),
                 buf(3, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: comp,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: comp,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
+                shadow_texture,
+                shadow_sampler,
                 buf(6, true),
                 buf(7, false),
             ],

@@ -487,16 +487,7 @@ impl Interleave {
             },
         ];
         if method == SplitMethod::Compute {
-            entries.push(wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            });
+            entries.push(crate::passes::builder::storage_texture_entry(2, format));
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("interleave"),

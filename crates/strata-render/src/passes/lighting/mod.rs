@@ -110,28 +110,15 @@ impl LightingPass {
         let device = &gpu.device;
         let tex =
             |b: u32, filterable: bool| crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, filterable);
+        let [shadow_texture, shadow_sampler] = crate::passes::shadow_map_entries(5, wgpu::ShaderStages::FRAGMENT);
         let mut entries = vec![
             tex(0, false),
             tex(1, false),
             tex(2, false),
             tex(3, false),
             crate::passes::storage_entry(4),
-            wgpu::BindGroupLayoutEntry {
-                binding: 5,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 6,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                count: None,
-            },
+            shadow_texture,
+            shadow_sampler,
             crate::passes::uniform_entry(7),
             crate::passes::storage_entry(8),
         ];
