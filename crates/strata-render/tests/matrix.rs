@@ -194,6 +194,17 @@ fn algorithm_switching_settings_render_cleanly() {
         ("ao", &[("ao-scale", "2")]),
         ("full", &[("ao-scale", "3"), ("ao-kernel", "compute")]),
         ("full", &[("gather-scale", "3"), ("indirect-kernel", "compute")]),
+        // every screen pass in its compute form, as GPUs run them (`tests/kernels.rs`
+        // compares the forms' values)
+        (
+            "full",
+            &[
+                ("ao-kernel", "compute"),
+                ("indirect-kernel", "compute"),
+                ("lighting-kernel", "compute"),
+                ("reflection-kernel", "compute"),
+            ],
+        ),
     ];
     let gpu = common::gpu();
     let mut images = 0;
