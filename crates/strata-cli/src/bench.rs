@@ -222,6 +222,8 @@ fn print_stage(name: &str, s: &StageBench) {
     let forms: Vec<String> = [
         ("ao_kernel", "AO pass"),
         ("indirect_kernel", "radiosity gather and blurs"),
+        ("lighting_kernel", "lighting"),
+        ("reflection_kernel", "reflections"),
     ]
     .iter()
     .filter_map(|(key, what)| {
@@ -232,7 +234,10 @@ fn print_stage(name: &str, s: &StageBench) {
     })
     .collect();
     if !forms.is_empty() {
-        println!("({}; --set ao-kernel / indirect-kernel choose)", forms.join(", "));
+        println!(
+            "({}; --set ao-kernel / indirect-kernel / lighting-kernel / reflection-kernel choose)",
+            forms.join(", ")
+        );
     }
     let reduced: Vec<String> = [("ao_scale", "AO pass"), ("gather_scale", "radiosity gather")]
         .iter()

@@ -19,6 +19,10 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             "adapter": i.name, "backend": format!("{:?}", i.backend), "device_type": format!("{:?}", i.device_type),
             "driver": i.driver, "driver_info": i.driver_info, "features": feats,
             "max_multiview_view_count": gpu.device.limits().max_multiview_view_count,
+            "storage_formats": strata_render::passes::SCREEN_FORMATS
+                .iter()
+                .map(|f| (format!("{f:?}"), strata_render::passes::storable(&gpu, *f).into()))
+                .collect::<serde_json::Map<String, serde_json::Value>>(),
             "driver_issue": gpu.driver_issue(),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);

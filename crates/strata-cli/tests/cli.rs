@@ -319,6 +319,11 @@ fn info_lists_multiview_and_timestamps_present() {
             "{feature} not present: {line}"
         );
     }
+    // the storage formats of the compute passes: WebGPU guarantees RGBA16F and R32F
+    let v = json_of(&strata(&["info", "--json"]));
+    for format in ["Rgba16Float", "R32Float"] {
+        assert_eq!(v["storage_formats"][format], true, "{v}");
+    }
 }
 
 #[test]
@@ -747,6 +752,32 @@ fn bench_ao_splits_first_layer_and_increment() {
         ]))
     };
     assert_eq!(bench_with("ao-kernel=compute")["ao_kernel"], "compute");
+    // the lighting's and the reflections' forms, in `full`
+    let v = json_of(&strata(&[
+        "bench",
+        "technique",
+        "--technique",
+        "full",
+        "--scene",
+        "mirror",
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--frames",
+        "1",
+        "--set",
+        "lighting-kernel=compute",
+        "--set",
+        "reflection-kernel=compute",
+        "--json",
+    ]));
+    assert_eq!(
+        (&v["lighting_kernel"], &v["reflection_kernel"]),
+        (&"compute".into(), &"compute".into()),
+        "{v}"
+    );
+    assert_eq!(v["indirect_kernel"], if cpu { "fragment" } else { "compute" }, "{v}");
     // a reduced AO pass: its upsampling is timed right after it, and the scale is reported
     let v = bench_with("ao-scale=2");
     assert_eq!(v["ao_scale"], 2, "{v}");

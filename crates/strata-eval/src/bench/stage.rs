@@ -91,6 +91,17 @@ pub(crate) fn run(b: Stage) -> Result<StageBench> {
         settings.insert("indirect_kernel".into(), form(rad.kernel.compute_on(&gpu)).into());
         settings.insert("gather_scale".into(), rad.gather_scale.into());
     }
+    if rs.shade {
+        let compute = strata_render::passes::lighting::LightingPass::compute_on(&gpu, &rs.lighting);
+        settings.insert("lighting_kernel".into(), form(compute).into());
+    }
+    if let Some(refl) = &rs.reflections {
+        let formats = strata_render::passes::reflections::OUTPUTS.map(|t| t.format);
+        settings.insert(
+            "reflection_kernel".into(),
+            form(refl.kernel.compute_for(&gpu, &formats)).into(),
+        );
+    }
     Ok(StageBench {
         run: bench_run(&s.scene, s.frames, &scene, &gpu),
         layers: s.layers,
