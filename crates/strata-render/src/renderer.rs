@@ -715,7 +715,15 @@ impl Renderer {
                 settings.deep.layers,
                 shaded,
                 rs,
-                true,
+                crate::passes::reflections::Layer1Radiance {
+                    ambient: true,
+                    indirect: radiosity.as_ref().zip(settings.radiosity.as_ref()).map(|(stage, r)| {
+                        crate::passes::reflections::Layer1Indirect {
+                            probes: stage.probes.as_ref().map(|(p, mode)| (p, *mode)),
+                            boost: r.boost,
+                        }
+                    }),
+                },
             )
         });
         let shown = if reflections.is_some() { "hdr-reflected" } else { shaded };

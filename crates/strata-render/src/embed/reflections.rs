@@ -179,7 +179,7 @@ impl EmbeddedReflections {
                 config.layers,
                 "hdr",
                 s,
-                false,
+                Default::default(),
             );
             Ok(Self {
                 core,

@@ -21,6 +21,9 @@ pub(crate) struct RadiosityStage {
     pub(crate) blur_v: BilateralPass,
     /// `None` where the frame's composite is someone else's (`embed::EmbeddedRadiosity`).
     pub(crate) compose: Option<crate::passes::compose::ComposePass>,
+    /// The light probes on the GPU and compose's blend mode (1 DGB's, 2 probes + detail,
+    /// 3 one-sided), for the reflections' second-layer hits.
+    pub(crate) probes: Option<(crate::passes::compose::ProbeGpu, u32)>,
 }
 
 impl RadiosityStage {
@@ -203,6 +206,11 @@ impl RadiosityStage {
                 compute,
             )
         });
+        let mode = match (detail, s.one_sided_confidence) {
+            (true, _) => 2,
+            (false, true) => 3,
+            (false, false) => 1,
+        };
         Self {
             propagate,
             gather,
@@ -211,6 +219,7 @@ impl RadiosityStage {
             blur_h,
             blur_v,
             compose,
+            probes: probe_gpu.map(|p| (p, mode)),
         }
     }
 

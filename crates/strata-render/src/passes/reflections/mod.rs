@@ -78,6 +78,8 @@ pub struct ReflectionUniforms {
     pub steps: u32,
     pub thickness: f32,
     pub max_roughness: f32,
+    /// The light probes' grid, for second-layer hits ([`Layer1Radiance::indirect`]).
+    pub grid: crate::passes::compose::ProbeGridUniform,
 }
 
 pub const OUTPUTS: [TargetDesc; 2] = [
@@ -95,15 +97,36 @@ pub const OUTPUTS: [TargetDesc; 2] = [
     ),
 ];
 
+/// What a hit on layer 1 reflects besides that layer's radiance target (`radiosity1`, or an
+/// application's): the terms layer 0's shaded image holds and B does not.
+#[derive(Clone, Copy, Default)]
+pub struct Layer1Radiance<'a> {
+    /// Add ambient × diffuse albedo (the renderer's B has no ambient term).
+    pub ambient: bool,
+    /// Add ρ/π · k · E as compose adds layer 0's: E is the gather's layer-1 irradiance
+    /// (`indirect1-raw`), blended with the light probes at the hit where there are probes;
+    /// k = boost(ρ) when `boost`.
+    pub indirect: Option<Layer1Indirect<'a>>,
+}
+
+/// The radiosity stage's light for second-layer hits ([`Layer1Radiance::indirect`]).
+#[derive(Clone, Copy)]
+pub struct Layer1Indirect<'a> {
+    /// The probes and compose's blend mode (1 DGB's blend, 2 probes + detail, 3 one-sided);
+    /// `None`: the gather alone.
+    pub probes: Option<(&'a crate::passes::compose::ProbeGpu, u32)>,
+    pub boost: bool,
+}
+
 pub struct ReflectionPass {
     pass: ScreenPass,
     settings: ReflectionSettings,
+    grid: crate::passes::compose::ProbeGridUniform,
 }
 
 impl ReflectionPass {
-    /// Reflects `input` (the shaded layer 0) and layer 1's radiosity; creates [`OUTPUTS`].
-    /// `layer1_ambient`: layer 1's radiance is the renderer's `radiosity1` (B, without the
-    /// ambient term that `input` holds), so a hit there adds ambient × diffuse albedo.
+    /// Reflects `input` (the shaded layer 0) and layer 1's radiosity with what `layer1`
+    /// adds; creates [`OUTPUTS`].
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -111,7 +134,7 @@ impl ReflectionPass {
         layers: u32,
         input: &'static str,
         settings: &ReflectionSettings,
-        layer1_ambient: bool,
+        layer1: Layer1Radiance<'_>,
     ) -> Self {
         let compute = settings.kernel.compute_for(gpu, &OUTPUTS.map(|t| t.format));
         for t in OUTPUTS {
@@ -119,7 +142,8 @@ impl ReflectionPass {
         }
         let targets = &*targets;
         // one layer: the binding holds the input, never read
-        let (layer1, declared) = if layers > 1 {
+        let dummy = crate::passes::compose::ProbeGpu::new(gpu, None, None);
+        let (layer1_name, declared) = if layers > 1 {
             ("radiosity1", "radiosity1")
         } else {
             (input, "")
@@ -128,7 +152,12 @@ impl ReflectionPass {
             .kernel(compute)
             .shader("reflections", include_str!("reflections.wgsl"))
             .constant("LAYERS", layers as f64)
-            .constant("LAYER1_AMBIENT", layer1_ambient as u32 as f64)
+            .constant("LAYER1_AMBIENT", layer1.ambient as u32 as f64)
+            .constant(
+                "LAYER1_INDIRECT",
+                layer1.indirect.map_or(0, |i| i.probes.map_or(4, |(_, mode)| mode)) as f64,
+            )
+            .constant("LAYER1_BOOST", layer1.indirect.is_some_and(|i| i.boost) as u32 as f64)
             .frame(scene)
             .uniforms(&<ReflectionUniforms as bytemuck::Zeroable>::zeroed())
             .read_array("csz")
@@ -137,13 +166,22 @@ impl ReflectionPass {
             .read(input)
             .view(
                 declared,
-                &targets.get(layer1).view,
+                &targets.get(layer1_name).view,
                 wgpu::TextureViewDimension::D2,
                 false,
             );
+        // without the radiosity stage the bindings hold the input and empty probes, unread
+        let (e1, declared) = match layer1.indirect {
+            Some(_) if layers > 1 => ("indirect1-raw", "indirect1-raw"),
+            _ => (input, ""),
+        };
+        let b = b.view(declared, &targets.get(e1).view, wgpu::TextureViewDimension::D2, false);
+        let probes = layer1.indirect.and_then(|i| i.probes).map_or(&dummy, |(p, _)| p);
+        let b = b.storage(&probes.probes).storage(&probes.depth);
         Self {
             pass: ScreenPass::build(b, &OUTPUTS.map(|t| t.name), compute),
             settings: *settings,
+            grid: probes.grid,
         }
     }
 
@@ -154,6 +192,7 @@ impl ReflectionPass {
             steps: s.steps,
             thickness: s.thickness.unwrap_or(min_separation),
             max_roughness: s.max_roughness,
+            grid: self.grid,
         };
         self.pass.set_uniforms(gpu, &u);
     }

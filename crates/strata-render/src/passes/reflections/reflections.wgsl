@@ -7,11 +7,21 @@
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
+#import "common/color.wgsl"
+#import "common/probes.wgsl"
 
 override LAYERS: u32 = 2u;
 // 1: layer 1's radiance is the renderer's B (Lambertian direct + emission), and a hit
 // there adds the ambient term that layer 0's shaded image holds (ambient × diffuse albedo)
 override LAYER1_AMBIENT: u32 = 0u;
+// a hit on layer 1 adds its indirect light ρ/π · k · E as compose adds layer 0's: E blends
+// the gather's layer-1 irradiance (`indirect1`, confidence in a) with the light probes at
+// the hit. 0: no; 1: DGB's blend by the confidence; 2: the probes + c × the gather;
+// 3: DGB's blend with the one-sided confidence (compose's modes); 4: the gather alone (no
+// probes)
+override LAYER1_INDIRECT: u32 = 0u;
+// 1: k = boost(ρ) (Eq. 7), as compose
+override LAYER1_BOOST: u32 = 0u;
 
 // Matches `reflections::ReflectionUniforms`.
 struct Reflections {
@@ -20,6 +30,8 @@ struct Reflections {
     // thickness Δz of a layer's surface
     thickness: f32,
     max_roughness: f32,
+    // the light probes (LAYER1_INDIRECT)
+    grid: ProbeGrid,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -30,6 +42,46 @@ struct Reflections {
 // outgoing radiance of layer 0 (the shaded image) and of layer 1 (its B)
 @group(1) @binding(4) var radiance0: texture_2d<f32>;
 @group(1) @binding(5) var radiance1: texture_2d<f32>;
+// layer 1's gather irradiance E (rgb) and confidence (a) (LAYER1_INDIRECT)
+@group(1) @binding(6) var indirect1: texture_2d<f32>;
+@group(1) @binding(7) var<storage, read> probes: array<Probe>;
+@group(1) @binding(8) var<storage, read> probe_depth: array<vec2f>;
+
+// What a layer-1 hit at pixel t adds besides its B: ambient and indirect light, seen from
+// the mirror point x.
+fn layer1_extra(t: vec2i, x: vec3f) -> vec3f {
+    let nrm = textureLoad(normal, t, 1, 0);
+    let rho = textureLoad(albedo, t, 1, 0).rgb * (1.0 - nrm.a);
+    var l = vec3f(0.0);
+    if (LAYER1_AMBIENT != 0u) {
+        l += frame.ambient.rgb * rho;
+    }
+    if (LAYER1_INDIRECT != 0u) {
+        let g = textureLoad(indirect1, t, 0);
+        let c = clamp(g.a, 0.0, 1.0);
+        let y = world_from_csz(frame, vec2f(t) + 0.5, textureLoad(csz, t, 1, 0).r);
+        let ep = probe_field(refl.grid, y, oct_decode(nrm.rg), normalize(x - y)).rgb;
+        var e = g.rgb;
+        if (LAYER1_INDIRECT == 4u) {
+            // no probes: the gather's E, as compose without them
+        } else if (LAYER1_INDIRECT == 2u) {
+            e = max(ep + c * g.rgb, vec3f(0.0));
+        } else {
+            var cb = c;
+            if (LAYER1_INDIRECT == 3u) {
+                let luma = vec3f(0.2126, 0.7152, 0.0722);
+                cb = c * min(1.0, dot(g.rgb, luma) / max(dot(ep, luma), 1e-6));
+            }
+            e = cb * g.rgb + (1.0 - cb) * ep;
+        }
+        var k = 1.0;
+        if (LAYER1_BOOST != 0u) {
+            k = boost(rho);
+        }
+        l += rho / 3.14159265358979 * e * k;
+    }
+    return l;
+}
 
 struct Out {
     // rgb = reflected radiance, a = 0 not a mirror, 1 environment, 2 layer 0, 3 layer 1
@@ -158,11 +210,7 @@ fn reflected(p: vec2i) -> Out {
                 l = textureLoad(radiance0, t, 0).rgb;
                 code = 2.0;
             } else {
-                l = textureLoad(radiance1, t, 0).rgb;
-                if (LAYER1_AMBIENT != 0u) {
-                    let rho = textureLoad(albedo, t, 1, 0).rgb * (1.0 - textureLoad(normal, t, 1, 0).a);
-                    l += frame.ambient.rgb * rho;
-                }
+                l = textureLoad(radiance1, t, 0).rgb + layer1_extra(t, x);
                 code = 3.0;
             }
         }
@@ -188,8 +236,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
 }
 
 // The same pass as compute (`Kernel`), 8×8 pixels per workgroup.
-@group(1) @binding(6) var reflection_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
-@group(1) @binding(7) var hdr_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
+@group(1) @binding(9) var reflection_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
+@group(1) @binding(10) var hdr_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
 
 @compute @workgroup_size(8, 8)
 fn cs_main(@builtin(global_invocation_id) id: vec3u) {
