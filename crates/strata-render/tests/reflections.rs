@@ -3,28 +3,20 @@
 mod common;
 
 use strata_render::frame::FrameCameras;
-use strata_render::passes::deep_gbuffer::{DeepGBufferSettings, Variant};
 use strata_render::passes::reflections::ReflectionSettings;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::{procedural, ImageBuf, Scene};
 
+/// Peeled `layers` at `w`×`h` with the mirror reflections.
+fn settings(scene: &Scene, layers: u32, w: u32, h: u32) -> RenderSettings {
+    RenderSettings {
+        reflections: Some(ReflectionSettings::default()),
+        ..common::peeled_layers(scene, w, h, layers)
+    }
+}
+
 fn reflect(gpu: &GpuContext, scene: &Scene, layers: u32, w: u32, h: u32) -> (ImageBuf, Renderer) {
-    let mut r = Renderer::new(
-        gpu,
-        scene,
-        RenderSettings {
-            width: w,
-            height: h,
-            deep: DeepGBufferSettings {
-                layers,
-                variant: Variant::Peel,
-                ..Default::default()
-            },
-            reflections: Some(ReflectionSettings::default()),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let mut r = Renderer::new(gpu, scene, settings(scene, layers, w, h)).unwrap();
     r.render(gpu, scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
     (r.read_target(gpu, "reflection").unwrap(), r)
 }
@@ -265,17 +257,9 @@ fn second_layer_hits_reflect_the_composed_light_under_radiosity() {
             c[0] = [0.8, 0.8, 0.8];
         }
         let settings = RenderSettings {
-            width: w,
-            height: h,
-            deep: DeepGBufferSettings {
-                layers,
-                variant: Variant::Peel,
-                ..Default::default()
-            },
-            reflections: Some(ReflectionSettings::default()),
             radiosity: Some(RadiositySettings::default()),
             probes: Some(probes),
-            ..Default::default()
+            ..settings(scene, layers, w, h)
         };
         let mut r = Renderer::new(&gpu, scene, settings).unwrap();
         for f in 0..4 {
