@@ -58,21 +58,22 @@ fn layer1_extra(t: vec2i, x: vec3f) -> vec3f {
     }
     if (LAYER1_INDIRECT != 0u) {
         let g = textureLoad(indirect1, t, 0);
-        let c = clamp(g.a, 0.0, 1.0);
-        let y = world_from_csz(frame, vec2f(t) + 0.5, textureLoad(csz, t, 1, 0).r);
-        let ep = probe_field(refl.grid, y, oct_decode(nrm.rg), normalize(x - y)).rgb;
+        // no probes (4): the gather's E, as compose without them
         var e = g.rgb;
-        if (LAYER1_INDIRECT == 4u) {
-            // no probes: the gather's E, as compose without them
-        } else if (LAYER1_INDIRECT == 2u) {
-            e = max(ep + c * g.rgb, vec3f(0.0));
-        } else {
-            var cb = c;
-            if (LAYER1_INDIRECT == 3u) {
-                let luma = vec3f(0.2126, 0.7152, 0.0722);
-                cb = c * min(1.0, dot(g.rgb, luma) / max(dot(ep, luma), 1e-6));
+        if (LAYER1_INDIRECT != 4u) {
+            let c = clamp(g.a, 0.0, 1.0);
+            let y = world_from_csz(frame, vec2f(t) + 0.5, textureLoad(csz, t, 1, 0).r);
+            let ep = probe_field(refl.grid, y, oct_decode(nrm.rg), normalize(x - y)).rgb;
+            if (LAYER1_INDIRECT == 2u) {
+                e = max(ep + c * g.rgb, vec3f(0.0));
+            } else {
+                var cb = c;
+                if (LAYER1_INDIRECT == 3u) {
+                    let luma = vec3f(0.2126, 0.7152, 0.0722);
+                    cb = c * min(1.0, dot(g.rgb, luma) / max(dot(ep, luma), 1e-6));
+                }
+                e = cb * g.rgb + (1.0 - cb) * ep;
             }
-            e = cb * g.rgb + (1.0 - cb) * ep;
         }
         var k = 1.0;
         if (LAYER1_BOOST != 0u) {
