@@ -43,9 +43,7 @@ impl Kernel {
             Kernel::Compute => true,
         }
     }
-}
 
-impl Kernel {
     /// [`Kernel::compute_on`] for a pass writing `formats`: compute only where `gpu` can
     /// write each of them as a storage texture ([`storable`]); R16F and RG11B10 need the
     /// adapter's own format features. Elsewhere the pass stays a fragment pass.
@@ -66,8 +64,9 @@ pub const SCREEN_FORMATS: &[wgpu::TextureFormat] = &[
 
 /// Whether a compute pass on `gpu` can write `format` as a write-only storage texture: the
 /// adapter's own format features where the device has
-/// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` (NVIDIA's and lavapipe's Vulkan drivers write
-/// R16F and RG11B10), WebGPU's guaranteed ones elsewhere (RGBA16F and R32F).
+/// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` (lavapipe writes R16F and RG11B10; whether a
+/// GPU's driver does, `strata info` tells), WebGPU's guaranteed ones elsewhere (RGBA16F, R32F
+/// and RG32F among strata's).
 pub fn storable(gpu: &GpuContext, format: wgpu::TextureFormat) -> bool {
     let features = gpu.device.features();
     let f = if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
