@@ -6,7 +6,9 @@
 #
 # BIN holds binaries built elsewhere (`cargo test --release --no-run` and
 # `cargo build --release`): `strata`, optionally `strata-old` (the build to compare
-# with), the examples `embed_ao`, `embed_gi`, `embed_reflect` (and `*-old`), and the test
+# with; without it the A/B is one build's fragment forms, every `*-kernel` set to
+# `fragment`, against `auto`), the examples `embed_ao`, `embed_gi`, `embed_reflect`
+# (and `*-old`), and the test
 # binaries under `t/`, named after their test targets. The CLI's tests find the `strata`
 # binary where cargo built it, so copy BIN/strata there first. Tests that need
 # ../shared skip where it is absent. Each part is bounded (TEST_S, SUITE_S seconds) and
@@ -34,19 +36,26 @@ echo "tests done $(($(date +%s) - T0)) s"
 
 # A/B: the two builds alternated, two rounds, at 1080p (AB_SIZE: other --width/--height)
 HD="${AB_SIZE:---width 1920 --height 1080}"
-builds=new
+builds="frag new"
 [ -x "$BIN/strata-old" ] && builds="old new"
 for rep in 1 2; do
   for v in $builds; do
     S="$BIN/strata"
     [ "$v" = old ] && S="$BIN/strata-old"
+    # frag: the same build with the passes that have both forms forced to fragment
+    k() { [ "$v" = frag ] && for n in "$@"; do printf -- '--set %s-kernel=fragment ' "$n"; done; }
     ab() { timeout 60 "$S" "$@" --json >"$OUT/ab-$v-$rep-$name.json" 2>/dev/null; }
-    name=full-atrium ab bench technique --technique full --scene atrium $HD --frames 5
-    name=full-mirror ab bench technique --technique full --scene mirror $HD --frames 5
-    name=ao-atrium ab bench ao --scene atrium $HD --layers 2 --frames 8
-    name=radiosity-atrium ab bench radiosity --scene atrium $HD --layers 2 --frames 5 --preset balanced
-    name=reflections-mirror ab bench reflections --scene mirror $HD --layers 2 --frames 5
+    name=full-atrium ab bench technique --technique full --scene atrium $HD --frames 5 $(k ao indirect lighting reflection)
+    name=full-mirror ab bench technique --technique full --scene mirror $HD --frames 5 $(k ao indirect lighting reflection)
+    name=ao-tech-atrium ab bench technique --technique ao --scene atrium $HD --frames 8 $(k ao)
+    name=direct-atrium ab bench technique --technique direct --scene atrium $HD --frames 8 $(k lighting)
+    if [ "$v" != frag ]; then # the stage benches take no settings
+      name=ao-atrium ab bench ao --scene atrium $HD --layers 2 --frames 8
+      name=radiosity-atrium ab bench radiosity --scene atrium $HD --layers 2 --frames 5 --preset balanced
+      name=reflections-mirror ab bench reflections --scene mirror $HD --layers 2 --frames 5
+    fi
     for e in embed_ao embed_gi embed_reflect; do
+      [ "$v" = frag ] && continue # the examples take no settings
       X="$BIN/$e"
       [ "$v" = old ] && X="$BIN/$e-old"
       [ -x "$X" ] && timeout 30 "$X" "$OUT/$e-$v.png" >"$OUT/ab-$v-$rep-$e.txt" 2>&1
@@ -61,8 +70,13 @@ for v in $builds; do
   S="$BIN/strata"
   [ "$v" = old ] && S="$BIN/strata-old"
   "$S" render --scene atrium --technique full --preset balanced --layers 2 --width 640 --height 360 --warmup 8 \
-    --out "$OUT/atrium-full-$v.png" >/dev/null 2>&1
+    $(k ao indirect lighting reflection) --out "$OUT/atrium-full-$v.png" >/dev/null 2>&1
   "$S" render --scene mirror-sign --technique full --layers 2 --width 640 --height 360 --warmup 4 \
-    --out "$OUT/mirror-sign-$v.png" >/dev/null 2>&1
+    $(k ao indirect lighting reflection) --out "$OUT/mirror-sign-$v.png" >/dev/null 2>&1
 done
+# a longer embedded soak (SOAK_FRAMES), waiting for the GPU before each sample
+if [ -n "${SOAK_FRAMES:-}" ] && [ -x "$BIN/t/embed_soak" ]; then
+  STRATA_SOAK_FRAMES="$SOAK_FRAMES" timeout 120 "$BIN/t/embed_soak" --nocapture >"$OUT/soak.txt" 2>&1
+  echo "soak rc=$?"; grep -v "^$" "$OUT/soak.txt" | tail -n 12
+fi
 echo "total $(($(date +%s) - T0)) s"
