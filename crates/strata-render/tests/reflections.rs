@@ -95,79 +95,98 @@ fn rays_leaving_the_buffer_take_the_environment() {
     assert!(env > 1000, "only {env} mirror pixels");
 }
 
-/// What each mirror pixel's reflection ray truly finds, from the CPU tracer's first hit
-/// along it: the layer (code 2 or 3) whose depth at the hit's pixel is the hit's, else
-/// the environment (1: off screen, past the march, or in neither layer). Returns
-/// (mirror pixels, pixels whose GPU code is that, GPU hits on a surface the ray does not
-/// reach first).
-fn agreement_with_the_tracer(gpu: &GpuContext, scene: &Scene, layers: u32, w: u32, h: u32) -> (usize, usize, usize) {
-    use glam::{Mat4, Vec3, Vec4};
-    let (_, r) = reflect(gpu, scene, layers, w, h);
-    let img = r.read_target_full(gpu, "reflection", 0).unwrap();
-    let (fw, fh) = (img.width, img.height);
-    let csz: Vec<ImageBuf> = (0..layers)
-        .map(|j| r.read_target_full(gpu, "csz", j).unwrap())
-        .collect();
-    let normals = r.read_target_full(gpu, "normal", 0).unwrap();
-    gpu.check_errors().unwrap();
-    let u = r.frame_uniforms();
-    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-    let (eye, fwd, right, up) = (v(u.eye), v(u.cam_forward), v(u.cam_right), v(u.cam_up));
-    let vp = Mat4::from_cols_array_2d(&u.view_proj);
-    let tracer = strata_reference::tracer::AnyTracer::build(
-        scene.world_triangles(0.0),
-        strata_reference::tracer::TracerKind::Binary,
-    );
-    let settings = ReflectionSettings::default();
-    let dz = scene.settings.min_separation;
-    let (mut mirrors, mut agree, mut false_hits) = (0, 0, 0);
-    for y in 0..fh {
-        for x in 0..fw {
-            let i = (y * fw + x) as usize;
-            let code = img.data[i * 4 + 3];
-            if code == 0.0 {
-                continue;
-            }
-            mirrors += 1;
-            let z = csz[0].data[i];
-            let ndc = Vec3::new(
-                (x as f32 + 0.5) / fw as f32 * 2.0 - 1.0,
-                1.0 - (y as f32 + 0.5) / fh as f32 * 2.0,
-                0.0,
-            );
-            let p = eye + z * (fwd + right * ndc.x + up * ndc.y);
-            let n4 = &normals.data[i * 4..i * 4 + 2];
-            let q = |c: f32| (c * 255.0).round() as u8;
-            let n = strata_render::packing::oct16_unpack([q(n4[0]), q(n4[1])]);
-            let d = (p - eye).normalize();
-            let rdir = d - 2.0 * d.dot(n) * n;
-            let expected = match tracer.intersect(p + n * 1e-3, rdir, 0.0, settings.max_distance) {
-                None => 1.0,
-                Some(hit) => {
-                    let hp = p + n * 1e-3 + rdir * hit.t;
-                    let c = vp * Vec4::new(hp.x, hp.y, hp.z, 1.0);
-                    let (sx, sy) = ((c.x / c.w * 0.5 + 0.5) * fw as f32, (0.5 - 0.5 * c.y / c.w) * fh as f32);
-                    if c.w <= 0.0 || sx < 0.0 || sy < 0.0 || sx >= fw as f32 || sy >= fh as f32 {
-                        1.0
-                    } else {
-                        let t = (sy as u32 * fw + sx as u32) as usize;
-                        let hz = (hp - eye).dot(fwd);
-                        // within half the minimum separation: the same surface
-                        match (0..layers as usize).find(|&j| (csz[j].data[t] - hz).abs() <= 0.5 * dz) {
-                            Some(j) => 2.0 + j as f32,
-                            None => 1.0,
+/// Per pixel of a `w`×`h` render: the reflection pass's code (0 not a mirror, 1 the
+/// environment, 2 layer 0, 3 layer 1) and what the ray truly finds, from the CPU tracer's
+/// first hit along it: the layer whose depth at the hit's pixel is the hit's, else the
+/// environment (1: off screen, past the march, or in neither layer). `expected` is 0
+/// where the pass's code is.
+struct MirrorCodes {
+    w: usize,
+    code: Vec<f32>,
+    expected: Vec<f32>,
+    /// layer 0's camera-space depth
+    csz: Vec<f32>,
+}
+
+impl MirrorCodes {
+    fn new(gpu: &GpuContext, scene: &Scene, layers: u32, w: u32, h: u32) -> Self {
+        use glam::{Mat4, Vec3, Vec4};
+        let (_, r) = reflect(gpu, scene, layers, w, h);
+        let img = r.read_target_full(gpu, "reflection", 0).unwrap();
+        let (fw, fh) = (img.width, img.height);
+        let csz: Vec<ImageBuf> = (0..layers)
+            .map(|j| r.read_target_full(gpu, "csz", j).unwrap())
+            .collect();
+        let normals = r.read_target_full(gpu, "normal", 0).unwrap();
+        gpu.check_errors().unwrap();
+        let u = r.frame_uniforms();
+        let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+        let (eye, fwd, right, up) = (v(u.eye), v(u.cam_forward), v(u.cam_right), v(u.cam_up));
+        let vp = Mat4::from_cols_array_2d(&u.view_proj);
+        let tracer = strata_reference::tracer::AnyTracer::build(
+            scene.world_triangles(0.0),
+            strata_reference::tracer::TracerKind::Binary,
+        );
+        let settings = ReflectionSettings::default();
+        let dz = scene.settings.min_separation;
+        let code: Vec<f32> = img.data.chunks_exact(4).map(|p| p[3]).collect();
+        let mut expected = vec![0.0; code.len()];
+        for y in 0..fh {
+            for x in 0..fw {
+                let i = (y * fw + x) as usize;
+                if code[i] == 0.0 {
+                    continue;
+                }
+                let z = csz[0].data[i];
+                let ndc = Vec3::new(
+                    (x as f32 + 0.5) / fw as f32 * 2.0 - 1.0,
+                    1.0 - (y as f32 + 0.5) / fh as f32 * 2.0,
+                    0.0,
+                );
+                let p = eye + z * (fwd + right * ndc.x + up * ndc.y);
+                let n4 = &normals.data[i * 4..i * 4 + 2];
+                let q = |c: f32| (c * 255.0).round() as u8;
+                let n = strata_render::packing::oct16_unpack([q(n4[0]), q(n4[1])]);
+                let d = (p - eye).normalize();
+                let rdir = d - 2.0 * d.dot(n) * n;
+                expected[i] = match tracer.intersect(p + n * 1e-3, rdir, 0.0, settings.max_distance) {
+                    None => 1.0,
+                    Some(hit) => {
+                        let hp = p + n * 1e-3 + rdir * hit.t;
+                        let c = vp * Vec4::new(hp.x, hp.y, hp.z, 1.0);
+                        let (sx, sy) = ((c.x / c.w * 0.5 + 0.5) * fw as f32, (0.5 - 0.5 * c.y / c.w) * fh as f32);
+                        if c.w <= 0.0 || sx < 0.0 || sy < 0.0 || sx >= fw as f32 || sy >= fh as f32 {
+                            1.0
+                        } else {
+                            let t = (sy as u32 * fw + sx as u32) as usize;
+                            let hz = (hp - eye).dot(fwd);
+                            // within half the minimum separation: the same surface
+                            match (0..layers as usize).find(|&j| (csz[j].data[t] - hz).abs() <= 0.5 * dz) {
+                                Some(j) => 2.0 + j as f32,
+                                None => 1.0,
+                            }
                         }
                     }
-                }
-            };
-            if code == expected {
-                agree += 1;
-            } else if code >= 2.0 {
-                false_hits += 1;
+                };
             }
         }
+        Self {
+            w: fw as usize,
+            code,
+            expected,
+            csz: csz[0].data.clone(),
+        }
     }
-    (mirrors, agree, false_hits)
+
+    /// (mirror pixels, pixels whose GPU code is the tracer's, GPU hits on a surface the
+    /// ray does not reach first)
+    fn agreement(&self) -> (usize, usize, usize) {
+        let mirrors = self.code.iter().filter(|&&c| c > 0.0).count();
+        let pairs = || self.code.iter().zip(&self.expected).filter(|(c, _)| **c > 0.0);
+        let agree = pairs().filter(|(c, e)| c == e).count();
+        let false_hits = pairs().filter(|(c, e)| c != e && **c >= 2.0).count();
+        (mirrors, agree, false_hits)
+    }
 }
 
 /// DGB §3.6 hits within [z, z + Δz] of a layer. A ray that passes under an edge more than
@@ -181,13 +200,38 @@ fn mirror_rays_find_the_surface_the_tracer_hits() {
         let scene = procedural::builtin(name).unwrap();
         let shares: Vec<f64> = [1, 2]
             .map(|layers| {
-                let (mirrors, agree, false_hits) = agreement_with_the_tracer(&gpu, &scene, layers, 160, 120);
+                let (mirrors, agree, false_hits) = MirrorCodes::new(&gpu, &scene, layers, 160, 120).agreement();
                 let share = agree as f64 / mirrors as f64;
                 eprintln!("{name}, k = {layers}: {agree} of {mirrors} mirror px agree with the tracer ({share:.4}); {false_hits} hit a surface the ray does not reach first");
                 share
             })
             .to_vec();
         assert!(shares.iter().all(|s| *s >= 0.95), "{name}: agreement {shares:?}");
+    }
+}
+
+/// Where a surface stands on a mirror (`mirror-sign`'s wall on the floor), the mirror's
+/// pixels next to the contact reflect that surface from their first step. Their ray
+/// passes the wall within one step of the mirror point, by more than Δz, and the first
+/// step's sample may still fall in the mirror's own pixel. Once, those pixels reflected the
+/// sky, a bright seam between the wall and its reflection. Against the CPU tracer: every
+/// mirror pixel below a non-mirror one whose ray hits layer 0 there has code 2.
+#[test]
+fn mirror_pixels_at_a_contact_reflect_the_surface_they_touch() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("mirror-sign").unwrap();
+    for (w, h) in [(160, 120), (640, 360)] {
+        let m = MirrorCodes::new(&gpu, &scene, 2, w, h);
+        let contact: Vec<usize> = (m.w..m.code.len())
+            .filter(|&i| m.code[i] > 0.0 && m.code[i - m.w] == 0.0 && m.expected[i] == 2.0)
+            .collect();
+        let wrong = contact.iter().filter(|&&i| m.code[i] != 2.0).count();
+        eprintln!("{w}x{h}: {} contact px, {wrong} without the surface", contact.len());
+        assert!(contact.len() >= w as usize / 4, "{w}x{h}: only {} contact pixels", contact.len());
+        assert_eq!(wrong, 0, "{w}x{h}: {wrong} of {} contact pixels miss the wall", contact.len());
+        // the depth beside the contact: the wall stands on the floor there
+        let i = contact[contact.len() / 2];
+        assert!((m.csz[i] - m.csz[i - m.w]).abs() < scene.settings.min_separation);
     }
 }
 

@@ -123,10 +123,19 @@ fn layer_depths(s: vec4f) -> vec2f {
 fn behind_layer(j: u32, s: vec4f, zl: vec2f, prev_z: f32, prev_zl: vec2f) -> bool {
     let zj = zl[j];
     var allowance = refl.thickness;
-    if (prev_z < prev_zl[j]) {
+    // `<=`: the mirror point itself lies on layer 0 (prev_z = prev_zl[0] before the first
+    // step), and the ray leaves it on the viewer's side
+    if (prev_z <= prev_zl[j]) {
         allowance = max(allowance, abs(s.z - prev_z) + abs(zj - prev_zl[j]));
     }
     return zj > 0.0 && s.z >= zj && s.z <= zj + allowance;
+}
+
+// Whether sample s lies in pixel p, the mirror's own: a ray cannot hit the surface it
+// leaves, and within that pixel the surface's depth is its centre's. Tested in the first
+// step only: after it the ray has left the pixel (or faces the viewer and is in front).
+fn own_pixel(s: vec4f, p: vec2i) -> bool {
+    return all(vec2i(s.xy) == p);
 }
 
 // DGB §3.6's hit test at the refined point `sh`, `slack` the ray's depth change over
@@ -185,7 +194,7 @@ fn reflected(p: vec2i) -> Out {
         var hit = -1;
         let zl = layer_depths(s);
         for (var j = 0u; j < min(LAYERS, 2u) && hit < 0; j++) {
-            if (!behind_layer(j, s, zl, prev_z, prev_zl)) {
+            if ((i == 1u && own_pixel(s, p)) || !behind_layer(j, s, zl, prev_z, prev_zl)) {
                 continue;
             }
             // refine between the previous and this step: the first point behind
@@ -194,7 +203,7 @@ fn reflected(p: vec2i) -> Out {
             for (var k = 0; k < 6; k++) {
                 let mid = 0.5 * (lo + hi);
                 let sm = project(x + r * mid);
-                if (sm.w >= 0.0 && behind_layer(j, sm, layer_depths(sm), prev_z, prev_zl)) {
+                if (sm.w >= 0.0 && !(i == 1u && own_pixel(sm, p)) && behind_layer(j, sm, layer_depths(sm), prev_z, prev_zl)) {
                     hi = mid;
                 } else {
                     lo = mid;
