@@ -164,18 +164,27 @@ fn reflected(p: vec2i) -> Out {
     var l = frame.sky.rgb;
     var code = 1.0;
     let step = refl.max_distance / f32(refl.steps);
+    var prev_t = 0.0;
     var prev_z = z;
     var prev_zl = layer_depths(vec4f(vec2f(p) + 0.5, z, 1.0));
-    // start one step out so the mirror does not hit itself
-    for (var i = 1u; i <= refl.steps; i++) {
-        var q = x + r * (step * f32(i));
+    // start one step out so the mirror does not hit itself; sample the end of step i, or
+    // before it a point where the ray may cross a surface's silhouette (`detour`)
+    var i = 1u;
+    var t = step;
+    var detour = false;
+    var detoured = 0u;
+    loop {
+        if (i > refl.steps) {
+            break;
+        }
+        var q = x + r * t;
         var s = project(q);
         var leaving = false;
         if (s.w < 0.0) {
             // leaving the buffer (or passing the near plane) within this step:
             // test the last point still inside, then take the environment
-            var lo = step * f32(i - 1u);
-            var hi = step * f32(i);
+            var lo = prev_t;
+            var hi = t;
             for (var k = 0; k < 6; k++) {
                 let mid = 0.5 * (lo + hi);
                 if (project(x + r * mid).w >= 0.0) {
@@ -191,19 +200,34 @@ fn reflected(p: vec2i) -> Out {
                 break;
             }
         }
+        // the mirror's own pixel is tested in the first step only: after it the ray has
+        // left the pixel (or faces the viewer and is in front)
+        let first = prev_t == 0.0;
         var hit = -1;
+        var cross = -1.0;
         let zl = layer_depths(s);
         for (var j = 0u; j < min(LAYERS, 2u) && hit < 0; j++) {
-            if ((i == 1u && own_pixel(s, p)) || !behind_layer(j, s, zl, prev_z, prev_zl)) {
+            if ((first && own_pixel(s, p)) || !behind_layer(j, s, zl, prev_z, prev_zl)) {
+                // The ray was in front of layer j and is now deeper than that surface was
+                // at the previous sample, yet this sample is not behind it: it may have
+                // crossed the surface and left its silhouette within the step (a wall's
+                // top edge seen in a mirror floor). Sample next the point just past that
+                // depth (by Δz/2 at most), where the ray crosses a surface facing the
+                // camera; once per step.
+                if (detoured != i && !leaving && prev_z < prev_zl[j] && s.z > prev_zl[j]) {
+                    let past = prev_zl[j] + 0.5 * min(refl.thickness, s.z - prev_zl[j]);
+                    let tc = prev_t + (t - prev_t) * (past - prev_z) / (s.z - prev_z);
+                    cross = select(tc, min(cross, tc), cross > 0.0);
+                }
                 continue;
             }
-            // refine between the previous and this step: the first point behind
-            var lo = step * f32(i - 1u);
+            // refine between the previous sample and this one: the first point behind
+            var lo = prev_t;
             var hi = length(q - x);
             for (var k = 0; k < 6; k++) {
                 let mid = 0.5 * (lo + hi);
                 let sm = project(x + r * mid);
-                if (sm.w >= 0.0 && !(i == 1u && own_pixel(sm, p)) && behind_layer(j, sm, layer_depths(sm), prev_z, prev_zl)) {
+                if (sm.w >= 0.0 && !(first && own_pixel(sm, p)) && behind_layer(j, sm, layer_depths(sm), prev_z, prev_zl)) {
                     hi = mid;
                 } else {
                     lo = mid;
@@ -215,23 +239,34 @@ fn reflected(p: vec2i) -> Out {
                 continue;
             }
             hit = i32(j);
-            let t = vec2i(sh.xy);
+            let th = vec2i(sh.xy);
             if (j == 0u) {
-                l = textureLoad(radiance0, t, 0).rgb;
+                l = textureLoad(radiance0, th, 0).rgb;
                 code = 2.0;
             } else {
-                l = textureLoad(radiance1, t, 0).rgb + layer1_extra(t, x);
+                l = textureLoad(radiance1, th, 0).rgb + layer1_extra(th, x);
                 code = 3.0;
             }
         }
-        if (hit >= 0) {
+        if (hit >= 0 || leaving) {
             break;
         }
-        if (leaving) {
-            break;
+        if (cross > prev_t) {
+            // the silhouette point, then this step's end again from there
+            detoured = i;
+            detour = true;
+            t = cross;
+            continue;
         }
+        prev_t = t;
         prev_z = s.z;
         prev_zl = zl;
+        if (detour) {
+            detour = false;
+        } else {
+            i++;
+        }
+        t = step * f32(i);
     }
     // Fresnel at normal incidence: the metal's albedo (F0)
     let f0 = mix(vec3f(0.04), textureLoad(albedo, p, 0, 0).rgb, nrm.a);
