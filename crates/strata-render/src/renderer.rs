@@ -724,6 +724,8 @@ impl Renderer {
                         }
                     }),
                 },
+                // the scene's sky colour
+                None,
             )
         });
         let shown = if reflections.is_some() { "hdr-reflected" } else { shaded };

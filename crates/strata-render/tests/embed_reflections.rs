@@ -246,6 +246,159 @@ fn embedded_reflections_on_an_applications_gbuffer_find_the_renderers_hits() {
 }
 
 /// Bad configurations and inputs are one-line errors naming the parameter.
+/// A cube map of 4×4 texels per face (Rgba8Unorm) in WebGPU's face order +x, −x, +y, −y,
+/// +z, −z. Texel (column i, row j) of face k is (20 + 60 i, 20 + 60 j, 20 + 40 k): under
+/// bilinear filtering r and g are linear in the face coordinates (s, t) between the
+/// texel centres, and b names the face.
+fn face_cube(gpu: &GpuContext) -> wgpu::Texture {
+    let t = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("environment"),
+        size: wgpu::Extent3d {
+            width: 4,
+            height: 4,
+            depth_or_array_layers: 6,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let mut data = Vec::new();
+    for k in 0..6u8 {
+        for j in 0..4u8 {
+            for i in 0..4u8 {
+                data.extend([20 + 60 * i, 20 + 60 * j, 20 + 40 * k, 255]);
+            }
+        }
+    }
+    gpu.queue.write_texture(
+        t.as_image_copy(),
+        &data,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(16),
+            rows_per_image: Some(4),
+        },
+        t.size(),
+    );
+    t
+}
+
+/// Face and (s, t) in [0, 1]² of direction d (the Vulkan and WebGPU cube map face
+/// selection: the major axis, then sc, tc per face).
+fn cube_face(d: glam::Vec3) -> (usize, f32, f32) {
+    let m = d.abs();
+    let (face, ma, sc, tc) = if m.x >= m.y && m.x >= m.z {
+        if d.x > 0.0 {
+            (0, m.x, -d.z, -d.y)
+        } else {
+            (1, m.x, d.z, -d.y)
+        }
+    } else if m.y >= m.z {
+        if d.y > 0.0 {
+            (2, m.y, d.x, d.z)
+        } else {
+            (3, m.y, d.x, -d.z)
+        }
+    } else if d.z > 0.0 {
+        (4, m.z, d.x, -d.y)
+    } else {
+        (5, m.z, -d.x, -d.y)
+    };
+    (face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0))
+}
+
+/// With an environment cube map, a ray that finds nothing (a = 1) reflects the cube along
+/// itself. The cube's colours encode face and face coordinates ([`face_cube`]), so per
+/// mirror pixel they say where the pass looked: the CPU's reflection of the pixel's view
+/// ray about its decoded normal must point there (within 3/255; away from the texel
+/// centres' border, where filtering clamps or blends faces). Hits (a = 2, 3) are what they
+/// are without the cube.
+#[test]
+fn an_environment_cube_map_lights_the_rays_that_find_nothing() {
+    use glam::Vec3;
+    let gpu = common::gpu();
+    let scene = mirror_scene();
+    let cams = FrameCameras::fixed(scene.camera);
+    let (view, proj) = (scene.camera.view(), scene.camera.projection(W as f32 / H as f32));
+    let settings = RenderSettings {
+        reflections: Some(ReflectionSettings::default()),
+        ..common::peeled_layers(&scene, W, H, 1)
+    };
+    let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
+    r.render(&gpu, &scene, &cams, 0.0).unwrap();
+    let cube = face_cube(&gpu);
+    let plain = embedded(&gpu, &scene, 1, false);
+    let config = EmbeddedReflectionsConfig {
+        environment: Some(cube.clone()),
+        ..plain.config().clone()
+    };
+    let lit = EmbeddedReflections::new(&gpu.adapter, &gpu.device, &gpu.queue, config).unwrap();
+    let t = |n| r.target_texture(n).unwrap();
+    let layer = |n| TextureLayer {
+        texture: t(n),
+        layer: 0,
+    };
+    let inputs = ReflectionInputs {
+        gbuffer: AoInputs::new(layer("depth"), layer("normal"), view, proj),
+        material: layer("normal"),
+        radiance: layer("hdr"),
+        second_radiance: None,
+    };
+    let mut out = Vec::new();
+    for mut refl in [plain, lit] {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        refl.encode(&mut encoder, &inputs).expect("valid inputs");
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+        out.push(refl.read_target("reflection").unwrap());
+    }
+    let normals = r.read_target_full(&gpu, "normal", 0).unwrap();
+    let u = r.frame_uniforms();
+    let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let (fwd, right, up) = (v3(u.cam_forward), v3(u.cam_right), v3(u.cam_up));
+    let (mut checked, mut wrong, mut faces) = (0, 0, [0usize; 6]);
+    for (i, (a, b)) in out[0].data.chunks_exact(4).zip(out[1].data.chunks_exact(4)).enumerate() {
+        assert_eq!(a[3], b[3], "pixel {i}: the cube changed what the ray found");
+        if a[3] >= 2.0 {
+            assert_eq!(a[..3], b[..3], "pixel {i}: a hit's radiance changed");
+        }
+        if a[3] != 1.0 {
+            continue;
+        }
+        assert_eq!(a[..3], [0.0; 3], "without a cube, rgb 0 where nothing is found");
+        let (x, y) = ((i as u32 % W) as f32, (i as u32 / W) as f32);
+        let ndc = (2.0 * (x + 0.5) / W as f32 - 1.0, 1.0 - 2.0 * (y + 0.5) / H as f32);
+        let d = (fwd + right * ndc.0 + up * ndc.1).normalize();
+        let q = |c: f32| (c * 255.0).round() as u8;
+        let n = strata_render::packing::oct16_unpack([q(normals.data[i * 4]), q(normals.data[i * 4 + 1])]);
+        let rd = d - 2.0 * d.dot(n) * n;
+        let (face, fs, ft) = cube_face(rd);
+        if !(0.15..=0.85).contains(&fs) || !(0.15..=0.85).contains(&ft) {
+            continue;
+        }
+        // between the texel centres (k + ½) / 4: 20 + 60 (4 s − ½)
+        let expected = [
+            (20.0 + 60.0 * (4.0 * fs - 0.5)) / 255.0,
+            (20.0 + 60.0 * (4.0 * ft - 0.5)) / 255.0,
+            (20.0 + 40.0 * face as f32) / 255.0,
+        ];
+        checked += 1;
+        faces[face] += 1;
+        if (0..3).any(|k| (b[k] - expected[k]).abs() > 3.0 / 255.0) {
+            if wrong < 3 {
+                println!("pixel {i}: {:?} against {expected:?}", &b[..3]);
+            }
+            wrong += 1;
+        }
+    }
+    println!("{checked} environment pixels checked, per face {faces:?}, {wrong} wrong");
+    assert!(checked > 500, "only {checked} mirror pixels reflect the environment");
+    assert_eq!(wrong, 0, "{wrong} of {checked} pixels reflect another face");
+}
+
 #[test]
 fn bad_embedded_reflections_input_is_a_one_line_error() {
     use wgpu::TextureFormat as F;
@@ -274,6 +427,29 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
     one_line(err(&|c| c.settings.max_roughness = 2.0), &["max_roughness 2", "0..=1"]);
     one_line(err(&|c| c.layers = 3), &["layers 3", "1..=2"]);
     one_line(err(&|c| c.width = 0), &["size 0x120"]);
+    let flat = common::app_texture(&gpu, [8, 8], F::Rgba8Unorm, wgpu::TextureUsages::TEXTURE_BINDING, 1);
+    one_line(
+        err(&|c| c.environment = Some(flat.clone())),
+        &["embedded reflections: environment", "8x8x1", "6 square layers"],
+    );
+    let unfiltered = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width: 4,
+            height: 4,
+            depth_or_array_layers: 6,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: F::R32Uint,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    one_line(
+        err(&|c| c.environment = Some(unfiltered.clone())),
+        &["environment format R32Uint", "filterable float"],
+    );
 
     let texture = |format| common::app_texture(&gpu, [W, H], format, wgpu::TextureUsages::TEXTURE_BINDING, 1);
     let (depth, normals) = (texture(F::Depth32Float), texture(F::Rgba16Float));

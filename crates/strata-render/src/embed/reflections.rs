@@ -1,6 +1,7 @@
 //! Deep-G-buffer mirror reflections (DGB §3.6) on an application's G-buffer: the pass of
 //! `strata render --technique full`, a camera-space ray march tested against every
-//! layer, without strata's environment or composite.
+//! layer, without strata's composite; the environment is the application's cube map, if
+//! it gives one.
 //!
 //! The application gives, per layer, depth and normals (as for [`super::EmbeddedAo`]) and
 //! the outgoing radiance a reflection ray that hits the layer sees: layer 0's shaded image
@@ -8,7 +9,8 @@
 //! from its material texture: a pixel is a mirror where metallic ≥ ½ and roughness ≤
 //! `settings.max_roughness`. It gets back [`EmbeddedReflections::output`]: the reflected
 //! radiance (rgb) and what the ray found (a): 0 not a mirror, 1 no hit (the ray left the
-//! buffer or went `max_distance`: the application's environment goes there), 2 a layer-0
+//! buffer or went `max_distance`: the application's environment cube map along the ray,
+//! [`EmbeddedReflectionsConfig::environment`], or the application's own), 2 a layer-0
 //! surface, 3 a second-layer surface. The application weights it by its own Fresnel term
 //! and adds it to its image.
 //!
@@ -32,7 +34,8 @@
 //!     second_radiance: None,
 //! })?;
 //! queue.submit([encoder.finish()]);
-//! // add F · refl.output() to the image where its alpha is 2 or 3, F · environment where 1
+//! // add F · refl.output() to the image where its alpha is 2 or 3 (and 1 with an
+//! // environment in the config; without one, F · the application's environment there)
 //! # Ok(()) }
 //! ```
 
@@ -77,11 +80,17 @@ pub struct EmbeddedReflectionsConfig {
     pub normals: NormalEncoding,
     pub normal_space: NormalSpace,
     pub material: MaterialChannels,
+    /// The application's environment: a cube map (a 2D texture of 6 square layers in
+    /// WebGPU's face order +x, −x, +y, −y, +z, −z, world-space directions, a filterable
+    /// float format, `TEXTURE_BINDING` usage). A ray that finds no surface takes its
+    /// radiance along the ray (mip 0, bilinear); `None`: rgb 0 there, for the
+    /// application's own composite.
+    pub environment: Option<wgpu::Texture>,
 }
 
 impl Default for EmbeddedReflectionsConfig {
     /// 1×1 (set the size), one layer, [`ReflectionSettings::default`], Δz = 0.5, signed
-    /// world-space normals, glTF's material channels.
+    /// world-space normals, glTF's material channels, no environment.
     fn default() -> Self {
         Self {
             width: 1,
@@ -92,8 +101,39 @@ impl Default for EmbeddedReflectionsConfig {
             normals: NormalEncoding::Signed,
             normal_space: NormalSpace::World,
             material: MaterialChannels::default(),
+            environment: None,
         }
     }
+}
+
+/// The cube view of an application's environment ([`EmbeddedReflectionsConfig::environment`]),
+/// or a one-line error naming what is wrong.
+fn environment_view(device: &wgpu::Device, t: &wgpu::Texture) -> Result<wgpu::TextureView, RenderError> {
+    let what = "embedded reflections: environment";
+    let (w, h, n) = (t.width(), t.height(), t.depth_or_array_layers());
+    if t.dimension() != wgpu::TextureDimension::D2 || n != 6 || w != h {
+        return Err(RenderError::Parameter(format!(
+            "{what} is a {:?} texture of {w}x{h}x{n}: must be a cube map, a 2D texture of 6 square layers",
+            t.dimension()
+        )));
+    }
+    let f = t.format();
+    if !matches!(
+        f.sample_type(None, Some(device.features())),
+        Some(wgpu::TextureSampleType::Float { filterable: true })
+    ) {
+        return Err(RenderError::Parameter(format!(
+            "{what} format {f:?} is not a filterable float format on this device (e.g. Rgba16Float, Rgba8Unorm)"
+        )));
+    }
+    if !t.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
+        return Err(RenderError::Parameter(format!("{what} lacks TEXTURE_BINDING usage")));
+    }
+    Ok(t.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("embedded reflections environment"),
+        dimension: Some(wgpu::TextureViewDimension::Cube),
+        ..Default::default()
+    }))
 }
 
 /// One frame's inputs to [`EmbeddedReflections::encode`].
@@ -168,6 +208,11 @@ impl EmbeddedReflections {
                 metallic: m.metallic,
             },
         };
+        let environment = config
+            .environment
+            .as_ref()
+            .map(|t| environment_view(device, t))
+            .transpose()?;
         let mut scene = strata_scene::Scene::default();
         scene.settings.min_separation = dz;
         Core::scoped(device, || {
@@ -180,6 +225,7 @@ impl EmbeddedReflections {
                 "hdr",
                 s,
                 Default::default(),
+                environment.as_ref(),
             );
             Ok(Self {
                 core,
@@ -191,8 +237,10 @@ impl EmbeddedReflections {
 
     /// The reflected radiance (rgb) and what each ray found (a: 0 not a mirror, 1 no hit,
     /// 2 layer 0, 3 the second layer), `Rgba16Float`, written by the last
-    /// [`EmbeddedReflections::encode`] once its encoder is submitted. Where a = 1, rgb is 0:
-    /// the application's environment belongs there.
+    /// [`EmbeddedReflections::encode`] once its encoder is submitted. Where a = 1, rgb is
+    /// the environment's radiance along the ray
+    /// ([`EmbeddedReflectionsConfig::environment`]), or 0 without one: the application's
+    /// environment belongs there.
     pub fn output(&self) -> &wgpu::Texture {
         &self.core.targets.get(OUTPUTS[0].name).texture
     }

@@ -469,8 +469,7 @@ impl<'a> PassBuilder<'a> {
         )
     }
 
-    /// A sampler of binding type `ty` (for the passes to come: ILS, A-buffer, BZB).
-    #[allow(dead_code)]
+    /// A sampler of binding type `ty`.
     pub fn sampler(self, sampler: &'a wgpu::Sampler, ty: wgpu::SamplerBindingType) -> Self {
         self.push(
             wgpu::BindingType::Sampler(ty),

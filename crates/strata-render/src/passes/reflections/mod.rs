@@ -135,6 +135,7 @@ impl ReflectionPass {
         input: &'static str,
         settings: &ReflectionSettings,
         layer1: Layer1Radiance<'_>,
+        environment: Option<&wgpu::TextureView>,
     ) -> Self {
         let compute = settings.kernel.compute_for(gpu, &OUTPUTS.map(|t| t.format));
         for t in OUTPUTS {
@@ -178,6 +179,19 @@ impl ReflectionPass {
         let b = b.view(declared, &targets.get(e1).view, wgpu::TextureViewDimension::D2, false);
         let probes = layer1.indirect.and_then(|i| i.probes).map_or(&dummy, |(p, _)| p);
         let b = b.storage(&probes.probes).storage(&probes.depth);
+        // without an environment cube map the binding holds a 1-texel stand-in, unread
+        let stand_in = environment.is_none().then(|| environment_stand_in(gpu));
+        let environment_view = environment.or(stand_in.as_ref()).expect("one of the two");
+        let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("reflections environment"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let b = b
+            .constant("ENVIRONMENT", environment.is_some() as u32 as f64)
+            .view("", environment_view, wgpu::TextureViewDimension::Cube, true)
+            .sampler(&sampler, wgpu::SamplerBindingType::Filtering);
         Self {
             pass: ScreenPass::build(b, &OUTPUTS.map(|t| t.name), compute),
             settings: *settings,
@@ -196,6 +210,28 @@ impl ReflectionPass {
         };
         self.pass.set_uniforms(gpu, &u);
     }
+}
+
+/// A 1×1 cube map for the environment binding when there is none.
+fn environment_stand_in(gpu: &GpuContext) -> wgpu::TextureView {
+    let t = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("reflections environment stand-in"),
+        size: wgpu::Extent3d {
+            width: 1,
+            height: 1,
+            depth_or_array_layers: 6,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    t.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::Cube),
+        ..Default::default()
+    })
 }
 
 crate::passes::builder::delegate_pass!(ReflectionPass);

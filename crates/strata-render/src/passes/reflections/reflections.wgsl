@@ -2,7 +2,7 @@
 // reflection ray in world space, project each step into the layers, and hit
 // when the ray lies within [z, z + Δz] of a layer's surface; the reflected
 // radiance is that surface's outgoing radiance. After `max_distance` or when
-// the ray leaves the (guard-banded) buffer: the environment (the sky).
+// the ray leaves the (guard-banded) buffer: the environment (the sky, or a cube map).
 #import "common/fullscreen.wgsl"
 #import "common/frame.wgsl"
 #import "common/camera.wgsl"
@@ -22,6 +22,11 @@ override LAYER1_AMBIENT: u32 = 0u;
 override LAYER1_INDIRECT: u32 = 0u;
 // 1: k = boost(ρ) (Eq. 7), as compose
 override LAYER1_BOOST: u32 = 0u;
+
+// 1: a ray that finds no surface takes the radiance of the environment cube map along
+// it (an application's, `embed::EmbeddedReflectionsConfig::environment`); 0: the scene's
+// sky colour
+override ENVIRONMENT: u32 = 0u;
 
 // Matches `reflections::ReflectionUniforms`.
 struct Reflections {
@@ -46,6 +51,17 @@ struct Reflections {
 @group(1) @binding(6) var indirect1: texture_2d<f32>;
 @group(1) @binding(7) var<storage, read> probes: array<Probe>;
 @group(1) @binding(8) var<storage, read> probe_depth: array<vec2f>;
+// the environment (ENVIRONMENT; a 1-texel stand-in otherwise) and its linear sampler
+@group(1) @binding(9) var environment: texture_cube<f32>;
+@group(1) @binding(10) var environment_sampler: sampler;
+
+// What a ray r that finds no surface reflects.
+fn missed(r: vec3f) -> vec3f {
+    if (ENVIRONMENT != 0u) {
+        return textureSampleLevel(environment, environment_sampler, r, 0.0).rgb;
+    }
+    return frame.sky.rgb;
+}
 
 // What a layer-1 hit at pixel t adds besides its B: ambient and indirect light, seen from
 // the mirror point x.
@@ -161,7 +177,7 @@ fn reflected(p: vec2i) -> Out {
     let n = oct_decode(nrm.rg);
     let v = normalize(x - frame.eye.xyz);
     let r = reflect(v, n);
-    var l = frame.sky.rgb;
+    var l = missed(r);
     var code = 1.0;
     let step = refl.max_distance / f32(refl.steps);
     var prev_t = 0.0;
@@ -281,8 +297,8 @@ fn fs_main(@builtin(position) pos: vec4f) -> Out {
 }
 
 // The same pass as compute (`Kernel`), 8×8 pixels per workgroup.
-@group(1) @binding(9) var reflection_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
-@group(1) @binding(10) var hdr_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
+@group(1) @binding(11) var reflection_out: texture_storage_2d<STORAGE_FORMAT_0, write>;
+@group(1) @binding(12) var hdr_out: texture_storage_2d<STORAGE_FORMAT_1, write>;
 
 @compute @workgroup_size(8, 8)
 fn cs_main(@builtin(global_invocation_id) id: vec3u) {
