@@ -715,17 +715,19 @@ impl Renderer {
                 settings.deep.layers,
                 shaded,
                 rs,
-                crate::passes::reflections::Layer1Radiance {
-                    ambient: true,
-                    indirect: radiosity.as_ref().zip(settings.radiosity.as_ref()).map(|(stage, r)| {
-                        crate::passes::reflections::Layer1Indirect {
-                            probes: stage.probes.as_ref().map(|(p, mode)| (p, *mode)),
-                            boost: r.boost,
-                        }
-                    }),
+                crate::passes::reflections::ReflectedLight {
+                    layer1: crate::passes::reflections::Layer1Radiance {
+                        ambient: true,
+                        indirect: radiosity.as_ref().zip(settings.radiosity.as_ref()).map(|(stage, r)| {
+                            crate::passes::reflections::Layer1Indirect {
+                                probes: stage.probes.as_ref().map(|(p, mode)| (p, *mode)),
+                                boost: r.boost,
+                            }
+                        }),
+                    },
+                    // the scene's sky colour
+                    environment: None,
                 },
-                // the scene's sky colour
-                None,
             )
         });
         let shown = if reflections.is_some() { "hdr-reflected" } else { shaded };

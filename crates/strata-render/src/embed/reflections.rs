@@ -42,7 +42,7 @@
 use super::core::{Core, CoreConfig, Shading, ShadingImport};
 use super::{AoInputs, NormalEncoding, NormalSpace, TextureLayer};
 use crate::frame::Pass;
-use crate::passes::reflections::{ReflectionPass, ReflectionSettings, OUTPUTS};
+use crate::passes::reflections::{ReflectedLight, ReflectionPass, ReflectionSettings, OUTPUTS};
 use crate::RenderError;
 
 /// The channels of the application's material texture that hold roughness and metallic
@@ -224,8 +224,10 @@ impl EmbeddedReflections {
                 config.layers,
                 "hdr",
                 s,
-                Default::default(),
-                environment.as_ref(),
+                ReflectedLight {
+                    environment: environment.as_ref(),
+                    ..Default::default()
+                },
             );
             Ok(Self {
                 core,

@@ -97,6 +97,16 @@ pub const OUTPUTS: [TargetDesc; 2] = [
     ),
 ];
 
+/// What the rays reflect besides layer 0's shaded image: a layer-1 hit's terms and, for a
+/// ray that finds nothing, the environment.
+#[derive(Clone, Copy, Default)]
+pub struct ReflectedLight<'a> {
+    pub layer1: Layer1Radiance<'a>,
+    /// A cube map view (world-space directions, filterable) read along rays that find
+    /// nothing; `None`: the scene's sky colour.
+    pub environment: Option<&'a wgpu::TextureView>,
+}
+
 /// What a hit on layer 1 reflects besides that layer's radiance target (`radiosity1`, or an
 /// application's): the terms layer 0's shaded image holds and B does not.
 #[derive(Clone, Copy, Default)]
@@ -125,8 +135,8 @@ pub struct ReflectionPass {
 }
 
 impl ReflectionPass {
-    /// Reflects `input` (the shaded layer 0) and layer 1's radiosity with what `layer1`
-    /// adds; creates [`OUTPUTS`].
+    /// Reflects `input` (the shaded layer 0), layer 1's radiosity with what
+    /// `light.layer1` adds, and `light.environment`; creates [`OUTPUTS`].
     pub fn new(
         gpu: &GpuContext,
         scene: &GpuScene,
@@ -134,9 +144,9 @@ impl ReflectionPass {
         layers: u32,
         input: &'static str,
         settings: &ReflectionSettings,
-        layer1: Layer1Radiance<'_>,
-        environment: Option<&wgpu::TextureView>,
+        light: ReflectedLight<'_>,
     ) -> Self {
+        let ReflectedLight { layer1, environment } = light;
         let compute = settings.kernel.compute_for(gpu, &OUTPUTS.map(|t| t.format));
         for t in OUTPUTS {
             targets.create_storable(gpu, t, compute);
