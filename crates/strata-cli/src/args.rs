@@ -737,8 +737,9 @@ pub struct FrameArgs {
     /// Lights that cast no shadow, by the index `--list-lights` prints (comma-separated, e.g. 0,2).
     #[arg(long, value_delimiter = ',')]
     pub no_shadow: Vec<usize>,
-    /// --technique full: no light-probe fallback (the probes are baked once per scene by the CPU
-    /// path tracer and cached in $STRATA_CACHE).
+    /// --technique full: no light-probe fallback and no environment map for the reflections
+    /// (the sky colour instead); both are baked once per scene by the CPU path tracer and
+    /// cached in $STRATA_CACHE.
     #[arg(long)]
     pub no_probes: bool,
     #[command(flatten)]

@@ -355,6 +355,18 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
             .map_err(|e| anyhow::anyhow!("--set {name}={value}: {e}"))?;
     }
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let cache = strata_eval::cache::RefCache::new(&s.cache);
+    // the reflections' environment map, as `render` bakes it
+    if settings
+        .reflections
+        .is_some_and(|r| strata_eval::cache::environment::has_mirrors(&scene, r.max_roughness))
+    {
+        settings.environment = Some(strata_eval::cache::environment::scene_environment(
+            &scene,
+            &cache,
+            !s.progress,
+        )?);
+    }
     // the probes of another scene (`--probes-from`): a bake that has not seen a change
     let source = match &a.probes_from {
         Some(other) => strata_scene::load_scene(other).map_err(|e| anyhow::anyhow!("--probes-from: {e}"))?,
@@ -363,7 +375,7 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
     settings.probes = Some(strata_eval::cache::probes::scene_probes(
         &source,
         a.radiosity.probe_bake(),
-        &strata_eval::cache::RefCache::new(&s.cache),
+        &cache,
         !s.progress,
     )?);
     let mut e = views::run(s, settings)?;

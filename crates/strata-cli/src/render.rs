@@ -53,12 +53,22 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
     settings.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
     // blended with baked light probes (modulated by AO); baked only once the settings are
     // known to be valid, so a bad flag is a one-line error without a bake before it
+    let cache = strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir());
     if settings.radiosity.is_some() && !f.no_probes {
         settings.probes = Some(strata_eval::cache::probes::scene_probes(
             scene,
             f.radiosity.probe_bake(),
-            &strata_eval::cache::RefCache::new(strata_eval::cache::RefCache::default_dir()),
+            &cache,
             false,
+        )?);
+    }
+    // the reflection rays that find nothing on screen: a baked environment map (DGB §3.6)
+    let mirrors = settings
+        .reflections
+        .is_some_and(|r| strata_eval::cache::environment::has_mirrors(scene, r.max_roughness));
+    if mirrors && !f.no_probes {
+        settings.environment = Some(strata_eval::cache::environment::scene_environment(
+            scene, &cache, false,
         )?);
     }
     // ILS: VPLs by instant radiosity on the CPU, once per run (static scenes)

@@ -3171,31 +3171,7 @@ fn probe_grid_and_rays_reach_the_bake_and_are_range_checked() {
     }
     let cache = scratch("probe-grid-cache");
     let _ = std::fs::remove_dir_all(&cache);
-    let run = |grid: &str, rays: &str| {
-        let o = strata_cached(
-            &[
-                "render",
-                "--scene",
-                "cornell",
-                "--technique",
-                "full",
-                "--probe-grid",
-                grid,
-                "--probe-rays",
-                rays,
-                "--width",
-                "32",
-                "--height",
-                "24",
-                "--force",
-                "--out",
-                out.to_str().unwrap(),
-            ],
-            &cache,
-        );
-        assert!(o.status.success(), "{}", stderr(&o));
-        stderr(&o)
-    };
+    let run = |grid: &str, rays: &str| full_at_32x24(&cache, "cornell", grid, rays, &out, &[]);
     let e = run("2,3,2", "256");
     assert!(e.contains("baking 12 light probes (2×3×2, 256 paths each)"), "{e}");
     let e = run("2,3,2", "256");
@@ -3347,4 +3323,53 @@ fn the_main_job_renders_evaluates_and_times_every_registered_technique() {
             assert!(evaluated.contains(t.name), "scripts/demo.sh evaluates no '{}'", t.name);
         }
     }
+}
+
+/// `render --technique full` bakes the reflections' environment map (DGB §3.6's fallback)
+/// for a scene with a mirror material, once (then from the cache), never for a scene
+/// without one, and not with `--no-probes`.
+#[test]
+fn full_bakes_an_environment_map_for_scenes_with_mirrors() {
+    let cache = scratch("environment-cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let out = scratch("environment.png");
+    let run = |scene: &str, extra: &[&str]| full_at_32x24(&cache, scene, "2,2,2", "64", &out, extra);
+    let baking = "baking the reflections' environment map";
+    assert!(
+        !run("mirror", &["--no-probes"]).contains(baking),
+        "--no-probes bakes no fallback"
+    );
+    assert!(run("mirror", &[]).contains(baking));
+    assert!(
+        !run("mirror", &[]).contains(baking),
+        "a cached environment map is baked again"
+    );
+    assert!(!run("cornell", &[]).contains(baking), "cornell has no mirror");
+}
+
+/// `render --technique full` of `scene` at 32×24 with a `grid` of probes, `rays` paths
+/// each, and `extra` flags, with `$STRATA_CACHE` = `cache`; it succeeds; its stderr.
+fn full_at_32x24(cache: &Path, scene: &str, grid: &str, rays: &str, out: &Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "render",
+        "--scene",
+        scene,
+        "--technique",
+        "full",
+        "--probe-grid",
+        grid,
+        "--probe-rays",
+        rays,
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--force",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = strata_cached(&args, cache);
+    assert!(o.status.success(), "{}", stderr(&o));
+    stderr(&o)
 }

@@ -252,6 +252,19 @@ impl Reference<'_> {
         (d - direct_light.unwrap_or(Vec3::ZERO)).max(Vec3::ZERO) + i
     }
 
+    /// One path sample of the radiance arriving at `origin` from direction −`dir`, as
+    /// (the first surface's emission and direct light, or the sky; the further bounces).
+    pub fn path_radiance(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        settings: &GiSettings,
+        rng: &mut Rng,
+        rays: &mut u64,
+    ) -> (Vec3, Vec3) {
+        self.trace_path(origin, 0.0, dir, settings, None, None, rng, rays)
+    }
+
     /// Whether `p` lies on one of the scene's [`Light::Rect`] rectangles (within 1 mm of
     /// its plane, inside its edges).
     fn on_rect_light(&self, p: Vec3) -> bool {

@@ -51,6 +51,7 @@ pub mod brdf;
 pub mod bundle;
 pub mod bvh;
 pub mod converge;
+pub mod environment;
 pub mod gi;
 pub mod layers;
 pub mod oit;

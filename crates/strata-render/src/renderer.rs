@@ -166,6 +166,9 @@ pub struct RenderSettings {
     pub radiosity: Option<RadiositySettings>,
     /// Deep-G-buffer mirror reflections (DGB §3.6) into `hdr-reflected`; needs `shade`.
     pub reflections: Option<crate::passes::reflections::ReflectionSettings>,
+    /// The radiance environment map the reflection rays that find nothing take (DGB
+    /// §3.6's "environment map lookups"); `None`: the scene's sky colour.
+    pub environment: Option<strata_scene::environment::EnvironmentMap>,
     /// Static irradiance probes blended with the radiosity by confidence
     /// (Fig. 9); they replace the scene's constant ambient term.
     pub probes: Option<strata_scene::probes::IrradianceProbes>,
@@ -200,6 +203,7 @@ impl Default for RenderSettings {
             ao: None,
             radiosity: None,
             reflections: None,
+            environment: None,
             probes: None,
             ils: None,
             abuffer: None,
@@ -707,6 +711,10 @@ impl Renderer {
         } else {
             "hdr"
         };
+        let environment = settings
+            .environment
+            .as_ref()
+            .map(|e| crate::passes::reflections::environment_cube(gpu, e));
         let reflections = settings.reflections.as_ref().map(|rs| {
             crate::passes::reflections::ReflectionPass::new(
                 gpu,
@@ -725,8 +733,8 @@ impl Renderer {
                             }
                         }),
                     },
-                    // the scene's sky colour
-                    environment: None,
+                    // the baked environment, else the scene's sky colour
+                    environment: environment.as_ref(),
                 },
             )
         });

@@ -251,20 +251,12 @@ fn embedded_reflections_on_an_applications_gbuffer_find_the_renderers_hits() {
 /// bilinear filtering r and g are linear in the face coordinates (s, t) between the
 /// texel centres, and b names the face.
 fn face_cube(gpu: &GpuContext) -> wgpu::Texture {
-    let t = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("environment"),
-        size: wgpu::Extent3d {
-            width: 4,
-            height: 4,
-            depth_or_array_layers: 6,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let t = strata_render::passes::reflections::cube_texture(
+        gpu,
+        4,
+        wgpu::TextureFormat::Rgba8Unorm,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    );
     let mut data = Vec::new();
     for k in 0..6u8 {
         for j in 0..4u8 {
@@ -284,30 +276,6 @@ fn face_cube(gpu: &GpuContext) -> wgpu::Texture {
         t.size(),
     );
     t
-}
-
-/// Face and (s, t) in [0, 1]² of direction d (the Vulkan and WebGPU cube map face
-/// selection: the major axis, then sc, tc per face).
-fn cube_face(d: glam::Vec3) -> (usize, f32, f32) {
-    let m = d.abs();
-    let (face, ma, sc, tc) = if m.x >= m.y && m.x >= m.z {
-        if d.x > 0.0 {
-            (0, m.x, -d.z, -d.y)
-        } else {
-            (1, m.x, d.z, -d.y)
-        }
-    } else if m.y >= m.z {
-        if d.y > 0.0 {
-            (2, m.y, d.x, d.z)
-        } else {
-            (3, m.y, d.x, -d.z)
-        }
-    } else if d.z > 0.0 {
-        (4, m.z, d.x, -d.y)
-    } else {
-        (5, m.z, -d.x, -d.y)
-    };
-    (face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0))
 }
 
 /// With an environment cube map, a ray that finds nothing (a = 1) reflects the cube along
@@ -375,7 +343,7 @@ fn an_environment_cube_map_lights_the_rays_that_find_nothing() {
         let q = |c: f32| (c * 255.0).round() as u8;
         let n = strata_render::packing::oct16_unpack([q(normals.data[i * 4]), q(normals.data[i * 4 + 1])]);
         let rd = d - 2.0 * d.dot(n) * n;
-        let (face, fs, ft) = cube_face(rd);
+        let (face, fs, ft) = strata_scene::environment::cube_face(rd);
         if !(0.15..=0.85).contains(&fs) || !(0.15..=0.85).contains(&ft) {
             continue;
         }
@@ -432,20 +400,8 @@ fn bad_embedded_reflections_input_is_a_one_line_error() {
         err(&|c| c.environment = Some(flat.clone())),
         &["embedded reflections: environment", "8x8x1", "6 square layers"],
     );
-    let unfiltered = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: None,
-        size: wgpu::Extent3d {
-            width: 4,
-            height: 4,
-            depth_or_array_layers: 6,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: F::R32Uint,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    });
+    let unfiltered =
+        strata_render::passes::reflections::cube_texture(&gpu, 4, F::R32Uint, wgpu::TextureUsages::TEXTURE_BINDING);
     one_line(
         err(&|c| c.environment = Some(unfiltered.clone())),
         &["environment format R32Uint", "filterable float"],

@@ -11,6 +11,7 @@
 
 pub mod atomic;
 pub mod camera;
+pub mod environment;
 pub mod error;
 pub mod files;
 pub mod image_buf;

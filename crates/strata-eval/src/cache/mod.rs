@@ -16,6 +16,7 @@ use anyhow::{bail, Context, Result};
 use strata_scene::{ImageBuf, Scene};
 
 pub mod converged;
+pub mod environment;
 pub mod probes;
 
 /// Most channels an entry may have (converged GI halves hold 6: direct and indirect RGB).

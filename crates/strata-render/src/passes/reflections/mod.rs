@@ -222,22 +222,91 @@ impl ReflectionPass {
     }
 }
 
-/// A 1×1 cube map for the environment binding when there is none.
-fn environment_stand_in(gpu: &GpuContext) -> wgpu::TextureView {
-    let t = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("reflections environment stand-in"),
+/// A cube map's texture: 6 square layers of `size` texels, one mip.
+pub fn cube_texture(
+    gpu: &GpuContext,
+    size: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("cube map"),
         size: wgpu::Extent3d {
-            width: 1,
-            height: 1,
+            width: size,
+            height: size,
             depth_or_array_layers: 6,
         },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+        format,
+        usage,
         view_formats: &[],
-    });
+    })
+}
+
+/// Environment map `e` as a cube map view (Rgba16Float, one mip).
+pub fn environment_cube(gpu: &GpuContext, e: &strata_scene::environment::EnvironmentMap) -> wgpu::TextureView {
+    let t = cube_texture(
+        gpu,
+        e.size,
+        wgpu::TextureFormat::Rgba16Float,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    );
+    let bytes: Vec<u8> = e
+        .texels
+        .iter()
+        .flat_map(|c| [c[0], c[1], c[2], 1.0])
+        .flat_map(|v| half_bits(v).to_le_bytes())
+        .collect();
+    gpu.queue.write_texture(
+        t.as_image_copy(),
+        &bytes,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(8 * e.size),
+            rows_per_image: Some(e.size),
+        },
+        t.size(),
+    );
+    t.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::Cube),
+        ..Default::default()
+    })
+}
+
+/// IEEE half of a non-negative radiance `v` (round to nearest; NaN and negatives 0, above
+/// the largest half the largest half).
+pub fn half_bits(v: f32) -> u16 {
+    if v.is_nan() || v <= 0.0 {
+        return 0;
+    }
+    let b = v.to_bits();
+    let e = ((b >> 23) & 0xff) as i32 - 127 + 15;
+    let m = (b & 0x7f_ffff) | 0x80_0000;
+    let h = if e >= 31 {
+        0x7bff
+    } else if e <= 0 {
+        // subnormal: the significand shifted down by 1 - e more places
+        let shift = (14 - e) as u32;
+        if shift > 24 {
+            return 0;
+        }
+        (m >> shift) + ((m >> (shift - 1)) & 1)
+    } else {
+        (((e as u32) << 10) | ((m & 0x7f_ffff) >> 13)) + ((m >> 12) & 1)
+    };
+    h.min(0x7bff) as u16
+}
+
+/// A 1×1 cube map for the environment binding when there is none.
+fn environment_stand_in(gpu: &GpuContext) -> wgpu::TextureView {
+    let t = cube_texture(
+        gpu,
+        1,
+        wgpu::TextureFormat::Rgba8Unorm,
+        wgpu::TextureUsages::TEXTURE_BINDING,
+    );
     t.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::Cube),
         ..Default::default()
@@ -245,3 +314,31 @@ fn environment_stand_in(gpu: &GpuContext) -> wgpu::TextureView {
 }
 
 crate::passes::builder::delegate_pass!(ReflectionPass);
+
+#[cfg(test)]
+mod tests {
+    /// Against IEEE half values: normals, rounding, the subnormals, the clamps.
+    #[test]
+    fn half_bits_are_ieee_halves() {
+        use super::half_bits;
+        for (v, h) in [
+            (1.0f32, 0x3c00u16),
+            (0.5, 0x3800),
+            (2.0, 0x4000),
+            (0.1, 0x2e66),
+            (1.0 + 1.5 / 1024.0, 0x3c02),
+            (65504.0, 0x7bff),
+            (1e9, 0x7bff),
+            (f32::INFINITY, 0x7bff),
+            (2f32.powi(-14), 0x0400),
+            (2f32.powi(-24), 0x0001),
+            (3.0 * 2f32.powi(-16), 0x0300),
+            (2f32.powi(-26), 0),
+            (0.0, 0),
+            (-1.0, 0),
+            (f32::NAN, 0),
+        ] {
+            assert_eq!(half_bits(v), h, "{v}");
+        }
+    }
+}
