@@ -18,9 +18,9 @@ pub const PATHS: u32 = 256;
 /// Bounces of each path after its first hit, as the light probes'.
 pub const BOUNCES: u32 = super::probes::BOUNCES;
 
-/// Whether a material of `scene` can be a mirror for the reflection pass (metallic ≥ ½ and
-/// roughness ≤ `max_roughness`; textures scale these factors down, never up): only then
-/// does a reflection ray read the environment map.
+/// Whether a material of `scene` is a mirror for the reflection pass (metallic ≥ ½ and
+/// roughness ≤ `max_roughness`; both are per-material scalars in strata's scenes): only
+/// then does a reflection ray read the environment map.
 pub fn has_mirrors(scene: &Scene, max_roughness: f32) -> bool {
     scene
         .materials
