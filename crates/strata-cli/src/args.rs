@@ -216,6 +216,54 @@ pub fn parse_set(kv: &str) -> Result<(String, f64), String> {
     Ok((name.trim().to_string(), v))
 }
 
+/// `--exposure`: a fixed multiplier or auto-exposure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ExposureArg {
+    Fixed(f32),
+    Auto(strata_render::passes::exposure::AutoExposure),
+}
+
+impl ExposureArg {
+    /// The fixed exposure, if that is what was asked for.
+    pub fn fixed(this: Option<Self>) -> Option<f32> {
+        match this {
+            Some(Self::Fixed(e)) => Some(e),
+            _ => None,
+        }
+    }
+
+    /// The auto-exposure settings, if that is what was asked for.
+    pub fn auto(this: Option<Self>) -> Option<strata_render::passes::exposure::AutoExposure> {
+        match this {
+            Some(Self::Auto(a)) => Some(a),
+            _ => None,
+        }
+    }
+}
+
+pub fn parse_exposure(s: &str) -> Result<ExposureArg, String> {
+    use strata_render::passes::exposure::AutoExposure;
+    if let Some(rest) = s.strip_prefix("auto") {
+        let mut a = AutoExposure::default();
+        if let Some(k) = rest.strip_prefix(':') {
+            a.key = k
+                .parse()
+                .map_err(|_| format!("'{k}' is not a number: use auto or auto:KEY, KEY in (0, 10]"))?;
+        } else if !rest.is_empty() {
+            return Err(format!("'{s}': use a number > 0, auto or auto:KEY"));
+        }
+        a.validate()?;
+        return Ok(ExposureArg::Auto(a));
+    }
+    let e: f32 = s
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number: use a number > 0, auto or auto:KEY"))?;
+    if !(e > 0.0 && e.is_finite()) {
+        return Err(format!("exposure {e} is out of range: must be > 0 (or auto)"));
+    }
+    Ok(ExposureArg::Fixed(e))
+}
+
 fn parse_probe_grid(s: &str) -> Result<[u32; 3], String> {
     let bad = || {
         format!(
@@ -724,9 +772,11 @@ pub struct FrameArgs {
     pub ao: AoArgs,
     #[command(flatten)]
     pub radiosity: RadiosityArgs,
-    /// Exposure multiplier before tonemapping (default: the scene's).
-    #[arg(long, allow_negative_numbers = true)]
-    pub exposure: Option<f32>,
+    /// Exposure multiplier before tonemapping (default: the scene's), or `auto[:KEY]`: the
+    /// exposure that maps the image's log-average luminance to KEY (default 0.18, in
+    /// (0, 10]), metered every frame.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_exposure)]
+    pub exposure: Option<ExposureArg>,
     /// Shadow map resolution per light, 64..=8192.
     #[arg(long, default_value_t = 2048)]
     pub shadow_resolution: u32,

@@ -34,7 +34,8 @@ pub fn settings_for(f: &FrameArgs, scene: &Scene) -> Result<RenderSettings> {
             point_lights: f.point_shadows,
             unshadowed: f.no_shadow.clone(),
         },
-        exposure: f.exposure,
+        exposure: crate::args::ExposureArg::fixed(f.exposure),
+        auto_exposure: crate::args::ExposureArg::auto(f.exposure),
         ao: Some(f.ao.settings()),
         ..Default::default()
     };
@@ -174,6 +175,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 c.triangles_in, c.triangles_culled, c.subtriangles, c.fine_surfels, c.surfels
             );
         }
+    }
+    if r.settings.auto_exposure.is_some() {
+        eprintln!("exposure (metered): {:.4}", r.displayed_exposure(&gpu)?);
     }
     eprintln!(
         "wrote {} ({}x{}, {} triangles)",

@@ -3373,3 +3373,52 @@ fn full_at_32x24(cache: &Path, scene: &str, grid: &str, rays: &str, out: &Path, 
     assert!(o.status.success(), "{}", stderr(&o));
     stderr(&o)
 }
+
+/// `--exposure auto` meters the frame (the metered value is printed and differs from the
+/// scene's), `auto:KEY` scales it by KEY, and bad values are one-line errors naming the
+/// flag and the range.
+#[test]
+fn exposure_auto_meters_the_frame() {
+    let out = scratch("exposure-auto.png");
+    let metered = |mode: &str| {
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--exposure",
+            mode,
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let err = stderr(&o);
+        let line = err.lines().find(|l| l.starts_with("exposure (metered): ")).expect(&err);
+        line["exposure (metered): ".len()..].trim().parse::<f32>().unwrap()
+    };
+    let e = metered("auto");
+    // the Cornell box's scene exposure is 1; its lit walls meter brighter than that needs
+    assert!(e > 1.5, "{e}");
+    let half = metered("auto:0.09");
+    assert!((half / e - 0.5).abs() < 1e-3, "key 0.09 against 0.18: {half} vs {e}");
+    for (bad, needles) in [
+        ("auto:0", vec!["--exposure", "(0, 10]"]),
+        ("auto:x", vec!["--exposure", "auto:KEY"]),
+        ("-2", vec!["--exposure", "must be > 0"]),
+    ] {
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--exposure",
+            bad,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_one_line_error(&o, &needles);
+    }
+}

@@ -159,6 +159,9 @@ pub struct RenderSettings {
     pub lighting: lighting::LightingSettings,
     /// Overrides the scene's exposure.
     pub exposure: Option<f32>,
+    /// Meters the exposure from the image instead (`passes::exposure`; not in the
+    /// papers); `None`: the scene's or `exposure`.
+    pub auto_exposure: Option<crate::passes::exposure::AutoExposure>,
     /// Deep-G-buffer ambient occlusion (DGB §3.1) into target `ao`; `None` = off.
     pub ao: Option<AoSettings>,
     /// Deep-G-buffer radiosity (DGB §3.2) into target `indirect`; `None` = off.
@@ -200,6 +203,7 @@ impl Default for RenderSettings {
             shadow: Default::default(),
             lighting: Default::default(),
             exposure: None,
+            auto_exposure: None,
             ao: None,
             radiosity: None,
             reflections: None,
@@ -234,6 +238,9 @@ impl RenderSettings {
                     "exposure {e} is out of range: must be > 0"
                 )));
             }
+        }
+        if let Some(a) = &self.auto_exposure {
+            a.validate().map_err(RenderError::Parameter)?;
         }
         if let GuardBand::Fraction(f) = self.guard_band {
             if !(0.0..=1.0).contains(&f) {
@@ -521,6 +528,10 @@ pub struct Renderer {
     pack: deep_gbuffer::PackPass,
     lighting: Option<lighting::LightingPass>,
     tonemap: Option<tonemap::TonemapPass>,
+    /// Auto-exposure's metering, before `tonemap` (`RenderSettings::auto_exposure`).
+    exposure: Option<crate::passes::exposure::ExposurePass>,
+    /// Whether a frame has left a metered exposure to adapt from.
+    exposure_history: bool,
     mip: Option<DepthMipPass>,
     ao: Option<AoStage>,
     radiosity: Option<RadiosityStage>,
@@ -586,7 +597,7 @@ impl Renderer {
         let lights = gpu_lights_for(scene, 0.0, &settings.shadow);
         let geometry = deep_gbuffer::geometry_passes(gpu, &scene_gpu, &targets, &settings.deep)?;
         let pack = deep_gbuffer::PackPass::new(gpu, &targets, &settings.deep);
-        let (mut shadow, lighting, tonemap) = if settings.shade {
+        let (mut shadow, lighting) = if settings.shade {
             let matrices = crate::lights::shadow_matrices(scene, 0.0, &lights);
             let shadow = shadow::ShadowPass::new(gpu, &scene_gpu, &matrices, &settings.shadow);
             let lighting = lighting::LightingPass::new(
@@ -600,10 +611,9 @@ impl Renderer {
                 settings.deep.layers,
                 lighting_compute,
             );
-            let tonemap = tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, "hdr");
-            (Some(shadow), Some(lighting), Some(tonemap))
+            (Some(shadow), Some(lighting))
         } else {
-            (None, None, None)
+            (None, None)
         };
         // one depth MIP chain for every screen-space technique
         let mip_levels = [
@@ -749,25 +759,23 @@ impl Renderer {
             )?),
             None => None,
         };
-        let tonemap = if abuffer.is_some() && tonemap.is_none() {
-            // the A-buffer's composite is the image
+        // the tonemapper shows direct + indirect + reflections, or the A-buffer's composite
+        let tonemap_input = if settings.shade {
+            Some(shown)
+        } else if abuffer.is_some() {
             for d in tonemap::OUTPUTS {
                 targets.create(gpu, *d);
             }
-            Some(tonemap::TonemapPass::new(
-                gpu,
-                &scene_gpu,
-                &targets,
-                crate::passes::abuffer::OUTPUT.name,
-            ))
+            Some(crate::passes::abuffer::OUTPUT.name)
         } else {
-            tonemap
+            None
         };
-        let tonemap = match tonemap {
-            // the tonemapper shows direct + indirect + reflections
-            Some(_) if shown != "hdr" => Some(tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, shown)),
-            t => t,
-        };
+        let exposure = tonemap_input
+            .zip(settings.auto_exposure)
+            .map(|(input, a)| crate::passes::exposure::ExposurePass::new(gpu, &targets, input, a));
+        let tonemap = tonemap_input.map(|input| {
+            tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, input, exposure.as_ref().map(|e| e.buffer()))
+        });
         let mut copies = Vec::new();
         if settings.deep.uses_history() || temporal_on {
             copies.push(("csz", "csz-history"));
@@ -824,6 +832,8 @@ impl Renderer {
             pack,
             lighting,
             tonemap,
+            exposure,
+            exposure_history: false,
             mip,
             ao,
             radiosity,
@@ -890,11 +900,17 @@ impl Renderer {
             if let Some(r) = &self.reflections {
                 v.push(r);
             }
+            if let Some(e) = &self.exposure {
+                v.push(e);
+            }
             v.push(t);
         }
         if let Some(a) = &self.abuffer {
             v.extend(a.passes());
             if let (None, Some(t)) = (&self.lighting, &self.tonemap) {
+                if let Some(e) = &self.exposure {
+                    v.push(e);
+                }
                 v.push(t);
             }
         }
@@ -913,6 +929,7 @@ impl Renderer {
     /// layers have no oracle.
     pub fn reset_history(&mut self) {
         self.has_history = false;
+        self.exposure_history = false;
         self.last_object_frame = None;
     }
 
@@ -1011,6 +1028,9 @@ impl Renderer {
                 temporal_history,
             );
         }
+        if let Some(e) = &self.exposure {
+            e.set_frame(gpu, self.exposure_history);
+        }
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
@@ -1028,7 +1048,23 @@ impl Renderer {
         self.frames_rendered = self.frames_rendered.wrapping_add(1);
         self.last_object_frame = Some(frame);
         self.has_history = self.history.is_some();
+        self.exposure_history = true;
         self.profiler.read(gpu)
+    }
+
+    /// The last frame's auto-exposure histogram (pixels per bin of
+    /// [`crate::passes::exposure::bin_of`]); `None` without auto-exposure.
+    pub fn exposure_histogram(&self, gpu: &GpuContext) -> Result<Option<Vec<u32>>, RenderError> {
+        self.exposure.as_ref().map(|e| e.read_histogram(gpu)).transpose()
+    }
+
+    /// The exposure the last frame was tonemapped with: the metered one with
+    /// [`RenderSettings::auto_exposure`] (read back), else the frame's.
+    pub fn displayed_exposure(&self, gpu: &GpuContext) -> Result<f32, RenderError> {
+        match (&self.exposure, self.exposure_history) {
+            (Some(e), true) => Ok(e.read(gpu)?.0),
+            _ => Ok(self.last_frame.sky[3]),
+        }
     }
 
     /// Replaces the ILS VPLs for the next frames (moving lights: regenerate per
@@ -1370,7 +1406,7 @@ impl Renderer {
         let normal = self.read_target_layer(gpu, "normal", 0)?;
         let csz = self.read_target(gpu, "csz")?;
         let boost = self.settings.radiosity.as_ref().is_some_and(|r| r.boost);
-        let exposure = self.last_frame.sky[3];
+        let exposure = self.displayed_exposure(gpu)?;
         let mut out = ImageBuf::new(e.width, e.height, 3);
         let (ca, cn, ce, cz) = (
             albedo.channels as usize,
@@ -1424,7 +1460,7 @@ impl Renderer {
                 // the PNG shows it tonemapped like the frame: the last frame's exposure (the
                 // scene's unless overridden; was the override or 1) and the final ACES curve
                 // (was Reinhard)
-                let e = self.last_frame.sky[3];
+                let e = self.displayed_exposure(gpu)?;
                 img.data
                     .iter_mut()
                     .for_each(|v| *v = crate::passes::tonemap::tonemap(*v, e));

@@ -448,6 +448,14 @@ impl<'a> PassBuilder<'a> {
         self.view(name, t.layer(j), wgpu::TextureViewDimension::D2, false)
     }
 
+    /// Declares input `name` without a binding (a buffer an earlier pass writes).
+    pub fn input(mut self, name: &'static str) -> Self {
+        if !self.inputs.contains(&name) {
+            self.inputs.push(name);
+        }
+        self
+    }
+
     /// A read-only storage buffer.
     pub fn storage(self, buffer: &'a wgpu::Buffer) -> Self {
         self.storage_buffer(buffer, true)

@@ -9,6 +9,7 @@ pub mod bzb;
 pub mod compose;
 pub mod deep_gbuffer;
 pub mod depth_mip;
+pub mod exposure;
 pub mod ils;
 pub mod interleave;
 pub mod lighting;

@@ -25,14 +25,34 @@ pub struct TonemapPass {
 }
 
 impl TonemapPass {
-    /// Tonemaps target `input` (normally "hdr").
-    pub fn new(gpu: &GpuContext, scene: &GpuScene, targets: &Targets, input: &'static str) -> Self {
-        let pass = PassBuilder::new(gpu, targets, "tonemap")
+    /// Tonemaps target `input` (normally "hdr") with the frame's exposure, or with the
+    /// exposure `metered` holds in its first f32 ([`crate::passes::exposure`]).
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        input: &'static str,
+        metered: Option<&wgpu::Buffer>,
+    ) -> Self {
+        // without metering the binding holds a stand-in, unread
+        let stand_in = metered.is_none().then(|| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("tonemap exposure stand-in"),
+                size: 8,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        });
+        let b = PassBuilder::new(gpu, targets, "tonemap")
             .shader("tonemap", include_str!("tonemap.wgsl"))
+            .constant("AUTO_EXPOSURE", metered.is_some() as u32 as f64)
             .frame(scene)
-            .read(input)
-            .write(OUTPUTS[0].name)
-            .build();
+            .read(input);
+        let b = match metered {
+            Some(m) => b.input("exposure").storage(m),
+            None => b.storage(stand_in.as_ref().expect("no metering")),
+        };
+        let pass = b.write(OUTPUTS[0].name).build();
         Self { pass }
     }
 }
