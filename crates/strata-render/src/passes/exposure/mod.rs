@@ -1,13 +1,13 @@
 //! Auto-exposure (`RenderSettings::auto_exposure`, `strata render --exposure auto`): not
 //! in the four papers, which hand-set their exposures. The tonemapper's exposure maps the
 //! image's typical luminance L̄ to a key value (Reinhard et al. 2002, Eq. 2: key / L̄),
-//! adapted over frames in log space. L̄ is 2^(mean log2 L) over the pixels between two
-//! percentiles of a log2-luminance histogram, the way game engines meter eye adaptation:
-//! Eq. 1's plain log-average over every pixel metered the Cornell box, half of whose frame
-//! is black background, at 197 (its scene exposure is 1). Two compute dispatches
-//! (`exposure.wgsl`): each 16×16 tile's histogram added into one, then the exposure, into
-//! a storage buffer the tonemapper reads; nothing is read back unless asked
-//! ([`ExposurePass::read`]).
+//! adapted over frames in log space. L̄ is 2^(mean log2 L) over the non-black pixels
+//! between two percentiles of a log2-luminance histogram, the way game engines meter eye
+//! adaptation: Eq. 1's plain log-average over every pixel metered the Cornell box, half of
+//! whose frame is black background, at 197 (its scene exposure is 1). Two compute
+//! dispatches (`exposure.wgsl`): each 16×16 tile's histogram added into one, then the
+//! exposure, into a storage buffer the tonemapper reads; nothing is read back unless
+//! asked ([`ExposurePass::read`]).
 
 use crate::frame::{Pass, PassInfo, Targets};
 use crate::gpu::GpuContext;
