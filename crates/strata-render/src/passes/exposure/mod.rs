@@ -76,7 +76,8 @@ impl AutoExposure {
 /// The histogram bin of a linear rgb pixel (as `bin_of` in `exposure.wgsl`).
 pub fn bin_of(c: [f32; 3]) -> usize {
     let l = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-    if !(l > 0.0) {
+    // NaN fails the comparison too
+    if l.is_nan() || l <= 0.0 {
         return 0;
     }
     ((l.log2() - MIN_LOG2) * BINS_PER_STOP)
