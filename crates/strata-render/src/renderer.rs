@@ -770,9 +770,9 @@ impl Renderer {
         } else {
             None
         };
-        let exposure = tonemap_input
-            .zip(settings.auto_exposure)
-            .map(|(input, a)| crate::passes::exposure::ExposurePass::new(gpu, &targets, input, a));
+        let exposure = tonemap_input.zip(settings.auto_exposure).map(|(input, a)| {
+            crate::passes::exposure::ExposurePass::new(gpu, &targets, input, settings.guard_pixels(), a)
+        });
         let tonemap = tonemap_input.map(|input| {
             tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, input, exposure.as_ref().map(|e| e.buffer()))
         });

@@ -42,15 +42,20 @@ fn brighter(scene: &Scene, k: f32) -> Scene {
     s
 }
 
-/// The GPU's histogram is the CPU's of the read-back `hdr` (but for pixels whose log2
-/// luminance lies on a bin edge), and its exposure the CPU twin's; the tonemapper uses it.
+/// The GPU's histogram is the CPU's of the read-back `hdr` inside the guard band (but for
+/// pixels whose log2 luminance lies on a bin edge), and its exposure the CPU twin's; the
+/// tonemapper uses it.
 #[test]
 fn metered_exposure_matches_its_cpu_twin() {
     let gpu = common::gpu();
-    for name in ["cornell", "atrium"] {
+    for (name, guard) in [("cornell", 0), ("atrium", 0), ("atrium", 12)] {
         let scene = procedural::builtin(name).unwrap();
         let a = AutoExposure::default();
-        let mut r = Renderer::new(&gpu, &scene, auto(a)).unwrap();
+        let settings = RenderSettings {
+            guard_band: strata_render::renderer::GuardBand::Pixels(guard),
+            ..auto(a)
+        };
+        let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
         let (hdr, e) = frame(&gpu, &mut r, &scene, scene.camera);
         let mut cpu = vec![0u32; BINS];
         for c in hdr.data.chunks_exact(hdr.channels as usize) {
@@ -59,7 +64,14 @@ fn metered_exposure_matches_its_cpu_twin() {
         let gpu_hist = r.exposure_histogram(&gpu).unwrap().expect("auto exposure");
         let moved: u32 = cpu.iter().zip(&gpu_hist).map(|(a, b)| a.abs_diff(*b)).sum();
         let (e_cpu, lbar) = metered_exposure(&hdr.data, hdr.channels as usize, &a);
-        eprintln!("{name}: exposure GPU {e} CPU {e_cpu} (L̄ {lbar}); histogram differs by {moved} counts");
+        eprintln!(
+            "{name}, guard band {guard}: exposure GPU {e} CPU {e_cpu} (L̄ {lbar}); histogram differs by {moved} counts"
+        );
+        assert_eq!(
+            gpu_hist.iter().sum::<u32>(),
+            160 * 120,
+            "{name}: the guard band was metered"
+        );
         assert!(moved <= 2 * (hdr.data.len() as u32 / 4) / 1000, "{name}: {moved}");
         assert!((e / e_cpu - 1.0).abs() < 2e-3, "{name}: GPU {e}, CPU {e_cpu}");
         assert!(

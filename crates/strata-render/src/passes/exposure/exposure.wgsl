@@ -19,6 +19,8 @@ struct Meter {
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
+    // the image inside the guard band: origin (xy) and size (zw) in texels
+    image: vec4u,
 }
 
 @group(0) @binding(0) var<uniform> meter: Meter;
@@ -49,18 +51,19 @@ fn bin_of(c: vec3f) -> u32 {
     return u32(clamp(b, 0.0, f32(BINS - 1u)));
 }
 
-// One invocation per 16×16 tile: a private histogram, then one atomic add per bin it
-// holds (few atomics and no workgroup barriers, which a CPU adapter runs slowly).
+// One invocation per 16×16 tile of the image (not the guard band): a private histogram,
+// then one atomic add per bin it holds (few atomics and no workgroup barriers, which a
+// CPU adapter runs slowly).
 @compute @workgroup_size(8, 8)
 fn cs_histogram(@builtin(global_invocation_id) id: vec3u) {
-    let size = textureDimensions(hdr);
+    let size = meter.image.zw;
     let tiles = (size + vec2u(15u)) / 16u;
     if (any(id.xy >= tiles)) {
         return;
     }
     var local: array<u32, BINS>;
-    let origin = id.xy * 16u;
-    let end = min(origin + vec2u(16u), size);
+    let origin = meter.image.xy + id.xy * 16u;
+    let end = min(origin + vec2u(16u), meter.image.xy + size);
     for (var y = origin.y; y < end.y; y++) {
         for (var x = origin.x; x < end.x; x++) {
             local[bin_of(textureLoad(hdr, vec2u(x, y), 0).rgb)] += 1u;

@@ -120,10 +120,11 @@ struct MeterUniforms {
     high: f32,
     has_history: u32,
     _pad: [u32; 3],
+    image: [u32; 4],
 }
 
 impl MeterUniforms {
-    fn new(a: &AutoExposure, has_history: bool) -> Self {
+    fn new(a: &AutoExposure, has_history: bool, image: [u32; 4]) -> Self {
         Self {
             key: a.key,
             adaptation: a.adaptation,
@@ -131,6 +132,7 @@ impl MeterUniforms {
             high: a.high,
             has_history: has_history as u32,
             _pad: [0; 3],
+            image,
         }
     }
 }
@@ -140,7 +142,8 @@ pub struct ExposurePass {
     input: &'static str,
     histogram_pass: ComputePass,
     exposure_pass: ComputePass,
-    size: [u32; 2],
+    /// The image inside the guard band: origin and size in texels.
+    image: [u32; 4],
     settings: AutoExposure,
     histogram: wgpu::Buffer,
     /// [0] the exposure, [1] L̄.
@@ -151,10 +154,16 @@ pub struct ExposurePass {
 const TILE: u32 = 16;
 
 impl ExposurePass {
-    /// Meters target `input` (the tonemapper's).
-    pub fn new(gpu: &GpuContext, targets: &Targets, input: &'static str, settings: AutoExposure) -> Self {
+    /// Meters the image inside a guard band of `guard` texels of target `input` (the
+    /// tonemapper's).
+    pub fn new(gpu: &GpuContext, targets: &Targets, input: &'static str, guard: u32, settings: AutoExposure) -> Self {
         let t = &targets.get(input).texture;
-        let size = [t.width(), t.height()];
+        let image = [
+            guard,
+            guard,
+            t.width().saturating_sub(2 * guard).max(1),
+            t.height().saturating_sub(2 * guard).max(1),
+        ];
         let storage = |label, bytes: u64| {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -170,7 +179,7 @@ impl ExposurePass {
                 .compute()
                 .entry(entry)
                 .shader("exposure", include_str!("exposure.wgsl"))
-                .uniforms(&MeterUniforms::new(&settings, false))
+                .uniforms(&MeterUniforms::new(&settings, false, image))
                 .read(input)
                 .storage_rw(&histogram)
                 .storage_rw(&buffer)
@@ -181,7 +190,7 @@ impl ExposurePass {
             input,
             histogram_pass,
             exposure_pass,
-            size,
+            image,
             settings,
             histogram,
             buffer,
@@ -195,7 +204,7 @@ impl ExposurePass {
 
     /// Before encoding a frame: whether an earlier frame left an exposure to adapt from.
     pub fn set_frame(&self, gpu: &GpuContext, has_history: bool) {
-        let u = MeterUniforms::new(&self.settings, has_history);
+        let u = MeterUniforms::new(&self.settings, has_history, self.image);
         self.histogram_pass.set_uniforms(gpu, &u);
         self.exposure_pass.set_uniforms(gpu, &u);
     }
@@ -228,7 +237,7 @@ impl Pass for ExposurePass {
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, _targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
         encoder.clear_buffer(&self.histogram, 0, None);
         // one invocation per tile, 8×8 per workgroup
-        let tiles = [self.size[0].div_ceil(TILE), self.size[1].div_ceil(TILE)];
+        let tiles = [self.image[2].div_ceil(TILE), self.image[3].div_ceil(TILE)];
         self.histogram_pass.encode_grid(scene, encoder, tiles, [8, 8]);
         self.exposure_pass.encode_grid(scene, encoder, [1, 1], [1, 1]);
     }
