@@ -773,8 +773,9 @@ pub struct FrameArgs {
     #[command(flatten)]
     pub radiosity: RadiosityArgs,
     /// Exposure multiplier before tonemapping (default: the scene's), or `auto[:KEY]`: the
-    /// exposure that maps the image's log-average luminance to KEY (default 0.18, in
-    /// (0, 10]), metered every frame.
+    /// exposure that maps the image's typical luminance (the log mean of its non-black
+    /// pixels from the 50th to the 95th percentile) to KEY (default 0.18, in (0, 10]),
+    /// metered every frame.
     #[arg(long, allow_negative_numbers = true, value_parser = parse_exposure)]
     pub exposure: Option<ExposureArg>,
     /// Shadow map resolution per light, 64..=8192.
