@@ -33,6 +33,7 @@ const MANAGED: &[&str] = &[
     "--variant",
     "--layer-scale",
     "--guard-band",
+    "--exposure",
     "--set",
     "--debug-view",
     "--frames",
@@ -43,10 +44,11 @@ const MANAGED: &[&str] = &[
 ];
 
 /// The `render` flags of the command line that the viewer does not manage, verbatim
-/// (e.g. `--samples 32 --no-probes`), and the raw `--guard-band` value.
-fn passthrough(argv: &[String]) -> (Vec<String>, Option<String>) {
+/// (e.g. `--samples 32 --no-probes`), and the raw `--guard-band` and `--exposure` values.
+fn passthrough(argv: &[String]) -> (Vec<String>, Option<String>, Option<String>) {
     let mut out = Vec::new();
     let mut guard = None;
+    let mut exposure = None;
     let mut i = 0;
     while i < argv.len() {
         let a = &argv[i];
@@ -62,15 +64,17 @@ fn passthrough(argv: &[String]) -> (Vec<String>, Option<String>) {
                     argv.get(i).cloned().unwrap_or_default()
                 }
             };
-            if name == "--guard-band" {
-                guard = Some(v);
+            match name {
+                "--guard-band" => guard = Some(v),
+                "--exposure" => exposure = Some(v),
+                _ => {}
             }
         } else if name != "--force" {
             out.push(a.clone());
         }
         i += 1;
     }
-    (out, guard)
+    (out, guard, exposure)
 }
 
 fn clap_line(e: clap::Error) -> String {
@@ -102,7 +106,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     crate::render::settings_for(f, &scene)?;
 
     let argv: Vec<String> = std::env::args().skip_while(|x| x != "view").skip(1).collect();
-    let (extra, guard) = passthrough(&argv);
+    let (extra, guard, exposure) = passthrough(&argv);
     let t = f.technique;
     let spec = strata_view::RenderSpec {
         technique: t.name.to_string(),
@@ -112,6 +116,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         variant: f.deep.variant.to_string(),
         layer_scale: f.deep.layer_scale,
         guard_band: guard.unwrap_or_else(|| "auto".into()),
+        exposure,
         sets: f.set.values.iter().map(|(n, v)| (n.clone(), v.to_string())).collect(),
         extra,
     };
@@ -151,12 +156,13 @@ mod tests {
 
     #[test]
     fn passthrough_keeps_render_flags_and_drops_managed_ones() {
-        let argv: Vec<String> = "--scene cornell --samples 32 --technique=ao --set radius=1 --guard-band 10% --no-probes --eye -1,2,3 --force --frames 3"
+        let argv: Vec<String> = "--scene cornell --samples 32 --technique=ao --set radius=1 --guard-band 10% --no-probes --exposure=auto --eye -1,2,3 --force --frames 3"
             .split(' ')
             .map(String::from)
             .collect();
-        let (extra, guard) = passthrough(&argv);
+        let (extra, guard, exposure) = passthrough(&argv);
         assert_eq!(extra, ["--samples", "32", "--no-probes"]);
         assert_eq!(guard.as_deref(), Some("10%"));
+        assert_eq!(exposure.as_deref(), Some("auto"));
     }
 }

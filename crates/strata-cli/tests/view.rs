@@ -786,6 +786,41 @@ fn scripted_technique_and_debug_view_switch_match_render() {
     assert!(flip(&reduced, &dir.join("reduced-render.png")) < FLIP_BOUND);
 }
 
+/// The exposure field: a script's `exposure auto` meters the frame as `render --exposure
+/// auto` does (the printed command carries it and reproduces the screenshot), it changes
+/// the Cornell box's frame, and `exposure scene` returns to the scene's.
+#[test]
+fn scripted_exposure_matches_render() {
+    let Some(x) = xvfb("view::scripted_exposure_matches_render") else {
+        return;
+    };
+    let dir = scratch("exposure");
+    let base = [&["--scene", "cornell"][..], &SIZE].concat();
+    let (o0, scene) = view(&x, &dir, "scene", 3, None, &base);
+    ok(&o0);
+    let (o, auto) = view(&x, &dir, "auto", 4, Some("exposure auto\nwait 2\n"), &base);
+    ok(&o);
+    let line = run_cmd_txt(&auto, &dir.join("auto-render.png"));
+    assert!(line.contains("--exposure auto"), "{line}");
+    assert!(flip(&auto, &dir.join("auto-render.png")) < FLIP_BOUND);
+    assert!(
+        flip(&scene, &auto) > 0.05,
+        "auto-exposure does not change the Cornell box's frame"
+    );
+    let (o, back) = view(
+        &x,
+        &dir,
+        "back",
+        6,
+        Some("exposure auto\nwait 2\nexposure scene\nwait 2\n"),
+        &base,
+    );
+    ok(&o);
+    let line = run_cmd_txt(&back, &dir.join("back-render.png"));
+    assert!(!line.contains("--exposure"), "{line}");
+    assert!(flip(&scene, &back) < FLIP_BOUND);
+}
+
 #[test]
 fn bad_settings_show_the_cli_error_and_keep_the_frame() {
     let Some(x) = xvfb("view::bad_settings_show_the_cli_error") else {

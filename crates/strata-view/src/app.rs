@@ -92,6 +92,8 @@ pub struct App {
     pub(crate) open_text: String,
     pub(crate) setting_text: std::collections::HashMap<String, String>,
     pub(crate) guard_text: String,
+    /// The exposure field's text (empty: the scene's).
+    pub(crate) exposure_text: String,
     pub(crate) fit_window: bool,
     pub(crate) render_size: (u32, u32),
     pub(crate) viewport_px: (u32, u32),
@@ -144,6 +146,7 @@ impl App {
             scene_spec: o.scene_spec,
             camera_index: o.camera_index,
             guard_text: o.spec.guard_band.clone(),
+            exposure_text: o.spec.exposure.clone().unwrap_or_default(),
             spec: o.spec,
             settings: None,
             full: None,
@@ -283,6 +286,7 @@ impl App {
                 self.settings = Some(settings);
                 self.spec = spec;
                 self.guard_text = self.spec.guard_band.clone();
+                self.exposure_text = self.spec.exposure.clone().unwrap_or_default();
                 self.setting_text.clear();
                 self.broken = false;
                 self.still_frames = 0;
@@ -354,6 +358,13 @@ impl App {
                     s.guard_band = g;
                     if !self.apply_spec(s, None) {
                         self.guard_text = self.spec.guard_band.clone();
+                    }
+                }
+                Action::Exposure(e) => {
+                    let mut s = self.spec.clone();
+                    s.exposure = e;
+                    if !self.apply_spec(s, None) {
+                        self.exposure_text = self.spec.exposure.clone().unwrap_or_default();
                     }
                 }
                 Action::Set(n, v) => {

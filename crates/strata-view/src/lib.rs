@@ -42,6 +42,8 @@ pub struct RenderSpec {
     /// `--layer-scale`: resolution divisor of layers ≥ 1 (DGB Fig. 11; 1 = full resolution).
     pub layer_scale: u32,
     pub guard_band: String,
+    /// `--exposure` (a number, `auto` or `auto:KEY`); `None`: the scene's.
+    pub exposure: Option<String>,
     /// `--set NAME=VALUE` in order (a later one wins).
     pub sets: Vec<(String, String)>,
     /// Every other `render` flag given on the command line, verbatim (e.g. `--samples 32`).
@@ -64,6 +66,9 @@ impl RenderSpec {
             }
         }
         a.extend(["--guard-band".to_string(), self.guard_band.clone()]);
+        if let Some(e) = &self.exposure {
+            a.extend(["--exposure".to_string(), e.clone()]);
+        }
         a.extend(self.extra.iter().cloned());
         for (n, v) in &self.sets {
             a.extend(["--set".to_string(), format!("{n}={v}")]);
@@ -102,6 +107,8 @@ pub enum Action {
     Variant(String),
     LayerScale(u32),
     GuardBand(String),
+    /// `--exposure` as typed (a number, `auto`, `auto:KEY`); `None`: the scene's.
+    Exposure(Option<String>),
     /// A technique setting by name, value as typed (a number or a named value).
     Set(String, String),
     DebugView(Option<String>),

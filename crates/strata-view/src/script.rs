@@ -100,6 +100,11 @@ impl Script {
                 "variant" => act(Action::Variant(arg(0)?.to_string())),
                 "layer-scale" => act(Action::LayerScale(frames(0)?)),
                 "guard-band" => act(Action::GuardBand(arg(0)?.to_string())),
+                // a number, auto or auto:KEY; `scene`: the scene's
+                "exposure" => act(Action::Exposure(match arg(0)? {
+                    "scene" => None,
+                    e => Some(e.to_string()),
+                })),
                 "set" => act(Action::Set(arg(0)?.to_string(), arg(1)?.to_string())),
                 "debug-view" => act(Action::DebugView(match arg(0)? {
                     "final" => None,

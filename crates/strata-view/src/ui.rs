@@ -214,6 +214,21 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
             ui.label(RichText::new(format!("= {} px", s.guard_pixels())).small());
         }
     });
+    ui.horizontal(|ui| {
+        ui.label("exposure");
+        let r = ui
+            .add(
+                egui::TextEdit::singleline(&mut app.exposure_text)
+                    .desired_width(60.0)
+                    .hint_text("scene"),
+            )
+            .on_hover_text("a number > 0, auto or auto:KEY (metered every frame); empty: the scene's");
+        if entered(ui, &r) {
+            let e = app.exposure_text.trim();
+            app.actions
+                .push(Action::Exposure((!e.is_empty()).then(|| e.to_string())));
+        }
+    });
 
     // every setting of the technique, applied through the CLI's validation
     egui::CollapsingHeader::new("settings")
