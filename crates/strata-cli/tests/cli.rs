@@ -3421,4 +3421,20 @@ fn exposure_auto_meters_the_frame() {
         ]);
         assert_one_line_error(&o, &needles);
     }
+    // the technique setting `exposure` is the fixed exposure: not with auto
+    {
+        let (bad, needles) = ("auto", vec!["exposure 2", "auto-exposure", "both"]);
+        let o = strata(&[
+            "render",
+            "--scene",
+            "cornell",
+            "--exposure",
+            bad,
+            "--set",
+            "exposure=2",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_one_line_error(&o, &needles);
+    }
 }

@@ -241,6 +241,11 @@ impl RenderSettings {
         }
         if let Some(a) = &self.auto_exposure {
             a.validate().map_err(RenderError::Parameter)?;
+            if let Some(e) = self.exposure {
+                return Err(RenderError::Parameter(format!(
+                    "exposure {e} and auto-exposure are both set: give one (a fixed exposure, or auto)"
+                )));
+            }
         }
         if let GuardBand::Fraction(f) = self.guard_band {
             if !(0.0..=1.0).contains(&f) {
