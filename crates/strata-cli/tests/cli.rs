@@ -3405,36 +3405,23 @@ fn exposure_auto_meters_the_frame() {
     assert!(e > 1.5, "{e}");
     let half = metered("auto:0.09");
     assert!((half / e - 0.5).abs() < 1e-3, "key 0.09 against 0.18: {half} vs {e}");
-    for (bad, needles) in [
-        ("auto:0", vec!["--exposure", "(0, 10]"]),
-        ("auto:x", vec!["--exposure", "auto:KEY"]),
-        ("-2", vec!["--exposure", "must be > 0"]),
+    for (args, needles) in [
+        (&["--exposure", "auto:0"][..], &["--exposure", "(0, 10]"][..]),
+        (&["--exposure", "auto:x"], &["--exposure", "auto:KEY"]),
+        (&["--exposure", "-2"], &["--exposure", "must be > 0"]),
+        // the technique setting `exposure` is the fixed exposure: not beside auto
+        (
+            &["--exposure", "auto", "--set", "exposure=2"],
+            &["exposure 2", "auto-exposure", "both"],
+        ),
     ] {
-        let o = strata(&[
-            "render",
-            "--scene",
-            "cornell",
-            "--exposure",
-            bad,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_one_line_error(&o, &needles);
-    }
-    // the technique setting `exposure` is the fixed exposure: not with auto
-    {
-        let (bad, needles) = ("auto", vec!["exposure 2", "auto-exposure", "both"]);
-        let o = strata(&[
-            "render",
-            "--scene",
-            "cornell",
-            "--exposure",
-            bad,
-            "--set",
-            "exposure=2",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_one_line_error(&o, &needles);
+        let o = strata(
+            &[
+                &["render", "--scene", "cornell", "--out", out.to_str().unwrap()][..],
+                args,
+            ]
+            .concat(),
+        );
+        assert_one_line_error(&o, needles);
     }
 }
