@@ -803,6 +803,27 @@ fn scripted_exposure_matches_render() {
     let line = run_cmd_txt(&auto, &dir.join("auto-render.png"));
     assert!(line.contains("--exposure auto"), "{line}");
     assert!(flip(&auto, &dir.join("auto-render.png")) < FLIP_BOUND);
+    // the exposure the panel shows is the one `render` meters for the same frame
+    let metered = |text: &str| -> f32 {
+        let l = text
+            .lines()
+            .find_map(|l| l.trim_start_matches("# ").strip_prefix("exposure (metered): "));
+        l.unwrap_or_else(|| panic!("no metered exposure in {text}"))
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    let shown = metered(&std::fs::read_to_string(auto.with_extension("cmd.txt")).unwrap());
+    let mut words: Vec<String> = line.split(' ').map(String::from).collect();
+    let i = words.iter().position(|w| w == "--out").unwrap();
+    words[i + 1] = dir.join("auto-render2.png").display().to_string();
+    let o = strata(None, &words[1..].iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    ok(&o);
+    let rendered = metered(&text(&o.stderr));
+    assert!(
+        (shown / rendered - 1.0).abs() < 0.01,
+        "the viewer shows exposure {shown}, render meters {rendered}"
+    );
     assert!(
         flip(&scene, &auto) > 0.05,
         "auto-exposure does not change the Cornell box's frame"
@@ -812,12 +833,16 @@ fn scripted_exposure_matches_render() {
         &dir,
         "back",
         6,
-        Some("exposure auto\nwait 2\nexposure scene\nwait 2\n"),
+        // a fixed `set exposure` first: the field replaces it rather than refusing auto beside it
+        Some("set exposure 3\nwait 1\nexposure auto\nwait 2\nexposure scene\nwait 2\n"),
         &base,
     );
     ok(&o);
     let line = run_cmd_txt(&back, &dir.join("back-render.png"));
     assert!(!line.contains("--exposure"), "{line}");
+    let cmd = std::fs::read_to_string(back.with_extension("cmd.txt")).unwrap();
+    assert!(!cmd.contains("metered"), "a fixed exposure is not metered: {cmd}");
+    assert!(!text(&o.stderr).contains("exposure="), "{}", text(&o.stderr));
     assert!(flip(&scene, &back) < FLIP_BOUND);
 }
 

@@ -48,6 +48,8 @@ pub struct Shown {
     pub srgb: bool,
     pub full: bool,
     pub camera: Camera,
+    /// The exposure this frame was tonemapped with (the metered one under auto-exposure).
+    pub exposure: f32,
 }
 
 pub struct App {
@@ -363,6 +365,9 @@ impl App {
                 Action::Exposure(e) => {
                     let mut s = self.spec.clone();
                     s.exposure = e;
+                    // the field is the one place for the exposure: it replaces a fixed
+                    // `--set exposure=X`, which auto-exposure would refuse beside it
+                    s.sets.retain(|(n, _)| n != "exposure");
                     if !self.apply_spec(s, None) {
                         self.exposure_text = self.spec.exposure.clone().unwrap_or_default();
                     }
@@ -543,6 +548,7 @@ impl App {
             }
         }
         let t = r.render(gpu, &self.scene, &cams, self.frame_t)?;
+        let exposure = r.displayed_exposure(gpu)?;
         let t_name = strata_render::technique::find(&self.spec.technique).map(|t| t.display);
         let (image, srgb) = match &self.debug_view {
             Some(v) => (r.debug_view(gpu, v, false)?, true),
@@ -563,6 +569,7 @@ impl App {
             srgb,
             full: !use_reduced,
             camera: cam,
+            exposure,
         });
         Ok(Some(FrameTiming {
             passes: t.passes,
@@ -648,6 +655,10 @@ impl App {
         let mut note = String::new();
         if self.gain != 1.0 || self.false_colour {
             note = "# the viewer's display gain / false colour are not in the PNG or the command\n".into();
+        }
+        if self.spec.exposure.as_deref().is_some_and(|e| e.starts_with("auto")) {
+            // as `render` prints it, so the two can be compared
+            note += &format!("# exposure (metered): {:.4}\n", s.exposure);
         }
         if let Err(e) = s.image.save(&path, s.srgb) {
             self.say(e, true);

@@ -228,6 +228,11 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
             app.actions
                 .push(Action::Exposure((!e.is_empty()).then(|| e.to_string())));
         }
+        if let Some(s) = &app.shown {
+            let metered = app.spec.exposure.as_deref().is_some_and(|e| e.starts_with("auto"));
+            ui.label(RichText::new(format!("= {:.3}{}", s.exposure, if metered { " metered" } else { "" })).small())
+                .on_hover_text("the exposure the shown frame was tonemapped with");
+        }
     });
 
     // every setting of the technique, applied through the CLI's validation
@@ -238,7 +243,8 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
                 .num_columns(3)
                 .striped(true)
                 .show(ui, |ui| {
-                    for info in tech.setting_list() {
+                    // the exposure field above stands for the `exposure` setting
+                    for info in tech.setting_list().filter(|i| i.name != "exposure") {
                         let current = app.settings.as_ref().and_then(|s| (info.get)(s));
                         let shown = match current {
                             Some(v) if !info.values.is_empty() => {
