@@ -33,11 +33,12 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             anyhow::bail!("{flag} is only read by eval --technique gi or full (the deep-G-buffer radiosity against the path tracer, without --views)");
         }
     }
-    // the warm-up along the camera path: the deep-G-buffer comparisons with a temporal filter
-    let dgb_ao = a.technique.eval == EvalKind::AmbientVisibility && !is_bzb && !is_aba;
+    // the warm-up along the camera path: the comparisons with a temporal filter (bzb-ao's
+    // `--set alpha`, BZB §6's re-projection)
+    let dgb_ao = a.technique.eval == EvalKind::AmbientVisibility && !is_aba;
     let dgb_gi = a.technique.eval == EvalKind::Radiance && !is_bzb_gi;
     if a.moving && (a.views || !(dgb_ao || dgb_gi)) {
-        anyhow::bail!("--moving is only read by eval --technique gi, full or ao (the deep-G-buffer radiosity or AO along the camera path, without --views)");
+        anyhow::bail!("--moving is only read by eval --technique gi, full, ao or bzb-ao (the deep-G-buffer radiosity or AO, or bzb-ao, along the camera path, without --views)");
     }
     // --layer-scale reduces layers >= 1: an error where no configuration builds one (ILS and
     // the OIT composite shade layer 0 alone; bzb-ao, aba-ao and bzb-gi compare against DGB
@@ -181,9 +182,13 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 )
             };
             println!(
-                "{} bzb-ao S={} {w}x{h} (reference {} spp, noise FLIP {:.4}):",
+                "{} bzb-ao S={}{} {w}x{h} (reference {} spp, noise FLIP {:.4}):",
                 run.scene,
                 e.samples,
+                match (e.temporal_alpha, e.warmup_frames) {
+                    (Some(a), Some(n)) => format!(" temporal α={a} after {n} frames"),
+                    _ => String::new(),
+                },
                 run.ref_spp,
                 noise(&e.errors.binary)
             );

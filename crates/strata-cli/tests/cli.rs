@@ -1167,11 +1167,11 @@ fn eval_gi_reports_indirect_and_full_errors() {
         "--scene",
         "cornell",
         "--technique",
-        "bzb-ao",
+        "aba-ao",
         "--moving",
         "--json",
     ]);
-    assert_one_line_error(&o, &["--moving", "ao"]);
+    assert_one_line_error(&o, &["--moving", "bzb-ao"]);
     // the GI comparison's own flags are errors where nothing reads them
     let o = strata(&[
         "eval",
@@ -2643,6 +2643,61 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
         b < 0.85 * a,
         "indirect RMSE {a} one frame vs {b} after 8 frames of the filter"
     );
+}
+
+/// `eval --technique bzb-ao --set alpha` warms the temporal filter up on the still camera
+/// (or along the path with `--moving`), records α and the warm-up in its JSON, and ends
+/// closer to the ray-traced binary AO than one frame (no bilateral filter in either, so the
+/// comparison isolates the temporal one).
+#[test]
+fn eval_bzb_ao_warms_up_its_temporal_filter() {
+    let cache = scratch("bzb-ao-temporal-cache");
+    let eval = |extra: &[&str]| {
+        let args = [
+            &[
+                "eval",
+                "--scene",
+                "cornell",
+                "--technique",
+                "bzb-ao",
+                "--width",
+                "64",
+                "--height",
+                "64",
+                "--ref-spp",
+                "1024",
+                "--set",
+                "filter-radius=0",
+                "--json",
+                "--quiet",
+                "--cache",
+                cache.to_str().unwrap(),
+            ][..],
+            extra,
+        ]
+        .concat();
+        json_of(&strata(&args))
+    };
+    let single = eval(&[]);
+    let filtered = eval(&["--set", "alpha=0.85", "--warmup", "8"]);
+    assert!(
+        single["temporal_alpha"].is_null() && single["warmup_frames"].is_null(),
+        "{single}"
+    );
+    assert!(
+        (filtered["temporal_alpha"].as_f64().unwrap() - 0.85).abs() < 1e-6 && filtered["warmup_frames"] == 8,
+        "{filtered}"
+    );
+    let rmse = |j: &serde_json::Value| j["binary"]["rmse"].as_f64().unwrap();
+    let (a, b) = (rmse(&single), rmse(&filtered));
+    assert!(
+        b < 0.6 * a,
+        "binary-AO RMSE {a} one frame vs {b} after 8 frames of the filter"
+    );
+    // --moving: Cornell has no camera path, so the warm-up is the still one
+    let moving = eval(&["--set", "alpha=0.85", "--warmup", "8", "--moving"]);
+    assert_eq!(moving["moving"], true, "{moving}");
+    assert_eq!(rmse(&moving), b);
 }
 
 /// The side-by-side evaluations (`bzb-ao`, `aba-ao`, `bzb-gi`) write a JSON with every

@@ -422,6 +422,12 @@ pub struct AoEval {
     /// `bzb-ao`: DGB AO with 2 layers (its `--ao-*` flags) for the same camera.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dgb_2_layers: Option<AoErrors>,
+    /// `bzb-ao`: the temporal filter's α (`--set alpha`; absent: off, every frame stands
+    /// alone) and the frames rendered on the still camera before the evaluated one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temporal_alpha: Option<f32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warmup_frames: Option<u32>,
 }
 
 /// Deep-G-buffer radiosity errors: the indirect light (top level) and direct + indirect.
@@ -732,6 +738,8 @@ mod tests {
             visibility: None,
             no_visibility: None,
             dgb_2_layers: None,
+            temporal_alpha: None,
+            warmup_frames: None,
         };
         let v = serde_json::to_value(EvalResult::Ao(e.clone())).unwrap();
         for key in [

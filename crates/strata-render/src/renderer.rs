@@ -501,7 +501,6 @@ impl RenderSettings {
         Ok(())
     }
 
-    /// Guard-band pixels per side.
     /// Whether a pass reprojects last frame's values (a temporal filter, the multi-bounce
     /// propagation), so the deep G-buffer writes its `motion` target.
     pub fn needs_motion(&self) -> bool {
@@ -510,9 +509,11 @@ impl RenderSettings {
                 .radiosity
                 .as_ref()
                 .is_some_and(|r| r.temporal.is_some() || r.delta > 0.0)
+            || self.bzb.as_ref().is_some_and(|b| b.temporal.is_some())
             || self.bzb_gi.as_ref().is_some_and(|b| b.temporal.is_some())
     }
 
+    /// Guard-band pixels per side.
     pub fn guard_pixels(&self) -> u32 {
         self.guard_band.pixels(self.height)
     }
@@ -641,13 +642,7 @@ impl Renderer {
             targets.create_storable(gpu, zmip, compute);
             DepthMipPass::new(gpu, &targets, settings.deep.layers, compute)
         });
-        let temporal_on = settings.ao.as_ref().is_some_and(|a| a.temporal.is_some())
-            || settings
-                .radiosity
-                .as_ref()
-                .is_some_and(|r| r.temporal.is_some() || r.delta > 0.0)
-            || settings.bzb_gi.as_ref().is_some_and(|g| g.temporal.is_some());
-        if temporal_on && targets.try_get("csz-history").is_none() {
+        if settings.needs_motion() && targets.try_get("csz-history").is_none() {
             let l = settings.deep.array_layers();
             targets.create(
                 gpu,
@@ -672,6 +667,7 @@ impl Renderer {
                 &mut targets,
                 b,
                 scene,
+                settings.deep.layers,
             )?),
             None => None,
         };
@@ -782,7 +778,7 @@ impl Renderer {
             tonemap::TonemapPass::new(gpu, &scene_gpu, &targets, input, exposure.as_ref().map(|e| e.buffer()))
         });
         let mut copies = Vec::new();
-        if settings.deep.uses_history() || temporal_on {
+        if settings.deep.uses_history() || settings.needs_motion() {
             copies.push(("csz", "csz-history"));
         }
         if ao.as_ref().is_some_and(|a| a.temporal.is_some()) {
@@ -793,6 +789,14 @@ impl Renderer {
         if radiosity.as_ref().is_some_and(|r| r.temporal.is_some()) {
             copies.push(("indirect-temporal", "indirect-temporal-history"));
             let [n, h] = crate::passes::radiosity::stage::INDIRECT_FRAMES;
+            copies.push((n, h));
+        }
+        if settings.bzb.as_ref().is_some_and(|b| b.temporal.is_some()) {
+            copies.push((
+                crate::passes::bzb::TEMPORAL[0].name,
+                crate::passes::bzb::TEMPORAL[1].name,
+            ));
+            let [n, h] = crate::passes::bzb::TEMPORAL_FRAMES;
             copies.push((n, h));
         }
         if settings.bzb_gi.as_ref().is_some_and(|g| g.temporal.is_some()) {
@@ -977,7 +981,7 @@ impl Renderer {
             }
         }
         if let Some(b) = &self.bzb {
-            b.set_frame(gpu, scene, frame, self.animated);
+            b.set_frame(gpu, scene, frame, self.animated, self.frames_rendered, temporal_history);
         }
         // the deep G-buffer's minimum separation Δz (its override, else the scene's)
         let dz = self
@@ -1081,17 +1085,13 @@ impl Renderer {
         }
     }
 
-    /// Whether this frame's output builds up over frames: AO's or the radiosity's
-    /// temporal filter (DGB §3.3), or the radiosity's progressive bounces. The first
-    /// frame after a cut then shows one frame's sampling pattern and a single bounce;
-    /// `strata render` warms such frames up by [`ACCUMULATION_WARMUP`] unless told otherwise.
+    /// Whether this frame's output builds up over frames: a temporal filter (DGB §3.3)
+    /// or the radiosity's progressive bounces, the passes that reproject
+    /// ([`RenderSettings::needs_motion`]). The first frame after a cut then shows one
+    /// frame's sampling pattern and a single bounce; `strata render` warms such frames
+    /// up by [`ACCUMULATION_WARMUP`] unless told otherwise.
     pub fn accumulates(&self) -> bool {
-        self.ao.as_ref().is_some_and(|a| a.temporal.is_some())
-            || self
-                .radiosity
-                .as_ref()
-                .is_some_and(|r| r.temporal.is_some() || r.propagate.is_some())
-            || self.settings.bzb_gi.as_ref().is_some_and(|g| g.temporal.is_some())
+        self.settings.needs_motion()
     }
 
     /// The A-buffer stage (read-back of its lists and compressed nodes), if on.

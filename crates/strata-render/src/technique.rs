@@ -1113,7 +1113,7 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
     s.bzb.clone().unwrap_or_default()
 }
 
-static BZB_SETTINGS: [SettingInfo; 12] = [
+static BZB_SETTINGS: [SettingInfo; 13] = [
     bool_setting!(
         "visibility",
         "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
@@ -1213,6 +1213,14 @@ static BZB_SETTINGS: [SettingInfo; 12] = [
         true,
         |s| Some(bzb_of(s).filter.step as f64),
         |s, v| bzb_mut(s).filter.step = v as u32
+    ),
+    setting!(
+        "alpha",
+        "temporal filter weight α of the history (BZB §6's re-projection: DGB §3.3's filter on the reconstructed AV before the bilateral filter, directions re-drawn every frame). 0 = off, the default: every frame stands alone. With it a narrower bilateral filter (filter-radius=1) measured closer to the ray-traced AO (docs/bzb.md)",
+        Range::HalfOpen(0.0, 1.0),
+        false,
+        |s| Some(bzb_of(s).temporal.map_or(0.0, |t| t.alpha as f64)),
+        |s, v| set_alpha(&mut bzb_mut(s).temporal, v, crate::passes::bzb::temporal_filter())
     ),
 ];
 

@@ -50,7 +50,7 @@ pub fn run(
         }
         // BZB: the splatting algorithm's own passes (AOV or DSS)
         None => match (&checked.bzb, &checked.bzb_gi) {
-            (Some(b), _) => b.pass_names().to_vec(),
+            (Some(b), _) => b.pass_names(),
             // bzb-gi: the registry's (AOV) passes, DSS's and the temporal filter's; the
             // frame times those it has
             (None, Some(_)) => technique

@@ -107,6 +107,8 @@ pub fn run(s: &EvalSettings, abuffer: &ABufferSettings, ao: &AoSettings) -> Resu
         visibility: None,
         no_visibility: None,
         dgb_2_layers: Some(dgb.errors),
+        temporal_alpha: None,
+        warmup_frames: None,
     };
     if let Some(dir) = &s.report {
         write_side_by_side_report(

@@ -108,6 +108,8 @@ pub fn run(s: &EvalSettings, settings: &AoSettings) -> Result<AoEval> {
         visibility: None,
         no_visibility: None,
         dgb_2_layers: None,
+        temporal_alpha: None,
+        warmup_frames: None,
     };
     if let Some(dir) = &s.report {
         write_ao_report(
@@ -281,10 +283,13 @@ pub(crate) fn render_frame(
         super::render_along_path(r, gpu, scene, s, f)?;
         return Ok(r.read_target(gpu, "ao")?);
     }
-    if r.settings.ao.as_ref().is_some_and(|a| a.temporal_noise) {
-        // per-frame spiral rotations: `warmup` static frames at the evaluated camera first, so
-        // the temporal filter averages different tap patterns as in `render --warmup N` (with the
-        // paper's fixed rotation every static frame is the same, so none are rendered)
+    if r.settings.ao.as_ref().is_some_and(|a| a.temporal_noise)
+        || r.settings.bzb.as_ref().is_some_and(|b| b.temporal.is_some())
+    {
+        // per-frame spiral rotations (bzb-ao with `alpha`: per-frame directions): `warmup`
+        // static frames at the evaluated camera first, so the temporal filter averages
+        // different tap patterns as in `render --warmup N` (with the paper's fixed rotation
+        // every static frame is the same, so none are rendered)
         let fixed = strata_render::frame::FrameCameras::fixed(s.scene.cameras_at(scene, f).current);
         for _ in 0..s.warmup.max(r.settings.deep.uses_history() as u32) {
             r.render(gpu, scene, &fixed, f)?;

@@ -18,7 +18,7 @@ use crate::results::{AoEval, EvalResult};
 /// `ao` are the DGB AO settings of the 2-layer comparison.
 pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEval> {
     if s.frames.is_some() {
-        bail!("--frames is not available for --technique bzb-ao (it has no temporal filter): drop --frames");
+        bail!("--frames is not available for --technique bzb-ao (it evaluates one still frame, after --warmup frames with --set alpha): drop --frames");
     }
     let rule = s.check(DEFAULT_CAP, 16)?;
     let (scene, cams) = s.scene.load()?;
@@ -73,6 +73,8 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
         visibility: Some(bzb.visibility),
         no_visibility: Some(no_visibility.errors),
         dgb_2_layers: Some(dgb.errors),
+        temporal_alpha: bzb.temporal.as_ref().map(|t| t.alpha),
+        warmup_frames: bzb.temporal.is_some().then_some(s.warmup),
     };
     if let Some(dir) = &s.report {
         write_side_by_side_report(

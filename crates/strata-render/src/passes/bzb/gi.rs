@@ -115,15 +115,9 @@ pub const DSS_PASSES: [&str; 8] = [
 ];
 
 impl BzbGiSettings {
-    /// The temporal filter `alpha` turns on: DGB's defaults without the history clamp.
-    /// A few directions per pixel make the current 3×3 neighbourhood a skewed sample
-    /// (most rays dark, a few bright), whose range often lies below the history's mean:
-    /// clamping pulled the average towards the median (the atrium's shade 2.5 % dark).
+    /// The temporal filter `alpha` turns on ([`super::temporal_filter`]).
     pub fn temporal_filter() -> crate::passes::temporal::TemporalSettings {
-        crate::passes::temporal::TemporalSettings {
-            clamp_history: false,
-            ..Default::default()
-        }
+        super::temporal_filter()
     }
 
     pub fn validate(&self) -> Result<(), String> {
@@ -1037,7 +1031,7 @@ impl BzbGiStage {
     ) {
         let mut u = self.settings.uniforms(scene, self.count);
         if let Some(t) = &self.temporal {
-            u.seed = self.settings.seed.wrapping_add(frame_index.wrapping_mul(0x9e37_79b9));
+            u.seed = super::frame_seed(self.settings.seed, frame_index);
             for p in t {
                 p.set_frame(gpu, has_history);
             }
