@@ -165,14 +165,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 "{} ao k={k} {w}x{h}: FLIP {:.4}  RMSE {:.4}  MAE {:.4} (vs obscurance, {} spp, reference noise FLIP {:.4}); vs binary AO: FLIP {:.4}  MAE {:.4}",
                 run.scene, o.flip, o.rmse, o.mae, run.ref_spp, noise(o), b.flip, b.mae
             );
-            if let Some(f) = &run.flicker {
-                println!(
-                    "flicker over {} frames: {:.5} (mean |ΔAV| after reprojection, {:.1} % of pixels valid)",
-                    f.frames,
-                    f.mean,
-                    100.0 * f.valid_fraction
-                );
-            }
+            print_av_flicker(run);
         }
         EvalResult::Bzb(e) => {
             let line = |what: &str, x: &strata_eval::results::AoErrors| {
@@ -206,6 +199,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             if let Some(x) = &e.dgb_2_layers {
                 line("DGB AO, 2 layers", x);
             }
+            print_av_flicker(run);
         }
         EvalResult::AbaAo(e) => {
             let line = |what: &str, x: &strata_eval::results::AoErrors| {
@@ -415,4 +409,16 @@ fn views(a: &EvalArgs, s: &EvalSettings) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// `--frames`: the AV's flicker along the camera path (ao, bzb-ao).
+fn print_av_flicker(run: &strata_eval::results::EvalRun) {
+    if let Some(f) = &run.flicker {
+        println!(
+            "flicker over {} frames: {:.5} (mean |ΔAV| after reprojection, {:.1} % of pixels valid)",
+            f.frames,
+            f.mean,
+            100.0 * f.valid_fraction
+        );
+    }
 }

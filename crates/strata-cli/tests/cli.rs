@@ -2648,7 +2648,8 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
 /// `eval --technique bzb-ao --set alpha` warms the temporal filter up on the still camera
 /// (or along the path with `--moving`), records α and the warm-up in its JSON, and ends
 /// closer to the ray-traced binary AO than one frame (no bilateral filter in either, so the
-/// comparison isolates the temporal one).
+/// comparison isolates the temporal one); along the atrium's path (`--frames`) it flickers
+/// less.
 #[test]
 fn eval_bzb_ao_warms_up_its_temporal_filter() {
     let cache = scratch("bzb-ao-temporal-cache");
@@ -2698,6 +2699,37 @@ fn eval_bzb_ao_warms_up_its_temporal_filter() {
     let moving = eval(&["--set", "alpha=0.85", "--warmup", "8", "--moving"]);
     assert_eq!(moving["moving"], true, "{moving}");
     assert_eq!(rmse(&moving), b);
+    // BZB §6's reason for the re-projection: flicker along the atrium's camera path
+    let flicker = |alpha: &str| {
+        let j = json_of(&strata(&[
+            "eval",
+            "--scene",
+            "atrium",
+            "--technique",
+            "bzb-ao",
+            "--width",
+            "160",
+            "--height",
+            "90",
+            "--frames",
+            "10",
+            "--ref-spp",
+            "64",
+            "--set",
+            alpha,
+            "--json",
+            "--quiet",
+            "--cache",
+            cache.to_str().unwrap(),
+        ]));
+        assert_eq!(j["flicker_frames"], 10, "{j}");
+        j["flicker"].as_f64().unwrap()
+    };
+    let (none, filtered) = (flicker("alpha=0"), flicker("alpha=0.85"));
+    assert!(
+        filtered < 0.8 * none,
+        "flicker {none} one frame at a time vs {filtered} with the temporal filter"
+    );
 }
 
 /// The side-by-side evaluations (`bzb-ao`, `aba-ao`, `bzb-gi`) write a JSON with every

@@ -17,9 +17,6 @@ use crate::results::{AoEval, EvalResult};
 /// `bzb` as configured (its radius and bias default to `ao`'s, then the scene's);
 /// `ao` are the DGB AO settings of the 2-layer comparison.
 pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEval> {
-    if s.frames.is_some() {
-        bail!("--frames is not available for --technique bzb-ao (it evaluates one still frame, after --warmup frames with --set alpha): drop --frames");
-    }
     let rule = s.check(DEFAULT_CAP, 16)?;
     let (scene, cams) = s.scene.load()?;
     let camera = cams.current;
@@ -52,11 +49,28 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
     let main = evaluate(bzb_settings(bzb.visibility), "bzb-ao")?;
     let no_visibility = evaluate(bzb_settings(false), "bzb-ao visibility=off")?;
     let dgb = evaluate(render_settings(s, 2, &ao), "ao k=2")?;
+    // BZB §6: "the sampling directions are randomly selected for each frame [...] leading
+    // to flickering in animated scenes" — measured along the camera path (`--frames`)
+    let flicker = match s.frames {
+        Some(n) => {
+            let threshold = bzb.temporal.map_or(0.01, |t| t.max_distance);
+            Some(super::flicker(
+                &gpu,
+                &scene,
+                &s.scene,
+                bzb_settings(bzb.visibility),
+                "ao",
+                threshold,
+                n,
+            )?)
+        }
+        None => None,
+    };
     let mut run = s.run_info(
         ref_binary.noise.spp,
         "binary AO within r (cosine-weighted hemisphere rays), and DGB Eq. 2 obscurance over all surfaces",
         gpu.describe(),
-        None,
+        flicker,
         noise_warnings(&[("bzb-ao vs binary AO", &main.errors.binary)]),
     );
     run.layers = 1;
