@@ -254,6 +254,14 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             line("bzb-gi (bounced z-buffer)", &e.errors);
             line("no visibility (additive)", &e.no_visibility);
             line("DGB radiosity, 2 layers", &e.dgb_2_layers);
+            if let Some(f) = &run.flicker {
+                println!(
+                    "flicker over {} frames: {:.5} (mean |ΔE| of the indirect irradiance's red channel after reprojection, {:.1} % of pixels valid)",
+                    f.frames,
+                    f.mean,
+                    100.0 * f.valid_fraction
+                );
+            }
         }
         EvalResult::Oit(e) => {
             println!(

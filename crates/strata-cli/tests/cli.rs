@@ -2643,6 +2643,20 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
         b < 0.85 * a,
         "indirect RMSE {a} one frame vs {b} after 8 frames of the filter"
     );
+    // --frames: Cornell has no camera path, so a frame with fixed directions repeats
+    // exactly (no flicker but the reprojection's rounding), while the filter's new
+    // directions every frame move it
+    let still = json_of(&eval(&["--frames", "3"]));
+    assert_eq!(still["flicker_frames"], 3, "{still}");
+    let f = |j: &serde_json::Value| j["flicker"].as_f64().unwrap();
+    assert!(f(&still) < 1e-6, "{still}");
+    let renewed = json_of(&eval(&["--frames", "3", "--set", "alpha=0.85"]));
+    eprintln!(
+        "bzb-gi flicker on a still camera: {} fixed directions, {} renewed",
+        f(&still),
+        f(&renewed)
+    );
+    assert!(f(&renewed) > 1e-4, "{renewed}");
 }
 
 /// `eval --technique bzb-ao --set alpha` warms the temporal filter up on the still camera

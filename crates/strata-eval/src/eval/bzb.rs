@@ -5,7 +5,7 @@
 //! (additive AOV, or additive shell splatting) and of 2-layer deep-G-buffer AO, so
 //! one run says which is closest.
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use strata_render::passes::ao::AoSettings;
 use strata_render::passes::bzb::BzbSettings;
 use strata_render::RenderSettings;
@@ -128,9 +128,6 @@ pub fn run_gi(
     use crate::metrics::{compare_radiance, display};
     use crate::results::GiErrors;
 
-    if s.frames.is_some() {
-        bail!("--frames is not available for --technique bzb-gi (it evaluates one still frame, after --warmup frames with --set alpha): drop --frames");
-    }
     let rule = s.check(super::gi::DEFAULT_CAP, 8)?;
     let t = strata_render::technique::find("bzb-gi")?;
     let base = RenderSettings {
@@ -225,12 +222,29 @@ pub fn run_gi(
         (splat_ms_no_visibility, splat_ms)
     };
     let (d_max, t_min) = gi.resolve(&scene);
+    // BZB §6's flicker along the camera path (`--frames`): the indirect irradiance's red
+    // channel, as `eval gi` measures it
+    let flicker = match s.frames {
+        Some(n) => {
+            let threshold = gi.temporal.map_or(0.01, |t| t.max_distance);
+            Some(super::flicker(
+                &gpu,
+                &scene,
+                &s.scene,
+                main.clone(),
+                "indirect",
+                threshold,
+                n,
+            )?)
+        }
+        None => None,
+    };
     let mut run = s.run_info(
         converged.spp(),
         "path-traced GI (GGX for glossy materials) with 1 indirect bounce, sky and ambient off; \
          errors of the indirect light (composed − direct) at top level, the full image in `full`",
         gpu.describe(),
-        None,
+        flicker,
         noise_warnings(&[("bzb-gi indirect", &errors.indirect), ("bzb-gi full", &errors.full)]),
     );
     run.layers = 1;
