@@ -24,6 +24,7 @@ const COMMON: &[(&str, &str)] = &[
         include_str!("shaders/common/bzb_geometry.wgsl"),
     ),
     ("common/dss.wgsl", include_str!("shaders/common/dss.wgsl")),
+    ("common/zminmax.wgsl", include_str!("shaders/common/zminmax.wgsl")),
     ("abuffer/lists.wgsl", include_str!("passes/abuffer/lists.wgsl")),
     ("abuffer/ao_common.wgsl", include_str!("passes/abuffer/ao_common.wgsl")),
     ("ao/uniforms.wgsl", include_str!("passes/ao/uniforms.wgsl")),

@@ -1124,7 +1124,7 @@ static BZB_SETTINGS: [SettingInfo; 13] = [
     ),
     bool_setting!(
         "culling",
-        "AOV: cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        "cull splats (AOV triangles, DSS shells) whose depth range misses every receiver under them (min/max depth tiles, BZB §4.3; the image is unchanged)",
         bzb_of,
         bzb_mut,
         culling,
@@ -1296,7 +1296,7 @@ static BZB_GI_SETTINGS: [SettingInfo; 12] = [
     ),
     bool_setting!(
         "culling",
-        "cull splats whose depth range misses every receiver under them (min/max depth tiles; the image is unchanged)",
+        "cull splats (AOV triangles, DSS shells) whose depth range misses every receiver under them (min/max depth tiles, BZB §4.3; the image is unchanged)",
         bzb_gi_of,
         bzb_gi_mut,
         culling,

@@ -794,3 +794,46 @@ fn temporal_filter_averages_new_directions_on_a_still_camera() {
     assert!(rms8 <= 0.5 * single_err.0, "RMS {rms8} vs one frame's {}", single_err.0);
     assert!(bias8 < 0.03, "the mean moved by {bias8}");
 }
+
+/// Depth-tile culling (`culling`, BZB §4.3's min/max culling; for DSS's shells since
+/// 2026-11-30) removes only splats with no receiver in their depth range: the payload and
+/// the reconstructed irradiance are the same bits with and without it, for AOV triangles
+/// and DSS surfels, with and without visibility, on the Cornell box.
+#[test]
+fn depth_tile_culling_leaves_the_gi_unchanged() {
+    let gpu = common::gpu();
+    let scene = strata_scene::procedural::builtin("cornell").unwrap();
+    for splat in [
+        strata_render::passes::bzb::Splat::Aov,
+        strata_render::passes::bzb::Splat::Dss,
+    ] {
+        for visibility in [true, false] {
+            let g = |culling: bool| BzbGiSettings {
+                visibility,
+                culling,
+                splat,
+                ..Default::default()
+            };
+            let (on, off) = (
+                render(&gpu, &scene, 48, 36, g(true)),
+                render(&gpu, &scene, 48, 36, g(false)),
+            );
+            for t in ["bzb-gi-raw", "indirect"] {
+                let (a, b) = (on.read_target(&gpu, t).unwrap(), off.read_target(&gpu, t).unwrap());
+                let differ = a
+                    .data
+                    .iter()
+                    .zip(&b.data)
+                    .filter(|(x, y)| x.to_bits() != y.to_bits())
+                    .count();
+                assert_eq!(
+                    differ, 0,
+                    "{splat:?} visibility={visibility} {t}: {differ} values differ"
+                );
+            }
+            let lit = on.read_target(&gpu, "bzb-gi-raw").unwrap();
+            let n = lit.data.iter().filter(|&&v| v > 0.0).count();
+            assert!(n > 100, "{splat:?} visibility={visibility}: only {n} lit values");
+        }
+    }
+}

@@ -34,14 +34,6 @@ struct Bzb {
     culling: u32,
 }
 
-// The min/max depth tiles (bzb_zminmax.wgsl): ZMINMAX_LEVELS levels of square
-// tiles, 8, 32, 128 pixels, then one tile over the whole image.
-const ZMINMAX_LEVELS: u32 = 4u;
-
-fn zminmax_tile(level: u32) -> u32 {
-    return select(8u << (2u * level), 0x40000000u, level == ZMINMAX_LEVELS - 1u);
-}
-
 // §3.1 / Fig. 5: direction s of pixel p lives in sub-image s; sub-image s is the
 // (W×H) tile at (s % cols, s / cols) of the bounced z-buffer.
 fn bzb_tile_origin(s: u32, cols: u32, size: vec2u) -> vec2u {

@@ -9,6 +9,7 @@
 //   fs_additive:   the analytic AOV occlusion, summed by additive blending (McGuire 2010).
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
+#import "common/zminmax.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var<uniform> bzb: Bzb;
@@ -19,34 +20,6 @@
 @group(1) @binding(4) var npack: texture_2d<f32>;
 // min/max receiver depth per tile (bzb_zminmax.wgsl)
 @group(1) @binding(5) var<storage, read> tiles: array<vec2f>;
-
-// Whether some receiver under the pixel rectangle [rmin, rmax) has a camera
-// depth in [zlo, zhi]: the tiles of the finest level on which the rectangle
-// spans at most 3 × 3 of them.
-fn receivers_in_range(rmin: vec2f, rmax: vec2f, zlo: f32, zhi: f32) -> bool {
-    let size = vec2u(frame.size.xy);
-    let extent = max(rmax.x - rmin.x, rmax.y - rmin.y);
-    var offset = 0u;
-    for (var level = 0u; level < ZMINMAX_LEVELS; level++) {
-        let t = zminmax_tile(level);
-        let n = (size + vec2u(t - 1u)) / t;
-        if (extent <= 2.0 * f32(t) || level == ZMINMAX_LEVELS - 1u) {
-            let t0 = min(vec2u(rmin) / t, n - 1u);
-            let t1 = min(vec2u(max(rmax - 1.0, rmin)) / t, n - 1u);
-            for (var y = t0.y; y <= t1.y; y++) {
-                for (var x = t0.x; x <= t1.x; x++) {
-                    let r = tiles[offset + y * n.x + x];
-                    if (r.x <= zhi && r.y >= zlo) {
-                        return true;
-                    }
-                }
-            }
-            return false;
-        }
-        offset += n.x * n.y;
-    }
-    return true;
-}
 
 struct SplatVertex {
     @builtin(position) position: vec4f,
@@ -81,7 +54,7 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
         return out;
     }
     // issue 13 item 4: no receiver under the splat within its depth range
-    if (bzb.culling == 1u && !receivers_in_range(rmin, rmax, sb.zlo, sb.zhi)) {
+    if (bzb.culling == 1u && !receivers_in_range(vec2u(size), rmin, rmax, sb.zlo, sb.zhi)) {
         return out;
     }
     // corners of two triangles: (0,0) (1,0) (0,1) / (0,1) (1,0) (1,1)

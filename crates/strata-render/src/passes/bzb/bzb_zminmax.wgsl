@@ -7,6 +7,8 @@
 // is culled. (One invocation per tile reading texels at every level took 45 ms
 // at 768×512 on an H100: the whole-image tile was 393k serial loads.)
 
+#import "common/zminmax.wgsl"
+
 const BIG: f32 = 3.0e38;
 
 override LEVEL: u32 = 0u;

@@ -127,7 +127,10 @@ pub struct DssUniforms {
     pub max_split: u32,
     /// 1 = bzb-gi (RGBA radiance payload, hit flag in alpha), 0 = bzb-ao.
     pub gi: u32,
-    pub _pad: [u32; 2],
+    /// 1 = shells whose depth range misses every receiver under them are culled
+    /// (BZB §4.3's min/max culling, from the AOV path's depth tiles).
+    pub depth_culling: u32,
+    pub _pad: u32,
 }
 
 /// Buffer capacities (entries) for `triangles` scene triangles.
@@ -660,14 +663,15 @@ macro_rules! dss_shader {
 }
 
 impl DssStage {
-    /// `u`: the uniforms; `triangles`: the scene's triangle buffer (3 vec4 each);
+    /// `u`: the uniforms; `triangles`: the scene's triangle buffer (3 vec4 each) and
+    /// `tiles` the receivers' min/max depth tiles (`bzb-zminmax`) its shells are culled against;
     /// `payload`: the bounced z-buffer's payload target the reduction writes.
     pub fn new(
         gpu: &GpuContext,
         scene_gpu: &GpuScene,
         targets: &mut Targets,
         u: &DssUniforms,
-        triangles: &wgpu::Buffer,
+        (triangles, tiles): (&wgpu::Buffer, &wgpu::Buffer),
         payload: &'static str,
         gi: Option<DssGiInputs>,
     ) -> Result<Self, crate::RenderError> {
@@ -839,7 +843,15 @@ impl DssStage {
         let shade = gi
             .as_ref()
             .map(|g| Self::shade_pass(gpu, scene_gpu, u, triangles, &buffers, g));
-        let splat = Self::splat_pass(gpu, scene_gpu, targets, u, &uniforms, &buffers, level_payload.name);
+        let splat = Self::splat_pass(
+            gpu,
+            scene_gpu,
+            targets,
+            u,
+            (&uniforms, tiles),
+            &buffers,
+            level_payload.name,
+        );
         Ok(Self {
             tessellate,
             fine,
@@ -856,12 +868,14 @@ impl DssStage {
         })
     }
 
+    /// `tiles`: the receivers' min/max depth tiles (`bzb-zminmax`) the vertex shader culls
+    /// shells against (`DssUniforms::depth_culling`).
     fn splat_pass(
         gpu: &GpuContext,
         scene_gpu: &GpuScene,
         targets: &Targets,
         u: &DssUniforms,
-        uniforms: &wgpu::Buffer,
+        (uniforms, tiles): (&wgpu::Buffer, &wgpu::Buffer),
         buffers: &SurfelBuffers,
         payload: &'static str,
     ) -> DssSplatPass {
@@ -901,10 +915,15 @@ impl DssStage {
             wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
             wgpu::BindingResource::TextureView(&targets.get("npack").view),
         ];
+        entries.push(wgpu::BindGroupLayoutEntry {
+            visibility: wgpu::ShaderStages::VERTEX,
+            ..buf(5, wgpu::BufferBindingType::Storage { read_only: true })
+        });
+        resources.push(tiles.as_entire_binding());
         if let Some(r) = &buffers.radiance {
             entries.push(wgpu::BindGroupLayoutEntry {
                 visibility: wgpu::ShaderStages::FRAGMENT,
-                ..buf(5, wgpu::BufferBindingType::Storage { read_only: true })
+                ..buf(6, wgpu::BufferBindingType::Storage { read_only: true })
             });
             resources.push(r.as_entire_binding());
         }

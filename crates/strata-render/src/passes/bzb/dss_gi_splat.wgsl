@@ -6,7 +6,7 @@
 //   fs_gi_additive:   every surfel in the shell adds π · F · L (F the disk's
 //                     form factor, dss_disk_occlusion; L the face towards the
 //                     receiver): the irradiance of DSS without visibility.
-@group(1) @binding(5) var<storage, read> radiance: array<vec4f>;
+@group(1) @binding(6) var<storage, read> radiance: array<vec4f>;
 
 // The ray–disk radius of fs_gi_visibility over the surfel's (area-preserving)
 // radius (`dss::GI_COVER`): surfels placed at random with total area = the

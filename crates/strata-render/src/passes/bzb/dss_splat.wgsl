@@ -16,6 +16,7 @@
 #import "common/camera.wgsl"
 #import "common/dss.wgsl"
 #import "common/packing.wgsl"
+#import "common/zminmax.wgsl"
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var<uniform> dss: Dss;
@@ -23,6 +24,8 @@
 @group(1) @binding(2) var origins: texture_2d<f32>;
 @group(1) @binding(3) var directions: texture_2d<f32>;
 @group(1) @binding(4) var npack: texture_2d<f32>;
+// min/max receiver depth per tile (bzb_zminmax.wgsl), for §4.3's splat culling
+@group(1) @binding(5) var<storage, read> tiles: array<vec2f>;
 
 // The receiver's normal: origins.w = 1 + its pixel index (dss-shuffle).
 fn receiver_normal(w: f32) -> vec3f {
@@ -57,6 +60,14 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     let hi = c + vec3f(outer);
     let sb = screen_box(frame, lo, hi);
     if (!sb.visible) {
+        return out;
+    }
+    // §4.3 "Min/Max MIP-map for splat culling": no receiver under the shell's box lies
+    // in its depth range (the AOV path's tiles over the frame's pixels)
+    let size = vec2f(dss.size);
+    let pmin = clamp(floor(sb.rmin) - 1.0, vec2f(0.0), size);
+    let pmax = clamp(ceil(sb.rmax) + 1.0, vec2f(0.0), size);
+    if (dss.depth_culling == 1u && !receivers_in_range(dss.size, pmin, pmax, sb.zlo, sb.zhi)) {
         return out;
     }
     // in neighbourhoods of 2^l × 2^l pixels (the sub-image's texels)

@@ -59,7 +59,8 @@ pub struct BzbGiSettings {
     pub bias: Option<f32>,
     pub seed: u32,
     pub filter: BilateralSettings,
-    /// Depth-tile culling of splats (the AOV path's; the image is unchanged).
+    /// Depth-tile culling of splats, AOV triangles and DSS shells (BZB §4.3; the
+    /// image is unchanged).
     pub culling: bool,
     /// Largest sender radiance a payload keeps (its RGB scaled down to this
     /// maximum component; biased, trades caustic fireflies for energy); `None` = off.
@@ -178,7 +179,8 @@ impl BzbGiSettings {
             triangles,
             max_split: super::dss::MAX_SPLIT,
             gi: 1,
-            _pad: [0; 2],
+            depth_culling: self.culling as u32,
+            _pad: 0,
         }
     }
 
@@ -792,7 +794,10 @@ impl BzbGiStage {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let zminmax = aov.then(|| super::BzbStage::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count));
+        // the AOV splats and DSS's shells cull against the same tiles
+        let zminmax = Some(super::BzbStage::zminmax_pass(
+            gpu, scene_gpu, targets, &tiles, tile_count,
+        ));
 
         // group 2 of the splat: sender data, lights, shadow maps, receiver material
         let frag = wgpu::ShaderStages::FRAGMENT;
@@ -929,7 +934,7 @@ impl BzbGiStage {
                 scene_gpu,
                 targets,
                 &s.dss_uniforms(scene, w, h, count),
-                &triangles,
+                (&triangles, &tiles),
                 PAYLOAD.name,
                 Some(super::dss::DssGiInputs {
                     gi_uniforms: &gi_uniforms,

@@ -106,9 +106,9 @@ pub struct BzbSettings {
     pub seed: u32,
     /// The cross-bilateral reconstruction filter (§3.3).
     pub filter: BilateralSettings,
-    /// Cull splats whose camera-depth range misses every receiver under them,
-    /// from min/max depth tiles (issue 13 item 4, BZB Table 3's "MIP map"); the
-    /// image is the same either way.
+    /// Cull splats (AOV triangles, DSS shells) whose camera-depth range misses every
+    /// receiver under them, from min/max depth tiles (issue 13 item 4, BZB §4.3's
+    /// "Min/Max MIP-map for splat culling"); the image is the same either way.
     pub culling: bool,
     /// The splatting algorithm (AOV or DSS).
     pub splat: Splat,
@@ -218,7 +218,8 @@ impl BzbSettings {
             triangles,
             max_split: dss::MAX_SPLIT,
             gi: 0,
-            _pad: [0; 2],
+            depth_culling: self.culling as u32,
+            _pad: 0,
         }
     }
 
@@ -229,6 +230,7 @@ impl BzbSettings {
             Splat::Aov => &["bzb-directions", "bzb-zminmax", "bzb-splat", "bzb-reconstruct"],
             Splat::Dss => &[
                 "bzb-directions",
+                "bzb-zminmax",
                 "dss-tessellate",
                 "dss-fine",
                 "dss-filter",
@@ -784,14 +786,14 @@ impl BzbStage {
             Splat::Dss => {
                 let du = s.dss_uniforms(w, h, u.radius, u.t_min, count);
                 (
-                    None,
+                    Some(Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count)),
                     None,
                     Some(dss::DssStage::new(
                         gpu,
                         scene_gpu,
                         targets,
                         &du,
-                        &buffer,
+                        (&buffer, &tiles),
                         PAYLOAD.name,
                         None,
                     )?),
@@ -1011,8 +1013,10 @@ impl BzbStage {
 
     pub fn passes(&self) -> Vec<&dyn Pass> {
         let mut v: Vec<&dyn Pass> = vec![&self.directions];
-        if let (Some(z), Some(s)) = (&self.zminmax, &self.splat) {
+        if let Some(z) = &self.zminmax {
             v.push(z);
+        }
+        if let Some(s) = &self.splat {
             v.push(s);
         }
         if let Some(d) = &self.dss {

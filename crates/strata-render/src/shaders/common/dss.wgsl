@@ -39,8 +39,9 @@ struct Dss {
     max_split: u32,
     // 1 = bzb-gi: RGBA radiance payload, hit flag in alpha (0 = bzb-ao occlusion)
     gi: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1 = shells whose depth range misses every receiver under them are culled (§4.3)
+    depth_culling: u32,
+    _pad: u32,
 }
 
 // Hash of a world position (§4.3: "hash this position"): bit patterns of x, y, z.
