@@ -2589,30 +2589,7 @@ fn bzb_gi_renders_with_and_without_visibility() {
 #[test]
 fn eval_bzb_gi_warms_up_its_temporal_filter() {
     let cache = scratch("bzb-gi-temporal-cache");
-    let eval = |extra: &[&str]| {
-        let args = [
-            &[
-                "eval",
-                "--scene",
-                "cornell",
-                "--technique",
-                "bzb-gi",
-                "--width",
-                "64",
-                "--height",
-                "64",
-                "--ref-spp",
-                "1024",
-                "--json",
-                "--quiet",
-                "--cache",
-                cache.to_str().unwrap(),
-            ][..],
-            extra,
-        ]
-        .concat();
-        strata(&args)
-    };
+    let eval = |extra: &[&str]| cornell_eval("bzb-gi", &cache, extra);
     let single = json_of(&eval(&[]));
     let filtered = json_of(&eval(&["--set", "alpha=0.85", "--warmup", "8"]));
     // --set exposure: ꟻLIP displays both images at it (RMSE compares linear values), and
@@ -2659,6 +2636,29 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
     assert!(f(&renewed) > 1e-4, "{renewed}");
 }
 
+/// `strata eval --technique T` on the Cornell box at 64×64 against a 1024-spp reference
+/// cached in `cache`, with `extra` flags, as JSON on stdout.
+fn cornell_eval(technique: &str, cache: &std::path::Path, extra: &[&str]) -> std::process::Output {
+    let base = [
+        "eval",
+        "--scene",
+        "cornell",
+        "--technique",
+        technique,
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--ref-spp",
+        "1024",
+        "--json",
+        "--quiet",
+        "--cache",
+        cache.to_str().unwrap(),
+    ];
+    strata(&[&base[..], extra].concat())
+}
+
 /// `eval --technique bzb-ao --set alpha` warms the temporal filter up on the still camera
 /// (or along the path with `--moving`), records α and the warm-up in its JSON, and ends
 /// closer to the ray-traced binary AO than one frame (no bilateral filter in either, so the
@@ -2668,30 +2668,11 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
 fn eval_bzb_ao_warms_up_its_temporal_filter() {
     let cache = scratch("bzb-ao-temporal-cache");
     let eval = |extra: &[&str]| {
-        let args = [
-            &[
-                "eval",
-                "--scene",
-                "cornell",
-                "--technique",
-                "bzb-ao",
-                "--width",
-                "64",
-                "--height",
-                "64",
-                "--ref-spp",
-                "1024",
-                "--set",
-                "filter-radius=0",
-                "--json",
-                "--quiet",
-                "--cache",
-                cache.to_str().unwrap(),
-            ][..],
-            extra,
-        ]
-        .concat();
-        json_of(&strata(&args))
+        json_of(&cornell_eval(
+            "bzb-ao",
+            &cache,
+            &[&["--set", "filter-radius=0"], extra].concat(),
+        ))
     };
     let single = eval(&[]);
     let filtered = eval(&["--set", "alpha=0.85", "--warmup", "8"]);

@@ -366,6 +366,32 @@ fn mean_abs(a: &ImageBuf, b: &ImageBuf, mask: &[bool]) -> f32 {
     s / n.max(1) as f32
 }
 
+/// The ray-traced binary AO within r = 1 (1024 spp) the plate-stack tests compare with.
+fn binary_ao(scene: &Scene, camera: &Camera) -> ImageBuf {
+    Reference::new(scene, 0.0).ao_binary(
+        camera,
+        W,
+        H,
+        &AoBinarySettings {
+            radius: 1.0,
+            spp: 1024,
+            seed: 1,
+        },
+    )
+}
+
+/// `bzb-ao` without the bilateral filter, so a test sees the temporal filter alone.
+fn unblurred(temporal: Option<strata_render::passes::temporal::TemporalSettings>) -> BzbSettings {
+    BzbSettings {
+        filter: strata_render::passes::bilateral::BilateralSettings {
+            radius: 0,
+            ..Default::default()
+        },
+        temporal,
+        ..Default::default()
+    }
+}
+
 fn mean_of(a: &ImageBuf, mask: &[bool]) -> f32 {
     let v: Vec<f32> = a.data.iter().zip(mask).filter(|(_, m)| **m).map(|(v, _)| *v).collect();
     v.iter().sum::<f32>() / v.len().max(1) as f32
@@ -379,16 +405,7 @@ fn mean_of(a: &ImageBuf, mask: &[bool]) -> f32 {
 fn visibility_removes_the_over_occlusion_of_stacked_occluders() {
     let gpu = common::gpu();
     let scene = plate_stack(3);
-    let reference = Reference::new(&scene, 0.0).ao_binary(
-        &scene.camera,
-        W,
-        H,
-        &AoBinarySettings {
-            radius: 1.0,
-            spp: 1024,
-            seed: 1,
-        },
-    );
+    let reference = binary_ao(&scene, &scene.camera);
     let run = |visibility: bool, directions: u32| {
         let r = render(
             &gpu,
@@ -595,27 +612,8 @@ fn depth_tiles_equal_their_cpu_twin() {
 fn temporal_filter_averages_new_directions_on_a_still_camera() {
     let gpu = common::gpu();
     let scene = plate_stack(3);
-    let reference = Reference::new(&scene, 0.0).ao_binary(
-        &scene.camera,
-        W,
-        H,
-        &AoBinarySettings {
-            radius: 1.0,
-            spp: 1024,
-            seed: 1,
-        },
-    );
-    let single = BzbSettings {
-        filter: strata_render::passes::bilateral::BilateralSettings {
-            radius: 0,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    let filtered = BzbSettings {
-        temporal: Some(bzb::temporal_filter()),
-        ..single.clone()
-    };
+    let reference = binary_ao(&scene, &scene.camera);
+    let (single, filtered) = (unblurred(None), unblurred(Some(bzb::temporal_filter())));
     let all = vec![true; reference.data.len()];
     let occluded: Vec<bool> = reference.data.iter().map(|v| *v < 0.9).collect();
     let one = render(&gpu, &scene, single).read_target(&gpu, "ao").unwrap();
@@ -650,24 +648,8 @@ fn temporal_filter_follows_a_moving_camera() {
         c
     };
     let last = cam(7);
-    let reference = Reference::new(&scene, 0.0).ao_binary(
-        &last,
-        W,
-        H,
-        &AoBinarySettings {
-            radius: 1.0,
-            spp: 1024,
-            seed: 1,
-        },
-    );
-    let s = BzbSettings {
-        filter: strata_render::passes::bilateral::BilateralSettings {
-            radius: 0,
-            ..Default::default()
-        },
-        temporal: Some(bzb::temporal_filter()),
-        ..Default::default()
-    };
+    let reference = binary_ao(&scene, &last);
+    let s = unblurred(Some(bzb::temporal_filter()));
     let run = |told_still: bool| {
         let mut r = Renderer::new(&gpu, &scene, settings(s.clone())).unwrap();
         for k in 0..8 {
@@ -680,15 +662,7 @@ fn temporal_filter_follows_a_moving_camera() {
         }
         r.read_target(&gpu, "ao").unwrap()
     };
-    let mut one = Renderer::new(
-        &gpu,
-        &scene,
-        settings(BzbSettings {
-            temporal: None,
-            ..s.clone()
-        }),
-    )
-    .unwrap();
+    let mut one = Renderer::new(&gpu, &scene, settings(unblurred(None))).unwrap();
     one.render(&gpu, &scene, &FrameCameras::fixed(last), 0.0).unwrap();
     let one = one.read_target(&gpu, "ao").unwrap();
     let all = vec![true; reference.data.len()];

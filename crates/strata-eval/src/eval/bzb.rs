@@ -49,23 +49,8 @@ pub fn run(s: &EvalSettings, bzb: &BzbSettings, ao: &AoSettings) -> Result<AoEva
     let main = evaluate(bzb_settings(bzb.visibility), "bzb-ao")?;
     let no_visibility = evaluate(bzb_settings(false), "bzb-ao visibility=off")?;
     let dgb = evaluate(render_settings(s, 2, &ao), "ao k=2")?;
-    // BZB §6: "the sampling directions are randomly selected for each frame [...] leading
-    // to flickering in animated scenes" — measured along the camera path (`--frames`)
-    let flicker = match s.frames {
-        Some(n) => {
-            let threshold = bzb.temporal.map_or(0.01, |t| t.max_distance);
-            Some(super::flicker(
-                &gpu,
-                &scene,
-                &s.scene,
-                bzb_settings(bzb.visibility),
-                "ao",
-                threshold,
-                n,
-            )?)
-        }
-        None => None,
-    };
+    // the AV's flicker along the camera path (`--frames`)
+    let flicker = flicker_along_path(&gpu, &scene, s, bzb_settings(bzb.visibility), "ao", bzb.temporal)?;
     let mut run = s.run_info(
         ref_binary.noise.spp,
         "binary AO within r (cosine-weighted hemisphere rays), and DGB Eq. 2 obscurance over all surfaces",
@@ -222,23 +207,8 @@ pub fn run_gi(
         (splat_ms_no_visibility, splat_ms)
     };
     let (d_max, t_min) = gi.resolve(&scene);
-    // BZB §6's flicker along the camera path (`--frames`): the indirect irradiance's red
-    // channel, as `eval gi` measures it
-    let flicker = match s.frames {
-        Some(n) => {
-            let threshold = gi.temporal.map_or(0.01, |t| t.max_distance);
-            Some(super::flicker(
-                &gpu,
-                &scene,
-                &s.scene,
-                main.clone(),
-                "indirect",
-                threshold,
-                n,
-            )?)
-        }
-        None => None,
-    };
+    // the flicker of the indirect irradiance's red channel (as `eval gi`), `--frames`
+    let flicker = flicker_along_path(&gpu, &scene, s, main.clone(), "indirect", gi.temporal)?;
     let mut run = s.run_info(
         converged.spp(),
         "path-traced GI (GGX for glossy materials) with 1 indirect bounce, sky and ambient off; \
@@ -310,4 +280,21 @@ fn write_gi_report(
         &crate::results::EvalResult::BzbGi(out.clone()),
         sections,
     )
+}
+
+/// `--frames N`: the flicker of `target` along the camera path (BZB §6: "the sampling
+/// directions are randomly selected for each frame [...] leading to flickering in animated
+/// scenes"), pairing pixels within the temporal filter's distance threshold (else 1 cm).
+fn flicker_along_path(
+    gpu: &strata_render::GpuContext,
+    scene: &strata_scene::Scene,
+    s: &EvalSettings,
+    settings: RenderSettings,
+    target: &str,
+    temporal: Option<strata_render::passes::temporal::TemporalSettings>,
+) -> Result<Option<crate::results::Flicker>> {
+    let threshold = temporal.map_or(0.01, |t| t.max_distance);
+    s.frames
+        .map(|n| super::flicker(gpu, scene, &s.scene, settings, target, threshold, n))
+        .transpose()
 }

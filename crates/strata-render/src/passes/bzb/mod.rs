@@ -498,8 +498,7 @@ pub const RAW: TargetDesc = TargetDesc::new(
     1,
     "BZB §3.3 AV = 1 - mean weighted occlusion over the S directions, before filtering",
 );
-/// The temporal filter's output (`BzbSettings::temporal`), last frame's copy, and the
-/// per-pixel count of accepted histories with its copy.
+/// The temporal filter's output (`BzbSettings::temporal`) and last frame's copy.
 pub const TEMPORAL: [TargetDesc; 2] = [
     TargetDesc::new(
         "bzb-temporal",
@@ -514,11 +513,12 @@ pub const TEMPORAL: [TargetDesc; 2] = [
         "last frame's bzb-temporal",
     ),
 ];
+/// The temporal filter's per-pixel count of accepted histories and its copy.
 pub const TEMPORAL_FRAMES: [&str; 2] = ["bzb-temporal-frames", "bzb-temporal-frames-history"];
 /// The pass the temporal filter adds (`alpha` > 0; the registry lists the default frame's).
 pub const TEMPORAL_PASS: &str = "bzb-temporal";
 
-/// Square tile sizes of the min/max depth tiles (`zminmax_tile` in bzb.wgsl);
+/// Square tile sizes of the min/max depth tiles (`zminmax_tile` in common/zminmax.wgsl);
 /// the last level is one tile over the whole image.
 pub const ZMINMAX_TILES: [u32; 3] = [8, 32, 128];
 
