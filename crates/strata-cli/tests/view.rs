@@ -209,6 +209,11 @@ fn assert_not_flat(path: &Path) {
 
 /// Runs the `strata render …` command a screenshot's `.cmd.txt` holds, writing `out`.
 fn run_cmd_txt(shot: &Path, out: &Path) -> String {
+    run_cmd_txt_output(shot, out).0
+}
+
+/// [`run_cmd_txt`], with the command's output (its stderr carries what `render` prints).
+fn run_cmd_txt_output(shot: &Path, out: &Path) -> (String, Output) {
     let cmd_path = shot.with_extension("cmd.txt");
     let line = std::fs::read_to_string(&cmd_path).unwrap_or_else(|e| panic!("{}: {e}", cmd_path.display()));
     let line = line.lines().next().unwrap().to_string();
@@ -217,8 +222,9 @@ fn run_cmd_txt(shot: &Path, out: &Path) -> String {
     let i = words.iter().position(|w| w == "--out").expect("--out in the command");
     words[i + 1] = out.display().to_string();
     let args: Vec<&str> = words[1..].iter().map(|s| s.as_str()).collect();
-    ok(&strata(None, &args));
-    line
+    let o = strata(None, &args);
+    ok(&o);
+    (line, o)
 }
 
 const SIZE: [&str; 4] = ["--width", "160", "--height", "120"];
@@ -800,7 +806,7 @@ fn scripted_exposure_matches_render() {
     ok(&o0);
     let (o, auto) = view(&x, &dir, "auto", 4, Some("exposure auto\nwait 2\n"), &base);
     ok(&o);
-    let line = run_cmd_txt(&auto, &dir.join("auto-render.png"));
+    let (line, rendered) = run_cmd_txt_output(&auto, &dir.join("auto-render.png"));
     assert!(line.contains("--exposure auto"), "{line}");
     assert!(flip(&auto, &dir.join("auto-render.png")) < FLIP_BOUND);
     // the exposure the panel shows is the one `render` meters for the same frame
@@ -814,12 +820,7 @@ fn scripted_exposure_matches_render() {
             .unwrap()
     };
     let shown = metered(&std::fs::read_to_string(auto.with_extension("cmd.txt")).unwrap());
-    let mut words: Vec<String> = line.split(' ').map(String::from).collect();
-    let i = words.iter().position(|w| w == "--out").unwrap();
-    words[i + 1] = dir.join("auto-render2.png").display().to_string();
-    let o = strata(None, &words[1..].iter().map(|s| s.as_str()).collect::<Vec<_>>());
-    ok(&o);
-    let rendered = metered(&text(&o.stderr));
+    let rendered = metered(&text(&rendered.stderr));
     assert!(
         (shown / rendered - 1.0).abs() < 0.01,
         "the viewer shows exposure {shown}, render meters {rendered}"
