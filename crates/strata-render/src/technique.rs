@@ -1113,7 +1113,7 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
     s.bzb.clone().unwrap_or_default()
 }
 
-static BZB_SETTINGS: [SettingInfo; 13] = [
+static BZB_SETTINGS: [SettingInfo; 14] = [
     bool_setting!(
         "visibility",
         "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
@@ -1198,6 +1198,14 @@ static BZB_SETTINGS: [SettingInfo; 13] = [
         dss.culling,
         ["off", "on"]
     ),
+    bool_setting!(
+        "inner-shell",
+        "DSS fragments whose receiver lies inside the level's shell: redirect (BZB §4.3 \"more efficient use of fill rate\": tested with the disk of the finer level whose shell holds it) or discard (the original DSS)",
+        bzb_of,
+        bzb_mut,
+        dss.redirect,
+        ["discard", "redirect"]
+    ),
     setting!(
         "filter-radius",
         "cross-bilateral taps on each side (BZB §3.3; 0 = none)",
@@ -1232,7 +1240,7 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.clone().unwrap_or_default()
 }
 
-static BZB_GI_SETTINGS: [SettingInfo; 12] = [
+static BZB_GI_SETTINGS: [SettingInfo; 13] = [
     splat_setting!(
         "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
         bzb_gi_of,
@@ -1253,6 +1261,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 12] = [
         false,
         |s| Some(bzb_gi_of(s).dss.surfel_px as f64),
         |s, v| bzb_gi_mut(s).dss.surfel_px = v as f32
+    ),
+    bool_setting!(
+        "inner-shell",
+        "DSS fragments whose receiver lies inside the level's shell (splat=dss): redirect (BZB §4.3: tested with the disk of the finer level whose shell holds it) or discard (the original DSS)",
+        bzb_gi_of,
+        bzb_gi_mut,
+        dss.redirect,
+        ["discard", "redirect"]
     ),
     bool_setting!(
         "visibility",

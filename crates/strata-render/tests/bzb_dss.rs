@@ -63,7 +63,7 @@ fn dss_settings(directions: u32, levels: u32, surfel_px: f32, visibility: bool) 
         dss: DssSettings {
             levels,
             surfel_px,
-            culling: true,
+            ..Default::default()
         },
         ..Default::default()
     }
@@ -372,49 +372,72 @@ fn samples(dirs: &ImageBuf, w: u32, h: u32, directions: u32, cols: u32) -> Vec<(
 #[test]
 fn dss_bounced_zbuffer_equals_the_cpu_twin() {
     // shuffle, shell splatting with visibility on 3 levels, unshuffle and the
-    // finest-level reduction together against `dss::dss_hit` per (pixel, direction)
+    // finest-level reduction together against `dss::dss_hit` per (pixel, direction),
+    // with inner-shell fragments discarded (the original DSS) and redirected (§4.3)
     let gpu = common::gpu();
     let scene = corner_scene(1.2);
     let (w, h) = (64, 48);
-    let b = dss_settings(2, 3, 3.0, true);
-    let r = render(&gpu, &scene, b.clone(), w, h);
-    let s = surfels(&gpu, &r);
-    let origins = r.read_target(&gpu, "bzb-origins").unwrap();
-    let dirs = r.read_target(&gpu, "bzb-directions").unwrap();
-    let payload = r.read_target(&gpu, "bzb-payload").unwrap();
-    let unshuffled = r.read_target(&gpu, "dss-unshuffled").unwrap();
-    let normals = common::npack_normals(&r.read_target(&gpu, "npack").unwrap(), 0);
-    let (radius, t_min) = b.resolve(&scene);
-    let d_max = b.dss.d_max(radius);
-    let (cols, _) = b.grid();
-    let (mut total, mut hits, mut differ, mut level_differ) = (0, 0, 0, 0);
-    let mut per_level = [0u32; 3];
-    for (sd, p, t) in samples(&dirs, w, h, 2, cols) {
-        let o = v3(origins.pixel(t[0], t[1]));
-        let d = v3(dirs.pixel(t[0], t[1]));
-        let n = v3(normals.pixel(p[0], p[1]));
-        let cpu = dss::dss_hit(p, sd, o, n, d, &s, 3, d_max, t_min, b.seed);
-        let gpu_hit = payload.pixel(t[0], t[1])[0] > 0.5;
-        total += 1;
-        if cpu.is_some() != gpu_hit {
-            differ += 1;
-        }
-        if let Some((l, _)) = cpu {
-            hits += 1;
-            per_level[l as usize] += 1;
-            // the finest level with a hit is the first level band with a hit
-            let first = (0..3).find(|k| unshuffled.pixel(t[0], t[1] + k * h)[0] > 0.5);
-            if first != Some(l) {
-                level_differ += 1;
+    let mut hit_sets = Vec::new();
+    for redirect in [false, true] {
+        let mut b = dss_settings(2, 3, 3.0, true);
+        b.dss.redirect = redirect;
+        let r = render(&gpu, &scene, b.clone(), w, h);
+        let s = surfels(&gpu, &r);
+        let origins = r.read_target(&gpu, "bzb-origins").unwrap();
+        let dirs = r.read_target(&gpu, "bzb-directions").unwrap();
+        let payload = r.read_target(&gpu, "bzb-payload").unwrap();
+        let unshuffled = r.read_target(&gpu, "dss-unshuffled").unwrap();
+        let normals = common::npack_normals(&r.read_target(&gpu, "npack").unwrap(), 0);
+        let (radius, t_min) = b.resolve(&scene);
+        let d_max = b.dss.d_max(radius);
+        let (cols, _) = b.grid();
+        let (mut total, mut hits, mut differ, mut level_differ) = (0, 0, 0, 0);
+        let mut per_level = [0u32; 3];
+        let mut gpu_hits = Vec::new();
+        for (sd, p, t) in samples(&dirs, w, h, 2, cols) {
+            let o = v3(origins.pixel(t[0], t[1]));
+            let d = v3(dirs.pixel(t[0], t[1]));
+            let n = v3(normals.pixel(p[0], p[1]));
+            let cpu = dss::dss_hit(p, sd, o, n, d, &s, 3, d_max, t_min, b.seed, redirect);
+            let gpu_hit = payload.pixel(t[0], t[1])[0] > 0.5;
+            gpu_hits.push(gpu_hit);
+            total += 1;
+            if cpu.is_some() != gpu_hit {
+                differ += 1;
+            }
+            if let Some((l, _)) = cpu {
+                hits += 1;
+                per_level[l as usize] += 1;
+                // the finest level with a hit is the first level band with a hit
+                let first = (0..3).find(|k| unshuffled.pixel(t[0], t[1] + k * h)[0] > 0.5);
+                if first != Some(l) {
+                    level_differ += 1;
+                }
             }
         }
+        eprintln!("DSS vs CPU twin (redirect {redirect}): {total} samples, {hits} hits (per level {per_level:?}), {differ} differ, {level_differ} on another level");
+        assert!(total > 2000 && hits > total / 20, "{hits} hits of {total}");
+        assert!(per_level.iter().all(|n| *n > 0), "hits on every level: {per_level:?}");
+        // rays grazing a disk rim or a shell boundary may round either way
+        assert!(differ * 1000 <= total, "{differ} of {total} samples differ");
+        assert!(level_differ * 1000 <= total, "{level_differ} hits on another level");
+        hit_sets.push(gpu_hits);
     }
-    eprintln!("DSS vs CPU twin: {total} samples, {hits} hits (per level {per_level:?}), {differ} differ, {level_differ} on another level");
-    assert!(total > 2000 && hits > total / 20, "{hits} hits of {total}");
-    assert!(per_level.iter().all(|n| *n > 0), "hits on every level: {per_level:?}");
-    // rays grazing a disk rim or a shell boundary may round either way
-    assert!(differ * 1000 <= total, "{differ} of {total} samples differ");
-    assert!(level_differ * 1000 <= total, "{level_differ} hits on another level");
+    // §4.3: redirection "may override non-hits on finer levels" but never removes a
+    // hit: the redirected hits are a superset, and some are new
+    let lost = hit_sets[0]
+        .iter()
+        .zip(&hit_sets[1])
+        .filter(|(a, b)| **a && !**b)
+        .count();
+    let gained = hit_sets[0]
+        .iter()
+        .zip(&hit_sets[1])
+        .filter(|(a, b)| !**a && **b)
+        .count();
+    eprintln!("redirect: {gained} hits gained, {lost} lost");
+    assert!(lost * 1000 <= hit_sets[0].len(), "{lost} hits lost");
+    assert!(gained > 0, "redirection adds hits where the finer level missed");
 }
 
 #[test]

@@ -51,7 +51,7 @@ pub const GI_COVER: f32 = 2.0;
 
 /// DSS settings. Defaults: l_max = 4 (Table 3's memory is 4 levels' worth of
 /// shuffled positions: 18 MB at 768×512 = 4 × 12 B per pixel), surfels of 2
-/// pixels' radius, frustum culling on.
+/// pixels' radius, frustum culling on, inner-shell fragments redirected (§4.3).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DssSettings {
     /// l_max: levels of the hierarchical framebuffer (1..=6).
@@ -61,6 +61,11 @@ pub struct DssSettings {
     /// View-frustum culling of triangles before surfelization, with the largest
     /// shell radius as the safety margin.
     pub culling: bool,
+    /// BZB §4.3 "More efficient use of fill rate": a level-l fragment whose receiver
+    /// lies inside the level's shell is treated as if splatted on the finer level whose
+    /// shell holds it (disk radius r·2^l' there) instead of being discarded
+    /// ([`fragment_level`]). Off: the original DSS discard.
+    pub redirect: bool,
 }
 
 impl Default for DssSettings {
@@ -69,6 +74,7 @@ impl Default for DssSettings {
             levels: 4,
             surfel_px: 2.0,
             culling: true,
+            redirect: true,
         }
     }
 }
@@ -130,7 +136,8 @@ pub struct DssUniforms {
     /// 1 = shells whose depth range misses every receiver under them are culled
     /// (BZB §4.3's min/max culling, from the AOV path's depth tiles).
     pub depth_culling: u32,
-    pub _pad: u32,
+    /// 1 = inner-shell fragments are redirected to their level (§4.3), 0 = discarded.
+    pub redirect: u32,
 }
 
 /// Buffer capacities (entries) for `triangles` scene triangles.
@@ -242,6 +249,23 @@ pub fn shell(level: u32, d_max: f32) -> (f32, f32) {
     (if level == 0 { 0.0 } else { 0.5 * outer }, outer)
 }
 
+/// `dss_fragment_level`: the level whose disk radius a fragment of the level-`level`
+/// splat uses for a receiver at distance `dist` from the surfel, or `None` (discard).
+/// `level` itself inside its shell; with `redirect` (BZB §4.3, "we compute which
+/// shell around the surfel x_p belongs to and then perform the same computations as
+/// if the fragment was actually placed on the corresponding level") the finer level
+/// whose shell holds a receiver inside the inner radius.
+pub fn fragment_level(dist: f32, level: u32, d_max: f32, redirect: bool) -> Option<u32> {
+    let (inner, outer) = shell(level, d_max);
+    if dist > inner && dist <= outer {
+        return Some(level);
+    }
+    if !redirect || !(dist > 0.0) || dist > inner {
+        return None;
+    }
+    (0..level).find(|l| dist <= shell(*l, d_max).1)
+}
+
 /// `dss_surfel_subimage` (dss_splat.wgsl, §4.1): the sub-image of level
 /// `level` that receives the surfel at `c` for direction `s`.
 pub fn surfel_subimage(c: Vec3, level: u32, s: u32, seed: u32) -> u32 {
@@ -253,8 +277,9 @@ pub fn surfel_subimage(c: Vec3, level: u32, s: u32, seed: u32) -> u32 {
 /// `s`, origin `o`, direction `d`): the finest level l with a hit among the
 /// surfels that level l's shell splatting brings to p (those in p's sub-image,
 /// centre in the shell, disk enlarged to r·2^l, t > t_min), as
-/// `Some((level, t))`, or `None`. What dss-shuffle, dss-splat, dss-unshuffle
-/// and dss-reduce compute together.
+/// `Some((level, t))`, or `None`. With `redirect` (§4.3) level l also tests the
+/// surfels inside its shell, with their own level's radius ([`fragment_level`]).
+/// What dss-shuffle, dss-splat, dss-unshuffle and dss-reduce compute together.
 #[allow(clippy::too_many_arguments)]
 pub fn dss_hit(
     p: [u32; 2],
@@ -267,20 +292,20 @@ pub fn dss_hit(
     d_max: f32,
     t_min: f32,
     seed: u32,
+    redirect: bool,
 ) -> Option<(u32, f32)> {
     for l in 0..levels {
         let (k, _) = unshuffle(l, s, p, seed);
-        let (inner, outer) = shell(l, d_max);
-        let scale = (1u32 << l) as f32;
         let mut best: Option<f32> = None;
         for sf in surfels {
             let dist = (o - sf.position).length();
-            if !(dist > inner && dist <= outer)
-                || surfel_subimage(sf.position, l, s, seed) != k
-                || !above_tangent_plane(o, n, sf.position)
-            {
+            let Some(fl) = fragment_level(dist, l, d_max, redirect) else {
+                continue;
+            };
+            if surfel_subimage(sf.position, l, s, seed) != k || !above_tangent_plane(o, n, sf.position) {
                 continue;
             }
+            let scale = (1u32 << fl) as f32;
             if let Some(t) = ray_disk(o, d, sf.position, sf.normal, sf.radius * scale) {
                 if occluding_hit(o, sf.position, sf.normal, t, t_min) && best.is_none_or(|b| t < b) {
                     best = Some(t);
@@ -1210,5 +1235,38 @@ mod overflow_tests {
             !m.contains("sub-triangles") && !m.contains(" surfels for a buffer of 300"),
             "{m}"
         );
+    }
+}
+
+#[cfg(test)]
+mod fragment_level_tests {
+    use super::{fragment_level, shell};
+
+    /// Every distance in (0, d_max·2^(l_max−1)] has exactly one shell; a level-l
+    /// fragment keeps its own level there, and with §4.3's redirection a receiver
+    /// inside the inner radius goes to the level whose shell holds it.
+    #[test]
+    fn redirection_finds_the_shell_holding_the_receiver() {
+        let d_max = 0.125;
+        for i in 1..=4000 {
+            let dist = i as f32 * 1e-3 * 0.25;
+            let own: Vec<u32> = (0..4)
+                .filter(|l| fragment_level(dist, *l, d_max, false).is_some())
+                .collect();
+            if dist > shell(3, d_max).1 {
+                assert!(own.is_empty(), "{dist} beyond the outermost shell");
+                continue;
+            }
+            assert_eq!(own.len(), 1, "{dist}: levels {own:?}");
+            let home = own[0];
+            let (inner, outer) = shell(home, d_max);
+            assert!(dist > inner && dist <= outer);
+            for l in 0..4 {
+                let redirected = fragment_level(dist, l, d_max, true);
+                let expect = if l >= home { Some(home) } else { None };
+                assert_eq!(redirected, expect, "{dist} splatted on level {l}");
+            }
+        }
+        assert_eq!(fragment_level(0.0, 2, d_max, true), None);
     }
 }

@@ -33,20 +33,23 @@ fn fs_gi_visibility(in: SplatVertex) -> VisibilityOut {
     let n = surfels[2u * in.surfel + 1u].xyz;
     let shell = dss_shell(in.level, dss.d_max);
     let dist = distance(o.xyz, cr.xyz);
-    if (!(dist > shell.x && dist <= shell.y)) {
+    // in the level's shell, or (§4.3) redirected to the finer level whose shell holds it
+    let fl = dss_fragment_level(dist, in.level, dss.d_max, dss.redirect == 1u);
+    if (fl == DSS_NO_LEVEL) {
         discard;
     }
     if (!(dot(receiver_normal(o.w), cr.xyz - o.xyz) > 0.0)) {
         discard;
     }
-    let r = DSS_GI_COVER * cr.w * f32(1u << in.level);
+    let r = DSS_GI_COVER * cr.w * f32(1u << fl);
     let t = dss_ray_disk(o.xyz, d.xyz, cr.xyz, n, r);
     if (!dss_occluding_hit(o.xyz, cr.xyz, n, t, dss.t_min)) {
         discard;
     }
     var out: VisibilityOut;
     out.occlusion = vec4f(dss_gi_radiance(in.surfel, cr.xyz, n, o.xyz), 1.0);
-    let m = shell.y + r;
+    // (normalised by this level's largest: a redirected disk is smaller)
+    let m = shell.y + DSS_GI_COVER * cr.w * f32(1u << in.level);
     out.depth = min(t * t / (m * m), 0.99999);
     return out;
 }

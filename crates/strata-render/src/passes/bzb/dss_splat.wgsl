@@ -6,7 +6,10 @@
 // (outer radius d_max·2^l). Each fragment reads its receiver x_p and ω_p
 // (shuffled there by dss-shuffle) and keeps only receivers in the shell
 // (inner, outer]; the surfel stands for 4^l surfels on level l (one of 4^l
-// sub-images receives it), so it is enlarged to radius r·2^l.
+// sub-images receives it), so it is enlarged to radius r·2^l. With §4.3's
+// redirection (`dss.redirect`) a receiver inside the inner radius is tested as on
+// the finer level l' whose shell holds it (radius r·2^l') instead of discarded; the
+// reduction keeps the finest level's hit, so this only fills misses.
 //   fs_visibility: disks centred above the receiver's tangent plane only;
 //                  ray–disk hit at t > t_min, disk plane not through the
 //                  receiver (dss_occluding_hit) → depth t²/(outer + r·2^l)², payload 1
@@ -104,7 +107,9 @@ fn fs_visibility(in: SplatVertex) -> VisibilityOut {
     let n = surfels[2u * in.surfel + 1u].xyz;
     let shell = dss_shell(in.level, dss.d_max);
     let dist = distance(o.xyz, cr.xyz);
-    if (!(dist > shell.x && dist <= shell.y)) {
+    // in the level's shell, or (§4.3) redirected to the finer level whose shell holds it
+    let fl = dss_fragment_level(dist, in.level, dss.d_max, dss.redirect == 1u);
+    if (fl == DSS_NO_LEVEL) {
         discard;
     }
     // only disks centred above the receiver's tangent plane occlude: a disk
@@ -113,7 +118,7 @@ fn fs_visibility(in: SplatVertex) -> VisibilityOut {
     if (!(dot(receiver_normal(o.w), cr.xyz - o.xyz) > 0.0)) {
         discard;
     }
-    let r = cr.w * f32(1u << in.level);
+    let r = cr.w * f32(1u << fl);
     let t = dss_ray_disk(o.xyz, d.xyz, cr.xyz, n, r);
     if (!dss_occluding_hit(o.xyz, cr.xyz, n, t, dss.t_min)) {
         discard;
@@ -121,7 +126,8 @@ fn fs_visibility(in: SplatVertex) -> VisibilityOut {
     var out: VisibilityOut;
     out.occlusion = vec4f(1.0);
     // §3.2 / §4.2: squared distance over the level's largest, t ≤ outer + r
-    let m = shell.y + r;
+    // (normalised by this level's largest: a redirected disk is smaller)
+    let m = shell.y + cr.w * f32(1u << in.level);
     out.depth = min(t * t / (m * m), 0.99999);
     return out;
 }

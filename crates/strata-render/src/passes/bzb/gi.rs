@@ -180,7 +180,7 @@ impl BzbGiSettings {
             max_split: super::dss::MAX_SPLIT,
             gi: 1,
             depth_culling: self.culling as u32,
-            _pad: 0,
+            redirect: self.dss.redirect as u32,
         }
     }
 

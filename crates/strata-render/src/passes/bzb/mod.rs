@@ -219,7 +219,7 @@ impl BzbSettings {
             max_split: dss::MAX_SPLIT,
             gi: 0,
             depth_culling: self.culling as u32,
-            _pad: 0,
+            redirect: self.dss.redirect as u32,
         }
     }
 

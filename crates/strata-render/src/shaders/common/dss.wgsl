@@ -41,7 +41,8 @@ struct Dss {
     gi: u32,
     // 1 = shells whose depth range misses every receiver under them are culled (§4.3)
     depth_culling: u32,
-    _pad: u32,
+    // 1 = inner-shell fragments redirected to their level (§4.3), 0 = discarded
+    redirect: u32,
 }
 
 // Hash of a world position (§4.3: "hash this position"): bit patterns of x, y, z.
@@ -129,6 +130,29 @@ fn dss_occluding_hit(o: vec3f, c: vec3f, ns: vec3f, t: f32, t_min: f32) -> bool 
 fn dss_shell(level: u32, d_max: f32) -> vec2f {
     let outer = d_max * f32(1u << level);
     return vec2f(select(0.5 * outer, 0.0, level == 0u), outer);
+}
+
+const DSS_NO_LEVEL: u32 = 0xffffffffu;
+
+// The level whose disk radius a fragment of the level-`level` splat uses for a
+// receiver at distance `dist` from the surfel, or DSS_NO_LEVEL (discard): `level`
+// inside its shell; with `redirect` (§4.3, "more efficient use of fill rate") the
+// finer level whose shell holds a receiver inside the inner radius, instead of the
+// original DSS discard. Rust twin: dss::fragment_level.
+fn dss_fragment_level(dist: f32, level: u32, d_max: f32, redirect: bool) -> u32 {
+    let shell = dss_shell(level, d_max);
+    if (dist > shell.x && dist <= shell.y) {
+        return level;
+    }
+    if (!redirect || !(dist > 0.0) || dist > shell.x) {
+        return DSS_NO_LEVEL;
+    }
+    for (var l = 0u; l < level; l++) {
+        if (dist <= dss_shell(l, d_max).y) {
+            return l;
+        }
+    }
+    return DSS_NO_LEVEL;
 }
 
 // The original DSS AO term of one disk (area A, normal ns, centre at v = c − x
