@@ -241,14 +241,38 @@ impl ExposureArg {
     }
 }
 
+/// `--exposure`: a number > 0, or `auto[:SPEC]`. SPEC is a comma list of `key=K`,
+/// `adapt=A`, `low=L` and `high=H` ([`AutoExposure`]'s fields); a bare number first is
+/// the key (`auto:0.09`).
+///
+/// [`AutoExposure`]: strata_render::passes::exposure::AutoExposure
 pub fn parse_exposure(s: &str) -> Result<ExposureArg, String> {
     use strata_render::passes::exposure::AutoExposure;
+    const USE: &str = "use auto or auto:KEY or auto:key=K,adapt=A,low=L,high=H";
     if let Some(rest) = s.strip_prefix("auto") {
         let mut a = AutoExposure::default();
-        if let Some(k) = rest.strip_prefix(':') {
-            a.key = k
-                .parse()
-                .map_err(|_| format!("'{k}' is not a number: use auto or auto:KEY, KEY in (0, 10]"))?;
+        if let Some(spec) = rest.strip_prefix(':') {
+            for (i, item) in spec.split(',').enumerate() {
+                let (name, value) = match item.split_once('=') {
+                    Some((n, v)) => (n.trim(), v.trim()),
+                    None if i == 0 => ("key", item.trim()),
+                    None => return Err(format!("'{item}' in '{s}' is not NAME=VALUE: {USE}")),
+                };
+                let v: f32 = value
+                    .parse()
+                    .map_err(|_| format!("'{value}' is not a number (auto-exposure {name}): {USE}"))?;
+                match name {
+                    "key" => a.key = v,
+                    "adapt" => a.adaptation = v,
+                    "low" => a.low = v,
+                    "high" => a.high = v,
+                    _ => {
+                        return Err(format!(
+                            "'{name}' in '{s}' is not an auto-exposure setting: valid are key, adapt, low and high"
+                        ))
+                    }
+                }
+            }
         } else if !rest.is_empty() {
             return Err(format!("'{s}': use a number > 0, auto or auto:KEY"));
         }
@@ -775,7 +799,10 @@ pub struct FrameArgs {
     /// Exposure multiplier before tonemapping (default: the scene's), or `auto[:KEY]`: the
     /// exposure that maps the image's typical luminance (the log mean of its non-black
     /// pixels from the 50th to the 95th percentile) to KEY (default 0.18, in (0, 10]),
-    /// metered every frame.
+    /// metered every frame. `auto:key=K,adapt=A,low=L,high=H` also sets the weight of each
+    /// frame's metering in log space (A in (0, 1], default 1: at once; A < 1 adapts over
+    /// about 1/A frames, and the frame is warmed up like a temporal filter's) and the
+    /// percentile window (0 <= L < H <= 1).
     #[arg(long, allow_negative_numbers = true, value_parser = parse_exposure)]
     pub exposure: Option<ExposureArg>,
     /// Shadow map resolution per light, 64..=8192.

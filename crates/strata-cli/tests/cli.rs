@@ -3487,9 +3487,25 @@ fn exposure_auto_meters_the_frame() {
     assert!(e > 1.5, "{e}");
     let half = metered("auto:0.09");
     assert!((half / e - 0.5).abs() < 1e-3, "key 0.09 against 0.18: {half} vs {e}");
+    assert_eq!(metered("auto:key=0.09"), half, "the named key");
+    // the darker half of the non-black pixels needs more exposure than the brighter half
+    let dark = metered("auto:low=0,high=0.5");
+    assert!(dark > 1.5 * e, "window 0..0.5: {dark} against 0.5..0.95: {e}");
     for (args, needles) in [
         (&["--exposure", "auto:0"][..], &["--exposure", "(0, 10]"][..]),
         (&["--exposure", "auto:x"], &["--exposure", "auto:KEY"]),
+        (
+            &["--exposure", "auto:adapt=0"],
+            &["--exposure", "adaptation 0", "(0, 1]"],
+        ),
+        (
+            &["--exposure", "auto:speed=1"],
+            &["--exposure", "'speed'", "key, adapt, low and high"],
+        ),
+        (
+            &["--exposure", "auto:low=0.9,high=0.5"],
+            &["--exposure", "0 <= low < high <= 1"],
+        ),
         (&["--exposure", "-2"], &["--exposure", "must be > 0"]),
         // the technique setting `exposure` is the fixed exposure: not beside auto
         (
@@ -3506,4 +3522,56 @@ fn exposure_auto_meters_the_frame() {
         );
         assert_one_line_error(&o, needles);
     }
+}
+
+/// `--exposure auto:adapt=A` weighs each frame's metering by A in log space: `render`
+/// then warms the frame up along the camera path like a temporal filter's, so the
+/// exposure lags towards the earlier frames' meterings; after a cut (`--warmup 0`) the
+/// first frame takes its metering at once.
+#[test]
+fn exposure_auto_adapts_along_the_camera_path() {
+    let out = scratch("exposure-adapt.png");
+    let metered = |mode: &str, frame: &str, warmup: Option<&str>| {
+        let mut args = vec![
+            "render",
+            "--scene",
+            "atrium",
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "--frame",
+            frame,
+            "--exposure",
+            mode,
+            "--out",
+        ];
+        args.push(out.to_str().unwrap());
+        args.push("--force");
+        if let Some(w) = warmup {
+            args.extend(["--warmup", w]);
+        }
+        let o = strata(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let err = stderr(&o);
+        let line = err.lines().find(|l| l.starts_with("exposure (metered): ")).expect(&err);
+        line["exposure (metered): ".len()..].trim().parse::<f32>().unwrap()
+    };
+    let (early, now) = (metered("auto", "2", Some("0")), metered("auto", "10", Some("0")));
+    assert!(
+        (early - now).abs() > 1e-3,
+        "the metering changes along the path: {early} {now}"
+    );
+    assert_eq!(
+        metered("auto:adapt=0.25", "10", Some("0")),
+        now,
+        "a cut takes the metering at once"
+    );
+    // the default warm-up (8 frames, 2..=9) applies because the exposure adapts
+    let lagged = metered("auto:adapt=0.25", "10", None);
+    eprintln!("metered: frame 2 {early}, frame 10 {now}, adapted over frames 2..=10 {lagged}");
+    assert!(
+        (lagged - now).abs() > 1e-4 && (lagged - early).abs() < (now - early).abs(),
+        "adapted {lagged} lies between frame 2's {early} and frame 10's {now}"
+    );
 }

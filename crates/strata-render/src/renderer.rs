@@ -1087,11 +1087,14 @@ impl Renderer {
 
     /// Whether this frame's output builds up over frames: a temporal filter (DGB §3.3)
     /// or the radiosity's progressive bounces, the passes that reproject
-    /// ([`RenderSettings::needs_motion`]). The first frame after a cut then shows one
-    /// frame's sampling pattern and a single bounce; `strata render` warms such frames
-    /// up by [`ACCUMULATION_WARMUP`] unless told otherwise.
+    /// ([`RenderSettings::needs_motion`]), or an auto-exposure that adapts over frames
+    /// ([`AutoExposure::adapts`](crate::passes::exposure::AutoExposure::adapts)). The
+    /// first frame after a cut then shows one frame's sampling pattern and a single
+    /// bounce; `strata render` warms such frames up by [`ACCUMULATION_WARMUP`] unless told
+    /// otherwise, and the viewer keeps drawing still frames as long as for a temporal
+    /// filter.
     pub fn accumulates(&self) -> bool {
-        self.settings.needs_motion()
+        self.settings.needs_motion() || self.settings.auto_exposure.is_some_and(|a| a.adapts())
     }
 
     /// The A-buffer stage (read-back of its lists and compressed nodes), if on.

@@ -42,7 +42,7 @@ pub struct RenderSpec {
     /// `--layer-scale`: resolution divisor of layers ≥ 1 (DGB Fig. 11; 1 = full resolution).
     pub layer_scale: u32,
     pub guard_band: String,
-    /// `--exposure` (a number, `auto` or `auto:KEY`); `None`: the scene's.
+    /// `--exposure` (a number, `auto`, `auto:KEY` or `auto:key=K,adapt=A,low=L,high=H`); `None`: the scene's.
     pub exposure: Option<String>,
     /// `--set NAME=VALUE` in order (a later one wins).
     pub sets: Vec<(String, String)>,
@@ -107,7 +107,7 @@ pub enum Action {
     Variant(String),
     LayerScale(u32),
     GuardBand(String),
-    /// `--exposure` as typed (a number, `auto`, `auto:KEY`); `None`: the scene's.
+    /// `--exposure` as typed (a number or `auto[:SPEC]`); `None`: the scene's.
     Exposure(Option<String>),
     /// A technique setting by name, value as typed (a number or a named value).
     Set(String, String),

@@ -100,7 +100,7 @@ impl Script {
                 "variant" => act(Action::Variant(arg(0)?.to_string())),
                 "layer-scale" => act(Action::LayerScale(frames(0)?)),
                 "guard-band" => act(Action::GuardBand(arg(0)?.to_string())),
-                // a number, auto or auto:KEY; `scene`: the scene's
+                // a number, auto, auto:KEY or auto:key=K,adapt=A,...; `scene`: the scene's
                 "exposure" => act(Action::Exposure(match arg(0)? {
                     "scene" => None,
                     e => Some(e.to_string()),

@@ -220,9 +220,11 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
             .add(
                 egui::TextEdit::singleline(&mut app.exposure_text)
                     .desired_width(60.0)
+                    // grows with `auto:key=K,adapt=A,...` instead of hiding its end
+                    .clip_text(false)
                     .hint_text("scene"),
             )
-            .on_hover_text("a number > 0, auto or auto:KEY (metered every frame); empty: the scene's");
+            .on_hover_text("a number > 0, auto, auto:KEY or auto:key=K,adapt=A,low=L,high=H (metered every frame; adapt < 1 follows it over about 1/A frames); empty: the scene's");
         if entered(ui, &r) {
             let e = app.exposure_text.trim();
             app.actions

@@ -50,6 +50,11 @@ impl Default for AutoExposure {
 }
 
 impl AutoExposure {
+    /// The exposure follows the metering over several frames (adaptation < 1).
+    pub fn adapts(&self) -> bool {
+        self.adaptation < 1.0
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         if !(self.key > 0.0 && self.key <= 10.0) {
             return Err(format!(
