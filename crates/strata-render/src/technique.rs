@@ -1113,7 +1113,7 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
     s.bzb.clone().unwrap_or_default()
 }
 
-static BZB_SETTINGS: [SettingInfo; 14] = [
+static BZB_SETTINGS: [SettingInfo; 15] = [
     bool_setting!(
         "visibility",
         "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
@@ -1215,6 +1215,14 @@ static BZB_SETTINGS: [SettingInfo; 14] = [
         |s, v| bzb_mut(s).filter.radius = v as u32
     ),
     setting!(
+        "filter-fresh-radius",
+        "with alpha > 0: taps on each side for a pixel whose history was just rejected (disoccluded), falling as 1/sqrt(n + 1) over its n history frames to filter-radius; 0 = off (not in the paper)",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(bzb_of(s).filter.fresh_radius.unwrap_or(0) as f64),
+        |s, v| bzb_mut(s).filter.fresh_radius = (v >= 1.0).then_some(v as u32)
+    ),
+    setting!(
         "filter-step",
         "pixels between cross-bilateral taps",
         Range::Closed(1.0, 8.0),
@@ -1240,7 +1248,7 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.clone().unwrap_or_default()
 }
 
-static BZB_GI_SETTINGS: [SettingInfo; 13] = [
+static BZB_GI_SETTINGS: [SettingInfo; 14] = [
     splat_setting!(
         "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
         bzb_gi_of,
@@ -1325,6 +1333,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 13] = [
         true,
         |s| Some(bzb_gi_of(s).filter.radius as f64),
         |s, v| bzb_gi_mut(s).filter.radius = v as u32
+    ),
+    setting!(
+        "filter-fresh-radius",
+        "with alpha > 0: taps on each side for a pixel whose history was just rejected (disoccluded), falling as 1/sqrt(n + 1) over its n history frames to filter-radius; 0 = off (not in the paper)",
+        Range::Closed(0.0, 32.0),
+        true,
+        |s| Some(bzb_gi_of(s).filter.fresh_radius.unwrap_or(0) as f64),
+        |s, v| bzb_gi_mut(s).filter.fresh_radius = (v >= 1.0).then_some(v as u32)
     ),
     setting!(
         "filter-step",

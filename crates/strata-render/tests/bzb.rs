@@ -681,3 +681,106 @@ fn temporal_filter_follows_a_moving_camera() {
         "reprojected MAE {e_moving} vs told-still {e_still}"
     );
 }
+
+/// `filter-fresh-radius` (not in the paper): after the temporal filter, a pixel whose
+/// history holds n frames is filtered with max(radius, round(R / √(n + 1))) taps. Both
+/// GPU passes equal `bilateral_cpu_history` on the same buffers; pixels with a long
+/// history keep the plain radius-1 filter, and the ones the moving camera uncovered get a
+/// wider one.
+#[test]
+fn fresh_radius_widens_the_filter_where_the_history_is_short() {
+    use strata_render::passes::bilateral::{bilateral_cpu, bilateral_cpu_history, history_radius, BilateralSettings};
+    let gpu = common::gpu();
+    let scene = plate_stack(3);
+    // still for 8 frames, then two steps sideways that uncover the plates' sides
+    let cam = |k: u32| {
+        let mut c = scene.camera;
+        let d = Vec3::new(0.15 * k.saturating_sub(7) as f32, 0.0, 0.0);
+        c.eye += d;
+        c.target += d;
+        c
+    };
+    let filter = BilateralSettings {
+        radius: 1,
+        fresh_radius: Some(4),
+        ..Default::default()
+    };
+    let s = BzbSettings {
+        filter,
+        temporal: Some(bzb::temporal_filter()),
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &scene, settings(s)).unwrap();
+    for k in 0..10 {
+        let cams = FrameCameras {
+            previous: cam(k.max(1) - 1),
+            current: cam(k),
+            next_view: cam(k).view(),
+        };
+        r.render(&gpu, &scene, &cams, 0.0).unwrap();
+    }
+    let read = |n: &str| r.read_target(&gpu, n).unwrap();
+    let (temporal, frames, blur_h, out) = (
+        read("bzb-temporal"),
+        read("bzb-temporal-frames"),
+        read("bzb-blur-h"),
+        read("ao"),
+    );
+    let zpack = read("zpack");
+    let normals = common::npack_normals(&read("npack"), 0);
+    let f = r.frame_uniforms();
+    let n = (W * H) as usize;
+    let ch = |img: &ImageBuf, i: usize| img.data[i * img.channels as usize];
+    let near = |g: &ImageBuf, c: &ImageBuf| {
+        (0..n)
+            .filter(|&i| (ch(g, i) - ch(c, i)).abs() <= 2e-3 + 2e-3 * ch(c, i).abs())
+            .count()
+    };
+    let twin =
+        |src: &ImageBuf, vertical| bilateral_cpu_history(src, &zpack, &normals, &f, &filter, vertical, Some(&frames));
+    let (twin_h, twin_v) = (twin(&temporal, false), twin(&blur_h, true));
+    let (close_h, close_v) = (near(&blur_h, &twin_h), near(&out, &twin_v));
+    // the plain radius-1 filter of the same input
+    let plain = bilateral_cpu(
+        &temporal,
+        &zpack,
+        &normals,
+        &f,
+        &BilateralSettings {
+            fresh_radius: None,
+            ..filter
+        },
+        false,
+    );
+    let surface = |i: usize| ch(&zpack, i) > 0.0;
+    let radius_of = |i: usize| history_radius(1, 4, ch(&frames, i));
+    let long: Vec<usize> = (0..n).filter(|&i| surface(i) && radius_of(i) == 1).collect();
+    let short: Vec<usize> = (0..n).filter(|&i| surface(i) && radius_of(i) >= 3).collect();
+    let widened = short
+        .iter()
+        .filter(|&&i| (ch(&twin_h, i) - ch(&plain, i)).abs() > 1e-4)
+        .count();
+    eprintln!(
+        "fresh radius: GPU = twin {close_h}/{n} (h), {close_v}/{n} (v); {} pixels with a long history, {} uncovered ({widened} changed by the wider filter)",
+        long.len(),
+        short.len()
+    );
+    assert!(close_h as f32 >= 0.995 * n as f32, "h: {close_h}/{n} GPU = CPU twin");
+    assert!(close_v as f32 >= 0.995 * n as f32, "v: {close_v}/{n} GPU = CPU twin");
+    assert!(
+        long.len() > n / 4 && short.len() >= 20,
+        "the test needs both kinds: {} / {}",
+        long.len(),
+        short.len()
+    );
+    assert!(
+        long.iter().all(|&i| ch(&twin_h, i) == ch(&plain, i)),
+        "a long history keeps radius 1"
+    );
+    // (where every neighbour holds the same AV, e.g. unoccluded floor, widening changes nothing)
+    assert!(
+        widened >= 20 && widened * 4 >= short.len(),
+        "the wider filter changes the uncovered pixels: {widened} of {}",
+        short.len()
+    );
+}

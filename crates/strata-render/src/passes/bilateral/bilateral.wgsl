@@ -22,6 +22,11 @@ struct Bilateral {
     // 1/R²: taps whose surface lies R or more from X get no weight (0: off;
     // `bilateral::distance_weight`)
     inv_radius2: f32,
+    // > 0: the history-aware radius R_fresh (`BilateralSettings::fresh_radius`), read
+    // from the temporal filter's count in `frames`
+    fresh_radius: i32,
+    pad0: f32,
+    pad1: f32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -29,12 +34,34 @@ struct Bilateral {
 @group(1) @binding(1) var src: texture_2d<f32>;
 @group(1) @binding(2) var zpack: texture_2d<f32>;
 @group(1) @binding(3) var npack: texture_2d<f32>;
+// the temporal filter's count of accepted history frames (read when fresh_radius > 0)
+@group(1) @binding(4) var frames: texture_2d<f32>;
+
+// Taps of a pixel whose history holds n frames: max(radius, round(R_fresh / √(n + 1)))
+// (2-D taps grow as r², the history's variance falls as 1/(n + 1)). Rust twin:
+// bilateral::history_radius.
+fn history_radius(n: f32) -> i32 {
+    return max(blur.radius, i32(floor(f32(blur.fresh_radius) / sqrt(max(n, 0.0) + 1.0) + 0.5)));
+}
+
+// Gaussian weight of tap |k| = a for a filter of `radius` taps (bilateral::gauss_weight).
+fn gauss_weight(a: u32, radius: i32) -> f32 {
+    if (radius == blur.radius) {
+        return blur.gauss[a / 4u][a % 4u];
+    }
+    let sigma = max(0.75 * f32(radius), 0.5);
+    return exp(-f32(a * a) / (2.0 * sigma * sigma));
+}
 
 // The filtered value at pixel p.
 fn filtered(p: vec2i) -> vec4f {
     let centre = textureLoad(src, p, 0);
     let z = textureLoad(zpack, p, 0).r;
-    if (z <= 0.0 || blur.radius == 0) {
+    var radius = blur.radius;
+    if (blur.fresh_radius > 0) {
+        radius = history_radius(textureLoad(frames, p, 0).r);
+    }
+    if (z <= 0.0 || radius == 0) {
         return centre;
     }
     let x = world_from_csz(frame, vec2f(p) + 0.5, z);
@@ -46,7 +73,7 @@ fn filtered(p: vec2i) -> vec4f {
     }
     var sum = centre;
     var weight = 1.0;
-    for (var k = -blur.radius; k <= blur.radius; k++) {
+    for (var k = -radius; k <= radius; k++) {
         if (k == 0) {
             continue;
         }
@@ -67,7 +94,7 @@ fn filtered(p: vec2i) -> vec4f {
             normal *= c;
         }
         let a = u32(abs(k));
-        var w = blur.gauss[a / 4u][a % 4u] * plane * normal;
+        var w = gauss_weight(a, radius) * plane * normal;
         if (blur.inv_radius2 > 0.0) {
             let d = y - x;
             w *= max(0.0, 1.0 - dot(d, d) * blur.inv_radius2);
@@ -84,7 +111,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
 }
 
 // The same pass as compute (`Kernel`), 8×8 pixels per workgroup.
-@group(1) @binding(4) var out: texture_storage_2d<STORAGE_FORMAT_0, write>;
+@group(1) @binding(5) var out: texture_storage_2d<STORAGE_FORMAT_0, write>;
 
 @compute @workgroup_size(8, 8)
 fn cs_main(@builtin(global_invocation_id) id: vec3u) {

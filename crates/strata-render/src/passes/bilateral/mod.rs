@@ -29,6 +29,12 @@ pub struct BilateralSettings {
     /// normal, so on a surface seen at a grazing angle neighbouring pixels metres apart
     /// are averaged). `None`: off. AO sets it to its radius (`ao::AoSettings::distance_weight`).
     pub world_radius: Option<f32>,
+    /// History-aware radius after a temporal filter (not in the papers): a pixel whose
+    /// history holds n accepted frames (the temporal filter's count) filters with radius
+    /// max(`radius`, round(R_fresh / √(n + 1))) taps, so a disoccluded pixel (n = 0) gets
+    /// R_fresh and the extra taps fall away as its history builds up (2-D taps ∝ r²,
+    /// history variance ∝ 1/(n + 1)). `None`: off; only passes given the count use it.
+    pub fresh_radius: Option<u32>,
 }
 
 /// The bilateral filter's distance weight of a tap whose surface lies `d2` = |Y − X|² from
@@ -45,6 +51,7 @@ impl Default for BilateralSettings {
             plane_sharpness: 100.0,
             normal_power: 8,
             world_radius: None,
+            fresh_radius: None,
         }
     }
 }
@@ -77,6 +84,11 @@ impl BilateralSettings {
                 return Err(format!("blur world radius {r} is out of range: must be > 0"));
             }
         }
+        if let Some(r) = self.fresh_radius {
+            if !(1..=32).contains(&r) {
+                return Err(format!("blur fresh radius {r} is out of range: must be in 1..=32"));
+            }
+        }
         Ok(())
     }
 
@@ -84,6 +96,20 @@ impl BilateralSettings {
     pub fn taps(&self) -> u32 {
         2 * self.radius + 1
     }
+}
+
+/// The Gaussian weight of tap k for a filter of `radius` taps (σ = 0.75·radius, at least
+/// ½), as `BilateralUniforms::gauss` holds it and bilateral.wgsl computes it for the
+/// history-aware radii.
+pub fn gauss_weight(k: u32, radius: u32) -> f32 {
+    let sigma = (0.75 * radius as f32).max(0.5);
+    (-((k * k) as f32) / (2.0 * sigma * sigma)).exp()
+}
+
+/// [`BilateralSettings::fresh_radius`]: the radius of a pixel whose temporal history holds
+/// `n` accepted frames (WGSL twin `history_radius`).
+pub fn history_radius(radius: u32, fresh_radius: u32, n: f32) -> u32 {
+    radius.max((fresh_radius as f32 / (n.max(0.0) + 1.0).sqrt() + 0.5).floor() as u32)
 }
 
 /// CPU twin of one direction of `bilateral.wgsl` on channel 0 of `src`: along x, or
@@ -97,7 +123,21 @@ pub fn bilateral_cpu(
     s: &BilateralSettings,
     vertical: bool,
 ) -> ImageBuf {
-    let u = BilateralUniforms::new(s);
+    bilateral_cpu_history(src, csz, normals, frame, s, vertical, None)
+}
+
+/// [`bilateral_cpu`] with the temporal filter's per-pixel count `frames` (channel 0) for
+/// [`BilateralSettings::fresh_radius`].
+pub fn bilateral_cpu_history(
+    src: &ImageBuf,
+    csz: &ImageBuf,
+    normals: &ImageBuf,
+    frame: &FrameUniforms,
+    s: &BilateralSettings,
+    vertical: bool,
+    frames: Option<&ImageBuf>,
+) -> ImageBuf {
+    let u = BilateralUniforms::new(s, frames.is_some());
     let (w, h) = (src.width as i32, src.height as i32);
     let normal = |x: i32, y: i32| {
         let p = normals.pixel(x as u32, y as u32);
@@ -110,13 +150,26 @@ pub fn bilateral_cpu(
             let centre = src.pixel(px as u32, py as u32)[0];
             let z = csz.pixel(px as u32, py as u32)[0];
             let o = (py * w + px) as usize;
-            if z <= 0.0 || u.radius == 0 {
+            let radius = match frames {
+                Some(f) if u.fresh_radius > 0 => {
+                    history_radius(u.radius as u32, u.fresh_radius as u32, f.pixel(px as u32, py as u32)[0]) as i32
+                }
+                _ => u.radius,
+            };
+            if z <= 0.0 || radius == 0 {
                 out.data[o] = centre;
                 continue;
             }
+            let gauss = |k: i32| {
+                if radius == u.radius {
+                    u.gauss[k.unsigned_abs() as usize]
+                } else {
+                    gauss_weight(k.unsigned_abs(), radius as u32)
+                }
+            };
             let (x, n) = (at(px, py, z), normal(px, py));
             let (mut sum, mut weight) = (centre, 1.0f32);
-            for k in -u.radius..=u.radius {
+            for k in -radius..=radius {
                 let (qx, qy) = if vertical {
                     (px, py + k * u.step)
                 } else {
@@ -132,7 +185,7 @@ pub fn bilateral_cpu(
                 let y = at(qx, qy, zq);
                 let plane = (1.0 - u.plane_sharpness * n.dot(y - x).abs() / z).max(0.0);
                 let c = n.dot(normal(qx, qy)).max(0.0);
-                let mut wt = u.gauss[k.unsigned_abs() as usize] * plane * c.powi(u.normal_power as i32);
+                let mut wt = gauss(k) * plane * c.powi(u.normal_power as i32);
                 if let Some(r) = s.world_radius {
                     wt *= distance_weight((y - x).length_squared(), r);
                 }
@@ -157,21 +210,23 @@ pub struct BilateralUniforms {
     gauss: [f32; 36],
     /// 1/R² of [`BilateralSettings::world_radius`] (0: no distance weight).
     inv_radius2: f32,
-    _pad: [f32; 3],
+    /// [`BilateralSettings::fresh_radius`] where the pass reads a history count, else 0.
+    fresh_radius: i32,
+    _pad: [f32; 2],
 }
 
 impl BilateralUniforms {
-    pub fn new(s: &BilateralSettings) -> Self {
-        let sigma = (0.75 * s.radius as f32).max(0.5);
-        let gauss = std::array::from_fn(|k| (-((k * k) as f32) / (2.0 * sigma * sigma)).exp());
+    /// `history`: the pass reads the temporal filter's count (`fresh_radius` applies).
+    pub fn new(s: &BilateralSettings, history: bool) -> Self {
         Self {
             radius: s.radius as i32,
             step: s.step as i32,
             plane_sharpness: s.plane_sharpness,
             normal_power: s.normal_power,
-            gauss,
+            gauss: std::array::from_fn(|k| gauss_weight(k as u32, s.radius)),
             inv_radius2: s.world_radius.map_or(0.0, |r| 1.0 / (r * r)),
-            _pad: [0.0; 3],
+            fresh_radius: s.fresh_radius.filter(|_| history).unwrap_or(0) as i32,
+            _pad: [0.0; 2],
         }
     }
 }
@@ -196,15 +251,37 @@ impl BilateralPass {
         vertical: bool,
         compute: bool,
     ) -> Self {
+        Self::with_history(
+            gpu, scene, targets, settings, name, input, output, vertical, compute, None,
+        )
+    }
+
+    /// [`BilateralPass::new`] after a temporal filter: `frames` is its per-pixel count of
+    /// accepted history frames, which [`BilateralSettings::fresh_radius`] reads.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_history(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &Targets,
+        settings: &BilateralSettings,
+        name: &'static str,
+        input: &'static str,
+        output: &'static str,
+        vertical: bool,
+        compute: bool,
+        frames: Option<&'static str>,
+    ) -> Self {
         let builder = PassBuilder::new(gpu, targets, name)
             .kernel(compute)
             .shader("bilateral", include_str!("bilateral.wgsl"))
             .constant("DIRECTION", vertical as u32 as f64)
             .frame(scene)
-            .uniforms(&BilateralUniforms::new(settings))
+            .uniforms(&BilateralUniforms::new(settings, frames.is_some()))
             .read(input)
             .read("zpack")
-            .read("npack");
+            .read("npack")
+            // without a count the binding holds the depth, which the shader then never reads
+            .read(frames.unwrap_or("zpack"));
         let pass = ScreenPass::build(builder, &[output], compute);
         Self { pass }
     }

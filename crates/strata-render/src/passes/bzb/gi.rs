@@ -977,14 +977,19 @@ impl BzbGiStage {
                 pass(TEMPORAL_PASSES[1], GLOSSY_RAW.name, 1),
             ]
         });
-        let blur = |name, input, output, vertical| {
-            BilateralPass::new(gpu, scene_gpu, targets, &s.filter, name, input, output, vertical, false)
+        // after the temporal filters the blur may widen where the history is short
+        let has_temporal = temporal.is_some();
+        let blur = |name, input, output, vertical, k: usize| {
+            let frames = has_temporal.then_some(TEMPORAL_FRAMES[k][0]);
+            BilateralPass::with_history(
+                gpu, scene_gpu, targets, &s.filter, name, input, output, vertical, false, frames,
+            )
         };
         let blur = [
-            blur("bzb-gi-blur-h", filtered, BLUR_H.name, false),
-            blur("bzb-gi-blur-v", BLUR_H.name, crate::passes::ils::INDIRECT.name, true),
-            blur("bzb-gi-glossy-blur-h", glossy_filtered, GLOSSY_BLUR_H.name, false),
-            blur("bzb-gi-glossy-blur-v", GLOSSY_BLUR_H.name, GLOSSY.name, true),
+            blur("bzb-gi-blur-h", filtered, BLUR_H.name, false, 0),
+            blur("bzb-gi-blur-v", BLUR_H.name, crate::passes::ils::INDIRECT.name, true, 0),
+            blur("bzb-gi-glossy-blur-h", glossy_filtered, GLOSSY_BLUR_H.name, false, 1),
+            blur("bzb-gi-glossy-blur-v", GLOSSY_BLUR_H.name, GLOSSY.name, true, 1),
         ];
         let compose = crate::passes::compose::ComposePass::new(
             gpu,

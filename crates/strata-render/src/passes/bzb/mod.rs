@@ -824,7 +824,9 @@ impl BzbStage {
                 false,
             )
         });
-        let blur_h = BilateralPass::new(
+        // after the temporal filter the blur may widen where the history is short
+        let frames = temporal.is_some().then_some(TEMPORAL_FRAMES[0]);
+        let blur_h = BilateralPass::with_history(
             gpu,
             scene_gpu,
             targets,
@@ -834,8 +836,9 @@ impl BzbStage {
             "bzb-blur-h",
             false,
             false,
+            frames,
         );
-        let blur_v = BilateralPass::new(
+        let blur_v = BilateralPass::with_history(
             gpu,
             scene_gpu,
             targets,
@@ -845,6 +848,7 @@ impl BzbStage {
             "ao",
             true,
             false,
+            frames,
         );
         Ok(Self {
             directions,
