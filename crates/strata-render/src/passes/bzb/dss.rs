@@ -260,7 +260,7 @@ pub fn fragment_level(dist: f32, level: u32, d_max: f32, redirect: bool) -> Opti
     if dist > inner && dist <= outer {
         return Some(level);
     }
-    if !redirect || !(dist > 0.0) || dist > inner {
+    if !redirect || dist <= 0.0 || dist > inner {
         return None;
     }
     (0..level).find(|l| dist <= shell(*l, d_max).1)
