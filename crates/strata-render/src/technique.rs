@@ -222,6 +222,22 @@ macro_rules! splat_setting {
     };
 }
 
+/// `filter-fresh-radius` of a BZB technique's bilateral filter (`$of`/`$mut` its settings):
+/// [`BilateralSettings::fresh_radius`](crate::passes::bilateral::BilateralSettings::fresh_radius), 0 = off.
+macro_rules! fresh_radius_setting {
+    ($of:ident, $mut:ident) => {
+        SettingInfo {
+            name: "filter-fresh-radius",
+            doc: "with alpha > 0: taps on each side for a pixel whose history was just rejected (disoccluded), falling as 1/sqrt(n + 1) over its n history frames to filter-radius; 0 = off (not in the paper)",
+            range: Range::Closed(0.0, 32.0),
+            integer: true,
+            get: |s: &RenderSettings| Some($of(s).filter.fresh_radius.unwrap_or(0) as f64),
+            set: |s: &mut RenderSettings, v: f64| $mut(s).filter.fresh_radius = (v >= 1.0).then_some(v as u32),
+            values: &[],
+        }
+    };
+}
+
 /// A two-valued switch (off, on) of the temporal filter of the settings `$of` reads and
 /// `$mut` writes: `$field` of [`TemporalSettings`](crate::passes::temporal::TemporalSettings)
 /// (the history clamp, the start-up ramp).
@@ -1214,14 +1230,7 @@ static BZB_SETTINGS: [SettingInfo; 15] = [
         |s| Some(bzb_of(s).filter.radius as f64),
         |s, v| bzb_mut(s).filter.radius = v as u32
     ),
-    setting!(
-        "filter-fresh-radius",
-        "with alpha > 0: taps on each side for a pixel whose history was just rejected (disoccluded), falling as 1/sqrt(n + 1) over its n history frames to filter-radius; 0 = off (not in the paper)",
-        Range::Closed(0.0, 32.0),
-        true,
-        |s| Some(bzb_of(s).filter.fresh_radius.unwrap_or(0) as f64),
-        |s, v| bzb_mut(s).filter.fresh_radius = (v >= 1.0).then_some(v as u32)
-    ),
+    fresh_radius_setting!(bzb_of, bzb_mut),
     setting!(
         "filter-step",
         "pixels between cross-bilateral taps",
@@ -1334,14 +1343,7 @@ static BZB_GI_SETTINGS: [SettingInfo; 14] = [
         |s| Some(bzb_gi_of(s).filter.radius as f64),
         |s, v| bzb_gi_mut(s).filter.radius = v as u32
     ),
-    setting!(
-        "filter-fresh-radius",
-        "with alpha > 0: taps on each side for a pixel whose history was just rejected (disoccluded), falling as 1/sqrt(n + 1) over its n history frames to filter-radius; 0 = off (not in the paper)",
-        Range::Closed(0.0, 32.0),
-        true,
-        |s| Some(bzb_gi_of(s).filter.fresh_radius.unwrap_or(0) as f64),
-        |s, v| bzb_gi_mut(s).filter.fresh_radius = (v >= 1.0).then_some(v as u32)
-    ),
+    fresh_radius_setting!(bzb_gi_of, bzb_gi_mut),
     setting!(
         "filter-step",
         "pixels between cross-bilateral taps",
