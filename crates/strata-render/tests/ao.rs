@@ -944,7 +944,7 @@ fn distance_weighted_reconstruction_matches_its_cpu_twin_and_cuts_far_taps() {
     let radius = s.resolve(&scene).0;
     let blur = s.reconstruction(radius);
     assert_eq!(blur.world_radius, Some(radius));
-    let twin = |src: &ImageBuf, b, vertical| bilateral_cpu(src, &zpack, &normals, &f, b, vertical);
+    let twin = |src: &ImageBuf, b, vertical| bilateral_cpu(src, &zpack, &normals, &f, b, vertical, None);
     let n = (w * h) as usize;
     // R16F targets
     let near = |g: &ImageBuf, c: &ImageBuf| {

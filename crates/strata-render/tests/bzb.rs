@@ -684,12 +684,12 @@ fn temporal_filter_follows_a_moving_camera() {
 
 /// `filter-fresh-radius` (not in the paper): after the temporal filter, a pixel whose
 /// history holds n frames is filtered with max(radius, round(R / √(n + 1))) taps. Both
-/// GPU passes equal `bilateral_cpu_history` on the same buffers; pixels with a long
+/// GPU passes equal `bilateral_cpu` on the same buffers; pixels with a long
 /// history keep the plain radius-1 filter, and the ones the moving camera uncovered get a
 /// wider one.
 #[test]
 fn fresh_radius_widens_the_filter_where_the_history_is_short() {
-    use strata_render::passes::bilateral::{bilateral_cpu, bilateral_cpu_history, history_radius, BilateralSettings};
+    use strata_render::passes::bilateral::{bilateral_cpu, history_radius, BilateralSettings};
     let gpu = common::gpu();
     let scene = plate_stack(3);
     // still for 8 frames, then two steps sideways that uncover the plates' sides
@@ -736,8 +736,7 @@ fn fresh_radius_widens_the_filter_where_the_history_is_short() {
             .filter(|&i| (ch(g, i) - ch(c, i)).abs() <= 2e-3 + 2e-3 * ch(c, i).abs())
             .count()
     };
-    let twin =
-        |src: &ImageBuf, vertical| bilateral_cpu_history(src, &zpack, &normals, &f, &filter, vertical, Some(&frames));
+    let twin = |src: &ImageBuf, vertical| bilateral_cpu(src, &zpack, &normals, &f, &filter, vertical, Some(&frames));
     let (twin_h, twin_v) = (twin(&temporal, false), twin(&blur_h, true));
     let (close_h, close_v) = (near(&blur_h, &twin_h), near(&out, &twin_v));
     // the plain radius-1 filter of the same input
@@ -751,6 +750,7 @@ fn fresh_radius_widens_the_filter_where_the_history_is_short() {
             ..filter
         },
         false,
+        None,
     );
     let surface = |i: usize| ch(&zpack, i) > 0.0;
     let radius_of = |i: usize| history_radius(1, 4, ch(&frames, i));

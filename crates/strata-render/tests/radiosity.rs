@@ -941,7 +941,7 @@ fn indirect_blur_matches_its_cpu_twin_in_both_kernels() {
         let zpack = read("zpack");
         let normals = common::npack_normals(&read("npack"), 0);
         let f = r.frame_uniforms();
-        let twin = |src: &ImageBuf, vertical| bilateral_cpu(src, &zpack, &normals, &f, &blur, vertical);
+        let twin = |src: &ImageBuf, vertical| bilateral_cpu(src, &zpack, &normals, &f, &blur, vertical, None);
         let n = (raw.width * raw.height) as usize;
         let near = |g: &ImageBuf, c: &ImageBuf| {
             (0..n)

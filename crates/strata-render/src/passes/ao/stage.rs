@@ -209,7 +209,7 @@ pub(crate) fn reconstruction(
         compute,
     );
     let pass = |name, input, output, vertical| {
-        BilateralPass::new(gpu, scene, targets, blur, name, input, output, vertical, compute)
+        BilateralPass::new(gpu, scene, targets, blur, name, input, output, vertical, compute, None)
     };
     [
         pass("ao-blur-h", input, "ao-blur-h", false),

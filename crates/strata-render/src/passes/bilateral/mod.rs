@@ -114,21 +114,10 @@ pub fn history_radius(radius: u32, fresh_radius: u32, n: f32) -> u32 {
 
 /// CPU twin of one direction of `bilateral.wgsl` on channel 0 of `src`: along x, or
 /// along y when `vertical`; `csz` = camera-space depth per pixel (channel 0; ≤ 0 = no
-/// surface), `normals` = unit normals (3 channels), `frame` = the frame's uniforms.
-pub fn bilateral_cpu(
-    src: &ImageBuf,
-    csz: &ImageBuf,
-    normals: &ImageBuf,
-    frame: &FrameUniforms,
-    s: &BilateralSettings,
-    vertical: bool,
-) -> ImageBuf {
-    bilateral_cpu_history(src, csz, normals, frame, s, vertical, None)
-}
-
-/// [`bilateral_cpu`] with the temporal filter's per-pixel count `frames` (channel 0) for
+/// surface), `normals` = unit normals (3 channels), `frame` = the frame's uniforms;
+/// `frames`: a temporal filter's per-pixel count (channel 0), for
 /// [`BilateralSettings::fresh_radius`].
-pub fn bilateral_cpu_history(
+pub fn bilateral_cpu(
     src: &ImageBuf,
     csz: &ImageBuf,
     normals: &ImageBuf,
@@ -238,28 +227,11 @@ pub struct BilateralPass {
 
 impl BilateralPass {
     /// `vertical` picks the direction; `output` must already exist in `targets`; `compute`:
-    /// the compute form ([`crate::passes::Kernel`]), for an `output` with storage binding.
+    /// the compute form ([`crate::passes::Kernel`]), for an `output` with storage binding;
+    /// `frames`: after a temporal filter, its per-pixel count of accepted history frames,
+    /// which [`BilateralSettings::fresh_radius`] reads.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
-        gpu: &GpuContext,
-        scene: &GpuScene,
-        targets: &Targets,
-        settings: &BilateralSettings,
-        name: &'static str,
-        input: &'static str,
-        output: &'static str,
-        vertical: bool,
-        compute: bool,
-    ) -> Self {
-        Self::with_history(
-            gpu, scene, targets, settings, name, input, output, vertical, compute, None,
-        )
-    }
-
-    /// [`BilateralPass::new`] after a temporal filter: `frames` is its per-pixel count of
-    /// accepted history frames, which [`BilateralSettings::fresh_radius`] reads.
-    #[allow(clippy::too_many_arguments)]
-    pub fn with_history(
         gpu: &GpuContext,
         scene: &GpuScene,
         targets: &Targets,

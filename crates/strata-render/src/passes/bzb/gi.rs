@@ -981,7 +981,7 @@ impl BzbGiStage {
         let has_temporal = temporal.is_some();
         let blur = |name, input, output, vertical, k: usize| {
             let frames = has_temporal.then_some(TEMPORAL_FRAMES[k][0]);
-            BilateralPass::with_history(
+            BilateralPass::new(
                 gpu, scene_gpu, targets, &s.filter, name, input, output, vertical, false, frames,
             )
         };

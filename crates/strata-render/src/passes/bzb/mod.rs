@@ -826,7 +826,7 @@ impl BzbStage {
         });
         // after the temporal filter the blur may widen where the history is short
         let frames = temporal.is_some().then_some(TEMPORAL_FRAMES[0]);
-        let blur_h = BilateralPass::with_history(
+        let blur_h = BilateralPass::new(
             gpu,
             scene_gpu,
             targets,
@@ -838,7 +838,7 @@ impl BzbStage {
             false,
             frames,
         );
-        let blur_v = BilateralPass::with_history(
+        let blur_v = BilateralPass::new(
             gpu,
             scene_gpu,
             targets,

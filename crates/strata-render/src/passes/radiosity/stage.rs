@@ -174,6 +174,7 @@ impl RadiosityStage {
             "indirect-blur-h",
             false,
             compute,
+            None,
         );
         let blur_v = BilateralPass::new(
             gpu,
@@ -185,6 +186,7 @@ impl RadiosityStage {
             "indirect",
             true,
             compute,
+            None,
         );
         let compose = compose.then(|| {
             for t in crate::passes::compose::OUTPUTS {
