@@ -613,7 +613,7 @@ pub struct EvalArgs {
     /// object, a recoloured surface), which only the screen-space radiosity can follow.
     #[arg(long, value_name = "SCENE", conflicts_with = "no_probes")]
     pub probes_from: Option<String>,
-    /// gi, ao: the warm-up frames follow the scene's camera path and animation up to the
+    /// gi, full, ao, bzb-ao, bzb-gi: the warm-up frames follow the scene's camera path and animation up to the
     /// evaluated --frame (frames f − warmup … f) instead of holding its camera still: the error
     /// of a moving camera and moving objects, with the temporal filter (and the progressive
     /// bounces) reprojecting every frame.

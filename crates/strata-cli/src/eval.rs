@@ -35,10 +35,12 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     }
     // the warm-up along the camera path: the comparisons with a temporal filter (bzb-ao's
     // `--set alpha`, BZB §6's re-projection)
-    let dgb_ao = a.technique.eval == EvalKind::AmbientVisibility && !is_aba;
-    let dgb_gi = a.technique.eval == EvalKind::Radiance && !is_bzb_gi;
-    if a.moving && (a.views || !(dgb_ao || dgb_gi)) {
-        anyhow::bail!("--moving is only read by eval --technique gi, full, ao or bzb-ao (the deep-G-buffer radiosity or AO, or bzb-ao, along the camera path, without --views)");
+    // (DGB AO and bzb-ao; DGB radiosity and bzb-gi, whose `--set alpha` is BZB §6's
+    // re-projection)
+    let ao = a.technique.eval == EvalKind::AmbientVisibility && !is_aba;
+    let radiance = a.technique.eval == EvalKind::Radiance;
+    if a.moving && (a.views || !(ao || radiance)) {
+        anyhow::bail!("--moving is only read by eval --technique gi, full, ao, bzb-ao or bzb-gi (the deep-G-buffer radiosity or AO, or the bounced z-buffer, along the camera path, without --views)");
     }
     // --layer-scale reduces layers >= 1: an error where no configuration builds one (ILS and
     // the OIT composite shade layer 0 alone; bzb-ao, aba-ao and bzb-gi compare against DGB

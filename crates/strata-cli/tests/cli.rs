@@ -1171,7 +1171,7 @@ fn eval_gi_reports_indirect_and_full_errors() {
         "--moving",
         "--json",
     ]);
-    assert_one_line_error(&o, &["--moving", "bzb-ao"]);
+    assert_one_line_error(&o, &["--moving", "bzb-ao", "bzb-gi"]);
     // the GI comparison's own flags are errors where nothing reads them
     let o = strata(&[
         "eval",
@@ -2580,7 +2580,7 @@ fn bzb_gi_renders_with_and_without_visibility() {
 }
 
 /// `eval --technique bzb-gi --set alpha=0.85` renders `--warmup` frames on the still camera
-/// before the evaluated one, so its temporal filter averages new directions: the indirect
+/// (or along the camera path with `--moving`) before the evaluated one, so its temporal filter averages new directions: the indirect
 /// RMSE against the path tracer falls below the single frame's (cornell 64×64, 1024 spp:
 /// 0.0039 → 0.0028 with 8 frames). It rendered one frame before, and the two were equal.
 /// The JSON records α and the frames; without the filter a frame stands alone (0).
@@ -2620,6 +2620,11 @@ fn eval_bzb_gi_warms_up_its_temporal_filter() {
         b < 0.85 * a,
         "indirect RMSE {a} one frame vs {b} after 8 frames of the filter"
     );
+    // --moving: Cornell has no camera path, so the warm-up along it is the still one
+    let moving = json_of(&eval(&["--set", "alpha=0.85", "--warmup", "8", "--moving"]));
+    assert_eq!(moving["moving"], true, "{moving}");
+    assert_eq!(moving["warmup_frames"], 8, "{moving}");
+    assert_eq!(moving["rmse"], filtered["rmse"], "{moving}");
     // --frames: Cornell has no camera path, so a frame with fixed directions repeats
     // exactly (no flicker but the reprojection's rounding), while the filter's new
     // directions every frame move it

@@ -163,8 +163,13 @@ pub fn run_gi(
     let evaluate = |rs: RenderSettings, renders: u32| -> Result<(GiErrors, f64, f64, GiImages)> {
         let mut r = Renderer::new(&gpu, &scene, rs)?;
         let mut timings = Default::default();
-        for _ in 0..renders {
-            timings = r.render(&gpu, &scene, &fixed, s.scene.frame)?;
+        if s.moving {
+            // the warm-up follows the camera path up to the evaluated frame (--moving)
+            timings = super::render_along_path(&mut r, &gpu, &scene, s, s.scene.frame)?;
+        } else {
+            for _ in 0..renders {
+                timings = r.render(&gpu, &scene, &fixed, s.scene.frame)?;
+            }
         }
         let full = rgb(&r.read_target(&gpu, "hdr-full")?);
         let direct = rgb(&r.read_target(&gpu, "hdr")?);
@@ -190,9 +195,13 @@ pub fn run_gi(
         Ok((errors, splat.unwrap_or(f64::NAN), timings.total(), images))
     };
     // a frame stands alone, unless the temporal filter (`--set alpha`) accumulates new
-    // directions on the still camera: then --warmup frames before the evaluated one, as
-    // the DGB configuration has
-    let renders = if gi.temporal.is_some() { s.warmup.max(1) + 1 } else { 1 };
+    // directions on the still camera, or the warm-up follows the path (--moving): then
+    // --warmup frames before the evaluated one, as the DGB configuration has
+    let renders = if gi.temporal.is_some() || s.moving {
+        s.warmup.max(1) + 1
+    } else {
+        1
+    };
     let (errors, splat_ms, frame_ms, images) = evaluate(main.clone(), renders)?;
     let (no_visibility, splat_ms_no_visibility, _, images_no_visibility) = evaluate(baseline, renders)?;
     let (dgb_2_layers, _, _, images_dgb) = evaluate(dgb, s.warmup.max(1) + 1)?;

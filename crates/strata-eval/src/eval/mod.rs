@@ -373,19 +373,20 @@ fn reproject(csz: &ImageBuf, av: &ImageBuf, px: f32, py: f32) -> Option<(f32, f3
 }
 
 /// Renders the warm-up frames f − warmup … f − 1 along the camera path (clamped at frame 0;
-/// at least one), then frame `f`: `EvalSettings::moving`.
+/// at least one), then frame `f`, whose pass timings it returns: `EvalSettings::moving`.
 pub(crate) fn render_along_path(
     r: &mut Renderer,
     gpu: &GpuContext,
     scene: &Scene,
     s: &EvalSettings,
     f: f32,
-) -> Result<()> {
+) -> Result<strata_render::PassTimings> {
+    let mut timings = Default::default();
     for k in (0..=s.warmup.max(1)).rev() {
         let fk = (f - k as f32).max(0.0);
-        r.render(gpu, scene, &s.scene.cameras_at(scene, fk), fk)?;
+        timings = r.render(gpu, scene, &s.scene.cameras_at(scene, fk), fk)?;
     }
-    Ok(())
+    Ok(timings)
 }
 
 /// Temporal instability of channel 0 of target `target` rendered with `settings` along the
