@@ -230,7 +230,12 @@ impl Targets {
                 | wgpu::TextureUsages::COPY_SRC
                 | wgpu::TextureUsages::COPY_DST
                 | extra,
-            view_formats: &[],
+            // an 8-bit sRGB target can also be read as its raw bytes (`crate::display`)
+            view_formats: if desc.format == wgpu::TextureFormat::Rgba8UnormSrgb {
+                &[wgpu::TextureFormat::Rgba8Unorm]
+            } else {
+                &[]
+            },
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(if desc.layers > 1 {

@@ -5,6 +5,7 @@
 //! Passes live in [`passes`], one module per technique with its WGSL beside it;
 //! shared WGSL lives in `shaders/common/` and is imported with `#import`.
 
+pub mod display;
 pub mod embed;
 pub mod frame;
 pub mod gpu;

@@ -67,11 +67,9 @@ impl ImageBuf {
         let mut bytes = Vec::with_capacity(px.len() * 4);
         for p in px {
             for &v in &p[..3] {
-                let v = v.clamp(0.0, 1.0);
-                let v = if srgb { linear_to_srgb(v) } else { v };
-                bytes.push((v * 255.0 + 0.5) as u8);
+                bytes.push(to_byte(v, srgb));
             }
-            bytes.push((p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
+            bytes.push(to_byte(p[3], false));
         }
         bytes
     }
@@ -141,6 +139,14 @@ impl ImageBuf {
 /// Whether `path` names a PNG (by its extension).
 pub fn is_png(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
+}
+
+/// The PNG byte of one channel value: clamped to [0, 1], sRGB-encoded if `srgb`, rounded
+/// ([`ImageBuf::to_rgba8`]; `strata_render::display` matches it on the GPU).
+pub fn to_byte(v: f32, srgb: bool) -> u8 {
+    let v = v.clamp(0.0, 1.0);
+    let v = if srgb { linear_to_srgb(v) } else { v };
+    (v * 255.0 + 0.5) as u8
 }
 
 pub fn linear_to_srgb(c: f32) -> f32 {
