@@ -1074,6 +1074,26 @@ pub enum BenchWhat {
     /// Bounced z-buffer AO (BZB Table 1): per-pass GPU ms with the bounced z-buffer and
     /// with the additive AOV baseline (no visibility), the visibility step's cost, memory.
     Bzb(BenchBzbArgs),
+    /// A frame onto a window (`strata view`): read back and encoded to 8-bit sRGB on the
+    /// CPU, against the GPU encoder of the same bytes; wall-clock ms until the texture is ready.
+    Display(BenchDisplayArgs),
+}
+
+#[derive(Args)]
+pub struct BenchDisplayArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub gpu: GpuArgs,
+    /// Frames to time (after one warm-up frame), 1..=10000.
+    #[arg(long, default_value_t = 10)]
+    pub frames: u32,
+    /// Registered technique whose display target is shown (`strata techniques`).
+    #[arg(long, default_value = "direct", value_parser = parse_technique)]
+    pub technique: &'static strata_render::technique::Technique,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args)]
@@ -1176,7 +1196,7 @@ impl BenchWhat {
             BenchWhat::Abuffer(b) => Some(&mut b.stage),
             BenchWhat::Bzb(b) => Some(&mut b.stage),
             BenchWhat::Reflections(b) => Some(&mut b.stage),
-            BenchWhat::Gbuffer(_) | BenchWhat::DeepGbuffer(_) | BenchWhat::Reference(_) => None,
+            BenchWhat::Gbuffer(_) | BenchWhat::DeepGbuffer(_) | BenchWhat::Reference(_) | BenchWhat::Display(_) => None,
         }
     }
 }

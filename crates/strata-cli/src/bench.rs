@@ -2,7 +2,7 @@
 //! object or a table.
 
 use anyhow::Result;
-use strata_eval::bench::{abuffer, ao, bzb, deep, gbuffer, ils, radiosity, reference, reflections, technique};
+use strata_eval::bench::{abuffer, ao, bzb, deep, display, gbuffer, ils, radiosity, reference, reflections, technique};
 use strata_eval::results::{to_json_string, BenchResult, DeepBench, GbufferBench, ReferenceBench, StageBench};
 use strata_render::passes::reflections::ReflectionSettings;
 
@@ -34,6 +34,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     let (result, json) = match &a.what {
         BenchWhat::Gbuffer(b) => (BenchResult::Gbuffer(gbuffer::run(&b.into())?), b.json),
+        BenchWhat::Display(b) => (BenchResult::Display(display::run(&b.into())?), b.json),
         BenchWhat::DeepGbuffer(b) => (BenchResult::DeepGbuffer(deep::run(&b.into())?), b.json),
         BenchWhat::Reference(b) => (
             BenchResult::Reference(reference::run(&(&b.scene).into(), b.mrays)?),
@@ -84,6 +85,20 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     }
     match &result {
         BenchResult::Gbuffer(g) => print_gbuffer(g),
+        BenchResult::Display(d) => {
+            let r = &d.run;
+            println!(
+                "{} ({} target '{}') at {}x{}, {} frames on {}",
+                r.scene, d.technique, d.target, r.width, r.height, r.frames, r.device
+            );
+            println!("{:<34} {:>10} {:>10}", "frame to window texture", "median ms", "min ms");
+            println!(
+                "{:<34} {:>10.3} {:>10.3}",
+                "read back, to_rgba8, upload", d.readback_median_ms, d.readback_min_ms
+            );
+            println!("{:<34} {:>10.3} {:>10.3}", "GPU encoder", d.gpu_median_ms, d.gpu_min_ms);
+            println!("GPU encoder {:.2}x faster (median)", d.speedup);
+        }
         BenchResult::DeepGbuffer(d) => print_deep(d, frame_of(a)),
         BenchResult::Reference(r) => print_reference(r),
         BenchResult::Ao(s) | BenchResult::Radiosity(s) | BenchResult::Reflections(s) => print_stage(result.name(), s),

@@ -7,7 +7,7 @@ use strata_eval::cache::RefCache;
 use strata_eval::eval::EvalSettings;
 use strata_eval::scene::SceneSpec;
 
-use crate::args::{BenchDeepArgs, BenchGbufferArgs, BenchStageArgs, EvalArgs, SceneArgs};
+use crate::args::{BenchDeepArgs, BenchDisplayArgs, BenchGbufferArgs, BenchStageArgs, EvalArgs, SceneArgs};
 
 impl From<&SceneArgs> for SceneSpec {
     fn from(a: &SceneArgs) -> Self {
@@ -64,6 +64,17 @@ impl From<&BenchStageArgs> for StageSettings {
             frames: a.frames,
             layers: a.layers,
             variant: a.variant,
+        }
+    }
+}
+
+impl From<&BenchDisplayArgs> for strata_eval::bench::display::DisplaySettings {
+    fn from(a: &BenchDisplayArgs) -> Self {
+        strata_eval::bench::display::DisplaySettings {
+            scene: (&a.scene).into(),
+            adapter: a.gpu.adapter.clone(),
+            frames: a.frames,
+            technique: a.technique,
         }
     }
 }

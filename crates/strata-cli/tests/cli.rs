@@ -447,6 +447,46 @@ fn bench_gbuffer_json_has_per_pass_times() {
     }
 }
 
+/// `bench display` times both ways of getting the frame onto a window, for a technique's own
+/// display target, and names a bad technique in one line.
+#[test]
+fn bench_display_json_times_both_paths() {
+    for (technique, target) in [("direct", "ldr"), ("ao", "ao")] {
+        let o = strata(&[
+            "bench",
+            "display",
+            "--scene",
+            "cornell",
+            "--technique",
+            technique,
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--frames",
+            "2",
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("bench output is not JSON");
+        assert_eq!(v["bench"], "display");
+        assert_eq!(v["target"], target);
+        assert_eq!((v["width"].as_u64(), v["frames"].as_u64()), (Some(48), Some(2)));
+        for k in ["readback", "gpu"] {
+            let (med, min) = (
+                v[format!("{k}_median_ms")].as_f64().unwrap(),
+                v[format!("{k}_min_ms")].as_f64().unwrap(),
+            );
+            assert!(med > 0.0 && min > 0.0 && min <= med, "{technique}: bad {k} timing {v}");
+        }
+        let ratio = v["readback_median_ms"].as_f64().unwrap() / v["gpu_median_ms"].as_f64().unwrap();
+        assert!((v["speedup"].as_f64().unwrap() - ratio).abs() < 1e-9, "{v}");
+    }
+    let o = strata(&["bench", "display", "--technique", "nope"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("nope"), "{}", stderr(&o));
+}
+
 #[test]
 fn render_ao_writes_visibility_in_unit_range_darker_in_corners() {
     let out = scratch("ao-cornell.exr");

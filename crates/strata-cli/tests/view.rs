@@ -688,6 +688,10 @@ fn hidpi_scale_factor_keeps_the_viewport_exact() {
     ok(&strata_env(Some(&x.display), &args, &[("WINIT_X11_SCALE_FACTOR", "2")]));
     let (ww, _, _) = rgb(&win);
     assert!(ww >= 2 * 160 + 600, "the window is laid out at scale 2 ({ww} px wide)");
+    assert!(
+        find_exact(&rgb(&win), &rgb(&shot)).is_some(),
+        "at scale 2 the viewport still shows the frame 1:1 in physical pixels"
+    );
     let r = dir.join("render.png");
     ok(&strata(
         None,
@@ -1208,4 +1212,64 @@ fn view_warns_of_a_full_screen_bzb_gi_splat_before_its_frame() {
         !shot.exists(),
         "the frame of minutes finished before the warning was read"
     );
+}
+
+/// Where `small` (w×h RGB) lies inside `big` pixel for pixel, if anywhere.
+fn find_exact(big: &(u32, u32, Vec<u8>), small: &(u32, u32, Vec<u8>)) -> Option<(u32, u32)> {
+    let (bw, bh, b) = big;
+    let (sw, sh, s) = small;
+    let row = |img: &Vec<u8>, w: u32, x: u32, y: u32, n: u32| {
+        let i = ((y * w + x) * 3) as usize;
+        img[i..i + (n * 3) as usize].to_vec()
+    };
+    for y in 0..=bh.checked_sub(*sh)? {
+        for x in 0..=bw.checked_sub(*sw)? {
+            if (0..*sh).all(|j| row(b, *bw, x, y + j, *sw) == row(s, *sw, 0, j, *sw)) {
+                return Some((x, y));
+            }
+        }
+    }
+    None
+}
+
+/// The window shows the frame's PNG bytes exactly: the viewport inside the whole window's
+/// screenshot equals the frame's screenshot (= `strata render`'s PNG) pixel for pixel, for
+/// a target encoded on the GPU (`ldr`, sRGB; `ao`, linear R16Float) and for a debug view,
+/// which the CPU encodes.
+#[test]
+fn the_window_shows_the_frame_bytes_exactly() {
+    let Some(x) = xvfb("view::the_window_shows_the_frame_bytes_exactly") else {
+        return;
+    };
+    let dir = scratch("window-bytes");
+    for (name, extra) in [
+        ("direct", &["--technique", "direct"][..]),
+        ("ao", &["--technique", "ao"][..]),
+        (
+            "normal",
+            &["--technique", "direct", "--debug-view", "layer0-normal"][..],
+        ),
+    ] {
+        let win = dir.join(format!("{name}-window.png"));
+        let (o, shot) = view(
+            &x,
+            &dir,
+            name,
+            6,
+            None,
+            &[
+                &["--scene", "cornell", "--window-screenshot", win.to_str().unwrap()][..],
+                extra,
+                &SIZE,
+            ]
+            .concat(),
+        );
+        ok(&o);
+        if name != "normal" {
+            // (the box's flat walls have a handful of normals)
+            assert_not_flat(&shot);
+        }
+        let at = find_exact(&rgb(&win), &rgb(&shot));
+        assert!(at.is_some(), "{name}: the window does not show the frame's bytes 1:1");
+    }
 }

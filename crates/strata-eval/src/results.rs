@@ -194,6 +194,27 @@ pub enum BenchResult {
     Abuffer(Box<AbufferBench>),
     /// Bounced z-buffer AO with and without visibility (`strata bench bzb`, BZB Table 1/3).
     Bzb(Box<BzbBench>),
+    /// A frame onto a window: read back and encoded on the CPU, or encoded on the GPU
+    /// (`strata bench display`).
+    Display(DisplayBench),
+}
+
+/// `strata bench display`: wall-clock ms from an idle GPU until a window's 8-bit texture
+/// of the frame is ready, by read-back (read the target, `to_rgba8`, upload) and by the GPU
+/// encoder (`strata_render::display`); the two give the same bytes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DisplayBench {
+    #[serde(flatten)]
+    pub run: BenchRun,
+    pub technique: String,
+    /// The display target (`ldr`, or `ao` for the AO techniques).
+    pub target: String,
+    pub readback_median_ms: f64,
+    pub readback_min_ms: f64,
+    pub gpu_median_ms: f64,
+    pub gpu_min_ms: f64,
+    /// `readback_median_ms / gpu_median_ms`.
+    pub speedup: f64,
 }
 
 fn bzb_ao_name() -> String {
@@ -329,6 +350,7 @@ impl BenchResult {
             BenchResult::Ils(_) => "ils",
             BenchResult::Abuffer(_) => "abuffer",
             BenchResult::Bzb(_) => "bzb",
+            BenchResult::Display(_) => "display",
         }
     }
 }

@@ -1236,12 +1236,30 @@ impl Renderer {
     /// Reads array layer `layer` of target `name`, cropped to the image.
     pub fn read_target_layer(&self, gpu: &GpuContext, name: &str, layer: u32) -> Result<ImageBuf, RenderError> {
         let full = self.read_target_full(gpu, name, layer)?;
-        if (full.width, full.height) != (self.targets.width, self.targets.height) {
-            // a target of its own size (the ILS tiled buffers): shown whole
-            return Ok(full);
+        let (origin, size) = self.image_region(full.width, full.height);
+        Ok(if origin == [0, 0] && size == [full.width, full.height] {
+            full
+        } else {
+            crop(&full, origin[0], origin[1], size[0], size[1])
+        })
+    }
+
+    /// Target `name`'s texture and the region [`Renderer::read_target`] reads of it (origin,
+    /// size): what a window shows without reading it back ([`crate::display`]).
+    pub fn display_region(&self, name: &str) -> Option<(&wgpu::Texture, [u32; 2], [u32; 2])> {
+        let t = &self.targets.try_get(name)?.texture;
+        let (origin, size) = self.image_region(t.width(), t.height());
+        Some((t, origin, size))
+    }
+
+    /// The image inside the guard band of a `w`×`h` target; a target of its own size (the
+    /// ILS tiled buffers) is the image whole.
+    fn image_region(&self, w: u32, h: u32) -> ([u32; 2], [u32; 2]) {
+        if (w, h) != (self.targets.width, self.targets.height) {
+            return ([0, 0], [w, h]);
         }
         let g = self.settings.guard_pixels();
-        Ok(crop(&full, g, g, self.settings.width, self.settings.height))
+        ([g, g], [self.settings.width, self.settings.height])
     }
 
     /// Reads array layer `layer` of target `name` including the guard band.

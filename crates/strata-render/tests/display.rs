@@ -217,10 +217,9 @@ fn display_of_a_rendered_frame_equals_its_png_bytes() {
             .unwrap();
         let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
-        let g = r.settings.guard_pixels();
-        assert_eq!(g, 6);
-        let tex = r.target_texture(target).unwrap();
-        let shown = gpu_bytes(&gpu, &mut enc, tex, 0, [g, g], [96, 64], srgb, 1.0);
+        let (tex, origin, size) = r.display_region(target).unwrap();
+        assert_eq!((origin, size), ([6, 6], [96, 64]), "the image inside the guard band");
+        let shown = gpu_bytes(&gpu, &mut enc, tex, 0, origin, size, srgb, 1.0);
         let png = cpu_bytes(&r.read_target(&gpu, target).unwrap(), srgb, 1.0);
         assert_eq!(shown.len(), png.len());
         let differ = shown.iter().zip(&png).filter(|(a, b)| a != b).count();

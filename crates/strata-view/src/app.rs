@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+use strata_render::display::DisplayEncoder;
 use strata_render::frame::FrameCameras;
 use strata_render::technique::Technique;
 use strata_render::{GpuContext, GpuOptions, RenderError, RenderSettings, Renderer};
@@ -40,11 +41,26 @@ struct Gfx {
     gpu: GpuContext,
     egui_state: egui_winit::State,
     egui_rend: egui_wgpu::Renderer,
+    /// Encodes the shown target into the viewport's texture on the GPU.
+    display: DisplayEncoder,
+    /// That texture as egui knows it: its id, size and filter.
+    native: Option<(egui::TextureId, [u32; 2], wgpu::FilterMode)>,
+    /// `STRATA_VIEW_READBACK=1`: show every frame through the CPU as before the GPU
+    /// encoder (to measure what it saves; `docs/viewer.md`).
+    read_back: bool,
 }
 
 /// The last frame shown: the image exactly as `strata render` would save it.
 pub struct Shown {
-    pub image: ImageBuf,
+    /// The image, once read back: debug views always; the technique's display target only
+    /// when a screenshot, false colour or a renderer about to be replaced needs it (the
+    /// window shows it from the GPU, [`DisplayEncoder`]).
+    pub image: Option<ImageBuf>,
+    /// The target of the renderer that drew the frame (full or reduced) holding it while
+    /// `image` is not read back.
+    pub target: Option<&'static str>,
+    pub width: u32,
+    pub height: u32,
     pub srgb: bool,
     pub full: bool,
     pub camera: Camera,
@@ -81,7 +97,12 @@ pub struct App {
     record_start: u32,
     pub(crate) debug_view: Option<String>,
     pub(crate) view_names: Vec<String>,
-    pub(crate) texture: Option<egui::TextureHandle>,
+    /// The viewport's texture when the CPU encodes it (debug views, false colour).
+    texture: Option<egui::TextureHandle>,
+    /// The texture the viewport draws: `texture`'s, or the GPU-encoded one.
+    pub(crate) viewport_tex: Option<egui::TextureId>,
+    /// The display gain and false colour the viewport texture was made with.
+    display_key: Option<(f32, bool)>,
     pub(crate) shown: Option<Shown>,
     pub(crate) timings: VecDeque<FrameTiming>,
     pub(crate) status: Option<(String, bool)>,
@@ -165,6 +186,8 @@ impl App {
             debug_view: o.debug_view,
             view_names: Vec::new(),
             texture: None,
+            viewport_tex: None,
+            display_key: None,
             shown: None,
             timings: VecDeque::new(),
             status: None,
@@ -279,6 +302,11 @@ impl App {
         let warning = settings.cost_warning(scene_ref);
         match Renderer::new(&gfx.gpu, scene_ref, settings.clone()) {
             Ok(r) => {
+                // the shown frame stays on screen (and can be saved) after its renderer goes
+                if let Err(e) = read_back_shown(&mut self.shown, &self.full, &self.reduced, &gfx.gpu) {
+                    self.shown = None;
+                    self.say(one_line(&e.to_string()), true);
+                }
                 self.view_names = r.debug_view_names();
                 self.full = Some(r);
                 self.reduced = None;
@@ -420,6 +448,16 @@ impl App {
                 Action::MotionScale(s) => {
                     if (0.1..=1.0).contains(&s) {
                         self.motion_scale = s;
+                        // a frame of the reduced renderer stays on screen after it goes
+                        if let Some(g) = self
+                            .gfx
+                            .as_ref()
+                            .filter(|_| self.shown.as_ref().is_some_and(|s| !s.full))
+                        {
+                            if read_back_shown(&mut self.shown, &self.full, &self.reduced, &g.gpu).is_err() {
+                                self.shown = None;
+                            }
+                        }
                         self.reduced = None;
                         self.vpls_at[1] = None;
                         self.reduced_tried = false;
@@ -550,12 +588,21 @@ impl App {
         let t = r.render(gpu, &self.scene, &cams, self.frame_t)?;
         let exposure = r.displayed_exposure(gpu)?;
         let t_name = strata_render::technique::find(&self.spec.technique).map(|t| t.display);
-        let (image, srgb) = match &self.debug_view {
-            Some(v) => (r.debug_view(gpu, v, false)?, true),
+        let (image, srgb, target) = match &self.debug_view {
+            Some(v) => (Some(r.debug_view(gpu, v, false)?), true, None),
             None => {
                 let (target, srgb) = t_name.unwrap_or(("ldr", true));
-                (r.read_target(gpu, target)?, srgb)
+                match r.display_region(target) {
+                    // shown from the GPU; read back only when needed
+                    Some((t, _, _)) if strata_render::display::supports(t.format()) => (None, srgb, Some(target)),
+                    _ => (Some(r.read_target(gpu, target)?), srgb, None),
+                }
             }
+        };
+        let (width, height) = match (&image, target.and_then(|t| r.display_region(t))) {
+            (Some(i), _) => (i.width, i.height),
+            (None, Some((_, _, size))) => (size[0], size[1]),
+            (None, None) => unreachable!("a target without an image has its region"),
         };
         self.used_last = which;
         if !use_reduced && continuing && self.prev_cam == Some(cam) {
@@ -566,6 +613,9 @@ impl App {
         self.prev_cam = Some(cam);
         self.shown = Some(Shown {
             image,
+            target,
+            width,
+            height,
             srgb,
             full: !use_reduced,
             camera: cam,
@@ -578,9 +628,62 @@ impl App {
         }))
     }
 
+    /// Makes the viewport's texture for the shown frame: encoded on the GPU from the
+    /// renderer's target (`strata_render::display`, the same bytes as below), or from the
+    /// read-back image for debug views and false colour.
+    fn show(&mut self, gfx: &mut Gfx) -> Result<(), RenderError> {
+        let s = self.shown.as_ref().expect("checked by the caller");
+        let filter = if s.full {
+            wgpu::FilterMode::Nearest
+        } else {
+            wgpu::FilterMode::Linear
+        };
+        let source = if s.full { &self.full } else { &self.reduced };
+        let region = s
+            .target
+            .filter(|_| s.image.is_none() && !self.false_colour && !gfx.read_back)
+            .and_then(|t| source.as_ref()?.display_region(t));
+        if let Some((tex, origin, size)) = region {
+            gfx.display.encode(&gfx.gpu, tex, 0, origin, size, s.srgb, self.gain)?;
+            let (out, view) = gfx.display.output().expect("encoded above");
+            let size = [out.width(), out.height()];
+            let id = match gfx.native {
+                Some((id, sz, f)) if sz == size && f == filter => id,
+                Some((id, _, _)) => {
+                    gfx.egui_rend
+                        .update_egui_texture_from_wgpu_texture(&gfx.gpu.device, view, filter, id);
+                    id
+                }
+                None => gfx.egui_rend.register_native_texture(&gfx.gpu.device, view, filter),
+            };
+            gfx.native = Some((id, size, filter));
+            self.viewport_tex = Some(id);
+            return Ok(());
+        }
+        read_back_shown(&mut self.shown, &self.full, &self.reduced, &gfx.gpu)?;
+        let s = self.shown.as_ref().expect("checked by the caller");
+        let Some(image) = &s.image else {
+            return Ok(());
+        };
+        let bytes = self.display_bytes(s, image);
+        let img = egui::ColorImage::from_rgba_unmultiplied([image.width as usize, image.height as usize], &bytes);
+        // full frames are shown 1:1 (nearest); reduced ones are upscaled (linear)
+        let filter = if s.full {
+            egui::TextureOptions::NEAREST
+        } else {
+            egui::TextureOptions::LINEAR
+        };
+        match &mut self.texture {
+            Some(t) => t.set(img, filter),
+            None => self.texture = Some(gfx.egui_state.egui_ctx().load_texture("viewport", img, filter)),
+        }
+        self.viewport_tex = self.texture.as_ref().map(|t| t.id());
+        Ok(())
+    }
+
     /// The bytes the viewport texture shows (display gain and false colour applied).
-    fn display_bytes(&self, s: &Shown) -> Vec<u8> {
-        let mut img = s.image.clone();
+    fn display_bytes(&self, s: &Shown, img: &ImageBuf) -> Vec<u8> {
+        let mut img = img.clone();
         if self.false_colour && img.channels == 1 {
             let max = img.data.iter().cloned().fold(0.0f32, f32::max).max(1e-9);
             let mut c = ImageBuf::new(img.width, img.height, 3);
@@ -660,7 +763,11 @@ impl App {
             // as `render` prints it, so the two can be compared
             note += &format!("# exposure (metered): {:.4}\n", s.exposure);
         }
-        if let Err(e) = s.image.save(&path, s.srgb) {
+        let Some(image) = &s.image else {
+            self.say("screenshot: the frame was not read back".into(), true);
+            return;
+        };
+        if let Err(e) = image.save(&path, s.srgb) {
             self.say(e, true);
             return;
         }
@@ -781,26 +888,22 @@ impl App {
                 None
             }
         };
-        if let Some(s) = &self.shown {
-            let bytes = self.display_bytes(s);
-            let img =
-                egui::ColorImage::from_rgba_unmultiplied([s.image.width as usize, s.image.height as usize], &bytes);
-            // full frames are shown 1:1 (nearest); reduced ones are upscaled (linear)
-            let filter = if s.full {
-                egui::TextureOptions::NEAREST
-            } else {
-                egui::TextureOptions::LINEAR
-            };
-            match &mut self.texture {
-                Some(t) => t.set(img, filter),
-                None => self.texture = Some(gfx.egui_state.egui_ctx().load_texture("viewport", img, filter)),
+        // the viewport's texture, when the frame or the display controls changed
+        let key = (self.gain, self.false_colour);
+        if self.shown.is_some() && (timing.is_some() || self.display_key != Some(key) || self.viewport_tex.is_none()) {
+            self.display_key = Some(key);
+            if let Err(e) = self.show(gfx) {
+                self.say(one_line(&e.to_string()), true);
             }
         }
         // saved once `render --warmup` can reproduce the frame: full resolution, and a
         // second still frame where single-pass layers need last frame's depths
         if self.pending_shot.is_some() && self.shot_ready() {
             let p = self.pending_shot.take().expect("checked");
-            self.save_screenshot(p);
+            match read_back_shown(&mut self.shown, &self.full, &self.reduced, &gfx.gpu) {
+                Ok(()) => self.save_screenshot(p),
+                Err(e) => self.say(format!("screenshot: {}", one_line(&e.to_string())), true),
+            }
         }
         // --frames: done when the frames are rendered and nothing is left to apply or save
         // (a screenshot may take a few more frames; give up after 100)
@@ -892,6 +995,24 @@ impl App {
             el.exit();
         }
     }
+}
+
+/// Reads the shown frame back from the renderer that drew it, if it is still only there
+/// (before a screenshot, false colour, or replacing that renderer).
+fn read_back_shown(
+    shown: &mut Option<Shown>,
+    full: &Option<Renderer>,
+    reduced: &Option<Renderer>,
+    gpu: &GpuContext,
+) -> Result<(), RenderError> {
+    let Some(s) = shown.as_mut().filter(|s| s.image.is_none()) else {
+        return Ok(());
+    };
+    let (Some(target), Some(r)) = (s.target, if s.full { full } else { reduced }) else {
+        return Err(RenderError::Other("the shown frame's renderer is gone".into()));
+    };
+    s.image = Some(r.read_target(gpu, target)?);
+    Ok(())
 }
 
 fn one_line(s: &str) -> String {
@@ -1246,6 +1367,7 @@ impl App {
             Some(gpu.device.limits().max_texture_dimension_2d as usize),
         );
         let egui_rend = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        let display = DisplayEncoder::new(&gpu);
         let info = gpu.adapter.get_info();
         self.adapter_name = format!("{} ({:?})", info.name, info.backend);
         window.set_title(&format!("strata view — {} — {}", self.scene.name, self.adapter_name));
@@ -1262,6 +1384,9 @@ impl App {
             gpu,
             egui_state,
             egui_rend,
+            display,
+            native: None,
+            read_back: std::env::var_os("STRATA_VIEW_READBACK").is_some_and(|v| v == "1"),
         });
         let spec = self.spec.clone();
         if !self.apply_spec(spec, None) {

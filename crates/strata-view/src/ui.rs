@@ -48,14 +48,14 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
     );
     let r = ui.max_rect();
     app.viewport_rect = Some([r.min.x * ppp, r.min.y * ppp, r.max.x * ppp, r.max.y * ppp]);
-    let Some(t) = &app.texture else {
+    let Some(t) = app.viewport_tex else {
         ui.centered_and_justified(|ui| ui.label("no frame yet"));
         return;
     };
     let (w, h) = match &app.shown {
         // the reduced frame is shown at the full frame's size
         Some(s) if !s.full => (app.render_size.0 as f32, app.render_size.1 as f32),
-        Some(s) => (s.image.width as f32, s.image.height as f32),
+        Some(s) => (s.width as f32, s.height as f32),
         None => (1.0, 1.0),
     };
     // 1:1 in physical pixels when it fits, else scaled down keeping the aspect
@@ -65,7 +65,7 @@ fn viewport(app: &mut App, ui: &mut egui::Ui) {
         size *= k;
     }
     ui.centered_and_justified(|ui| {
-        ui.add(egui::Image::new((t.id(), size)).fit_to_exact_size(size));
+        ui.add(egui::Image::new((t, size)).fit_to_exact_size(size));
     });
 }
 

@@ -14,6 +14,7 @@ pub mod abuffer;
 pub mod ao;
 pub mod bzb;
 pub mod deep;
+pub mod display;
 pub mod gbuffer;
 pub mod ils;
 pub mod radiosity;

@@ -709,7 +709,7 @@ pub fn bench_sections(b: &BenchResult, dir: &Path, prefix: &str) -> Result<Vec<S
             let title = format!("bench {name} {}: {}", b.technique, b.visibility.run.scene);
             section = passes_figure(section, title, &series, dir, prefix)?;
         }
-        BenchResult::Reference(_) => {}
+        BenchResult::Reference(_) | BenchResult::Display(_) => {}
     }
     Ok(vec![section])
 }

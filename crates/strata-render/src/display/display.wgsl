@@ -1,6 +1,6 @@
 // The 8-bit display bytes of a target, on the GPU: the bytes `ImageBuf::to_rgba8` (and so
 // every PNG strata writes) holds for the same texels, without reading the target back.
-// The encoding is a count of thresholds (see `display/mod.rs`): the smallest f32 that
+// The encoding is settled by thresholds (see `display/mod.rs`): the smallest f32 that
 // the CPU encodes to each byte 1..=255, so GPU and CPU agree bit for bit.
 
 struct Params {
@@ -22,21 +22,24 @@ struct Params {
 @group(0) @binding(3) var<uniform> p: Params;
 @group(0) @binding(4) var out: texture_storage_2d<rgba8unorm, write>;
 
-// How many of the 255 sorted thresholds are <= v: the byte. NaN compares false
-// everywhere and gives 0, as the CPU's saturating cast does.
+// The byte: how many of the 255 sorted thresholds are <= v. A first guess from the
+// GPU's own encoding is within one byte of it; two threshold tests settle it (CPU twin
+// `encode_cpu`). NaN gives 0, as the CPU's saturating cast does.
 fn encode(v: f32) -> u32 {
-    let base = select(0u, 255u, p.srgb != 0u);
-    var lo = 0u;
-    var hi = 255u;
-    while lo < hi {
-        let mid = (lo + hi) / 2u;
-        if thresholds[base + mid] <= v {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
+    if (bitcast<u32>(v) & 0x7fffffffu) > 0x7f800000u {
+        return 0u;
     }
-    return lo;
+    let base = select(0u, 255u, p.srgb != 0u);
+    let c = clamp(v, 0.0, 1.0);
+    let e = select(c, select(1.055 * pow(c, 1.0 / 2.4) - 0.055, c * 12.92, c <= 0.0031308), p.srgb != 0u);
+    var b = min(u32(max(e * 255.0 + 0.5, 0.0)), 255u);
+    // byte >= k exactly when v >= thresholds[base + k - 1]
+    if b > 0u && v < thresholds[base + max(b, 1u) - 1u] {
+        b -= 1u;
+    } else if b < 255u && v >= thresholds[base + min(b, 254u)] {
+        b += 1u;
+    }
+    return b;
 }
 
 fn channel(x: f32) -> f32 {

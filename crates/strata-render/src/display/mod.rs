@@ -299,9 +299,9 @@ impl DisplayEncoder {
         Ok(out)
     }
 
-    /// The last output, if any.
-    pub fn output(&self) -> Option<&wgpu::Texture> {
-        self.output.as_ref().map(|(t, _)| t)
+    /// The last output and its view, if any.
+    pub fn output(&self) -> Option<(&wgpu::Texture, &wgpu::TextureView)> {
+        self.output.as_ref().map(|(t, v)| (t, v))
     }
 }
 
