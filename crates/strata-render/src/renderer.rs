@@ -1244,12 +1244,17 @@ impl Renderer {
         })
     }
 
-    /// Target `name`'s texture and the region [`Renderer::read_target`] reads of it (origin,
-    /// size): what a window shows without reading it back ([`crate::display`]).
-    pub fn display_region(&self, name: &str) -> Option<(&wgpu::Texture, [u32; 2], [u32; 2])> {
-        let t = &self.targets.try_get(name)?.texture;
-        let (origin, size) = self.image_region(t.width(), t.height());
-        Some((t, origin, size))
+    /// The region of target `name` (layer 0) that [`Renderer::read_target`] reads: what a
+    /// window shows without reading it back ([`crate::display`]).
+    pub fn display_region(&self, name: &str) -> Option<crate::display::Region<'_>> {
+        let texture = &self.targets.try_get(name)?.texture;
+        let (origin, size) = self.image_region(texture.width(), texture.height());
+        Some(crate::display::Region {
+            texture,
+            layer: 0,
+            origin,
+            size,
+        })
     }
 
     /// The image inside the guard band of a `w`×`h` target; a target of its own size (the

@@ -4,7 +4,7 @@
 
 mod common;
 
-use strata_render::display::{thresholds, DisplayEncoder};
+use strata_render::display::{thresholds, DisplayEncoder, Region};
 use strata_render::frame::FrameCameras;
 use strata_render::renderer::{crop, decode_texels, GuardBand};
 use strata_render::{GpuContext, RenderSettings, Renderer};
@@ -23,17 +23,8 @@ fn cpu_bytes(img: &ImageBuf, srgb: bool, gain: f32) -> Vec<u8> {
     b
 }
 
-fn gpu_bytes(
-    gpu: &GpuContext,
-    enc: &mut DisplayEncoder,
-    tex: &wgpu::Texture,
-    layer: u32,
-    origin: [u32; 2],
-    size: [u32; 2],
-    srgb: bool,
-    gain: f32,
-) -> Vec<u8> {
-    let out = enc.encode(gpu, tex, layer, origin, size, srgb, gain).unwrap();
+fn gpu_bytes(gpu: &GpuContext, enc: &mut DisplayEncoder, region: &Region<'_>, srgb: bool, gain: f32) -> Vec<u8> {
+    let out = enc.encode(gpu, region, srgb, gain).unwrap();
     let b = gpu.read_texture(out, 0).unwrap();
     gpu.check_errors().expect("no wgpu validation errors");
     b
@@ -115,7 +106,9 @@ fn texels(format: F, n: usize, seed: u32) -> Vec<u8> {
                 .collect()
         }
         // every byte value, then pseudo-random ones
-        F::Rgba8Unorm | F::Rgba8UnormSrgb => (0..n * 4).map(|i| (i as u32 * 2_654_435_761 >> 7) as u8).collect(),
+        F::Rgba8Unorm | F::Rgba8UnormSrgb => (0..n * 4)
+            .map(|i| ((i as u32).wrapping_mul(2_654_435_761) >> 7) as u8)
+            .collect(),
         _ => unreachable!(),
     }
 }
@@ -183,7 +176,18 @@ fn display_encoder_equals_to_rgba8() {
         let region = crop(&full, origin[0], origin[1], size[0], size[1]);
         for srgb in [false, true] {
             for gain in [1.0, 1.7, 0.3] {
-                let g = gpu_bytes(&gpu, &mut enc, &tex, 1, origin, size, srgb, gain);
+                let g = gpu_bytes(
+                    &gpu,
+                    &mut enc,
+                    &Region {
+                        texture: &tex,
+                        layer: 1,
+                        origin,
+                        size,
+                    },
+                    srgb,
+                    gain,
+                );
                 let c = cpu_bytes(&region, srgb, gain);
                 let differ = g.iter().zip(&c).filter(|(a, b)| a != b).count();
                 assert_eq!(
@@ -217,9 +221,13 @@ fn display_of_a_rendered_frame_equals_its_png_bytes() {
             .unwrap();
         let mut r = Renderer::new(&gpu, &scene, settings).unwrap();
         r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
-        let (tex, origin, size) = r.display_region(target).unwrap();
-        assert_eq!((origin, size), ([6, 6], [96, 64]), "the image inside the guard band");
-        let shown = gpu_bytes(&gpu, &mut enc, tex, 0, origin, size, srgb, 1.0);
+        let region = r.display_region(target).unwrap();
+        assert_eq!(
+            (region.origin, region.size),
+            ([6, 6], [96, 64]),
+            "the image inside the guard band"
+        );
+        let shown = gpu_bytes(&gpu, &mut enc, &region, srgb, 1.0);
         let png = cpu_bytes(&r.read_target(&gpu, target).unwrap(), srgb, 1.0);
         assert_eq!(shown.len(), png.len());
         let differ = shown.iter().zip(&png).filter(|(a, b)| a != b).count();
@@ -255,20 +263,26 @@ fn display_encoder_rejects_a_bad_region_or_format() {
             view_formats: &[],
         })
     };
+    let region = |texture, layer, origin| Region {
+        texture,
+        layer,
+        origin,
+        size: [16, 8],
+    };
     let t = make(F::Rgba16Float);
     let e = enc
-        .encode(&gpu, &t, 0, [4, 0], [16, 8], true, 1.0)
+        .encode(&gpu, &region(&t, 0, [4, 0]), true, 1.0)
         .unwrap_err()
         .to_string();
     common::assert_one_line(&e, &["display", "outside", "16×8×1"]);
     let e = enc
-        .encode(&gpu, &t, 1, [0, 0], [16, 8], true, 1.0)
+        .encode(&gpu, &region(&t, 1, [0, 0]), true, 1.0)
         .unwrap_err()
         .to_string();
     common::assert_one_line(&e, &["layer 1"]);
     let d = make(F::Depth32Float);
     let e = enc
-        .encode(&gpu, &d, 0, [0, 0], [16, 8], true, 1.0)
+        .encode(&gpu, &region(&d, 0, [0, 0]), true, 1.0)
         .unwrap_err()
         .to_string();
     common::assert_one_line(&e, &["Depth32Float", "cannot be shown"]);

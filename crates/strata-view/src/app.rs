@@ -594,14 +594,14 @@ impl App {
                 let (target, srgb) = t_name.unwrap_or(("ldr", true));
                 match r.display_region(target) {
                     // shown from the GPU; read back only when needed
-                    Some((t, _, _)) if strata_render::display::supports(t.format()) => (None, srgb, Some(target)),
+                    Some(g) if strata_render::display::supports(g.texture.format()) => (None, srgb, Some(target)),
                     _ => (Some(r.read_target(gpu, target)?), srgb, None),
                 }
             }
         };
         let (width, height) = match (&image, target.and_then(|t| r.display_region(t))) {
             (Some(i), _) => (i.width, i.height),
-            (None, Some((_, _, size))) => (size[0], size[1]),
+            (None, Some(g)) => (g.size[0], g.size[1]),
             (None, None) => unreachable!("a target without an image has its region"),
         };
         self.used_last = which;
@@ -643,8 +643,8 @@ impl App {
             .target
             .filter(|_| s.image.is_none() && !self.false_colour && !gfx.read_back)
             .and_then(|t| source.as_ref()?.display_region(t));
-        if let Some((tex, origin, size)) = region {
-            gfx.display.encode(&gfx.gpu, tex, 0, origin, size, s.srgb, self.gain)?;
+        if let Some(region) = region {
+            gfx.display.encode(&gfx.gpu, &region, s.srgb, self.gain)?;
             let (out, view) = gfx.display.output().expect("encoded above");
             let size = [out.width(), out.height()];
             let id = match gfx.native {

@@ -90,11 +90,11 @@ pub fn run(s: &DisplaySettings) -> Result<DisplayBench> {
         let t = Instant::now();
         read_back(&gpu, &r, target, srgb, &upload)?;
         let rb = t.elapsed().as_secs_f64() * 1e3;
-        let (tex, origin, size) = r
+        let region = r
             .display_region(target)
             .ok_or_else(|| anyhow::anyhow!("the frame has no target '{target}'"))?;
         let t = Instant::now();
-        enc.encode(&gpu, tex, 0, origin, size, srgb, 1.0)?;
+        enc.encode(&gpu, &region, srgb, 1.0)?;
         wait(&gpu);
         let gp = t.elapsed().as_secs_f64() * 1e3;
         if i > 0 {

@@ -70,6 +70,16 @@ pub fn supports(format: wgpu::TextureFormat) -> bool {
     layout_of(format).is_some()
 }
 
+/// The part of a texture to show: array layer `layer`, `size` texels from `origin`
+/// ([`crate::Renderer::display_region`] gives a target's image inside its guard band).
+#[derive(Clone, Copy, Debug)]
+pub struct Region<'a> {
+    pub texture: &'a wgpu::Texture,
+    pub layer: u32,
+    pub origin: [u32; 2],
+    pub size: [u32; 2],
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Params {
@@ -178,19 +188,22 @@ impl DisplayEncoder {
         }
     }
 
-    /// Encodes the `size` region at `origin` of array layer `layer` of `src` (as
-    /// `ImageBuf::to_rgba8(srgb)` of its values times `gain`, alpha 255) and returns the
-    /// output texture, `size` large. The work is submitted; nothing waits for it.
+    /// Encodes `region` (as `ImageBuf::to_rgba8(srgb)` of its values times `gain`, alpha
+    /// 255) and returns the output texture, the region's size. The work is submitted;
+    /// nothing waits for it.
     pub fn encode(
         &mut self,
         gpu: &GpuContext,
-        src: &wgpu::Texture,
-        layer: u32,
-        origin: [u32; 2],
-        size: [u32; 2],
+        region: &Region<'_>,
         srgb: bool,
         gain: f32,
     ) -> Result<&wgpu::Texture, RenderError> {
+        let Region {
+            texture: src,
+            layer,
+            origin,
+            size,
+        } = *region;
         let format = src.format();
         let (channels, table) = layout_of(format)
             .ok_or_else(|| RenderError::Parameter(format!("display: a {format:?} texture cannot be shown")))?;
