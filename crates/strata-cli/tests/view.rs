@@ -1273,3 +1273,80 @@ fn the_window_shows_the_frame_bytes_exactly() {
         assert!(at.is_some(), "{name}: the window does not show the frame's bytes 1:1");
     }
 }
+
+/// The display gain and false colour (script `gain`, `false-colour`) change what the window
+/// shows and not the screenshot: with gain 2 the viewport holds the PNG's bytes decoded,
+/// doubled and encoded again (the GPU encoder's gain), and false colour turns the grey AO
+/// into colours (the CPU path, from the frame read back while its renderer lives).
+#[test]
+fn display_gain_and_false_colour_change_only_the_window() {
+    let Some(x) = xvfb("view::display_gain_and_false_colour_change_only_the_window") else {
+        return;
+    };
+    let dir = scratch("window-gain");
+    let run = |name: &str, technique: &str, script: Option<&str>| {
+        let win = dir.join(format!("{name}-window.png"));
+        let (o, shot) = view(
+            &x,
+            &dir,
+            name,
+            8,
+            script,
+            &[
+                &[
+                    "--scene",
+                    "cornell",
+                    "--technique",
+                    technique,
+                    "--window-screenshot",
+                    win.to_str().unwrap(),
+                ][..],
+                &SIZE,
+            ]
+            .concat(),
+        );
+        ok(&o);
+        (rgb(&win), rgb(&shot))
+    };
+    let region = |win: &(u32, u32, Vec<u8>), (x0, y0): (u32, u32), w: u32, h: u32| -> Vec<u8> {
+        (0..h)
+            .flat_map(|y| {
+                let i = (((y0 + y) * win.0 + x0) * 3) as usize;
+                win.2[i..i + (w * 3) as usize].to_vec()
+            })
+            .collect()
+    };
+    // gain 2 on the final image
+    let (win, shot) = run("plain", "direct", None);
+    let at = find_exact(&win, &shot).expect("the plain window shows the frame");
+    let (gwin, gshot) = run("gain", "direct", Some("wait 3\ngain 2\nwait 4\n"));
+    assert_eq!(gshot.2, shot.2, "the screenshot has no gain");
+    let want: Vec<u8> = shot
+        .2
+        .iter()
+        .map(|&b| strata_scene::image_buf::to_byte(strata_scene::model::srgb_to_linear(b) * 2.0, true))
+        .collect();
+    let got = region(&gwin, at, shot.0, shot.1);
+    let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "{differ} bytes of the gained viewport differ");
+    assert!(want != shot.2, "gain 2 changes the bytes");
+    // false colour on the AO
+    let (win, shot) = run("ao", "ao", None);
+    let at = find_exact(&win, &shot).expect("the AO window shows the frame");
+    assert!(
+        shot.2.chunks_exact(3).all(|p| p[0] == p[1] && p[1] == p[2]),
+        "AO is grey"
+    );
+    let (fwin, _) = run("ao-false", "ao", Some("wait 3\nfalse-colour on\nwait 4\n"));
+    let got = region(&fwin, at, shot.0, shot.1);
+    let coloured = got
+        .chunks_exact(3)
+        .filter(|p| p.iter().max().unwrap() - p.iter().min().unwrap() > 30)
+        .count();
+    // (the heat scale is white where AO is 1, most of the box)
+    assert!(
+        coloured * 5 > got.len() / 3,
+        "false colour: {coloured} of {} pixels are coloured",
+        got.len() / 3
+    );
+}

@@ -1076,6 +1076,17 @@ impl Renderer {
         }
     }
 
+    /// [`Renderer::displayed_exposure`] without waiting for the GPU: exact for a fixed
+    /// exposure; under auto-exposure the latest metered value that has arrived (an earlier
+    /// frame's, [`ExposurePass::read_latest`](crate::passes::exposure::ExposurePass::read_latest)),
+    /// `None` until one has.
+    pub fn latest_exposure(&self, gpu: &GpuContext) -> Option<f32> {
+        match (&self.exposure, self.exposure_history) {
+            (Some(e), true) => e.read_latest(gpu).map(|v| v.0),
+            _ => Some(self.last_frame.sky[3]),
+        }
+    }
+
     /// Replaces the ILS VPLs for the next frames (moving lights: regenerate per
     /// frame); at most as many as the renderer was built with.
     pub fn set_vpls(&mut self, gpu: &GpuContext, vpls: &[crate::passes::ils::GpuVpl]) -> Result<(), RenderError> {

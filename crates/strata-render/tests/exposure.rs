@@ -165,6 +165,46 @@ fn exposure_adapts_in_log_space() {
     assert!((e2 / t1 - 1.0).abs() < 3e-3, "after a cut: {e2} vs {t1}");
 }
 
+/// `latest_exposure` (the viewer's label; it never waits): a fixed exposure at once; a
+/// metered one from the read-back an earlier call started, so it trails
+/// `displayed_exposure` by one call and then equals it exactly.
+#[test]
+fn latest_exposure_trails_the_waiting_read_by_one_call() {
+    let gpu = common::gpu();
+    let scene = procedural::builtin("atrium").unwrap();
+    let fixed = RenderSettings {
+        width: 160,
+        height: 120,
+        exposure: Some(0.7),
+        ..Default::default()
+    };
+    let mut r = Renderer::new(&gpu, &scene, fixed).unwrap();
+    r.render(&gpu, &scene, &FrameCameras::fixed(scene.camera), 0.0).unwrap();
+    assert_eq!(r.latest_exposure(&gpu), Some(0.7));
+    assert_eq!(r.displayed_exposure(&gpu).unwrap(), 0.7);
+
+    let a = AutoExposure {
+        adaptation: 0.25,
+        ..AutoExposure::default()
+    };
+    let mut r = Renderer::new(&gpu, &scene, auto(a)).unwrap();
+    let mut dark_view = scene.camera;
+    dark_view.target = dark_view.eye + glam::Vec3::new(-0.2, -0.3, -1.0);
+    let (_, e0) = frame(&gpu, &mut r, &scene, scene.camera);
+    assert_eq!(r.latest_exposure(&gpu), None, "nothing has arrived yet");
+    gpu.check_errors().unwrap(); // waits for the GPU
+    assert_eq!(r.latest_exposure(&gpu), Some(e0), "the first frame's, exactly");
+    let (_, e1) = frame(&gpu, &mut r, &scene, dark_view);
+    assert!((e1 / e0 - 1.0).abs() > 0.05, "the exposure adapts: {e0} → {e1}");
+    gpu.check_errors().unwrap();
+    // the copy collected now was started before frame 1
+    assert_eq!(r.latest_exposure(&gpu), Some(e0), "one call behind");
+    gpu.check_errors().unwrap();
+    assert_eq!(r.latest_exposure(&gpu), Some(e1), "then frame 1's");
+    gpu.check_errors()
+        .expect("no wgpu validation errors (a mapped buffer is never copied into)");
+}
+
 /// Out-of-range settings are one-line errors naming the parameter.
 #[test]
 fn bad_auto_exposure_settings_are_refused() {

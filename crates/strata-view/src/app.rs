@@ -64,8 +64,11 @@ pub struct Shown {
     pub srgb: bool,
     pub full: bool,
     pub camera: Camera,
-    /// The exposure this frame was tonemapped with (the metered one under auto-exposure).
-    pub exposure: f32,
+    /// The exposure this frame was tonemapped with. Under auto-exposure it is read back
+    /// without waiting, so it may be an earlier frame's until `exposure_exact` (set when
+    /// the frame is read back for a screenshot); `None` before the first arrives.
+    pub exposure: Option<f32>,
+    pub exposure_exact: bool,
 }
 
 pub struct App {
@@ -466,6 +469,14 @@ impl App {
                     }
                 }
                 Action::Fit(on) => self.fit_window = on,
+                Action::Gain(g) => {
+                    if (0.125..=16.0).contains(&g) {
+                        self.gain = g;
+                    } else {
+                        self.say(format!("gain {g} is out of range: must be in 0.125..=16"), true);
+                    }
+                }
+                Action::FalseColour(on) => self.false_colour = on,
                 Action::Resize(w, h) => {
                     if let Some(g) = &self.gfx {
                         let _ = g.window.request_inner_size(winit::dpi::PhysicalSize::new(w, h));
@@ -546,7 +557,8 @@ impl App {
         Some(r)
     }
 
-    /// Renders the 3D frame and reads back what the viewport shows.
+    /// Renders the 3D frame; the viewport shows its display target from the GPU (debug
+    /// views are read back and encoded on the CPU).
     fn render_3d(&mut self, gpu: &GpuContext, reduced: bool, cam: Camera) -> Result<Option<FrameTiming>, RenderError> {
         if self.full.is_none() || self.broken {
             return Ok(None);
@@ -586,7 +598,10 @@ impl App {
             }
         }
         let t = r.render(gpu, &self.scene, &cams, self.frame_t)?;
-        let exposure = r.displayed_exposure(gpu)?;
+        let metered = r.settings.auto_exposure.is_some();
+        let exposure = r
+            .latest_exposure(gpu)
+            .or_else(|| self.shown.as_ref().and_then(|s| s.exposure));
         let t_name = strata_render::technique::find(&self.spec.technique).map(|t| t.display);
         let (image, srgb, target) = match &self.debug_view {
             Some(v) => (Some(r.debug_view(gpu, v, false)?), true, None),
@@ -620,6 +635,7 @@ impl App {
             full: !use_reduced,
             camera: cam,
             exposure,
+            exposure_exact: !metered,
         });
         Ok(Some(FrameTiming {
             passes: t.passes,
@@ -761,7 +777,7 @@ impl App {
         }
         if self.spec.exposure.as_deref().is_some_and(|e| e.starts_with("auto")) {
             // as `render` prints it, so the two can be compared
-            note += &format!("# exposure (metered): {:.4}\n", s.exposure);
+            note += &format!("# exposure (metered): {:.4}\n", s.exposure.unwrap_or(f32::NAN));
         }
         let Some(image) = &s.image else {
             self.say("screenshot: the frame was not read back".into(), true);
@@ -1005,13 +1021,19 @@ fn read_back_shown(
     reduced: &Option<Renderer>,
     gpu: &GpuContext,
 ) -> Result<(), RenderError> {
-    let Some(s) = shown.as_mut().filter(|s| s.image.is_none()) else {
+    let Some(s) = shown.as_mut().filter(|s| s.image.is_none() || !s.exposure_exact) else {
         return Ok(());
     };
-    let (Some(target), Some(r)) = (s.target, if s.full { full } else { reduced }) else {
+    let Some(r) = (if s.full { full } else { reduced }) else {
         return Err(RenderError::Other("the shown frame's renderer is gone".into()));
     };
-    s.image = Some(r.read_target(gpu, target)?);
+    if let (None, Some(target)) = (&s.image, s.target) {
+        s.image = Some(r.read_target(gpu, target)?);
+    }
+    if !s.exposure_exact {
+        s.exposure = Some(r.displayed_exposure(gpu)?);
+        s.exposure_exact = true;
+    }
     Ok(())
 }
 

@@ -125,6 +125,10 @@ pub enum Action {
     Resize(u32, u32),
     /// The render size follows the viewport's size.
     Fit(bool),
+    /// The display gain (0.125..=16; what the viewer shows, not the PNG).
+    Gain(f32),
+    /// False colour for one-channel views (what the viewer shows, not the PNG).
+    FalseColour(bool),
 }
 
 /// Everything `strata view` starts from.

@@ -124,6 +124,12 @@ impl Script {
                 "record-stop" => act(Action::Record(Some(rest.join(" ").into()))),
                 "motion-scale" => act(Action::MotionScale(num(0)?)),
                 "resize" => act(Action::Resize(frames(0)?, frames(1)?)),
+                "gain" => act(Action::Gain(num(0)?)),
+                "false-colour" => act(Action::FalseColour(match arg(0)? {
+                    "on" => true,
+                    "off" => false,
+                    v => return Err(err(format!("'{v}': use on or off"))),
+                })),
                 "fit" => act(Action::Fit(match arg(0)? {
                     "on" => true,
                     "off" => false,
@@ -167,5 +173,22 @@ mod tests {
                 Event::Action(Action::LayerScale(2)),
             ]
         );
+        // the display controls
+        let s = Script::parse(
+            "gain 2.5
+false-colour on
+",
+        )
+        .unwrap();
+        let acts: Vec<_> = s.at(0).cloned().collect();
+        assert_eq!(
+            acts,
+            [
+                Event::Action(Action::Gain(2.5)),
+                Event::Action(Action::FalseColour(true))
+            ]
+        );
+        let e = Script::parse("false-colour yes").unwrap_err();
+        assert!(e.starts_with("line 1:") && e.contains("use on or off"), "{e}");
     }
 }

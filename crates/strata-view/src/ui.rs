@@ -230,9 +230,9 @@ fn settings_panel(app: &mut App, ui: &mut egui::Ui) {
             app.actions
                 .push(Action::Exposure((!e.is_empty()).then(|| e.to_string())));
         }
-        if let Some(s) = &app.shown {
+        if let Some(e) = app.shown.as_ref().and_then(|s| s.exposure) {
             let metered = app.spec.exposure.as_deref().is_some_and(|e| e.starts_with("auto"));
-            ui.label(RichText::new(format!("= {:.3}{}", s.exposure, if metered { " metered" } else { "" })).small())
+            ui.label(RichText::new(format!("= {e:.3}{}", if metered { " metered" } else { "" })).small())
                 .on_hover_text("the exposure the shown frame was tonemapped with");
         }
     });

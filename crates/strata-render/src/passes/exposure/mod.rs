@@ -153,6 +153,11 @@ pub struct ExposurePass {
     histogram: wgpu::Buffer,
     /// [0] the exposure, [1] L̄.
     buffer: wgpu::Buffer,
+    /// The read-back that does not wait ([`ExposurePass::read_latest`]): a copy of `buffer`,
+    /// its state (0 idle, 1 mapping, 2 mapped, 3 failed) and the last value that arrived.
+    staging: wgpu::Buffer,
+    staging_state: std::sync::Arc<std::sync::atomic::AtomicU8>,
+    latest: std::sync::Mutex<Option<(f32, f32)>>,
 }
 
 /// Pixels per tile side of `cs_histogram`.
@@ -191,6 +196,12 @@ impl ExposurePass {
                 .build_compute()
         };
         let (histogram_pass, exposure_pass) = (build("cs_histogram"), build("cs_exposure"));
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("exposure read-back"),
+            size: 8,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
         Self {
             input,
             histogram_pass,
@@ -199,7 +210,42 @@ impl ExposurePass {
             settings,
             histogram,
             buffer,
+            staging,
+            staging_state: Default::default(),
+            latest: Default::default(),
         }
+    }
+
+    /// The (exposure, L̄) of the latest frame whose read-back has arrived, without waiting
+    /// for the GPU: each call collects the copy an earlier call started, if it has landed,
+    /// and starts a copy of the current value. `None` until the first lands (a frame or so
+    /// behind [`ExposurePass::read`], which waits). For a window's label, not for the image.
+    pub fn read_latest(&self, gpu: &GpuContext) -> Option<(f32, f32)> {
+        use std::sync::atomic::Ordering;
+        let _ = gpu.device.poll(wgpu::PollType::Poll);
+        let mut latest = self.latest.lock().unwrap_or_else(|p| p.into_inner());
+        match self.staging_state.load(Ordering::Acquire) {
+            1 => return *latest,
+            2 => {
+                if let Ok(b) = self.staging.get_mapped_range(..) {
+                    let f = |i: usize| f32::from_le_bytes([b[4 * i], b[4 * i + 1], b[4 * i + 2], b[4 * i + 3]]);
+                    *latest = Some((f(0), f(1)));
+                }
+                self.staging.unmap();
+            }
+            _ => {}
+        }
+        let mut enc = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("exposure read-back"),
+        });
+        enc.copy_buffer_to_buffer(&self.buffer, 0, &self.staging, 0, 8);
+        gpu.queue.submit([enc.finish()]);
+        self.staging_state.store(1, Ordering::Release);
+        let state = self.staging_state.clone();
+        self.staging.map_async(wgpu::MapMode::Read, .., move |r| {
+            state.store(if r.is_ok() { 2 } else { 3 }, Ordering::Release);
+        });
+        *latest
     }
 
     /// The storage buffer holding the exposure (f32 [0]) and L̄ ([1]).
