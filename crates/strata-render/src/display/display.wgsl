@@ -17,7 +17,12 @@ struct Params {
 }
 
 @group(0) @binding(0) var src: texture_2d<f32>;
-@group(0) @binding(1) var<storage, read> thresholds: array<f32, 510>;
+// 510 thresholds (linear, then sRGB), four to a vec4 (uniform arrays are 16-byte strided)
+@group(0) @binding(1) var<uniform> thresholds: array<vec4<f32>, 128>;
+
+fn threshold(i: u32) -> f32 {
+    return thresholds[i / 4u][i % 4u];
+}
 @group(0) @binding(2) var<storage, read> decode: array<f32, 256>;
 @group(0) @binding(3) var<uniform> p: Params;
 @group(0) @binding(4) var out: texture_storage_2d<rgba8unorm, write>;
@@ -31,12 +36,16 @@ fn encode(v: f32) -> u32 {
     }
     let base = select(0u, 255u, p.srgb != 0u);
     let c = clamp(v, 0.0, 1.0);
-    let e = select(c, select(1.055 * pow(c, 1.0 / 2.4) - 0.055, c * 12.92, c <= 0.0031308), p.srgb != 0u);
+    var e = c;
+    if p.srgb != 0u {
+        // (uniform over the dispatch: a linear target skips the pow)
+        e = select(1.055 * pow(c, 1.0 / 2.4) - 0.055, c * 12.92, c <= 0.0031308);
+    }
     var b = min(u32(max(e * 255.0 + 0.5, 0.0)), 255u);
     // byte >= k exactly when v >= thresholds[base + k - 1]
-    if b > 0u && v < thresholds[base + max(b, 1u) - 1u] {
+    if b > 0u && v < threshold(base + max(b, 1u) - 1u) {
         b -= 1u;
-    } else if b < 255u && v >= thresholds[base + min(b, 254u)] {
+    } else if b < 255u && v >= threshold(base + min(b, 254u)) {
         b += 1u;
     }
     return b;

@@ -128,7 +128,14 @@ impl DisplayEncoder {
                         multisampled: false,
                     },
                 ),
-                entry(1, storage),
+                entry(
+                    1,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
                 entry(2, storage),
                 entry(
                     3,
@@ -170,8 +177,9 @@ impl DisplayEncoder {
                 mapped_at_creation: false,
             })
         };
-        let thresholds = buffer("display thresholds", 510 * 4, wgpu::BufferUsages::STORAGE);
-        let table: Vec<f32> = [thresholds_of(false), thresholds_of(true)].concat();
+        let thresholds = buffer("display thresholds", 512 * 4, wgpu::BufferUsages::UNIFORM);
+        let mut table: Vec<f32> = [thresholds_of(false), thresholds_of(true)].concat();
+        table.resize(512, f32::INFINITY);
         gpu.queue.write_buffer(&thresholds, 0, bytemuck::cast_slice(&table));
         DisplayEncoder {
             pipeline,
