@@ -64,5 +64,6 @@ run bzb-gi-still-life bench bzb --technique bzb-gi --scene still-life --width 76
 run bzb-gi-dominoes bench bzb --technique bzb-gi --scene dominoes --width 768 --height 512 --frames 3
 
 # CPU reference tracer throughput on this machine's cores
+run display-atrium bench display --scene atrium --technique full $HD --frames 10
 run reference-atrium bench reference --scene atrium --width 256 --height 256
 echo "done" | tee -a "$LOG"
