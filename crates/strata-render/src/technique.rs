@@ -1129,7 +1129,7 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
     s.bzb.clone().unwrap_or_default()
 }
 
-static BZB_SETTINGS: [SettingInfo; 15] = [
+static BZB_SETTINGS: [SettingInfo; 16] = [
     bool_setting!(
         "visibility",
         "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
@@ -1145,6 +1145,14 @@ static BZB_SETTINGS: [SettingInfo; 15] = [
         bzb_mut,
         culling,
         ["off", "on"]
+    ),
+    bool_setting!(
+        "splat-bounds",
+        "AOV splats: rect = the screen rectangle of the triangle's AABB grown by r; box = the box around its occlusion volume, clipped to that rectangle (fewer texels; the image is unchanged)",
+        bzb_of,
+        bzb_mut,
+        box_splats,
+        ["rect", "box"]
     ),
     setting!(
         "directions",
@@ -1257,7 +1265,7 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.clone().unwrap_or_default()
 }
 
-static BZB_GI_SETTINGS: [SettingInfo; 14] = [
+static BZB_GI_SETTINGS: [SettingInfo; 15] = [
     splat_setting!(
         "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
         bzb_gi_of,
@@ -1334,6 +1342,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 14] = [
         bzb_gi_mut,
         culling,
         ["off", "on"]
+    ),
+    bool_setting!(
+        "splat-bounds",
+        "AOV splats: rect = the screen rectangle of the triangle's AABB grown by d_max; box = the box around its occlusion volume, clipped to that rectangle (fewer texels; the image is unchanged)",
+        bzb_gi_of,
+        bzb_gi_mut,
+        box_splats,
+        ["rect", "box"]
     ),
     setting!(
         "filter-radius",

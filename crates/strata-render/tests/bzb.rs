@@ -558,6 +558,82 @@ fn depth_tile_culling_leaves_the_image_unchanged() {
     }
 }
 
+/// AOV splats drawn as the box around each occlusion volume cover every texel the AABB's
+/// screen rectangle covered that a triangle can occlude: the bounced z-buffer, the
+/// payload and the AO are the same bits either way, in both modes. Scenes: atrium and
+/// Cornell, the plate stack, and large tilted triangles seen at a grazing angle, one
+/// of them crossing the near plane (the rectangle fallback).
+#[test]
+fn box_splats_equal_rectangle_splats() {
+    let gpu = common::gpu();
+    let tilted = {
+        let camera = Camera::new(Vec3::new(0.0, 0.6, 2.0), Vec3::new(0.0, 0.0, -1.0), Vec3::Y, 60.0, 0.05);
+        let quads = [
+            // the floor, seen at a grazing angle
+            (
+                Vec3::new(-4.0, 0.0, 3.0),
+                Vec3::new(8.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -9.0),
+            ),
+            // a plate rotated about two axes, standing on it
+            (
+                Vec3::new(-1.2, 0.0, -0.5),
+                Vec3::new(1.6, 0.3, -0.9),
+                Vec3::new(0.2, 1.1, 0.3),
+            ),
+            // a long thin sliver across the view
+            (
+                Vec3::new(-3.0, 0.05, -1.0),
+                Vec3::new(6.0, 0.4, 0.5),
+                Vec3::new(0.0, 0.02, 0.06),
+            ),
+            // a panel passing beside the camera, through its near plane
+            (
+                Vec3::new(0.4, 0.1, 2.5),
+                Vec3::new(0.0, 0.0, -2.0),
+                Vec3::new(0.3, 0.8, 0.0),
+            ),
+        ];
+        quads_scene("tilted", &quads, camera, 0.6)
+    };
+    for scene in [
+        procedural::builtin("atrium").unwrap(),
+        procedural::builtin("cornell").unwrap(),
+        plate_stack(3),
+        tilted,
+    ] {
+        for visibility in [true, false] {
+            let b = |box_splats: bool| BzbSettings {
+                visibility,
+                box_splats,
+                ..Default::default()
+            };
+            let (boxed, rect) = (render(&gpu, &scene, b(true)), render(&gpu, &scene, b(false)));
+            let mut targets = vec!["bzb-payload", "bzb-raw", "ao"];
+            if visibility {
+                targets.push("bzb-depth");
+            }
+            for t in targets {
+                let (a, c) = (boxed.read_target(&gpu, t).unwrap(), rect.read_target(&gpu, t).unwrap());
+                let differ = a
+                    .data
+                    .iter()
+                    .zip(&c.data)
+                    .filter(|(x, y)| x.to_bits() != y.to_bits())
+                    .count();
+                assert_eq!(
+                    differ, 0,
+                    "{} visibility={visibility} {t}: {differ} values differ",
+                    scene.name
+                );
+            }
+            let payload = boxed.read_target(&gpu, "bzb-payload").unwrap();
+            let hits = payload.data.iter().filter(|&&v| v > 0.0).count();
+            assert!(hits > 40, "{}: the scene occludes ({hits})", scene.name);
+        }
+    }
+}
+
 /// `bzb-zminmax` (one workgroup per tile, a workgroup reduction) equals its CPU
 /// twin over `bzb-origins`: every level, partial tiles at the borders (odd size).
 #[test]

@@ -32,6 +32,9 @@ struct Bzb {
     triangles: u32,
     // 1 = splats whose depth range misses every receiver under them are culled
     culling: u32,
+    // 1 = AOV splats draw the box around the occlusion volume, 0 = its screen
+    // rectangle only (bzb_splat.wgsl)
+    box_splats: u32,
 }
 
 // §3.1 / Fig. 5: direction s of pixel p lives in sub-image s; sub-image s is the

@@ -34,6 +34,9 @@ struct GiVisibilityOut {
 
 @fragment
 fn fs_gi_visibility(in: SplatVertex) -> GiVisibilityOut {
+    if (outside_rect(in)) {
+        discard;
+    }
     let texel = vec2i(in.position.xy);
     let o = textureLoad(origins, texel, 0);
     let d = textureLoad(directions, texel, 0);
@@ -55,6 +58,9 @@ fn fs_gi_visibility(in: SplatVertex) -> GiVisibilityOut {
 
 @fragment
 fn fs_gi_additive(in: SplatVertex) -> @location(0) vec4f {
+    if (outside_rect(in)) {
+        discard;
+    }
     let texel = vec2i(in.position.xy);
     let o = textureLoad(origins, texel, 0);
     if (o.w <= 0.0) {

@@ -1,8 +1,8 @@
 // BZB §3.2 splatting with ambient occlusion volumes: one instance per
-// (triangle, sub-image s); its 6 vertices (pulled from the triangle storage
-// buffer: wgpu has no geometry shaders) span the screen rectangle of the
-// triangle's AABB grown by r, a conservative bound of its occlusion volume
-// {x : dist(x, T) < r}, placed in sub-image s. Each covered texel tests its own
+// (triangle, sub-image s); its vertices (pulled from the triangle storage
+// buffer: wgpu has no geometry shaders) draw the back faces of a box around the
+// triangle's occlusion volume {x : dist(x, T) < r}, clipped to the screen
+// rectangle of T's AABB grown by r (both conservative), placed in sub-image s. Each covered texel tests its own
 // ray (x_p, ω) against the triangle:
 //   fs_visibility: hit at t in (t_min, r) → depth t²/r², payload 1 (depth test
 //                  Less, no blending: the nearest occluder along ω wins); miss → discard.
@@ -24,8 +24,72 @@
 struct SplatVertex {
     @builtin(position) position: vec4f,
     @location(0) @interpolate(flat) triangle: u32,
+    // the conservative rectangle (texels of the whole bounced z-buffer, [lo, hi)):
+    // fragments of the box's faces outside it are discarded (`outside_rect`)
+    @location(1) @interpolate(flat) rect: vec4f,
 }
 
+// Vertices per instance: a box's 6 faces × 2 triangles (`vs_splat`).
+const SPLAT_VERTICES: u32 = 36u;
+
+// Homogeneous position in the whole bounced z-buffer (sub-image at `origin`) of world
+// point q, which lies beyond the near plane: the rasteriser's division gives
+// `pixel_of_world(q)` + origin.
+fn splat_clip(q: vec3f, origin: vec2f, big: vec2f) -> vec4f {
+    let v = q - frame.eye.xyz;
+    let z = dot(v, frame.cam_forward.xyz);
+    let right = frame.cam_right.xyz;
+    let up = frame.cam_up.xyz;
+    let a = dot(v, right) / dot(right, right);
+    let b = dot(v, up) / dot(up, up);
+    let px = origin.x * z + (0.5 * a + 0.5 * z) * frame.size.x;
+    let py = origin.y * z + (0.5 * z - 0.5 * b) * frame.size.y;
+    return vec4f(px / big.x * 2.0 - z, z - py / big.y * 2.0, 0.5 * z, z);
+}
+
+fn outside_rect(in: SplatVertex) -> bool {
+    return any(in.position.xy < in.rect.xy) || any(in.position.xy >= in.rect.zw);
+}
+
+// The box around T's occlusion volume {x : dist(x, T) < r}: T's extent along one of its
+// edges (axis 0) and the in-plane perpendicular (axis 1) grown by r, ±r along its normal
+// (axis 2), each grown a little more against rounding at the outline; of the three
+// edges, the one whose box is smallest (a right triangle's leg: its AABB when it is
+// axis-aligned). Returns the centre; `axes` and `half` get the axes and half sizes.
+// (McGuire's AOV are prisms around T; this is their bounding box.)
+fn occlusion_box(a: vec3f, b: vec3f, c: vec3f, r: f32, axes: ptr<function, array<vec3f, 3>>, half: ptr<function, vec3f>) -> vec3f {
+    let v = array<vec3f, 3>(a, b, c);
+    let e2 = normalize(cross(b - a, c - a));
+    var best = 1e38;
+    var centre = a;
+    for (var k = 0u; k < 3u; k++) {
+        let p0 = v[k];
+        let e0 = normalize(v[(k + 1u) % 3u] - p0);
+        let e1 = cross(e2, e0);
+        // the third corner's in-plane coordinates (the others are (0, 0) and (|edge|, 0))
+        let q1 = v[(k + 1u) % 3u] - p0;
+        let q2 = v[(k + 2u) % 3u] - p0;
+        let u = vec3f(0.0, dot(q1, e0), dot(q2, e0));
+        let w = dot(q2, e1);
+        let lo2 = vec2f(min(min(u.x, u.y), u.z), min(0.0, w));
+        let hi2 = vec2f(max(max(u.x, u.y), u.z), max(0.0, w));
+        let g = r * 1.001 + 1e-4 * (hi2.x - lo2.x + hi2.y - lo2.y);
+        let h = 0.5 * (hi2 - lo2) + vec2f(g);
+        if (h.x * h.y < best) {
+            best = h.x * h.y;
+            *axes = array<vec3f, 3>(e0, e1, e2);
+            *half = vec3f(h, g);
+            centre = p0 + e0 * (0.5 * (lo2.x + hi2.x)) + e1 * (0.5 * (lo2.y + hi2.y));
+        }
+    }
+    return centre;
+}
+
+// Vertex vi of instance ii (triangle t = ii / S, sub-image s = ii % S): the faces of
+// `occlusion_box` that look away from the camera, which cover the box's screen outline
+// once without overlap (the others are dropped). Where a box corner lies before the near
+// plane the instance falls back to the screen rectangle of T's grown AABB (vertices
+// 0–5). Fragments are clipped to that rectangle in either case (`rect`).
 @vertex
 fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> SplatVertex {
     var out: SplatVertex;
@@ -34,6 +98,7 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     out.triangle = tri;
     // degenerate (no fragments) unless the rectangle is non-empty
     out.position = vec4f(-2.0, -2.0, 0.5, 1.0);
+    out.rect = vec4f(0.0);
     let a = triangles[3u * tri].xyz;
     let b = triangles[3u * tri + 1u].xyz;
     let c = triangles[3u * tri + 2u].xyz;
@@ -57,13 +122,42 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     if (bzb.culling == 1u && !receivers_in_range(vec2u(size), rmin, rmax, sb.zlo, sb.zhi)) {
         return out;
     }
+    let origin = vec2f(bzb_tile_origin(s, bzb.cols, vec2u(size)));
+    let big = size * vec2f(f32(bzb.cols), f32(bzb.rows));
+    out.rect = vec4f(origin + rmin, origin + rmax);
+    var axes: array<vec3f, 3>;
+    var half: vec3f;
+    let centre = occlusion_box(a, b, c, bzb.radius, &axes, &half);
+    var box_ok = true;
+    for (var k = 0u; k < 8u; k++) {
+        let q = centre + axes[0] * select(-half.x, half.x, (k & 1u) != 0u)
+            + axes[1] * select(-half.y, half.y, (k & 2u) != 0u)
+            + axes[2] * select(-half.z, half.z, (k & 4u) != 0u);
+        box_ok = box_ok && csz_of(frame, q) > frame.eye.w;
+    }
     // corners of two triangles: (0,0) (1,0) (0,1) / (0,1) (1,0) (1,1)
     var corners = array<vec2f, 6>(vec2f(0.0, 0.0), vec2f(1.0, 0.0), vec2f(0.0, 1.0), vec2f(0.0, 1.0), vec2f(1.0, 0.0), vec2f(1.0, 1.0));
-    let corner = corners[vi];
-    let origin = vec2f(bzb_tile_origin(s, bzb.cols, vec2u(size)));
-    let pix = origin + mix(rmin, rmax, corner);
-    let big = size * vec2f(f32(bzb.cols), f32(bzb.rows));
-    out.position = vec4f(pix.x / big.x * 2.0 - 1.0, 1.0 - pix.y / big.y * 2.0, 0.5, 1.0);
+    let corner = corners[vi % 6u];
+    if (!box_ok || bzb.box_splats == 0u) {
+        if (vi < 6u) {
+            let pix = origin + mix(rmin, rmax, corner);
+            out.position = vec4f(pix.x / big.x * 2.0 - 1.0, 1.0 - pix.y / big.y * 2.0, 0.5, 1.0);
+        }
+        return out;
+    }
+    // face f = vi / 6: axis f / 2, side ±; drawn when the camera is on its inner side
+    let f = vi / 6u;
+    let k = f / 2u;
+    let sgn = select(-1.0, 1.0, (f & 1u) != 0u);
+    let m = axes[k] * sgn;
+    let face = centre + m * half[k];
+    if (dot(m, frame.eye.xyz - face) >= 0.0) {
+        return out;
+    }
+    let k1 = (k + 1u) % 3u;
+    let k2 = (k + 2u) % 3u;
+    let q = face + axes[k1] * (half[k1] * (2.0 * corner.x - 1.0)) + axes[k2] * (half[k2] * (2.0 * corner.y - 1.0));
+    out.position = splat_clip(q, origin, big);
     return out;
 }
 
@@ -78,6 +172,9 @@ fn load_triangle(tri: u32) -> array<vec3f, 3> {
 
 @fragment
 fn fs_visibility(in: SplatVertex) -> VisibilityOut {
+    if (outside_rect(in)) {
+        discard;
+    }
     let texel = vec2i(in.position.xy);
     let o = textureLoad(origins, texel, 0);
     let d = textureLoad(directions, texel, 0);
@@ -99,6 +196,9 @@ fn fs_visibility(in: SplatVertex) -> VisibilityOut {
 
 @fragment
 fn fs_additive(in: SplatVertex) -> @location(0) vec4f {
+    if (outside_rect(in)) {
+        discard;
+    }
     let texel = vec2i(in.position.xy);
     let o = textureLoad(origins, texel, 0);
     if (o.w <= 0.0) {

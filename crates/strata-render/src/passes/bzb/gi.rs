@@ -62,6 +62,9 @@ pub struct BzbGiSettings {
     /// Depth-tile culling of splats, AOV triangles and DSS shells (BZB §4.3; the
     /// image is unchanged).
     pub culling: bool,
+    /// AOV splats draw the box around each triangle's occlusion volume (as `bzb-ao`'s
+    /// [`super::BzbSettings::box_splats`]); the image is unchanged.
+    pub box_splats: bool,
     /// Largest sender radiance a payload keeps (its RGB scaled down to this
     /// maximum component; biased, trades caustic fireflies for energy); `None` = off.
     pub clamp: Option<f32>,
@@ -93,6 +96,7 @@ impl Default for BzbGiSettings {
                 ..BilateralSettings::default()
             },
             culling: true,
+            box_splats: false,
             clamp: None,
             splat: super::Splat::Aov,
             dss: super::dss::DssSettings::default(),
@@ -269,6 +273,7 @@ impl BzbGiSettings {
             visibility: self.visibility as u32,
             triangles,
             culling: self.culling as u32,
+            box_splats: self.box_splats as u32,
         }
     }
 }
@@ -907,6 +912,7 @@ impl BzbGiStage {
                 SplatSpec {
                     visibility: s.visibility,
                     instances: count.saturating_mul(s.directions),
+                    box_splats: s.box_splats,
                     source: concat!(
                         include_str!("bzb.wgsl"),
                         "\n",

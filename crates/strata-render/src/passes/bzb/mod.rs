@@ -110,6 +110,12 @@ pub struct BzbSettings {
     /// receiver under them, from min/max depth tiles (issue 13 item 4, BZB §4.3's
     /// "Min/Max MIP-map for splat culling"); the image is the same either way.
     pub culling: bool,
+    /// AOV splats draw the box around each triangle's occlusion volume, clipped to the
+    /// screen rectangle of its grown AABB (true), or that rectangle alone (false, the
+    /// default). Both bound the volume, so the image is the same. The box covers fewer
+    /// texels but draws 36 vertices an instance against 6; on lavapipe it is slower
+    /// (`docs/bzb.md` § "Box splats").
+    pub box_splats: bool,
     /// The splatting algorithm (AOV or DSS).
     pub splat: Splat,
     /// DSS's levels, surfel size and frustum culling (used with `Splat::Dss`).
@@ -155,6 +161,7 @@ impl Default for BzbSettings {
                 ..BilateralSettings::default()
             },
             culling: true,
+            box_splats: false,
             splat: Splat::Aov,
             dss: dss::DssSettings::default(),
             temporal: None,
@@ -296,6 +303,7 @@ pub struct BzbUniforms {
     pub visibility: u32,
     pub triangles: u32,
     pub culling: u32,
+    pub box_splats: u32,
 }
 
 impl BzbUniforms {
@@ -315,6 +323,7 @@ impl BzbUniforms {
             visibility: s.visibility as u32,
             triangles,
             culling: s.culling as u32,
+            box_splats: s.box_splats as u32,
         }
     }
 }
@@ -607,6 +616,8 @@ pub struct SplatPass {
     group: wgpu::BindGroup,
     visibility: bool,
     instances: u32,
+    /// Vertices per instance: 36 for box splats (`SPLAT_VERTICES`), 6 for rectangles.
+    vertices: u32,
     /// The payload target (`bzb-payload`, or `bzb-gi-payload` for GI).
     payload: &'static str,
     /// bzb-gi's sender data (group 2: materials, lights, shadow maps).
@@ -647,7 +658,7 @@ impl Pass for SplatPass {
         if let Some(g) = &self.extra {
             pass.set_bind_group(2, g, &[]);
         }
-        pass.draw(0..6, 0..self.instances);
+        pass.draw(0..self.vertices, 0..self.instances);
     }
 }
 
@@ -960,6 +971,7 @@ impl BzbStage {
             SplatSpec {
                 visibility: s.visibility,
                 instances: count.saturating_mul(s.directions),
+                box_splats: s.box_splats,
                 source: bzb_shader!("bzb_splat.wgsl"),
                 entries: ("fs_visibility", "fs_additive"),
                 payload: PAYLOAD,
@@ -1055,6 +1067,8 @@ impl BzbStage {
 pub(crate) struct SplatSpec<'a> {
     pub visibility: bool,
     pub instances: u32,
+    /// Box splats (36 vertices an instance) or rectangles (6).
+    pub box_splats: bool,
     pub source: &'static str,
     pub entries: (&'static str, &'static str),
     pub payload: TargetDesc,
@@ -1163,6 +1177,8 @@ pub(crate) fn splat_pass_with(
         group,
         visibility: spec.visibility,
         instances: spec.instances,
+        // bzb_splat.wgsl's `SPLAT_VERTICES`, or its fallback rectangle alone
+        vertices: if spec.box_splats { 36 } else { 6 },
         payload: spec.payload.name,
         extra,
     }
