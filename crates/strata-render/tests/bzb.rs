@@ -536,13 +536,7 @@ fn depth_tile_culling_leaves_the_image_unchanged() {
             };
             let (on, off) = (render(&gpu, &scene, b(true)), render(&gpu, &scene, b(false)));
             for t in ["bzb-payload", "bzb-raw", "ao"] {
-                let (a, c) = (on.read_target(&gpu, t).unwrap(), off.read_target(&gpu, t).unwrap());
-                let differ = a
-                    .data
-                    .iter()
-                    .zip(&c.data)
-                    .filter(|(x, y)| x.to_bits() != y.to_bits())
-                    .count();
+                let differ = common::target_bits_differing(&gpu, &on, &off, t);
                 assert_eq!(
                     differ, 0,
                     "{} visibility={visibility} {splat:?} {t}: {differ} values differ",
@@ -614,13 +608,7 @@ fn box_splats_equal_rectangle_splats() {
                 targets.push("bzb-depth");
             }
             for t in targets {
-                let (a, c) = (boxed.read_target(&gpu, t).unwrap(), rect.read_target(&gpu, t).unwrap());
-                let differ = a
-                    .data
-                    .iter()
-                    .zip(&c.data)
-                    .filter(|(x, y)| x.to_bits() != y.to_bits())
-                    .count();
+                let differ = common::target_bits_differing(&gpu, &boxed, &rect, t);
                 assert_eq!(
                     differ, 0,
                     "{} visibility={visibility} {t}: {differ} values differ",

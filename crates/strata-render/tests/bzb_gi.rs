@@ -819,13 +819,7 @@ fn depth_tile_culling_leaves_the_gi_unchanged() {
                 render(&gpu, &scene, 48, 36, g(false)),
             );
             for t in ["bzb-gi-raw", "indirect"] {
-                let (a, b) = (on.read_target(&gpu, t).unwrap(), off.read_target(&gpu, t).unwrap());
-                let differ = a
-                    .data
-                    .iter()
-                    .zip(&b.data)
-                    .filter(|(x, y)| x.to_bits() != y.to_bits())
-                    .count();
+                let differ = common::target_bits_differing(&gpu, &on, &off, t);
                 assert_eq!(
                     differ, 0,
                     "{splat:?} visibility={visibility} {t}: {differ} values differ"
@@ -862,13 +856,7 @@ fn box_splats_equal_rectangle_splats() {
             targets.push("bzb-gi-hit");
         }
         for t in targets {
-            let (a, c) = (boxed.read_target(&gpu, t).unwrap(), rect.read_target(&gpu, t).unwrap());
-            let differ = a
-                .data
-                .iter()
-                .zip(&c.data)
-                .filter(|(x, y)| x.to_bits() != y.to_bits())
-                .count();
+            let differ = common::target_bits_differing(&gpu, &boxed, &rect, t);
             assert_eq!(differ, 0, "visibility={visibility} {t}: {differ} values differ");
         }
         let raw = boxed.read_target(&gpu, "bzb-gi-raw").unwrap();

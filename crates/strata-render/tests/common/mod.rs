@@ -142,6 +142,18 @@ pub fn values_differing(a: &strata_scene::ImageBuf, b: &strata_scene::ImageBuf, 
         .count()
 }
 
+/// How many values of target `name` differ in their bits between renderers `a` and `b`
+/// (the same-image checks of settings that must not change the image).
+pub fn target_bits_differing(gpu: &GpuContext, a: &Renderer, b: &Renderer, name: &str) -> usize {
+    let (x, y) = (a.read_target(gpu, name).unwrap(), b.read_target(gpu, name).unwrap());
+    assert_eq!(x.data.len(), y.data.len(), "{name}: sizes differ");
+    x.data
+        .iter()
+        .zip(&y.data)
+        .filter(|(p, q)| p.to_bits() != q.to_bits())
+        .count()
+}
+
 /// World normals of layer `layer` (0 or 1) decoded from a read-back `npack`
 /// (Oct16, RGBA8) exactly as the shaders decode them.
 pub fn npack_normals(npack: &strata_scene::ImageBuf, layer: usize) -> strata_scene::ImageBuf {
