@@ -603,21 +603,26 @@ impl App {
             .latest_exposure(gpu)
             .or_else(|| self.shown.as_ref().and_then(|s| s.exposure));
         let t_name = strata_render::technique::find(&self.spec.technique).map(|t| t.display);
-        let (image, srgb, target) = match &self.debug_view {
-            Some(v) => (Some(r.debug_view(gpu, v, false)?), true, None),
+        let (image, srgb, target, [width, height]) = match &self.debug_view {
+            Some(v) => {
+                let i = r.debug_view(gpu, v, false)?;
+                let size = [i.width, i.height];
+                (Some(i), true, None, size)
+            }
             None => {
                 let (target, srgb) = t_name.unwrap_or(("ldr", true));
                 match r.display_region(target) {
                     // shown from the GPU; read back only when needed
-                    Some(g) if strata_render::display::supports(g.texture.format()) => (None, srgb, Some(target)),
-                    _ => (Some(r.read_target(gpu, target)?), srgb, None),
+                    Some(g) if strata_render::display::supports(g.texture.format()) => {
+                        (None, srgb, Some(target), g.size)
+                    }
+                    _ => {
+                        let i = r.read_target(gpu, target)?;
+                        let size = [i.width, i.height];
+                        (Some(i), srgb, None, size)
+                    }
                 }
             }
-        };
-        let (width, height) = match (&image, target.and_then(|t| r.display_region(t))) {
-            (Some(i), _) => (i.width, i.height),
-            (None, Some(g)) => (g.size[0], g.size[1]),
-            (None, None) => unreachable!("a target without an image has its region"),
         };
         self.used_last = which;
         if !use_reduced && continuing && self.prev_cam == Some(cam) {

@@ -127,9 +127,13 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     out.rect = vec4f(origin + rmin, origin + rmax);
     var axes: array<vec3f, 3>;
     var half: vec3f;
-    let centre = occlusion_box(a, b, c, bzb.radius, &axes, &half);
-    var box_ok = true;
-    for (var k = 0u; k < 8u; k++) {
+    var centre = a;
+    // the box only for box splats (rectangles, the default, skip its cost)
+    var box_ok = bzb.box_splats != 0u;
+    if (box_ok) {
+        centre = occlusion_box(a, b, c, bzb.radius, &axes, &half);
+    }
+    for (var k = 0u; k < 8u && box_ok; k++) {
         let q = centre + axes[0] * select(-half.x, half.x, (k & 1u) != 0u)
             + axes[1] * select(-half.y, half.y, (k & 2u) != 0u)
             + axes[2] * select(-half.z, half.z, (k & 4u) != 0u);
@@ -138,7 +142,7 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     // corners of two triangles: (0,0) (1,0) (0,1) / (0,1) (1,0) (1,1)
     var corners = array<vec2f, 6>(vec2f(0.0, 0.0), vec2f(1.0, 0.0), vec2f(0.0, 1.0), vec2f(0.0, 1.0), vec2f(1.0, 0.0), vec2f(1.0, 1.0));
     let corner = corners[vi % 6u];
-    if (!box_ok || bzb.box_splats == 0u) {
+    if (!box_ok) {
         if (vi < 6u) {
             let pix = origin + mix(rmin, rmax, corner);
             out.position = vec4f(pix.x / big.x * 2.0 - 1.0, 1.0 - pix.y / big.y * 2.0, 0.5, 1.0);
