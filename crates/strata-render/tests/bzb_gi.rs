@@ -505,48 +505,111 @@ fn sunlit_floor(name: &str) -> (Scene, Vec3, Vec3) {
     (scene, dir, Vec3::from(color) * illuminance)
 }
 
-/// Senders read their base-colour texture: a triangle's ρ is the base colour times the
-/// texture's mean over it (`gi::sender_texture_means`). On the CPU: a texture red for
-/// u < ½ and green beyond, on the triangle (0,0), (1,0), (0,1) in UV, averages to exactly
-/// ¾ red + ¼ green (the sub-triangle grid follows u = ½); an untextured triangle gets 1.
-/// On the GPU: the sunlit plane of the surfel test, white with a uniform texture c, has
-/// surfels of radiance c/π · E cos θ (the base colour alone would give 1/π · E cos θ).
-#[test]
-fn senders_read_their_base_colour_texture() {
-    use strata_scene::model::Texture;
-    let (red, green) = ([230u8, 40, 20], [30u8, 200, 60]);
-    let lin = |c: [u8; 3]| Vec3::from(c.map(strata_scene::model::srgb_to_linear));
-    let tri = [Vec3::ZERO, Vec3::X, Vec3::Z];
-    let mut scene = common::polygons_scene("textured", &[&tri, &tri], Camera::default(), 0.1);
-    scene.meshes[0].uvs = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-    scene.materials[0].base_color = [1.0; 3];
-    scene.materials[0].base_color_texture = Some(0);
-    scene.materials.push(Material::diffuse("plain", [0.5; 3]));
-    scene.meshes[1].material = 1;
-    scene.textures.push(Texture {
-        name: "halves".into(),
-        width: 2,
-        height: 1,
-        rgba8: [red, green].iter().flat_map(|c| [c[0], c[1], c[2], 255]).collect(),
-    });
-    let means = gi::sender_texture_means(&scene);
-    let want = lin(red) * 0.75 + lin(green) * 0.25;
-    assert!(
-        (Vec3::from(means[0]) - want).abs().max_element() < 1e-5,
-        "{means:?} vs {want}"
-    );
-    assert_eq!(means[1], [1.0; 3], "no texture: the base colour alone");
+/// A 4 × 4 texture of 16 distinct colours.
+fn checker_texture() -> strata_scene::model::Texture {
+    let rgba8 = (0..16u32)
+        .flat_map(|i| [(37 * i + 20) % 256, (91 * i + 50) % 256, (53 * i + 90) % 256, 255].map(|c| c as u8))
+        .collect();
+    strata_scene::model::Texture {
+        name: "checker".into(),
+        width: 4,
+        height: 4,
+        rgba8,
+    }
+}
 
+/// BZB §3.2: a hit's payload is the sender's radiance at the hit y, so ρ(y) is the
+/// texel under y's UV (`gi::sender_texels`, read nearest with wrap as the reference
+/// reads it). A point light lights a floor textured with 16 colours (UV = (x, z)/4,
+/// so the UVs wrap and go negative) under a grey ceiling the camera looks up at. The
+/// frame is rendered textured and again white: at every bounced-z-buffer texel whose
+/// ray hits the floor, the ratio of the two payloads is the texel under the hit's UV.
+/// With DSS surfels on the sunlit floor, each surfel's radiance is ρ(y)/π E cos θ.
+/// One colour per triangle (the texture's mean, strata's form until 2026-11-30) fails
+/// both.
+#[test]
+fn senders_read_the_texel_under_the_hit() {
     let gpu = common::gpu();
+    let lin = |c: &[f32]| Vec3::new(c[0], c[1], c[2]);
+    let floor = [
+        Vec3::new(-4.0, 0.0, -4.0),
+        Vec3::new(-4.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, -4.0),
+    ];
+    let ceiling = floor.map(|p| Vec3::new(p.z, 1.0, p.x));
+    let camera = Camera::new(Vec3::new(0.0, 0.3, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Z, 60.0, 0.01);
+    let mut scene = common::polygons_scene("textured-floor", &[&floor, &ceiling], camera, 0.1);
+    scene.settings = common::unlit_settings();
+    scene.meshes[0].uvs = floor.iter().map(|p| [p.x / 4.0, p.z / 4.0]).collect();
+    scene.materials[0].base_color = [1.0; 3];
+    scene.materials.push(Material::diffuse("ceiling", [0.5; 3]));
+    scene.meshes[1].material = 1;
+    scene.lights.push(strata_scene::model::Light::Point {
+        position: Vec3::new(0.3, 0.5, 0.2),
+        color: [1.0; 3],
+        intensity: 2.0,
+    });
+    let texture = checker_texture();
+    let mut textured = scene.clone();
+    textured.materials[0].base_color_texture = Some(0);
+    textured.textures.push(texture.clone());
+    let (w, h) = (40, 30);
+    let g = BzbGiSettings {
+        directions: 4,
+        ..Default::default()
+    };
+    let read = |r: &Renderer, name: &str| r.read_target(&gpu, name).unwrap();
+    let white = render(&gpu, &scene, w, h, g.clone());
+    let tex = render(&gpu, &textured, w, h, g.clone());
+    let (hits, origins, dirs) = (
+        read(&tex, "bzb-gi-hit"),
+        read(&tex, "bzb-origins"),
+        read(&tex, "bzb-directions"),
+    );
+    let (p_white, p_tex) = (read(&white, "bzb-gi-payload"), read(&tex, "bzb-gi-payload"));
+    assert_eq!(
+        hits.data,
+        read(&white, "bzb-gi-hit").data,
+        "the same rays hit the same senders"
+    );
+    let (mut n, mut wrong, mut seen) = (0, 0, std::collections::BTreeSet::new());
+    for y in 0..hits.height {
+        for x in 0..hits.width {
+            let id = hits.pixel(x, y)[0].round() as u32;
+            let base = lin(p_white.pixel(x, y));
+            if !(1..=2).contains(&id) || base.min_element() < 1e-3 {
+                continue;
+            }
+            let (o, d) = (lin(origins.pixel(x, y)), lin(dirs.pixel(x, y)));
+            let hit = o + d * (-o.y / d.y);
+            let uv = [hit.x / 4.0, hit.z / 4.0];
+            let want = lin(&texture.sample_linear(uv));
+            let got = lin(p_tex.pixel(x, y)) / base;
+            n += 1;
+            if ((got - want) / want).abs().max_element() > 4e-3 {
+                wrong += 1;
+            } else {
+                seen.insert(want.to_array().map(f32::to_bits));
+            }
+        }
+    }
+    eprintln!(
+        "{n} floor hits: {wrong} off the texel under the hit; {} of 16 texels seen",
+        seen.len()
+    );
+    assert!(n > 1000, "{n} floor hits");
+    assert!(
+        wrong * 100 <= n,
+        "{wrong} of {n} hits' payloads are not ρ(y) × the white payload"
+    );
+    assert!(seen.len() >= 14, "hits saw {} of the 16 texels", seen.len());
+
     let (mut scene, dir, sun) = sunlit_floor("sunlit-textured");
+    scene.meshes[0].uvs = floor.iter().map(|p| [p.x / 4.0, p.z / 4.0]).collect();
     scene.materials[0].base_color = [1.0; 3];
     scene.materials[0].base_color_texture = Some(0);
-    scene.textures.push(Texture {
-        name: "c".into(),
-        width: 1,
-        height: 1,
-        rgba8: vec![red[0], red[1], red[2], 255],
-    });
+    scene.textures.push(texture.clone());
     let r = render(
         &gpu,
         &scene,
@@ -559,18 +622,19 @@ fn senders_read_their_base_colour_texture() {
     );
     let surfels = r.dss_gi_surfels(&gpu).expect("bzb-gi DSS stage").unwrap();
     assert!(surfels.len() > 50, "{} surfels", surfels.len());
-    let want = sun * lin(red) * (Vec3::Y.dot(-dir) / std::f32::consts::PI);
-    let worst = surfels
+    let cos = Vec3::Y.dot(-dir) / std::f32::consts::PI;
+    let off = surfels
         .iter()
-        .map(|(_, front, _)| ((*front - want) / want).abs().max_element())
-        .fold(0.0f32, f32::max);
-    eprintln!(
-        "{} textured surfels: worst relative error {worst:.5} (want {want})",
-        surfels.len()
-    );
+        .filter(|(s, front, _)| {
+            let want = sun * lin(&texture.sample_linear([s.position.x / 4.0, s.position.z / 4.0])) * cos;
+            ((*front - want) / want).abs().max_element() > 2e-3
+        })
+        .count();
+    eprintln!("{} textured surfels: {off} off ρ(y)/π E cos θ", surfels.len());
     assert!(
-        worst < 2e-3,
-        "surfel radiance off by {worst} relative to c/π E cos θ = {want}"
+        off * 100 <= surfels.len(),
+        "{off} of {} surfels' radiance is not ρ(y)/π E cos θ",
+        surfels.len()
     );
 }
 

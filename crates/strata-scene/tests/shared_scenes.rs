@@ -170,6 +170,24 @@ fn toml_sponza_and_dragon_load() {
     );
     assert_eq!((s.settings.ao_radius, s.settings.min_separation), (1.0, 0.5));
 
+    // sponza-polished.toml: the same scene with only the stone floor polished
+    let p = load_path(&common::repo_scenes().join("sponza-polished.toml")).expect("sponza-polished.toml");
+    assert_eq!(
+        (p.triangle_count(), p.camera.eye, p.lights.len()),
+        (66_454, s.camera.eye, 2)
+    );
+    for (a, b) in s.materials.iter().zip(&p.materials) {
+        if a.name == "sp_00_pod" {
+            assert!(b.glossy && (b.roughness, b.metallic) == (0.1, 1.0), "{b:?}");
+            assert_eq!(
+                (b.base_color, b.base_color_texture),
+                (a.base_color, a.base_color_texture)
+            );
+        } else {
+            assert_eq!(a, b, "only the floor changes");
+        }
+    }
+
     let d = load_path(&common::repo_scenes().join("dragon.toml")).expect("dragon.toml");
     assert_eq!(d.triangle_count(), 871_414 + 2);
     let (lo, hi) = d.bounds(0.0);

@@ -1,9 +1,14 @@
 // bzb-gi: the sender's outgoing radiance towards a receiver (BZB §3.2's GI
 // payload), shared by the shade pass (bounced z-buffer) and the additive
 // baseline's splats. The importer declares `gi` (BzbGi), `gi_tris` (sender
-// data, 5 vec4 per triangle), `triangles` (3 vec4 of positions per triangle),
-// `lights` (array<GpuLight>) and the globals of common/shadow.wgsl.
+// data, GI_TRI_VEC4S vec4 per triangle: gi::sender_data), `sender_texels`
+// (array<u32>: gi::sender_texels), `triangles` (3 vec4 of positions per
+// triangle), `lights` (array<GpuLight>) and the globals of common/shadow.wgsl.
 #import "common/shadow.wgsl"
+
+const GI_TRI_VEC4S: u32 = 7u;
+// words of the sRGB decode table at the start of sender_texels
+const GI_TEXEL_LUT: u32 = 256u;
 
 fn gi_triangle(tri: u32) -> array<vec3f, 3> {
     return array<vec3f, 3>(triangles[3u * tri].xyz, triangles[3u * tri + 1u].xyz, triangles[3u * tri + 2u].xyz);
@@ -26,6 +31,32 @@ fn gi_barycentrics(y: vec3f, a: vec3f, b: vec3f, c: vec3f) -> vec2f {
     return vec2f(d22 * q1 - d12 * q2, d11 * q2 - d12 * q1) / det;
 }
 
+// The sender's base-colour texture at barycentrics `bary` (BZB §3.2: the radiance
+// at the hit y, so ρ(y)): the texel under y's UV, nearest with wrap, decoded with
+// the reference's table (Texture::sample_linear); 1 without a texture. CPU twin:
+// gi::sender_texel_cpu.
+fn gi_sender_texture(tri: u32, bary: vec2f) -> vec3f {
+    let base = GI_TRI_VEC4S * tri;
+    let slot = u32(gi_tris[base + 4u].z + 0.5);
+    if (slot == 0u) {
+        return vec3f(1.0);
+    }
+    let q5 = gi_tris[base + 5u];
+    let q6 = gi_tris[base + 6u];
+    let uv = q5.xy * (1.0 - bary.x - bary.y) + q5.zw * bary.x + q6.xy * bary.y;
+    let e = GI_TEXEL_LUT + 4u * (slot - 1u);
+    let w = sender_texels[e + 1u];
+    let h = sender_texels[e + 2u];
+    let x = u32((uv.x - floor(uv.x)) * f32(w));
+    let y = u32((uv.y - floor(uv.y)) * f32(h));
+    let p = sender_texels[sender_texels[e] + min(y, h - 1u) * w + min(x, w - 1u)];
+    return vec3f(
+        bitcast<f32>(sender_texels[p & 0xffu]),
+        bitcast<f32>(sender_texels[(p >> 8u) & 0xffu]),
+        bitcast<f32>(sender_texels[(p >> 16u) & 0xffu]),
+    );
+}
+
 // The sender's outgoing radiance at y (barycentrics `bary` on triangle `tri`)
 // towards the unit direction `to_x`: direct light of every analytic light
 // (lights.wgsl's irradiance, shadowed by the lighting pass's shadow maps)
@@ -34,13 +65,13 @@ fn gi_barycentrics(y: vec3f, a: vec3f, b: vec3f, c: vec3f) -> vec2f {
 // when no Rect light carries it (the lighting pass's convention). Surfaces are
 // two-sided, as in the path tracer.
 fn gi_sender(tri: u32, y: vec3f, bary: vec2f, to_x: vec3f) -> vec3f {
-    let base = 5u * tri;
+    let base = GI_TRI_VEC4S * tri;
     let q0 = gi_tris[base];
     let q1 = gi_tris[base + 1u];
     let q2 = gi_tris[base + 2u];
     let q3 = gi_tris[base + 3u];
     let q4 = gi_tris[base + 4u];
-    let rho = vec3f(q0.w, q1.w, q2.w);
+    let rho = vec3f(q0.w, q1.w, q2.w) * gi_sender_texture(tri, bary);
     let v = gi_triangle(tri);
     var ng = normalize(cross(v[1] - v[0], v[2] - v[0]));
     let front = dot(ng, to_x) > 0.0;

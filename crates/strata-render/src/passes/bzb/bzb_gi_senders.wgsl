@@ -12,6 +12,7 @@
 @group(0) @binding(5) var shadow_sampler: sampler_comparison;
 @group(0) @binding(6) var<storage, read> shadow_mats: array<mat4x4f>;
 @group(0) @binding(7) var<storage, read_write> mean_radiance: array<vec4f>;
+@group(0) @binding(8) var<storage, read> sender_texels: array<u32>;
 
 const GI_SENDER_GRID: u32 = 8u;
 

@@ -14,6 +14,7 @@
 @group(1) @binding(7) var shadow_maps: texture_depth_2d_array;
 @group(1) @binding(8) var shadow_sampler: sampler_comparison;
 @group(1) @binding(9) var<storage, read> shadow_mats: array<mat4x4f>;
+@group(1) @binding(10) var<storage, read> sender_texels: array<u32>;
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {

@@ -13,7 +13,7 @@
 //       The sum does not depend on ω, so it is splatted into sub-image 0 only.
 
 @group(2) @binding(0) var<uniform> gi: BzbGi;
-// 5 vec4 per triangle: (n0, ρ.r), (n1, ρ.g), (n2, ρ.b), (emission, glossy), (roughness, metallic, 0, 0)
+// GI_TRI_VEC4S vec4 per triangle (gi::sender_data)
 @group(2) @binding(1) var<storage, read> gi_tris: array<vec4f>;
 @group(2) @binding(2) var<storage, read> lights: array<GpuLight>;
 @group(2) @binding(3) var shadow_maps: texture_depth_2d_array;
@@ -25,6 +25,8 @@
 @group(2) @binding(8) var emission_tex: texture_2d<f32>;
 // the baseline's per-triangle mean radiance L̄_T (bzb_gi_senders.wgsl)
 @group(2) @binding(9) var<storage, read> mean_radiance: array<vec4f>;
+// the senders' textures (gi::sender_texels), read by bzb_gi_sender.wgsl
+@group(2) @binding(10) var<storage, read> sender_texels: array<u32>;
 
 struct GiVisibilityOut {
     // the hit triangle + 1 (bzb-gi-hit; the shade pass computes its radiance)

@@ -574,6 +574,8 @@ pub(crate) struct DssGiInputs<'a> {
     pub shadow_view: &'a wgpu::TextureView,
     pub sampler: &'a wgpu::Sampler,
     pub shadow_mats: &'a wgpu::Buffer,
+    /// The senders' textures (`gi::sender_texels`).
+    pub texels: &'a wgpu::Buffer,
 }
 
 /// Buffers of the surfelization.
@@ -1027,6 +1029,7 @@ impl DssStage {
                 buf(7, ro),
                 buf(8, ro),
                 buf(9, wgpu::BufferBindingType::Storage { read_only: false }),
+                buf(10, ro),
             ],
         });
         let radiance = buffers.radiance.as_ref().expect("bzb-gi DSS has a radiance buffer");
@@ -1045,6 +1048,7 @@ impl DssStage {
                 buffers.surfels.as_entire_binding(),
                 buffers.counters.as_entire_binding(),
                 radiance.as_entire_binding(),
+                g.texels.as_entire_binding(),
             ],
         );
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

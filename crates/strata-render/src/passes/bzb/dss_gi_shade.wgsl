@@ -18,6 +18,7 @@
 // dss counters: [sub-triangles, fine surfels, surfels, triangles after culling]
 @group(1) @binding(8) var<storage, read> counters: array<u32>;
 @group(1) @binding(9) var<storage, read_write> radiance: array<vec4f>;
+@group(1) @binding(10) var<storage, read> sender_texels: array<u32>;
 
 @compute @workgroup_size(64)
 fn cs_main(@builtin(global_invocation_id) id: vec3u) {

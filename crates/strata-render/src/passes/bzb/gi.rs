@@ -441,74 +441,124 @@ pub fn direction(n: Vec3, v: Vec3, glossy: Option<Glossy>, u_lobe: f32, u: [f32;
     }
 }
 
-/// Subdivisions per edge of [`sender_texture_means`]: n² texture reads per triangle.
-pub const SENDER_TEXTURE_SUBDIVISIONS: u32 = 8;
+/// vec4s per triangle in the sender data ([`sender_data`], `gi_tris` in WGSL).
+pub const SENDER_VEC4S: usize = 7;
 
-/// Each triangle's mean base-colour texture over its surface, in
-/// `Scene::world_triangles` order (linear RGB; 1 where the material has no texture). The
-/// texture is read (nearest texel, wrap, as the CPU reference reads it) at the centroids
-/// of the n × n equal sub-triangles of the triangle ([`SENDER_TEXTURE_SUBDIVISIONS`]):
-/// exact for a texture whose colour regions follow that grid, and the texture's mean
-/// over a triangle that tiles it many times. The splats carry no UVs, so one colour per
-/// triangle stands for its texture: a sender lights receivers from a distance, where
-/// the bounce averages its texture anyway. UVs do not animate: computed once per scene.
-pub fn sender_texture_means(scene: &Scene) -> Vec<[f32; 3]> {
-    let lut: Vec<f32> = (0..=255u8).map(strata_scene::model::srgb_to_linear).collect();
-    let n = SENDER_TEXTURE_SUBDIVISIONS;
-    let mut points = Vec::with_capacity((n * n) as usize);
-    for i in 0..n {
-        for j in 0..n - i {
-            let (a, b) = (i as f32, j as f32);
-            points.push(((a + 1.0 / 3.0) / n as f32, (b + 1.0 / 3.0) / n as f32));
-            if i + j + 1 < n {
-                points.push(((a + 2.0 / 3.0) / n as f32, (b + 2.0 / 3.0) / n as f32));
-            }
-        }
-    }
-    scene
-        .world_triangles(0.0)
-        .iter()
-        .map(|t| {
-            let m = &scene.materials[t.material as usize];
-            let Some(tex) = m
-                .base_color_texture
-                .and_then(|i| scene.textures.get(i))
-                .filter(|x| x.width > 0 && x.height > 0 && x.rgba8.len() >= (x.width * x.height * 4) as usize)
-            else {
-                return [1.0; 3];
-            };
-            let mut sum = [0.0f64; 3];
-            for &(a, b) in &points {
-                let uv = [0, 1].map(|k| t.uv[0][k] * (1.0 - a - b) + t.uv[1][k] * a + t.uv[2][k] * b);
-                let (u, v) = (uv[0] - uv[0].floor(), uv[1] - uv[1].floor());
-                let x = ((u * tex.width as f32) as u32).min(tex.width - 1);
-                let y = ((v * tex.height as f32) as u32).min(tex.height - 1);
-                let i = ((y * tex.width + x) * 4) as usize;
-                for (s, &byte) in sum.iter_mut().zip(&tex.rgba8[i..i + 3]) {
-                    *s += lut[byte as usize] as f64;
-                }
-            }
-            sum.map(|s| (s / points.len() as f64) as f32)
-        })
-        .collect()
+/// Words of the sRGB decode table at the start of [`SenderTexels::words`].
+pub const SENDER_TEXEL_LUT: usize = 256;
+
+/// The most bytes of sender texels strata uploads by default: larger texture sets are
+/// halved, largest first, until they fit ([`sender_texels`]).
+pub const SENDER_TEXEL_BUDGET: u64 = 64 << 20;
+
+/// The senders' base-colour textures as `bzb_gi_sender.wgsl` reads them: BZB §3.2's
+/// payload is the sender's radiance at the hit y, so ρ(y) takes the texel under y's UV.
+/// One `u32` storage buffer (no bindless):
+/// - words 0–255: the reference's sRGB decode of each byte, as f32 bits (so the GPU
+///   decodes exactly as `Texture::sample_linear`);
+/// - then 4 words per uploaded texture (slot): offset of its first texel, width, height, 0;
+/// - then the texels, RGBA8 packed little-endian (r in the low byte).
+#[derive(Clone, Debug)]
+pub struct SenderTexels {
+    pub words: Vec<u32>,
+    /// Per scene texture: its slot + 1, 0 where it is missing or malformed (the
+    /// reference skips those too).
+    pub slots: Vec<u32>,
+    /// How many times a texture was halved to fit the budget (0: all at full size).
+    pub halvings: u32,
 }
 
-/// Per-triangle sender data as `bzb_gi_splat.wgsl` pulls it: 5 vec4 per
-/// triangle, (n0, ρ.r), (n1, ρ.g), (n2, ρ.b), (emission, glossy), (roughness,
-/// metallic, 0, 0). ρ is the material's base colour times the triangle's mean texture
-/// (`texture_means`, from [`sender_texture_means`]).
-pub fn sender_data(scene: &Scene, frame: f32, texture_means: &[[f32; 3]]) -> Vec<[f32; 4]> {
+/// Packs the scene's textures into [`SenderTexels`], at most `budget` bytes: while they
+/// do not fit, the texture with the most texels is halved (triangle filter on the sRGB
+/// bytes). Only the halved ones then differ from what the reference reads.
+pub fn sender_texels(scene: &Scene, budget: u64) -> SenderTexels {
+    let mut images: Vec<Option<image::RgbaImage>> = scene
+        .textures
+        .iter()
+        .map(|t| {
+            (t.width > 0 && t.height > 0 && t.rgba8.len() >= (t.width * t.height * 4) as usize)
+                .then(|| {
+                    image::RgbaImage::from_raw(t.width, t.height, t.rgba8[..(t.width * t.height * 4) as usize].to_vec())
+                })
+                .flatten()
+        })
+        .collect();
+    let bytes = |images: &[Option<image::RgbaImage>]| -> u64 {
+        let words: u64 = images
+            .iter()
+            .flatten()
+            .map(|i| 4 + i.width() as u64 * i.height() as u64)
+            .sum();
+        (SENDER_TEXEL_LUT as u64 + words) * 4
+    };
+    let mut halvings = 0;
+    while bytes(&images) > budget {
+        let Some(big) = images
+            .iter_mut()
+            .flatten()
+            .filter(|i| i.width() * i.height() > 1)
+            .max_by_key(|i| i.width() as u64 * i.height() as u64)
+        else {
+            break;
+        };
+        let (w, h) = ((big.width() / 2).max(1), (big.height() / 2).max(1));
+        *big = image::imageops::resize(big, w, h, image::imageops::FilterType::Triangle);
+        halvings += 1;
+    }
+    let mut words: Vec<u32> = (0..=255u8)
+        .map(|b| strata_scene::model::srgb_to_linear(b).to_bits())
+        .collect();
+    let uploaded = images.iter().flatten().count();
+    let mut offset = (SENDER_TEXEL_LUT + 4 * uploaded) as u32;
+    let mut slots = Vec::with_capacity(images.len());
+    for image in &images {
+        match image {
+            Some(i) => {
+                slots.push(1 + (words.len() - SENDER_TEXEL_LUT) as u32 / 4);
+                words.extend([offset, i.width(), i.height(), 0]);
+                offset += i.width() * i.height();
+            }
+            None => slots.push(0),
+        }
+    }
+    for i in images.iter().flatten() {
+        words.extend(i.pixels().map(|p| u32::from_le_bytes(p.0)));
+    }
+    SenderTexels { words, slots, halvings }
+}
+
+/// CPU twin of `gi_sender_texture` (`bzb_gi_sender.wgsl`): the linear base-colour
+/// texture of slot `slot` (1-based; 0: none, white) under `uv`: nearest texel, wrap.
+pub fn sender_texel_cpu(words: &[u32], slot: u32, uv: [f32; 2]) -> [f32; 3] {
+    if slot == 0 {
+        return [1.0; 3];
+    }
+    let e = SENDER_TEXEL_LUT + 4 * (slot as usize - 1);
+    let (offset, w, h) = (words[e], words[e + 1], words[e + 2]);
+    let x = ((uv[0] - uv[0].floor()) * w as f32) as u32;
+    let y = ((uv[1] - uv[1].floor()) * h as f32) as u32;
+    let p = words[(offset + y.min(h - 1) * w + x.min(w - 1)) as usize];
+    [0, 8, 16].map(|s| f32::from_bits(words[((p >> s) & 0xff) as usize]))
+}
+
+/// Per-triangle sender data as `bzb_gi_sender.wgsl` pulls it: [`SENDER_VEC4S`] vec4
+/// per triangle, (n0, ρ.r), (n1, ρ.g), (n2, ρ.b), (emission, glossy), (roughness,
+/// metallic, texture slot, 0), (uv0, uv1), (uv2, 0, 0). ρ is the material's base
+/// colour; the shader multiplies it by the texture (slot from `slots`,
+/// [`SenderTexels::slots`]; 0 = none) at the point it shades.
+pub fn sender_data(scene: &Scene, frame: f32, slots: &[u32]) -> Vec<[f32; 4]> {
     let mut out = Vec::new();
-    for (k, t) in scene.world_triangles(frame).iter().enumerate() {
+    for t in scene.world_triangles(frame).iter() {
         let m = &scene.materials[t.material as usize];
-        let tex = texture_means.get(k).copied().unwrap_or([1.0; 3]);
-        let rho = [0, 1, 2].map(|c| m.base_color[c] * tex[c]);
-        for (n, r) in t.n.iter().zip(rho) {
+        for (n, r) in t.n.iter().zip(m.base_color) {
             out.push(n.extend(r).to_array());
         }
         let e = m.emission;
         out.push([e[0], e[1], e[2], m.glossy as u32 as f32]);
-        out.push([m.roughness, m.metallic, 0.0, 0.0]);
+        let slot = m.base_color_texture.and_then(|i| slots.get(i)).copied().unwrap_or(0);
+        out.push([m.roughness, m.metallic, slot as f32, 0.0]);
+        out.push([t.uv[0][0], t.uv[0][1], t.uv[1][0], t.uv[1][1]]);
+        out.push([t.uv[2][0], t.uv[2][1], 0.0, 0.0]);
     }
     out
 }
@@ -651,8 +701,8 @@ pub(crate) struct BzbGiStage {
     lights: wgpu::Buffer,
     triangles: wgpu::Buffer,
     senders: wgpu::Buffer,
-    /// Each triangle's mean base-colour texture ([`sender_texture_means`]).
-    texture_means: Vec<[f32; 3]>,
+    /// Each scene texture's slot in the senders' texels ([`sender_texels`]).
+    texture_slots: Vec<u32>,
     count: u32,
     settings: BzbGiSettings,
     base: GiUniforms,
@@ -709,10 +759,18 @@ impl BzbGiStage {
         }
         let data = super::triangle_data(scene, 0.0);
         let count = (data.len() / 3) as u32;
-        let texture_means = sender_texture_means(scene);
-        let senders_data = sender_data(scene, 0.0, &texture_means);
         let limit = device.limits().max_storage_buffer_binding_size;
-        let sender_bytes = (senders_data.len() * 16).max(80) as u64;
+        let packed = sender_texels(scene, SENDER_TEXEL_BUDGET.min(limit));
+        if packed.halvings > 0 {
+            tracing::warn!(
+                "scene '{}': bzb-gi halved its senders' textures {} times to fit {} bytes (the reference reads them at full size)",
+                scene.name,
+                packed.halvings,
+                SENDER_TEXEL_BUDGET.min(limit)
+            );
+        }
+        let senders_data = sender_data(scene, 0.0, &packed.slots);
+        let sender_bytes = (senders_data.len() * 16).max(16 * SENDER_VEC4S) as u64;
         if sender_bytes > limit {
             return Err(crate::RenderError::Parameter(format!(
                 "scene '{}' has {count} triangles: {sender_bytes} bytes of bzb-gi sender data exceed the adapter's storage buffer binding size {limit}",
@@ -732,7 +790,13 @@ impl BzbGiStage {
         let senders = buffer(
             "bzb-gi-senders",
             bytemuck::cast_slice(&senders_data).to_vec(),
-            80,
+            16 * SENDER_VEC4S,
+            storage,
+        );
+        let texels = buffer(
+            "bzb-gi-sender-texels",
+            bytemuck::cast_slice(&packed.words).to_vec(),
+            0,
             storage,
         );
         let mut light_data = light.lights.to_vec();
@@ -840,6 +904,7 @@ impl BzbGiStage {
                 tex(7),
                 tex(8),
                 storage_ro(9),
+                storage_ro(10),
             ],
         });
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -865,6 +930,7 @@ impl BzbGiStage {
                 view("albedo"),
                 view("emission"),
                 mean.as_entire_binding(),
+                texels.as_entire_binding(),
             ],
         );
         let senders_pass = (!s.visibility && aov).then(|| {
@@ -879,6 +945,7 @@ impl BzbGiStage {
                     wgpu::BindingResource::Sampler(&sampler),
                     light.shadow.matrices.as_entire_binding(),
                     mean.as_entire_binding(),
+                    texels.as_entire_binding(),
                 ],
                 count,
             )
@@ -901,6 +968,7 @@ impl BzbGiStage {
                 )
                 .sampler(&sampler, wgpu::SamplerBindingType::Comparison)
                 .storage(&light.shadow.matrices)
+                .storage(&texels)
                 .write(PAYLOAD.name)
                 .build()
         });
@@ -949,6 +1017,7 @@ impl BzbGiStage {
                     shadow_view: &light.shadow.array_view,
                     sampler: &sampler,
                     shadow_mats: &light.shadow.matrices,
+                    texels: &texels,
                 }),
             )?),
         };
@@ -1023,7 +1092,7 @@ impl BzbGiStage {
             lights,
             triangles,
             senders,
-            texture_means,
+            texture_slots: packed.slots,
             count,
             settings: s.clone(),
             base,
@@ -1068,7 +1137,7 @@ impl BzbGiStage {
         if animated && self.count > 0 {
             let data = super::triangle_data(scene, frame);
             gpu.queue.write_buffer(&self.triangles, 0, bytemuck::cast_slice(&data));
-            let senders = sender_data(scene, frame, &self.texture_means);
+            let senders = sender_data(scene, frame, &self.texture_slots);
             gpu.queue.write_buffer(&self.senders, 0, bytemuck::cast_slice(&senders));
             if !lights.is_empty() {
                 gpu.queue.write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));
@@ -1126,7 +1195,7 @@ struct SenderPass {
 }
 
 impl SenderPass {
-    fn new(gpu: &GpuContext, resources: [wgpu::BindingResource; 8], count: u32) -> Self {
+    fn new(gpu: &GpuContext, resources: [wgpu::BindingResource; 9], count: u32) -> Self {
         let device = &gpu.device;
         let comp = wgpu::ShaderStages::COMPUTE;
         let buf = |binding, read_only| wgpu::BindGroupLayoutEntry {
@@ -1155,6 +1224,7 @@ impl SenderPass {
                 shadow_sampler,
                 buf(6, true),
                 buf(7, false),
+                buf(8, true),
             ],
         });
         let group = crate::passes::bind_group(device, "bzb-gi-senders", &layout, &resources);
@@ -1193,5 +1263,81 @@ impl Pass for SenderPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.group, &[]);
         pass.dispatch_workgroups(self.count.div_ceil(64), 1, 1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use strata_scene::model::{Material, Texture};
+
+    fn texture(name: &str, width: u32, height: u32, seed: u32) -> Texture {
+        let rgba8 = (0..width * height * 4)
+            .map(|i| (i.wrapping_mul(2_654_435_761).wrapping_add(seed) >> 13) as u8)
+            .collect();
+        Texture {
+            name: name.into(),
+            width,
+            height,
+            rgba8,
+        }
+    }
+
+    fn scene_with(textures: Vec<Texture>) -> Scene {
+        let mut scene = Scene::default();
+        for (i, t) in textures.into_iter().enumerate() {
+            let mut m = Material::diffuse(&t.name, [1.0; 3]);
+            m.base_color_texture = Some(i);
+            scene.materials.push(m);
+            scene.textures.push(t);
+        }
+        scene
+    }
+
+    /// The packed texels read back exactly what the reference reads
+    /// (`Texture::sample_linear`), at random UVs, negative and beyond 1 too; a
+    /// malformed texture gets no slot (white), as the reference skips it.
+    #[test]
+    fn sender_texels_read_as_the_reference_reads_its_textures() {
+        let mut bad = texture("short", 4, 4, 1);
+        bad.rgba8.truncate(10);
+        let scene = scene_with(vec![texture("a", 7, 3, 5), bad, texture("b", 16, 9, 11)]);
+        let packed = sender_texels(&scene, SENDER_TEXEL_BUDGET);
+        assert_eq!(packed.slots, vec![1, 0, 2]);
+        assert_eq!(packed.halvings, 0);
+        assert_eq!(packed.words.len(), SENDER_TEXEL_LUT + 8 + 7 * 3 + 16 * 9);
+        assert_eq!(sender_texel_cpu(&packed.words, 0, [0.3, 0.4]), [1.0; 3]);
+        let mut state = 12345u32;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1 << 24) as f32 * 6.0 - 3.0
+        };
+        for _ in 0..2000 {
+            let uv = [next(), next()];
+            for (t, slot) in [(0usize, 1u32), (2, 2)] {
+                let want = scene.textures[t].sample_linear(uv);
+                assert_eq!(
+                    sender_texel_cpu(&packed.words, slot, uv),
+                    [want[0], want[1], want[2]],
+                    "{uv:?}"
+                );
+            }
+        }
+    }
+
+    /// Over the budget the largest texture is halved first, until the words fit.
+    #[test]
+    fn sender_texels_halve_the_largest_texture_to_fit_the_budget() {
+        let scene = scene_with(vec![texture("big", 64, 32, 3), texture("small", 8, 8, 7)]);
+        let full = sender_texels(&scene, SENDER_TEXEL_BUDGET);
+        let budget = (full.words.len() as u64 * 4) / 2;
+        let packed = sender_texels(&scene, budget);
+        assert!(packed.words.len() as u64 * 4 <= budget);
+        assert_eq!(packed.halvings, 1);
+        let dims = |slot: u32| {
+            let e = SENDER_TEXEL_LUT + 4 * (slot as usize - 1);
+            (packed.words[e + 1], packed.words[e + 2])
+        };
+        assert_eq!((dims(1), dims(2)), ((32, 16), (8, 8)));
     }
 }
