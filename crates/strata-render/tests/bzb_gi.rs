@@ -673,8 +673,9 @@ fn dss_hidden_sender_adds_light_without_visibility_and_little_with_it() {
 /// random emitter surfels carry it, so one draw misses π L F by up to 9 %
 /// (seeds 0–5 on lavapipe: −9 % … +6 %; seed 0 gave −3 % there and −6 % on
 /// NVIDIA 580, whose position bits hash to another draw): the test averages
-/// SEEDS draws (−2.7 %). With visibility the enlarged disks overhang the
-/// rectangle's edges (+7 % averaged; +4 … +10 % per draw).
+/// SEEDS draws (−2.7 %). With visibility the enlarged disks stop at the
+/// rectangle's outline (`dss::open_edges`): −1.4 % averaged (−4 … +0.6 % per draw).
+/// Without that stop they overhang it: +9.8 % (+6.6 … +12.2 % per draw), which fails.
 #[test]
 fn dss_irradiance_under_an_emissive_rectangle() {
     const SEEDS: u32 = 6;
@@ -715,7 +716,7 @@ fn dss_irradiance_under_an_emissive_rectangle() {
         );
         assert!(px.len() > 300, "{} floor pixels", px.len());
         if visibility {
-            assert!(rel.abs() < 0.1, "rel {rel}");
+            assert!(rel.abs() < 0.04, "rel {rel}");
         } else {
             assert!(rel.abs() < 0.05, "rel {rel}");
         }

@@ -49,6 +49,45 @@ pub const FINE_RATIO: f32 = 0.25;
 /// the nearest hit only, so disks ×2 (coverage 1 − e^−4 ≈ 98 %) add no energy.
 pub const GI_COVER: f32 = 2.0;
 
+/// Adjacent triangles whose planes meet at more than this angle (degrees) form a
+/// crease: [`open_edges`] counts the edge as open, where GI disks stop.
+pub const CREASE_DEG: f32 = 10.0;
+
+/// Per triangle of `scene.world_triangles(0.0)`: which of its edges (a–b, b–c, c–a)
+/// are open, i.e. on no other triangle, or on others only at a crease of more than
+/// [`CREASE_DEG`] (either winding). Positions are matched to 10 µm. An enlarged GI
+/// disk that overhangs an open edge stands in the air beyond the surface's silhouette;
+/// one that overhangs a smooth edge lies on the neighbouring triangle.
+pub fn open_edges(scene: &strata_scene::Scene) -> Vec<[bool; 3]> {
+    let tris = scene.world_triangles(0.0);
+    let key = |p: Vec3| (p * 1e5).round().as_i64vec3().to_array();
+    let normal = |t: &strata_scene::model::WorldTriangle| (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).normalize();
+    let mut edges: std::collections::HashMap<_, Vec<u32>> = std::collections::HashMap::new();
+    for (i, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (key(t.p[k]), key(t.p[(k + 1) % 3]));
+            edges
+                .entry(if a < b { (a, b) } else { (b, a) })
+                .or_default()
+                .push(i as u32);
+        }
+    }
+    let cos = CREASE_DEG.to_radians().cos();
+    tris.iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let n = normal(t);
+            std::array::from_fn(|k| {
+                let (a, b) = (key(t.p[k]), key(t.p[(k + 1) % 3]));
+                let shared = &edges[&if a < b { (a, b) } else { (b, a) }];
+                !shared
+                    .iter()
+                    .any(|&j| j != i as u32 && n.dot(normal(&tris[j as usize])).abs() >= cos)
+            })
+        })
+        .collect()
+}
+
 /// DSS settings. Defaults: l_max = 4 (Table 3's memory is 4 levels' worth of
 /// shuffled positions: 18 MB at 768×512 = 4 × 12 B per pixel), surfels of 2
 /// pixels' radius, frustum culling on, inner-shell fragments redirected (§4.3).
@@ -875,7 +914,7 @@ impl DssStage {
             scene_gpu,
             targets,
             u,
-            (&uniforms, tiles),
+            (&uniforms, tiles, triangles),
             &buffers,
             level_payload.name,
         );
@@ -902,7 +941,7 @@ impl DssStage {
         scene_gpu: &GpuScene,
         targets: &Targets,
         u: &DssUniforms,
-        (uniforms, tiles): (&wgpu::Buffer, &wgpu::Buffer),
+        (uniforms, tiles, triangles): (&wgpu::Buffer, &wgpu::Buffer, &wgpu::Buffer),
         buffers: &SurfelBuffers,
         payload: &'static str,
     ) -> DssSplatPass {
@@ -953,6 +992,12 @@ impl DssStage {
                 ..buf(6, wgpu::BufferBindingType::Storage { read_only: true })
             });
             resources.push(r.as_entire_binding());
+            // the surfels' source triangles: GI disks end at their triangle's edges
+            entries.push(wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ..buf(7, wgpu::BufferBindingType::Storage { read_only: true })
+            });
+            resources.push(triangles.as_entire_binding());
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dss-splat"),
@@ -1272,5 +1317,78 @@ mod fragment_level_tests {
             }
         }
         assert_eq!(fragment_level(0.0, 2, d_max, true), None);
+    }
+}
+
+#[cfg(test)]
+mod open_edge_tests {
+    use super::{open_edges, CREASE_DEG};
+    use glam::Vec3;
+    use strata_scene::model::{Material, Mesh, Object};
+    use strata_scene::Scene;
+
+    /// A scene of one mesh per list of triangles.
+    fn scene(meshes: &[Vec<[Vec3; 3]>]) -> Scene {
+        let mut s = Scene {
+            materials: vec![Material::diffuse("grey", [0.5; 3])],
+            ..Default::default()
+        };
+        for (i, tris) in meshes.iter().enumerate() {
+            s.meshes.push(Mesh {
+                name: format!("m{i}"),
+                positions: tris.iter().flatten().map(|p| p.to_array()).collect(),
+                normals: vec![[0.0, 1.0, 0.0]; 3 * tris.len()],
+                uvs: vec![[0.0; 2]; 3 * tris.len()],
+                indices: (0..3 * tris.len() as u32).collect(),
+                material: 0,
+            });
+            s.objects.push(Object {
+                name: format!("m{i}"),
+                mesh: i,
+                transform: glam::Mat4::IDENTITY,
+                animation: None,
+            });
+        }
+        s
+    }
+
+    fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> Vec<[Vec3; 3]> {
+        vec![[a, b, c], [a, c, d]]
+    }
+
+    /// A flat quad's diagonal is smooth and its outline open; a cube's face diagonals
+    /// are smooth and its twelve 90° edges open, even with each face in its own mesh
+    /// (edges match by position); a strip folded by less than [`CREASE_DEG`] stays
+    /// smooth along the fold, and one folded by more does not.
+    #[test]
+    fn open_edges_are_outlines_and_creases() {
+        let (o, x, y, z) = (Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z);
+        let flat = open_edges(&scene(&[quad(o, x, x + z, z)]));
+        assert_eq!(flat, vec![[true, true, false], [false, true, true]]);
+
+        let faces = [
+            quad(o, z, z + y, y),
+            quad(x, x + y, x + y + z, x + z),
+            quad(o, x, x + z, z),
+            quad(y, y + z, x + y + z, x + y),
+            quad(o, y, x + y, x),
+            quad(z, x + z, x + y + z, y + z),
+        ];
+        let cube = open_edges(&scene(&faces));
+        let open: usize = cube.iter().flatten().filter(|&&e| e).count();
+        assert_eq!(
+            open, 24,
+            "each of the 12 cube edges is open on both its faces: {cube:?}"
+        );
+        assert!(cube.iter().all(|e| e.iter().filter(|&&v| v).count() == 2));
+
+        for (deg, fold_open) in [(0.5 * CREASE_DEG, false), (2.0 * CREASE_DEG, true)] {
+            let t = deg.to_radians();
+            let far = Vec3::new(1.0 + t.cos(), t.sin(), 0.0);
+            let strip = open_edges(&scene(&[quad(o, x, x + z, z), quad(x, far, far + z, x + z)]));
+            // the fold is the first quad's edge x → x + z (triangle 0, edge 1) and the
+            // second's edge x + z → x (triangle 1, edge 2)
+            assert_eq!((strip[0][1], strip[3][2]), (fold_open, fold_open), "{deg}°: {strip:?}");
+        }
     }
 }

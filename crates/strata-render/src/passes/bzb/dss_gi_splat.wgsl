@@ -7,6 +7,9 @@
 //                     form factor, dss_disk_occlusion; L the face towards the
 //                     receiver): the irradiance of DSS without visibility.
 @group(1) @binding(6) var<storage, read> radiance: array<vec4f>;
+// the scene's triangles (3 vec4 each: a vertex, w = 1 where the edge to the next
+// vertex is open: gi::gi_triangle_data), the surfels' sources
+@group(1) @binding(7) var<storage, read> gi_triangles: array<vec4f>;
 
 // The ray–disk radius of fs_gi_visibility over the surfel's (area-preserving)
 // radius (`dss::GI_COVER`): surfels placed at random with total area = the
@@ -15,6 +18,30 @@
 // kept, never a sum, so overlapping disks add no energy: radius ×2 (area ×4)
 // leaves e^−4 ≈ 2 %. The additive baseline keeps the area-preserving radius.
 const DSS_GI_COVER: f32 = 2.0;
+
+// Whether the point p of a disk lies within its source triangle's open edges
+// (dss::open_edges: outlines and creases, flagged in each vertex's w), p projected
+// onto the triangle's plane. The enlarged disks (DSS_GI_COVER) would otherwise
+// overhang a surface's silhouette and occlude what lies behind it; across a smooth
+// edge the overhang lies on the neighbouring triangle, and is kept.
+fn dss_within_open_edges(p: vec3f, tri: u32) -> bool {
+    let a = gi_triangles[3u * tri].xyz;
+    let e1 = gi_triangles[3u * tri + 1u].xyz - a;
+    let e2 = gi_triangles[3u * tri + 2u].xyz - a;
+    let q = p - a;
+    let d11 = dot(e1, e1);
+    let d12 = dot(e1, e2);
+    let d22 = dot(e2, e2);
+    let det = d11 * d22 - d12 * d12;
+    if (!(det > 0.0)) {
+        return true;
+    }
+    let b = vec2f(d22 * dot(q, e1) - d12 * dot(q, e2), d11 * dot(q, e2) - d12 * dot(q, e1)) / det;
+    // vertex k's w: the edge from it to the next is open; edge a–b bounds b.y, b–c
+    // 1 − b.x − b.y, c–a b.x
+    let open = vec3f(gi_triangles[3u * tri].w, gi_triangles[3u * tri + 1u].w, gi_triangles[3u * tri + 2u].w) > vec3f(0.5);
+    return (!open.x || b.y >= 0.0) && (!open.y || 1.0 - b.x - b.y >= 0.0) && (!open.z || b.x >= 0.0);
+}
 
 // The shaded face of surfel j (normal n) seen from receiver o.
 fn dss_gi_radiance(j: u32, c: vec3f, n: vec3f, o: vec3f) -> vec3f {
@@ -44,6 +71,11 @@ fn fs_gi_visibility(in: SplatVertex) -> VisibilityOut {
     let r = DSS_GI_COVER * cr.w * f32(1u << fl);
     let t = dss_ray_disk(o.xyz, d.xyz, cr.xyz, n, r);
     if (!dss_occluding_hit(o.xyz, cr.xyz, n, t, dss.t_min)) {
+        discard;
+    }
+    // the surfel's source triangle (normal.w)
+    let nw = surfels[2u * in.surfel + 1u].w;
+    if (!dss_within_open_edges(o.xyz + t * d.xyz, u32(nw + 0.5))) {
         discard;
     }
     var out: VisibilityOut;

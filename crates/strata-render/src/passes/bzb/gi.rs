@@ -441,6 +441,19 @@ pub fn direction(n: Vec3, v: Vec3, glossy: Option<Glossy>, u_lobe: f32, u: [f32;
     }
 }
 
+/// The splat's triangles (`super::triangle_data`, 3 vec4 of positions each) with each
+/// vertex's w = 1 where the edge from it to the next vertex is open
+/// ([`super::dss::open_edges`]): DSS's GI disks stop there.
+pub fn gi_triangle_data(scene: &Scene, frame: f32, open_edges: &[[bool; 3]]) -> Vec<[f32; 4]> {
+    let mut data = super::triangle_data(scene, frame);
+    for (v, open) in data.chunks_exact_mut(3).zip(open_edges) {
+        for k in 0..3 {
+            v[k][3] = open[k] as u32 as f32;
+        }
+    }
+    data
+}
+
 /// vec4s per triangle in the sender data ([`sender_data`], `gi_tris` in WGSL).
 pub const SENDER_VEC4S: usize = 7;
 
@@ -703,6 +716,8 @@ pub(crate) struct BzbGiStage {
     senders: wgpu::Buffer,
     /// Each scene texture's slot in the senders' texels ([`sender_texels`]).
     texture_slots: Vec<u32>,
+    /// [`super::dss::open_edges`] of every triangle.
+    open_edges: Vec<[bool; 3]>,
     count: u32,
     settings: BzbGiSettings,
     base: GiUniforms,
@@ -757,7 +772,8 @@ impl BzbGiStage {
                 targets.create(gpu, t);
             }
         }
-        let data = super::triangle_data(scene, 0.0);
+        let open_edges: Vec<[bool; 3]> = super::dss::open_edges(scene);
+        let data = gi_triangle_data(scene, 0.0, &open_edges);
         let count = (data.len() / 3) as u32;
         let limit = device.limits().max_storage_buffer_binding_size;
         let packed = sender_texels(scene, SENDER_TEXEL_BUDGET.min(limit));
@@ -1093,6 +1109,7 @@ impl BzbGiStage {
             triangles,
             senders,
             texture_slots: packed.slots,
+            open_edges,
             count,
             settings: s.clone(),
             base,
@@ -1135,7 +1152,7 @@ impl BzbGiStage {
         gpu.queue
             .write_buffer(&self.gi_uniforms, 0, bytemuck::bytes_of(&self.base));
         if animated && self.count > 0 {
-            let data = super::triangle_data(scene, frame);
+            let data = gi_triangle_data(scene, frame, &self.open_edges);
             gpu.queue.write_buffer(&self.triangles, 0, bytemuck::cast_slice(&data));
             let senders = sender_data(scene, frame, &self.texture_slots);
             gpu.queue.write_buffer(&self.senders, 0, bytemuck::cast_slice(&senders));
