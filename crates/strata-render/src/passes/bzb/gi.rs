@@ -443,7 +443,8 @@ pub fn direction(n: Vec3, v: Vec3, glossy: Option<Glossy>, u_lobe: f32, u: [f32;
 
 /// The splat's triangles (`super::triangle_data`, 3 vec4 of positions each) with each
 /// vertex's w = 1 where the edge from it to the next vertex is open
-/// ([`super::dss::open_edges`]): DSS's GI disks stop there.
+/// ([`super::dss::open_edges`]; with none given, as for AOV splats, w stays 0): DSS's
+/// GI disks stop there.
 pub fn gi_triangle_data(scene: &Scene, frame: f32, open_edges: &[[bool; 3]]) -> Vec<[f32; 4]> {
     let mut data = super::triangle_data(scene, frame);
     for (v, open) in data.chunks_exact_mut(3).zip(open_edges) {
@@ -489,10 +490,9 @@ pub fn sender_texels(scene: &Scene, budget: u64) -> SenderTexels {
         .textures
         .iter()
         .map(|t| {
-            (t.width > 0 && t.height > 0 && t.rgba8.len() >= (t.width * t.height * 4) as usize)
-                .then(|| {
-                    image::RgbaImage::from_raw(t.width, t.height, t.rgba8[..(t.width * t.height * 4) as usize].to_vec())
-                })
+            let bytes = t.width as u64 * t.height as u64 * 4;
+            (t.width > 0 && t.height > 0 && t.rgba8.len() as u64 >= bytes)
+                .then(|| image::RgbaImage::from_raw(t.width, t.height, t.rgba8[..bytes as usize].to_vec()))
                 .flatten()
         })
         .collect();
@@ -716,7 +716,7 @@ pub(crate) struct BzbGiStage {
     senders: wgpu::Buffer,
     /// Each scene texture's slot in the senders' texels ([`sender_texels`]).
     texture_slots: Vec<u32>,
-    /// [`super::dss::open_edges`] of every triangle.
+    /// [`super::dss::open_edges`] of every triangle (DSS only; empty for AOV splats).
     open_edges: Vec<[bool; 3]>,
     count: u32,
     settings: BzbGiSettings,
@@ -772,7 +772,11 @@ impl BzbGiStage {
                 targets.create(gpu, t);
             }
         }
-        let open_edges: Vec<[bool; 3]> = super::dss::open_edges(scene);
+        // only DSS's disks need them (AOV splats test the triangle itself)
+        let open_edges = match s.splat {
+            super::Splat::Dss => super::dss::open_edges(scene),
+            super::Splat::Aov => Vec::new(),
+        };
         let data = gi_triangle_data(scene, 0.0, &open_edges);
         let count = (data.len() / 3) as u32;
         let limit = device.limits().max_storage_buffer_binding_size;
