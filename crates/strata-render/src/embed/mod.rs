@@ -47,10 +47,12 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+mod bzb;
 mod core;
 mod radiosity;
 mod reflections;
 
+pub use bzb::{indexed_triangles, EmbeddedBzbAo, EmbeddedBzbAoConfig};
 pub use radiosity::{EmbeddedRadiosity, EmbeddedRadiosityConfig, RadiosityInputs};
 pub use reflections::{EmbeddedReflections, EmbeddedReflectionsConfig, MaterialChannels, ReflectionInputs};
 
@@ -333,7 +335,12 @@ macro_rules! embedded_common {
             pub fn config(&self) -> &$config {
                 &self.config
             }
+        }
+    };
+    ($t:ty, $config:ty, resize) => {
+        $crate::embed::embedded_common!($t, $config);
 
+        impl $t {
             /// Rebuilds the passes for a new render size (a resized window), keeping the
             /// rest of the config; the temporal history starts afresh. On error the old
             /// size stays.
@@ -357,7 +364,7 @@ pub struct EmbeddedAo {
     stage: AoStage,
 }
 
-embedded_common!(EmbeddedAo, EmbeddedAoConfig);
+embedded_common!(EmbeddedAo, EmbeddedAoConfig, resize);
 
 impl EmbeddedAo {
     /// Builds the passes for `config` on the application's device. Errors name the

@@ -74,7 +74,7 @@ pub struct EmbeddedRadiosity {
     stage: RadiosityStage,
 }
 
-super::embedded_common!(EmbeddedRadiosity, EmbeddedRadiosityConfig);
+super::embedded_common!(EmbeddedRadiosity, EmbeddedRadiosityConfig, resize);
 
 impl EmbeddedRadiosity {
     /// Builds the passes for `config` on the application's device. Errors name the

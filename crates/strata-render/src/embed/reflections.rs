@@ -165,7 +165,7 @@ impl ReflectionPass {
     }
 }
 
-super::embedded_common!(EmbeddedReflections, EmbeddedReflectionsConfig);
+super::embedded_common!(EmbeddedReflections, EmbeddedReflectionsConfig, resize);
 
 impl EmbeddedReflections {
     /// Builds the pass for `config` on the application's device. Errors name the

@@ -696,6 +696,23 @@ impl BzbStage {
         scene: &Scene,
         layers: u32,
     ) -> Result<Self, crate::RenderError> {
+        Self::with_triangles(gpu, scene_gpu, targets, s, scene, layers, &triangle_data(scene, 0.0))
+    }
+
+    /// [`BzbStage::new`] splatting `data` (3 × vec4 per world-space triangle, as
+    /// [`triangle_data`] lays them out) instead of `scene`'s triangles; `scene` gives
+    /// the radius where the settings have none. The embedded AO passes the
+    /// application's geometry this way (`embed::EmbeddedBzbAo`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_triangles(
+        gpu: &GpuContext,
+        scene_gpu: &GpuScene,
+        targets: &mut Targets,
+        s: &BzbSettings,
+        scene: &Scene,
+        layers: u32,
+        data: &[[f32; 4]],
+    ) -> Result<Self, crate::RenderError> {
         use wgpu::util::DeviceExt;
         let (w, h) = (targets.width, targets.height);
         let (cols, rows) = s.grid();
@@ -737,7 +754,6 @@ impl BzbStage {
                 ),
             );
         }
-        let data = triangle_data(scene, 0.0);
         let count = (data.len() / 3) as u32;
         let bytes = (data.len() * 16).max(48) as u64;
         let limit = gpu.device.limits().max_storage_buffer_binding_size;
@@ -747,7 +763,7 @@ impl BzbStage {
                 scene.name
             )));
         }
-        let mut contents = bytemuck::cast_slice::<[f32; 4], u8>(&data).to_vec();
+        let mut contents = bytemuck::cast_slice::<[f32; 4], u8>(data).to_vec();
         contents.resize(bytes as usize, 0);
         let buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("bzb-triangles"),
@@ -1020,6 +1036,17 @@ impl BzbStage {
                 .write_buffer(&self.triangles.buffer, 0, bytemuck::cast_slice(&data));
         }
         self.last.set(u);
+    }
+
+    /// Overwrites the splat triangles with `data` (as [`triangle_data`] lays them out),
+    /// which must hold as many triangles as the stage was built with; for geometry that
+    /// moves between frames.
+    pub fn write_triangles(&self, gpu: &GpuContext, data: &[[f32; 4]]) {
+        debug_assert_eq!(data.len(), self.triangles.count as usize * 3);
+        if !data.is_empty() {
+            gpu.queue
+                .write_buffer(&self.triangles.buffer, 0, bytemuck::cast_slice(data));
+        }
     }
 
     /// The uniforms of the last frame.

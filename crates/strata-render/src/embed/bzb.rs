@@ -1,0 +1,237 @@
+//! Bounced-z-buffer AO (BZB §3) on an application's G-buffer and geometry: the passes of
+//! `strata render --technique bzb-ao`, from the directions to the bilateral filter.
+//!
+//! Screen-space AO sees only what the G-buffer holds. The bounced z-buffer splats the
+//! scene's triangles themselves into a depth-buffered framebuffer of per-pixel directions,
+//! so each ray's nearest occluder wins wherever it is, on screen or not (BZB §3.2). The
+//! application therefore gives its world-space triangles once ([`EmbeddedBzbAo::new`]), and
+//! again when they move ([`EmbeddedBzbAo::set_triangles`]), besides the per-frame depth and
+//! normals [`super::EmbeddedAo`] reads. It gets back the same output: ambient visibility
+//! AV in [0, 1], 1 = unoccluded, binary AO within the radius r.
+
+use glam::{Mat4, Vec3};
+
+use super::core::{Core, CoreConfig};
+use super::{AoInputs, NormalEncoding, NormalSpace};
+use crate::frame::{FrameUniforms, Pass, TargetDesc};
+use crate::passes::bzb::{BzbSettings, BzbStage, TEMPORAL, TEMPORAL_FRAMES};
+use crate::RenderError;
+
+/// What [`EmbeddedBzbAo::new`] builds.
+#[derive(Clone, Debug)]
+pub struct EmbeddedBzbAoConfig {
+    /// The application's render size in pixels (the inputs' size).
+    pub width: u32,
+    pub height: u32,
+    /// The settings of `strata render --technique bzb-ao`: S directions, AOV triangle
+    /// splats or DSS surfels, the temporal filter (`temporal`, BZB §6), the bilateral
+    /// filter. `radius` is required: r = d_max in world units.
+    pub settings: BzbSettings,
+    pub normals: NormalEncoding,
+    pub normal_space: NormalSpace,
+}
+
+impl Default for EmbeddedBzbAoConfig {
+    /// 1×1 (set the size), [`BzbSettings::default`] (S = 4, AOV splats with visibility; no
+    /// radius: set it), signed world-space normals.
+    fn default() -> Self {
+        Self {
+            width: 1,
+            height: 1,
+            settings: BzbSettings::default(),
+            normals: NormalEncoding::Signed,
+            normal_space: NormalSpace::World,
+        }
+    }
+}
+
+/// The triangles of an indexed mesh in world space: `indices` in threes into `positions`,
+/// each position moved by `model`. An index out of range is a one-line error.
+pub fn indexed_triangles(positions: &[Vec3], indices: &[u32], model: Mat4) -> Result<Vec<[Vec3; 3]>, RenderError> {
+    if indices.len() % 3 != 0 {
+        return Err(RenderError::Parameter(format!(
+            "indexed triangles: {} indices is not a multiple of 3",
+            indices.len()
+        )));
+    }
+    indices
+        .chunks_exact(3)
+        .map(|t| {
+            let mut tri = [Vec3::ZERO; 3];
+            for (k, &i) in t.iter().enumerate() {
+                let p = positions.get(i as usize).ok_or_else(|| {
+                    RenderError::Parameter(format!(
+                        "indexed triangles: index {i} is out of range: must be in 0..{}",
+                        positions.len()
+                    ))
+                })?;
+                tri[k] = model.transform_point3(*p);
+            }
+            Ok(tri)
+        })
+        .collect()
+}
+
+/// `triangles` in the splat buffer's layout (3 × vec4 each), checked finite.
+fn splat_data(triangles: &[[Vec3; 3]]) -> Result<Vec<[f32; 4]>, RenderError> {
+    if let Some(i) = triangles.iter().position(|t| !t.iter().all(|p| p.is_finite())) {
+        return Err(RenderError::Parameter(format!(
+            "embedded bzb AO: triangles[{i}] has a non-finite vertex ({:?})",
+            triangles[i]
+        )));
+    }
+    Ok(triangles
+        .iter()
+        .flat_map(|t| t.map(|p| p.extend(0.0).to_array()))
+        .collect())
+}
+
+/// The bounced-z-buffer AO passes of `strata render --technique bzb-ao` on an
+/// application's G-buffer and triangles.
+pub struct EmbeddedBzbAo {
+    core: Core,
+    config: EmbeddedBzbAoConfig,
+    stage: BzbStage,
+    /// The triangles the stage splats (kept to rebuild on a resize or a new count).
+    data: Vec<[f32; 4]>,
+}
+
+super::embedded_common!(EmbeddedBzbAo, EmbeddedBzbAoConfig);
+
+impl EmbeddedBzbAo {
+    /// Builds the passes for `config` on the application's device, splatting `triangles`
+    /// (world space, the occluders: typically every opaque triangle of the scene). Errors
+    /// name the parameter and its valid range.
+    pub fn new(
+        adapter: &wgpu::Adapter,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: EmbeddedBzbAoConfig,
+        triangles: &[[Vec3; 3]],
+    ) -> Result<Self, RenderError> {
+        let data = splat_data(triangles)?;
+        Self::build(adapter, device, queue, config, data)
+    }
+
+    fn build(
+        adapter: &wgpu::Adapter,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: EmbeddedBzbAoConfig,
+        data: Vec<[f32; 4]>,
+    ) -> Result<Self, RenderError> {
+        let what = "embedded bzb AO";
+        let s = &config.settings;
+        let radius = s.radius.ok_or_else(|| {
+            RenderError::Parameter(format!(
+                "{what}: settings.radius is required: the world-space AO radius r = d_max (> 0, in the application's units)"
+            ))
+        })?;
+        s.validate()
+            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
+        let mut scene = strata_scene::Scene::default();
+        scene.name = "embedded".into();
+        scene.settings.ao_radius = radius;
+        let core = CoreConfig {
+            what,
+            width: config.width,
+            height: config.height,
+            // BZB's receivers are the visible surfaces; its occluders are the triangles
+            layers: 1,
+            normals: config.normals,
+            normal_space: config.normal_space,
+            mip_levels: None,
+            kernel: crate::passes::Kernel::Fragment,
+            shading: super::core::ShadingImport::None,
+        };
+        Core::scoped(device, || {
+            let mut core = Core::new(adapter, device, queue, core, scene)?;
+            if s.temporal.is_some() {
+                core.targets.create(
+                    &core.gpu,
+                    TargetDesc::new("csz-history", wgpu::TextureFormat::R32Float, 1, "last frame's csz"),
+                );
+            }
+            let stage =
+                BzbStage::with_triangles(&core.gpu, &core.scene_gpu, &mut core.targets, s, &core.scene, 1, &data)?;
+            if stage.temporal.is_some() {
+                let [n, h] = TEMPORAL_FRAMES;
+                core.history.copies = vec![("csz", "csz-history"), (TEMPORAL[0].name, TEMPORAL[1].name), (n, h)];
+            }
+            Ok(Self {
+                core,
+                config: config.clone(),
+                stage,
+                data,
+            })
+        })
+    }
+
+    /// Replaces the splatted triangles (moving or changed geometry). With as many
+    /// triangles as before they are written in place; another count rebuilds the passes
+    /// (the temporal history then starts afresh). On error nothing changes.
+    pub fn set_triangles(&mut self, triangles: &[[Vec3; 3]]) -> Result<(), RenderError> {
+        let data = splat_data(triangles)?;
+        if data.len() == self.data.len() {
+            self.stage.write_triangles(&self.core.gpu, &data);
+            self.data = data;
+            return Ok(());
+        }
+        let gpu = &self.core.gpu;
+        *self = Self::build(&gpu.adapter, &gpu.device, &gpu.queue, self.config.clone(), data)?;
+        Ok(())
+    }
+
+    /// Triangles splatted each frame.
+    pub fn triangle_count(&self) -> u32 {
+        self.stage.triangle_count()
+    }
+
+    /// Rebuilds the passes for a new render size (a resized window), keeping the config
+    /// and the triangles; the temporal history starts afresh. On error the old size stays.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        let mut config = self.config.clone();
+        config.width = width;
+        config.height = height;
+        let gpu = &self.core.gpu;
+        *self = Self::build(
+            &gpu.adapter,
+            &gpu.device,
+            &gpu.queue,
+            config,
+            std::mem::take(&mut self.data),
+        )?;
+        Ok(())
+    }
+
+    /// The ambient visibility AV (`R16Float`, 1 = unoccluded), written by the last
+    /// [`EmbeddedBzbAo::encode`] once its encoder is submitted.
+    pub fn output(&self) -> &wgpu::Texture {
+        &self.core.targets.get("ao").texture
+    }
+
+    /// A view of [`EmbeddedBzbAo::output`] to bind in the application's lighting pass.
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        &self.core.targets.get("ao").view
+    }
+
+    /// Records this frame's AO into `encoder` and writes its uniforms with the queue: submit
+    /// `encoder` before the next call. `inputs` has one layer (no `second`). Inputs are
+    /// checked first; a bad one is a one-line error and nothing is recorded.
+    pub fn encode(&mut self, encoder: &mut wgpu::CommandEncoder, inputs: &AoInputs<'_>) -> Result<(), RenderError> {
+        let cam = self.core.check_inputs(inputs, &[], None)?;
+        let (_frame, has_history): (FrameUniforms, bool) = self.core.begin(inputs, &cam);
+        // the triangles are the application's: written by `set_triangles`, not per frame
+        self.stage.set_frame(
+            &self.core.gpu,
+            &self.core.scene,
+            0.0,
+            false,
+            self.core.frames,
+            has_history,
+        );
+        let passes: Vec<&dyn Pass> = self.stage.passes();
+        self.core.record(encoder, inputs, &[], None, passes);
+        Ok(())
+    }
+}

@@ -1,0 +1,347 @@
+//! `strata_render::embed::EmbeddedBzbAo`: bounced-z-buffer AO on an application's G-buffer
+//! and triangles. Its output is checked against the renderer's own `bzb-ao` of the same
+//! frames, and against the analytic binary AO under a plate the camera never sees.
+
+mod common;
+
+#[path = "../examples/embed_ao/app.rs"]
+mod app;
+
+use glam::{Mat4, Vec3};
+use strata_render::embed::{
+    indexed_triangles, AoInputs, EmbeddedBzbAo, EmbeddedBzbAoConfig, NormalEncoding, NormalSpace, TextureLayer,
+};
+use strata_render::frame::FrameCameras;
+use strata_render::passes::bzb::{self, BzbSettings, Splat};
+use strata_render::{GpuContext, RenderSettings, Renderer};
+use strata_scene::{ImageBuf, Scene};
+
+const W: u32 = 160;
+const H: u32 = 90;
+
+fn embedded(gpu: &GpuContext, w: u32, h: u32, settings: BzbSettings, triangles: &[[Vec3; 3]]) -> EmbeddedBzbAo {
+    EmbeddedBzbAo::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedBzbAoConfig {
+            width: w,
+            height: h,
+            settings,
+            normals: NormalEncoding::Octahedral,
+            normal_space: NormalSpace::World,
+        },
+        triangles,
+    )
+    .expect("the embedded bzb AO builds without validation errors")
+}
+
+/// Records one embedded frame and submits it; validation errors fail the test.
+fn run(gpu: &GpuContext, ao: &mut EmbeddedBzbAo, inputs: &AoInputs<'_>) {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    ao.encode(&mut encoder, inputs).expect("valid inputs");
+    gpu.queue.submit([encoder.finish()]);
+    gpu.check_errors().expect("no wgpu validation errors");
+}
+
+/// (mean |a − b|, fraction of pixels with |a − b| > `tol`) over channel 0.
+fn diff(a: &ImageBuf, b: &ImageBuf, tol: f32) -> (f64, f64) {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let n = (a.width * a.height) as usize;
+    let (mut sum, mut over) = (0.0f64, 0usize);
+    for i in 0..n {
+        let d = (a.data[i * a.channels as usize] - b.data[i * b.channels as usize]).abs();
+        sum += d as f64;
+        over += (d > tol) as usize;
+    }
+    (sum / n as f64, over as f64 / n as f64)
+}
+
+fn world_triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
+    scene.world_triangles(0.0).iter().map(|t| t.p).collect()
+}
+
+/// The renderer's G-buffer and the scene's own triangles in, the renderer's `bzb-ao` out:
+/// the same passes on the same data, for AOV splats (one frame, and four with the temporal
+/// filter) and for DSS surfels.
+#[test]
+fn embedded_bzb_ao_on_the_renderers_gbuffer_is_the_renderers() {
+    let gpu = common::gpu();
+    let scene = common::frozen("atrium");
+    let cams = FrameCameras::fixed(scene.camera);
+    let (view, proj) = (scene.camera.view(), scene.camera.projection(W as f32 / H as f32));
+    let triangles = world_triangles(&scene);
+    let radius = scene.settings.ao_radius;
+    let base = BzbSettings {
+        radius: Some(radius),
+        ..BzbSettings::default()
+    };
+    let cases = [
+        ("AOV splats", 1, base.clone()),
+        (
+            "AOV splats, temporal filter",
+            4,
+            BzbSettings {
+                temporal: Some(bzb::temporal_filter()),
+                ..base.clone()
+            },
+        ),
+        (
+            "DSS surfels",
+            1,
+            BzbSettings {
+                splat: Splat::Dss,
+                ..base.clone()
+            },
+        ),
+    ];
+    for (what, frames, settings) in cases {
+        let mut r = Renderer::new(
+            &gpu,
+            &scene,
+            RenderSettings {
+                shade: false,
+                bzb: Some(settings.clone()),
+                ..common::peeled_layers(&scene, W, H, 1)
+            },
+        )
+        .unwrap();
+        let mut ao = embedded(&gpu, W, H, settings, &triangles);
+        assert_eq!(ao.triangle_count() as usize, triangles.len());
+        for _ in 0..frames {
+            r.render(&gpu, &scene, &cams, 0.0).unwrap();
+            let (depth, normal) = (r.target_texture("depth").unwrap(), r.target_texture("normal").unwrap());
+            let layer0 = |t| TextureLayer { texture: t, layer: 0 };
+            run(&gpu, &mut ao, &AoInputs::new(layer0(depth), layer0(normal), view, proj));
+        }
+        let (a, b) = (ao.read_target("ao").unwrap(), r.read_target(&gpu, "ao").unwrap());
+        let (mean, over) = diff(&a, &b, 1.0 / 255.0);
+        println!(
+            "{what}: mean |ΔAV| {mean:.2e}, {:.3} % of pixels over 1/255",
+            100.0 * over
+        );
+        // a receiver's z differs from the renderer's by f32 rounding, which flips a
+        // grazing ray's binary hit now and then
+        assert!(mean < 1e-3 && over < 0.01, "{what}: mean {mean}, {over} over 1/255");
+        let lo = b.data.iter().cloned().fold(1.0f32, f32::min);
+        assert!(
+            lo < 0.6,
+            "{what}: the atrium has occlusion to compare (darkest AV {lo})"
+        );
+        if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
+            let t = ao.timings().unwrap();
+            let names: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
+            assert_eq!(names, ao.pass_names(), "{what}: one time per pass, in order");
+        }
+    }
+}
+
+/// What BZB exists for (§1, Fig. 1): an occluder the camera never sees still occludes.
+/// The camera looks down at a floor from just under a large plate at height h; the plate
+/// is above the frustum, so the G-buffer holds the floor alone. Binary AO within r of a
+/// floor point under an infinite plane at height h < r is (h/r)² (the cosine-weighted
+/// directions with cos θ > h/r hit it within r). The embedded AO reads the application's
+/// G-buffer, drawn by `app.rs` (standard depth, signed normals), and the triangles given:
+/// floor alone → AV 1; floor and plate → (h/r)²; the plate moved up in place → the new
+/// (h/r)² once the history restarts; back to the floor alone (another count: a rebuild) → 1.
+#[test]
+fn an_occluder_off_screen_occludes_as_the_analytic_value() {
+    use glam::camera::rh;
+    let gpu = common::gpu();
+    let (w, h) = (128u32, 96u32);
+    let r = 0.5f32;
+    let grey = Vec3::splat(0.5);
+    let floor = app::cuboid(Vec3::new(-20.0, -0.1, -20.0), Vec3::new(20.0, 0.0, 20.0), grey);
+    let plate = |y: f32| {
+        world_of(&app::cuboid(
+            Vec3::new(-20.0, y, -20.0),
+            Vec3::new(20.0, y + 0.02, 20.0),
+            grey,
+        ))
+    };
+    let eye = Vec3::new(0.0, 0.22, 0.0);
+    let view = rh::view::look_at_mat4(eye, Vec3::new(0.0, 0.0, -0.6), Vec3::Y);
+    let proj = rh::proj::directx::perspective(40f32.to_radians(), w as f32 / h as f32, 0.01, 50.0);
+    let layout = app::Layout::standard();
+    let gbuffer = app::GBuffer::new(&gpu.device, [w, h], layout, &floor);
+    let floor_only = world_of(&floor);
+    let settings = BzbSettings {
+        radius: Some(r),
+        directions: 16,
+        temporal: Some(bzb::temporal_filter()),
+        ..BzbSettings::default()
+    };
+    let mut ao = EmbeddedBzbAo::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedBzbAoConfig {
+            width: w,
+            height: h,
+            settings,
+            normals: NormalEncoding::Signed,
+            ..EmbeddedBzbAoConfig::default()
+        },
+        &floor_only,
+    )
+    .unwrap();
+    let mean_av = |ao: &mut EmbeddedBzbAo| {
+        for _ in 0..8 {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            gbuffer.draw(&gpu.queue, &mut encoder, view, proj);
+            ao.encode(
+                &mut encoder,
+                &AoInputs::new((&gbuffer.depth).into(), (&gbuffer.normals).into(), view, proj),
+            )
+            .unwrap();
+            gpu.queue.submit([encoder.finish()]);
+            gpu.check_errors().expect("no wgpu validation errors");
+        }
+        let av = ao.read_target("ao").unwrap();
+        let z = ao.read_target("csz").unwrap();
+        // floor points, all far from the plate's edges (the plate spans ±20)
+        let floor_px: Vec<f32> = (0..av.data.len())
+            .filter(|i| z.data[*i] > 0.0)
+            .map(|i| av.data[i])
+            .collect();
+        assert!(floor_px.len() > (w * h / 2) as usize, "the floor fills the view");
+        floor_px.iter().sum::<f32>() / floor_px.len() as f32
+    };
+    let clear = mean_av(&mut ao);
+    let mut with_plate = floor_only.clone();
+    with_plate.extend(plate(0.3));
+    ao.set_triangles(&with_plate).unwrap();
+    let under_03 = mean_av(&mut ao);
+    let mut moved = floor_only.clone();
+    moved.extend(plate(0.4));
+    ao.set_triangles(&moved).unwrap();
+    // written in place, the temporal history stays (it follows receivers, not occluders):
+    // a jump this large wants a fresh start
+    ao.reset_history();
+    let under_04 = mean_av(&mut ao);
+    ao.set_triangles(&floor_only).unwrap();
+    let cleared = mean_av(&mut ao);
+    let expect = |h: f32| (h / r) * (h / r);
+    println!(
+        "floor alone {clear:.4}; plate at 0.3: {under_03:.4} (analytic {:.4}); at 0.4: {under_04:.4} ({:.4}); removed {cleared:.4}",
+        expect(0.3),
+        expect(0.4)
+    );
+    assert!(
+        clear > 0.995 && cleared > 0.995,
+        "an unoccluded floor is 1: {clear}, {cleared}"
+    );
+    assert!((under_03 - expect(0.3)).abs() < 0.03, "plate at 0.3: {under_03}");
+    assert!((under_04 - expect(0.4)).abs() < 0.03, "plate at 0.4: {under_04}");
+}
+
+/// The app's triangles without their surfaces.
+fn world_of(t: &[app::Triangle]) -> Vec<[Vec3; 3]> {
+    t.iter().map(|t| t.0).collect()
+}
+
+/// Bad configs and triangles are one-line errors naming the parameter; nothing panics.
+#[test]
+fn bad_embedded_bzb_input_is_a_one_line_error() {
+    let gpu = common::gpu();
+    let quad = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
+    let config = |settings| EmbeddedBzbAoConfig {
+        width: 64,
+        height: 48,
+        settings,
+        ..EmbeddedBzbAoConfig::default()
+    };
+    let new = |c: EmbeddedBzbAoConfig, t: &[[Vec3; 3]]| EmbeddedBzbAo::new(&gpu.adapter, &gpu.device, &gpu.queue, c, t);
+    let err = |r: Result<EmbeddedBzbAo, strata_render::RenderError>| match r {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    };
+    let r1 = || BzbSettings {
+        radius: Some(1.0),
+        ..BzbSettings::default()
+    };
+    let cases = [
+        (
+            err(new(config(BzbSettings::default()), &quad)),
+            "settings.radius is required",
+        ),
+        (
+            err(new(config(BzbSettings { directions: 0, ..r1() }), &quad)),
+            "directions 0 is out of range",
+        ),
+        (
+            err(new(
+                EmbeddedBzbAoConfig {
+                    width: 0,
+                    ..config(r1())
+                },
+                &quad,
+            )),
+            "size 0x48 is out of range",
+        ),
+        (
+            err(new(
+                config(r1()),
+                &[[Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0), Vec3::Y]],
+            )),
+            "triangles[0] has a non-finite vertex",
+        ),
+    ];
+    for (e, want) in cases {
+        println!("{e}");
+        assert!(e.contains(want) && !e.contains('\n'), "'{e}' lacks '{want}'");
+    }
+    // set_triangles refuses bad triangles and keeps the old ones
+    let mut ao = new(config(r1()), &quad).unwrap();
+    let e = ao
+        .set_triangles(&[[Vec3::ZERO, Vec3::X, Vec3::splat(f32::INFINITY)]])
+        .unwrap_err();
+    assert!(e.to_string().contains("triangles[0]"), "{e}");
+    assert_eq!(ao.triangle_count(), 1);
+    // a second layer is not read: an AoInputs with one is refused
+    let texture = |format| {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: 64,
+                height: 48,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+    };
+    let (d, n) = (
+        texture(wgpu::TextureFormat::Depth32Float),
+        texture(wgpu::TextureFormat::Rgba16Float),
+    );
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let proj = glam::camera::rh::proj::directx::perspective(1.0, 4.0 / 3.0, 0.1, 10.0);
+    let inputs = AoInputs {
+        second: Some(((&d).into(), (&n).into())),
+        ..AoInputs::new((&d).into(), (&n).into(), Mat4::IDENTITY, proj)
+    };
+    let e = ao.encode(&mut encoder, &inputs).unwrap_err().to_string();
+    assert!(e.contains("AoInputs::second"), "{e}");
+    // indexed meshes: an index out of range names it
+    let e = indexed_triangles(&[Vec3::ZERO, Vec3::X], &[0, 1, 2], Mat4::IDENTITY).unwrap_err();
+    assert!(
+        e.to_string().contains("index 2 is out of range: must be in 0..2"),
+        "{e}"
+    );
+    let tris = indexed_triangles(
+        &[Vec3::ZERO, Vec3::X, Vec3::Y],
+        &[0, 1, 2],
+        Mat4::from_translation(Vec3::Z),
+    )
+    .unwrap();
+    assert_eq!(
+        tris,
+        vec![[Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)]]
+    );
+    gpu.check_errors().expect("no wgpu validation errors");
+}
