@@ -49,7 +49,7 @@ fn ambient(p: vec2i) -> vec4f {
             continue;
         }
         let m = spiral_mip(tap.radius, ao.q, ao.max_mip);
-        let t = q >> vec2u(m);
+        let t = mip_texel(zmip, q, m);
         let zs = textureLoad(zmip, t, i32(m));
         // the full-resolution pixel whose depth the MIP texel holds
         let src = mip_source_pixel(zmip, t, m);

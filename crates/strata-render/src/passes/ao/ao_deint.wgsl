@@ -92,7 +92,7 @@ fn fs_main(@builtin(position) pos: vec4f) -> @location(0) vec4f {
             zs = textureLoad(zsplit, origin + local + dl, 0);
             src = q;
         } else {
-            let tm = q >> vec2u(m);
+            let tm = mip_texel(zmip, q, m);
             zs = textureLoad(zmip, tm, i32(m));
             src = mip_source_pixel(zmip, tm, m);
         }

@@ -495,7 +495,7 @@ pub fn deinterleaved_obscurance_cpu(
             continue;
         }
         let m = spiral::mip_level(tap.radius, u.q, u.max_mip);
-        let (tx, ty) = ((qx >> m) as u32, (qy >> m) as u32);
+        let (tx, ty) = crate::passes::depth_mip::mip_texel(qx as u32, qy as u32, m, w as u32, h as u32);
         let zs = zmip[m as usize].pixel(tx, ty);
         let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
         let mut a = 0.0f32;

@@ -178,6 +178,13 @@ pub fn child_texel(x: u32, y: u32) -> (u32, u32) {
     (2 * x + ((y & 1) ^ 1), 2 * y + ((x & 1) ^ 1))
 }
 
+/// The level-`m` texel that level-0 pixel (x, y) of a chain with level-0 size `w`×`h`
+/// reads (`mip_texel` in common/spiral.wgsl): (x, y) >> m, clamped to the level's floor
+/// size, whose last texel stands in for the pixels of a partial block.
+pub fn mip_texel(x: u32, y: u32, m: u32, w: u32, h: u32) -> (u32, u32) {
+    ((x >> m).min((w >> m).max(1) - 1), (y >> m).min((h >> m).max(1) - 1))
+}
+
 /// The level-0 pixel whose depth level-`m` texel (x, y) of a chain with level-0
 /// size `w`×`h` holds (children clamped to each level's size, as the shader does).
 pub fn source_pixel(x: u32, y: u32, m: u32, w: u32, h: u32) -> (u32, u32) {
@@ -186,4 +193,36 @@ pub fn source_pixel(x: u32, y: u32, m: u32, w: u32, h: u32) -> (u32, u32) {
         let (lw, lh) = ((w >> (l - 1)).max(1), (h >> (l - 1)).max(1));
         (cx.min(lw - 1), cy.min(lh - 1))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{mip_texel, source_pixel};
+
+    /// Every pixel of a chain whose levels end in partial blocks reads a texel inside its
+    /// level, and that texel's source pixel lies within one block of the pixel (the block
+    /// of 2^m pixels, or the level's last, partial one); inside whole blocks it is q >> m.
+    #[test]
+    fn every_pixel_reads_a_texel_inside_its_level() {
+        for (w, h) in [(203u32, 117u32), (96, 64), (1, 1), (640, 360)] {
+            for m in 0..5 {
+                let (lw, lh) = ((w >> m).max(1), (h >> m).max(1));
+                for y in 0..h {
+                    for x in 0..w {
+                        let (tx, ty) = mip_texel(x, y, m, w, h);
+                        assert!(tx < lw && ty < lh, "{w}x{h} level {m}: ({x},{y}) -> ({tx},{ty})");
+                        if (x >> m) < lw && (y >> m) < lh {
+                            assert_eq!((tx, ty), (x >> m, y >> m));
+                        }
+                        let (sx, sy) = source_pixel(tx, ty, m, w, h);
+                        let reach = 2 << m;
+                        assert!(
+                            sx.abs_diff(x) < reach && sy.abs_diff(y) < reach,
+                            "{w}x{h} level {m}: ({x},{y}) reads ({sx},{sy})"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

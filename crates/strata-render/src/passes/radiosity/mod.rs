@@ -864,7 +864,7 @@ pub fn irradiance_cpu(g: &GatherInputs, receiver: usize, x: u32, y: u32) -> (Vec
             continue;
         }
         let m = spiral::mip_level(tap.radius, u.q, u.max_mip).max(u.min_mip.min(u.max_mip));
-        let (tx, ty) = ((qx >> m) as u32, (qy >> m) as u32);
+        let (tx, ty) = crate::passes::depth_mip::mip_texel(qx as u32, qy as u32, m, w as u32, h as u32);
         let zs = g.zmip[m as usize].pixel(tx, ty);
         let (sx, sy) = crate::passes::depth_mip::source_pixel(tx, ty, m, w as u32, h as u32);
         // (light · cos · w, w, w · cos, carries light, ω̂): a light-carrying term wins over a

@@ -379,7 +379,7 @@ fn gather(p: vec2i) -> Out {
             continue;
         }
         let m = max(spiral_mip(tap.radius, rad.q, rad.max_mip), min(rad.min_mip, rad.max_mip));
-        let t = q >> vec2u(m);
+        let t = mip_texel(zmip, q, m);
         let zs = textureLoad(zmip, t, i32(m));
         let src = mip_source_pixel(zmip, t, m);
         var best0: Term;

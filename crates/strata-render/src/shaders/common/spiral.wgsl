@@ -69,6 +69,14 @@ fn tap_texel(offset: vec2f) -> vec2i {
     return vec2i(floor(offset + vec2f(0.5)));
 }
 
+// The level-m texel of `zmip` that level-0 pixel q reads. Levels have floor sizes
+// (depth_mip.wgsl), so a level whose finer level has an odd size has no texel for the
+// last row or column of pixels: there the last texel stands in (one past it would be
+// an out-of-bounds load, whose value the backend picks).
+fn mip_texel(zmip: texture_2d<f32>, q: vec2i, m: u32) -> vec2i {
+    return min(q >> vec2u(m), vec2i(textureDimensions(zmip, m)) - 1);
+}
+
 // The level-0 pixel whose depth level-m texel t of the depth MIP chain `zmip`
 // holds (depth_mip.wgsl's rotated grid applied m times, children clamped to
 // each level), so a tap is reconstructed where its depth was seen.
