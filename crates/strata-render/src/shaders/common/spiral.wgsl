@@ -69,12 +69,19 @@ fn tap_texel(offset: vec2f) -> vec2i {
     return vec2i(floor(offset + vec2f(0.5)));
 }
 
+// The size of level m of `zmip`: ⌊size₀ / 2^m⌋, at least 1 (wgpu's rule), from level 0's
+// size. lavapipe's fragment shaders answer textureDimensions with a level that differs
+// between the pixels of a quad wrongly, so no level is passed.
+fn mip_size(zmip: texture_2d<f32>, m: u32) -> vec2i {
+    return max(vec2i(textureDimensions(zmip, 0) >> vec2u(m)), vec2i(1));
+}
+
 // The level-m texel of `zmip` that level-0 pixel q reads. Levels have floor sizes
 // (depth_mip.wgsl), so a level whose finer level has an odd size has no texel for the
 // last row or column of pixels: there the last texel stands in (one past it would be
 // an out-of-bounds load, whose value the backend picks).
 fn mip_texel(zmip: texture_2d<f32>, q: vec2i, m: u32) -> vec2i {
-    return min(q >> vec2u(m), vec2i(textureDimensions(zmip, m)) - 1);
+    return min(q >> vec2u(m), mip_size(zmip, m) - 1);
 }
 
 // The level-0 pixel whose depth level-m texel t of the depth MIP chain `zmip`
@@ -83,7 +90,7 @@ fn mip_texel(zmip: texture_2d<f32>, q: vec2i, m: u32) -> vec2i {
 fn mip_source_pixel(zmip: texture_2d<f32>, t: vec2i, m: u32) -> vec2i {
     var c = t;
     for (var l = m; l > 0u; l--) {
-        let last = vec2i(textureDimensions(zmip, l - 1u)) - 1;
+        let last = mip_size(zmip, l - 1u) - 1;
         c = min(c * 2 + vec2i((c.y & 1) ^ 1, (c.x & 1) ^ 1), last);
     }
     return c;
