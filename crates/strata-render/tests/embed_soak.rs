@@ -1,5 +1,5 @@
 //! `strata_render::embed` over a long run: an application that records the embedded AO,
-//! radiosity and reflections every frame for hundreds of frames (two layers, a moving camera, no `poll` but
+//! radiosity, reflections and bounced-z-buffer AO (its triangles rewritten each frame) every frame for hundreds of frames (two layers, a moving camera, no `poll` but
 //! its submits, and a wait for the GPU before each memory sample) holds its GPU allocations and resident memory flat. `encode` creates a bind group and
 //! views of the application's textures each frame; they must not pile up. Its own test
 //! binary: resident memory is per process, and other tests would move it.
@@ -10,8 +10,9 @@ mod common;
 mod app;
 
 use strata_render::embed::{
-    AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedRadiosity, EmbeddedRadiosityConfig, EmbeddedReflections,
-    EmbeddedReflectionsConfig, NormalEncoding, RadiosityInputs, ReflectionInputs,
+    AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedBzbAo, EmbeddedBzbAoConfig, EmbeddedRadiosity,
+    EmbeddedRadiosityConfig, EmbeddedReflections, EmbeddedReflectionsConfig, NormalEncoding, RadiosityInputs,
+    ReflectionInputs,
 };
 use strata_render::passes::ao::AoSettings;
 use strata_render::passes::radiosity::RadiositySettings;
@@ -23,7 +24,7 @@ fn resident_bytes() -> u64 {
 }
 
 #[test]
-fn embedded_ao_radiosity_and_reflections_soak_flat() {
+fn embedded_ao_radiosity_reflections_and_bzb_soak_flat() {
     let gpu = common::gpu();
     let mut scene = strata_scene::procedural::builtin("atrium").unwrap();
     scene.camera_path = None;
@@ -77,6 +78,26 @@ fn embedded_ao_radiosity_and_reflections_soak_flat() {
         },
     )
     .unwrap();
+    // a few hundred occluders and one direction keep the splat short on lavapipe
+    let mut occluders: Vec<[glam::Vec3; 3]> = tris.iter().take(512).map(|t| t.0).collect();
+    let mut bzb = EmbeddedBzbAo::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedBzbAoConfig {
+            width: w,
+            height: h,
+            settings: strata_render::passes::bzb::BzbSettings {
+                radius: Some(scene.settings.ao_radius),
+                directions: 1,
+                temporal: Some(strata_render::passes::bzb::temporal_filter()),
+                ..Default::default()
+            },
+            ..EmbeddedBzbAoConfig::default()
+        },
+        &occluders,
+    )
+    .unwrap();
     let cam = scene.camera;
     let proj =
         glam::camera::rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), w as f32 / h as f32, cam.near, 500.0);
@@ -116,6 +137,11 @@ fn embedded_ao_radiosity_and_reflections_soak_flat() {
             second_radiance: Some((&second.normals).into()),
         };
         refl.encode(&mut encoder, &mirrors).unwrap();
+        // the first triangle bobs up and down: written in place every frame
+        let lift = glam::Vec3::Y * (0.01 * (f as f32 * 0.3).sin());
+        occluders[0] = tris[0].0.map(|p| p + lift);
+        bzb.set_triangles(&occluders).unwrap();
+        bzb.encode(&mut encoder, &AoInputs { second: None, ..inputs }).unwrap();
         gpu.queue.submit([encoder.finish()]);
         if f >= first_sample && (f % 100 == 0 || f == frames) {
             // each sample waits for the GPU, so work still in flight is not counted as

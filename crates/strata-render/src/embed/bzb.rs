@@ -219,6 +219,11 @@ impl EmbeddedBzbAo {
     /// `encoder` before the next call. `inputs` has one layer (no `second`). Inputs are
     /// checked first; a bad one is a one-line error and nothing is recorded.
     pub fn encode(&mut self, encoder: &mut wgpu::CommandEncoder, inputs: &AoInputs<'_>) -> Result<(), RenderError> {
+        if inputs.second.is_some() {
+            return Err(RenderError::Parameter(
+                "embedded bzb AO: AoInputs::second is given, but the bounced z-buffer reads one layer (its occluders are the triangles): pass None".into(),
+            ));
+        }
         let cam = self.core.check_inputs(inputs, &[], None)?;
         let (_frame, has_history): (FrameUniforms, bool) = self.core.begin(inputs, &cam);
         // the triangles are the application's: written by `set_triangles`, not per frame
