@@ -94,6 +94,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         bzb.encode(&mut encoder, &inputs)?;
         queue.submit([encoder.finish()]);
     }
+    println!("DGB AO (screen space):");
+    app::print_timings(&dgb.timings()?);
     println!("bounced z-buffer ({} triangles):", bzb.triangle_count());
     app::print_timings(&bzb.timings()?);
 
