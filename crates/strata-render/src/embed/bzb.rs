@@ -48,7 +48,7 @@ impl Default for EmbeddedBzbAoConfig {
 /// The triangles of an indexed mesh in world space: `indices` in threes into `positions`,
 /// each position moved by `model`. An index out of range is a one-line error.
 pub fn indexed_triangles(positions: &[Vec3], indices: &[u32], model: Mat4) -> Result<Vec<[Vec3; 3]>, RenderError> {
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(RenderError::Parameter(format!(
             "indexed triangles: {} indices is not a multiple of 3",
             indices.len()
@@ -129,8 +129,10 @@ impl EmbeddedBzbAo {
         })?;
         s.validate()
             .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
-        let mut scene = strata_scene::Scene::default();
-        scene.name = "embedded".into();
+        let mut scene = strata_scene::Scene {
+            name: "embedded".into(),
+            ..Default::default()
+        };
         scene.settings.ao_radius = radius;
         let core = CoreConfig {
             what,
