@@ -12,7 +12,7 @@ use strata_render::frame::FrameCameras;
 use strata_render::passes::ao::AoSettings;
 use strata_render::passes::Kernel;
 use strata_render::{GpuContext, RenderSettings, Renderer};
-use strata_scene::{ImageBuf, Scene};
+use strata_scene::Scene;
 
 const W: u32 = 160;
 const H: u32 = 90;
@@ -62,23 +62,7 @@ fn embedded(
 
 /// Records one embedded frame and submits it; validation errors fail the test.
 fn run(gpu: &GpuContext, ao: &mut EmbeddedAo, inputs: &AoInputs<'_>) {
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    ao.encode(&mut encoder, inputs).expect("valid inputs");
-    gpu.queue.submit([encoder.finish()]);
-    gpu.check_errors().expect("no wgpu validation errors");
-}
-
-/// (mean |a − b|, fraction of pixels with |a − b| > `tol`) over channel 0.
-fn diff(a: &ImageBuf, b: &ImageBuf, tol: f32) -> (f64, f64) {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let n = (a.width * a.height) as usize;
-    let (mut sum, mut over) = (0.0f64, 0usize);
-    for i in 0..n {
-        let d = (a.data[i * a.channels as usize] - b.data[i * b.channels as usize]).abs();
-        sum += d as f64;
-        over += (d > tol) as usize;
-    }
-    (sum / n as f64, over as f64 / n as f64)
+    common::submit_checked(gpu, |encoder| ao.encode(encoder, inputs).expect("valid inputs"));
 }
 
 #[test]
@@ -166,7 +150,7 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
         );
         // the same passes on the same data: the same AO but for f32 rounding of z
         let (a, b) = (ao.read_target("ao").unwrap(), r.read_target(&gpu, "ao").unwrap());
-        let (mean, over) = diff(&a, &b, 1.0 / 255.0);
+        let (mean, over) = common::channel0_diff(&a, &b, 1.0 / 255.0);
         println!(
             "k = {layers}, {what}: mean |ΔAV| {mean:.2e}, {:.3} % of pixels over 1/255",
             100.0 * over
@@ -288,7 +272,7 @@ fn embedded_ao_takes_the_depth_and_normal_conventions_applications_use() {
             }
         }
         let a = ao.read_target("ao").unwrap();
-        let (mean, over) = diff(&a, &reference, 4.0 / 255.0);
+        let (mean, over) = common::channel0_diff(&a, &reference, 4.0 / 255.0);
         println!(
             "{}: z within {worst:.1e} relative, {missed} pixels' coverage differs; mean |ΔAV| {mean:.2e}, {:.2} % over 4/255",
             c.name,
@@ -493,8 +477,8 @@ fn embedded_two_layer_ao_from_an_applications_peel_is_the_renderers() {
         r2.read_target(&gpu, "ao").unwrap(),
         r1.read_target(&gpu, "ao").unwrap(),
     );
-    let (mean, over) = diff(&a, &b2, 4.0 / 255.0);
-    let (mean1, _) = diff(&b1, &b2, 4.0 / 255.0);
+    let (mean, over) = common::channel0_diff(&a, &b2, 4.0 / 255.0);
+    let (mean1, _) = common::channel0_diff(&b1, &b2, 4.0 / 255.0);
     println!(
         "second layer: {both} pixels in both, {apart} in one; mean |ΔAV| {mean:.2e} ({:.2} % over 4/255), 1 vs 2 layers {mean1:.2e}",
         100.0 * over
@@ -642,7 +626,7 @@ fn embedded_ao_from_depth_alone_reconstructs_the_normals() {
                 shares.push(within as f64 / covered as f64);
             }
             let (a, b) = (ao.read_target("ao").unwrap(), r.read_target(&gpu, "ao").unwrap());
-            let (mean, over) = diff(&a, &b, 4.0 / 255.0);
+            let (mean, over) = common::channel0_diff(&a, &b, 4.0 / 255.0);
             println!(
                 "{name}, k = {layers}: normals within 2° per layer {shares:.3?}; mean |ΔAV| {mean:.2e} against the renderer's, {:.2} % of pixels over 4/255",
                 100.0 * over
@@ -656,7 +640,7 @@ fn embedded_ao_from_depth_alone_reconstructs_the_normals() {
             }
             results.push((b, mean, a));
         }
-        let (between_layers, _) = diff(&results[0].0, &results[1].0, 4.0 / 255.0);
+        let (between_layers, _) = common::channel0_diff(&results[0].0, &results[1].0, 4.0 / 255.0);
         println!("{name}: the renderer's AO, 1 against 2 layers: mean |ΔAV| {between_layers:.2e}");
         // against the CPU reference (DGB obscurance over the whole scene, shading normals)
         let (radius, beta, epsilon) = settings.resolve(&scene);
@@ -671,8 +655,8 @@ fn embedded_ao_from_depth_alone_reconstructs_the_normals() {
         let reference = strata_reference::Reference::new(&scene, 0.0).ao_obscurance(&scene.camera, W, H, &s);
         for (k, (true_normals, _, _)) in results.iter().enumerate() {
             let from_depth = &results[k].2;
-            let (e_true, _) = diff(true_normals, &reference, 1.0);
-            let (e_depth, _) = diff(from_depth, &reference, 1.0);
+            let (e_true, _) = common::channel0_diff(true_normals, &reference, 1.0);
+            let (e_depth, _) = common::channel0_diff(from_depth, &reference, 1.0);
             println!(
                 "{name}, k = {}: AV error against the CPU reference: true normals {e_true:.4}, from depth {e_depth:.4}",
                 k + 1

@@ -14,12 +14,19 @@ use strata_render::embed::{
 use strata_render::frame::FrameCameras;
 use strata_render::passes::bzb::{self, BzbSettings, Splat};
 use strata_render::{GpuContext, RenderSettings, Renderer};
-use strata_scene::{ImageBuf, Scene};
+use strata_scene::Scene;
 
 const W: u32 = 160;
 const H: u32 = 90;
 
-fn embedded(gpu: &GpuContext, w: u32, h: u32, settings: BzbSettings, triangles: &[[Vec3; 3]]) -> EmbeddedBzbAo {
+/// The embedded bounced-z-buffer AO at `w`×`h` over `triangles`, world-space normals.
+fn embedded(
+    gpu: &GpuContext,
+    [w, h]: [u32; 2],
+    settings: BzbSettings,
+    normals: NormalEncoding,
+    triangles: &[[Vec3; 3]],
+) -> EmbeddedBzbAo {
     EmbeddedBzbAo::new(
         &gpu.adapter,
         &gpu.device,
@@ -28,7 +35,7 @@ fn embedded(gpu: &GpuContext, w: u32, h: u32, settings: BzbSettings, triangles: 
             width: w,
             height: h,
             settings,
-            normals: NormalEncoding::Octahedral,
+            normals,
             normal_space: NormalSpace::World,
         },
         triangles,
@@ -38,23 +45,7 @@ fn embedded(gpu: &GpuContext, w: u32, h: u32, settings: BzbSettings, triangles: 
 
 /// Records one embedded frame and submits it; validation errors fail the test.
 fn run(gpu: &GpuContext, ao: &mut EmbeddedBzbAo, inputs: &AoInputs<'_>) {
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    ao.encode(&mut encoder, inputs).expect("valid inputs");
-    gpu.queue.submit([encoder.finish()]);
-    gpu.check_errors().expect("no wgpu validation errors");
-}
-
-/// (mean |a − b|, fraction of pixels with |a − b| > `tol`) over channel 0.
-fn diff(a: &ImageBuf, b: &ImageBuf, tol: f32) -> (f64, f64) {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let n = (a.width * a.height) as usize;
-    let (mut sum, mut over) = (0.0f64, 0usize);
-    for i in 0..n {
-        let d = (a.data[i * a.channels as usize] - b.data[i * b.channels as usize]).abs();
-        sum += d as f64;
-        over += (d > tol) as usize;
-    }
-    (sum / n as f64, over as f64 / n as f64)
+    common::submit_checked(gpu, |encoder| ao.encode(encoder, inputs).expect("valid inputs"));
 }
 
 fn world_triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
@@ -106,7 +97,7 @@ fn embedded_bzb_ao_on_the_renderers_gbuffer_is_the_renderers() {
             },
         )
         .unwrap();
-        let mut ao = embedded(&gpu, W, H, settings, &triangles);
+        let mut ao = embedded(&gpu, [W, H], settings, NormalEncoding::Octahedral, &triangles);
         assert_eq!(ao.triangle_count() as usize, triangles.len());
         for _ in 0..frames {
             r.render(&gpu, &scene, &cams, 0.0).unwrap();
@@ -115,7 +106,7 @@ fn embedded_bzb_ao_on_the_renderers_gbuffer_is_the_renderers() {
             run(&gpu, &mut ao, &AoInputs::new(layer0(depth), layer0(normal), view, proj));
         }
         let (a, b) = (ao.read_target("ao").unwrap(), r.read_target(&gpu, "ao").unwrap());
-        let (mean, over) = diff(&a, &b, 1.0 / 255.0);
+        let (mean, over) = common::channel0_diff(&a, &b, 1.0 / 255.0);
         println!(
             "{what}: mean |ΔAV| {mean:.2e}, {:.3} % of pixels over 1/255",
             100.0 * over
@@ -171,20 +162,7 @@ fn an_occluder_off_screen_occludes_as_the_analytic_value() {
         temporal: Some(bzb::temporal_filter()),
         ..BzbSettings::default()
     };
-    let mut ao = EmbeddedBzbAo::new(
-        &gpu.adapter,
-        &gpu.device,
-        &gpu.queue,
-        EmbeddedBzbAoConfig {
-            width: w,
-            height: h,
-            settings,
-            normals: NormalEncoding::Signed,
-            ..EmbeddedBzbAoConfig::default()
-        },
-        &floor_only,
-    )
-    .unwrap();
+    let mut ao = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &floor_only);
     let mean_av = |ao: &mut EmbeddedBzbAo| {
         for _ in 0..8 {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());

@@ -142,6 +142,28 @@ pub fn values_differing(a: &strata_scene::ImageBuf, b: &strata_scene::ImageBuf, 
         .count()
 }
 
+/// (mean |a − b|, fraction of pixels with |a − b| > `tol`) over channel 0 of two images
+/// of one size (the embedded techniques against the renderer's).
+pub fn channel0_diff(a: &strata_scene::ImageBuf, b: &strata_scene::ImageBuf, tol: f32) -> (f64, f64) {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let n = (a.width * a.height) as usize;
+    let (mut sum, mut over) = (0.0f64, 0usize);
+    for i in 0..n {
+        let d = (a.data[i * a.channels as usize] - b.data[i * b.channels as usize]).abs();
+        sum += d as f64;
+        over += (d > tol) as usize;
+    }
+    (sum / n as f64, over as f64 / n as f64)
+}
+
+/// Records one encoder with `record`, submits it, and fails on a wgpu validation error.
+pub fn submit_checked(gpu: &GpuContext, record: impl FnOnce(&mut wgpu::CommandEncoder)) {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    record(&mut encoder);
+    gpu.queue.submit([encoder.finish()]);
+    gpu.check_errors().expect("no wgpu validation errors");
+}
+
 /// How many values of target `name` differ in their bits between renderers `a` and `b`
 /// (the same-image checks of settings that must not change the image).
 pub fn target_bits_differing(gpu: &GpuContext, a: &Renderer, b: &Renderer, name: &str) -> usize {
