@@ -305,6 +305,11 @@ fn bad_embedded_bzb_input_is_a_one_line_error() {
     };
     let e = ao.encode(&mut encoder, &inputs).unwrap_err().to_string();
     assert!(e.contains("AoInputs::second"), "{e}");
+    // a refused resize keeps the instance as it was, triangles included
+    let e = ao.resize(0, 48).unwrap_err().to_string();
+    assert!(e.contains("size 0x48 is out of range"), "{e}");
+    ao.resize(32, 24).unwrap();
+    assert_eq!((ao.config().width, ao.triangle_count()), (32, 1));
     // indexed meshes: an index out of range names it
     let e = indexed_triangles(&[Vec3::ZERO, Vec3::X], &[0, 1, 2], Mat4::IDENTITY).unwrap_err();
     assert!(

@@ -196,13 +196,7 @@ impl EmbeddedBzbAo {
         config.width = width;
         config.height = height;
         let gpu = &self.core.gpu;
-        *self = Self::build(
-            &gpu.adapter,
-            &gpu.device,
-            &gpu.queue,
-            config,
-            std::mem::take(&mut self.data),
-        )?;
+        *self = Self::build(&gpu.adapter, &gpu.device, &gpu.queue, config, self.data.clone())?;
         Ok(())
     }
 
