@@ -122,13 +122,7 @@ impl EmbeddedBzbAo {
     ) -> Result<Self, RenderError> {
         let what = "embedded bzb AO";
         let s = &config.settings;
-        let radius = s.radius.ok_or_else(|| {
-            RenderError::Parameter(format!(
-                "{what}: settings.radius is required: the world-space AO radius r = d_max (> 0, in the application's units)"
-            ))
-        })?;
-        s.validate()
-            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
+        let radius = super::required_radius(what, s.radius, "the world-space AO radius r = d_max", s.validate())?;
         let mut scene = strata_scene::Scene {
             name: "embedded".into(),
             ..Default::default()

@@ -277,6 +277,23 @@ impl CameraModel {
     }
 }
 
+/// The settings' world-space radius, required (`meaning` names it in the error), once the
+/// settings validate: the one-line errors every embedded technique's `new` gives first.
+fn required_radius(
+    what: &str,
+    radius: Option<f32>,
+    meaning: &str,
+    valid: Result<(), String>,
+) -> Result<f32, RenderError> {
+    let r = radius.ok_or_else(|| {
+        RenderError::Parameter(format!(
+            "{what}: settings.radius is required: {meaning} (> 0, in the application's units)"
+        ))
+    })?;
+    valid.map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
+    Ok(r)
+}
+
 /// A rotation (or a reflection, for left-handed views) and a translation: camera-space z
 /// is then in world units, as the AO radius is.
 fn is_rigid(m: Mat4) -> bool {
@@ -377,13 +394,7 @@ impl EmbeddedAo {
     ) -> Result<Self, RenderError> {
         let what = "embedded AO";
         let s = &config.settings;
-        let radius = s.radius.ok_or_else(|| {
-            RenderError::Parameter(format!(
-                "{what}: settings.radius is required: the world-space AO radius r (> 0, in the application's units)"
-            ))
-        })?;
-        s.validate()
-            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
+        let radius = required_radius(what, s.radius, "the world-space AO radius r", s.validate())?;
         let mut scene = strata_scene::Scene::default();
         scene.settings.ao_radius = radius;
         let core = CoreConfig {

@@ -87,13 +87,7 @@ impl EmbeddedRadiosity {
     ) -> Result<Self, RenderError> {
         let what = "embedded radiosity";
         let s = &config.settings;
-        let radius = s.radius.ok_or_else(|| {
-            RenderError::Parameter(format!(
-                "{what}: settings.radius is required: the world-space gather radius (> 0, in the application's units)"
-            ))
-        })?;
-        s.validate()
-            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
+        let radius = super::required_radius(what, s.radius, "the world-space gather radius", s.validate())?;
         let needed = wgpu::Features::RG11B10UFLOAT_RENDERABLE;
         if !device.features().contains(needed) {
             return Err(RenderError::Parameter(format!(
