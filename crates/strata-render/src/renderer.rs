@@ -1168,9 +1168,12 @@ impl Renderer {
     /// With DSS splatting: a one-line message when the last frame's
     /// surfelization overflowed a buffer ([`crate::passes::bzb::dss::SurfelCounts::overflow`]).
     pub fn dss_overflow(&self, gpu: &GpuContext) -> Option<Result<Option<String>, RenderError>> {
-        let b = self.bzb.as_ref()?;
-        let d = b.dss()?;
-        Some(d.read_counts(gpu, b.triangle_count()).map(|c| c.overflow(d.capacity())))
+        let (d, triangles) = match (&self.bzb_gi, &self.bzb) {
+            (Some(g), _) => (g.dss()?, g.triangle_count()),
+            (None, Some(b)) => (b.dss()?, b.triangle_count()),
+            (None, None) => return None,
+        };
+        Some(d.read_counts(gpu, triangles).map(|c| c.overflow(d.capacity())))
     }
 
     /// The DSS surfels of the last frame (GPU append order).

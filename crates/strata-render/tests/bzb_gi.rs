@@ -931,3 +931,46 @@ fn box_splats_equal_rectangle_splats() {
         );
     }
 }
+
+/// `bzb-gi`'s DSS surfels share `bzb-ao`'s fixed-capacity buffers: a frame whose
+/// surfelization overflows one is reported (`Renderer::dss_overflow`, which `strata
+/// render` prints), as it is for AO. Twenty large triangles under the floor fill the
+/// sub-triangle buffer; the emitter scene alone fits.
+#[test]
+fn dss_overflow_is_reported_for_gi() {
+    let gpu = common::gpu();
+    let g = dss(BzbGiSettings {
+        directions: 1,
+        d_max: Some(2.0),
+        ..Default::default()
+    });
+    let fits = emitter_scene(1.0, 1.5, 1.0, 2.0, None);
+    let r = render(&gpu, &fits, 32, 24, g.clone());
+    assert_eq!(r.dss_overflow(&gpu).expect("DSS runs").unwrap(), None);
+    let mut full = fits.clone();
+    let sheets: Vec<Vec<Vec3>> = (0..20)
+        .map(|i| {
+            let y = -0.2 - 0.01 * i as f32;
+            vec![
+                Vec3::new(-50.0, y, -50.0),
+                Vec3::new(0.0, y, 50.0),
+                Vec3::new(50.0, y, -50.0),
+            ]
+        })
+        .collect();
+    let refs: Vec<&[Vec3]> = sheets.iter().map(|p| p.as_slice()).collect();
+    let extra = common::polygons_scene("sheets", &refs, fits.camera, 0.1);
+    let base = full.meshes.len();
+    full.meshes.extend(extra.meshes);
+    full.objects.extend(extra.objects.into_iter().map(|mut o| {
+        o.mesh += base;
+        o
+    }));
+    let r = render(&gpu, &full, 32, 24, g);
+    let message = r.dss_overflow(&gpu).expect("DSS runs").unwrap().expect("an overflow");
+    println!("{message}");
+    assert!(
+        message.contains("sub-triangles for a buffer of 65536") && !message.contains('\n'),
+        "{message}"
+    );
+}

@@ -162,7 +162,7 @@ fn an_occluder_off_screen_occludes_as_the_analytic_value() {
         temporal: Some(bzb::temporal_filter()),
         ..BzbSettings::default()
     };
-    let mut ao = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &floor_only);
+    let mut ao = embedded(&gpu, [w, h], settings.clone(), NormalEncoding::Signed, &floor_only);
     let mean_av = |ao: &mut EmbeddedBzbAo| {
         for _ in 0..8 {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -192,13 +192,25 @@ fn an_occluder_off_screen_occludes_as_the_analytic_value() {
     let under_03 = mean_av(&mut ao);
     let mut moved = floor_only.clone();
     moved.extend(plate(0.4));
-    ao.set_triangles(&moved).unwrap();
+    // only the plate's range is written (set_triangles would write all, in place)
+    ao.set_triangle_range(floor_only.len() as u32, &plate(0.4)).unwrap();
     // written in place, the temporal history stays (it follows receivers, not occluders):
     // a jump this large wants a fresh start
     ao.reset_history();
     let under_04 = mean_av(&mut ao);
     ao.set_triangles(&floor_only).unwrap();
     let cleared = mean_av(&mut ao);
+    // the range write leaves exactly what an instance built with the moved plate has
+    // (both run the same frames from their first)
+    let mut ranged = embedded(&gpu, [w, h], settings.clone(), NormalEncoding::Signed, &with_plate);
+    ranged.set_triangle_range(floor_only.len() as u32, &plate(0.4)).unwrap();
+    let mut fresh = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &moved);
+    let (ranged_av, fresh_av) = (mean_av(&mut ranged), mean_av(&mut fresh));
+    let (a, b) = (ranged.read_target("ao").unwrap(), fresh.read_target("ao").unwrap());
+    assert!(
+        a.data == b.data,
+        "the plate's range written in place gives the AV of a fresh build ({ranged_av} against {fresh_av})"
+    );
     let expect = |h: f32| (h / r) * (h / r);
     println!(
         "floor alone {clear:.4}; plate at 0.3: {under_03:.4} (analytic {:.4}); at 0.4: {under_04:.4} ({:.4}); removed {cleared:.4}",
@@ -276,6 +288,28 @@ fn bad_embedded_bzb_input_is_a_one_line_error() {
         .unwrap_err();
     assert!(e.to_string().contains("triangles[0]"), "{e}");
     assert_eq!(ao.triangle_count(), 1);
+    // a range must lie within the triangles, and names the bad triangle by its index
+    let mut two = new(config(r1()), &[quad[0], quad[0]]).unwrap();
+    for (first, tris, want) in [
+        (
+            1,
+            vec![quad[0]; 2],
+            "triangle range 1..3 is out of range: must lie within 0..2",
+        ),
+        (u32::MAX, vec![quad[0]], "is out of range: must lie within 0..2"),
+        (
+            1,
+            vec![[Vec3::ZERO, Vec3::X, Vec3::splat(f32::NAN)]],
+            "triangles[1] has a non-finite vertex",
+        ),
+    ] {
+        let e = two.set_triangle_range(first, &tris).unwrap_err().to_string();
+        println!("{e}");
+        assert!(e.contains(want) && !e.contains('\n'), "'{e}' lacks '{want}'");
+    }
+    two.set_triangle_range(2, &[])
+        .expect("an empty range at the end is nothing to write");
+    assert_eq!(two.triangle_count(), 2);
     // a second layer is not read: an AoInputs with one is refused
     let texture = |format| {
         gpu.device.create_texture(&wgpu::TextureDescriptor {
@@ -327,4 +361,79 @@ fn bad_embedded_bzb_input_is_a_one_line_error() {
         vec![[Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)]]
     );
     gpu.check_errors().expect("no wgpu validation errors");
+}
+
+/// DSS surfels live in buffers of fixed capacity (BZB §4.3 streams them out; here atomic
+/// appends). Triangles that fill them are reported as a one-line message naming the full
+/// buffer, its capacity and the setting to change, never dropped in silence; once the
+/// triangles fit again the message goes.
+#[test]
+fn dss_surfel_overflow_is_reported_and_clears() {
+    use glam::camera::rh;
+    let gpu = common::gpu();
+    let (w, h) = (96u32, 64u32);
+    let grey = Vec3::splat(0.5);
+    let floor = app::cuboid(Vec3::new(-4.0, -0.1, -4.0), Vec3::new(4.0, 0.0, 4.0), grey);
+    let floor_only = world_of(&floor);
+    let eye = Vec3::new(0.0, 0.5, 1.0);
+    let view = rh::view::look_at_mat4(eye, Vec3::new(0.0, 0.0, -1.0), Vec3::Y);
+    let proj = rh::proj::directx::perspective(60f32.to_radians(), w as f32 / h as f32, 0.01, 50.0);
+    let gbuffer = app::GBuffer::new(&gpu.device, [w, h], app::Layout::standard(), &floor);
+    let settings = BzbSettings {
+        radius: Some(0.3),
+        directions: 1,
+        splat: Splat::Dss,
+        ..BzbSettings::default()
+    };
+    // large triangles under the floor, right below the eye: each is pre-tessellated into
+    // the most sub-triangles (64²) of the most fine surfels (64); under the floor's
+    // tangent plane they occlude nothing
+    let sheet = |i: usize| {
+        let y = -0.2 - 0.01 * i as f32;
+        [
+            Vec3::new(-50.0, y, -50.0),
+            Vec3::new(50.0, y, -50.0),
+            Vec3::new(0.0, y, 50.0),
+        ]
+    };
+    let mut sheets = floor_only.clone();
+    sheets.extend((0..20).map(sheet));
+    let mut ao = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &floor_only);
+    let mut frame = |ao: &mut EmbeddedBzbAo| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        gbuffer.draw(&gpu.queue, &mut encoder, view, proj);
+        ao.encode(
+            &mut encoder,
+            &AoInputs::new((&gbuffer.depth).into(), (&gbuffer.normals).into(), view, proj),
+        )
+        .unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+        let c = ao.dss_counts().expect("DSS counts").unwrap();
+        println!("{c:?}");
+        (c, ao.dss_overflow().unwrap())
+    };
+    let (fits, none) = frame(&mut ao);
+    assert!(
+        fits.surfels > 0 && none.is_none(),
+        "the floor alone fits: {fits:?}, {none:?}"
+    );
+    ao.set_triangles(&sheets).unwrap();
+    let (full, message) = frame(&mut ao);
+    let message = message.expect("the sheets overflow a surfel buffer");
+    println!("{message}");
+    assert!(
+        message.starts_with("embedded bzb AO: dss surfelization overflowed (")
+            && message.contains("sub-triangles for a buffer of 65536")
+            && message.contains("surfel-size (0.5..=16 px)")
+            && !message.contains('\n'),
+        "{message}"
+    );
+    assert!(full.subtriangles > 65536, "{full:?}");
+    ao.set_triangles(&floor_only).unwrap();
+    let (again, none) = frame(&mut ao);
+    assert!(
+        none.is_none() && again == fits,
+        "the floor alone fits again: {again:?}, {none:?}"
+    );
 }

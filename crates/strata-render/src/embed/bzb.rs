@@ -5,7 +5,8 @@
 //! scene's triangles themselves into a depth-buffered framebuffer of per-pixel directions,
 //! so each ray's nearest occluder wins wherever it is, on screen or not (BZB §3.2). The
 //! application therefore gives its world-space triangles once ([`EmbeddedBzbAo::new`]), and
-//! again when they move ([`EmbeddedBzbAo::set_triangles`]), besides the per-frame depth and
+//! again when they move ([`EmbeddedBzbAo::set_triangles`], or
+//! [`EmbeddedBzbAo::set_triangle_range`] for one object's range), besides the per-frame depth and
 //! normals [`super::EmbeddedAo`] reads. It gets back the same output: ambient visibility
 //! AV in [0, 1], 1 = unoccluded, binary AO within the radius r.
 
@@ -14,6 +15,7 @@ use glam::{Mat4, Vec3};
 use super::core::{Core, CoreConfig};
 use super::{AoInputs, NormalEncoding, NormalSpace};
 use crate::frame::{FrameUniforms, Pass, TargetDesc};
+use crate::passes::bzb::dss::SurfelCounts;
 use crate::passes::bzb::{BzbSettings, BzbStage, TEMPORAL, TEMPORAL_FRAMES};
 use crate::RenderError;
 
@@ -72,18 +74,32 @@ pub fn indexed_triangles(positions: &[Vec3], indices: &[u32], model: Mat4) -> Re
         .collect()
 }
 
+/// A one-line error for the first triangle with a non-finite vertex; `first` is the index
+/// of `triangles[0]` in the whole buffer.
+fn check_finite(triangles: &[[Vec3; 3]], first: usize) -> Result<(), RenderError> {
+    match triangles.iter().position(|t| !t.iter().all(|p| p.is_finite())) {
+        Some(i) => Err(RenderError::Parameter(format!(
+            "embedded bzb AO: triangles[{}] has a non-finite vertex ({:?})",
+            first + i,
+            triangles[i]
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// `triangles` in the splat buffer's layout (3 × vec4 each), checked finite.
 fn splat_data(triangles: &[[Vec3; 3]]) -> Result<Vec<[f32; 4]>, RenderError> {
-    if let Some(i) = triangles.iter().position(|t| !t.iter().all(|p| p.is_finite())) {
-        return Err(RenderError::Parameter(format!(
-            "embedded bzb AO: triangles[{i}] has a non-finite vertex ({:?})",
-            triangles[i]
-        )));
+    check_finite(triangles, 0)?;
+    let mut data = vec![[0.0; 4]; triangles.len() * 3];
+    fill_splat_data(&mut data, triangles);
+    Ok(data)
+}
+
+/// Writes `triangles` into `data` (3 entries each) in the splat buffer's layout.
+fn fill_splat_data(data: &mut [[f32; 4]], triangles: &[[Vec3; 3]]) {
+    for (d, p) in data.iter_mut().zip(triangles.iter().flatten()) {
+        *d = p.extend(0.0).to_array();
     }
-    Ok(triangles
-        .iter()
-        .flat_map(|t| t.map(|p| p.extend(0.0).to_array()))
-        .collect())
 }
 
 /// The bounced-z-buffer AO passes of `strata render --technique bzb-ao` on an
@@ -167,15 +183,51 @@ impl EmbeddedBzbAo {
     /// triangles as before they are written in place; another count rebuilds the passes
     /// (the temporal history then starts afresh). On error nothing changes.
     pub fn set_triangles(&mut self, triangles: &[[Vec3; 3]]) -> Result<(), RenderError> {
-        let data = splat_data(triangles)?;
-        if data.len() == self.data.len() {
-            self.stage.write_triangles(&self.core.gpu, &data);
-            self.data = data;
-            return Ok(());
+        if triangles.len() * 3 == self.data.len() {
+            return self.set_triangle_range(0, triangles);
         }
+        let data = splat_data(triangles)?;
         let gpu = &self.core.gpu;
         *self = Self::build(&gpu.adapter, &gpu.device, &gpu.queue, self.config.clone(), data)?;
         Ok(())
+    }
+
+    /// Replaces triangles `first..first + triangles.len()` in place, for an object that
+    /// moves while the rest stays: only that range is written to the GPU, and nothing is
+    /// allocated. The range must lie within the current triangles; a range outside them
+    /// or a non-finite vertex is a one-line error, and then nothing changes.
+    pub fn set_triangle_range(&mut self, first: u32, triangles: &[[Vec3; 3]]) -> Result<(), RenderError> {
+        let count = self.data.len() / 3;
+        let (start, end) = (first as usize, first as usize + triangles.len());
+        if end > count {
+            return Err(RenderError::Parameter(format!(
+                "embedded bzb AO: triangle range {start}..{end} is out of range: must lie within 0..{count} (set_triangles changes the count)"
+            )));
+        }
+        check_finite(triangles, start)?;
+        let data = &mut self.data[start * 3..end * 3];
+        fill_splat_data(data, triangles);
+        self.stage.write_triangles(&self.core.gpu, first, data);
+        Ok(())
+    }
+
+    /// With DSS surfels (`settings.splat`): the last submitted frame's surfel counts
+    /// (BZB Table 2), read back (this waits for the GPU). `None` with AOV splats.
+    pub fn dss_counts(&self) -> Option<Result<SurfelCounts, RenderError>> {
+        let d = self.stage.dss()?;
+        Some(d.read_counts(&self.core.gpu, self.stage.triangle_count()))
+    }
+
+    /// With DSS surfels: a one-line message when the last submitted frame's surfelization
+    /// overflowed a buffer ([`SurfelCounts::overflow`]; the excess was dropped, so that
+    /// frame misses occluders), `Ok(None)` when everything fitted or with AOV splats. It
+    /// reads the counts back, so call it now and then (after a change of triangles or
+    /// camera), not every frame.
+    pub fn dss_overflow(&self) -> Result<Option<String>, RenderError> {
+        match (self.stage.dss(), self.dss_counts()) {
+            (Some(d), Some(c)) => Ok(c?.overflow(d.capacity()).map(|m| format!("embedded bzb AO: {m}"))),
+            _ => Ok(None),
+        }
     }
 
     /// Triangles splatted each frame.

@@ -394,7 +394,7 @@ impl SurfelCounts {
             .collect();
         (!full.is_empty()).then(|| {
             format!(
-                "dss surfelization overflowed ({}; the excess was dropped, so the AO misses occluders): \
+                "dss surfelization overflowed ({}; the excess was dropped, so the frame misses those surfaces): \
                  raise surfel-size (0.5..=16 px) or lower the resolution",
                 full.join(", ")
             )

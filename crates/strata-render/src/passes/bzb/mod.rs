@@ -1038,14 +1038,15 @@ impl BzbStage {
         self.last.set(u);
     }
 
-    /// Overwrites the splat triangles with `data` (as [`triangle_data`] lays them out),
-    /// which must hold as many triangles as the stage was built with; for geometry that
-    /// moves between frames.
-    pub fn write_triangles(&self, gpu: &GpuContext, data: &[[f32; 4]]) {
-        debug_assert_eq!(data.len(), self.triangles.count as usize * 3);
+    /// Overwrites splat triangles `first..` with `data` (as [`triangle_data`] lays them
+    /// out, 3 entries per triangle), which must end within the count the stage was built
+    /// with; for geometry that moves between frames.
+    pub fn write_triangles(&self, gpu: &GpuContext, first: u32, data: &[[f32; 4]]) {
+        debug_assert!(data.len() % 3 == 0 && first as usize + data.len() / 3 <= self.triangles.count as usize);
         if !data.is_empty() {
+            let offset = first as u64 * 3 * std::mem::size_of::<[f32; 4]>() as u64;
             gpu.queue
-                .write_buffer(&self.triangles.buffer, 0, bytemuck::cast_slice(data));
+                .write_buffer(&self.triangles.buffer, offset, bytemuck::cast_slice(data));
         }
     }
 
