@@ -696,6 +696,7 @@ impl Renderer {
                 &mut targets,
                 i,
                 scene,
+                true,
             )?),
             None => None,
         };

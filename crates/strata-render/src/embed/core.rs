@@ -39,6 +39,9 @@ pub(crate) enum ShadingImport {
     /// `radiosity1`, both `Rgba16Float`), and layer 0's roughness and metallic from
     /// channels `roughness` and `metallic` of a material texture (into `normal`'s b, a).
     Reflections { roughness: u32, metallic: u32 },
+    /// Each layer's normal alone (`normal`, roughness and metallic 0); `albedo` exists and
+    /// stays 0 (ILS: Lambert receivers, whose ρ the application applies).
+    Normals,
 }
 
 /// What an input texture holds, for [`Core::check`].
@@ -134,7 +137,7 @@ impl Core {
         let (w, h, layers) = (c.width, c.height, c.layers);
         let shading = c.shading != ShadingImport::None;
         let radiance_targets: Vec<&'static str> = match c.shading {
-            ShadingImport::None => Vec::new(),
+            ShadingImport::None | ShadingImport::Normals => Vec::new(),
             ShadingImport::Radiosity => crate::passes::lighting::RADIOSITY.to_vec(),
             ShadingImport::Reflections { .. } => vec!["hdr", crate::passes::lighting::RADIOSITY[1]],
         };
@@ -267,9 +270,12 @@ impl Core {
         }
         let geometry = pipeline(if layers == 2 { "fs_import2" } else { "fs_import1" }, 0, &formats);
         let per_layer = [F::Rgba8Unorm, F::Rgba8UnormSrgb, radiance_format];
-        let shading_pipelines = (0..radiance_targets.len() as u32)
-            .map(|j| pipeline("fs_shading", j, &per_layer))
-            .collect();
+        let shading_pipelines = match c.shading {
+            ShadingImport::Normals => (0..layers).map(|j| pipeline("fs_normal", j, &per_layer[..1])).collect(),
+            _ => (0..radiance_targets.len() as u32)
+                .map(|j| pipeline("fs_shading", j, &per_layer))
+                .collect(),
+        };
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("embed-import"),
             size: std::mem::size_of::<ImportUniforms>() as u64,
@@ -549,12 +555,17 @@ impl Core {
         if !self.shading.is_empty() {
             let slot = prof.begin(encoder, "embed-import-shading");
             for (j, pipeline) in self.shading.iter().enumerate() {
-                let outputs = [
-                    &t.get("normal").layer_views[j],
-                    &t.get("albedo").layer_views[j],
-                    &t.get(self.radiance_targets[j]).view,
-                ];
-                crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &outputs, &[&group]);
+                let normal = &t.get("normal").layer_views[j];
+                match self.radiance_targets.get(j) {
+                    Some(radiance) => {
+                        let outputs = [normal, &t.get("albedo").layer_views[j], &t.get(radiance).view];
+                        crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &outputs, &[&group]);
+                    }
+                    // ShadingImport::Normals
+                    None => {
+                        crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &[normal], &[&group])
+                    }
+                }
             }
             prof.end(encoder, slot);
         }

@@ -234,3 +234,10 @@ fn fs_shading(@builtin(position) pos: vec4f) -> Shading {
     }
     return Shading(l.normal, l.albedo, l.radiosity);
 }
+
+// ShadingImport::Normals (the embedded ILS): the layer's `normal` alone, roughness and
+// metallic 0
+@fragment
+fn fs_normal(@builtin(position) pos: vec4f) -> @location(0) vec4f {
+    return vec4f(layer_oct(LAYER, vec2i(pos.xy)), 0.0, 0.0);
+}

@@ -49,10 +49,12 @@ use glam::{Mat4, Vec3, Vec4};
 
 mod bzb;
 mod core;
+mod ils;
 mod radiosity;
 mod reflections;
 
 pub use bzb::{indexed_triangles, EmbeddedBzbAo, EmbeddedBzbAoConfig};
+pub use ils::{EmbeddedIls, EmbeddedIlsConfig};
 pub use radiosity::{EmbeddedRadiosity, EmbeddedRadiosityConfig, RadiosityInputs};
 pub use reflections::{EmbeddedReflections, EmbeddedReflectionsConfig, MaterialChannels, ReflectionInputs};
 

@@ -319,14 +319,7 @@ impl IlsSettings {
                 self.vpl_shadow_resolution
             ));
         }
-        for (k, v) in self.vpls.iter().enumerate() {
-            let finite = v.position.iter().chain(&v.normal).chain(&v.flux).all(|c| c.is_finite());
-            if !finite || v.flux.iter().any(|&c| c < 0.0) {
-                return Err(format!(
-                    "vpls[{k}] is invalid: position, normal and flux must be finite and the flux >= 0"
-                ));
-            }
-        }
+        check_vpls(&self.vpls)?;
         Ok(())
     }
 
@@ -354,6 +347,18 @@ impl IlsSettings {
     /// has all N VPLs, so it is never blurred, whatever `blur` says.
     pub fn blurs(&self) -> bool {
         self.blur > 0.0 && !self.brute_force
+    }
+
+    /// The target holding the frame's indirect irradiance E for these settings: refined,
+    /// blurred, or as gathered.
+    pub fn output(&self) -> TargetDesc {
+        if self.refines() {
+            REFINED
+        } else if self.blurs() {
+            INDIRECT
+        } else {
+            IRRADIANCE
+        }
     }
 
     /// Whether `ils-refine` runs (after a blur of the interleaved frame).
@@ -669,6 +674,19 @@ pub fn blur_weights(radius: u32, sigma: f32, period: u32) -> Vec<f32> {
 
 /// Whether any material of `scene` is glossy (GGX): only then does the frame blur the
 /// glossy receivers' radiance (`ils-glossy` is 0 otherwise, and compose reads it as is).
+/// A one-line error for the first VPL with a non-finite component or a negative flux.
+pub fn check_vpls(vpls: &[GpuVpl]) -> Result<(), String> {
+    for (k, v) in vpls.iter().enumerate() {
+        let finite = v.position.iter().chain(&v.normal).chain(&v.flux).all(|c| c.is_finite());
+        if !finite || v.flux.iter().any(|&c| c < 0.0) {
+            return Err(format!(
+                "vpls[{k}] is invalid: position, normal and flux must be finite and the flux >= 0"
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn has_glossy_receivers(scene: &strata_scene::Scene) -> bool {
     scene.materials.iter().any(|m| m.glossy)
 }
@@ -838,7 +856,8 @@ pub(crate) struct IlsStage {
     /// averaged too few VPL subsets for, sharp glossy receivers and VPLs close to the
     /// receivers
     refine: Option<RefinePass>,
-    compose: crate::passes::compose::ComposePass,
+    /// The renderer's composite (`None` in an application's renderer, `embed::EmbeddedIls`).
+    compose: Option<crate::passes::compose::ComposePass>,
     vpl_buffer: wgpu::Buffer,
     vpl_capacity: usize,
     shade_uniforms: ShadeUniforms,
@@ -1019,6 +1038,7 @@ impl IlsStage {
         targets: &mut Targets,
         s: &IlsSettings,
         scene: &strata_scene::Scene,
+        compose: bool,
     ) -> Result<Self, RenderError> {
         s.validate().map_err(RenderError::Parameter)?;
         let (w, h) = (targets.width, targets.height);
@@ -1187,19 +1207,22 @@ impl IlsStage {
         } else {
             (shown, glossy_shown)
         };
-        for t in crate::passes::compose::OUTPUTS {
-            targets.create(gpu, t);
-        }
-        let compose = crate::passes::compose::ComposePass::new(
-            gpu,
-            scene_gpu,
-            targets,
-            false,
-            None,
-            shown,
-            Some(glossy_shown),
-            false,
-        );
+        debug_assert_eq!(shown, s.output().name);
+        let compose = compose.then(|| {
+            for t in crate::passes::compose::OUTPUTS {
+                targets.create(gpu, t);
+            }
+            crate::passes::compose::ComposePass::new(
+                gpu,
+                scene_gpu,
+                targets,
+                false,
+                None,
+                shown,
+                Some(glossy_shown),
+                false,
+            )
+        });
         Ok(Self {
             gbuffer,
             split,
@@ -1280,7 +1303,9 @@ impl IlsStage {
         if let Some(p) = &self.refine {
             v.push(p);
         }
-        v.push(&self.compose);
+        if let Some(c) = &self.compose {
+            v.push(c);
+        }
         v
     }
 }

@@ -1,0 +1,179 @@
+//! Interleaved deferred shading of virtual point lights (ILS §4, SNSM) on an application's
+//! G-buffer: the passes of `strata render --technique ils` from the split G-buffer to the
+//! discontinuity-aware blur, without strata's lighting, VPL generation or composite.
+//!
+//! The application gives its depth and normals (as for [`super::EmbeddedAo`]) and a list of
+//! VPLs ([`GpuVpl`]: position, the normal on the lit side, reflected flux Φ), for example
+//! from a reflective shadow map of its own lights. Each pixel of an n×m sub-buffer shades
+//! 1/(n·m) of the VPLs (§4.2), the gather puts the pixels back (§4.4) and the blur averages
+//! the n·m subsets across pixels of the same surface (§4.5). It gets back
+//! [`EmbeddedIls::output`]: layer 0's indirect irradiance E (rgb); the application composes
+//! `direct + ρ/π · E`. Receivers are Lambertian. VPL visibility is not computed (SNSM, §6.2's
+//! interactive mode): SSM's shadow maps need the scene's geometry.
+
+use super::core::{Core, CoreConfig};
+use super::{AoInputs, NormalEncoding, NormalSpace};
+use crate::frame::{FrameUniforms, Pass, TargetDesc};
+use crate::passes::ils::{GpuVpl, IlsSettings, IlsStage, VplShadows};
+use crate::RenderError;
+
+/// What [`EmbeddedIls::new`] builds.
+#[derive(Clone, Debug)]
+pub struct EmbeddedIlsConfig {
+    /// The application's render size in pixels (the inputs' size).
+    pub width: u32,
+    pub height: u32,
+    /// The settings of `strata render --technique ils`: the n×m pattern, the split method,
+    /// the blur, `refine`. `clamp_distance` d_c is required (the renderer's default is a
+    /// share of the scene's diagonal, which the embedding does not know); `vpls` are the
+    /// first frame's VPLs and set how many later frames may pass (a larger count rebuilds).
+    /// `shadows` must be [`VplShadows::None`].
+    pub settings: IlsSettings,
+    pub normals: NormalEncoding,
+    pub normal_space: NormalSpace,
+}
+
+impl Default for EmbeddedIlsConfig {
+    /// 1×1 (set the size), [`IlsSettings::default`] (8×6 sub-buffers, the paper's blur; no
+    /// clamp distance and no VPLs: set them), signed world-space normals.
+    fn default() -> Self {
+        Self {
+            width: 1,
+            height: 1,
+            settings: IlsSettings::default(),
+            normals: NormalEncoding::Signed,
+            normal_space: NormalSpace::World,
+        }
+    }
+}
+
+/// The ILS passes of `strata render --technique ils` on an application's G-buffer and VPLs.
+pub struct EmbeddedIls {
+    core: Core,
+    config: EmbeddedIlsConfig,
+    stage: IlsStage,
+    /// The VPL buffer's capacity (the VPLs given to `new` or the last rebuild).
+    capacity: usize,
+}
+
+super::embedded_common!(EmbeddedIls, EmbeddedIlsConfig, resize);
+
+impl EmbeddedIls {
+    /// Builds the passes for `config` on the application's device. Errors name the
+    /// parameter and its valid range.
+    pub fn new(
+        adapter: &wgpu::Adapter,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        config: EmbeddedIlsConfig,
+    ) -> Result<Self, RenderError> {
+        let what = "embedded ILS";
+        let s = &config.settings;
+        s.validate()
+            .map_err(|e| RenderError::Parameter(format!("{what}: {e}")))?;
+        if s.clamp_distance.is_none() {
+            return Err(RenderError::Parameter(format!(
+                "{what}: settings.clamp_distance is required: the world-space clamp distance d_c (> 0), \
+                 below which a VPL's 1/d² is held (the renderer's default, 4 % of the scene's diagonal, needs the scene)"
+            )));
+        }
+        if s.shadows != VplShadows::None {
+            return Err(RenderError::Parameter(format!(
+                "{what}: settings.shadows '{}' is not available: SSM's VPL shadow maps need the scene's geometry; use none (SNSM)",
+                s.shadows.name()
+            )));
+        }
+        if s.vpls.is_empty() {
+            return Err(RenderError::Parameter(format!(
+                "{what}: settings.vpls is empty: give the first frame's VPLs (their count is the capacity)"
+            )));
+        }
+        let scene = strata_scene::Scene {
+            name: "embedded".into(),
+            ..Default::default()
+        };
+        let core = CoreConfig {
+            what,
+            width: config.width,
+            height: config.height,
+            layers: 1,
+            normals: config.normals,
+            normal_space: config.normal_space,
+            mip_levels: None,
+            kernel: crate::passes::Kernel::Fragment,
+            shading: super::core::ShadingImport::Normals,
+        };
+        Core::scoped(device, || {
+            let mut core = Core::new(adapter, device, queue, core, scene)?;
+            // the G-buffer's emission (a = 2 flags a glossy receiver): none here, all Lambert
+            core.targets.create(
+                &core.gpu,
+                TargetDesc::new("emission", wgpu::TextureFormat::Rgba16Float, 1, "0: Lambert receivers"),
+            );
+            let stage = IlsStage::new(&core.gpu, &core.scene_gpu, &mut core.targets, s, &core.scene, false)?;
+            Ok(Self {
+                core,
+                config: config.clone(),
+                stage,
+                capacity: s.vpls.len(),
+            })
+        })
+    }
+
+    /// Replaces the VPLs. Up to as many as the capacity are written in place; more
+    /// rebuild the passes with the new count as the capacity. An empty list or a
+    /// non-finite VPL is a one-line error, and then nothing changes.
+    pub fn set_vpls(&mut self, vpls: &[GpuVpl]) -> Result<(), RenderError> {
+        if vpls.is_empty() {
+            return Err(RenderError::Parameter(
+                "embedded ILS: set_vpls was given no VPLs: pass at least one (a black one for no light)".into(),
+            ));
+        }
+        crate::passes::ils::check_vpls(vpls).map_err(|e| RenderError::Parameter(format!("embedded ILS: {e}")))?;
+        if vpls.len() <= self.capacity {
+            self.stage.set_vpls(&self.core.gpu, vpls)?;
+            // kept for `resize`, which rebuilds from the config
+            self.config.settings.vpls = vpls.into();
+            return Ok(());
+        }
+        let mut config = self.config.clone();
+        config.settings.vpls = vpls.into();
+        config.settings.vpl_count = vpls.len() as u32;
+        let gpu = &self.core.gpu;
+        *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
+        Ok(())
+    }
+
+    /// VPLs the buffer holds without a rebuild (after `resize`: the current count).
+    pub fn vpl_capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// Layer 0's indirect irradiance E (rgb; a = the share of the n·m VPL subsets the blur
+    /// averaged), `Rgba16Float`, written by the last [`EmbeddedIls::encode`] once its
+    /// encoder is submitted.
+    pub fn output(&self) -> &wgpu::Texture {
+        &self.core.targets.get(self.config.settings.output().name).texture
+    }
+
+    /// A view of [`EmbeddedIls::output`] to bind in the application's composite.
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        &self.core.targets.get(self.config.settings.output().name).view
+    }
+
+    /// Records this frame's ILS passes into `encoder` and writes its uniforms with the
+    /// queue: submit `encoder` before the next call. `inputs` has one layer (no `second`).
+    /// Inputs are checked first; a bad one is a one-line error and nothing is recorded.
+    pub fn encode(&mut self, encoder: &mut wgpu::CommandEncoder, inputs: &AoInputs<'_>) -> Result<(), RenderError> {
+        if inputs.second.is_some() {
+            return Err(RenderError::Parameter(
+                "embedded ILS: AoInputs::second is given, but ILS shades layer 0 only: pass None".into(),
+            ));
+        }
+        let cam = self.core.check_inputs(inputs, &[], None)?;
+        let (_frame, _history): (FrameUniforms, bool) = self.core.begin(inputs, &cam);
+        let passes: Vec<&dyn Pass> = self.stage.passes();
+        self.core.record(encoder, inputs, &[], None, passes);
+        Ok(())
+    }
+}

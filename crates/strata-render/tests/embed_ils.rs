@@ -1,0 +1,432 @@
+//! `strata_render::embed::EmbeddedIls`: interleaved deferred shading (ILS §4, SNSM) of an
+//! application's VPLs on its G-buffer. Its output is checked against the renderer's own
+//! `ils` of the same frame and VPLs, and against the CPU reference's VPL irradiance on a
+//! floor the application draws.
+
+mod common;
+
+#[path = "../examples/embed_ao/app.rs"]
+mod app;
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3, Vec4Swizzles};
+use strata_reference::vpl::{Vpl, VplSettings};
+use strata_reference::Reference;
+use strata_render::embed::{AoInputs, EmbeddedIls, EmbeddedIlsConfig, NormalEncoding, NormalSpace, TextureLayer};
+use strata_render::packing::{oct16_pack, oct16_unpack};
+use strata_render::passes::ils::{blur_weights, GpuVpl, IlsSettings, VplShadows};
+use strata_render::GpuContext;
+use strata_scene::{procedural, ImageBuf};
+
+fn gpu_vpl(v: &Vpl) -> GpuVpl {
+    GpuVpl::new(v.position.into(), v.normal.into(), v.flux.into())
+}
+
+fn embedded(gpu: &GpuContext, [w, h]: [u32; 2], settings: IlsSettings, normals: NormalEncoding) -> EmbeddedIls {
+    EmbeddedIls::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedIlsConfig {
+            width: w,
+            height: h,
+            settings,
+            normals,
+            normal_space: NormalSpace::World,
+        },
+    )
+    .expect("the embedded ILS builds without validation errors")
+}
+
+/// The largest |a − b| over the rgb channels relative to b's largest value, and the share
+/// of pixels whose difference exceeds 1 % of it.
+fn rgb_diff(a: &ImageBuf, b: &ImageBuf) -> (f32, f32) {
+    let scale = b.data.iter().cloned().fold(0.0f32, f32::max).max(1e-9);
+    let (mut worst, mut over) = (0.0f32, 0usize);
+    for (p, q) in a.data.chunks_exact(4).zip(b.data.chunks_exact(4)) {
+        let d = (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max) / scale;
+        worst = worst.max(d);
+        over += (d > 0.01) as usize;
+    }
+    (worst, over as f32 / (a.data.len() / 4) as f32)
+}
+
+/// The renderer's G-buffer and VPLs in, the renderer's ILS irradiance out: the same passes
+/// on the same data, for the paper's blur, no blur, the brute force and `refine`.
+#[test]
+fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
+    let gpu = common::gpu();
+    let (w, h) = (96u32, 64u32);
+    for name in ["cornell", "atrium"] {
+        let scene = procedural::builtin(name).unwrap();
+        assert!(
+            !scene.materials.iter().any(|m| m.glossy),
+            "{name}: Lambert receivers only (the embedded ILS shades no glossy ones)"
+        );
+        let vpls: Arc<[GpuVpl]> = Reference::new(&scene, 0.0)
+            .vpls(&VplSettings {
+                paths: 240,
+                ..Default::default()
+            })
+            .iter()
+            .map(gpu_vpl)
+            .collect();
+        let base = IlsSettings {
+            vpls: vpls.clone(),
+            ..IlsSettings::default()
+        };
+        let base = IlsSettings {
+            clamp_distance: Some(base.clamp_distance_for(&scene)),
+            ..base
+        };
+        let cases = [
+            ("the paper's blur", base.clone()),
+            (
+                "no blur",
+                IlsSettings {
+                    blur: 0.0,
+                    ..base.clone()
+                },
+            ),
+            (
+                "brute force",
+                IlsSettings {
+                    brute_force: true,
+                    ..base.clone()
+                },
+            ),
+            (
+                "refine 0.5",
+                IlsSettings {
+                    refine: 0.5,
+                    ..base.clone()
+                },
+            ),
+        ];
+        for (what, settings) in cases {
+            let r = common::ils_renderer(&gpu, &scene, settings.clone(), (w, h));
+            let mut ils = embedded(&gpu, [w, h], settings.clone(), NormalEncoding::Octahedral);
+            let (view, proj) = (scene.camera.view(), scene.camera.projection(w as f32 / h as f32));
+            let (depth, normal) = (r.target_texture("depth").unwrap(), r.target_texture("normal").unwrap());
+            let layer0 = |t| TextureLayer { texture: t, layer: 0 };
+            common::submit_checked(&gpu, |encoder| {
+                ils.encode(encoder, &AoInputs::new(layer0(depth), layer0(normal), view, proj))
+                    .expect("valid inputs")
+            });
+            let out = settings.output().name;
+            let (a, b) = (ils.read_target(out).unwrap(), r.read_target(&gpu, out).unwrap());
+            let (worst, over) = rgb_diff(&a, &b);
+            println!("{name}, {what} ({out}): largest difference {worst:.2e} of the image's largest, {:.2} % of pixels over 1 %", 100.0 * over);
+            let lit = b.data.chunks_exact(4).filter(|p| p[0] + p[1] + p[2] > 0.0).count();
+            assert!(
+                lit > (w * h / 5) as usize,
+                "{name}: the VPLs light the view ({lit} pixels)"
+            );
+            // a receiver's z differs from the renderer's by f32 rounding, which can flip a
+            // discontinuity flag of the blur now and then
+            assert!(
+                over < 0.005,
+                "{name}, {what}: {:.2} % of pixels differ by over 1 %",
+                100.0 * over
+            );
+            if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
+                let t = ils.timings().unwrap();
+                let names: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
+                assert_eq!(names, ils.pass_names(), "{what}: one time per pass, in order");
+            }
+        }
+    }
+}
+
+/// A floor drawn by the application (`app.rs`: standard depth, signed normals) under
+/// n·m = 48 copies of one VPL, each carrying 1/48 of the flux Φ. Every sub-buffer then
+/// shades one copy scaled by 48 (§4.2), so the interleaved estimate is exactly one VPL of
+/// flux Φ, E(x) = Φ/π · cos θ_y cos θ_x / d² (clamped at d_c), at every pixel: the CPU
+/// reference's `Vpl::irradiance_at` at the floor point under the pixel centre, with the
+/// normal as the G-buffer's 8-bit Oct16 holds it. With the blur (§4.5), that E averaged
+/// with the blur's weights over the pixel's window. Per pixel within 0.2 % (0.5 % with the
+/// blur's bilinear taps) + 0.02 % of the largest. Then `set_vpls` moves the light.
+#[test]
+fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
+    use glam::camera::rh;
+    let gpu = common::gpu();
+    let (w, h) = (96u32, 64u32);
+    let floor = app::cuboid(
+        Vec3::new(-20.0, -0.1, -20.0),
+        Vec3::new(20.0, 0.0, 20.0),
+        Vec3::splat(0.5),
+    );
+    let eye = Vec3::new(0.0, 1.5, 2.5);
+    let view = rh::view::look_at_mat4(eye, Vec3::new(0.0, 0.0, -1.0), Vec3::Y);
+    let proj = rh::proj::directx::perspective(50f32.to_radians(), w as f32 / h as f32, 0.05, 100.0);
+    let gbuffer = app::GBuffer::new(&gpu.device, [w, h], app::Layout::standard(), &floor);
+    let light = |position: Vec3| Vpl {
+        position,
+        normal: Vec3::NEG_Y,
+        flux: Vec3::new(4.0, 3.0, 2.0),
+        albedo: Vec3::ONE,
+        bounce: 1,
+    };
+    let copies = |v: &Vpl| -> Vec<GpuVpl> {
+        let share = Vpl {
+            flux: v.flux / 48.0,
+            ..v.clone()
+        };
+        vec![gpu_vpl(&share); 48]
+    };
+    let d_c = 0.05f32;
+    let max_g = 1.0 / (d_c * d_c);
+    // the floor point under each pixel centre (the camera's ray meets y = 0)
+    let inv = (proj * view).inverse();
+    let floor_point = |x: u32, y: u32| {
+        let ndc = |z: f32| {
+            let p = inv
+                * glam::Vec4::new(
+                    (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                    1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+                    z,
+                    1.0,
+                );
+            p.xyz() / p.w
+        };
+        let (a, b) = (ndc(0.0), ndc(1.0));
+        let t = a.y / (a.y - b.y);
+        let p = a + (b - a) * t;
+        // on the floor's top, away from its far edge
+        (t > 0.0 && t < 1.0 && p.x.abs() < 19.5 && p.z.abs() < 19.5).then_some(p)
+    };
+    let run = |ils: &mut EmbeddedIls| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        gbuffer.draw(&gpu.queue, &mut encoder, view, proj);
+        ils.encode(
+            &mut encoder,
+            &AoInputs::new((&gbuffer.depth).into(), (&gbuffer.normals).into(), view, proj),
+        )
+        .unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        gpu.check_errors().expect("no wgpu validation errors");
+        ils.read_target(ils.config().settings.output().name).unwrap()
+    };
+    // the floor's normal as the G-buffer holds it: Oct16 in 8-bit channels (DGB Table 1)
+    let up = oct16_unpack(oct16_pack(Vec3::Y));
+    // E at every pixel's floor point (None off the floor); with the blur, E averaged with
+    // the blur's own weights (`blur_weights`: Gaussian, equal per sub-buffer, §4.5) over
+    // windows that lie on the floor, the others skipped
+    let expected = |v: &Vpl, blur: Option<([u32; 2], [u32; 2])>| -> Vec<Option<Vec3>> {
+        let e: Vec<Option<Vec3>> = (0..w * h)
+            .map(|i| floor_point(i % w, i / w).map(|p| v.irradiance_at(p, up, max_g)))
+            .collect();
+        let Some(([rx, ry], [n, m])) = blur else { return e };
+        let (wx, wy) = (
+            blur_weights(rx, rx.max(1) as f32, n),
+            blur_weights(ry, ry.max(1) as f32, m),
+        );
+        (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as i32, (i / w) as i32);
+                let (mut sum, mut total) = (Vec3::ZERO, 0.0);
+                for dy in -(ry as i32)..=ry as i32 {
+                    for dx in -(rx as i32)..=rx as i32 {
+                        let (u, t) = (x + dx, y + dy);
+                        if u < 0 || t < 0 || u >= w as i32 || t >= h as i32 {
+                            return None;
+                        }
+                        let k = wx[dx.unsigned_abs() as usize] * wy[dy.unsigned_abs() as usize];
+                        sum += e[(t as u32 * w + u as u32) as usize]? * k;
+                        total += k;
+                    }
+                }
+                Some(sum / total)
+            })
+            .collect()
+    };
+    // with the blur, pixels whose window the discontinuity test cut (the far floor, seen at
+    // a grazing angle: alpha, the share of the subsets averaged, below 1) are skipped
+    let check = |img: &ImageBuf, want: &[Option<Vec3>], blurred: bool, what: &str| {
+        let scale = want.iter().flatten().fold(0.0f32, |a, e| a.max(e.max_element()));
+        let (mut worst, mut n, mut cut) = (0.0f32, 0, 0);
+        let mut worst_at = (0, Vec3::ZERO, Vec3::ZERO);
+        for (i, e) in want.iter().enumerate() {
+            let Some(e) = e else { continue };
+            if blurred && img.data[i * 4 + 3] < 0.999 {
+                cut += 1;
+                continue;
+            }
+            let got = Vec3::from_slice(&img.data[i * 4..i * 4 + 3]);
+            let err = (got - *e).abs().max_element();
+            // f16 storage and the GPU's position reconstruction; the blur's bilinear taps
+            // add up to 0.4 % (the bound of the ILS unit test
+            // `equal_subset_weights_remove_the_interleaved_pattern`)
+            let tol = if blurred { 0.005 } else { 0.002 } * e.max_element() + 2e-4 * scale;
+            if err / tol > worst {
+                worst = err / tol;
+                worst_at = (i, got, *e);
+            }
+            n += 1;
+            assert!(err <= tol, "{what}: pixel {i}: got {got}, want {e} (largest {scale})");
+        }
+        println!("{what}: {n} floor pixels ({cut} with a cut window), worst error {worst:.3} of the tolerance at {worst_at:?} (largest E {scale:.4})");
+        assert!(
+            n > (w * h / 2) as usize && scale > 0.0,
+            "{what}: the floor fills the view and is lit"
+        );
+    };
+    let here = light(Vec3::new(0.2, 2.5, -0.5));
+    let there = light(Vec3::new(-0.6, 2.0, -1.5));
+    for (what, blur) in [("no blur", 0.0), ("the paper's blur", IlsSettings::default().blur)] {
+        let settings = IlsSettings {
+            vpls: copies(&here).into(),
+            clamp_distance: Some(d_c),
+            blur,
+            ..IlsSettings::default()
+        };
+        let window = settings.blurs().then(|| (settings.blur_radius(), settings.pattern));
+        let mut ils = embedded(&gpu, [w, h], settings, NormalEncoding::Signed);
+        check(&run(&mut ils), &expected(&here, window), window.is_some(), what);
+        // the light moves: written in place
+        ils.set_vpls(&copies(&there)).unwrap();
+        assert_eq!(ils.vpl_capacity(), 48);
+        check(
+            &run(&mut ils),
+            &expected(&there, window),
+            window.is_some(),
+            &format!("{what}, moved"),
+        );
+    }
+}
+
+/// Bad configs and VPLs are one-line errors naming the parameter; nothing panics, and a
+/// refused call changes nothing.
+#[test]
+fn bad_embedded_ils_input_is_a_one_line_error() {
+    let gpu = common::gpu();
+    let one = GpuVpl::new([0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [1.0; 3]);
+    let good = || IlsSettings {
+        vpls: vec![one; 4].into(),
+        clamp_distance: Some(0.1),
+        ..IlsSettings::default()
+    };
+    let config = |settings| EmbeddedIlsConfig {
+        width: 64,
+        height: 48,
+        settings,
+        ..EmbeddedIlsConfig::default()
+    };
+    let new = |c: EmbeddedIlsConfig| EmbeddedIls::new(&gpu.adapter, &gpu.device, &gpu.queue, c);
+    let err = |r: Result<EmbeddedIls, strata_render::RenderError>| match r {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    };
+    let mut nan = one;
+    nan.flux[1] = f32::NAN;
+    let cases = [
+        (
+            err(new(config(IlsSettings {
+                clamp_distance: None,
+                ..good()
+            }))),
+            "settings.clamp_distance is required",
+        ),
+        (
+            err(new(config(IlsSettings {
+                shadows: VplShadows::ShadowMaps,
+                ..good()
+            }))),
+            "settings.shadows 'vpl' is not available",
+        ),
+        (
+            err(new(config(IlsSettings {
+                vpls: Vec::new().into(),
+                ..good()
+            }))),
+            "settings.vpls is empty",
+        ),
+        (
+            err(new(config(IlsSettings {
+                vpls: vec![one, nan].into(),
+                ..good()
+            }))),
+            "embedded ILS: vpls[1] is invalid: position, normal and flux must be finite",
+        ),
+        (
+            err(new(config(IlsSettings {
+                pattern: [0, 6],
+                ..good()
+            }))),
+            "embedded ILS: ",
+        ),
+        (
+            err(new(config(IlsSettings {
+                clamp_distance: Some(-1.0),
+                ..good()
+            }))),
+            "clamp-distance -1 is out of range",
+        ),
+        (
+            err(new(EmbeddedIlsConfig {
+                width: 0,
+                ..config(good())
+            })),
+            "size 0x48 is out of range",
+        ),
+    ];
+    for (e, want) in cases {
+        println!("{e}");
+        assert!(e.contains(want) && !e.contains('\n'), "'{e}' lacks '{want}'");
+    }
+    let mut ils = new(config(good())).unwrap();
+    for (vpls, want) in [
+        (Vec::new(), "set_vpls was given no VPLs"),
+        (vec![one, one, nan], "embedded ILS: vpls[2] is invalid"),
+    ] {
+        let e = ils.set_vpls(&vpls).unwrap_err().to_string();
+        println!("{e}");
+        assert!(e.contains(want) && !e.contains('\n'), "'{e}' lacks '{want}'");
+    }
+    assert_eq!(ils.vpl_capacity(), 4);
+    // fewer VPLs are written in place; more rebuild with the new count as the capacity
+    ils.set_vpls(&[one; 2]).unwrap();
+    assert_eq!(ils.vpl_capacity(), 4);
+    ils.set_vpls(&[one; 9]).unwrap();
+    assert_eq!(ils.vpl_capacity(), 9);
+    // a resize keeps the VPLs; a refused one keeps the old size
+    ils.resize(40, 30).unwrap();
+    assert_eq!((ils.config().width, ils.vpl_capacity()), (40, 9));
+    let e = ils.resize(0, 30).unwrap_err().to_string();
+    assert!(e.contains("size 0x30 is out of range"), "{e}");
+    assert_eq!(ils.config().width, 40);
+    // one layer only
+    let texture = |format| {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: 40,
+                height: 30,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+    };
+    let (d, n) = (
+        texture(wgpu::TextureFormat::Depth32Float),
+        texture(wgpu::TextureFormat::Rgba16Float),
+    );
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let inputs = AoInputs {
+        second: Some(((&d).into(), (&n).into())),
+        ..AoInputs::new(
+            (&d).into(),
+            (&n).into(),
+            Mat4::IDENTITY,
+            glam::camera::rh::proj::directx::perspective(1.0, 4.0 / 3.0, 0.1, 10.0),
+        )
+    };
+    let e = ils.encode(&mut encoder, &inputs).unwrap_err().to_string();
+    assert!(e.contains("AoInputs::second is given") && !e.contains('\n'), "{e}");
+}
