@@ -94,12 +94,13 @@ cat "$OUT/bench-bzb.json"
 # BZB Table 1's GI columns (dominoes) at 160x90: a GI splat of 640x360 takes minutes on a CPU adapter
 $S bench bzb --technique bzb-gi --scene dominoes --width 160 --height 90 --frames 2 --json > "$OUT/bench-bzb-gi.json"
 cat "$OUT/bench-bzb-gi.json"
-echo "[strata demo] strata's AO, radiosity, reflections and bounced-z-buffer AO in an application's own wgpu renderer (strata_render::embed, docs/embed.md)" >&2
-cargo build --release -p strata-render --example embed_ao --example embed_gi --example embed_reflect --example embed_bzb
+echo "[strata demo] strata's AO, radiosity, reflections, bounced-z-buffer AO and ILS in an application's own wgpu renderer (strata_render::embed, docs/embed.md)" >&2
+cargo build --release -p strata-render --example embed_ao --example embed_gi --example embed_reflect --example embed_bzb --example embed_ils
 target/release/examples/embed_ao "$OUT/embed-ao.png" | tee "$OUT/embed-ao.txt"
 target/release/examples/embed_gi "$OUT/embed-gi.png" | tee "$OUT/embed-gi.txt"
 target/release/examples/embed_reflect "$OUT/embed-reflect.png" | tee "$OUT/embed-reflect.txt"
 target/release/examples/embed_bzb "$OUT/embed-bzb.png" | tee "$OUT/embed-bzb.txt"
+target/release/examples/embed_ils "$OUT/embed-ils.png" | tee "$OUT/embed-ils.txt"
 echo "[strata demo] report: tables and plots of the JSON above, the images, links to the evaluation reports" >&2
 $S report --from "$OUT" --out "$OUT/report.html" --title "strata demo report" --force \
   --figures "Renders=atrium-full.png,mirror-full.png,atrium.png,atrium-ao.png,atrium-ils.png,cornell.png,warehouse.png" \
@@ -107,5 +108,5 @@ $S report --from "$OUT" --out "$OUT/report.html" --title "strata demo report" --
   --figures "Fig. 9 views (atrium, full)=atrium-confidence.png,atrium-gbuffer-only.png,atrium-probe-only.png,atrium-blended.png" \
   --figures "atrium G-buffer and lighting targets=atrium-csz.png,atrium-normal.png,atrium-albedo.png,atrium-emission.png,atrium-direct-diffuse.png,atrium-shadow.png" \
   --figures "CPU reference (atrium AO with binary visibility; cornell path-traced GI)=atrium-ref-ao.png,cornell-ref-gi.png" \
-  --figures "AO, radiosity and reflections on an application's own G-buffer (examples/embed_ao; examples/embed_gi: direct | direct + indirect; examples/embed_reflect: no reflections | 1 layer | 2 layers; examples/embed_bzb: DGB AO | bounced-z-buffer AO under a table the camera does not see)=embed-ao.png,embed-gi.png,embed-reflect.png,embed-bzb.png"
+  --figures "AO, radiosity and reflections on an application's own G-buffer (examples/embed_ao; examples/embed_gi: direct | direct + indirect; examples/embed_reflect: no reflections | 1 layer | 2 layers; examples/embed_bzb: DGB AO | bounced-z-buffer AO under a table the camera does not see; examples/embed_ils: direct | + DGB radiosity | + ILS of the application's VPLs)=embed-ao.png,embed-gi.png,embed-reflect.png,embed-bzb.png,embed-ils.png"
 echo "[strata demo] wrote $OUT/report.html and images in $OUT/" >&2

@@ -7,7 +7,7 @@
 # BIN holds binaries built elsewhere (`cargo test --release --no-run` and
 # `cargo build --release`): `strata`, optionally `strata-old` (the build to compare
 # with; without it the A/B is one build's fragment forms, every `*-kernel` set to
-# `fragment`, against `auto`), the examples `embed_ao`, `embed_gi`, `embed_reflect`, `embed_bzb`
+# `fragment`, against `auto`), the examples `embed_ao`, `embed_gi`, `embed_reflect`, `embed_bzb`, `embed_ils`
 # (and `*-old`), and the test
 # binaries under `t/`, named after their test targets. The CLI's tests find the `strata`
 # binary where cargo built it, so copy BIN/strata there first. Tests that need
@@ -54,7 +54,7 @@ for rep in 1 2; do
       name=radiosity-atrium ab bench radiosity --scene atrium $HD --layers 2 --frames 5 --preset balanced
       name=reflections-mirror ab bench reflections --scene mirror $HD --layers 2 --frames 5
     fi
-    for e in embed_ao embed_gi embed_reflect embed_bzb; do
+    for e in embed_ao embed_gi embed_reflect embed_bzb embed_ils; do
       [ "$v" = frag ] && continue # the examples take no settings
       X="$BIN/$e"
       [ "$v" = old ] && X="$BIN/$e-old"

@@ -40,7 +40,7 @@ cargo test --release --workspace --no-run --message-format=json >"$TESTS"
 STAGE=$(mktemp -d)
 mkdir -p "$STAGE/t" .dev
 cp target/release/strata "$STAGE/"
-for e in embed_ao embed_gi embed_reflect embed_bzb; do cp "target/release/examples/$e" "$STAGE/"; done
+for e in embed_ao embed_gi embed_reflect embed_bzb embed_ils; do cp "target/release/examples/$e" "$STAGE/"; done
 [ -n "${STRATA_OLD:-}" ] && cp "$STRATA_OLD" "$STAGE/strata-old"
 # the integration tests of the crates that drive a GPU, named after their targets
 python3 - "$TESTS" "$STAGE/t" <<'EOF'

@@ -399,7 +399,7 @@ fn dss_surfel_overflow_is_reported_and_clears() {
     let mut sheets = floor_only.clone();
     sheets.extend((0..20).map(sheet));
     let mut ao = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &floor_only);
-    let mut frame = |ao: &mut EmbeddedBzbAo| {
+    let frame = |ao: &mut EmbeddedBzbAo| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         gbuffer.draw(&gpu.queue, &mut encoder, view, proj);
         ao.encode(

@@ -171,7 +171,7 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
     let copies = |v: &Vpl| -> Vec<GpuVpl> {
         let share = Vpl {
             flux: v.flux / 48.0,
-            ..v.clone()
+            ..*v
         };
         vec![gpu_vpl(&share); 48]
     };

@@ -1,5 +1,6 @@
 //! `strata_render::embed` over a long run: an application that records the embedded AO,
-//! radiosity, reflections and bounced-z-buffer AO (its triangles rewritten each frame) every frame for hundreds of frames (two layers, a moving camera, no `poll` but
+//! radiosity, reflections, bounced-z-buffer AO (its triangles rewritten each frame) and ILS
+//! (its VPLs rewritten each frame) every frame for hundreds of frames (two layers, a moving camera, no `poll` but
 //! its submits, and a wait for the GPU before each memory sample) holds its GPU allocations and resident memory flat. `encode` creates a bind group and
 //! views of the application's textures each frame; they must not pile up. Its own test
 //! binary: resident memory is per process, and other tests would move it.
@@ -10,11 +11,12 @@ mod common;
 mod app;
 
 use strata_render::embed::{
-    AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedBzbAo, EmbeddedBzbAoConfig, EmbeddedRadiosity,
-    EmbeddedRadiosityConfig, EmbeddedReflections, EmbeddedReflectionsConfig, NormalEncoding, RadiosityInputs,
-    ReflectionInputs,
+    AoInputs, EmbeddedAo, EmbeddedAoConfig, EmbeddedBzbAo, EmbeddedBzbAoConfig, EmbeddedIls, EmbeddedIlsConfig,
+    EmbeddedRadiosity, EmbeddedRadiosityConfig, EmbeddedReflections, EmbeddedReflectionsConfig, NormalEncoding,
+    RadiosityInputs, ReflectionInputs,
 };
 use strata_render::passes::ao::AoSettings;
+use strata_render::passes::ils::{GpuVpl, IlsSettings};
 use strata_render::passes::radiosity::RadiositySettings;
 
 fn resident_bytes() -> u64 {
@@ -24,7 +26,7 @@ fn resident_bytes() -> u64 {
 }
 
 #[test]
-fn embedded_ao_radiosity_reflections_and_bzb_soak_flat() {
+fn embedded_ao_radiosity_reflections_bzb_and_ils_soak_flat() {
     let gpu = common::gpu();
     let mut scene = strata_scene::procedural::builtin("atrium").unwrap();
     scene.camera_path = None;
@@ -98,6 +100,32 @@ fn embedded_ao_radiosity_reflections_and_bzb_soak_flat() {
         &occluders,
     )
     .unwrap();
+    // 96 VPLs above the atrium's floor, moved a little every frame (set_vpls in place)
+    let vpl = |k: usize, f: u32| {
+        let a = k as f32 * 0.7 + f as f32 * 0.05;
+        GpuVpl::new(
+            [3.0 * a.cos(), 1.0 + 0.01 * k as f32, 3.0 * a.sin()],
+            [0.0, -1.0, 0.0],
+            [0.5; 3],
+        )
+    };
+    let mut vpls: Vec<GpuVpl> = (0..96).map(|k| vpl(k, 0)).collect();
+    let mut ils = EmbeddedIls::new(
+        &gpu.adapter,
+        &gpu.device,
+        &gpu.queue,
+        EmbeddedIlsConfig {
+            width: w,
+            height: h,
+            settings: IlsSettings {
+                vpls: vpls.clone().into(),
+                clamp_distance: Some(0.5),
+                ..IlsSettings::default()
+            },
+            ..EmbeddedIlsConfig::default()
+        },
+    )
+    .unwrap();
     let cam = scene.camera;
     let proj =
         glam::camera::rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), w as f32 / h as f32, cam.near, 500.0);
@@ -147,6 +175,11 @@ fn embedded_ao_radiosity_reflections_and_bzb_soak_flat() {
             bzb.set_triangle_range(0, &occluders[..1]).unwrap();
         }
         bzb.encode(&mut encoder, &AoInputs { second: None, ..inputs }).unwrap();
+        for (k, v) in vpls.iter_mut().enumerate() {
+            *v = vpl(k, f);
+        }
+        ils.set_vpls(&vpls).unwrap();
+        ils.encode(&mut encoder, &AoInputs { second: None, ..inputs }).unwrap();
         gpu.queue.submit([encoder.finish()]);
         if f >= first_sample && (f % 100 == 0 || f == frames) {
             // each sample waits for the GPU, so work still in flight is not counted as
@@ -174,6 +207,14 @@ fn embedded_ao_radiosity_reflections_and_bzb_soak_flat() {
         .filter(|p| p[3] > 0.0)
         .count();
     assert!(marched > 0, "some pixels are mirrors, so the reflections march");
+    let lit = ils
+        .read_target(ils.config().settings.output().name)
+        .unwrap()
+        .data
+        .chunks(4)
+        .filter(|p| p[0] > 0.0)
+        .count();
+    assert!(lit > 0, "the VPLs light some pixels, so ILS shades");
     assert_eq!(a.2, b.2, "wgpu's allocations stay the same");
     assert!(
         growth <= 1.0,

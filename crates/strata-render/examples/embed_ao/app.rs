@@ -120,6 +120,32 @@ pub fn cuboid(lo: Vec3, hi: Vec3, surface: impl Into<Surface>) -> Vec<Triangle> 
         .collect()
 }
 
+/// The GI examples' scene: an open box (a red wall on the left, a green one on the right,
+/// a white floor and back wall) around two white blocks, a sun without shadows from the
+/// right and above (it lights the red wall, the floor and the blocks' right faces), and
+/// the camera looking in, for a `width`×`height` frame: triangles, sun, view, projection.
+pub fn open_box(width: u32, height: u32) -> (Vec<Triangle>, Sun, Mat4, Mat4) {
+    let (white, red, green) = (
+        Vec3::splat(0.75),
+        Vec3::new(0.75, 0.08, 0.06),
+        Vec3::new(0.1, 0.6, 0.12),
+    );
+    let mut triangles = cuboid(Vec3::new(-2.0, -0.1, -2.0), Vec3::new(2.0, 0.0, 2.0), white);
+    triangles.extend(cuboid(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(-1.9, 2.0, 2.0), red));
+    triangles.extend(cuboid(Vec3::new(1.9, 0.0, -2.0), Vec3::new(2.0, 2.0, 2.0), green));
+    triangles.extend(cuboid(Vec3::new(-1.9, 0.0, -2.0), Vec3::new(1.9, 2.0, -1.9), white));
+    triangles.extend(cuboid(Vec3::new(-1.2, 0.0, -1.0), Vec3::new(-0.4, 0.8, -0.2), white));
+    triangles.extend(cuboid(Vec3::new(0.4, 0.0, -1.3), Vec3::new(1.0, 1.4, -0.7), white));
+    let sun = Sun {
+        direction: Vec3::new(1.0, 0.8, 0.2),
+        irradiance: Vec3::splat(4.0),
+    };
+    use glam::camera::rh;
+    let view = rh::view::look_at_mat4(Vec3::new(0.0, 1.4, 4.2), Vec3::new(0.0, 0.7, -0.5), Vec3::Y);
+    let proj = rh::proj::directx::perspective(45f32.to_radians(), width as f32 / height as f32, 0.05, 50.0);
+    (triangles, sun, view, proj)
+}
+
 /// Linear → 8-bit sRGB of a value tone-mapped by v / (1 + v): the examples' PNGs.
 pub fn display(v: f32) -> u8 {
     let x = (v / (1.0 + v)).clamp(0.0, 1.0);

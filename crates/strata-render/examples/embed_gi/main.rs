@@ -15,7 +15,6 @@
 #[path = "../embed_ao/app.rs"]
 mod app;
 
-use glam::Vec3;
 use strata_render::embed::{AoInputs, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding, RadiosityInputs};
 use strata_render::passes::radiosity::RadiositySettings;
 
@@ -25,33 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // the radiosity buffers are R11G11B10 render targets (DGB Table 1)
     let (adapter, device, queue) = app::open_device(wgpu::Features::RG11B10UFLOAT_RENDERABLE)?;
 
-    let (white, red, green) = (
-        Vec3::splat(0.75),
-        Vec3::new(0.75, 0.08, 0.06),
-        Vec3::new(0.1, 0.6, 0.12),
-    );
-    let mut triangles = app::cuboid(Vec3::new(-2.0, -0.1, -2.0), Vec3::new(2.0, 0.0, 2.0), white);
-    triangles.extend(app::cuboid(Vec3::new(-2.0, 0.0, -2.0), Vec3::new(-1.9, 2.0, 2.0), red));
-    triangles.extend(app::cuboid(Vec3::new(1.9, 0.0, -2.0), Vec3::new(2.0, 2.0, 2.0), green));
-    triangles.extend(app::cuboid(
-        Vec3::new(-1.9, 0.0, -2.0),
-        Vec3::new(1.9, 2.0, -1.9),
-        white,
-    ));
-    triangles.extend(app::cuboid(
-        Vec3::new(-1.2, 0.0, -1.0),
-        Vec3::new(-0.4, 0.8, -0.2),
-        white,
-    ));
-    triangles.extend(app::cuboid(Vec3::new(0.4, 0.0, -1.3), Vec3::new(1.0, 1.4, -0.7), white));
-    // from the right and above: it lights the red wall, the floor and the blocks' right faces
-    let sun = app::Sun {
-        direction: Vec3::new(1.0, 0.8, 0.2),
-        irradiance: Vec3::splat(4.0),
-    };
-    use glam::camera::rh;
-    let view = rh::view::look_at_mat4(Vec3::new(0.0, 1.4, 4.2), Vec3::new(0.0, 0.7, -0.5), Vec3::Y);
-    let proj = rh::proj::directx::perspective(45f32.to_radians(), width as f32 / height as f32, 0.05, 50.0);
+    let (triangles, sun, view, proj) = app::open_box(width, height);
     let layout = app::Layout::standard();
     let first = app::GBuffer::lit(&device, [width, height], layout, &triangles, sun);
     let second = app::GBuffer::second_layer_lit(&device, &first, 0.3, &triangles);

@@ -1,6 +1,8 @@
 //! Deep-G-buffer ambient occlusion (DGB §3.1), screen-space radiosity (§3.2–3.3,
-//! [`EmbeddedRadiosity`]) and mirror reflections (§3.6, [`EmbeddedReflections`]) inside an
-//! application's own wgpu renderer (`docs/embed.md`).
+//! [`EmbeddedRadiosity`]) and mirror reflections (§3.6, [`EmbeddedReflections`]), the
+//! bounced z-buffer's AO ([`EmbeddedBzbAo`]) and interleaved deferred shading of the
+//! application's VPLs ([`EmbeddedIls`]) inside an application's own wgpu renderer
+//! (`docs/embed.md`).
 //!
 //! The application draws its scene as usual, into a depth texture and a normal texture
 //! (and, for DGB's second layer, a second pair). Each frame, [`EmbeddedAo::encode`] records

@@ -1042,7 +1042,7 @@ impl BzbStage {
     /// out, 3 entries per triangle), which must end within the count the stage was built
     /// with; for geometry that moves between frames.
     pub fn write_triangles(&self, gpu: &GpuContext, first: u32, data: &[[f32; 4]]) {
-        debug_assert!(data.len() % 3 == 0 && first as usize + data.len() / 3 <= self.triangles.count as usize);
+        debug_assert!(data.len().is_multiple_of(3) && first as usize + data.len() / 3 <= self.triangles.count as usize);
         if !data.is_empty() {
             let offset = first as u64 * 3 * std::mem::size_of::<[f32; 4]>() as u64;
             gpu.queue

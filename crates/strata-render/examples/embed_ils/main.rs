@@ -1,0 +1,170 @@
+//! strata's interleaved deferred shading (ILS) in an application's own wgpu renderer, beside
+//! its deep-G-buffer radiosity.
+//!
+//! The "application" draws the open box of `embed_gi` (`../embed_ao/app.rs`), lit by a sun
+//! without shadows. It makes its own virtual point lights: 480 points on the sunlit front
+//! faces of its triangles, in proportion to the power each face reflects, each carrying
+//! its share Φ = ρ · E_sun cos θ · A (ILS §3: VPLs as the first bounce). It hands them and
+//! its depth and normals to `strata_render::embed::EmbeddedIls` (the `clean-edges` preset),
+//! and its lit G-buffer to
+//! `EmbeddedRadiosity` (2 layers, 16 frames). It composes `B + ρ/π · E` with each
+//! technique's E on the CPU and writes three panels side by side as a PNG: direct light,
+//! + DGB radiosity, + ILS:
+//!
+//! ```sh
+//! cargo run --release -p strata-render --example embed_ils -- out/embed-ils.png
+//! ```
+
+#[path = "../embed_ao/app.rs"]
+mod app;
+
+use glam::Vec3;
+use strata_render::embed::{
+    AoInputs, EmbeddedIls, EmbeddedIlsConfig, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding,
+    RadiosityInputs,
+};
+use strata_render::passes::ils::{GpuVpl, IlsSettings};
+use strata_render::passes::radiosity::RadiositySettings;
+
+/// `count` VPLs on the front faces of `triangles` that face `sun`, allotted in proportion
+/// to the power each reflects (its luminance) and placed at stratified points.
+fn sun_vpls(triangles: &[app::Triangle], sun: app::Sun, count: usize) -> Vec<GpuVpl> {
+    let l = sun.direction.normalize();
+    // reflected power of each lit front face: ρ ⊙ E cos θ · A
+    let power: Vec<(usize, Vec3)> = triangles
+        .iter()
+        .enumerate()
+        .filter_map(|(i, (p, n, s))| {
+            let cos = n[0].dot(l);
+            let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+            (cos > 0.0).then(|| (i, s.albedo * sun.irradiance * (cos * area)))
+        })
+        .collect();
+    let luminance = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let total: f32 = power.iter().map(|(_, c)| luminance(*c)).sum();
+    let mut vpls = Vec::with_capacity(count);
+    let mut carried = 0.0f32;
+    for (i, c) in &power {
+        // the running total's share decides how many land here (largest remainder)
+        let before = (carried / total * count as f32).round() as usize;
+        carried += luminance(*c);
+        let k = (carried / total * count as f32).round() as usize - before;
+        let (p, n, _) = &triangles[*i];
+        for j in 0..k {
+            // stratified barycentric points: the golden-ratio sequence, square-root warped
+            let (u, v) = ((j as f32 + 0.5) / k as f32, (j as f32 * 0.618_034).fract());
+            let su = u.sqrt();
+            let q = p[0] * (1.0 - su) + p[1] * (su * (1.0 - v)) + p[2] * (su * v);
+            vpls.push(GpuVpl::new(q.into(), n[0].into(), (*c / k as f32).into()));
+        }
+    }
+    vpls
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let out = std::env::args().nth(1).unwrap_or_else(|| "embed-ils.png".into());
+    let (width, height) = (480u32, 320u32);
+    // the radiosity buffers are R11G11B10 render targets (DGB Table 1)
+    let (adapter, device, queue) = app::open_device(wgpu::Features::RG11B10UFLOAT_RENDERABLE)?;
+    let (triangles, sun, view, proj) = app::open_box(width, height);
+    let layout = app::Layout::standard();
+    let first = app::GBuffer::lit(&device, [width, height], layout, &triangles, sun);
+    let second = app::GBuffer::second_layer_lit(&device, &first, 0.3, &triangles);
+
+    let vpls = sun_vpls(&triangles, sun, 480);
+    let mut ils = EmbeddedIls::new(
+        &adapter,
+        &device,
+        &queue,
+        EmbeddedIlsConfig {
+            width,
+            height,
+            settings: IlsSettings {
+                vpls: vpls.clone().into(),
+                // below d_c a VPL's 1/d² is held: 4 % of the scene's diagonal (6 m), the
+                // renderer's default
+                clamp_distance: Some(0.24),
+                ..IlsSettings::default()
+            }
+            // the blur stops per axis at edges and slides its cut windows (`docs/ils.md`),
+            // against the paper's filter's dotted outlines
+            .with_preset("clean-edges")?,
+            normals: NormalEncoding::Signed,
+            ..EmbeddedIlsConfig::default()
+        },
+    )?;
+    let mut gi = EmbeddedRadiosity::new(
+        &adapter,
+        &device,
+        &queue,
+        EmbeddedRadiosityConfig {
+            width,
+            height,
+            layers: 2,
+            settings: RadiositySettings {
+                radius: Some(2.0),
+                ..RadiositySettings::default()
+            },
+            min_separation: 0.3,
+            normals: NormalEncoding::Signed,
+            ..EmbeddedRadiosityConfig::default()
+        },
+    )?;
+    println!("{} VPLs; ILS passes: {}", vpls.len(), ils.pass_names().join(" → "));
+    let (a0, b0) = first.shading.as_ref().ok_or("lit")?;
+    let (a1, b1) = second.shading.as_ref().ok_or("lit")?;
+    for frame in 0..16 {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        first.draw(&queue, &mut encoder, view, proj);
+        second.draw(&queue, &mut encoder, view, proj);
+        let gbuffer = AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj);
+        let inputs = RadiosityInputs {
+            gbuffer: AoInputs {
+                second: Some(((&second.depth).into(), (&second.normals).into())),
+                ..gbuffer
+            },
+            albedo: a0.into(),
+            radiance: b0.into(),
+            second: Some((a1.into(), b1.into())),
+        };
+        gi.encode(&mut encoder, &inputs)?;
+        // ILS needs no history: one frame is its image (the last one is kept)
+        if frame == 15 {
+            ils.encode(&mut encoder, &gbuffer)?;
+        }
+        queue.submit([encoder.finish()]);
+    }
+    println!("ILS:");
+    app::print_timings(&ils.timings()?);
+
+    // the application's composite, on the CPU from the embedded radiosity's imported copies
+    // of its albedo and radiance: B | B + ρ/π · E_DGB | B + ρ/π · E_ILS
+    let (e_dgb, e_ils, albedo, b) = (
+        gi.read_target("indirect")?,
+        ils.read_target(ils.config().settings.output().name)?,
+        gi.read_target("albedo")?,
+        gi.read_target("radiosity0")?,
+    );
+    let mut img = image::RgbImage::new(3 * width, height);
+    for y in 0..height {
+        for x in 0..width {
+            let (pa, pb) = (albedo.pixel(x, y), b.pixel(x, y));
+            for (panel, e) in [None, Some(&e_dgb), Some(&e_ils)].into_iter().enumerate() {
+                for k in 0..3 {
+                    let indirect = e.map_or(0.0, |e| pa[k] / std::f32::consts::PI * e.pixel(x, y)[k]);
+                    img.get_pixel_mut(panel as u32 * width + x, y)[k] = app::display(pb[k] + indirect);
+                }
+            }
+        }
+    }
+    img.save(&out)?;
+    let mean = |e: &strata_scene::ImageBuf| {
+        e.data.chunks_exact(4).map(|p| p[0] + p[1] + p[2]).sum::<f32>() / (3 * width * height) as f32
+    };
+    println!(
+        "wrote {out}: direct | + DGB radiosity | + ILS, {width}x{height} each; mean irradiance E: DGB {:.3}, ILS {:.3}",
+        mean(&e_dgb),
+        mean(&e_ils)
+    );
+    Ok(())
+}
