@@ -159,13 +159,7 @@ fn embedded_ao_on_the_renderers_gbuffer_is_the_renderers_ao() {
             mean < 2e-4 && over < 0.002,
             "k = {layers}, {what}: mean {mean}, {over} over 1/255"
         );
-        // per-pass GPU time, where the device has timestamps (lavapipe has)
-        if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
-            let t = ao.timings().unwrap();
-            let names: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
-            assert_eq!(names, ao.pass_names(), "one time per pass, in order");
-            assert!(t.passes.iter().all(|p| p.1 >= 0.0) && t.total() > 0.0, "{t:?}");
-        }
+        common::check_pass_timings(&gpu, || ao.timings(), ao.pass_names(), what);
         let lo = b.data.iter().cloned().fold(1.0f32, f32::min);
         assert!(lo < 0.6, "the atrium has occlusion to compare (darkest AV {lo})");
     }

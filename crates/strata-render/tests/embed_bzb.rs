@@ -119,11 +119,7 @@ fn embedded_bzb_ao_on_the_renderers_gbuffer_is_the_renderers() {
             lo < 0.6,
             "{what}: the atrium has occlusion to compare (darkest AV {lo})"
         );
-        if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
-            let t = ao.timings().unwrap();
-            let names: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
-            assert_eq!(names, ao.pass_names(), "{what}: one time per pass, in order");
-        }
+        common::check_pass_timings(&gpu, || ao.timings(), ao.pass_names(), what);
     }
 }
 
@@ -165,15 +161,10 @@ fn an_occluder_off_screen_occludes_as_the_analytic_value() {
     let mut ao = embedded(&gpu, [w, h], settings.clone(), NormalEncoding::Signed, &floor_only);
     let mean_av = |ao: &mut EmbeddedBzbAo| {
         for _ in 0..8 {
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            gbuffer.draw(&gpu.queue, &mut encoder, view, proj);
-            ao.encode(
-                &mut encoder,
-                &AoInputs::new((&gbuffer.depth).into(), (&gbuffer.normals).into(), view, proj),
-            )
-            .unwrap();
-            gpu.queue.submit([encoder.finish()]);
-            gpu.check_errors().expect("no wgpu validation errors");
+            common::submit_checked(&gpu, |e| {
+                gbuffer.draw(&gpu.queue, e, view, proj);
+                ao.encode(e, &gbuffer.inputs(view, proj)).unwrap();
+            });
         }
         let av = ao.read_target("ao").unwrap();
         let z = ao.read_target("csz").unwrap();
@@ -311,33 +302,7 @@ fn bad_embedded_bzb_input_is_a_one_line_error() {
         .expect("an empty range at the end is nothing to write");
     assert_eq!(two.triangle_count(), 2);
     // a second layer is not read: an AoInputs with one is refused
-    let texture = |format| {
-        gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
-                width: 64,
-                height: 48,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        })
-    };
-    let (d, n) = (
-        texture(wgpu::TextureFormat::Depth32Float),
-        texture(wgpu::TextureFormat::Rgba16Float),
-    );
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let proj = glam::camera::rh::proj::directx::perspective(1.0, 4.0 / 3.0, 0.1, 10.0);
-    let inputs = AoInputs {
-        second: Some(((&d).into(), (&n).into())),
-        ..AoInputs::new((&d).into(), (&n).into(), Mat4::IDENTITY, proj)
-    };
-    let e = ao.encode(&mut encoder, &inputs).unwrap_err().to_string();
+    let e = common::second_layer_error(&gpu, [64, 48], |enc, inputs| ao.encode(enc, inputs));
     assert!(e.contains("AoInputs::second"), "{e}");
     // a refused resize keeps the instance as it was, triangles included
     let e = ao.resize(0, 48).unwrap_err().to_string();
@@ -400,15 +365,10 @@ fn dss_surfel_overflow_is_reported_and_clears() {
     sheets.extend((0..20).map(sheet));
     let mut ao = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &floor_only);
     let frame = |ao: &mut EmbeddedBzbAo| {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        gbuffer.draw(&gpu.queue, &mut encoder, view, proj);
-        ao.encode(
-            &mut encoder,
-            &AoInputs::new((&gbuffer.depth).into(), (&gbuffer.normals).into(), view, proj),
-        )
-        .unwrap();
-        gpu.queue.submit([encoder.finish()]);
-        gpu.check_errors().expect("no wgpu validation errors");
+        common::submit_checked(&gpu, |e| {
+            gbuffer.draw(&gpu.queue, e, view, proj);
+            ao.encode(e, &gbuffer.inputs(view, proj)).unwrap();
+        });
         let c = ao.dss_counts().expect("DSS counts").unwrap();
         println!("{c:?}");
         (c, ao.dss_overflow().unwrap())

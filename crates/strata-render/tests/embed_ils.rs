@@ -10,7 +10,7 @@ mod app;
 
 use std::sync::Arc;
 
-use glam::{Mat4, Vec3, Vec4Swizzles};
+use glam::{Vec3, Vec4Swizzles};
 use strata_reference::vpl::{Vpl, VplSettings};
 use strata_reference::Reference;
 use strata_render::embed::{AoInputs, EmbeddedIls, EmbeddedIlsConfig, NormalEncoding, NormalSpace, TextureLayer};
@@ -130,11 +130,7 @@ fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
                 "{name}, {what}: {:.2} % of pixels differ by over 1 %",
                 100.0 * over
             );
-            if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
-                let t = ils.timings().unwrap();
-                let names: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
-                assert_eq!(names, ils.pass_names(), "{what}: one time per pass, in order");
-            }
+            common::check_pass_timings(&gpu, || ils.timings(), ils.pass_names(), what);
         }
     }
 }
@@ -197,15 +193,10 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
         (t > 0.0 && t < 1.0 && p.x.abs() < 19.5 && p.z.abs() < 19.5).then_some(p)
     };
     let run = |ils: &mut EmbeddedIls| {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        gbuffer.draw(&gpu.queue, &mut encoder, view, proj);
-        ils.encode(
-            &mut encoder,
-            &AoInputs::new((&gbuffer.depth).into(), (&gbuffer.normals).into(), view, proj),
-        )
-        .unwrap();
-        gpu.queue.submit([encoder.finish()]);
-        gpu.check_errors().expect("no wgpu validation errors");
+        common::submit_checked(&gpu, |e| {
+            gbuffer.draw(&gpu.queue, e, view, proj);
+            ils.encode(e, &gbuffer.inputs(view, proj)).unwrap();
+        });
         ils.read_target(ils.config().settings.output().name).unwrap()
     };
     // the floor's normal as the G-buffer holds it: Oct16 in 8-bit channels (DGB Table 1)
@@ -397,36 +388,6 @@ fn bad_embedded_ils_input_is_a_one_line_error() {
     assert!(e.contains("size 0x30 is out of range"), "{e}");
     assert_eq!(ils.config().width, 40);
     // one layer only
-    let texture = |format| {
-        gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d {
-                width: 40,
-                height: 30,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        })
-    };
-    let (d, n) = (
-        texture(wgpu::TextureFormat::Depth32Float),
-        texture(wgpu::TextureFormat::Rgba16Float),
-    );
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let inputs = AoInputs {
-        second: Some(((&d).into(), (&n).into())),
-        ..AoInputs::new(
-            (&d).into(),
-            (&n).into(),
-            Mat4::IDENTITY,
-            glam::camera::rh::proj::directx::perspective(1.0, 4.0 / 3.0, 0.1, 10.0),
-        )
-    };
-    let e = ils.encode(&mut encoder, &inputs).unwrap_err().to_string();
+    let e = common::second_layer_error(&gpu, [40, 30], |enc, inputs| ils.encode(enc, inputs));
     assert!(e.contains("AoInputs::second is given") && !e.contains('\n'), "{e}");
 }

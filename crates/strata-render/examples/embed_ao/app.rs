@@ -146,6 +146,112 @@ pub fn open_box(width: u32, height: u32) -> (Vec<Triangle>, Sun, Mat4, Mat4) {
     (triangles, sun, view, proj)
 }
 
+/// The GI examples' application around [`open_box`]: its device, both lit layers, the
+/// camera, and strata's `EmbeddedRadiosity` (2 layers, gather radius 2, Δz = 0.3).
+pub struct OpenBox {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter: wgpu::Adapter,
+    pub first: GBuffer,
+    pub second: GBuffer,
+    pub view: Mat4,
+    pub proj: Mat4,
+    pub gi: strata_render::embed::EmbeddedRadiosity,
+}
+
+impl OpenBox {
+    pub fn new(width: u32, height: u32) -> Result<Self, Box<dyn std::error::Error>> {
+        use strata_render::embed::{EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding};
+        // the radiosity buffers are R11G11B10 render targets (DGB Table 1)
+        let (adapter, device, queue) = open_device(wgpu::Features::RG11B10UFLOAT_RENDERABLE)?;
+        let (triangles, sun, view, proj) = open_box(width, height);
+        let first = GBuffer::lit(&device, [width, height], Layout::standard(), &triangles, sun);
+        let second = GBuffer::second_layer_lit(&device, &first, 0.3, &triangles);
+        let gi = EmbeddedRadiosity::new(
+            &adapter,
+            &device,
+            &queue,
+            EmbeddedRadiosityConfig {
+                width,
+                height,
+                layers: 2,
+                settings: strata_render::passes::radiosity::RadiositySettings {
+                    radius: Some(2.0),
+                    ..Default::default()
+                },
+                min_separation: 0.3,
+                normals: NormalEncoding::Signed,
+                ..EmbeddedRadiosityConfig::default()
+            },
+        )?;
+        Ok(Self {
+            device,
+            queue,
+            adapter,
+            first,
+            second,
+            view,
+            proj,
+            gi,
+        })
+    }
+
+    /// One frame: draws both layers, records the radiosity, then `more` with layer 0's
+    /// inputs into the same encoder, and submits it.
+    pub fn frame(
+        &mut self,
+        more: impl FnOnce(
+            &mut wgpu::CommandEncoder,
+            &strata_render::embed::AoInputs<'_>,
+        ) -> Result<(), strata_render::RenderError>,
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let (view, proj) = (self.view, self.proj);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        self.first.draw(&self.queue, &mut encoder, view, proj);
+        self.second.draw(&self.queue, &mut encoder, view, proj);
+        let (a0, b0) = self.first.shading.as_ref().ok_or("lit")?;
+        let (a1, b1) = self.second.shading.as_ref().ok_or("lit")?;
+        let layer0 = self.first.inputs(view, proj);
+        let inputs = strata_render::embed::RadiosityInputs {
+            gbuffer: strata_render::embed::AoInputs {
+                second: Some(((&self.second.depth).into(), (&self.second.normals).into())),
+                ..layer0
+            },
+            albedo: a0.into(),
+            radiance: b0.into(),
+            second: Some((a1.into(), b1.into())),
+        };
+        self.gi.encode(&mut encoder, &inputs)?;
+        more(&mut encoder, &layer0)?;
+        self.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// The application's composite, on the CPU from the embedded radiosity's imported
+    /// copies of its albedo ρ and radiance B: one panel per entry, side by side, each
+    /// B + ρ/π · E with that entry's irradiance E (`None`: B alone).
+    pub fn composite(
+        &self,
+        panels: &[Option<&strata_scene::ImageBuf>],
+    ) -> Result<image::RgbImage, strata_render::RenderError> {
+        let (albedo, b) = (self.gi.read_target("albedo")?, self.gi.read_target("radiosity0")?);
+        let (w, h) = (b.width, b.height);
+        let mut img = image::RgbImage::new(panels.len() as u32 * w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let (pa, pb) = (albedo.pixel(x, y), b.pixel(x, y));
+                for (panel, e) in panels.iter().enumerate() {
+                    for k in 0..3 {
+                        let indirect = e.map_or(0.0, |e| pa[k] / std::f32::consts::PI * e.pixel(x, y)[k]);
+                        img.get_pixel_mut(panel as u32 * w + x, y)[k] = display(pb[k] + indirect);
+                    }
+                }
+            }
+        }
+        Ok(img)
+    }
+}
+
 /// Linear → 8-bit sRGB of a value tone-mapped by v / (1 + v): the examples' PNGs.
 pub fn display(v: f32) -> u8 {
     let x = (v / (1.0 + v)).clamp(0.0, 1.0);
@@ -492,6 +598,11 @@ impl GBuffer {
             vertices,
             count: verts.len() as u32,
         }
+    }
+
+    /// This layer's depth and normals as strata's embedded techniques take them.
+    pub fn inputs(&self, view: Mat4, proj: Mat4) -> strata_render::embed::AoInputs<'_> {
+        strata_render::embed::AoInputs::new((&self.depth).into(), (&self.normals).into(), view, proj)
     }
 
     /// Draws the triangles with `view` and `proj` into the depth and normal textures.

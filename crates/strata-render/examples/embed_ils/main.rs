@@ -19,12 +19,8 @@
 mod app;
 
 use glam::Vec3;
-use strata_render::embed::{
-    AoInputs, EmbeddedIls, EmbeddedIlsConfig, EmbeddedRadiosity, EmbeddedRadiosityConfig, NormalEncoding,
-    RadiosityInputs,
-};
+use strata_render::embed::{EmbeddedIls, EmbeddedIlsConfig, NormalEncoding};
 use strata_render::passes::ils::{GpuVpl, IlsSettings};
-use strata_render::passes::radiosity::RadiositySettings;
 
 /// `count` VPLs on the front faces of `triangles` that face `sun`, allotted in proportion
 /// to the power each reflects (its luminance) and placed at stratified points.
@@ -64,18 +60,13 @@ fn sun_vpls(triangles: &[app::Triangle], sun: app::Sun, count: usize) -> Vec<Gpu
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "embed-ils.png".into());
     let (width, height) = (480u32, 320u32);
-    // the radiosity buffers are R11G11B10 render targets (DGB Table 1)
-    let (adapter, device, queue) = app::open_device(wgpu::Features::RG11B10UFLOAT_RENDERABLE)?;
-    let (triangles, sun, view, proj) = app::open_box(width, height);
-    let layout = app::Layout::standard();
-    let first = app::GBuffer::lit(&device, [width, height], layout, &triangles, sun);
-    let second = app::GBuffer::second_layer_lit(&device, &first, 0.3, &triangles);
-
+    let mut app = app::OpenBox::new(width, height)?;
+    let (triangles, sun, _, _) = app::open_box(width, height);
     let vpls = sun_vpls(&triangles, sun, 480);
     let mut ils = EmbeddedIls::new(
-        &adapter,
-        &device,
-        &queue,
+        &app.adapter,
+        &app.device,
+        &app.queue,
         EmbeddedIlsConfig {
             width,
             height,
@@ -93,71 +84,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..EmbeddedIlsConfig::default()
         },
     )?;
-    let mut gi = EmbeddedRadiosity::new(
-        &adapter,
-        &device,
-        &queue,
-        EmbeddedRadiosityConfig {
-            width,
-            height,
-            layers: 2,
-            settings: RadiositySettings {
-                radius: Some(2.0),
-                ..RadiositySettings::default()
-            },
-            min_separation: 0.3,
-            normals: NormalEncoding::Signed,
-            ..EmbeddedRadiosityConfig::default()
-        },
-    )?;
     println!("{} VPLs; ILS passes: {}", vpls.len(), ils.pass_names().join(" → "));
-    let (a0, b0) = first.shading.as_ref().ok_or("lit")?;
-    let (a1, b1) = second.shading.as_ref().ok_or("lit")?;
     for frame in 0..16 {
-        let mut encoder = device.create_command_encoder(&Default::default());
-        first.draw(&queue, &mut encoder, view, proj);
-        second.draw(&queue, &mut encoder, view, proj);
-        let gbuffer = AoInputs::new((&first.depth).into(), (&first.normals).into(), view, proj);
-        let inputs = RadiosityInputs {
-            gbuffer: AoInputs {
-                second: Some(((&second.depth).into(), (&second.normals).into())),
-                ..gbuffer
-            },
-            albedo: a0.into(),
-            radiance: b0.into(),
-            second: Some((a1.into(), b1.into())),
-        };
-        gi.encode(&mut encoder, &inputs)?;
         // ILS needs no history: one frame is its image (the last one is kept)
-        if frame == 15 {
-            ils.encode(&mut encoder, &gbuffer)?;
-        }
-        queue.submit([encoder.finish()]);
+        app.frame(|encoder, layer0| match frame {
+            15 => ils.encode(encoder, layer0),
+            _ => Ok(()),
+        })?;
     }
     println!("ILS:");
     app::print_timings(&ils.timings()?);
 
-    // the application's composite, on the CPU from the embedded radiosity's imported copies
-    // of its albedo and radiance: B | B + ρ/π · E_DGB | B + ρ/π · E_ILS
-    let (e_dgb, e_ils, albedo, b) = (
-        gi.read_target("indirect")?,
-        ils.read_target(ils.config().settings.output().name)?,
-        gi.read_target("albedo")?,
-        gi.read_target("radiosity0")?,
-    );
-    let mut img = image::RgbImage::new(3 * width, height);
-    for y in 0..height {
-        for x in 0..width {
-            let (pa, pb) = (albedo.pixel(x, y), b.pixel(x, y));
-            for (panel, e) in [None, Some(&e_dgb), Some(&e_ils)].into_iter().enumerate() {
-                for k in 0..3 {
-                    let indirect = e.map_or(0.0, |e| pa[k] / std::f32::consts::PI * e.pixel(x, y)[k]);
-                    img.get_pixel_mut(panel as u32 * width + x, y)[k] = app::display(pb[k] + indirect);
-                }
-            }
-        }
-    }
-    img.save(&out)?;
+    // the application's composite: B | B + ρ/π · E_DGB | B + ρ/π · E_ILS
+    let e_dgb = app.gi.read_target("indirect")?;
+    let e_ils = ils.read_target(ils.config().settings.output().name)?;
+    app.composite(&[None, Some(&e_dgb), Some(&e_ils)])?.save(&out)?;
     let mean = |e: &strata_scene::ImageBuf| {
         e.data.chunks_exact(4).map(|p| p[0] + p[1] + p[2]).sum::<f32>() / (3 * width * height) as f32
     };

@@ -144,18 +144,14 @@ impl EmbeddedBzbAo {
             ..Default::default()
         };
         scene.settings.ao_radius = radius;
-        let core = CoreConfig {
+        // BZB's receivers are the visible surfaces (one layer); its occluders are the
+        // triangles
+        let core = CoreConfig::one_layer(
             what,
-            width: config.width,
-            height: config.height,
-            // BZB's receivers are the visible surfaces; its occluders are the triangles
-            layers: 1,
-            normals: config.normals,
-            normal_space: config.normal_space,
-            mip_levels: None,
-            kernel: crate::passes::Kernel::Fragment,
-            shading: super::core::ShadingImport::None,
-        };
+            [config.width, config.height],
+            (config.normals, config.normal_space),
+            super::core::ShadingImport::None,
+        );
         Core::scoped(device, || {
             let mut core = Core::new(adapter, device, queue, core, scene)?;
             if s.temporal.is_some() {

@@ -72,6 +72,30 @@ pub(crate) struct CoreConfig {
     pub shading: ShadingImport,
 }
 
+impl CoreConfig {
+    /// One layer at the application's size and normal encoding, no depth MIP chain,
+    /// fragment passes: the techniques that read full-resolution layer 0 only (the
+    /// bounced z-buffer, ILS).
+    pub fn one_layer(
+        what: &'static str,
+        [width, height]: [u32; 2],
+        (normals, normal_space): (NormalEncoding, NormalSpace),
+        shading: ShadingImport,
+    ) -> Self {
+        Self {
+            what,
+            width,
+            height,
+            layers: 1,
+            normals,
+            normal_space,
+            mip_levels: None,
+            kernel: crate::passes::Kernel::Fragment,
+            shading,
+        }
+    }
+}
+
 pub(crate) struct Core {
     pub gpu: GpuContext,
     /// A scene without geometry: the technique's radii, and the frame uniforms' buffer.

@@ -92,17 +92,12 @@ impl EmbeddedIls {
             name: "embedded".into(),
             ..Default::default()
         };
-        let core = CoreConfig {
+        let core = CoreConfig::one_layer(
             what,
-            width: config.width,
-            height: config.height,
-            layers: 1,
-            normals: config.normals,
-            normal_space: config.normal_space,
-            mip_levels: None,
-            kernel: crate::passes::Kernel::Fragment,
-            shading: super::core::ShadingImport::Normals,
-        };
+            [config.width, config.height],
+            (config.normals, config.normal_space),
+            super::core::ShadingImport::Normals,
+        );
         Core::scoped(device, || {
             let mut core = Core::new(adapter, device, queue, core, scene)?;
             // the G-buffer's emission (a = 2 flags a glossy receiver): none here, all Lambert

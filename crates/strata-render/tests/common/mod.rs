@@ -164,6 +164,63 @@ pub fn submit_checked(gpu: &GpuContext, record: impl FnOnce(&mut wgpu::CommandEn
     gpu.check_errors().expect("no wgpu validation errors");
 }
 
+/// The error of an embedded technique that reads one layer, given `AoInputs` with a second
+/// (blank `w`×`h` depth and normal textures, an identity view).
+pub fn second_layer_error(
+    gpu: &GpuContext,
+    [w, h]: [u32; 2],
+    encode: impl FnOnce(
+        &mut wgpu::CommandEncoder,
+        &strata_render::embed::AoInputs<'_>,
+    ) -> Result<(), strata_render::RenderError>,
+) -> String {
+    let texture = |format| {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: None,
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        })
+    };
+    let (d, n) = (
+        texture(wgpu::TextureFormat::Depth32Float),
+        texture(wgpu::TextureFormat::Rgba16Float),
+    );
+    let proj = glam::camera::rh::proj::directx::perspective(1.0, w as f32 / h as f32, 0.1, 10.0);
+    let inputs = strata_render::embed::AoInputs {
+        second: Some(((&d).into(), (&n).into())),
+        ..strata_render::embed::AoInputs::new((&d).into(), (&n).into(), glam::Mat4::IDENTITY, proj)
+    };
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encode(&mut encoder, &inputs)
+        .expect_err("a second layer is refused")
+        .to_string()
+}
+
+/// Where the device times passes (lavapipe does): `timings` (an embedded technique's last
+/// frame) has one time per pass of `names`, in order, none negative.
+pub fn check_pass_timings(
+    gpu: &GpuContext,
+    timings: impl FnOnce() -> Result<strata_render::PassTimings, strata_render::RenderError>,
+    names: Vec<&'static str>,
+    what: &str,
+) {
+    if gpu.has(wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
+        let t = timings().unwrap();
+        let got: Vec<&str> = t.passes.iter().map(|p| p.0.as_str()).collect();
+        assert_eq!(got, names, "{what}: one time per pass, in order");
+        assert!(t.passes.iter().all(|p| p.1 >= 0.0) && t.total() > 0.0, "{what}: {t:?}");
+    }
+}
+
 /// How many values of target `name` differ in their bits between renderers `a` and `b`
 /// (the same-image checks of settings that must not change the image).
 pub fn target_bits_differing(gpu: &GpuContext, a: &Renderer, b: &Renderer, name: &str) -> usize {
