@@ -23,7 +23,15 @@ fn gpu_vpl(v: &Vpl) -> GpuVpl {
     GpuVpl::new(v.position.into(), v.normal.into(), v.flux.into())
 }
 
-fn embedded(gpu: &GpuContext, [w, h]: [u32; 2], settings: IlsSettings, normals: NormalEncoding) -> EmbeddedIls {
+/// The embedded ILS at `w`×`h` in world space; `triangles` are the VPL shadow maps'
+/// occluders (read with `shadows = vpl`).
+fn embedded(
+    gpu: &GpuContext,
+    [w, h]: [u32; 2],
+    settings: IlsSettings,
+    normals: NormalEncoding,
+    triangles: &[[Vec3; 3]],
+) -> EmbeddedIls {
     EmbeddedIls::new(
         &gpu.adapter,
         &gpu.device,
@@ -34,6 +42,7 @@ fn embedded(gpu: &GpuContext, [w, h]: [u32; 2], settings: IlsSettings, normals: 
             settings,
             normals,
             normal_space: NormalSpace::World,
+            triangles: triangles.into(),
         },
     )
     .expect("the embedded ILS builds without validation errors")
@@ -53,7 +62,8 @@ fn rgb_diff(a: &ImageBuf, b: &ImageBuf) -> (f32, f32) {
 }
 
 /// The renderer's G-buffer and VPLs in, the renderer's ILS irradiance out: the same passes
-/// on the same data, for the paper's blur, no blur, the brute force and `refine`.
+/// on the same data, for the paper's blur, no blur, the brute force, `refine` and SSM's
+/// VPL shadow maps of the scene's triangles.
 #[test]
 fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
     let gpu = common::gpu();
@@ -103,10 +113,18 @@ fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
                     ..base.clone()
                 },
             ),
+            (
+                "VPL shadow maps (SSM)",
+                IlsSettings {
+                    shadows: VplShadows::ShadowMaps,
+                    ..base.clone()
+                },
+            ),
         ];
+        let triangles: Vec<[Vec3; 3]> = scene.world_triangles(0.0).iter().map(|t| t.p).collect();
         for (what, settings) in cases {
             let r = common::ils_renderer(&gpu, &scene, settings.clone(), (w, h));
-            let mut ils = embedded(&gpu, [w, h], settings.clone(), NormalEncoding::Octahedral);
+            let mut ils = embedded(&gpu, [w, h], settings.clone(), NormalEncoding::Octahedral, &triangles);
             let (view, proj) = (scene.camera.view(), scene.camera.projection(w as f32 / h as f32));
             let (depth, normal) = (r.target_texture("depth").unwrap(), r.target_texture("normal").unwrap());
             let layer0 = |t| TextureLayer { texture: t, layer: 0 };
@@ -273,7 +291,7 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
             ..IlsSettings::default()
         };
         let window = settings.blurs().then(|| (settings.blur_radius(), settings.pattern));
-        let mut ils = embedded(&gpu, [w, h], settings, NormalEncoding::Signed);
+        let mut ils = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &[]);
         check(&run(&mut ils), &expected(&here, window), window.is_some(), what);
         // the light moves: written in place
         ils.set_vpls(&copies(&there)).unwrap();
@@ -285,6 +303,146 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
             &format!("{what}, moved"),
         );
     }
+}
+
+/// SSM (§4.3): a plate hangs between the VPL (48 copies, as above) and the floor. The
+/// application's G-buffer holds the floor alone; the plate is among the triangles given for
+/// the VPL shadow maps. Floor points whose segment to the VPL crosses the plate 5 cm or more
+/// inside its outline get no light (below 0.5 % of the largest E); those whose segment
+/// passes 5 cm or more outside it get the unshadowed E within 1 % + 0.05 % of the largest
+/// (the maps' PCF and bias). Without the maps (SNSM) the shadowed points are lit: the
+/// control. `set_triangles` then takes the plate away, and the shadow goes.
+#[test]
+fn vpl_shadow_maps_of_the_applications_triangles_shadow_the_floor() {
+    use glam::camera::rh;
+    let gpu = common::gpu();
+    let (w, h) = (96u32, 64u32);
+    let floor = app::cuboid(Vec3::new(-6.0, -0.1, -6.0), Vec3::new(6.0, 0.0, 6.0), Vec3::splat(0.5));
+    let (lo, hi) = (Vec3::new(-0.8, 1.0, -1.6), Vec3::new(0.6, 1.02, -0.4));
+    let plate = app::cuboid(lo, hi, Vec3::splat(0.5));
+    let eye = Vec3::new(0.0, 0.6, 2.5);
+    let view = rh::view::look_at_mat4(eye, Vec3::new(0.0, 0.0, -1.0), Vec3::Y);
+    let proj = rh::proj::directx::perspective(50f32.to_radians(), w as f32 / h as f32, 0.05, 100.0);
+    let gbuffer = app::GBuffer::new(&gpu.device, [w, h], app::Layout::standard(), &floor);
+    let light = Vpl {
+        position: Vec3::new(-0.1, 2.0, -1.0),
+        normal: Vec3::NEG_Y,
+        flux: Vec3::new(4.0, 3.0, 2.0),
+        albedo: Vec3::ONE,
+        bounce: 1,
+    };
+    let copies = vec![
+        gpu_vpl(&Vpl {
+            flux: light.flux / 48.0,
+            ..light
+        });
+        48
+    ];
+    let d_c = 0.05f32;
+    let up = oct16_unpack(oct16_pack(Vec3::Y));
+    let inv = (proj * view).inverse();
+    let floor_point = |x: u32, y: u32| {
+        let ndc = |z: f32| {
+            let p = inv
+                * glam::Vec4::new(
+                    (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                    1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+                    z,
+                    1.0,
+                );
+            p.xyz() / p.w
+        };
+        let (a, b) = (ndc(0.0), ndc(1.0));
+        let t = a.y / (a.y - b.y);
+        let p = a + (b - a) * t;
+        (t > 0.0 && t < 1.0 && p.x.abs() < 5.5 && p.z.abs() < 5.5).then_some(p)
+    };
+    // where the segment from p to the VPL meets the plate's height: its distance inside
+    // (> 0) or outside (< 0) the plate's outline
+    let inside = |p: Vec3| {
+        let q = p + (light.position - p) * ((lo.y - p.y) / (light.position.y - p.y));
+        ((q.x - lo.x).min(hi.x - q.x)).min((q.z - lo.z).min(hi.z - q.z))
+    };
+    let world = |t: &[app::Triangle]| t.iter().map(|t| t.0).collect::<Vec<[Vec3; 3]>>();
+    let mut occluders = world(&floor);
+    occluders.extend(world(&plate));
+    let frame = |ils: &mut EmbeddedIls| {
+        common::submit_checked(&gpu, |e| {
+            gbuffer.draw(&gpu.queue, e, view, proj);
+            ils.encode(e, &gbuffer.inputs(view, proj)).unwrap();
+        });
+        ils.read_target(ils.config().settings.output().name).unwrap()
+    };
+    let settings = |shadows| IlsSettings {
+        vpls: copies.clone().into(),
+        clamp_distance: Some(d_c),
+        blur: 0.0,
+        shadows,
+        ..IlsSettings::default()
+    };
+    let max_g = 1.0 / (d_c * d_c);
+    let scale = (0..w * h)
+        .filter_map(|i| floor_point(i % w, i / w))
+        .map(|p| light.irradiance_at(p, up, max_g).max_element())
+        .fold(0.0f32, f32::max);
+    // (shadowed pixels' largest E, the largest error of the lit ones over their tolerance,
+    // shadowed count, lit count)
+    let measure = |img: &ImageBuf| {
+        let (mut dark, mut worst, mut shadowed, mut lit) = (0.0f32, 0.0f32, 0, 0);
+        for i in 0..(w * h) as usize {
+            let Some(p) = floor_point(i as u32 % w, i as u32 / w) else {
+                continue;
+            };
+            let got = Vec3::from_slice(&img.data[i * 4..i * 4 + 3]);
+            let e = light.irradiance_at(p, up, max_g);
+            match inside(p) {
+                d if d > 0.05 => {
+                    dark = dark.max(got.max_element());
+                    shadowed += 1;
+                }
+                d if d < -0.05 => {
+                    let tol = 0.01 * e.max_element() + 5e-4 * scale;
+                    worst = worst.max((got - e).abs().max_element() / tol);
+                    lit += 1;
+                }
+                _ => {}
+            }
+        }
+        (dark, worst, shadowed, lit)
+    };
+    let mut ssm = embedded(
+        &gpu,
+        [w, h],
+        settings(VplShadows::ShadowMaps),
+        NormalEncoding::Signed,
+        &occluders,
+    );
+    let (dark, worst, shadowed, lit) = measure(&frame(&mut ssm));
+    println!("SSM: {shadowed} shadowed pixels, brightest {dark:.2e} (largest E {scale:.3}); {lit} lit, worst {worst:.3} of the tolerance");
+    assert!(
+        shadowed > 200 && lit > 2000,
+        "the plate shadows part of the floor: {shadowed}, {lit}"
+    );
+    assert!(
+        dark < 0.005 * scale,
+        "SSM: a shadowed pixel is lit: {dark} (largest {scale})"
+    );
+    assert!(worst <= 1.0, "SSM: a lit pixel is off by {worst} of the tolerance");
+    let mut snsm = embedded(&gpu, [w, h], settings(VplShadows::None), NormalEncoding::Signed, &[]);
+    let (dark_snsm, worst_snsm, ..) = measure(&frame(&mut snsm));
+    println!("SNSM: brightest shadowed pixel {dark_snsm:.3}, lit worst {worst_snsm:.3}");
+    assert!(
+        dark_snsm > 0.1 * scale,
+        "without visibility the plate does not shadow: {dark_snsm}"
+    );
+    // the plate taken away: the floor alone casts no shadow on itself
+    ssm.set_triangles(&world(&floor)).unwrap();
+    let (dark_gone, worst_gone, ..) = measure(&frame(&mut ssm));
+    println!("SSM without the plate: brightest formerly shadowed pixel {dark_gone:.3}, lit worst {worst_gone:.3}");
+    assert!(
+        dark_gone > 0.1 * scale && worst_gone <= 1.0,
+        "the shadow goes with the plate"
+    );
 }
 
 /// Bad configs and VPLs are one-line errors naming the parameter; nothing panics, and a
@@ -324,7 +482,17 @@ fn bad_embedded_ils_input_is_a_one_line_error() {
                 shadows: VplShadows::ShadowMaps,
                 ..good()
             }))),
-            "settings.shadows 'vpl' is not available",
+            "settings.shadows 'vpl' needs config.triangles",
+        ),
+        (
+            err(new(EmbeddedIlsConfig {
+                triangles: vec![[Vec3::ZERO, Vec3::X, Vec3::splat(f32::INFINITY)]].into(),
+                ..config(IlsSettings {
+                    shadows: VplShadows::ShadowMaps,
+                    ..good()
+                })
+            })),
+            "embedded ILS: triangles[0] has a non-finite vertex",
         ),
         (
             err(new(config(IlsSettings {

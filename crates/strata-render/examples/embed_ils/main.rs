@@ -2,7 +2,7 @@
 //! its deep-G-buffer radiosity.
 //!
 //! The "application" draws the open box of `embed_gi` (`../embed_ao/app.rs`), lit by a sun
-//! without shadows. It makes its own virtual point lights: 480 points on the sunlit front
+//! without shadows. It makes its own virtual point lights: 256 points on the sunlit front
 //! faces of its triangles, in proportion to the power each face reflects, each carrying
 //! its share Φ = ρ · E_sun cos θ · A (ILS §3: VPLs as the first bounce). It hands them and
 //! its depth and normals to `strata_render::embed::EmbeddedIls` (the `clean-edges` preset),
@@ -20,7 +20,7 @@ mod app;
 
 use glam::Vec3;
 use strata_render::embed::{EmbeddedIls, EmbeddedIlsConfig, NormalEncoding};
-use strata_render::passes::ils::{GpuVpl, IlsSettings};
+use strata_render::passes::ils::{GpuVpl, IlsSettings, VplShadows};
 
 /// `count` VPLs on the front faces of `triangles` that face `sun`, allotted in proportion
 /// to the power each reflects (its luminance) and placed at stratified points.
@@ -62,7 +62,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (width, height) = (480u32, 320u32);
     let mut app = app::OpenBox::new(width, height)?;
     let (triangles, sun, _, _) = app::open_box(width, height);
-    let vpls = sun_vpls(&triangles, sun, 480);
+    // SSM keeps one shadow-map layer per VPL: 256 fit every device's array limit
+    let vpls = sun_vpls(&triangles, sun, 256);
     let mut ils = EmbeddedIls::new(
         &app.adapter,
         &app.device,
@@ -75,12 +76,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 // below d_c a VPL's 1/d² is held: 4 % of the scene's diagonal (6 m), the
                 // renderer's default
                 clamp_distance: Some(0.24),
+                shadows: VplShadows::ShadowMaps,
                 ..IlsSettings::default()
             }
             // the blur stops per axis at edges and slides its cut windows (`docs/ils.md`),
             // against the paper's filter's dotted outlines
             .with_preset("clean-edges")?,
             normals: NormalEncoding::Signed,
+            // SSM (§4.3): the VPLs' shadow maps of the application's triangles
+            triangles: triangles.iter().map(|t| t.0).collect(),
             ..EmbeddedIlsConfig::default()
         },
     )?;

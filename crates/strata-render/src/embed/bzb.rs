@@ -74,22 +74,9 @@ pub fn indexed_triangles(positions: &[Vec3], indices: &[u32], model: Mat4) -> Re
         .collect()
 }
 
-/// A one-line error for the first triangle with a non-finite vertex; `first` is the index
-/// of `triangles[0]` in the whole buffer.
-fn check_finite(triangles: &[[Vec3; 3]], first: usize) -> Result<(), RenderError> {
-    match triangles.iter().position(|t| !t.iter().all(|p| p.is_finite())) {
-        Some(i) => Err(RenderError::Parameter(format!(
-            "embedded bzb AO: triangles[{}] has a non-finite vertex ({:?})",
-            first + i,
-            triangles[i]
-        ))),
-        None => Ok(()),
-    }
-}
-
 /// `triangles` in the splat buffer's layout (3 × vec4 each), checked finite.
 fn splat_data(triangles: &[[Vec3; 3]]) -> Result<Vec<[f32; 4]>, RenderError> {
-    check_finite(triangles, 0)?;
+    super::check_triangles("embedded bzb AO", triangles, 0)?;
     let mut data = vec![[0.0; 4]; triangles.len() * 3];
     fill_splat_data(&mut data, triangles);
     Ok(data)
@@ -200,7 +187,7 @@ impl EmbeddedBzbAo {
                 "embedded bzb AO: triangle range {start}..{end} is out of range: must lie within 0..{count} (set_triangles changes the count)"
             )));
         }
-        check_finite(triangles, start)?;
+        super::check_triangles("embedded bzb AO", triangles, start)?;
         let data = &mut self.data[start * 3..end * 3];
         fill_splat_data(data, triangles);
         self.stage.write_triangles(&self.core.gpu, first, data);

@@ -8,8 +8,13 @@
 //! 1/(n·m) of the VPLs (§4.2), the gather puts the pixels back (§4.4) and the blur averages
 //! the n·m subsets across pixels of the same surface (§4.5). It gets back
 //! [`EmbeddedIls::output`]: layer 0's indirect irradiance E (rgb); the application composes
-//! `direct + ρ/π · E`. Receivers are Lambertian. VPL visibility is not computed (SNSM, §6.2's
-//! interactive mode): SSM's shadow maps need the scene's geometry.
+//! `direct + ρ/π · E`. Receivers are Lambertian. VPL visibility is ignored by default (SNSM,
+//! §6.2's interactive mode). With `shadows = vpl` (SSM, §4.3) the application also gives
+//! its world-space triangles, and every VPL gets an omnidirectional shadow map of them.
+
+use std::sync::Arc;
+
+use glam::Vec3;
 
 use super::core::{Core, CoreConfig};
 use super::{AoInputs, NormalEncoding, NormalSpace};
@@ -27,10 +32,14 @@ pub struct EmbeddedIlsConfig {
     /// the blur, `refine`. `clamp_distance` d_c is required (the renderer's default is a
     /// share of the scene's diagonal, which the embedding does not know); `vpls` are the
     /// first frame's VPLs and set how many later frames may pass (a larger count rebuilds).
-    /// `shadows` must be [`VplShadows::None`].
+    /// `shadows`: [`VplShadows::None`] (SNSM) or [`VplShadows::ShadowMaps`] (SSM, which
+    /// needs `triangles`).
     pub settings: IlsSettings,
     pub normals: NormalEncoding,
     pub normal_space: NormalSpace,
+    /// The scene's triangles in world space, the occluders of the VPL shadow maps (SSM);
+    /// required with `shadows = vpl`, not read without.
+    pub triangles: Arc<[[Vec3; 3]]>,
 }
 
 impl Default for EmbeddedIlsConfig {
@@ -43,8 +52,43 @@ impl Default for EmbeddedIlsConfig {
             settings: IlsSettings::default(),
             normals: NormalEncoding::Signed,
             normal_space: NormalSpace::World,
+            triangles: Arc::from([]),
         }
     }
+}
+
+/// A scene of `triangles` (one mesh, flat normals, one grey material) for the VPL shadow
+/// maps to draw; no geometry without them.
+fn occluder_scene(triangles: &[[Vec3; 3]]) -> strata_scene::Scene {
+    use strata_scene::model::{Material, Mesh, Object};
+    let mut scene = strata_scene::Scene {
+        name: "embedded".into(),
+        ..Default::default()
+    };
+    if triangles.is_empty() {
+        return scene;
+    }
+    let positions: Vec<[f32; 3]> = triangles.iter().flatten().map(|p| p.to_array()).collect();
+    let normals = triangles
+        .iter()
+        .flat_map(|t| [(t[1] - t[0]).cross(t[2] - t[0]).normalize_or(Vec3::Y).to_array(); 3])
+        .collect();
+    scene.meshes.push(Mesh {
+        name: "occluders".into(),
+        uvs: vec![[0.0; 2]; positions.len()],
+        indices: (0..positions.len() as u32).collect(),
+        positions,
+        normals,
+        material: 0,
+    });
+    scene.objects.push(Object {
+        name: "occluders".into(),
+        mesh: 0,
+        transform: glam::Mat4::IDENTITY,
+        animation: None,
+    });
+    scene.materials.push(Material::diffuse("occluder", [0.5; 3]));
+    scene
 }
 
 /// The ILS passes of `strata render --technique ils` on an application's G-buffer and VPLs.
@@ -77,21 +121,20 @@ impl EmbeddedIls {
                  below which a VPL's 1/d² is held (the renderer's default, 4 % of the scene's diagonal, needs the scene)"
             )));
         }
-        if s.shadows != VplShadows::None {
+        if s.shadows == VplShadows::ShadowMaps && config.triangles.is_empty() {
             return Err(RenderError::Parameter(format!(
-                "{what}: settings.shadows '{}' is not available: SSM's VPL shadow maps need the scene's geometry; use none (SNSM)",
+                "{what}: settings.shadows '{}' needs config.triangles, the world-space occluders of the VPL shadow maps (SSM, §4.3); or shadows none (SNSM)",
                 s.shadows.name()
             )));
         }
+        super::check_triangles(what, &config.triangles, 0)?;
         if s.vpls.is_empty() {
             return Err(RenderError::Parameter(format!(
                 "{what}: settings.vpls is empty: give the first frame's VPLs (their count is the capacity)"
             )));
         }
-        let scene = strata_scene::Scene {
-            name: "embedded".into(),
-            ..Default::default()
-        };
+        let shadows = s.shadows == VplShadows::ShadowMaps;
+        let scene = occluder_scene(if shadows { &config.triangles } else { &[] });
         let core = CoreConfig::one_layer(
             what,
             [config.width, config.height],
@@ -100,6 +143,9 @@ impl EmbeddedIls {
         );
         Core::scoped(device, || {
             let mut core = Core::new(adapter, device, queue, core, scene)?;
+            // the occluders stand still: their (identity) transforms once
+            core.scene_gpu
+                .update_objects(&core.gpu, 0.0, 0.0, crate::scene_gpu::NextTransforms::Exact);
             // the G-buffer's emission (a = 2 flags a glossy receiver): none here, all Lambert
             core.targets.create(
                 &core.gpu,
@@ -134,6 +180,16 @@ impl EmbeddedIls {
         let mut config = self.config.clone();
         config.settings.vpls = vpls.into();
         config.settings.vpl_count = vpls.len() as u32;
+        let gpu = &self.core.gpu;
+        *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
+        Ok(())
+    }
+
+    /// Replaces the occluders of the VPL shadow maps (SSM) and rebuilds the passes. A
+    /// triangle with a non-finite vertex is a one-line error, and then nothing changes.
+    pub fn set_triangles(&mut self, triangles: &[[Vec3; 3]]) -> Result<(), RenderError> {
+        let mut config = self.config.clone();
+        config.triangles = triangles.into();
         let gpu = &self.core.gpu;
         *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
         Ok(())

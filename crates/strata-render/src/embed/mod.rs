@@ -283,6 +283,19 @@ impl CameraModel {
 
 /// The settings' world-space radius, required (`meaning` names it in the error), once the
 /// settings validate: the one-line errors every embedded technique's `new` gives first.
+/// A one-line error for the first triangle with a non-finite vertex; `first` is the index
+/// of `triangles[0]` in the whole list (`what` names the technique).
+fn check_triangles(what: &str, triangles: &[[glam::Vec3; 3]], first: usize) -> Result<(), RenderError> {
+    match triangles.iter().position(|t| !t.iter().all(|p| p.is_finite())) {
+        Some(i) => Err(RenderError::Parameter(format!(
+            "{what}: triangles[{}] has a non-finite vertex ({:?})",
+            first + i,
+            triangles[i]
+        ))),
+        None => Ok(()),
+    }
+}
+
 fn required_radius(
     what: &str,
     radius: Option<f32>,
