@@ -141,11 +141,11 @@ fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
                 lit > (w * h / 5) as usize,
                 "{name}: the VPLs light the view ({lit} pixels)"
             );
-            // a receiver's z differs from the renderer's by f32 rounding, which can flip a
-            // discontinuity flag of the blur now and then
+            // a receiver's z differs from the renderer's by f32 rounding (measured: at most
+            // 4.3e-4 of the largest value)
             assert!(
-                over < 0.005,
-                "{name}, {what}: {:.2} % of pixels differ by over 1 %",
+                worst < 5e-3 && over == 0.0,
+                "{name}, {what}: largest difference {worst} of the image's largest, {:.2} % of pixels over 1 %",
                 100.0 * over
             );
             common::check_pass_timings(&gpu, || ils.timings(), ils.pass_names(), what);

@@ -1,4 +1,4 @@
-//! Interleaved deferred shading of virtual point lights (ILS §4, SNSM) on an application's
+//! Interleaved deferred shading of virtual point lights (ILS §4) on an application's
 //! G-buffer: the passes of `strata render --technique ils` from the split G-buffer to the
 //! discontinuity-aware blur, without strata's lighting, VPL generation or composite.
 //!

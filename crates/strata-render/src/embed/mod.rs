@@ -281,8 +281,6 @@ impl CameraModel {
     }
 }
 
-/// The settings' world-space radius, required (`meaning` names it in the error), once the
-/// settings validate: the one-line errors every embedded technique's `new` gives first.
 /// A one-line error for the first triangle with a non-finite vertex; `first` is the index
 /// of `triangles[0]` in the whole list (`what` names the technique).
 fn check_triangles(what: &str, triangles: &[[glam::Vec3; 3]], first: usize) -> Result<(), RenderError> {
@@ -296,6 +294,8 @@ fn check_triangles(what: &str, triangles: &[[glam::Vec3; 3]], first: usize) -> R
     }
 }
 
+/// The settings' world-space radius, required (`meaning` names it in the error), once the
+/// settings validate: the one-line errors every embedded technique's `new` gives first.
 fn required_radius(
     what: &str,
     radius: Option<f32>,

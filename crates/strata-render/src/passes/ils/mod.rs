@@ -672,8 +672,6 @@ pub fn blur_weights(radius: u32, sigma: f32, period: u32) -> Vec<f32> {
         .collect()
 }
 
-/// Whether any material of `scene` is glossy (GGX): only then does the frame blur the
-/// glossy receivers' radiance (`ils-glossy` is 0 otherwise, and compose reads it as is).
 /// A one-line error for the first VPL with a non-finite component or a negative flux.
 pub fn check_vpls(vpls: &[GpuVpl]) -> Result<(), String> {
     for (k, v) in vpls.iter().enumerate() {
@@ -687,6 +685,8 @@ pub fn check_vpls(vpls: &[GpuVpl]) -> Result<(), String> {
     Ok(())
 }
 
+/// Whether any material of `scene` is glossy (GGX): only then does the frame blur the
+/// glossy receivers' radiance (`ils-glossy` is 0 otherwise, and compose reads it as is).
 fn has_glossy_receivers(scene: &strata_scene::Scene) -> bool {
     scene.materials.iter().any(|m| m.glossy)
 }
