@@ -16,6 +16,7 @@ use strata_reference::Reference;
 use strata_render::embed::{AoInputs, EmbeddedIls, EmbeddedIlsConfig, NormalEncoding, NormalSpace, TextureLayer};
 use strata_render::packing::{oct16_pack, oct16_unpack};
 use strata_render::passes::ils::{blur_weights, GpuVpl, IlsSettings, VplShadows};
+use strata_render::passes::interleave::SplitMethod;
 use strata_render::GpuContext;
 use strata_scene::{procedural, ImageBuf};
 
@@ -62,8 +63,9 @@ fn rgb_diff(a: &ImageBuf, b: &ImageBuf) -> (f32, f32) {
 }
 
 /// The renderer's G-buffer and VPLs in, the renderer's ILS irradiance out: the same passes
-/// on the same data, for the paper's blur, no blur, the brute force, `refine` and SSM's
-/// VPL shadow maps of the scene's triangles.
+/// on the same data, for the paper's blur, no blur, the brute force, `refine`, SSM's VPL
+/// shadow maps of the scene's triangles, the compute and block split methods and the
+/// `clean-edges` filter.
 #[test]
 fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
     let gpu = common::gpu();
@@ -119,6 +121,22 @@ fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
                     shadows: VplShadows::ShadowMaps,
                     ..base.clone()
                 },
+            ),
+            (
+                "compute split and gather",
+                IlsSettings {
+                    method: SplitMethod::Compute,
+                    ..base.clone()
+                },
+            ),
+            (
+                "block split (§3.3), clean-edges",
+                IlsSettings {
+                    method: SplitMethod::Blocks { block: 16 },
+                    ..base.clone()
+                }
+                .with_preset("clean-edges")
+                .unwrap(),
             ),
         ];
         let triangles: Vec<[Vec3; 3]> = scene.world_triangles(0.0).iter().map(|t| t.p).collect();
@@ -283,7 +301,13 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
     };
     let here = light(Vec3::new(0.2, 2.5, -0.5));
     let there = light(Vec3::new(-0.6, 2.0, -1.5));
-    for (what, blur) in [("no blur", 0.0), ("the paper's blur", IlsSettings::default().blur)] {
+    let blur = IlsSettings::default().blur;
+    for (what, blur, normals) in [
+        ("no blur", 0.0, NormalEncoding::Signed),
+        ("the paper's blur", blur, NormalEncoding::Signed),
+        // no normal buffer: the import reconstructs the floor's normal from its depth
+        ("no blur, normals from depth", 0.0, NormalEncoding::FromDepth),
+    ] {
         let settings = IlsSettings {
             vpls: copies(&here).into(),
             clamp_distance: Some(d_c),
@@ -291,7 +315,7 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
             ..IlsSettings::default()
         };
         let window = settings.blurs().then(|| (settings.blur_radius(), settings.pattern));
-        let mut ils = embedded(&gpu, [w, h], settings, NormalEncoding::Signed, &[]);
+        let mut ils = embedded(&gpu, [w, h], settings, normals, &[]);
         check(&run(&mut ils), &expected(&here, window), window.is_some(), what);
         // the light moves: written in place
         ils.set_vpls(&copies(&there)).unwrap();
