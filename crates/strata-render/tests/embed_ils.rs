@@ -582,4 +582,23 @@ fn bad_embedded_ils_input_is_a_one_line_error() {
     // one layer only
     let e = common::second_layer_error(&gpu, [40, 30], |enc, inputs| ils.encode(enc, inputs));
     assert!(e.contains("AoInputs::second is given") && !e.contains('\n'), "{e}");
+    // SSM keeps a shadow-map layer per VPL: more VPLs than the device's array layers are
+    // refused, at `new` and at a `set_vpls` that would rebuild, which keeps the old ones
+    let layers = gpu.device.limits().max_texture_array_layers as usize;
+    let quad = [[Vec3::ZERO, Vec3::X, Vec3::Z]];
+    let ssm = |n: usize| EmbeddedIlsConfig {
+        triangles: quad.as_slice().into(),
+        ..config(IlsSettings {
+            vpls: vec![one; n].into(),
+            shadows: VplShadows::ShadowMaps,
+            ..good()
+        })
+    };
+    let want = format!("embedded ILS: shadows vpl needs one shadow-map layer per VPL ({} VPLs): vpls must be in 1..={layers} on this device", layers + 1);
+    let e = err(new(ssm(layers + 1)));
+    assert!(e.contains(&want) && !e.contains('\n'), "'{e}' lacks '{want}'");
+    let mut shadowed = new(ssm(4)).unwrap();
+    let e = shadowed.set_vpls(&vec![one; layers + 1]).unwrap_err().to_string();
+    assert!(e.contains(&want), "'{e}' lacks '{want}'");
+    assert_eq!(shadowed.vpl_capacity(), 4);
 }

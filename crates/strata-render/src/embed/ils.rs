@@ -151,7 +151,12 @@ impl EmbeddedIls {
                 &core.gpu,
                 TargetDesc::new("emission", wgpu::TextureFormat::Rgba16Float, 1, "0: Lambert receivers"),
             );
-            let stage = IlsStage::new(&core.gpu, &core.scene_gpu, &mut core.targets, s, &core.scene, false)?;
+            let stage = IlsStage::new(&core.gpu, &core.scene_gpu, &mut core.targets, s, &core.scene, false).map_err(
+                |e| match e {
+                    RenderError::Parameter(m) => RenderError::Parameter(format!("{what}: {m}")),
+                    e => e,
+                },
+            )?;
             Ok(Self {
                 core,
                 config: config.clone(),
