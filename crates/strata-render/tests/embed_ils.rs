@@ -62,6 +62,27 @@ fn rgb_diff(a: &ImageBuf, b: &ImageBuf) -> (f32, f32) {
     (worst, over as f32 / (a.data.len() / 4) as f32)
 }
 
+/// Where the ray through the centre of pixel (x, y) of a `w`×`h` frame (view-projection
+/// `view_proj`, wgpu's depth range) meets the floor y = 0, if it does within `half` of the
+/// origin in x and z.
+fn floor_under_pixel(view_proj: glam::Mat4, [w, h]: [u32; 2], [x, y]: [u32; 2], half: f32) -> Option<Vec3> {
+    let inv = view_proj.inverse();
+    let ndc = |z: f32| {
+        let p = inv
+            * glam::Vec4::new(
+                (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+                z,
+                1.0,
+            );
+        p.xyz() / p.w
+    };
+    let (a, b) = (ndc(0.0), ndc(1.0));
+    let t = a.y / (a.y - b.y);
+    let p = a + (b - a) * t;
+    (t > 0.0 && t < 1.0 && p.x.abs() < half && p.z.abs() < half).then_some(p)
+}
+
 /// The renderer's G-buffer and VPLs in, the renderer's ILS irradiance out: the same passes
 /// on the same data, for the paper's blur, no blur, the brute force, `refine`, SSM's VPL
 /// shadow maps of the scene's triangles, the compute and block split methods and the
@@ -209,25 +230,8 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
     };
     let d_c = 0.05f32;
     let max_g = 1.0 / (d_c * d_c);
-    // the floor point under each pixel centre (the camera's ray meets y = 0)
-    let inv = (proj * view).inverse();
-    let floor_point = |x: u32, y: u32| {
-        let ndc = |z: f32| {
-            let p = inv
-                * glam::Vec4::new(
-                    (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
-                    1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
-                    z,
-                    1.0,
-                );
-            p.xyz() / p.w
-        };
-        let (a, b) = (ndc(0.0), ndc(1.0));
-        let t = a.y / (a.y - b.y);
-        let p = a + (b - a) * t;
-        // on the floor's top, away from its far edge
-        (t > 0.0 && t < 1.0 && p.x.abs() < 19.5 && p.z.abs() < 19.5).then_some(p)
-    };
+    // the floor point under each pixel centre, away from the floor's far edge
+    let floor_point = |x: u32, y: u32| floor_under_pixel(proj * view, [w, h], [x, y], 19.5);
     let run = |ils: &mut EmbeddedIls| {
         common::submit_checked(&gpu, |e| {
             gbuffer.draw(&gpu.queue, e, view, proj);
@@ -364,23 +368,7 @@ fn vpl_shadow_maps_of_the_applications_triangles_shadow_the_floor() {
     ];
     let d_c = 0.05f32;
     let up = oct16_unpack(oct16_pack(Vec3::Y));
-    let inv = (proj * view).inverse();
-    let floor_point = |x: u32, y: u32| {
-        let ndc = |z: f32| {
-            let p = inv
-                * glam::Vec4::new(
-                    (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
-                    1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
-                    z,
-                    1.0,
-                );
-            p.xyz() / p.w
-        };
-        let (a, b) = (ndc(0.0), ndc(1.0));
-        let t = a.y / (a.y - b.y);
-        let p = a + (b - a) * t;
-        (t > 0.0 && t < 1.0 && p.x.abs() < 5.5 && p.z.abs() < 5.5).then_some(p)
-    };
+    let floor_point = |x: u32, y: u32| floor_under_pixel(proj * view, [w, h], [x, y], 5.5);
     // where the segment from p to the VPL meets the plate's height: its distance inside
     // (> 0) or outside (< 0) the plate's outline
     let inside = |p: Vec3| {
