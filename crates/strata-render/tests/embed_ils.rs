@@ -194,7 +194,7 @@ fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
 
 /// A floor drawn by the application (`app.rs`: standard depth, signed normals) under
 /// n·m = 48 copies of one VPL, each carrying 1/48 of the flux Φ. Every sub-buffer then
-/// shades one copy scaled by 48 (§4.2), so the interleaved estimate is exactly one VPL of
+/// shades one copy scaled by 48 (§4.3), so the interleaved estimate is exactly one VPL of
 /// flux Φ, E(x) = Φ/π · cos θ_y cos θ_x / d² (clamped at d_c), at every pixel: the CPU
 /// reference's `Vpl::irradiance_at` at the floor point under the pixel centre, with the
 /// normal as the G-buffer's 8-bit Oct16 holds it. With the blur (§4.5), that E averaged

@@ -4,9 +4,10 @@
 //!
 //! The application gives its depth and normals (as for [`super::EmbeddedAo`]) and a list of
 //! VPLs ([`GpuVpl`]: position, the normal on the lit side, reflected flux Φ), for example
-//! from a reflective shadow map of its own lights. Each pixel of an n×m sub-buffer shades
-//! 1/(n·m) of the VPLs (§4.2), the gather puts the pixels back (§4.4) and the blur averages
-//! the n·m subsets across pixels of the same surface (§4.5). It gets back
+//! from a reflective shadow map of its own lights. The G-buffer is split into n×m
+//! sub-buffers (§4.2), each pixel shades 1/(n·m) of the VPLs (§4.3), the gather puts the
+//! pixels back (§4.4) and the blur averages the n·m subsets across pixels of the same
+//! surface (§4.5). It gets back
 //! [`EmbeddedIls::output`]: layer 0's indirect irradiance E (rgb); the application composes
 //! `direct + ρ/π · E`. Receivers are Lambertian. VPL visibility is ignored by default (SNSM,
 //! §6.2's interactive mode). With `shadows = vpl` (SSM, §4.3) the application also gives
