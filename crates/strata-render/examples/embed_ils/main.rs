@@ -2,14 +2,14 @@
 //! its deep-G-buffer radiosity.
 //!
 //! The "application" draws the open box of `embed_gi` (`../embed_ao/app.rs`), lit by a sun
-//! without shadows. It makes its own virtual point lights: 256 points on the sunlit front
-//! faces of its triangles, in proportion to the power each face reflects, each carrying
-//! its share Φ = ρ · E_sun cos θ · A (ILS §3: VPLs as the first bounce). It hands them and
-//! its depth and normals to `strata_render::embed::EmbeddedIls` (the `clean-edges` preset),
-//! and its lit G-buffer to
-//! `EmbeddedRadiosity` (2 layers, 16 frames). It composes `B + ρ/π · E` with each
-//! technique's E on the CPU and writes three panels side by side as a PNG: direct light,
-//! + DGB radiosity, + ILS:
+//! without shadows. It makes its own virtual point lights, instant radiosity's first
+//! bounce (Keller 1997; ILS §2): 256 points on the sunlit front faces of its
+//! triangles, in proportion to the power each face reflects, each carrying its share
+//! Φ = ρ · E_sun cos θ · A. It hands them, its depth and normals and its triangles (for the
+//! VPLs' shadow maps, SSM) to `strata_render::embed::EmbeddedIls` with the `clean-edges`
+//! preset, and its lit G-buffer to `EmbeddedRadiosity` (2 layers, 16 frames). It composes
+//! `B + ρ/π · E` with each technique's E on the CPU and writes three panels side by side
+//! as a PNG: direct light, + DGB radiosity, + ILS:
 //!
 //! ```sh
 //! cargo run --release -p strata-render --example embed_ils -- out/embed-ils.png
