@@ -199,7 +199,8 @@ fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
 /// reference's `Vpl::irradiance_at` at the floor point under the pixel centre, with the
 /// normal as the G-buffer's 8-bit Oct16 holds it. With the blur (§4.5), that E averaged
 /// with the blur's weights over the pixel's window. Per pixel within 0.2 % (0.5 % with the
-/// blur's bilinear taps) + 0.02 % of the largest. Then `set_vpls` moves the light.
+/// blur's bilinear taps) + 0.02 % of the largest. Then `set_vpls` moves the light, and a
+/// `resize` keeps the moved one.
 #[test]
 fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
     use glam::camera::rh;
@@ -329,6 +330,14 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
             &expected(&there, window),
             window.is_some(),
             &format!("{what}, moved"),
+        );
+        // a resize rebuilds from the config, which holds the moved light, not the first
+        ils.resize(w, h).unwrap();
+        check(
+            &run(&mut ils),
+            &expected(&there, window),
+            window.is_some(),
+            &format!("{what}, moved, resized"),
         );
     }
 }

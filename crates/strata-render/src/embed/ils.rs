@@ -179,8 +179,12 @@ impl EmbeddedIls {
         crate::passes::ils::check_vpls(vpls).map_err(|e| RenderError::Parameter(format!("embedded ILS: {e}")))?;
         if vpls.len() <= self.capacity {
             self.stage.set_vpls(&self.core.gpu, vpls)?;
-            // kept for `resize`, which rebuilds from the config
-            self.config.settings.vpls = vpls.into();
+            // kept for `resize`, which rebuilds from the config: copied into the kept list
+            // where it has the same length (a frame of moving lights allocates nothing)
+            match Arc::get_mut(&mut self.config.settings.vpls).filter(|kept| kept.len() == vpls.len()) {
+                Some(kept) => kept.copy_from_slice(vpls),
+                None => self.config.settings.vpls = vpls.into(),
+            }
             return Ok(());
         }
         let mut config = self.config.clone();
