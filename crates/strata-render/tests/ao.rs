@@ -152,10 +152,10 @@ fn gpu_ao_equals_cpu_eq1_eq2_over_the_same_buffers() {
             }
         }
         let n = (w * h) as usize;
-        // every pixel: a tap's MIP level may differ between the pixels of a quad, which
-        // lavapipe's textureDimensions(t, level) got wrong (`mip_size` in common/spiral.wgsl)
+        // every pixel on lavapipe: a tap's MIP level may differ between the pixels of a quad,
+        // which its textureDimensions(t, level) got wrong (`mip_size` in common/spiral.wgsl)
         assert!(
-            close == n,
+            close >= common::twin_pixels_required(&gpu, n),
             "{name} k={layers} {kernel:?}: only {close}/{n} pixels within 1e-4 (worst {worst})"
         );
         assert!(
@@ -219,7 +219,10 @@ fn reduced_resolution_ao_and_upsampling_match_their_cpu_twins() {
         }
         let m = (low.width * low.height) as usize;
         eprintln!("{name} s={scale}: {close}/{m} texels match, {occluded} occluded");
-        assert!(close == m, "{name} s={scale}: {close}/{m} texels");
+        assert!(
+            close >= common::twin_pixels_required(&gpu, m),
+            "{name} s={scale}: {close}/{m} texels"
+        );
         assert!(occluded > m / 10, "{name}: weak test, {occluded} occluded texels");
 
         let want = upsample_cpu(&low, &zmip[0], &normals, &f, &up, 0);
@@ -774,9 +777,9 @@ fn deinterleaved_gpu_ao_equals_its_cpu_twin() {
             }
         }
         let n = (fw * fh) as usize;
-        // every pixel, as for the single pass
+        // as for the single pass
         assert!(
-            close == n,
+            close >= common::twin_pixels_required(&gpu, n),
             "{name} k={layers} {pattern:?}: only {close}/{n} pixels within 1e-4 (worst {worst})"
         );
         eprintln!(
@@ -902,7 +905,10 @@ fn filtered_obscurance_is_eq1_before_the_square_root_and_resolves_to_av() {
             }
         }
         let n = (w * h) as usize;
-        assert!(close == n, "{pattern:?}: {close}/{n} S within 1e-4");
+        assert!(
+            close >= common::twin_pixels_required(&gpu, n),
+            "{pattern:?}: {close}/{n} S within 1e-4"
+        );
         assert!(
             positive > n / 10,
             "{pattern:?}: test is weak, {positive} pixels with S > 0.01"

@@ -883,12 +883,28 @@ fn depth_tile_culling_leaves_the_gi_unchanged() {
                 render(&gpu, &scene, 48, 36, g(true)),
                 render(&gpu, &scene, 48, 36, g(false)),
             );
+            // DSS appends its surfels with atomics; without visibility every surfel adds to the
+            // texel, so on a GPU, where the appends' order changes from frame to frame, the
+            // f16 sums round differently (an H200: 568 values differed in their last bits).
+            // There the test asks for the values to agree to 2^-7; on lavapipe, bit for bit.
+            let order_free = splat == strata_render::passes::bzb::Splat::Dss
+                && !visibility
+                && gpu.adapter.get_info().device_type != wgpu::DeviceType::Cpu;
             for t in ["bzb-gi-raw", "indirect"] {
-                let differ = common::target_bits_differing(&gpu, &on, &off, t);
-                assert_eq!(
-                    differ, 0,
-                    "{splat:?} visibility={visibility} {t}: {differ} values differ"
-                );
+                if order_free {
+                    let (differ, worst) = common::target_values_differing(&gpu, &on, &off, t, 1.0 / 128.0);
+                    eprintln!("{splat:?} visibility={visibility} {t}: largest relative difference {worst:.2e}");
+                    assert_eq!(
+                        differ, 0,
+                        "{splat:?} visibility={visibility} {t}: {differ} values differ by > 2^-7"
+                    );
+                } else {
+                    let differ = common::target_bits_differing(&gpu, &on, &off, t);
+                    assert_eq!(
+                        differ, 0,
+                        "{splat:?} visibility={visibility} {t}: {differ} values differ"
+                    );
+                }
             }
             let lit = on.read_target(&gpu, "bzb-gi-raw").unwrap();
             let n = lit.data.iter().filter(|&&v| v > 0.0).count();
