@@ -666,3 +666,67 @@ fn embedded_ao_from_depth_alone_reconstructs_the_normals() {
         }
     }
 }
+
+/// The import's bind group is kept while the application passes the same textures (a steady
+/// frame creates no views or bind groups). What each frame reads must still be that frame's:
+/// another texture, another array layer of the same texture, and new contents of the same
+/// texture each give the `zpack` that a fresh `EmbeddedAo` imports from those inputs.
+#[test]
+fn embedded_ao_reads_each_frames_textures() {
+    let gpu = common::gpu();
+    let scene = still_atrium();
+    let proj = scene.camera.projection(W as f32 / H as f32);
+    let mut moved = scene.camera;
+    moved.eye += Vec3::new(0.6, 0.3, 0.0);
+    let frame = |r: &mut Renderer, cam| {
+        r.render(&gpu, &scene, &FrameCameras::fixed(cam), 0.0).unwrap();
+    };
+    let (mut a, mut b) = (
+        renderer(&gpu, &scene, 2, AoSettings::default()),
+        renderer(&gpu, &scene, 2, AoSettings::default()),
+    );
+    frame(&mut a, scene.camera);
+    frame(&mut b, moved);
+    let make = || {
+        embedded(
+            &gpu,
+            &scene,
+            1,
+            AoSettings::default(),
+            NormalEncoding::Octahedral,
+            NormalSpace::World,
+        )
+    };
+    let zpack_of = |ao: &mut EmbeddedAo, r: &Renderer, layer: u32| {
+        let (depth, normal) = (r.target_texture("depth").unwrap(), r.target_texture("normal").unwrap());
+        let inputs = AoInputs::new(
+            TextureLayer { texture: depth, layer },
+            TextureLayer { texture: normal, layer },
+            scene.camera.view(),
+            proj,
+        );
+        run(&gpu, ao, &inputs);
+        ao.read_target("zpack").unwrap().data
+    };
+    let mut ao = make();
+    let first = zpack_of(&mut ao, &a, 0);
+    assert!(first == zpack_of(&mut make(), &a, 0), "the first frame");
+    assert!(first == zpack_of(&mut ao, &a, 0), "the same textures again");
+    let other = zpack_of(&mut ao, &b, 0);
+    assert!(other != first, "the two G-buffers differ");
+    assert!(other == zpack_of(&mut make(), &b, 0), "another texture");
+    let deeper = zpack_of(&mut ao, &a, 1);
+    assert!(deeper != first, "the layers differ");
+    assert!(
+        deeper == zpack_of(&mut make(), &a, 1),
+        "another layer of the same texture"
+    );
+    assert!(first == zpack_of(&mut ao, &a, 0), "back to the first");
+    frame(&mut a, moved);
+    let redrawn = zpack_of(&mut ao, &a, 0);
+    assert!(redrawn != first, "the moved camera sees other depths");
+    assert!(
+        redrawn == zpack_of(&mut make(), &a, 0),
+        "new contents of the same texture"
+    );
+}

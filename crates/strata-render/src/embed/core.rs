@@ -125,6 +125,28 @@ pub(crate) struct Core {
     profiler: crate::profiler::Profiler,
     pub frames: u32,
     prev_view_proj: Option<Mat4>,
+    /// The import's bind group and the textures it was made for: kept while the
+    /// application passes the same textures, so a steady frame creates no views or bind
+    /// groups (each one is a descriptor set the driver allocates and frees).
+    import: Option<(ImportKey, wgpu::BindGroup)>,
+}
+
+/// The textures (and array layers) of one frame's import: depth, normals, the second
+/// layer's depth and normals, motion, the shading inputs, the material.
+type ImportKey = Vec<Option<(wgpu::Texture, u32)>>;
+
+fn import_key(inputs: &AoInputs<'_>, shading: &[Shading<'_>], material: Option<TextureLayer<'_>>) -> ImportKey {
+    let k = |t: Option<TextureLayer<'_>>| t.map(|t| (t.texture.clone(), t.layer));
+    let mut key = vec![
+        k(Some(inputs.depth)),
+        k(Some(inputs.normals)),
+        k(inputs.second.map(|s| s.0)),
+        k(inputs.second.map(|s| s.1)),
+        k(inputs.motion),
+    ];
+    key.extend(shading.iter().flat_map(|(a, r)| [k(*a), k(Some(*r))]));
+    key.push(k(material));
+    key
 }
 
 impl Core {
@@ -340,6 +362,7 @@ impl Core {
             layout,
             uniforms,
             zeros,
+            import: None,
             mip,
             history: HistoryPass { copies: Vec::new() },
             profiler,
@@ -515,15 +538,13 @@ impl Core {
         })
     }
 
-    /// Records the import, the depth MIP chain, `stage` and the history copies, each timed.
-    pub fn record(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
+    /// The import's bind group over views of this frame's textures.
+    fn import_group(
+        &self,
         inputs: &AoInputs<'_>,
         shading: &[Shading<'_>],
         material: Option<TextureLayer<'_>>,
-        stage: Vec<&dyn Pass>,
-    ) {
+    ) -> wgpu::BindGroup {
         let depth0 = Self::view(inputs.depth, true);
         // NormalEncoding::FromDepth: the shader reads no normal texture
         let normal = |n| match self.normals_from_depth {
@@ -543,7 +564,7 @@ impl Core {
         let shade_at = |i: usize| shade.get(i).and_then(|v| v.as_ref()).unwrap_or(&self.zeros);
         let material = material.map(|m| Self::view(m, false));
         use wgpu::BindingResource as R;
-        let group = crate::passes::bind_group(
+        crate::passes::bind_group(
             &self.gpu.device,
             "embed-import",
             &self.layout,
@@ -560,7 +581,24 @@ impl Core {
                 R::TextureView(shade_at(3)),
                 R::TextureView(material.as_ref().unwrap_or(&self.zeros)),
             ],
-        );
+        )
+    }
+
+    /// Records the import, the depth MIP chain, `stage` and the history copies, each timed.
+    pub fn record(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &AoInputs<'_>,
+        shading: &[Shading<'_>],
+        material: Option<TextureLayer<'_>>,
+        stage: Vec<&dyn Pass>,
+    ) {
+        let key = import_key(inputs, shading, material);
+        if self.import.as_ref().is_none_or(|(k, _)| *k != key) {
+            let group = self.import_group(inputs, shading, material);
+            self.import = Some((key, group));
+        }
+        let group = &self.import.as_ref().expect("made above").1;
         let t = &self.targets;
         let mut outputs = vec![
             &t.get("zpack").view,
@@ -574,7 +612,7 @@ impl Core {
         let prof = &self.profiler;
         prof.reset();
         let slot = prof.begin(encoder, "embed-import");
-        crate::passes::fullscreen_pass(encoder, "embed-import", &self.geometry, &outputs, &[&group]);
+        crate::passes::fullscreen_pass(encoder, "embed-import", &self.geometry, &outputs, &[group]);
         prof.end(encoder, slot);
         if !self.shading.is_empty() {
             let slot = prof.begin(encoder, "embed-import-shading");
@@ -583,11 +621,11 @@ impl Core {
                 match self.radiance_targets.get(j) {
                     Some(radiance) => {
                         let outputs = [normal, &t.get("albedo").layer_views[j], &t.get(radiance).view];
-                        crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &outputs, &[&group]);
+                        crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &outputs, &[group]);
                     }
                     // ShadingImport::Normals
                     None => {
-                        crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &[normal], &[&group])
+                        crate::passes::fullscreen_pass(encoder, "embed-import-shading", pipeline, &[normal], &[group])
                     }
                 }
             }
