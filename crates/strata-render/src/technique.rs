@@ -1627,8 +1627,9 @@ const BZB_GI_PASSES: &[&str] = &[
     "tonemap",
 ];
 
-/// The default frame's passes in every scene; `ils-blur-glossy-h`, `-v` join them in
-/// scenes with glossy materials, and the settings add others (`IlsSettings::passes`).
+/// The default frame's passes in every scene; `ils-bg-glossy`, `ils-blur-glossy-h` and
+/// `-v` join them in scenes with glossy materials, and the settings add others
+/// (`IlsSettings::passes`).
 const ILS_PASSES: &[&str] = &[
     "shadow",
     "lighting",
@@ -1636,7 +1637,6 @@ const ILS_PASSES: &[&str] = &[
     "ils-bs",
     "ils-snsm",
     "ils-bg",
-    "ils-bg-glossy",
     "ils-db",
     "ils-blur-h",
     "ils-blur-v",

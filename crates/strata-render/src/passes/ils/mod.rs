@@ -8,7 +8,7 @@
 //! | `ils-bs` | §4.2 BS | split into n×m sub-buffers ([`Interleave`], any [`SplitMethod`]) |
 //! | `ils-snsm` | §4.3 SNSM | sub-buffer (i, j) shaded with its own subset of the N VPLs |
 //! | `ils-bg` | §4.4 BG | the tiled irradiance gathered back to the image |
-//! | `ils-bg-glossy` | – | the same for the glossy receivers' GGX radiance (`ils-glossy`) |
+//! | `ils-bg-glossy` | – | the same for the glossy receivers' GGX radiance (`ils-glossy`), in scenes with glossy materials |
 //! | `ils-db` | §4.5 DB | discontinuity buffer (depth and normal vs the three positive neighbours) |
 //! | `ils-blur-h`, `ils-blur-v` | §4.5 B | separable Gaussian blur stopping at discontinuities (Fig. 4 a or b) |
 //! | `ils-blur-glossy-h`, `-v` | – | the same blur over `ils-glossy` (docs/ils.md, "Glossy receivers"); only in scenes with glossy materials |
@@ -367,8 +367,8 @@ impl IlsSettings {
     }
 
     /// The frame's passes for these settings in `scene`, in order. A scene without
-    /// glossy materials has no glossy receivers, so its glossy radiance is 0 and is not
-    /// blurred.
+    /// glossy materials has no glossy receivers, so its glossy radiance is 0 and is
+    /// neither gathered nor blurred.
     pub fn passes(&self, scene: &strata_scene::Scene) -> Vec<&'static str> {
         let glossy = has_glossy_receivers(scene);
         let mut v = vec!["ils-gbuffer"];
@@ -378,7 +378,10 @@ impl IlsSettings {
         if self.brute_force {
             v.push(BRUTE_FORCE_PASS);
         } else {
-            v.extend(["ils-bs", self.shading_pass(), "ils-bg", "ils-bg-glossy"]);
+            v.extend(["ils-bs", self.shading_pass(), "ils-bg"]);
+            if glossy {
+                v.push("ils-bg-glossy");
+            }
         }
         if self.blurs() {
             v.extend(["ils-db", "ils-blur-h", "ils-blur-v"]);
@@ -1070,7 +1073,6 @@ impl IlsStage {
         } else {
             let bs = Interleave::new(gpu, GBUFFER.format, w, h, n, m, s.method)?;
             let bg = Interleave::new(gpu, IRRADIANCE.format, w, h, n, m, s.method)?;
-            let bg_glossy = Interleave::new(gpu, GLOSSY.format, w, h, n, m, s.method)?;
             let tiled = bs.tiled_size();
             targets.create_with_usage(gpu, GBUFFER_SPLIT, tiled, storage);
             targets.create_sized(gpu, IRRADIANCE_TILED, tiled);
@@ -1090,14 +1092,20 @@ impl IlsStage {
                 dst: IRRADIANCE.name,
                 split: false,
             };
-            let gather_glossy = InterleavePass {
-                name: "ils-bg-glossy",
-                interleave: bg_glossy,
-                src: GLOSSY_TILED.name,
-                dst: GLOSSY.name,
-                split: false,
+            // without glossy receivers the glossy radiance is 0: `ils-glossy` stays as
+            // created (zeros) and is not gathered
+            let gather_glossy = if glossy_receivers {
+                Some(InterleavePass {
+                    name: "ils-bg-glossy",
+                    interleave: Interleave::new(gpu, GLOSSY.format, w, h, n, m, s.method)?,
+                    src: GLOSSY_TILED.name,
+                    dst: GLOSSY.name,
+                    split: false,
+                })
+            } else {
+                None
             };
-            (Some(split), Some(gather), Some(gather_glossy), Some(geo))
+            (Some(split), Some(gather), gather_glossy, Some(geo))
         };
         let vpl_shadows = match s.shadows {
             VplShadows::None => None,
@@ -1176,6 +1184,11 @@ impl IlsStage {
 
         let (mut discontinuity, mut blur_h, mut blur_v) = (None, None, None);
         let (mut glossy_h, mut glossy_v) = (None, None);
+        // Without glossy receivers the interleaved frame gathers no glossy radiance:
+        // `ils-glossy` stays 0 as created. Compose then reads none, and refine keeps that of
+        // the tiled target, which the shading wrote as 0 everywhere.
+        let glossy_gathered = glossy_receivers || s.brute_force;
+        let unblurred_glossy = if glossy_gathered { GLOSSY.name } else { GLOSSY_TILED.name };
         let (shown, glossy_shown) = if s.blurs() {
             let (db, h, v) = filter_passes(gpu, scene_gpu, targets, s, IRRADIANCE.name, INDIRECT.name);
             (discontinuity, blur_h, blur_v) = (Some(db), Some(h), Some(v));
@@ -1184,10 +1197,10 @@ impl IlsStage {
                 (glossy_h, glossy_v) = (Some(gh), Some(gv));
                 (INDIRECT.name, GLOSSY_BLURRED.name)
             } else {
-                (INDIRECT.name, GLOSSY.name)
+                (INDIRECT.name, unblurred_glossy)
             }
         } else {
-            (IRRADIANCE.name, GLOSSY.name)
+            (IRRADIANCE.name, unblurred_glossy)
         };
         let (mut refine, mut peak) = (None, None);
         let (shown, glossy_shown) = if s.refines() {
@@ -1219,7 +1232,7 @@ impl IlsStage {
                 false,
                 None,
                 shown,
-                Some(glossy_shown),
+                glossy_gathered.then_some(glossy_shown),
                 false,
             )
         });
