@@ -11,7 +11,11 @@
 #   mkdir -p /tmp/xdg /work /tmp/b; [ "$PWD" = /work/main ] || ln -sfn "$PWD" /work/main
 #   tar -xJf .dev/bin.txz -C /tmp/b && tar -xJf .dev/shared.txz -C /work && ln -sfn /work/shared ../shared
 #   mkdir -p target/release && cp /tmp/b/strata target/release/
-#   BIN=/tmp/b OUT=$OUT/gc TEST_S=200 SUITE_S=150 SOAK_FRAMES=3000 bash scripts/gpu-check.sh
+#   G=/tmp/gc; BIN=/tmp/b OUT=$G TEST_S=150 SUITE_S=150 SOAK_FRAMES=3000 timeout 450 bash scripts/gpu-check.sh >$G.log 2>&1
+#   cp $G.log $G/; tar -czf $OUT/gc.tgz -C /tmp gc    # the device returns at most 8 files
+#
+# ONLY="ao embed_soak" packs just those test binaries (and `strata`, no examples) for a
+# quick rerun of a few tests: a few MB instead of ~35, and no full A/B or suite.
 #
 # The CLI's tests use absolute paths under /work/main, hence the link. STRATA_OLD=path
 # adds an older `strata` as strata-old (gpu-check's A/B then compares the two builds).
@@ -40,11 +44,11 @@ cargo test --release --workspace --no-run --message-format=json >"$TESTS"
 STAGE=$(mktemp -d)
 mkdir -p "$STAGE/t" .dev
 cp target/release/strata "$STAGE/"
-for e in embed_ao embed_gi embed_reflect embed_bzb embed_ils; do cp "target/release/examples/$e" "$STAGE/"; done
+[ -z "${ONLY:-}" ] && for e in embed_ao embed_gi embed_reflect embed_bzb embed_ils; do cp "target/release/examples/$e" "$STAGE/"; done
 [ -n "${STRATA_OLD:-}" ] && cp "$STRATA_OLD" "$STAGE/strata-old"
 # the integration tests of the crates that drive a GPU, named after their targets
 python3 - "$TESTS" "$STAGE/t" <<'EOF'
-import json, shutil, sys
+import json, os, shutil, sys
 gpu_crates = {"strata-render", "strata-cli", "strata-eval"}
 for line in open(sys.argv[1]):
     try:
@@ -63,10 +67,14 @@ for line in open(sys.argv[1]):
     # the viewer's tests need a display; the fuzz regressions and scene parsing no GPU
     if name in ("view", "fuzz_regressions"):
         continue
+    only = os.environ.get("ONLY", "").split()
+    if only and name not in only:
+        continue
     shutil.copy(m["executable"], f"{sys.argv[2]}/{name}")
 EOF
 rm -f "$TESTS"
-strip "$STAGE/strata" "$STAGE"/embed_* "$STAGE"/t/*
+strip "$STAGE/strata" "$STAGE"/t/*
+[ -z "${ONLY:-}" ] && strip "$STAGE"/embed_*
 [ -f "$STAGE/strata-old" ] && strip "$STAGE/strata-old"
 say "$(ls "$STAGE/t" | wc -l) test binaries; compressing"
 tar -cJf .dev/bin.txz -C "$STAGE" .
