@@ -100,7 +100,9 @@ impl GpuScene {
                     vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&m.name),
                         contents: bytemuck::cast_slice(&verts),
-                        usage: wgpu::BufferUsages::VERTEX,
+                        // COPY_DST: an application's occluders are rewritten in place
+                        // (`embed::EmbeddedIls::set_triangles`)
+                        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
                     }),
                     indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&m.name),

@@ -348,7 +348,8 @@ fn the_interleaved_estimate_of_copies_of_one_vpl_is_its_irradiance() {
 /// inside its outline get no light (below 0.5 % of the largest E); those whose segment
 /// passes 5 cm or more outside it get the unshadowed E within 1 % + 0.05 % of the largest
 /// (the maps' PCF and bias). Without the maps (SNSM) the shadowed points are lit: the
-/// control. `set_triangles` then takes the plate away, and the shadow goes.
+/// control. The plate then moves (in place inside the maps' box, rebuilt outside it:
+/// each a fresh build's image), and `set_triangles` takes it away, and the shadow goes.
 #[test]
 fn vpl_shadow_maps_of_the_applications_triangles_shadow_the_floor() {
     use glam::camera::rh;
@@ -456,6 +457,49 @@ fn vpl_shadow_maps_of_the_applications_triangles_shadow_the_floor() {
         dark_snsm > 0.1 * scale,
         "without visibility the plate does not shadow: {dark_snsm}"
     );
+    // Moving occluders. Triangles inside the box the maps were built for are written in
+    // place (the same output texture: nothing was rebuilt); others rebuild. Either way the
+    // output is that of a fresh EmbeddedIls built with those triangles, bit for bit.
+    let before = frame(&mut ssm);
+    let output = ssm.output().clone();
+    let moved = |d: Vec3| {
+        let mut t = world(&floor);
+        t.extend(world(&plate).iter().map(|t| t.map(|p| p + d)));
+        t
+    };
+    let fresh = |t: &[[Vec3; 3]]| {
+        let mut e = embedded(
+            &gpu,
+            [w, h],
+            settings(VplShadows::ShadowMaps),
+            NormalEncoding::Signed,
+            t,
+        );
+        frame(&mut e)
+    };
+    let sideways = moved(Vec3::new(0.5, 0.0, 0.3));
+    ssm.set_triangles(&sideways).unwrap();
+    let shifted = frame(&mut ssm);
+    assert!(*ssm.output() == output, "inside the box: written in place");
+    assert!(shifted.data != before.data, "the shadow moves with the plate");
+    assert!(shifted.data == fresh(&sideways).data, "in place = a fresh build");
+    // the plate's triangles alone, back where they were: the first image again
+    ssm.set_triangle_range(floor.len(), &world(&plate)).unwrap();
+    assert!(*ssm.output() == output, "a range inside the box: in place");
+    assert!(
+        frame(&mut ssm).data == before.data,
+        "set_triangle_range restores the frame"
+    );
+    assert!(
+        ssm.set_triangle_range(floor.len() + 1, &world(&plate)).is_err(),
+        "a range past the end is refused"
+    );
+    // above the box (its top is the plate's): rebuilt, and still a fresh build's image
+    let raised = moved(Vec3::new(0.0, 0.5, 0.0));
+    ssm.set_triangles(&raised).unwrap();
+    let high = frame(&mut ssm);
+    assert!(*ssm.output() != output, "outside the box: rebuilt");
+    assert!(high.data == fresh(&raised).data, "rebuilt = a fresh build");
     // the plate taken away: the floor alone casts no shadow on itself
     ssm.set_triangles(&world(&floor)).unwrap();
     let (dark_gone, worst_gone, ..) = measure(&frame(&mut ssm));

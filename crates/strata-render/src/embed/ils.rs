@@ -70,10 +70,7 @@ fn occluder_scene(triangles: &[[Vec3; 3]]) -> strata_scene::Scene {
         return scene;
     }
     let positions: Vec<[f32; 3]> = triangles.iter().flatten().map(|p| p.to_array()).collect();
-    let normals = triangles
-        .iter()
-        .flat_map(|t| [(t[1] - t[0]).cross(t[2] - t[0]).normalize_or(Vec3::Y).to_array(); 3])
-        .collect();
+    let normals = triangles.iter().flat_map(|t| [flat_normal(t).to_array(); 3]).collect();
     scene.meshes.push(Mesh {
         name: "occluders".into(),
         uvs: vec![[0.0; 2]; positions.len()],
@@ -92,6 +89,18 @@ fn occluder_scene(triangles: &[[Vec3; 3]]) -> strata_scene::Scene {
     scene
 }
 
+/// A triangle's unit normal (+y for a degenerate one), as the occluder mesh has it.
+fn flat_normal(t: &[Vec3; 3]) -> Vec3 {
+    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or(Vec3::Y)
+}
+
+/// The axis-aligned box of `triangles` (None without any).
+fn bounding_box(triangles: &[[Vec3; 3]]) -> Option<(Vec3, Vec3)> {
+    let mut points = triangles.iter().flatten();
+    let first = *points.next()?;
+    Some(points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
+}
+
 /// The ILS passes of `strata render --technique ils` on an application's G-buffer and VPLs.
 pub struct EmbeddedIls {
     core: Core,
@@ -99,6 +108,9 @@ pub struct EmbeddedIls {
     stage: IlsStage,
     /// The VPL buffer's capacity (the VPLs given to `new` or the last rebuild).
     capacity: usize,
+    /// With SSM: the box of the occluders the passes were built with. Their shadow maps'
+    /// depth ranges cover it, so triangles that stay inside are rewritten in place.
+    occluder_box: Option<(Vec3, Vec3)>,
 }
 
 super::embedded_common!(EmbeddedIls, EmbeddedIlsConfig, resize);
@@ -163,6 +175,7 @@ impl EmbeddedIls {
                 config: config.clone(),
                 stage,
                 capacity: s.vpls.len(),
+                occluder_box: if shadows { bounding_box(&config.triangles) } else { None },
             })
         })
     }
@@ -195,14 +208,92 @@ impl EmbeddedIls {
         Ok(())
     }
 
-    /// Replaces the occluders of the VPL shadow maps (SSM) and rebuilds the passes. A
-    /// triangle with a non-finite vertex is a one-line error, and then nothing changes.
+    /// Replaces the occluders of the VPL shadow maps (SSM). As many triangles as before,
+    /// inside the box of those the passes were built with, are written in place (a frame
+    /// of moving geometry allocates nothing and compiles nothing) and the maps are drawn
+    /// again; other triangles rebuild the passes. Without SSM they are only kept (for a
+    /// later rebuild). A triangle with a non-finite vertex is a one-line error, and then
+    /// nothing changes.
     pub fn set_triangles(&mut self, triangles: &[[Vec3; 3]]) -> Result<(), RenderError> {
+        super::check_triangles("embedded ILS", triangles, 0)?;
+        if triangles.len() == self.config.triangles.len() && self.write_in_place(0, triangles) {
+            return Ok(());
+        }
         let mut config = self.config.clone();
         config.triangles = triangles.into();
+        if self.config.settings.shadows != VplShadows::ShadowMaps {
+            self.config = config;
+            return Ok(());
+        }
         let gpu = &self.core.gpu;
         *self = Self::new(&gpu.adapter, &gpu.device, &gpu.queue, config)?;
         Ok(())
+    }
+
+    /// Replaces occluders `first..first + triangles.len()` of the VPL shadow maps (SSM),
+    /// in place where they stay inside the box the passes were built with (else the
+    /// passes are rebuilt with the whole list). A range past the end or a non-finite
+    /// vertex is a one-line error, and then nothing changes.
+    pub fn set_triangle_range(&mut self, first: usize, triangles: &[[Vec3; 3]]) -> Result<(), RenderError> {
+        let count = self.config.triangles.len();
+        if first.checked_add(triangles.len()).is_none_or(|end| end > count) {
+            return Err(RenderError::Parameter(format!(
+                "embedded ILS: set_triangle_range({first}, {} triangles) passes the end: the occluders are {count} triangles (set_triangles changes their number)",
+                triangles.len()
+            )));
+        }
+        super::check_triangles("embedded ILS", triangles, first)?;
+        if self.write_in_place(first, triangles) {
+            return Ok(());
+        }
+        let mut all = self.config.triangles.to_vec();
+        all[first..first + triangles.len()].copy_from_slice(triangles);
+        self.set_triangles(&all)
+    }
+
+    /// Writes `triangles` over the occluders from `first` on, keeps them in the config,
+    /// and has the maps drawn again, if they lie inside the built box (SSM) or no maps
+    /// are drawn (SNSM); false, with nothing changed, otherwise.
+    fn write_in_place(&mut self, first: usize, triangles: &[[Vec3; 3]]) -> bool {
+        let ssm = self.config.settings.shadows == VplShadows::ShadowMaps;
+        if ssm {
+            let Some((lo, hi)) = self.occluder_box else {
+                return false;
+            };
+            let inside = |p: &Vec3| p.cmpge(lo).all() && p.cmple(hi).all();
+            if !triangles.iter().flatten().all(inside) {
+                return false;
+            }
+            let vertices: Vec<crate::scene_gpu::Vertex> = triangles
+                .iter()
+                .flat_map(|t| {
+                    let normal = flat_normal(t).to_array();
+                    t.map(|p| crate::scene_gpu::Vertex {
+                        position: p.to_array(),
+                        normal,
+                        uv: [0.0; 2],
+                    })
+                })
+                .collect();
+            let stride = std::mem::size_of::<crate::scene_gpu::Vertex>() as u64;
+            let gpu = &self.core.gpu;
+            gpu.queue.write_buffer(
+                &self.core.scene_gpu.meshes[0].vertices,
+                3 * first as u64 * stride,
+                bytemuck::cast_slice(&vertices),
+            );
+            self.stage.invalidate_vpl_shadows();
+        }
+        // kept for `resize` and rebuilds: copied into the kept list where no one else holds it
+        match Arc::get_mut(&mut self.config.triangles) {
+            Some(kept) => kept[first..first + triangles.len()].copy_from_slice(triangles),
+            None => {
+                let mut all = self.config.triangles.to_vec();
+                all[first..first + triangles.len()].copy_from_slice(triangles);
+                self.config.triangles = all.into();
+            }
+        }
+        true
     }
 
     /// VPLs the buffer holds without a rebuild (after `resize`: the current count).

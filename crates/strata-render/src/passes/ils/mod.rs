@@ -1188,7 +1188,11 @@ impl IlsStage {
         // `ils-glossy` stays 0 as created. Compose then reads none, and refine keeps that of
         // the tiled target, which the shading wrote as 0 everywhere.
         let glossy_gathered = glossy_receivers || s.brute_force;
-        let unblurred_glossy = if glossy_gathered { GLOSSY.name } else { GLOSSY_TILED.name };
+        let unblurred_glossy = if glossy_gathered {
+            GLOSSY.name
+        } else {
+            GLOSSY_TILED.name
+        };
         let (shown, glossy_shown) = if s.blurs() {
             let (db, h, v) = filter_passes(gpu, scene_gpu, targets, s, IRRADIANCE.name, INDIRECT.name);
             (discontinuity, blur_h, blur_v) = (Some(db), Some(h), Some(v));
@@ -1276,6 +1280,13 @@ impl IlsStage {
             p.set_uniforms(gpu, &self.shade_uniforms);
         }
         Ok(())
+    }
+
+    /// Draws the VPL shadow maps again next frame (SSM; the occluders moved).
+    pub(crate) fn invalidate_vpl_shadows(&self) {
+        if let Some(p) = &self.vpl_shadows {
+            p.invalidate();
+        }
     }
 
     /// Whether the VPL shadow maps are kept from frame to frame (SSM only).

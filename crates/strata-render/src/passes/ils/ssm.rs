@@ -239,6 +239,11 @@ impl VplShadowPass {
         self.draw.set_cached(cached);
     }
 
+    /// Draws the maps again next frame (the occluders moved).
+    pub(crate) fn invalidate(&self) {
+        self.draw.invalidate();
+    }
+
     /// Whether the maps are kept from frame to frame.
     pub(crate) fn cached(&self) -> bool {
         self.draw.cached()
