@@ -25,13 +25,14 @@ fn gpu_vpl(v: &Vpl) -> GpuVpl {
 }
 
 /// The embedded ILS at `w`×`h` in world space; `triangles` are the VPL shadow maps'
-/// occluders (read with `shadows = vpl`).
-fn embedded(
+/// occluders (read with `shadows = vpl`), their maps reaching `occluder_margin` beyond them.
+fn embedded_with_margin(
     gpu: &GpuContext,
     [w, h]: [u32; 2],
     settings: IlsSettings,
     normals: NormalEncoding,
     triangles: &[[Vec3; 3]],
+    occluder_margin: f32,
 ) -> EmbeddedIls {
     EmbeddedIls::new(
         &gpu.adapter,
@@ -44,9 +45,22 @@ fn embedded(
             normals,
             normal_space: NormalSpace::World,
             triangles: triangles.into(),
+            occluder_margin,
         },
     )
     .expect("the embedded ILS builds without validation errors")
+}
+
+/// [`embedded_with_margin`] with the default margin.
+fn embedded(
+    gpu: &GpuContext,
+    size: [u32; 2],
+    settings: IlsSettings,
+    normals: NormalEncoding,
+    triangles: &[[Vec3; 3]],
+) -> EmbeddedIls {
+    let margin = EmbeddedIlsConfig::default().occluder_margin;
+    embedded_with_margin(gpu, size, settings, normals, triangles, margin)
 }
 
 /// The largest |a − b| over the rgb channels relative to b's largest value, and the share
@@ -163,7 +177,15 @@ fn embedded_ils_on_the_renderers_gbuffer_is_the_renderers() {
         let triangles: Vec<[Vec3; 3]> = scene.world_triangles(0.0).iter().map(|t| t.p).collect();
         for (what, settings) in cases {
             let r = common::ils_renderer(&gpu, &scene, settings.clone(), (w, h));
-            let mut ils = embedded(&gpu, [w, h], settings.clone(), NormalEncoding::Octahedral, &triangles);
+            // margin 0: the renderer's shadow-map range
+            let mut ils = embedded_with_margin(
+                &gpu,
+                [w, h],
+                settings.clone(),
+                NormalEncoding::Octahedral,
+                &triangles,
+                0.0,
+            );
             let (view, proj) = (scene.camera.view(), scene.camera.projection(w as f32 / h as f32));
             let (depth, normal) = (r.target_texture("depth").unwrap(), r.target_texture("normal").unwrap());
             let layer0 = |t| TextureLayer { texture: t, layer: 0 };
@@ -494,12 +516,37 @@ fn vpl_shadow_maps_of_the_applications_triangles_shadow_the_floor() {
         ssm.set_triangle_range(floor.len() + 1, &world(&plate)).is_err(),
         "a range past the end is refused"
     );
-    // above the box (its top is the plate's): rebuilt, and still a fresh build's image
+    // raised 0.5 m above the built box (its top is the plate's): within a margin of 0.1 ×
+    // the box's 17 m diagonal it is written in place, and a fresh build of those
+    // triangles (whose maps span a slightly different range) gives nearly the same image
     let raised = moved(Vec3::new(0.0, 0.5, 0.0));
-    ssm.set_triangles(&raised).unwrap();
-    let high = frame(&mut ssm);
+    let with_margin = |t: &[[Vec3; 3]]| {
+        embedded_with_margin(
+            &gpu,
+            [w, h],
+            settings(VplShadows::ShadowMaps),
+            NormalEncoding::Signed,
+            t,
+            0.1,
+        )
+    };
+    let mut margin = with_margin(&occluders);
+    frame(&mut margin);
+    let kept = margin.output().clone();
+    margin.set_triangles(&raised).unwrap();
+    let high = frame(&mut margin);
+    assert!(*margin.output() == kept, "within the margin: written in place");
+    let (worst, over) = rgb_diff(&high, &frame(&mut with_margin(&raised)));
+    println!(
+        "raised within the margin: largest difference from a fresh build {worst:.2e}, {over:.4} of pixels over 1 %"
+    );
+    assert!(worst < 0.01, "raised in place: {worst} from a fresh build");
+    // beyond the box: rebuilt, and a fresh build's image bit for bit
+    let away = moved(Vec3::new(0.0, 0.5, 0.0));
+    ssm.set_triangles(&away).unwrap();
+    let far = frame(&mut ssm);
     assert!(*ssm.output() != output, "outside the box: rebuilt");
-    assert!(high.data == fresh(&raised).data, "rebuilt = a fresh build");
+    assert!(far.data == fresh(&away).data, "rebuilt = a fresh build");
     // the plate taken away: the floor alone casts no shadow on itself
     ssm.set_triangles(&world(&floor)).unwrap();
     let (dark_gone, worst_gone, ..) = measure(&frame(&mut ssm));
@@ -558,6 +605,13 @@ fn bad_embedded_ils_input_is_a_one_line_error() {
                 })
             })),
             "embedded ILS: triangles[0] has a non-finite vertex",
+        ),
+        (
+            err(new(EmbeddedIlsConfig {
+                occluder_margin: -0.5,
+                ..config(good())
+            })),
+            "embedded ILS: occluder_margin -0.5 is out of range",
         ),
         (
             err(new(config(IlsSettings {

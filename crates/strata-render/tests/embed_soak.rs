@@ -1,6 +1,6 @@
 //! `strata_render::embed` over a long run: an application that records the embedded AO,
 //! radiosity, reflections, bounced-z-buffer AO (its triangles rewritten each frame) and ILS
-//! (its VPLs rewritten each frame) every frame for hundreds of frames (two layers, a moving
+//! (its VPLs and its shadow maps' occluders rewritten each frame) every frame for hundreds of frames (two layers, a moving
 //! camera) holds its GPU allocations, the Rust heap and resident memory flat. The import's
 //! bind group is kept while the textures stay the same; before it was (2026-12-01), each
 //! frame made one with views of the application's textures, and NVIDIA's driver kept
@@ -178,12 +178,18 @@ fn embedded_ao_radiosity_reflections_bzb_and_ils_soak_flat() {
             settings: IlsSettings {
                 vpls: vpls.clone().into(),
                 clamp_distance: Some(0.5),
+                // VPL shadow maps of the bounced z-buffer's occluders, which move in place
+                shadows: strata_render::passes::ils::VplShadows::ShadowMaps,
                 ..IlsSettings::default()
             },
+            triangles: occluders.clone().into(),
+            // the bobbing triangle may leave the box by its 1 cm: the margin keeps it in place
+            occluder_margin: 0.1,
             ..EmbeddedIlsConfig::default()
         },
     )
     .unwrap();
+    let ils_output = ils.output().clone();
     let cam = scene.camera;
     let proj =
         glam::camera::rh::proj::directx::perspective(cam.fov_y_deg.to_radians(), w as f32 / h as f32, cam.near, 500.0);
@@ -241,8 +247,10 @@ fn embedded_ao_radiosity_reflections_bzb_and_ils_soak_flat() {
         occluders[0] = tris[0].0.map(|p| p + lift);
         if f % 2 == 0 {
             bzb.set_triangles(&occluders).unwrap();
+            ils.set_triangles(&occluders).unwrap();
         } else {
             bzb.set_triangle_range(0, &occluders[..1]).unwrap();
+            ils.set_triangle_range(0, &occluders[..1]).unwrap();
         }
         bzb.encode(&mut encoder, &AoInputs { second: None, ..inputs }).unwrap();
         for (k, v) in vpls.iter_mut().enumerate() {
@@ -293,6 +301,10 @@ fn embedded_ao_radiosity_reflections_bzb_and_ils_soak_flat() {
         .filter(|p| p[0] > 0.0)
         .count();
     assert!(lit > 0, "the VPLs light some pixels, so ILS shades");
+    assert!(
+        *ils.output() == ils_output,
+        "the occluders moved in place: ILS was never rebuilt"
+    );
     assert_eq!(a.2, b.2, "wgpu's allocations stay the same");
     // Where each frame is waited for (or the adapter is lavapipe), nothing may pile up: what
     // strata and wgpu hold on the heap stays within 64 KiB (a leak of 200 bytes a frame
