@@ -477,11 +477,7 @@ fn compute_vs_twin_sized(
     let got = raw(gpu, &r);
     let (mut worst, mut worst_border, mut border_dark, mut beyond) = (0.0f32, 0.0f32, 0, 0);
     assert_eq!((got.width, got.height), (w, h));
-    let max_ulps = if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
-        0
-    } else {
-        4
-    };
+    let max_ulps = if common::cpu_adapter(gpu) { 0 } else { 4 };
     for y in 0..h {
         for x in 0..w {
             let want = ambient_visibility_cpu(&lists, &occ, &frame, &u, x, y);

@@ -205,7 +205,7 @@ fn embedded_ao_radiosity_reflections_bzb_and_ils_soak_flat() {
     // steps up to frame ~5,000 of 10,000, then stayed). lavapipe finishes each submit's work
     // before the next, so there the test never polls but for its samples.
     // STRATA_SOAK_WAIT=0 or 1 overrides this (a diagnosis).
-    let cpu_adapter = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    let cpu_adapter = common::cpu_adapter(&gpu);
     let wait_each_frame = match std::env::var("STRATA_SOAK_WAIT").as_deref() {
         Ok("1") => true,
         Ok("0") => false,

@@ -78,13 +78,19 @@ pub fn gpu() -> GpuContext {
     GpuContext::new(&GpuOptions::default()).expect("a Vulkan adapter (scripts/test.sh installs Mesa lavapipe)")
 }
 
+/// Whether `gpu` is a CPU adapter (lavapipe in CI): IEEE maths like Rust's, and a queue
+/// that finishes each submit's work in order.
+pub fn cpu_adapter(gpu: &GpuContext) -> bool {
+    gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+}
+
 /// How many of a GPU-vs-CPU twin test's `n` pixels must equal the CPU twin. On a CPU
 /// adapter (lavapipe, whose sin, cos and log2 round as Rust's do) every one. A GPU's
 /// transcendentals differ from Rust's by ulps, so a tap within about 1e-4 px of a texel
 /// edge, or a tap radius at a MIP level's boundary, can round the other way: 0.5 % of the
 /// pixels are excused there (an H200 missed 1 to 3 of 6,144 on 2026-12-01).
 pub fn twin_pixels_required(gpu: &GpuContext, n: usize) -> usize {
-    if gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu {
+    if cpu_adapter(gpu) {
         n
     } else {
         n - n / 200
@@ -247,8 +253,8 @@ pub fn target_bits_differing(gpu: &GpuContext, a: &Renderer, b: &Renderer, name:
 }
 
 /// The values of target `name` in `a` and `b` that differ by more than `rel` of the larger
-/// magnitude (or of the target's largest value, whichever is larger), and the largest such
-/// relative difference: for sums whose order a GPU does not fix (atomics, blending of
+/// of the two (or of 10⁻⁴ × the target's largest value, if that is larger), and the largest
+/// such relative difference: for sums whose order a GPU does not fix (atomics, blending of
 /// surfels appended in any order).
 pub fn target_values_differing(gpu: &GpuContext, a: &Renderer, b: &Renderer, name: &str, rel: f32) -> (usize, f32) {
     let (x, y) = (a.read_target(gpu, name).unwrap(), b.read_target(gpu, name).unwrap());
