@@ -1129,7 +1129,7 @@ fn bzb_of(s: &RenderSettings) -> BzbSettings {
     s.bzb.clone().unwrap_or_default()
 }
 
-static BZB_SETTINGS: [SettingInfo; 16] = [
+static BZB_SETTINGS: [SettingInfo; 17] = [
     bool_setting!(
         "visibility",
         "on: bounced z-buffer (BZB §3.2, nearest occluder per direction); off: AOV baseline (additive, McGuire 2010)",
@@ -1153,6 +1153,14 @@ static BZB_SETTINGS: [SettingInfo; 16] = [
         bzb_mut,
         box_splats,
         ["rect", "box"]
+    ),
+    bool_setting!(
+        "splat-raster",
+        "AOV splats with visibility: fragment = the rasteriser's depth test (the paper); compute = the same rectangles tested in a compute pass, nearest hit kept with 64-bit atomics (the image is unchanged)",
+        bzb_of,
+        bzb_mut,
+        compute_splat,
+        ["fragment", "compute"]
     ),
     setting!(
         "directions",
@@ -1265,7 +1273,7 @@ fn bzb_gi_of(s: &RenderSettings) -> crate::passes::bzb::gi::BzbGiSettings {
     s.bzb_gi.clone().unwrap_or_default()
 }
 
-static BZB_GI_SETTINGS: [SettingInfo; 15] = [
+static BZB_GI_SETTINGS: [SettingInfo; 16] = [
     splat_setting!(
         "splats: aov (the scene's triangles, radiance shaded per hit) or dss (surfels shaded with direct light at surfelization, shell-splatted into DSS's hierarchical framebuffer, BZB §4)",
         bzb_gi_of,
@@ -1350,6 +1358,14 @@ static BZB_GI_SETTINGS: [SettingInfo; 15] = [
         bzb_gi_mut,
         box_splats,
         ["rect", "box"]
+    ),
+    bool_setting!(
+        "splat-raster",
+        "AOV splats with visibility: fragment = the rasteriser's depth test (the paper); compute = the same rectangles tested in a compute pass, nearest hit kept with 64-bit atomics (the image is unchanged)",
+        bzb_gi_of,
+        bzb_gi_mut,
+        compute_splat,
+        ["fragment", "compute"]
     ),
     setting!(
         "filter-radius",

@@ -45,6 +45,39 @@ fn plate_stack(plates: usize) -> Scene {
     quads_scene("plate-stack", &quads, camera, 1.0)
 }
 
+/// Large tilted quads seen at a grazing angle, one crossing the near plane (the box
+/// splats' rectangle fallback).
+fn tilted_quads() -> Scene {
+    let camera = Camera::new(Vec3::new(0.0, 0.6, 2.0), Vec3::new(0.0, 0.0, -1.0), Vec3::Y, 60.0, 0.05);
+    let quads = [
+        // the floor, seen at a grazing angle
+        (
+            Vec3::new(-4.0, 0.0, 3.0),
+            Vec3::new(8.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -9.0),
+        ),
+        // a plate rotated about two axes, standing on it
+        (
+            Vec3::new(-1.2, 0.0, -0.5),
+            Vec3::new(1.6, 0.3, -0.9),
+            Vec3::new(0.2, 1.1, 0.3),
+        ),
+        // a long thin sliver across the view
+        (
+            Vec3::new(-3.0, 0.05, -1.0),
+            Vec3::new(6.0, 0.4, 0.5),
+            Vec3::new(0.0, 0.02, 0.06),
+        ),
+        // a panel passing beside the camera, through its near plane
+        (
+            Vec3::new(0.4, 0.1, 2.5),
+            Vec3::new(0.0, 0.0, -2.0),
+            Vec3::new(0.3, 0.8, 0.0),
+        ),
+    ];
+    quads_scene("tilted", &quads, camera, 0.6)
+}
+
 fn settings(b: BzbSettings) -> RenderSettings {
     RenderSettings {
         width: W,
@@ -499,6 +532,22 @@ fn settings_errors_name_the_parameter_and_range() {
             },
             "temporal alpha 1 is out of range: must be in [0, 1)",
         ),
+        (
+            BzbSettings {
+                compute_splat: true,
+                box_splats: true,
+                ..Default::default()
+            },
+            "splat-raster=compute tests the splats' rectangles: use splat-bounds=rect",
+        ),
+        (
+            BzbSettings {
+                compute_splat: true,
+                splat: bzb::Splat::Dss,
+                ..Default::default()
+            },
+            "splat-raster=compute applies to splat=aov",
+        ),
     ] {
         let e = Renderer::new(&gpu, &scene, settings(b))
             .err()
@@ -560,41 +609,11 @@ fn depth_tile_culling_leaves_the_image_unchanged() {
 #[test]
 fn box_splats_equal_rectangle_splats() {
     let gpu = common::gpu();
-    let tilted = {
-        let camera = Camera::new(Vec3::new(0.0, 0.6, 2.0), Vec3::new(0.0, 0.0, -1.0), Vec3::Y, 60.0, 0.05);
-        let quads = [
-            // the floor, seen at a grazing angle
-            (
-                Vec3::new(-4.0, 0.0, 3.0),
-                Vec3::new(8.0, 0.0, 0.0),
-                Vec3::new(0.0, 0.0, -9.0),
-            ),
-            // a plate rotated about two axes, standing on it
-            (
-                Vec3::new(-1.2, 0.0, -0.5),
-                Vec3::new(1.6, 0.3, -0.9),
-                Vec3::new(0.2, 1.1, 0.3),
-            ),
-            // a long thin sliver across the view
-            (
-                Vec3::new(-3.0, 0.05, -1.0),
-                Vec3::new(6.0, 0.4, 0.5),
-                Vec3::new(0.0, 0.02, 0.06),
-            ),
-            // a panel passing beside the camera, through its near plane
-            (
-                Vec3::new(0.4, 0.1, 2.5),
-                Vec3::new(0.0, 0.0, -2.0),
-                Vec3::new(0.3, 0.8, 0.0),
-            ),
-        ];
-        quads_scene("tilted", &quads, camera, 0.6)
-    };
     for scene in [
         procedural::builtin("atrium").unwrap(),
         procedural::builtin("cornell").unwrap(),
         plate_stack(3),
-        tilted,
+        tilted_quads(),
     ] {
         for visibility in [true, false] {
             let b = |box_splats: bool| BzbSettings {
@@ -620,6 +639,50 @@ fn box_splats_equal_rectangle_splats() {
             assert!(hits > 40, "{}: the scene occludes ({hits})", scene.name);
         }
     }
+}
+
+/// The compute form of the splats (`splat-raster=compute`: the same rectangles, the
+/// nearest hit kept with 64-bit atomics, then resolved into the same targets) builds
+/// the rasteriser's bounced z-buffer bit for bit: depth, payload, the reconstructed and
+/// the filtered AO, with and without the depth-tile culling. Scenes: atrium, Cornell,
+/// the plate stack (occluders behind each other) and the tilted quads.
+#[test]
+fn compute_splats_equal_fragment_splats() {
+    let gpu = common::gpu();
+    for (scene, culling) in [
+        (procedural::builtin("atrium").unwrap(), true),
+        (procedural::builtin("atrium").unwrap(), false),
+        (procedural::builtin("cornell").unwrap(), true),
+        (plate_stack(3), true),
+        (tilted_quads(), true),
+    ] {
+        let b = |compute_splat: bool| BzbSettings {
+            compute_splat,
+            culling,
+            ..Default::default()
+        };
+        let (compute, fragment) = (render(&gpu, &scene, b(true)), render(&gpu, &scene, b(false)));
+        for t in ["bzb-depth", "bzb-payload", "bzb-raw", "ao"] {
+            let differ = common::target_bits_differing(&gpu, &compute, &fragment, t);
+            assert_eq!(
+                differ, 0,
+                "{} culling={culling} {t}: {differ} values differ",
+                scene.name
+            );
+        }
+        let payload = compute.read_target(&gpu, "bzb-payload").unwrap();
+        let hits = payload.data.iter().filter(|&&v| v > 0.0).count();
+        assert!(hits > 40, "{}: the scene occludes ({hits})", scene.name);
+    }
+    // without visibility the additive baseline blends in fragments either way
+    let scene = plate_stack(3);
+    let b = |compute_splat: bool| BzbSettings {
+        compute_splat,
+        visibility: false,
+        ..Default::default()
+    };
+    let (compute, fragment) = (render(&gpu, &scene, b(true)), render(&gpu, &scene, b(false)));
+    assert_eq!(common::target_bits_differing(&gpu, &compute, &fragment, "ao"), 0);
 }
 
 /// `bzb-zminmax` (one workgroup per tile, a workgroup reduction) equals its CPU

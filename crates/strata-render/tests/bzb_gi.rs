@@ -947,6 +947,39 @@ fn box_splats_equal_rectangle_splats() {
     }
 }
 
+/// `bzb-gi`'s compute splats (`splat-raster=compute`) give the rasteriser's nearest
+/// senders bit for bit: hit indices, depth, payload and raw irradiance, with d_max the
+/// scene's diagonal (every splat covers its sub-image) and 0.5. One object is drawn
+/// twice, so rays that hit it find two senders at the same depth: both forms keep the
+/// first triangle (the depth test `Less` keeps the first drawn; the keys' tie-break).
+#[test]
+fn compute_splats_equal_fragment_splats() {
+    let gpu = common::gpu();
+    let mut scene = procedural::builtin("still-life").unwrap();
+    let twin = scene.objects[0].clone();
+    scene.objects.push(twin);
+    for d_max in [None, Some(0.5)] {
+        let g = |compute_splat: bool| BzbGiSettings {
+            compute_splat,
+            d_max,
+            ..Default::default()
+        };
+        let (compute, fragment) = (
+            render(&gpu, &scene, 96, 64, g(true)),
+            render(&gpu, &scene, 96, 64, g(false)),
+        );
+        for t in ["bzb-gi-hit", "bzb-depth", "bzb-gi-payload", "bzb-gi-raw"] {
+            let differ = common::target_bits_differing(&gpu, &compute, &fragment, t);
+            assert_eq!(differ, 0, "d_max {d_max:?} {t}: {differ} values differ");
+        }
+        let hit = compute.read_target(&gpu, "bzb-gi-hit").unwrap();
+        assert!(
+            hit.data.iter().filter(|&&v| v > 0.0).count() > 1000,
+            "d_max {d_max:?}: rays hit senders"
+        );
+    }
+}
+
 /// `bzb-gi`'s DSS surfels share `bzb-ao`'s fixed-capacity buffers: a frame whose
 /// surfelization overflows one is reported (`Renderer::dss_overflow`, which `strata
 /// render` prints), as it is for AO. Twenty large triangles under the floor fill the

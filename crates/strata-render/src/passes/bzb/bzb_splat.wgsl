@@ -85,6 +85,36 @@ fn occlusion_box(a: vec3f, b: vec3f, c: vec3f, r: f32, axes: ptr<function, array
     return centre;
 }
 
+// The texels of the whole bounced z-buffer, [lo, hi) as (lo, hi), that instance
+// (triangle a b c, sub-image s) covers: the screen rectangle of T's AABB grown by r
+// (every receiver T can occlude within r lies under it), clipped to the sub-image; an
+// empty rectangle (hi ≤ lo) when T is degenerate, off screen, or (culling on) no
+// receiver under it lies in its depth range.
+fn splat_rect(a: vec3f, b: vec3f, c: vec3f, s: u32) -> vec4f {
+    if (bzb_dot2(cross(b - a, c - a)) == 0.0) {
+        return vec4f(0.0);
+    }
+    let lo = min(min(a, b), c) - vec3f(bzb.radius);
+    let hi = max(max(a, b), c) + vec3f(bzb.radius);
+    let size = frame.size.xy;
+    // the camera-depth range of the grown box: every receiver it can occlude is in it
+    let sb = screen_box(frame, lo, hi);
+    if (!sb.visible) {
+        return vec4f(0.0);
+    }
+    let rmin = clamp(floor(sb.rmin) - 1.0, vec2f(0.0), size);
+    let rmax = clamp(ceil(sb.rmax) + 1.0, vec2f(0.0), size);
+    if (any(rmax <= rmin)) {
+        return vec4f(0.0);
+    }
+    // issue 13 item 4: no receiver under the splat within its depth range
+    if (bzb.culling == 1u && !receivers_in_range(vec2u(size), rmin, rmax, sb.zlo, sb.zhi)) {
+        return vec4f(0.0);
+    }
+    let origin = vec2f(bzb_tile_origin(s, bzb.cols, vec2u(size)));
+    return vec4f(origin + rmin, origin + rmax);
+}
+
 // Vertex vi of instance ii (triangle t = ii / S, sub-image s = ii % S): the faces of
 // `occlusion_box` that look away from the camera, which cover the box's screen outline
 // once without overlap (the others are dropped). Where a box corner lies before the near
@@ -102,29 +132,14 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     let a = triangles[3u * tri].xyz;
     let b = triangles[3u * tri + 1u].xyz;
     let c = triangles[3u * tri + 2u].xyz;
-    if (bzb_dot2(cross(b - a, c - a)) == 0.0) {
+    let rect = splat_rect(a, b, c, s);
+    if (any(rect.zw <= rect.xy)) {
         return out;
     }
-    let lo = min(min(a, b), c) - vec3f(bzb.radius);
-    let hi = max(max(a, b), c) + vec3f(bzb.radius);
     let size = frame.size.xy;
-    // the camera-depth range of the grown box: every receiver it can occlude is in it
-    let sb = screen_box(frame, lo, hi);
-    if (!sb.visible) {
-        return out;
-    }
-    let rmin = clamp(floor(sb.rmin) - 1.0, vec2f(0.0), size);
-    let rmax = clamp(ceil(sb.rmax) + 1.0, vec2f(0.0), size);
-    if (any(rmax <= rmin)) {
-        return out;
-    }
-    // issue 13 item 4: no receiver under the splat within its depth range
-    if (bzb.culling == 1u && !receivers_in_range(vec2u(size), rmin, rmax, sb.zlo, sb.zhi)) {
-        return out;
-    }
     let origin = vec2f(bzb_tile_origin(s, bzb.cols, vec2u(size)));
     let big = size * vec2f(f32(bzb.cols), f32(bzb.rows));
-    out.rect = vec4f(origin + rmin, origin + rmax);
+    out.rect = rect;
     var axes: array<vec3f, 3>;
     var half: vec3f;
     var centre = a;
@@ -144,7 +159,7 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     let corner = corners[vi % 6u];
     if (!box_ok) {
         if (vi < 6u) {
-            let pix = origin + mix(rmin, rmax, corner);
+            let pix = mix(rect.xy, rect.zw, corner);
             out.position = vec4f(pix.x / big.x * 2.0 - 1.0, 1.0 - pix.y / big.y * 2.0, 0.5, 1.0);
         }
         return out;
@@ -165,55 +180,6 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
     return out;
 }
 
-struct VisibilityOut {
-    @location(0) occlusion: vec4f,
-    @builtin(frag_depth) depth: f32,
-}
-
 fn load_triangle(tri: u32) -> array<vec3f, 3> {
     return array<vec3f, 3>(triangles[3u * tri].xyz, triangles[3u * tri + 1u].xyz, triangles[3u * tri + 2u].xyz);
-}
-
-@fragment
-fn fs_visibility(in: SplatVertex) -> VisibilityOut {
-    if (outside_rect(in)) {
-        discard;
-    }
-    let texel = vec2i(in.position.xy);
-    let o = textureLoad(origins, texel, 0);
-    let d = textureLoad(directions, texel, 0);
-    if (d.w <= 0.0) {
-        discard;
-    }
-    let v = load_triangle(in.triangle);
-    let t = bzb_ray_triangle(o.xyz, d.xyz, v[0], v[1], v[2]);
-    if (!(t > bzb.t_min && t < bzb.radius)) {
-        discard;
-    }
-    var out: VisibilityOut;
-    // AO payload: binary occlusion (the estimator of §3.3 divides by α)
-    out.occlusion = vec4f(1.0);
-    // §3.2: squared distance scaled by d_max² = r² keeps z in [0, 1)
-    out.depth = t * t * bzb.inv_r2;
-    return out;
-}
-
-@fragment
-fn fs_additive(in: SplatVertex) -> @location(0) vec4f {
-    if (outside_rect(in)) {
-        discard;
-    }
-    let texel = vec2i(in.position.xy);
-    let o = textureLoad(origins, texel, 0);
-    if (o.w <= 0.0) {
-        discard;
-    }
-    let p = vec2i(vec2u(in.position.xy) % vec2u(frame.size.xy));
-    let n = oct_decode(textureLoad(npack, p, 0).rg);
-    let v = load_triangle(in.triangle);
-    let a = bzb_aov_occlusion(o.xyz, n, v[0], v[1], v[2], bzb.radius, bzb.t_min);
-    if (a <= 0.0) {
-        discard;
-    }
-    return vec4f(a);
 }

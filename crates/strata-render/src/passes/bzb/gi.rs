@@ -65,6 +65,9 @@ pub struct BzbGiSettings {
     /// AOV splats draw the box around each triangle's occlusion volume (as `bzb-ao`'s
     /// [`super::BzbSettings::box_splats`]); the image is unchanged.
     pub box_splats: bool,
+    /// The AOV splats' bounced z-buffer built by a compute pass (as `bzb-ao`'s
+    /// [`super::BzbSettings::compute_splat`]); the image is unchanged.
+    pub compute_splat: bool,
     /// Largest sender radiance a payload keeps (its RGB scaled down to this
     /// maximum component; biased, trades caustic fireflies for energy); `None` = off.
     pub clamp: Option<f32>,
@@ -97,6 +100,7 @@ impl Default for BzbGiSettings {
             },
             culling: true,
             box_splats: false,
+            compute_splat: false,
             clamp: None,
             splat: super::Splat::Aov,
             dss: super::dss::DssSettings::default(),
@@ -147,6 +151,7 @@ impl BzbGiSettings {
                 return Err(format!("bzb-gi clamp {c} is out of range: must be > 0"));
             }
         }
+        super::compute_splat_valid("bzb-gi", self.compute_splat, self.box_splats, self.splat)?;
         self.dss.validate()?;
         if let Some(t) = &self.temporal {
             t.validate()?;
@@ -237,7 +242,8 @@ impl BzbGiSettings {
         };
         let (c, r) = self.grid();
         let px = w as u64 * h as u64;
-        dss + px * (c * r) as u64 * (16 + 16 + 8 + 4)
+        let keys = if self.compute_splat && self.visibility { 8 } else { 0 };
+        dss + px * (c * r) as u64 * (16 + 16 + 8 + 4 + keys)
             + px * 8 * 7
             + self.temporal.map_or(0, |_| px * (4 * 8 + 4 * 2))
             + triangles * (48 + 80)
@@ -888,8 +894,9 @@ impl BzbGiStage {
             gpu, scene_gpu, targets, &tiles, tile_count,
         ));
 
-        // group 2 of the splat: sender data, lights, shadow maps, receiver material
-        let frag = wgpu::ShaderStages::FRAGMENT;
+        // group 2 of the splat: sender data, lights, shadow maps, receiver material (the
+        // compute splat reads its uniforms)
+        let frag = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let tex = |binding| crate::passes::texture_entry(binding, wgpu::TextureViewDimension::D2, false);
         let storage_ro = |binding| wgpu::BindGroupLayoutEntry {
             binding,
@@ -992,6 +999,9 @@ impl BzbGiStage {
                 .write(PAYLOAD.name)
                 .build()
         });
+        if aov && s.compute_splat && s.visibility {
+            super::compute_splat_supported(gpu, "bzb-gi")?;
+        }
         let splat = aov.then(|| {
             super::splat_pass_with(
                 gpu,
@@ -1015,6 +1025,7 @@ impl BzbGiStage {
                     entries: ("fs_gi_visibility", "fs_gi_additive"),
                     payload: if s.visibility { HIT } else { PAYLOAD },
                     extra: Some((&layout, group)),
+                    compute: s.compute_splat.then_some(super::ComputePayload::HitIndex),
                 },
                 &splat_uniforms,
                 &triangles,

@@ -116,6 +116,13 @@ pub struct BzbSettings {
     /// texels but draws 36 vertices an instance against 6; on lavapipe it is slower
     /// (`docs/bzb.md` § "Box splats").
     pub box_splats: bool,
+    /// The AOV splats' bounced z-buffer built by a compute pass (true) instead of the
+    /// rasteriser (false, the default, as the paper): the same rectangles, tests and
+    /// nearest hit (ties to the first triangle, as the depth test's draw order), kept
+    /// with 64-bit atomics (`SHADER_INT64_ATOMIC_MIN_MAX`). Visibility on only: the
+    /// additive baseline blends in the fragment form either way. `docs/bzb.md` §
+    /// "Compute splats".
+    pub compute_splat: bool,
     /// The splatting algorithm (AOV or DSS).
     pub splat: Splat,
     /// DSS's levels, surfel size and frustum culling (used with `Splat::Dss`).
@@ -162,6 +169,7 @@ impl Default for BzbSettings {
             },
             culling: true,
             box_splats: false,
+            compute_splat: false,
             splat: Splat::Aov,
             dss: dss::DssSettings::default(),
             temporal: None,
@@ -187,6 +195,7 @@ impl BzbSettings {
                 return Err(format!("bzb AO bias {b} is out of range: must be >= 0"));
             }
         }
+        compute_splat_valid("bzb", self.compute_splat, self.box_splats, self.splat)?;
         self.dss.validate()?;
         if let Some(t) = &self.temporal {
             t.validate()?;
@@ -278,10 +287,42 @@ impl BzbSettings {
                 + m.layered_framebuffer
                 + m.surfels;
         }
-        px * (c * r) as u64 * (16 + 16 + 2 + 4)
+        let keys = if self.compute_splat && self.visibility { 8 } else { 0 };
+        px * (c * r) as u64 * (16 + 16 + 2 + 4 + keys)
             + px * (4 + 2 + 2)
             + triangles * 48
             + zminmax_tile_count(w, h) as u64 * 8
+    }
+}
+
+/// `splat-raster=compute` tests the AOV splats' rectangles: not box splats, not DSS.
+/// `technique` names it in the error.
+pub(crate) fn compute_splat_valid(
+    technique: &str,
+    compute: bool,
+    box_splats: bool,
+    splat: Splat,
+) -> Result<(), String> {
+    if compute && box_splats {
+        return Err(format!("{technique} splat-raster=compute tests the splats' rectangles: use splat-bounds=rect (box splats need splat-raster=fragment)"));
+    }
+    if compute && splat == Splat::Dss {
+        return Err(format!(
+            "{technique} splat-raster=compute applies to splat=aov (DSS splats its surfels in fragments)"
+        ));
+    }
+    Ok(())
+}
+
+/// Whether `gpu` can run the compute splat (64-bit atomic max on storage buffers); a
+/// one-line error naming the setting otherwise.
+pub(crate) fn compute_splat_supported(gpu: &GpuContext, technique: &str) -> Result<(), crate::RenderError> {
+    if gpu.has(wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX) {
+        Ok(())
+    } else {
+        Err(crate::RenderError::Parameter(format!(
+            "{technique} splat-raster=compute needs 64-bit atomics (SHADER_INT64_ATOMIC_MIN_MAX), which this adapter lacks: use splat-raster=fragment"
+        )))
     }
 }
 
@@ -612,7 +653,8 @@ struct TriangleBuffer {
 
 /// §3.2's splat pass: instanced draw of T × S screen rectangles.
 pub struct SplatPass {
-    pipeline: wgpu::RenderPipeline,
+    /// The rasteriser's form (`None` when `compute` replaces it).
+    pipeline: Option<wgpu::RenderPipeline>,
     group: wgpu::BindGroup,
     visibility: bool,
     instances: u32,
@@ -622,6 +664,29 @@ pub struct SplatPass {
     payload: &'static str,
     /// bzb-gi's sender data (group 2: materials, lights, shadow maps).
     extra: Option<wgpu::BindGroup>,
+    /// `splat-raster=compute`: the same splats tested in a compute pass.
+    compute: Option<ComputeSplat>,
+}
+
+/// §3.2's splats in a compute pass (`splat-raster=compute`, bzb_splat_compute.wgsl):
+/// one workgroup per instance walks its rectangle's texels and keeps the nearest hit
+/// with a 64-bit `atomicMax` on (depth, triangle) keys; a full-screen pass
+/// (bzb_splat_resolve.wgsl) then writes the keys into the fragment form's payload and
+/// depth targets, so every later pass and debug view reads the same targets.
+struct ComputeSplat {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    resolve: wgpu::RenderPipeline,
+    resolve_group: wgpu::BindGroup,
+    keys: wgpu::Buffer,
+}
+
+/// Workgroups (x, y) for `instances` compute-splat instances: x·y ≥ instances with
+/// both within the 65,535 a dispatch dimension allows (`cs_splat` skips ids past the end).
+pub fn compute_splat_groups(instances: u32) -> (u32, u32) {
+    const X: u32 = 32_768;
+    let x = instances.clamp(1, X);
+    (x, instances.div_ceil(x))
 }
 
 impl Pass for SplatPass {
@@ -638,6 +703,35 @@ impl Pass for SplatPass {
     }
 
     fn encode(&self, _gpu: &GpuContext, scene: &GpuScene, targets: &Targets, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(c) = &self.compute {
+            encoder.clear_buffer(&c.keys, 0, None);
+            if self.instances > 0 {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("bzb-splat"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&c.pipeline);
+                pass.set_bind_group(0, &scene.frame_bind_group, &[]);
+                pass.set_bind_group(1, &c.group, &[]);
+                if let Some(g) = &self.extra {
+                    pass.set_bind_group(2, g, &[]);
+                }
+                let (x, y) = compute_splat_groups(self.instances);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("bzb-splat-resolve"),
+                color_attachments: &[crate::passes::clear_attachment(&targets.get(self.payload).view)],
+                depth_stencil_attachment: Some(crate::passes::clear_depth_attachment(&targets.get(DEPTH.name).view)),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&c.resolve);
+            pass.set_bind_group(0, &c.resolve_group, &[]);
+            pass.draw(0..3, 0..1);
+            return;
+        }
         let depth = self
             .visibility
             .then(|| crate::passes::clear_depth_attachment(&targets.get(DEPTH.name).view));
@@ -649,10 +743,10 @@ impl Pass for SplatPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if self.instances == 0 {
+        let Some(pipeline) = self.pipeline.as_ref().filter(|_| self.instances > 0) else {
             return;
-        }
-        pass.set_pipeline(&self.pipeline);
+        };
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &scene.frame_bind_group, &[]);
         pass.set_bind_group(1, &self.group, &[]);
         if let Some(g) = &self.extra {
@@ -802,6 +896,9 @@ impl BzbStage {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
+        if s.compute_splat && s.visibility {
+            compute_splat_supported(gpu, "bzb")?;
+        }
         let (zminmax, splat, dss) = match s.splat {
             Splat::Aov => (
                 Some(Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count)),
@@ -988,10 +1085,17 @@ impl BzbStage {
                 visibility: s.visibility,
                 instances: count.saturating_mul(s.directions),
                 box_splats: s.box_splats,
-                source: bzb_shader!("bzb_splat.wgsl"),
+                source: concat!(
+                    include_str!("bzb.wgsl"),
+                    "\n",
+                    include_str!("bzb_splat.wgsl"),
+                    "\n",
+                    include_str!("bzb_splat_ao.wgsl")
+                ),
                 entries: ("fs_visibility", "fs_additive"),
                 payload: PAYLOAD,
                 extra: None,
+                compute: s.compute_splat.then_some(ComputePayload::Occlusion),
             },
             uniforms,
             triangles,
@@ -1101,6 +1205,17 @@ pub(crate) struct SplatSpec<'a> {
     pub entries: (&'static str, &'static str),
     pub payload: TargetDesc,
     pub extra: Option<(&'a wgpu::BindGroupLayout, wgpu::BindGroup)>,
+    /// `splat-raster=compute` (visibility only): what the resolve writes as the payload.
+    pub compute: Option<ComputePayload>,
+}
+
+/// The payload the compute form's resolve writes per hit texel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ComputePayload {
+    /// 1 (bzb-ao's binary occlusion, as `fs_visibility`).
+    Occlusion,
+    /// The hit triangle + 1 (bzb-gi's `bzb-gi-hit`, as `fs_gi_visibility`).
+    HitIndex,
 }
 
 /// §3.2's splat pass over the triangles in `triangles` (group 1: uniforms,
@@ -1115,68 +1230,19 @@ pub(crate) fn splat_pass_with(
     tiles: &wgpu::Buffer,
 ) -> SplatPass {
     let device = &gpu.device;
-    let vf = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
-    let tex = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    };
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("bzb-splat"),
-        entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: vf,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: vf,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            tex(2),
-            tex(3),
-            tex(4),
-            wgpu::BindGroupLayoutEntry {
-                binding: 5,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-        ],
+        entries: &splat_layout_entries(false),
     });
-    let group = crate::passes::bind_group(
-        device,
-        "bzb-splat",
-        &layout,
-        &[
-            uniforms.as_entire_binding(),
-            triangles.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
-            wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
-            wgpu::BindingResource::TextureView(&targets.get("npack").view),
-            tiles.as_entire_binding(),
-        ],
-    );
+    let resources = [
+        uniforms.as_entire_binding(),
+        triangles.as_entire_binding(),
+        wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+        wgpu::BindingResource::TextureView(&targets.get(DIRECTIONS.name).view),
+        wgpu::BindingResource::TextureView(&targets.get("npack").view),
+        tiles.as_entire_binding(),
+    ];
+    let group = crate::passes::bind_group(device, "bzb-splat", &layout, &resources);
     let (extra_layout, extra) = match spec.extra {
         Some((l, g)) => (Some(l), Some(g)),
         None => (None, None),
@@ -1185,24 +1251,72 @@ pub(crate) fn splat_pass_with(
     if let Some(l) = extra_layout {
         layouts.push(Some(l));
     }
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("bzb-splat"),
-        bind_group_layouts: &layouts,
-        immediate_size: 0,
+    let compute = spec.compute.filter(|_| spec.visibility).map(|payload| {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("bzb-splat compute"),
+            entries: &splat_layout_entries(true),
+        });
+        let size = targets.get(ORIGINS.name).texture.size();
+        let (w, h) = (size.width, size.height);
+        let keys = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bzb-splat keys"),
+            size: (w as u64 * h as u64 * 8).max(8),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut entries = resources.to_vec();
+        entries.push(keys.as_entire_binding());
+        let group = crate::passes::bind_group(device, "bzb-splat compute", &layout, &entries);
+        let mut layouts = vec![Some(&scene_gpu.frame_layout), Some(&layout)];
+        if let Some(l) = extra_layout {
+            layouts.push(Some(l));
+        }
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("bzb-splat compute"),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+        let source = format!("{}\n{}", spec.source, include_str!("bzb_splat_compute.wgsl"));
+        let module = crate::shader::module(device, "bzb-splat compute", &source);
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("bzb-splat compute"),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("cs_splat"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let (resolve, resolve_group) = resolve_pipeline(device, targets, &keys, spec.payload.format, payload);
+        ComputeSplat {
+            pipeline,
+            group,
+            resolve,
+            resolve_group,
+            keys,
+        }
     });
-    let module = crate::shader::module(device, "bzb-splat", spec.source);
-    let pipeline = splat_pipeline_with(
-        device,
-        "bzb-splat",
-        &pipeline_layout,
-        &module,
-        spec.visibility,
-        spec.payload.format,
-        spec.entries,
-    );
+    // the rasteriser's form, unless the compute form replaces it
+    let pipeline = compute.is_none().then(|| {
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("bzb-splat"),
+            bind_group_layouts: &layouts,
+            immediate_size: 0,
+        });
+        let module = crate::shader::module(device, "bzb-splat", spec.source);
+        splat_pipeline_with(
+            device,
+            "bzb-splat",
+            &pipeline_layout,
+            &module,
+            spec.visibility,
+            spec.payload.format,
+            spec.entries,
+        )
+    });
     SplatPass {
         pipeline,
         group,
+        compute,
         visibility: spec.visibility,
         instances: spec.instances,
         // bzb_splat.wgsl's `SPLAT_VERTICES`, or its fallback rectangle alone
@@ -1210,6 +1324,125 @@ pub(crate) fn splat_pass_with(
         payload: spec.payload.name,
         extra,
     }
+}
+
+/// Group 1 of the splat passes: uniforms, triangles, origins, directions, npack, depth
+/// tiles; for the compute form (`compute`) every entry is visible to the compute stage
+/// and binding 6 holds the keys (bzb_splat_compute.wgsl).
+fn splat_layout_entries(compute: bool) -> Vec<wgpu::BindGroupLayoutEntry> {
+    use wgpu::ShaderStages as S;
+    let (buffers, textures, tiles) = if compute {
+        (S::COMPUTE, S::COMPUTE, S::COMPUTE)
+    } else {
+        (S::VERTEX | S::FRAGMENT, S::FRAGMENT, S::VERTEX)
+    };
+    let buffer = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let read_only = wgpu::BufferBindingType::Storage { read_only: true };
+    let mut entries = vec![
+        buffer(0, buffers, wgpu::BufferBindingType::Uniform),
+        buffer(1, buffers, read_only),
+    ];
+    entries.extend((2..5).map(|b| wgpu::BindGroupLayoutEntry {
+        visibility: textures,
+        ..crate::passes::texture_entry(b, wgpu::TextureViewDimension::D2, false)
+    }));
+    entries.push(buffer(5, tiles, read_only));
+    if compute {
+        entries.push(buffer(
+            6,
+            S::COMPUTE,
+            wgpu::BufferBindingType::Storage { read_only: false },
+        ));
+    }
+    entries
+}
+
+/// The compute form's resolve (bzb_splat_resolve.wgsl): a full-screen pass over the
+/// bounced z-buffer writing each key's depth (test Always) and payload.
+fn resolve_pipeline(
+    device: &wgpu::Device,
+    targets: &Targets,
+    keys: &wgpu::Buffer,
+    format: wgpu::TextureFormat,
+    payload: ComputePayload,
+) -> (wgpu::RenderPipeline, wgpu::BindGroup) {
+    let frag = wgpu::ShaderStages::FRAGMENT;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("bzb-splat-resolve"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: frag,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            crate::passes::texture_entry(1, wgpu::TextureViewDimension::D2, false),
+        ],
+    });
+    let group = crate::passes::bind_group(
+        device,
+        "bzb-splat-resolve",
+        &layout,
+        &[
+            keys.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&targets.get(ORIGINS.name).view),
+        ],
+    );
+    let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("bzb-splat-resolve"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let module = crate::shader::module(device, "bzb-splat-resolve", include_str!("bzb_splat_resolve.wgsl"));
+    let hit_index = if payload == ComputePayload::HitIndex { 1.0 } else { 0.0 };
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("bzb-splat-resolve"),
+        layout: Some(&pl),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_fullscreen"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH.format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_resolve"),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &[("HIT_INDEX", hit_index)],
+                ..Default::default()
+            },
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    (pipeline, group)
 }
 
 impl Default for BzbUniforms {
