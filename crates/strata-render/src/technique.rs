@@ -1154,13 +1154,17 @@ static BZB_SETTINGS: [SettingInfo; 17] = [
         box_splats,
         ["rect", "box"]
     ),
-    bool_setting!(
-        "splat-raster",
-        "AOV splats with visibility: fragment = the rasteriser's depth test (the paper); compute = the same rectangles tested in a compute pass, nearest hit kept with 64-bit atomics (the image is unchanged)",
+    enum_setting!(
+        "splat-kernel",
+        "AOV splats with visibility: fragment = the rasteriser's depth test (the paper); compute = the same rectangles tested in a compute pass, the nearest hit kept with 64-bit atomics (rect splats only); auto: compute on GPUs with those atomics, fragment on CPU adapters (the image is unchanged; docs/bzb.md)",
         bzb_of,
         bzb_mut,
-        compute_splat,
-        ["fragment", "compute"]
+        splat_kernel,
+        [
+            crate::passes::Kernel::Auto => "auto",
+            crate::passes::Kernel::Fragment => "fragment",
+            crate::passes::Kernel::Compute => "compute",
+        ]
     ),
     setting!(
         "directions",
@@ -1359,13 +1363,17 @@ static BZB_GI_SETTINGS: [SettingInfo; 16] = [
         box_splats,
         ["rect", "box"]
     ),
-    bool_setting!(
-        "splat-raster",
-        "AOV splats with visibility: fragment = the rasteriser's depth test (the paper); compute = the same rectangles tested in a compute pass, nearest hit kept with 64-bit atomics (the image is unchanged)",
+    enum_setting!(
+        "splat-kernel",
+        "AOV splats with visibility: fragment = the rasteriser's depth test (the paper); compute = the same rectangles tested in a compute pass, the nearest hit kept with 64-bit atomics (rect splats only); auto: compute on GPUs with those atomics, fragment on CPU adapters (the image is unchanged; docs/bzb.md)",
         bzb_gi_of,
         bzb_gi_mut,
-        compute_splat,
-        ["fragment", "compute"]
+        splat_kernel,
+        [
+            crate::passes::Kernel::Auto => "auto",
+            crate::passes::Kernel::Fragment => "fragment",
+            crate::passes::Kernel::Compute => "compute",
+        ]
     ),
     setting!(
         "filter-radius",

@@ -534,19 +534,19 @@ fn settings_errors_name_the_parameter_and_range() {
         ),
         (
             BzbSettings {
-                compute_splat: true,
+                splat_kernel: strata_render::passes::Kernel::Compute,
                 box_splats: true,
                 ..Default::default()
             },
-            "splat-raster=compute tests the splats' rectangles: use splat-bounds=rect",
+            "splat-kernel=compute tests the splats' rectangles: use splat-bounds=rect",
         ),
         (
             BzbSettings {
-                compute_splat: true,
+                splat_kernel: strata_render::passes::Kernel::Compute,
                 splat: bzb::Splat::Dss,
                 ..Default::default()
             },
-            "splat-raster=compute applies to splat=aov",
+            "splat-kernel=compute applies to splat=aov",
         ),
     ] {
         let e = Renderer::new(&gpu, &scene, settings(b))
@@ -641,7 +641,7 @@ fn box_splats_equal_rectangle_splats() {
     }
 }
 
-/// The compute form of the splats (`splat-raster=compute`: the same rectangles, the
+/// The compute form of the splats (`splat-kernel=compute`: the same rectangles, the
 /// nearest hit kept with 64-bit atomics, then resolved into the same targets) builds
 /// the rasteriser's bounced z-buffer bit for bit: depth, payload, the reconstructed and
 /// the filtered AO, with and without the depth-tile culling. Scenes: atrium, Cornell,
@@ -656,8 +656,8 @@ fn compute_splats_equal_fragment_splats() {
         (plate_stack(3), true),
         (tilted_quads(), true),
     ] {
-        let b = |compute_splat: bool| BzbSettings {
-            compute_splat,
+        let b = |compute: bool| BzbSettings {
+            splat_kernel: common::kernel(compute),
             culling,
             ..Default::default()
         };
@@ -676,8 +676,8 @@ fn compute_splats_equal_fragment_splats() {
     }
     // without visibility the additive baseline blends in fragments either way
     let scene = plate_stack(3);
-    let b = |compute_splat: bool| BzbSettings {
-        compute_splat,
+    let b = |compute: bool| BzbSettings {
+        splat_kernel: common::kernel(compute),
         visibility: false,
         ..Default::default()
     };

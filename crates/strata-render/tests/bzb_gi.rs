@@ -947,7 +947,7 @@ fn box_splats_equal_rectangle_splats() {
     }
 }
 
-/// `bzb-gi`'s compute splats (`splat-raster=compute`) give the rasteriser's nearest
+/// `bzb-gi`'s compute splats (`splat-kernel=compute`) give the rasteriser's nearest
 /// senders bit for bit: hit indices, depth, payload and raw irradiance, with d_max the
 /// scene's diagonal (every splat covers its sub-image) and 0.5. One object is drawn
 /// twice, so rays that hit it find two senders at the same depth: both forms keep the
@@ -959,8 +959,8 @@ fn compute_splats_equal_fragment_splats() {
     let twin = scene.objects[0].clone();
     scene.objects.push(twin);
     for d_max in [None, Some(0.5)] {
-        let g = |compute_splat: bool| BzbGiSettings {
-            compute_splat,
+        let g = |compute: bool| BzbGiSettings {
+            splat_kernel: common::kernel(compute),
             d_max,
             ..Default::default()
         };

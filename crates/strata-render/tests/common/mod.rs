@@ -78,6 +78,15 @@ pub fn gpu() -> GpuContext {
     GpuContext::new(&GpuOptions::default()).expect("a Vulkan adapter (scripts/test.sh installs Mesa lavapipe)")
 }
 
+/// A pass that has both forms, pinned: compute (`true`) or fragment (`false`).
+pub fn kernel(compute: bool) -> strata_render::passes::Kernel {
+    if compute {
+        strata_render::passes::Kernel::Compute
+    } else {
+        strata_render::passes::Kernel::Fragment
+    }
+}
+
 /// Whether `gpu` is a CPU adapter (lavapipe in CI): IEEE maths like Rust's, and a queue
 /// that finishes each submit's work in order.
 pub fn cpu_adapter(gpu: &GpuContext) -> bool {

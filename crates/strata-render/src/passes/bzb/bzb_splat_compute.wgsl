@@ -1,4 +1,4 @@
-// §3.2's splats in a compute pass (`splat-raster=compute`): the bounced z-buffer's
+// §3.2's splats in a compute pass (`splat-kernel=compute`): the bounced z-buffer's
 // depth test done with 64-bit atomics instead of the rasteriser. Appended after the
 // fragment form's shaders (bzb_splat.wgsl and the AO or GI entries), whose
 // `splat_rect` and `splat_hit_depth` it calls, so both forms test the same texels

@@ -1,4 +1,4 @@
-// §3.2, the compute form's last step (`splat-raster=compute`): per texel of the
+// §3.2, the compute form's last step (`splat-kernel=compute`): per texel of the
 // bounced z-buffer, bzb_splat_compute.wgsl's key (0 = no hit) into the fragment form's
 // targets: the depth z = bits⁻¹(~key.hi) through frag_depth (depth test Always) and the
 // payload, 1 for AO or the hit triangle + 1 for GI (`HIT_INDEX`). Texels without a

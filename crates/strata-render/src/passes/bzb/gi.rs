@@ -65,9 +65,9 @@ pub struct BzbGiSettings {
     /// AOV splats draw the box around each triangle's occlusion volume (as `bzb-ao`'s
     /// [`super::BzbSettings::box_splats`]); the image is unchanged.
     pub box_splats: bool,
-    /// The AOV splats' bounced z-buffer built by a compute pass (as `bzb-ao`'s
-    /// [`super::BzbSettings::compute_splat`]); the image is unchanged.
-    pub compute_splat: bool,
+    /// The AOV splats as fragment or compute work (as `bzb-ao`'s
+    /// [`super::BzbSettings::splat_kernel`]; default `Auto`); the image is unchanged.
+    pub splat_kernel: crate::passes::Kernel,
     /// Largest sender radiance a payload keeps (its RGB scaled down to this
     /// maximum component; biased, trades caustic fireflies for energy); `None` = off.
     pub clamp: Option<f32>,
@@ -100,7 +100,7 @@ impl Default for BzbGiSettings {
             },
             culling: true,
             box_splats: false,
-            compute_splat: false,
+            splat_kernel: crate::passes::Kernel::Auto,
             clamp: None,
             splat: super::Splat::Aov,
             dss: super::dss::DssSettings::default(),
@@ -151,7 +151,7 @@ impl BzbGiSettings {
                 return Err(format!("bzb-gi clamp {c} is out of range: must be > 0"));
             }
         }
-        super::compute_splat_valid("bzb-gi", self.compute_splat, self.box_splats, self.splat)?;
+        super::splat_kernel_valid("bzb-gi", self.splat_kernel, self.box_splats, self.splat)?;
         self.dss.validate()?;
         if let Some(t) = &self.temporal {
             t.validate()?;
@@ -242,7 +242,9 @@ impl BzbGiSettings {
         };
         let (c, r) = self.grid();
         let px = w as u64 * h as u64;
-        let keys = if self.compute_splat && self.visibility { 8 } else { 0 };
+        // the compute splats' keys, where they may run
+        let compute = self.splat_kernel != crate::passes::Kernel::Fragment && !self.box_splats;
+        let keys = if compute && self.visibility { 8 } else { 0 };
         dss + px * (c * r) as u64 * (16 + 16 + 8 + 4 + keys)
             + px * 8 * 7
             + self.temporal.map_or(0, |_| px * (4 * 8 + 4 * 2))
@@ -999,9 +1001,7 @@ impl BzbGiStage {
                 .write(PAYLOAD.name)
                 .build()
         });
-        if aov && s.compute_splat && s.visibility {
-            super::compute_splat_supported(gpu, "bzb-gi")?;
-        }
+        let compute_splat = aov && super::splat_compute_on(gpu, "bzb-gi", s.splat_kernel, s.visibility, s.box_splats)?;
         let splat = aov.then(|| {
             super::splat_pass_with(
                 gpu,
@@ -1025,7 +1025,7 @@ impl BzbGiStage {
                     entries: ("fs_gi_visibility", "fs_gi_additive"),
                     payload: if s.visibility { HIT } else { PAYLOAD },
                     extra: Some((&layout, group)),
-                    compute: s.compute_splat.then_some(super::ComputePayload::HitIndex),
+                    compute: compute_splat.then_some(super::ComputePayload::HitIndex),
                 },
                 &splat_uniforms,
                 &triangles,

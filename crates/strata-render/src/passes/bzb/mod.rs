@@ -116,13 +116,14 @@ pub struct BzbSettings {
     /// texels but draws 36 vertices an instance against 6; on lavapipe it is slower
     /// (`docs/bzb.md` § "Box splats").
     pub box_splats: bool,
-    /// The AOV splats' bounced z-buffer built by a compute pass (true) instead of the
-    /// rasteriser (false, the default, as the paper): the same rectangles, tests and
-    /// nearest hit (ties to the first triangle, as the depth test's draw order), kept
-    /// with 64-bit atomics (`SHADER_INT64_ATOMIC_MIN_MAX`). Visibility on only: the
-    /// additive baseline blends in the fragment form either way. `docs/bzb.md` §
-    /// "Compute splats".
-    pub compute_splat: bool,
+    /// How the AOV splats build the bounced z-buffer: the rasteriser's depth test (the
+    /// paper) or a compute pass over the same rectangles with the same tests, keeping
+    /// the nearest hit (ties to the first triangle, as the depth test's draw order)
+    /// with 64-bit atomics (`SHADER_INT64_ATOMIC_MIN_MAX`); the same bits either way.
+    /// `Auto` (default): compute on GPUs that have those atomics, for rectangle splats;
+    /// fragment on CPU adapters. Visibility on only: the additive baseline blends in
+    /// fragments. `docs/bzb.md` § "Compute splats".
+    pub splat_kernel: crate::passes::Kernel,
     /// The splatting algorithm (AOV or DSS).
     pub splat: Splat,
     /// DSS's levels, surfel size and frustum culling (used with `Splat::Dss`).
@@ -169,7 +170,7 @@ impl Default for BzbSettings {
             },
             culling: true,
             box_splats: false,
-            compute_splat: false,
+            splat_kernel: crate::passes::Kernel::Auto,
             splat: Splat::Aov,
             dss: dss::DssSettings::default(),
             temporal: None,
@@ -195,7 +196,7 @@ impl BzbSettings {
                 return Err(format!("bzb AO bias {b} is out of range: must be >= 0"));
             }
         }
-        compute_splat_valid("bzb", self.compute_splat, self.box_splats, self.splat)?;
+        splat_kernel_valid("bzb", self.splat_kernel, self.box_splats, self.splat)?;
         self.dss.validate()?;
         if let Some(t) = &self.temporal {
             t.validate()?;
@@ -287,7 +288,9 @@ impl BzbSettings {
                 + m.layered_framebuffer
                 + m.surfels;
         }
-        let keys = if self.compute_splat && self.visibility { 8 } else { 0 };
+        // the compute splats' keys, where they may run
+        let compute = self.splat_kernel != crate::passes::Kernel::Fragment && !self.box_splats;
+        let keys = if compute && self.visibility { 8 } else { 0 };
         px * (c * r) as u64 * (16 + 16 + 2 + 4 + keys)
             + px * (4 + 2 + 2)
             + triangles * 48
@@ -295,35 +298,36 @@ impl BzbSettings {
     }
 }
 
-/// `splat-raster=compute` tests the AOV splats' rectangles: not box splats, not DSS.
+/// `splat-kernel=compute` tests the AOV splats' rectangles: not box splats, not DSS.
 /// `technique` names it in the error.
-pub(crate) fn compute_splat_valid(
-    technique: &str,
-    compute: bool,
-    box_splats: bool,
-    splat: Splat,
-) -> Result<(), String> {
-    if compute && box_splats {
-        return Err(format!("{technique} splat-raster=compute tests the splats' rectangles: use splat-bounds=rect (box splats need splat-raster=fragment)"));
+pub(crate) fn splat_kernel_valid(technique: &str, kernel: crate::passes::Kernel, box_splats: bool, splat: Splat) -> Result<(), String> {
+    if kernel == crate::passes::Kernel::Compute && box_splats {
+        return Err(format!("{technique} splat-kernel=compute tests the splats' rectangles: use splat-bounds=rect (box splats need splat-kernel=fragment or auto)"));
     }
-    if compute && splat == Splat::Dss {
-        return Err(format!(
-            "{technique} splat-raster=compute applies to splat=aov (DSS splats its surfels in fragments)"
-        ));
+    if kernel == crate::passes::Kernel::Compute && splat == Splat::Dss {
+        return Err(format!("{technique} splat-kernel=compute applies to splat=aov (DSS splats its surfels in fragments)"));
     }
     Ok(())
 }
 
-/// Whether `gpu` can run the compute splat (64-bit atomic max on storage buffers); a
-/// one-line error naming the setting otherwise.
-pub(crate) fn compute_splat_supported(gpu: &GpuContext, technique: &str) -> Result<(), crate::RenderError> {
-    if gpu.has(wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX) {
-        Ok(())
-    } else {
-        Err(crate::RenderError::Parameter(format!(
-            "{technique} splat-raster=compute needs 64-bit atomics (SHADER_INT64_ATOMIC_MIN_MAX), which this adapter lacks: use splat-raster=fragment"
-        )))
+/// Whether the AOV splats run as a compute pass on `gpu` ([`BzbSettings::splat_kernel`]):
+/// `Compute` where the adapter has 64-bit atomic max on storage buffers (a one-line
+/// error naming the setting otherwise), `Auto` on GPUs that have it, with visibility and
+/// rectangle splats; never without visibility (the baseline blends).
+pub(crate) fn splat_compute_on(
+    gpu: &GpuContext,
+    technique: &str,
+    kernel: crate::passes::Kernel,
+    visibility: bool,
+    box_splats: bool,
+) -> Result<bool, crate::RenderError> {
+    let atomics = gpu.has(wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
+    if kernel == crate::passes::Kernel::Compute && visibility && !atomics {
+        return Err(crate::RenderError::Parameter(format!(
+            "{technique} splat-kernel=compute needs 64-bit atomics (SHADER_INT64_ATOMIC_MIN_MAX), which this adapter lacks: use splat-kernel=fragment or auto"
+        )));
     }
+    Ok(visibility && atomics && !box_splats && kernel.compute_on(gpu))
 }
 
 /// Mirrors `Bzb` in `bzb.wgsl`.
@@ -664,11 +668,11 @@ pub struct SplatPass {
     payload: &'static str,
     /// bzb-gi's sender data (group 2: materials, lights, shadow maps).
     extra: Option<wgpu::BindGroup>,
-    /// `splat-raster=compute`: the same splats tested in a compute pass.
+    /// `splat-kernel=compute`: the same splats tested in a compute pass.
     compute: Option<ComputeSplat>,
 }
 
-/// §3.2's splats in a compute pass (`splat-raster=compute`, bzb_splat_compute.wgsl):
+/// §3.2's splats in a compute pass (`splat-kernel=compute`, bzb_splat_compute.wgsl):
 /// one workgroup per instance walks its rectangle's texels and keeps the nearest hit
 /// with a 64-bit `atomicMax` on (depth, triangle) keys; a full-screen pass
 /// (bzb_splat_resolve.wgsl) then writes the keys into the fragment form's payload and
@@ -896,14 +900,20 @@ impl BzbStage {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        if s.compute_splat && s.visibility {
-            compute_splat_supported(gpu, "bzb")?;
-        }
+        let compute_splat = s.splat == Splat::Aov && splat_compute_on(gpu, "bzb", s.splat_kernel, s.visibility, s.box_splats)?;
         let (zminmax, splat, dss) = match s.splat {
             Splat::Aov => (
                 Some(Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count)),
                 Some(Self::splat_pass(
-                    gpu, scene_gpu, targets, s, &uniforms, &buffer, &tiles, count,
+                    gpu,
+                    scene_gpu,
+                    targets,
+                    s,
+                    compute_splat,
+                    &uniforms,
+                    &buffer,
+                    &tiles,
+                    count,
                 )),
                 None,
             ),
@@ -1072,6 +1082,7 @@ impl BzbStage {
         scene_gpu: &GpuScene,
         targets: &Targets,
         s: &BzbSettings,
+        compute: bool,
         uniforms: &wgpu::Buffer,
         triangles: &wgpu::Buffer,
         tiles: &wgpu::Buffer,
@@ -1095,7 +1106,7 @@ impl BzbStage {
                 entries: ("fs_visibility", "fs_additive"),
                 payload: PAYLOAD,
                 extra: None,
-                compute: s.compute_splat.then_some(ComputePayload::Occlusion),
+                compute: compute.then_some(ComputePayload::Occlusion),
             },
             uniforms,
             triangles,
@@ -1205,7 +1216,7 @@ pub(crate) struct SplatSpec<'a> {
     pub entries: (&'static str, &'static str),
     pub payload: TargetDesc,
     pub extra: Option<(&'a wgpu::BindGroupLayout, wgpu::BindGroup)>,
-    /// `splat-raster=compute` (visibility only): what the resolve writes as the payload.
+    /// The compute form (`splat-kernel`; visibility only): what the resolve writes as the payload.
     pub compute: Option<ComputePayload>,
 }
 
