@@ -60,6 +60,8 @@ run abuffer-glasshouse bench abuffer --scene glasshouse --width 1280 --height 72
 # BZB Table 1 (768×512)
 run bzb-atrium bench bzb --scene atrium --width 768 --height 512 --frames 5
 run bzb-atrium-box bench bzb --scene atrium --width 768 --height 512 --frames 5 --set splat-bounds=box
+run bzb-atrium-fragment bench bzb --scene atrium --width 768 --height 512 --frames 5 --set splat-kernel=fragment
+run bzb-gi-still-life-fragment bench bzb --technique bzb-gi --scene still-life --width 768 --height 512 --frames 3 --set splat-kernel=fragment
 run technique-bzb-gi bench technique --technique bzb-gi --scene still-life --width 768 --height 512 --frames 3
 run bzb-gi-still-life bench bzb --technique bzb-gi --scene still-life --width 768 --height 512 --frames 3
 run bzb-gi-dominoes bench bzb --technique bzb-gi --scene dominoes --width 768 --height 512 --frames 3

@@ -49,6 +49,9 @@ for rep in 1 2; do
     name=full-mirror ab bench technique --technique full --scene mirror $HD --frames 5 $(k ao indirect lighting reflection)
     name=ao-tech-atrium ab bench technique --technique ao --scene atrium $HD --frames 8 $(k ao)
     name=direct-atrium ab bench technique --technique direct --scene atrium $HD --frames 8 $(k lighting)
+    # BZB Table 1's size: the splats' depth test in fragments or in compute (splat-kernel)
+    name=bzb-ao-atrium ab bench technique --technique bzb-ao --scene atrium --width 768 --height 512 --frames 5 $(k splat)
+    name=bzb-gi-still-life ab bench technique --technique bzb-gi --scene still-life --width 768 --height 512 --frames 3 $(k splat)
     if [ "$v" != frag ]; then # the stage benches take no settings
       name=ao-atrium ab bench ao --scene atrium $HD --layers 2 --frames 8
       name=radiosity-atrium ab bench radiosity --scene atrium $HD --layers 2 --frames 5 --preset balanced

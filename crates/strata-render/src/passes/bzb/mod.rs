@@ -300,12 +300,19 @@ impl BzbSettings {
 
 /// `splat-kernel=compute` tests the AOV splats' rectangles: not box splats, not DSS.
 /// `technique` names it in the error.
-pub(crate) fn splat_kernel_valid(technique: &str, kernel: crate::passes::Kernel, box_splats: bool, splat: Splat) -> Result<(), String> {
+pub(crate) fn splat_kernel_valid(
+    technique: &str,
+    kernel: crate::passes::Kernel,
+    box_splats: bool,
+    splat: Splat,
+) -> Result<(), String> {
     if kernel == crate::passes::Kernel::Compute && box_splats {
         return Err(format!("{technique} splat-kernel=compute tests the splats' rectangles: use splat-bounds=rect (box splats need splat-kernel=fragment or auto)"));
     }
     if kernel == crate::passes::Kernel::Compute && splat == Splat::Dss {
-        return Err(format!("{technique} splat-kernel=compute applies to splat=aov (DSS splats its surfels in fragments)"));
+        return Err(format!(
+            "{technique} splat-kernel=compute applies to splat=aov (DSS splats its surfels in fragments)"
+        ));
     }
     Ok(())
 }
@@ -900,7 +907,8 @@ impl BzbStage {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let compute_splat = s.splat == Splat::Aov && splat_compute_on(gpu, "bzb", s.splat_kernel, s.visibility, s.box_splats)?;
+        let compute_splat =
+            s.splat == Splat::Aov && splat_compute_on(gpu, "bzb", s.splat_kernel, s.visibility, s.box_splats)?;
         let (zminmax, splat, dss) = match s.splat {
             Splat::Aov => (
                 Some(Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count)),
