@@ -649,16 +649,21 @@ fn box_splats_equal_rectangle_splats() {
 #[test]
 fn compute_splats_equal_fragment_splats() {
     let gpu = common::gpu();
-    for (scene, culling) in [
-        (procedural::builtin("atrium").unwrap(), true),
-        (procedural::builtin("atrium").unwrap(), false),
-        (procedural::builtin("cornell").unwrap(), true),
-        (plate_stack(3), true),
-        (tilted_quads(), true),
+    // atrium with S = 16: 125,856 instances, four rows of the compute dispatch
+    // (`compute_splat_groups`); the others fit one row
+    for (scene, culling, directions) in [
+        (procedural::builtin("atrium").unwrap(), true, 4),
+        (procedural::builtin("atrium").unwrap(), false, 16),
+        (procedural::builtin("cornell").unwrap(), true, 4),
+        (plate_stack(3), true, 4),
+        (tilted_quads(), true, 4),
     ] {
+        let instances = world_triangles(&scene).len() as u32 * directions;
+        assert!(directions != 16 || bzb::compute_splat_groups(instances).1 > 1);
         let b = |compute: bool| BzbSettings {
             splat_kernel: common::kernel(compute),
             culling,
+            directions,
             ..Default::default()
         };
         let (compute, fragment) = (render(&gpu, &scene, b(true)), render(&gpu, &scene, b(false)));
