@@ -738,6 +738,9 @@ fn eval_refuses_a_layer_scale_without_a_second_layer() {
     }
 }
 
+/// `bench ao` splits the first layer from the increment; the benches report the form
+/// (fragment or compute) each pass with two forms ran in: AO, radiosity, lighting,
+/// reflections and BZB's splats.
 #[test]
 fn bench_ao_splits_first_layer_and_increment() {
     let o = strata(&[
@@ -818,6 +821,34 @@ fn bench_ao_splits_first_layer_and_increment() {
         "{v}"
     );
     assert_eq!(v["indirect_kernel"], if cpu { "fragment" } else { "compute" }, "{v}");
+    // BZB's splats: `auto` as the other kernels, and what --set chooses
+    let bzb = |set: &[&str]| {
+        let mut args = vec![
+            "bench",
+            "technique",
+            "--technique",
+            "bzb-ao",
+            "--scene",
+            "column-wall",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--frames",
+            "1",
+            "--json",
+        ];
+        args.extend(set);
+        json_of(&strata(&args))
+    };
+    let auto = if cpu { "fragment" } else { "compute" };
+    assert_eq!(bzb(&[])["splat_kernel"], auto);
+    assert_eq!(bzb(&["--set", "splat-kernel=fragment"])["splat_kernel"], "fragment");
+    // the additive baseline blends in fragments whatever the kernel
+    assert_eq!(
+        bzb(&["--set", "visibility=off", "--set", "splat-kernel=compute"])["splat_kernel"],
+        "fragment"
+    );
     // a reduced AO pass: its upsampling is timed right after it, and the scale is reported
     let v = bench_with("ao-scale=2");
     assert_eq!(v["ao_scale"], 2, "{v}");

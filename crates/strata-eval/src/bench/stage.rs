@@ -95,6 +95,15 @@ pub(crate) fn run(b: Stage) -> Result<StageBench> {
         let compute = strata_render::passes::lighting::LightingPass::compute_on(&gpu, &rs.lighting);
         settings.insert("lighting_kernel".into(), form(compute).into());
     }
+    // BZB's AOV splats: the rasteriser's depth test or the compute pass
+    if let Some(compute) = rs
+        .bzb
+        .as_ref()
+        .map(|b| b.compute_splat_on(&gpu))
+        .or(rs.bzb_gi.as_ref().map(|g| g.compute_splat_on(&gpu)))
+    {
+        settings.insert("splat_kernel".into(), form(compute).into());
+    }
     if let Some(refl) = &rs.reflections {
         let formats = strata_render::passes::reflections::OUTPUTS.map(|t| t.format);
         settings.insert(

@@ -159,6 +159,14 @@ impl BzbGiSettings {
         self.filter.validate()
     }
 
+    /// Whether the AOV splats run as a compute pass on `gpu` (as `bzb-ao`'s
+    /// [`super::BzbSettings::compute_splat_on`]).
+    pub fn compute_splat_on(&self, gpu: &GpuContext) -> bool {
+        self.splat == super::Splat::Aov
+            && super::splat_compute_on(gpu, "bzb-gi", self.splat_kernel, self.visibility, self.box_splats)
+                .unwrap_or(false)
+    }
+
     /// DSS uniforms (`splat = dss`) for a `w`×`h` frame: the outermost shell
     /// d_max_dss·2^(l_max−1) reaches bzb-gi's d_max; without visibility one
     /// direction (the additive sum does not depend on ω, reconstruction reads

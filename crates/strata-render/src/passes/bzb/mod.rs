@@ -204,6 +204,13 @@ impl BzbSettings {
         self.filter.validate()
     }
 
+    /// Whether the AOV splats run as a compute pass on `gpu` ([`Self::splat_kernel`]
+    /// resolved: `Auto` by adapter, features, visibility and splat bounds).
+    pub fn compute_splat_on(&self, gpu: &GpuContext) -> bool {
+        self.splat == Splat::Aov
+            && splat_compute_on(gpu, "bzb", self.splat_kernel, self.visibility, self.box_splats).unwrap_or(false)
+    }
+
     /// r and t_min for `scene`.
     pub fn resolve(&self, scene: &Scene) -> (f32, f32) {
         let r = self.radius.unwrap_or(scene.settings.ao_radius);
