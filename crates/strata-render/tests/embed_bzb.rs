@@ -70,6 +70,14 @@ fn embedded_bzb_ao_on_the_renderers_gbuffer_is_the_renderers() {
     let cases = [
         ("AOV splats", 1, base.clone()),
         (
+            "AOV splats in a compute pass",
+            1,
+            BzbSettings {
+                splat_kernel: common::kernel(true),
+                ..base.clone()
+            },
+        ),
+        (
             "AOV splats, temporal filter",
             4,
             BzbSettings {
@@ -325,6 +333,38 @@ fn bad_embedded_bzb_input_is_a_one_line_error() {
         tris,
         vec![[Vec3::Z, Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)]]
     );
+    // the compute splats: a device without 64-bit atomics, and one whose storage buffers
+    // cannot hold the keys (8 bytes for each of the 128 x 96 texels: 98,304 bytes)
+    let compute = || BzbSettings {
+        splat_kernel: common::kernel(true),
+        ..r1()
+    };
+    let (plain, plain_queue) = pollster::block_on(gpu.adapter.request_device(&Default::default())).unwrap();
+    let atomics = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
+    let small = wgpu::Limits {
+        max_storage_buffer_binding_size: 65_536,
+        ..wgpu::Limits::default()
+    };
+    let (narrow, narrow_queue) = pollster::block_on(gpu.adapter.request_device(&wgpu::DeviceDescriptor {
+        required_features: atomics,
+        required_limits: small,
+        ..Default::default()
+    }))
+    .unwrap();
+    for (device, queue, want) in [
+        (&plain, &plain_queue, "splat-kernel=compute needs 64-bit atomics (SHADER_INT64_ATOMIC_MIN_MAX)"),
+        (
+            &narrow,
+            &narrow_queue,
+            "splat-kernel=compute: the keys of 12288 bounced-z-buffer texels (98304 bytes) exceed the adapter's largest storage buffer (65536 bytes)",
+        ),
+    ] {
+        let e = err(EmbeddedBzbAo::new(&gpu.adapter, device, queue, config(compute()), &quad));
+        println!("{e}");
+        assert!(e.contains(want) && !e.contains('\n'), "'{e}' lacks '{want}'");
+        // `auto` takes the rasteriser there
+        EmbeddedBzbAo::new(&gpu.adapter, device, queue, config(r1()), &quad).expect("auto falls back to fragment");
+    }
     gpu.check_errors().expect("no wgpu validation errors");
 }
 

@@ -99,8 +99,11 @@ pub(crate) fn run(b: Stage) -> Result<StageBench> {
     if let Some(compute) = rs
         .bzb
         .as_ref()
-        .map(|b| b.compute_splat_on(&gpu))
-        .or(rs.bzb_gi.as_ref().map(|g| g.compute_splat_on(&gpu)))
+        .map(|b| b.compute_splat_on(&gpu, rs.width, rs.height))
+        .or(rs
+            .bzb_gi
+            .as_ref()
+            .map(|g| g.compute_splat_on(&gpu, rs.width, rs.height)))
     {
         settings.insert("splat_kernel".into(), form(compute).into());
     }

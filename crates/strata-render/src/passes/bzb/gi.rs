@@ -161,10 +161,12 @@ impl BzbGiSettings {
 
     /// Whether the AOV splats run as a compute pass on `gpu` (as `bzb-ao`'s
     /// [`super::BzbSettings::compute_splat_on`]).
-    pub fn compute_splat_on(&self, gpu: &GpuContext) -> bool {
+    pub fn compute_splat_on(&self, gpu: &GpuContext, w: u32, h: u32) -> bool {
+        let (c, r) = self.grid();
+        let texels = (w * c) as u64 * (h * r) as u64;
+        let form = (self.visibility, self.box_splats);
         self.splat == super::Splat::Aov
-            && super::splat_compute_on(gpu, "bzb-gi", self.splat_kernel, self.visibility, self.box_splats)
-                .unwrap_or(false)
+            && super::splat_compute_on(gpu, "bzb-gi", self.splat_kernel, form, texels).unwrap_or(false)
     }
 
     /// DSS uniforms (`splat = dss`) for a `w`×`h` frame: the outermost shell
@@ -1009,7 +1011,9 @@ impl BzbGiStage {
                 .write(PAYLOAD.name)
                 .build()
         });
-        let compute_splat = aov && super::splat_compute_on(gpu, "bzb-gi", s.splat_kernel, s.visibility, s.box_splats)?;
+        let big_texels = big[0] as u64 * big[1] as u64;
+        let form = (s.visibility, s.box_splats);
+        let compute_splat = aov && super::splat_compute_on(gpu, "bzb-gi", s.splat_kernel, form, big_texels)?;
         let splat = aov.then(|| {
             super::splat_pass_with(
                 gpu,

@@ -204,11 +204,14 @@ impl BzbSettings {
         self.filter.validate()
     }
 
-    /// Whether the AOV splats run as a compute pass on `gpu` ([`Self::splat_kernel`]
-    /// resolved: `Auto` by adapter, features, visibility and splat bounds).
-    pub fn compute_splat_on(&self, gpu: &GpuContext) -> bool {
-        self.splat == Splat::Aov
-            && splat_compute_on(gpu, "bzb", self.splat_kernel, self.visibility, self.box_splats).unwrap_or(false)
+    /// Whether the AOV splats of a `w`×`h` frame run as a compute pass on `gpu`
+    /// ([`Self::splat_kernel`] resolved: `Auto` by adapter, features, limits, visibility
+    /// and splat bounds).
+    pub fn compute_splat_on(&self, gpu: &GpuContext, w: u32, h: u32) -> bool {
+        let (c, r) = self.grid();
+        let texels = (w * c) as u64 * (h * r) as u64;
+        let form = (self.visibility, self.box_splats);
+        self.splat == Splat::Aov && splat_compute_on(gpu, "bzb", self.splat_kernel, form, texels).unwrap_or(false)
     }
 
     /// r and t_min for `scene`.
@@ -324,24 +327,35 @@ pub(crate) fn splat_kernel_valid(
     Ok(())
 }
 
-/// Whether the AOV splats run as a compute pass on `gpu` ([`BzbSettings::splat_kernel`]):
-/// `Compute` where the adapter has 64-bit atomic max on storage buffers (a one-line
-/// error naming the setting otherwise), `Auto` on GPUs that have it, with visibility and
-/// rectangle splats; never without visibility (the baseline blends).
+/// Whether the AOV splats run as a compute pass on `gpu` ([`BzbSettings::splat_kernel`])
+/// over a bounced z-buffer of `texels` texels: `Compute` where the adapter has 64-bit
+/// atomic max on storage buffers and a storage buffer can hold the keys (8 bytes a texel;
+/// a one-line error naming the setting otherwise), `Auto` on GPUs where both hold, with
+/// visibility and rectangle splats; never without visibility (the baseline blends).
 pub(crate) fn splat_compute_on(
     gpu: &GpuContext,
     technique: &str,
     kernel: crate::passes::Kernel,
-    visibility: bool,
-    box_splats: bool,
+    (visibility, box_splats): (bool, bool),
+    texels: u64,
 ) -> Result<bool, crate::RenderError> {
     let atomics = gpu.has(wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
-    if kernel == crate::passes::Kernel::Compute && visibility && !atomics {
-        return Err(crate::RenderError::Parameter(format!(
-            "{technique} splat-kernel=compute needs 64-bit atomics (SHADER_INT64_ATOMIC_MIN_MAX), which this adapter lacks: use splat-kernel=fragment or auto"
-        )));
+    let limits = gpu.device.limits();
+    let largest = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let keys = texels.saturating_mul(8);
+    if kernel == crate::passes::Kernel::Compute && visibility {
+        if !atomics {
+            return Err(crate::RenderError::Parameter(format!(
+                "{technique} splat-kernel=compute needs 64-bit atomics (SHADER_INT64_ATOMIC_MIN_MAX), which this adapter lacks: use splat-kernel=fragment or auto"
+            )));
+        }
+        if keys > largest {
+            return Err(crate::RenderError::Parameter(format!(
+                "{technique} splat-kernel=compute: the keys of {texels} bounced-z-buffer texels ({keys} bytes) exceed the adapter's largest storage buffer ({largest} bytes): lower the directions or the size, or use splat-kernel=fragment or auto"
+            )));
+        }
     }
-    Ok(visibility && atomics && !box_splats && kernel.compute_on(gpu))
+    Ok(visibility && atomics && keys <= largest && !box_splats && kernel.compute_on(gpu))
 }
 
 /// Mirrors `Bzb` in `bzb.wgsl`.
@@ -914,8 +928,9 @@ impl BzbStage {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let compute_splat =
-            s.splat == Splat::Aov && splat_compute_on(gpu, "bzb", s.splat_kernel, s.visibility, s.box_splats)?;
+        let big_texels = big[0] as u64 * big[1] as u64;
+        let form = (s.visibility, s.box_splats);
+        let compute_splat = s.splat == Splat::Aov && splat_compute_on(gpu, "bzb", s.splat_kernel, form, big_texels)?;
         let (zminmax, splat, dss) = match s.splat {
             Splat::Aov => (
                 Some(Self::zminmax_pass(gpu, scene_gpu, targets, &tiles, tile_count)),
