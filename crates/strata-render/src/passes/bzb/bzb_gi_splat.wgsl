@@ -34,23 +34,6 @@ struct GiVisibilityOut {
     @builtin(frag_depth) depth: f32,
 }
 
-// The bounced z-buffer's depth of sender `tri` at `texel`: t²/d_max² (§3.2's squared
-// distance over d_max²) when the texel's ray (x_p, ω) hits it at t in (t_min, d_max);
-// -1 otherwise. Also the test of the compute form (bzb_splat_compute.wgsl).
-fn splat_hit_depth(texel: vec2i, tri: u32) -> f32 {
-    let o = textureLoad(origins, texel, 0);
-    let d = textureLoad(directions, texel, 0);
-    if (d.w <= 0.0) {
-        return -1.0;
-    }
-    let v = load_triangle(tri);
-    let t = bzb_ray_triangle(o.xyz, d.xyz, v[0], v[1], v[2]);
-    if (!(t > gi.t_min && t < gi.d_max)) {
-        return -1.0;
-    }
-    return t * t / (gi.d_max * gi.d_max);
-}
-
 @fragment
 fn fs_gi_visibility(in: SplatVertex) -> GiVisibilityOut {
     if (outside_rect(in)) {

@@ -183,3 +183,22 @@ fn vs_splat(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) ->
 fn load_triangle(tri: u32) -> array<vec3f, 3> {
     return array<vec3f, 3>(triangles[3u * tri].xyz, triangles[3u * tri + 1u].xyz, triangles[3u * tri + 2u].xyz);
 }
+
+// The bounced z-buffer's depth of triangle `tri` at `texel`: t²/d_max² (§3.2's squared
+// distance scaled by d_max², in [0, 1); d_max = r for AO, bzb-gi's d_max for GI) when the
+// texel's ray (x_p, ω) hits it at t in (t_min, d_max); -1 otherwise. The test of both
+// forms: the fragment entries (bzb_splat_ao.wgsl, bzb_gi_splat.wgsl) and the compute
+// pass (bzb_splat_compute.wgsl).
+fn splat_hit_depth(texel: vec2i, tri: u32) -> f32 {
+    let o = textureLoad(origins, texel, 0);
+    let d = textureLoad(directions, texel, 0);
+    if (d.w <= 0.0) {
+        return -1.0;
+    }
+    let v = load_triangle(tri);
+    let t = bzb_ray_triangle(o.xyz, d.xyz, v[0], v[1], v[2]);
+    if (!(t > bzb.t_min && t < bzb.radius)) {
+        return -1.0;
+    }
+    return t * t * bzb.inv_r2;
+}

@@ -906,9 +906,8 @@ impl BzbGiStage {
             gpu, scene_gpu, targets, &tiles, tile_count,
         ));
 
-        // group 2 of the splat: sender data, lights, shadow maps, receiver material (the
-        // compute splat reads its uniforms)
-        let frag = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        // group 2 of the splat: sender data, lights, shadow maps, receiver material
+        let frag = wgpu::ShaderStages::FRAGMENT;
         let tex = |binding| crate::passes::texture_entry(binding, wgpu::TextureViewDimension::D2, false);
         let storage_ro = |binding| wgpu::BindGroupLayoutEntry {
             binding,

@@ -745,9 +745,6 @@ impl Pass for SplatPass {
                 pass.set_pipeline(&c.pipeline);
                 pass.set_bind_group(0, &scene.frame_bind_group, &[]);
                 pass.set_bind_group(1, &c.group, &[]);
-                if let Some(g) = &self.extra {
-                    pass.set_bind_group(2, g, &[]);
-                }
                 let (x, y) = compute_splat_groups(self.instances);
                 pass.dispatch_workgroups(x, y, 1);
             }
@@ -1308,13 +1305,10 @@ pub(crate) fn splat_pass_with(
         let mut entries = resources.to_vec();
         entries.push(keys.as_entire_binding());
         let group = crate::passes::bind_group(device, "bzb-splat compute", &layout, &entries);
-        let mut layouts = vec![Some(&scene_gpu.frame_layout), Some(&layout)];
-        if let Some(l) = extra_layout {
-            layouts.push(Some(l));
-        }
+        // the test reads group 1 alone (bzb-gi's group 2 serves its fragment entries)
         let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("bzb-splat compute"),
-            bind_group_layouts: &layouts,
+            bind_group_layouts: &[Some(&scene_gpu.frame_layout), Some(&layout)],
             immediate_size: 0,
         });
         let source = format!("{}\n{}", spec.source, include_str!("bzb_splat_compute.wgsl"));
