@@ -42,6 +42,22 @@ pub(crate) fn fullscreen_pipeline_with(
     constants: &[(&str, f64)],
     targets: &[Option<wgpu::ColorTargetState>],
 ) -> wgpu::RenderPipeline {
+    fullscreen_pipeline_writing_depth(device, label, layout, module, fragment_entry, constants, targets, None)
+}
+
+/// [`fullscreen_pipeline_with`] that also writes its fragments' `frag_depth` into a
+/// depth attachment of `depth` format (test Always), where `depth` is given.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fullscreen_pipeline_writing_depth(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    fragment_entry: &str,
+    constants: &[(&str, f64)],
+    targets: &[Option<wgpu::ColorTargetState>],
+    depth: Option<wgpu::TextureFormat>,
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
@@ -52,7 +68,13 @@ pub(crate) fn fullscreen_pipeline_with(
             buffers: &[],
         },
         primitive: Default::default(),
-        depth_stencil: None,
+        depth_stencil: depth.map(|format| wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module,

@@ -1,10 +1,10 @@
 // bzb-gi §3.2: the AOV splats of bzb_splat.wgsl (same vertex shader: the screen
 // rectangle of the triangle's AABB grown by d_max, in sub-image s) with a
 // radiance payload. Appended after bzb.wgsl, bzb_gi.wgsl and bzb_splat.wgsl.
-//   fs_gi_visibility: the texel's ray (x_p, ω) hits the triangle at t in
-//       (t_min, d_max) → depth t²/d_max² and the triangle's index into
-//       bzb-gi-hit (depth test Less, no blending: the nearest sender along ω
-//       wins); a miss discards. The `bzb-gi-shade` pass then computes the
+//   bzb_splat.wgsl's fs_visibility with HIT_INDEX: the texel's ray (x_p, ω) hits
+//       the triangle at t in (t_min, d_max) → depth t²/d_max² and the triangle's
+//       index into bzb-gi-hit (depth test Less, no blending: the nearest sender
+//       along ω wins); a miss discards. The `bzb-gi-shade` pass then computes the
 //       winner's outgoing radiance L(y → x_p) once per texel (deferred: on a
 //       CPU rasteriser shading every hit fragment cost more than the test).
 //   fs_gi_additive: the baseline without visibility: every triangle within
@@ -27,28 +27,6 @@
 @group(2) @binding(9) var<storage, read> mean_radiance: array<vec4f>;
 // the senders' textures (gi::sender_texels), read by bzb_gi_sender.wgsl
 @group(2) @binding(10) var<storage, read> sender_texels: array<u32>;
-
-struct GiVisibilityOut {
-    // the hit triangle + 1 (bzb-gi-hit; the shade pass computes its radiance)
-    @location(0) hit: vec4f,
-    @builtin(frag_depth) depth: f32,
-}
-
-@fragment
-fn fs_gi_visibility(in: SplatVertex) -> GiVisibilityOut {
-    if (outside_rect(in)) {
-        discard;
-    }
-    let z = splat_hit_depth(vec2i(in.position.xy), in.triangle);
-    if (z < 0.0) {
-        discard;
-    }
-    var out: GiVisibilityOut;
-    // exact in f32 below 2^24 triangles
-    out.hit = vec4f(f32(in.triangle + 1u));
-    out.depth = z;
-    return out;
-}
 
 @fragment
 fn fs_gi_additive(in: SplatVertex) -> @location(0) vec4f {

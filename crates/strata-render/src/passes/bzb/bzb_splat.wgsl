@@ -202,3 +202,30 @@ fn splat_hit_depth(texel: vec2i, tri: u32) -> f32 {
     }
     return t * t * bzb.inv_r2;
 }
+
+// What a hit writes besides its depth: 1 for AO's binary occlusion (the estimator of
+// §3.3 divides by α), or, with HIT_INDEX, the hit triangle + 1 for bzb-gi-hit (exact in
+// f32 below 2^24 triangles; `bzb-gi-shade` computes its radiance).
+override HIT_INDEX: bool = false;
+
+struct VisibilityOut {
+    @location(0) payload: vec4f,
+    @builtin(frag_depth) depth: f32,
+}
+
+// With visibility (§3.2): a hit writes its depth and payload (depth test Less, no
+// blending: the nearest triangle along ω wins); a miss discards.
+@fragment
+fn fs_visibility(in: SplatVertex) -> VisibilityOut {
+    if (outside_rect(in)) {
+        discard;
+    }
+    let z = splat_hit_depth(vec2i(in.position.xy), in.triangle);
+    if (z < 0.0) {
+        discard;
+    }
+    var out: VisibilityOut;
+    out.payload = select(vec4f(1.0), vec4f(f32(in.triangle + 1u)), HIT_INDEX);
+    out.depth = z;
+    return out;
+}

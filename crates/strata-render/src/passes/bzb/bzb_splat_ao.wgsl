@@ -1,29 +1,7 @@
-// bzb-ao §3.2: the fragment entries of the AOV splats (appended after bzb.wgsl and
-// bzb_splat.wgsl, whose vertex shader draws them):
-//   fs_visibility: hit at t in (t_min, r) → depth t²/r², payload 1 (depth test
-//                  Less, no blending: the nearest occluder along ω wins); miss → discard.
-//   fs_additive:   the analytic AOV occlusion, summed by additive blending (McGuire 2010).
-
-struct VisibilityOut {
-    @location(0) occlusion: vec4f,
-    @builtin(frag_depth) depth: f32,
-}
-
-@fragment
-fn fs_visibility(in: SplatVertex) -> VisibilityOut {
-    if (outside_rect(in)) {
-        discard;
-    }
-    let z = splat_hit_depth(vec2i(in.position.xy), in.triangle);
-    if (z < 0.0) {
-        discard;
-    }
-    var out: VisibilityOut;
-    // AO payload: binary occlusion (the estimator of §3.3 divides by α)
-    out.occlusion = vec4f(1.0);
-    out.depth = z;
-    return out;
-}
+// bzb-ao §3.2: the AOV splats' baseline without visibility (appended after bzb.wgsl and
+// bzb_splat.wgsl, whose vertex shader draws the splats and whose `fs_visibility` tests
+// them with visibility: hit at t in (t_min, r) → depth t²/r², payload 1):
+//   fs_additive: the analytic AOV occlusion, summed by additive blending (McGuire 2010).
 
 @fragment
 fn fs_additive(in: SplatVertex) -> @location(0) vec4f {

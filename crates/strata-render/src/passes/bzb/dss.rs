@@ -1024,6 +1024,7 @@ impl DssStage {
                 visibility,
                 GI_PAYLOAD.format,
                 ("fs_gi_visibility", "fs_gi_additive"),
+                &[],
             )
         } else {
             let module = crate::shader::module(device, "dss-splat", dss_shader!("dss_splat.wgsl"));

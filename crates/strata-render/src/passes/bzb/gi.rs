@@ -1033,10 +1033,11 @@ impl BzbGiStage {
                         "\n",
                         include_str!("bzb_gi_splat.wgsl")
                     ),
-                    entries: ("fs_gi_visibility", "fs_gi_additive"),
+                    entries: ("fs_visibility", "fs_gi_additive"),
                     payload: if s.visibility { HIT } else { PAYLOAD },
                     extra: Some((&layout, group)),
-                    compute: compute_splat.then_some(super::ComputePayload::HitIndex),
+                    hit: super::HitPayload::HitIndex,
+                    compute: compute_splat,
                 },
                 &splat_uniforms,
                 &triangles,

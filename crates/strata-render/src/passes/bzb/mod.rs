@@ -1133,7 +1133,8 @@ impl BzbStage {
                 entries: ("fs_visibility", "fs_additive"),
                 payload: PAYLOAD,
                 extra: None,
-                compute: compute.then_some(ComputePayload::Occlusion),
+                hit: HitPayload::Occlusion,
+                compute,
             },
             uniforms,
             triangles,
@@ -1243,17 +1244,27 @@ pub(crate) struct SplatSpec<'a> {
     pub entries: (&'static str, &'static str),
     pub payload: TargetDesc,
     pub extra: Option<(&'a wgpu::BindGroupLayout, wgpu::BindGroup)>,
-    /// The compute form (`splat-kernel`; visibility only): what the resolve writes as the payload.
-    pub compute: Option<ComputePayload>,
+    /// What a hit writes besides its depth (with visibility).
+    pub hit: HitPayload,
+    /// The compute form (`splat-kernel`; visibility only).
+    pub compute: bool,
 }
 
-/// The payload the compute form's resolve writes per hit texel.
+/// What a hit writes besides its depth, in either form (`HIT_INDEX` in bzb_splat.wgsl
+/// and bzb_splat_resolve.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum ComputePayload {
-    /// 1 (bzb-ao's binary occlusion, as `fs_visibility`).
+pub(crate) enum HitPayload {
+    /// 1: bzb-ao's binary occlusion.
     Occlusion,
-    /// The hit triangle + 1 (bzb-gi's `bzb-gi-hit`, as `fs_gi_visibility`).
+    /// The hit triangle + 1: bzb-gi's `bzb-gi-hit`.
     HitIndex,
+}
+
+impl HitPayload {
+    /// The shaders' `HIT_INDEX` override.
+    fn constants(self) -> [(&'static str, f64); 1] {
+        [("HIT_INDEX", (self == HitPayload::HitIndex) as u32 as f64)]
+    }
 }
 
 /// §3.2's splat pass over the triangles in `triangles` (group 1: uniforms,
@@ -1289,7 +1300,7 @@ pub(crate) fn splat_pass_with(
     if let Some(l) = extra_layout {
         layouts.push(Some(l));
     }
-    let compute = spec.compute.filter(|_| spec.visibility).map(|payload| {
+    let compute = (spec.compute && spec.visibility).then(|| {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bzb-splat compute"),
             entries: &splat_layout_entries(true),
@@ -1321,7 +1332,7 @@ pub(crate) fn splat_pass_with(
             compilation_options: Default::default(),
             cache: None,
         });
-        let (resolve, resolve_group) = resolve_pipeline(device, targets, &keys, spec.payload.format, payload);
+        let (resolve, resolve_group) = resolve_pipeline(device, targets, &keys, spec.payload.format, spec.hit);
         ComputeSplat {
             pipeline,
             group,
@@ -1330,6 +1341,7 @@ pub(crate) fn splat_pass_with(
             keys,
         }
     });
+    let constants = spec.hit.constants();
     // the rasteriser's form, unless the compute form replaces it
     let pipeline = compute.is_none().then(|| {
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -1346,6 +1358,7 @@ pub(crate) fn splat_pass_with(
             spec.visibility,
             spec.payload.format,
             spec.entries,
+            if spec.visibility { &constants[..] } else { &[] },
         )
     });
     SplatPass {
@@ -1408,7 +1421,7 @@ fn resolve_pipeline(
     targets: &Targets,
     keys: &wgpu::Buffer,
     format: wgpu::TextureFormat,
-    payload: ComputePayload,
+    hit: HitPayload,
 ) -> (wgpu::RenderPipeline, wgpu::BindGroup) {
     let frag = wgpu::ShaderStages::FRAGMENT;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -1442,41 +1455,16 @@ fn resolve_pipeline(
         immediate_size: 0,
     });
     let module = crate::shader::module(device, "bzb-splat-resolve", include_str!("bzb_splat_resolve.wgsl"));
-    let hit_index = if payload == ComputePayload::HitIndex { 1.0 } else { 0.0 };
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("bzb-splat-resolve"),
-        layout: Some(&pl),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_fullscreen"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH.format,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Always),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_resolve"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &[("HIT_INDEX", hit_index)],
-                ..Default::default()
-            },
-            targets: &[Some(wgpu::ColorTargetState {
-                format,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let pipeline = crate::passes::fullscreen_pipeline_writing_depth(
+        device,
+        "bzb-splat-resolve",
+        &pl,
+        &module,
+        "fs_resolve",
+        &hit.constants(),
+        &[Some(wgpu::ColorTargetState::from(format))],
+        Some(DEPTH.format),
+    );
     (pipeline, group)
 }
 
@@ -1506,10 +1494,13 @@ pub(crate) fn splat_pipeline(
         visibility,
         PAYLOAD.format,
         ("fs_visibility", "fs_additive"),
+        &[],
     )
 }
 
-/// [`splat_pipeline`] with the payload format and fragment entries (visibility, additive) given.
+/// [`splat_pipeline`] with the payload format, fragment entries (visibility, additive)
+/// and the fragment stage's override constants given.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn splat_pipeline_with(
     device: &wgpu::Device,
     label: &str,
@@ -1518,6 +1509,7 @@ pub(crate) fn splat_pipeline_with(
     visibility: bool,
     format: wgpu::TextureFormat,
     entries: (&'static str, &'static str),
+    constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
     let (entry, blend, depth_stencil) = if visibility {
         (
@@ -1557,7 +1549,10 @@ pub(crate) fn splat_pipeline_with(
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             targets: &[Some(wgpu::ColorTargetState {
                 format,
                 blend,

@@ -98,33 +98,16 @@ impl LayerUpsamplePass {
             immediate_size: 0,
         });
         let color_targets = settings.layer_color_targets(motion);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(NAMES[layer as usize]),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_upsample"),
-                compilation_options: Default::default(),
-                targets: &color_targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::passes::fullscreen_pipeline_writing_depth(
+            device,
+            NAMES[layer as usize],
+            &layout,
+            &module,
+            "fs_upsample",
+            &[],
+            &color_targets,
+            Some(DEPTH_FORMAT),
+        );
         Self {
             name: NAMES[layer as usize],
             layer,
