@@ -37,7 +37,7 @@ pub const STRATA_FEATURES: &[(&str, wgpu::Features, &str)] = &[
     (
         "SHADER_INT64_ATOMIC_MIN_MAX",
         wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX,
-        "64-bit atomics (bounced z-buffer)",
+        "64-bit atomics (the bounced z-buffer's compute splats)",
     ),
     ("TEXTURE_ATOMIC", wgpu::Features::TEXTURE_ATOMIC, "R32 texture atomics"),
     ("SUBGROUP", wgpu::Features::SUBGROUP, "subgroup reductions"),

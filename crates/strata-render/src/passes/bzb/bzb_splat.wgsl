@@ -2,11 +2,15 @@
 // (triangle, sub-image s); its vertices (pulled from the triangle storage
 // buffer: wgpu has no geometry shaders) draw the back faces of a box around the
 // triangle's occlusion volume {x : dist(x, T) < r}, clipped to the screen
-// rectangle of T's AABB grown by r (both conservative), placed in sub-image s. Each covered texel tests its own
-// ray (x_p, ω) against the triangle:
-//   fs_visibility: hit at t in (t_min, r) → depth t²/r², payload 1 (depth test
-//                  Less, no blending: the nearest occluder along ω wins); miss → discard.
-//   fs_additive:   the analytic AOV occlusion, summed by additive blending (McGuire 2010).
+// rectangle of T's AABB grown by r (both conservative), placed in sub-image s. Each
+// covered texel tests its own ray (x_p, ω) against the triangle (`splat_hit_depth`):
+//   fs_visibility (below): hit at t in (t_min, r) → depth t²/r², payload 1 for AO or
+//       the triangle + 1 for bzb-gi (depth test Less, no blending: the nearest
+//       triangle along ω wins); miss → discard.
+//   the baselines without visibility, summed by additive blending: bzb_splat_ao.wgsl's
+//       fs_additive (McGuire 2010's AOV occlusion), bzb_gi_splat.wgsl's fs_gi_additive.
+// bzb_splat_compute.wgsl tests the same rectangles in a compute pass (`splat-kernel`).
+// For bzb-gi, r is its d_max.
 #import "common/camera.wgsl"
 #import "common/packing.wgsl"
 #import "common/zminmax.wgsl"
