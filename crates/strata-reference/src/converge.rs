@@ -37,6 +37,9 @@ pub enum Estimator {
     Obscurance(ObscuranceSettings),
     /// Path-traced diffuse GI (6 channels: direct RGB, then indirect RGB).
     Gi(GiSettings),
+    /// The screen-space oracle's split of the path tracer's indirect light
+    /// ([`crate::oracle`], [`crate::oracle::ORACLE_CHANNELS`] channels).
+    ScreenOracle(crate::oracle::ScreenOracleSettings),
 }
 
 impl Estimator {
@@ -45,6 +48,7 @@ impl Estimator {
         match self {
             Estimator::AoBinary(_) | Estimator::Obscurance(_) => 1,
             Estimator::Gi(_) => 6,
+            Estimator::ScreenOracle(_) => crate::oracle::ORACLE_CHANNELS,
         }
     }
 
@@ -53,6 +57,7 @@ impl Estimator {
             Estimator::AoBinary(s) => s.seed,
             Estimator::Obscurance(s) => s.seed,
             Estimator::Gi(s) => s.seed,
+            Estimator::ScreenOracle(s) => s.gi.seed,
         }
     }
 
@@ -63,6 +68,7 @@ impl Estimator {
             Estimator::AoBinary(s) => s.seed = seed,
             Estimator::Obscurance(s) => s.seed = seed,
             Estimator::Gi(s) => s.seed = seed,
+            Estimator::ScreenOracle(s) => s.gi.seed = seed,
         }
         e
     }
@@ -214,6 +220,12 @@ impl Reference<'_> {
                 let px = self.for_each_pixel("GI", width, height, |x, y, rays| {
                     let [d, i] = self.gi_pixel_sum(camera, x, y, width, height, s, samples.clone(), rays);
                     [d.x, d.y, d.z, i.x, i.y, i.z].map(f64::from)
+                });
+                px.into_iter().flatten().collect()
+            }
+            Estimator::ScreenOracle(s) => {
+                let px = self.for_each_pixel("screen-space oracle", width, height, |x, y, rays| {
+                    self.oracle_pixel_sum(camera, x, y, (width, height), s, samples.clone(), rays)
                 });
                 px.into_iter().flatten().collect()
             }

@@ -203,8 +203,33 @@ impl Reference<'_> {
         samples: std::ops::Range<u32>,
         rays: &mut u64,
     ) -> [Vec3; 2] {
-        let dir = camera.pixel_dir(x, y, width, height);
         let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
+        self.gi_pixel_paths(camera, x, y, width, height, settings, samples, rays, |d, i, _| {
+            direct += d;
+            indirect += i;
+        });
+        [direct, indirect]
+    }
+
+    /// Traces the paths with sample indices in `samples` through the centre of pixel
+    /// (x, y) and hands each one's (direct, indirect) radiance to `each`, with the
+    /// first bounce's hit point (`None` when it left the scene or the path ended at
+    /// the primary hit). [`Self::gi_pixel_sum`] sums them; the screen-space oracle
+    /// ([`crate::oracle`]) sorts them by where the first bounce landed.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn gi_pixel_paths(
+        &self,
+        camera: &Camera,
+        x: u32,
+        y: u32,
+        width: u32,
+        height: u32,
+        settings: &GiSettings,
+        samples: std::ops::Range<u32>,
+        rays: &mut u64,
+        mut each: impl FnMut(Vec3, Vec3, Option<Vec3>),
+    ) {
+        let dir = camera.pixel_dir(x, y, width, height);
         let pixel = y as u64 * width as u64 + x as u64;
         // The first bounce direction (the dimension the indirect light depends
         // on most) follows the R2 sequence with a per-pixel rotation; the
@@ -230,10 +255,8 @@ impl Reference<'_> {
                 &mut rng,
                 rays,
             );
-            direct += d;
-            indirect += i;
+            each(d, i, memo.bounce);
         }
-        [direct, indirect]
     }
 
     /// Radiance arriving at `origin` from direction −`dir` (one path sample) that a
@@ -300,6 +323,9 @@ impl Reference<'_> {
     ) -> (Vec3, Vec3) {
         let sky = Vec3::from(self.scene.settings.sky);
         let (mut direct, mut indirect) = (Vec3::ZERO, Vec3::ZERO);
+        if let Some(m) = memo.as_deref_mut() {
+            m.bounce = None;
+        }
         let first_hit = match memo.as_deref_mut() {
             Some(FirstVertex { hit: Some(h), .. }) => *h,
             _ => {
@@ -403,6 +429,9 @@ impl Reference<'_> {
                 throughput /= q;
             }
             hit = self.bvh.surface(&next, wi);
+            if let (0, Some(m)) = (depth, memo.as_deref_mut()) {
+                m.bounce = Some(hit.position);
+            }
             wo = wi;
         }
         (direct, indirect)
@@ -774,4 +803,6 @@ mod one_bounce_tests {
 pub(crate) struct FirstVertex {
     hit: Option<Option<crate::bvh::Hit>>,
     lights: Option<Vec3>,
+    /// The current path's first bounce hit (vertex 1), written by every path.
+    bounce: Option<Vec3>,
 }

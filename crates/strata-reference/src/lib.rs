@@ -55,6 +55,7 @@ pub mod environment;
 pub mod gi;
 pub mod layers;
 pub mod oit;
+pub mod oracle;
 pub mod probes;
 pub mod sampling;
 pub mod tracer;

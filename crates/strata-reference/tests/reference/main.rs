@@ -9,6 +9,7 @@ mod gi;
 mod glossy;
 mod layers;
 mod oit;
+mod oracle;
 mod scenes;
 mod tracer;
 mod vpl;

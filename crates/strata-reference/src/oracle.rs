@@ -1,0 +1,269 @@
+//! The screen-space oracle: the indirect light a *perfect* gather over k deep-G-buffer
+//! layers would see, and DGB's blend with light probes built on it.
+//!
+//! DGB §3.2 gathers the radiance of the surfaces its layers hold and blends the result
+//! with a probe's irradiance by the confidence c: E = c·Ê + (1 − c)·E_probe, Ê the
+//! gather's estimate of the whole hemisphere's irradiance from what it saw. A perfect
+//! gather sees exactly the directions whose first surface lies in one of the layers,
+//! and over them it gets the path tracer's light. Then c is the cosine-weighted share of
+//! those directions, c·Ê is their irradiance E_seen, and
+//!
+//!   E_oracle = E_seen + (1 − c)·E_probe                       (DGB §3.2's blend)
+//!
+//! is the best image that blend can give with these probes; Ê = E_seen / c is the best
+//! screen space alone can give. Neither depends on the gather's taps, MIP levels,
+//! filters or bounces: the errors left are the probes' and what the layers miss.
+//!
+//! Which surfaces "a layer holds" is decided along the camera ray through the bounce's
+//! hit point y itself, with the layer rule of [`crate::layers`]: y is in layer 0 when
+//! nothing lies in front of it, and in layer j when it is the first surface more than
+//! Δz behind layer j − 1's (the rule applied at y's own image position, not at a pixel
+//! centre: a gather at any resolution approaches this). y must also project inside the
+//! image. The radius-bounded variants also require |y − x| ≤ r, the gather's world-space
+//! radius.
+//!
+//! The estimator shares the path tracer's paths ([`Reference::gi_pixel_paths`]): its
+//! total is [`crate::Estimator::Gi`]'s indirect light with the same seed, bit for bit.
+//! Each path's indirect light arrives through its first bounce, so sorting paths by
+//! where that bounce landed splits the indirect light exactly.
+
+use glam::Vec3;
+use strata_scene::{Camera, ImageBuf};
+
+use crate::gi::GiSettings;
+use crate::Reference;
+
+/// The variants the estimator tracks: (layers k, bounded by the radius).
+pub const ORACLE_VARIANTS: [(usize, bool); 4] = [(1, false), (2, false), (1, true), (2, true)];
+
+/// Channels of [`crate::Estimator::ScreenOracle`]'s per-pixel means: the indirect
+/// light (3), the receiver's albedo ρ (3), then per variant of [`ORACLE_VARIANTS`] the
+/// indirect light of the paths it sees (3) and their share c (1).
+pub const ORACLE_CHANNELS: u32 = 6 + 4 * ORACLE_VARIANTS.len() as u32;
+
+/// Settings of the screen-space oracle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenOracleSettings {
+    /// The paths (bounces, seed; `spp` is unused, the sample range decides).
+    pub gi: GiSettings,
+    /// DGB's minimum separation Δz between layers (camera-space depth).
+    pub min_separation: f32,
+    /// The gather's world-space radius r for the bounded variants.
+    pub radius: f32,
+}
+
+/// The layer (0-based) that holds the point `p` as the camera sees it: the camera ray
+/// towards `p` peeled with the minimum separation `min_separation` (relative tolerance
+/// `tolerance`, as [`crate::LayerSettings::depth_tolerance`]), or `None` when `p` lies
+/// outside the image, within the separation of the layer before it, or deeper than
+/// `count` layers.
+#[allow(clippy::too_many_arguments)]
+pub fn screen_layer(
+    r: &Reference,
+    camera: &Camera,
+    (width, height): (u32, u32),
+    min_separation: f32,
+    tolerance: f32,
+    count: usize,
+    p: Vec3,
+    rays: &mut u64,
+) -> Option<usize> {
+    let (right, up, forward) = camera.basis();
+    let d = p - camera.eye;
+    let z = d.dot(forward);
+    if !(z > camera.near) {
+        return None;
+    }
+    let t = (0.5 * camera.fov_y_deg.to_radians()).tan();
+    let aspect = width as f32 / height as f32;
+    let (nx, ny) = (d.dot(right) / (z * t * aspect), d.dot(up) / (z * t));
+    if !(nx.abs() <= 1.0 && ny.abs() <= 1.0) {
+        return None;
+    }
+    // the ray's parameter is camera-space depth, as `Camera::pixel_dir`'s
+    let dir = d / z;
+    // p's own surface, a hair in front of it, does not count as a layer before it
+    let end = z * (1.0 - 1e-4);
+    let mut start = camera.near;
+    for j in 0..count {
+        if z < start {
+            return None;
+        }
+        *rays += 1;
+        match r.bvh.intersect(camera.eye, dir, start, end) {
+            None => return Some(j),
+            Some(h) => start = h.t + min_separation + tolerance * h.t,
+        }
+    }
+    None
+}
+
+/// DGB §3.2's blend with a perfect gather: E_seen + (1 − c)·E_probe, as the indirect
+/// *radiance* of a Lambertian receiver of albedo ρ (`seen` is already ρ/π·E_seen).
+pub fn oracle_blend(seen: Vec3, c: f32, albedo: Vec3, e_probe: Vec3) -> Vec3 {
+    seen + (1.0 - c.clamp(0.0, 1.0)) * albedo * e_probe * std::f32::consts::FRAC_1_PI
+}
+
+/// Screen space alone with a perfect gather: Ê = E_seen / c (0 where it saw nothing).
+pub fn oracle_alone(seen: Vec3, c: f32) -> Vec3 {
+    if c > 0.0 {
+        seen / c
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// The oracle's per-pixel means split into images.
+#[derive(Clone, Debug)]
+pub struct OracleImages {
+    /// The path tracer's indirect light (RGB).
+    pub total: ImageBuf,
+    /// The receiver's albedo (RGB; black where the pixel has no surface).
+    pub albedo: ImageBuf,
+    /// Per variant of [`ORACLE_VARIANTS`]: the indirect light of the paths it sees (RGB).
+    pub seen: Vec<ImageBuf>,
+    /// Per variant: the share of the paths it sees, c (1 channel).
+    pub confidence: Vec<ImageBuf>,
+}
+
+impl OracleImages {
+    /// Splits a [`ORACLE_CHANNELS`]-channel image of means.
+    pub fn from_means(means: &ImageBuf) -> Self {
+        assert_eq!(
+            means.channels, ORACLE_CHANNELS,
+            "oracle means have {ORACLE_CHANNELS} channels"
+        );
+        let take = |first: usize, n: u32| {
+            let mut out = ImageBuf::new(means.width, means.height, n);
+            for (o, p) in out
+                .data
+                .chunks_exact_mut(n as usize)
+                .zip(means.data.chunks_exact(ORACLE_CHANNELS as usize))
+            {
+                o.copy_from_slice(&p[first..first + n as usize]);
+            }
+            out
+        };
+        let variants = 0..ORACLE_VARIANTS.len();
+        Self {
+            total: take(0, 3),
+            albedo: take(3, 3),
+            seen: variants.clone().map(|v| take(6 + 4 * v, 3)).collect(),
+            confidence: variants.map(|v| take(9 + 4 * v, 1)).collect(),
+        }
+    }
+
+    /// The index of variant (k, bounded) in [`ORACLE_VARIANTS`].
+    pub fn variant(k: usize, bounded: bool) -> usize {
+        ORACLE_VARIANTS
+            .iter()
+            .position(|&v| v == (k.clamp(1, 2), bounded))
+            .expect("k is 1 or 2")
+    }
+
+    /// [`oracle_blend`] at every pixel with the probes' irradiance `e_probe` (RGB).
+    pub fn blend(&self, variant: usize, e_probe: &ImageBuf) -> ImageBuf {
+        self.per_pixel(variant, |seen, c, albedo, i| {
+            let e = Vec3::from_slice(&e_probe.data[e_probe.channels as usize * i..][..3]);
+            oracle_blend(seen, c, albedo, e)
+        })
+    }
+
+    /// [`oracle_alone`] at every pixel.
+    pub fn alone(&self, variant: usize) -> ImageBuf {
+        self.per_pixel(variant, |seen, c, _, _| oracle_alone(seen, c))
+    }
+
+    /// The mean confidence of a variant over the pixels with a surface.
+    pub fn mean_confidence(&self, variant: usize) -> f64 {
+        let (mut sum, mut n) = (0.0f64, 0u32);
+        for (c, a) in self.confidence[variant]
+            .data
+            .iter()
+            .zip(self.albedo.data.chunks_exact(3))
+        {
+            if a.iter().any(|v| *v > 0.0) {
+                sum += *c as f64;
+                n += 1;
+            }
+        }
+        sum / n.max(1) as f64
+    }
+
+    fn per_pixel(&self, variant: usize, f: impl Fn(Vec3, f32, Vec3, usize) -> Vec3) -> ImageBuf {
+        let mut out = ImageBuf::new(self.total.width, self.total.height, 3);
+        let seen = &self.seen[variant].data;
+        let c = &self.confidence[variant].data;
+        for (i, o) in out.data.chunks_exact_mut(3).enumerate() {
+            let s = Vec3::from_slice(&seen[3 * i..3 * i + 3]);
+            let a = Vec3::from_slice(&self.albedo.data[3 * i..3 * i + 3]);
+            o.copy_from_slice(&f(s, c[i], a, i).to_array());
+        }
+        out
+    }
+}
+
+impl Reference<'_> {
+    /// Per-pixel sums of the oracle over the sample indices `samples`
+    /// ([`ORACLE_CHANNELS`] values, see there).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn oracle_pixel_sum(
+        &self,
+        camera: &Camera,
+        x: u32,
+        y: u32,
+        (width, height): (u32, u32),
+        s: &ScreenOracleSettings,
+        samples: std::ops::Range<u32>,
+        rays: &mut u64,
+    ) -> [f64; ORACLE_CHANNELS as usize] {
+        let mut out = [0.0f64; ORACLE_CHANNELS as usize];
+        let dir = camera.pixel_dir(x, y, width, height);
+        *rays += 1;
+        let Some(h) = self.bvh.intersect(camera.eye, dir, camera.near, f32::INFINITY) else {
+            return out;
+        };
+        let hit = self.bvh.surface(&h, dir);
+        let receiver = hit.position;
+        let albedo = self.albedo(&hit);
+        let n = samples.len() as f64;
+        for c in 0..3 {
+            out[3 + c] = albedo[c] as f64 * n;
+        }
+        let tolerance = crate::LayerSettings::default().depth_tolerance;
+        let mut layer_rays = 0;
+        // summed as `gi_pixel_sum` sums, so that the total is its indirect light bit for bit
+        let mut total = Vec3::ZERO;
+        self.gi_pixel_paths(camera, x, y, width, height, &s.gi, samples, rays, |_, i, bounce| {
+            total += i;
+            let Some(p) = bounce else {
+                return;
+            };
+            let layer = screen_layer(
+                self,
+                camera,
+                (width, height),
+                s.min_separation,
+                tolerance,
+                2,
+                p,
+                &mut layer_rays,
+            );
+            let near = (p - receiver).length() <= s.radius;
+            for (v, &(k, bounded)) in ORACLE_VARIANTS.iter().enumerate() {
+                if layer.is_some_and(|j| j < k) && (!bounded || near) {
+                    let o = 6 + 4 * v;
+                    for c in 0..3 {
+                        out[o + c] += i[c] as f64;
+                    }
+                    out[o + 3] += 1.0;
+                }
+            }
+        });
+        *rays += layer_rays;
+        for c in 0..3 {
+            out[c] = total[c] as f64;
+        }
+        out
+    }
+}
