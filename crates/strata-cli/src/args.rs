@@ -602,6 +602,12 @@ pub struct EvalArgs {
     /// without the n_Y test against single-bounce references with and without visibility.
     #[arg(long)]
     pub fig10: bool,
+    /// gi: also evaluate DGB's blend with a *perfect* gather over 1 and k ≤ 2 layers: the path
+    /// tracer's light from the surfaces the layers hold, c the share of paths they hold, and
+    /// the GPU's probes for the rest (`docs/radiosity.md` § "The screen-space oracle"). Its
+    /// paths are traced and cached like the reference's.
+    #[arg(long)]
+    pub oracle: bool,
     /// gi: evaluate the deep G-buffer's screen-space radiosity alone. By default it is blended
     /// with light probes baked from the evaluated (sky-off) scene by its confidence, as
     /// `render --technique full` shows it (DGB §3.2: "all our results use static radiance and

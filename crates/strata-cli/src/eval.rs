@@ -26,6 +26,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
     if a.views || a.technique.eval != EvalKind::Radiance || is_bzb_gi {
         let gi_only = [
             ("--fig10", a.fig10),
+            ("--oracle", a.oracle),
             ("--no-probes", a.no_probes),
             ("--probes-from", a.probes_from.is_some() && !a.views),
         ];
@@ -145,6 +146,7 @@ pub fn run(a: &EvalArgs) -> Result<()> {
             let g = gi::GiEvalSettings {
                 bounces: a.bounces,
                 fig10: a.fig10,
+                oracle: a.oracle,
                 probes: !a.no_probes,
                 probes_from: a.probes_from.clone(),
                 probe_bake: a.radiosity.probe_bake(),
@@ -231,6 +233,32 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 "{} gi k={k} {w}x{h}: indirect FLIP {:.4} RMSE {:.4} MAE {:.4} mean ×{:.3}; full FLIP {:.4} RMSE {:.4} (reference {} spp, {} bounces, noise FLIP {:.4} indirect / {:.4} full)",
                 run.scene, i.flip, i.rmse, i.mae, i.mean_ratio.unwrap_or(f32::NAN), f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
             );
+            if let Some(o) = &e.oracle {
+                println!(
+                    "  perfect gather (oracle, {} spp, noise FLIP {:.4}; r = {:.3}; probe twin off by {:.2} %):",
+                    o.noise.spp,
+                    o.noise.flip,
+                    o.radius,
+                    100.0 * o.probe_twin_error.unwrap_or(0.0)
+                );
+                for row in &o.by_layers {
+                    println!(
+                        "    k={}: c {:.3} ({:.3} within r); GPU's denoised RMSE {:.5}",
+                        row.layers, row.confidence, row.confidence_within_radius, row.gpu_rmse_denoised
+                    );
+                    for x in &row.entries {
+                        println!(
+                            "      {:<8} {:<9} indirect FLIP {:.4} RMSE {:.5} (denoised {:.5}) mean ×{:.3}",
+                            x.blend,
+                            if x.within_radius { "within r" } else { "anywhere" },
+                            x.errors.flip,
+                            x.errors.rmse,
+                            x.rmse_denoised,
+                            x.errors.mean_ratio.unwrap_or(f32::NAN)
+                        );
+                    }
+                }
+            }
         }
         EvalResult::BzbGi(e) => {
             let line = |what: &str, x: &strata_eval::results::GiErrors| {

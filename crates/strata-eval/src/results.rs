@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::metrics::ErrorStats;
+use crate::metrics::{ErrorStats, RefNoise};
 use crate::stats::Spread;
 
 /// The JSON text of a result as the CLI prints it: through `serde_json::Value`, so keys are
@@ -508,6 +508,57 @@ pub struct GiEval {
     /// With a report: every k from 1 to `layers`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub by_layers: Vec<ByLayers<GiErrors>>,
+    /// `--oracle`: DGB's blend with a perfect gather beside the GPU's, for k = 1 and k.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub oracle: Option<GiOracle>,
+}
+
+/// `eval --technique gi --oracle`: what a perfect screen-space gather over k layers gives
+/// (`strata_reference::oracle`), path-traced along paths independent of the reference's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GiOracle {
+    /// The oracle's own noise: its two halves' blended images compared (k = `layers`, the
+    /// radius-bounded blend, or screen space alone without probes).
+    pub noise: RefNoise,
+    /// The gather's world-space radius of the bounded rows.
+    pub radius: f32,
+    /// Mean |E_cpu − E_gpu| / mean E_gpu of the probes' irradiance at the evaluated pixels:
+    /// how closely the CPU twin the `detail` rows read follows the GPU's probe field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe_twin_error: Option<f64>,
+    /// One row per evaluated layer count (1, then `layers`).
+    pub by_layers: Vec<GiOracleRow>,
+}
+
+/// The oracle's errors for one layer count, indirect light against the reference.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GiOracleRow {
+    pub layers: u32,
+    /// Mean confidence c (the share of paths whose first bounce the layers hold) over the
+    /// pixels with a surface: anywhere in the image, and within the radius.
+    pub confidence: f64,
+    pub confidence_within_radius: f64,
+    /// The GPU image's RMSE for this k with the reference's Monte Carlo noise taken out,
+    /// beside the entries' `rmse_denoised`.
+    pub gpu_rmse_denoised: f32,
+    pub entries: Vec<GiOracleEntry>,
+}
+
+/// One blend of the perfect gather.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GiOracleEntry {
+    /// `paper`: c·Ê + (1 − c)·E_probe (DGB §3.2); `renderer`: the rule the GPU ran, with
+    /// the one-sided confidence (listed when it is on); `detail`: E_probe + E_seen − the
+    /// probes' own light over the seen directions (the control variate of `--set
+    /// probe-detail=on`, with the CPU twin of the probe field); `alone`: Ê, screen space
+    /// alone; `probes`: E_probe alone (c = 0), the same for every k.
+    pub blend: String,
+    /// Only paths whose first bounce lies within the gather's radius count as seen.
+    pub within_radius: bool,
+    pub errors: ErrorStats,
+    /// RMSE with both images' Monte Carlo noise taken out (each image's variance from its
+    /// two halves).
+    pub rmse_denoised: f32,
 }
 
 /// `strata eval --technique bzb-gi`: bounced-z-buffer GI against the one-bounce path tracer,

@@ -10,9 +10,10 @@
 //!
 //!   E_oracle = E_seen + (1 − c)·E_probe                       (DGB §3.2's blend)
 //!
-//! is the best image that blend can give with these probes; Ê = E_seen / c is the best
-//! screen space alone can give. Neither depends on the gather's taps, MIP levels,
-//! filters or bounces: the errors left are the probes' and what the layers miss.
+//! is what that blend gives with these probes and nothing lost in the gather; Ê = E_seen / c
+//! is what screen space alone gives. Neither depends on the gather's taps, MIP levels,
+//! filters or bounces: the errors left are the probes', what the layers miss, and the
+//! blend's assumption that the directions the layers miss carry the probes' average.
 //!
 //! Which surfaces "a layer holds" is decided along the camera ray through the bounce's
 //! hit point y itself, with the layer rule of [`crate::layers`]: y is in layer 0 when
@@ -36,10 +37,17 @@ use crate::Reference;
 /// The variants the estimator tracks: (layers k, bounded by the radius).
 pub const ORACLE_VARIANTS: [(usize, bool); 4] = [(1, false), (2, false), (1, true), (2, true)];
 
-/// Channels of [`crate::Estimator::ScreenOracle`]'s per-pixel means: the indirect
-/// light (3), the receiver's albedo ρ (3), then per variant of [`ORACLE_VARIANTS`] the
-/// indirect light of the paths it sees (3) and their share c (1).
-pub const ORACLE_CHANNELS: u32 = 6 + 4 * ORACLE_VARIANTS.len() as u32;
+/// Channels per variant: the indirect light of the paths it sees (3), their share c (1),
+/// and the mean over all paths of the seen indicator × the order-2 SH basis of the first
+/// bounce's direction (9; `strata_scene::probes::sh9`).
+const PER_VARIANT: usize = 13;
+/// Channels before the variants: the indirect light (3), the receiver's albedo ρ (3), its
+/// position (3) and its shading normal facing the camera (3).
+const HEAD: usize = 12;
+
+/// Channels of [`crate::Estimator::ScreenOracle`]'s per-pixel means: see `HEAD` and
+/// `PER_VARIANT`, one block per variant of [`ORACLE_VARIANTS`].
+pub const ORACLE_CHANNELS: u32 = (HEAD + PER_VARIANT * ORACLE_VARIANTS.len()) as u32;
 
 /// Settings of the screen-space oracle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,19 +106,25 @@ pub fn screen_layer(
     None
 }
 
-/// DGB §3.2's blend with a perfect gather: E_seen + (1 − c)·E_probe, as the indirect
-/// *radiance* of a Lambertian receiver of albedo ρ (`seen` is already ρ/π·E_seen).
-pub fn oracle_blend(seen: Vec3, c: f32, albedo: Vec3, e_probe: Vec3) -> Vec3 {
-    seen + (1.0 - c.clamp(0.0, 1.0)) * albedo * e_probe * std::f32::consts::FRAC_1_PI
+/// The gather's irradiance Ê = E_seen / c of a receiver of albedo ρ, from the radiance
+/// `seen` (ρ/π·E_seen) of the paths the layers hold and their share `c` (0 where it saw
+/// nothing or ρ is 0).
+pub fn gathered_irradiance(seen: Vec3, c: f32, albedo: Vec3) -> Vec3 {
+    let e = |s: f32, a: f32| {
+        if c > 0.0 && a > 0.0 {
+            s * std::f32::consts::PI / (a * c)
+        } else {
+            0.0
+        }
+    };
+    Vec3::new(e(seen.x, albedo.x), e(seen.y, albedo.y), e(seen.z, albedo.z))
 }
 
-/// Screen space alone with a perfect gather: Ê = E_seen / c (0 where it saw nothing).
-pub fn oracle_alone(seen: Vec3, c: f32) -> Vec3 {
-    if c > 0.0 {
-        seen / c
-    } else {
-        Vec3::ZERO
-    }
+/// DGB §3.2's blend with a perfect gather, c·Ê + (1 − c)·E_probe = E_seen + (1 − c)·E_probe,
+/// as the blend rule of [`OracleImages::blend`].
+pub fn paper_blend(e_hat: Vec3, c: f32, e_probe: Vec3) -> Vec3 {
+    let c = c.clamp(0.0, 1.0);
+    c * e_hat + (1.0 - c) * e_probe
 }
 
 /// The oracle's per-pixel means split into images.
@@ -120,10 +134,17 @@ pub struct OracleImages {
     pub total: ImageBuf,
     /// The receiver's albedo (RGB; black where the pixel has no surface).
     pub albedo: ImageBuf,
+    /// The receiver's position and shading normal (facing the camera), RGB each.
+    pub position: ImageBuf,
+    pub normal: ImageBuf,
     /// Per variant of [`ORACLE_VARIANTS`]: the indirect light of the paths it sees (RGB).
     pub seen: Vec<ImageBuf>,
     /// Per variant: the share of the paths it sees, c (1 channel).
     pub confidence: Vec<ImageBuf>,
+    /// Per variant: the mean of the seen indicator × `sh9` of the path's first direction
+    /// (9 channels). With cosine-distributed paths, π Σ L_lm · this is the cosine-weighted
+    /// integral of an SH radiance L over the directions the variant sees.
+    pub seen_sh: Vec<ImageBuf>,
 }
 
 impl OracleImages {
@@ -145,11 +166,15 @@ impl OracleImages {
             out
         };
         let variants = 0..ORACLE_VARIANTS.len();
+        let block = |v: usize| HEAD + PER_VARIANT * v;
         Self {
             total: take(0, 3),
             albedo: take(3, 3),
-            seen: variants.clone().map(|v| take(6 + 4 * v, 3)).collect(),
-            confidence: variants.map(|v| take(9 + 4 * v, 1)).collect(),
+            position: take(6, 3),
+            normal: take(9, 3),
+            seen: variants.clone().map(|v| take(block(v), 3)).collect(),
+            confidence: variants.clone().map(|v| take(block(v) + 3, 1)).collect(),
+            seen_sh: variants.map(|v| take(block(v) + 4, 9)).collect(),
         }
     }
 
@@ -161,17 +186,19 @@ impl OracleImages {
             .expect("k is 1 or 2")
     }
 
-    /// [`oracle_blend`] at every pixel with the probes' irradiance `e_probe` (RGB).
-    pub fn blend(&self, variant: usize, e_probe: &ImageBuf) -> ImageBuf {
+    /// The indirect radiance ρ/π·E of a blend `rule`(Ê, c, E_probe) → E at every pixel, Ê
+    /// the perfect gather's irradiance ([`gathered_irradiance`]) and E_probe the probes'
+    /// irradiance `e_probe` (RGB).
+    pub fn blend(&self, variant: usize, e_probe: &ImageBuf, rule: impl Fn(Vec3, f32, Vec3) -> Vec3) -> ImageBuf {
         self.per_pixel(variant, |seen, c, albedo, i| {
             let e = Vec3::from_slice(&e_probe.data[e_probe.channels as usize * i..][..3]);
-            oracle_blend(seen, c, albedo, e)
+            albedo * std::f32::consts::FRAC_1_PI * rule(gathered_irradiance(seen, c, albedo), c, e)
         })
     }
 
-    /// [`oracle_alone`] at every pixel.
+    /// Screen space alone, ρ/π·Ê = seen / c, at every pixel.
     pub fn alone(&self, variant: usize) -> ImageBuf {
-        self.per_pixel(variant, |seen, c, _, _| oracle_alone(seen, c))
+        self.per_pixel(variant, |seen, c, _, _| if c > 0.0 { seen / c } else { Vec3::ZERO })
     }
 
     /// The mean confidence of a variant over the pixels with a surface.
@@ -190,7 +217,8 @@ impl OracleImages {
         sum / n.max(1) as f64
     }
 
-    fn per_pixel(&self, variant: usize, f: impl Fn(Vec3, f32, Vec3, usize) -> Vec3) -> ImageBuf {
+    /// `f`(seen radiance, c, albedo, pixel index) → radiance at every pixel of a variant.
+    pub fn per_pixel(&self, variant: usize, f: impl Fn(Vec3, f32, Vec3, usize) -> Vec3) -> ImageBuf {
         let mut out = ImageBuf::new(self.total.width, self.total.height, 3);
         let seen = &self.seen[variant].data;
         let c = &self.confidence[variant].data;
@@ -216,8 +244,8 @@ impl Reference<'_> {
         s: &ScreenOracleSettings,
         samples: std::ops::Range<u32>,
         rays: &mut u64,
-    ) -> [f64; ORACLE_CHANNELS as usize] {
-        let mut out = [0.0f64; ORACLE_CHANNELS as usize];
+    ) -> Vec<f64> {
+        let mut out = vec![0.0f64; ORACLE_CHANNELS as usize];
         let dir = camera.pixel_dir(x, y, width, height);
         *rays += 1;
         let Some(h) = self.bvh.intersect(camera.eye, dir, camera.near, f32::INFINITY) else {
@@ -225,10 +253,12 @@ impl Reference<'_> {
         };
         let hit = self.bvh.surface(&h, dir);
         let receiver = hit.position;
-        let albedo = self.albedo(&hit);
         let n = samples.len() as f64;
-        for c in 0..3 {
-            out[3 + c] = albedo[c] as f64 * n;
+        let fixed = [self.albedo(&hit), receiver, hit.facing_normals(dir).0];
+        for (j, v) in fixed.iter().enumerate() {
+            for c in 0..3 {
+                out[3 + 3 * j + c] = v[c] as f64 * n;
+            }
         }
         let tolerance = crate::LayerSettings::default().depth_tolerance;
         let mut layer_rays = 0;
@@ -250,13 +280,17 @@ impl Reference<'_> {
                 &mut layer_rays,
             );
             let near = (p - receiver).length() <= s.radius;
+            let sh = strata_scene::probes::sh9((p - receiver).normalize_or_zero());
             for (v, &(k, bounded)) in ORACLE_VARIANTS.iter().enumerate() {
                 if layer.is_some_and(|j| j < k) && (!bounded || near) {
-                    let o = 6 + 4 * v;
+                    let o = HEAD + PER_VARIANT * v;
                     for c in 0..3 {
                         out[o + c] += i[c] as f64;
                     }
                     out[o + 3] += 1.0;
+                    for (m, y) in sh.iter().enumerate() {
+                        out[o + 4 + m] += *y as f64;
+                    }
                 }
             }
         });

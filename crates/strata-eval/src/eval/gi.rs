@@ -5,11 +5,12 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
+use glam::Vec3;
 use strata_reference::gi::{GiSettings, OneBounceSettings};
 use strata_reference::{Estimator, Reference};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::lighting::LightingSettings;
-use strata_render::passes::radiosity::RadiositySettings;
+use strata_render::passes::radiosity::{probe_blend, RadiositySettings};
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, ImageBuf, Scene};
 
@@ -17,7 +18,7 @@ use super::{figure, flicker, half_flip, noise_warnings, write_report, EvalSettin
 use crate::cache::{scene_fingerprint, RefCache};
 use crate::metrics::{compare_radiance, display};
 use crate::report::Section;
-use crate::results::{EvalResult, Fig10, Fig10Row, GiErrors, GiEval};
+use crate::results::{EvalResult, Fig10, Fig10Row, GiErrors, GiEval, GiOracle, GiOracleEntry, GiOracleRow};
 
 /// Default cap on the path tracer's samples per pixel (`--ref-spp`).
 pub const DEFAULT_CAP: u32 = 32_768;
@@ -38,6 +39,8 @@ pub struct GiEvalSettings {
     pub probes_from: Option<String>,
     /// The probes' grid, probes per axis (`cache::probes::GRID` by default).
     pub probe_bake: crate::cache::probes::ProbeBake,
+    /// Also evaluate DGB's blend with a perfect gather (`strata_reference::oracle`).
+    pub oracle: bool,
 }
 
 /// GPU images of one configuration and their errors.
@@ -48,6 +51,8 @@ struct GiResult {
     errors: GiErrors,
     full_map: ImageBuf,
     indirect_map: ImageBuf,
+    /// The probes' irradiance the GPU blended with (`--oracle` with probes).
+    probe_irradiance: Option<ImageBuf>,
 }
 
 /// The path tracer's GI of `camera` with `bounces` indirect bounces, converged under
@@ -91,6 +96,12 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
     let rule = s.check(DEFAULT_CAP, 8)?;
     if !(1..=64).contains(&g.bounces) {
         bail!("--bounces {} is out of range: must be in 1..=64", g.bounces);
+    }
+    if g.oracle && !(1..=2).contains(&s.deep.layers) {
+        bail!(
+            "--layers {} with --oracle: the oracle splits the light by 1 or 2 layers, so --layers must be in 1..=2",
+            s.deep.layers
+        );
     }
     let (mut scene, cams) = s.scene.load()?;
     // Compare like with like: the reference is Lambertian with no ambient
@@ -154,6 +165,10 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         let (indirect_stats, indirect_map) = compare_radiance(&ref_indirect.image, &indirect, exposure)?;
         let full_stats = ref_total.annotate(full_stats, &display(&full, exposure));
         let indirect_stats = ref_indirect.annotate(indirect_stats, &display(&indirect, exposure));
+        let probe_irradiance = match g.oracle && probes.is_some() {
+            true => Some(rgb(&r.read_target(&gpu, "probe-irradiance")?)),
+            false => None,
+        };
         Ok(GiResult {
             layers,
             full,
@@ -164,6 +179,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
             },
             full_map,
             indirect_map,
+            probe_irradiance,
         })
     };
     let k = s.deep.layers;
@@ -190,6 +206,20 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         }
         None => None,
     };
+    let (oracle, oracle_figures) = match g.oracle {
+        true => oracle_rows(
+            s,
+            &scene,
+            camera,
+            (g.bounces, rs.radius.unwrap_or(scene.settings.radiosity_radius)),
+            (rs.one_sided_confidence, probes.as_ref()),
+            &rule,
+            (&converged, &ref_indirect),
+            results.iter().chain([&main]),
+        )
+        .map(|(o, f)| (Some(o), f))?,
+        false => (None, Vec::new()),
+    };
     let out = GiEval {
         run: s.run_info(
             converged.spp(),
@@ -214,12 +244,225 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         layers_1: results.first().map(|o| o.errors),
         fig10,
         by_layers: s.by_layers(results.iter().chain([&main]).map(|r| (r.layers, r.errors))),
+        oracle,
     };
     if let Some(dir) = &s.report {
         let refs = (&ref_total.image, &ref_indirect.image);
-        write_gi_report(dir, s, &out, &main, results.first(), refs, exposure)?;
+        write_gi_report(dir, s, &out, (&main, results.first()), &oracle_figures, refs, exposure)?;
     }
     Ok(out)
+}
+
+/// `--oracle`: the screen-space oracle converged under `rule` (paths independent of the
+/// reference's, cached like it), and per evaluated layer count its blends with the GPU's
+/// probe irradiance and its screen space alone against the reference's indirect light.
+#[allow(clippy::too_many_arguments)]
+fn oracle_rows<'a>(
+    s: &EvalSettings,
+    scene: &Scene,
+    camera: Camera,
+    (bounces, radius): (u32, f32),
+    (one_sided, field): (bool, Option<&strata_scene::probes::IrradianceProbes>),
+    rule: &strata_reference::ConvergeRule,
+    (reference, ref_indirect): (&strata_reference::Converged, &RefImage),
+    results: impl Iterator<Item = &'a GiResult>,
+) -> Result<(GiOracle, Vec<OracleFigure>)> {
+    use std::f32::consts::{FRAC_1_PI, PI};
+    use strata_reference::oracle::{paper_blend, OracleImages, ScreenOracleSettings};
+    let (w, h) = (s.scene.width, s.scene.height);
+    let min_separation = s.deep.min_separation.unwrap_or(scene.settings.min_separation);
+    let estimator = Estimator::ScreenOracle(ScreenOracleSettings {
+        gi: GiSettings {
+            bounces,
+            russian_roulette: false,
+            // a stream of its own: sharing the reference's paths would share its noise
+            seed: 0x05ac1e,
+            ..Default::default()
+        },
+        min_separation,
+        radius,
+    });
+    let exposure = s.display_exposure(scene);
+    let shown = |img: &ImageBuf| display(img, exposure);
+    let k = s.deep.layers as usize;
+    let results: Vec<&GiResult> = results.collect();
+    let probe_e = results.last().and_then(|r| r.probe_irradiance.clone());
+    // the renderer's blend rule, with a perfect gather
+    let renderer = |e_hat: Vec3, c: f32, e_probe: Vec3| probe_blend(e_hat, c, e_probe, one_sided);
+    // the image the oracle's noise is measured on: the renderer's rule, k layers, within r
+    let shown_blend = |means: &ImageBuf| {
+        let img = OracleImages::from_means(means);
+        let v = OracleImages::variant(k, true);
+        match &probe_e {
+            Some(e) => img.blend(v, e, renderer),
+            None => img.alone(v),
+        }
+    };
+    let description = format!(
+        "v1 screen oracle {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
+        scene_fingerprint(scene, s.scene.frame),
+    );
+    let converged = RefCache::new(&s.cache).converged(s.no_cache, &description, &estimator, || {
+        Reference::new(scene, s.scene.frame).with_progress(s.progress).converge(
+            &camera,
+            w,
+            h,
+            &estimator,
+            rule,
+            |a, b| half_flip(&shown_blend(a), &shown_blend(b), shown),
+        )
+    });
+    let noise = RefImage::of(&converged, shown_blend, shown)?.noise;
+    let image = OracleImages::from_means(&converged.image());
+    let halves = converged.halves.each_ref().map(OracleImages::from_means);
+    let ref_halves = reference.half_images().map(|hf| indirect(&hf));
+    // the `detail` rows read the CPU twin of the probe field: how far it is from the GPU's
+    let probe_twin_error = match (field, &probe_e) {
+        (Some(field), Some(e)) => {
+            let (mut d, mut t) = (0.0f64, 0.0f64);
+            for i in 0..(w * h) as usize {
+                let p = Vec3::from_slice(&image.position.data[3 * i..3 * i + 3]);
+                let n = Vec3::from_slice(&image.normal.data[3 * i..3 * i + 3]);
+                if n != Vec3::ZERO {
+                    let c = field.irradiance(p, n, (camera.eye - p).normalize_or_zero());
+                    let g = Vec3::from_slice(&e.data[3 * i..3 * i + 3]);
+                    d += (c - g).abs().element_sum() as f64;
+                    t += g.element_sum() as f64;
+                }
+            }
+            Some(d / t.max(1e-30))
+        }
+        _ => None,
+    };
+    let mut rows = Vec::new();
+    let mut figures = Vec::new();
+    for r in &results {
+        let kl = r.layers as usize;
+        let c = &image.confidence[OracleImages::variant(kl, true)];
+        figures.push(OracleFigure {
+            file: format!("oracle-confidence-k{kl}.png"),
+            caption: format!("perfect gather's c, k = {kl} (white = 1)"),
+            image: ImageBuf {
+                data: c.data.iter().flat_map(|v| [*v; 3]).collect(),
+                channels: 3,
+                ..c.clone()
+            },
+            radiance: false,
+        });
+        let mut entries = Vec::new();
+        for within_radius in [false, true] {
+            let v = OracleImages::variant(kl, within_radius);
+            let mut blends: Vec<(&str, Box<dyn Fn(&OracleImages) -> ImageBuf>)> = Vec::new();
+            if let Some(e) = r.probe_irradiance.clone() {
+                let e2 = e.clone();
+                blends.push(("paper", Box::new(move |o: &OracleImages| o.blend(v, &e, paper_blend))));
+                if one_sided {
+                    blends.push(("renderer", Box::new(move |o: &OracleImages| o.blend(v, &e2, renderer))));
+                }
+            }
+            // the probes' own radiance along the directions the layers miss (the control
+            // variate of `--set probe-detail=on`): E_probe + E_seen − ∫_seen L_probe cos,
+            // with the CPU twin of the GPU's probe field
+            if let Some(field) = field {
+                let eye = camera.eye;
+                blends.push((
+                    "detail",
+                    Box::new(move |o: &OracleImages| {
+                        o.per_pixel(v, |seen, _, albedo, i| {
+                            let p = Vec3::from_slice(&o.position.data[3 * i..3 * i + 3]);
+                            let n = Vec3::from_slice(&o.normal.data[3 * i..3 * i + 3]);
+                            if albedo == Vec3::ZERO || n == Vec3::ZERO {
+                                return Vec3::ZERO;
+                            }
+                            let view = (eye - p).normalize_or_zero();
+                            let l = field.radiance_sh(p, n, view);
+                            let moments = &o.seen_sh[v].data[9 * i..9 * i + 9];
+                            let e_probe_seen: Vec3 = l.iter().zip(moments).map(|(li, m)| *li * *m).sum::<Vec3>() * PI;
+                            let e = field.irradiance(p, n, view) - e_probe_seen;
+                            (seen + albedo * FRAC_1_PI * e).max(Vec3::ZERO)
+                        })
+                    }),
+                ));
+            }
+            blends.push(("alone", Box::new(move |o: &OracleImages| o.alone(v))));
+            // the probes alone (c = 0), once per row
+            if let (false, Some(e)) = (within_radius, r.probe_irradiance.clone()) {
+                blends.push((
+                    "probes",
+                    Box::new(move |o: &OracleImages| o.blend(v, &e, |_, _, ep| ep)),
+                ));
+            }
+            for (name, f) in blends {
+                let img = f(&image);
+                let (stats, _) = compare_radiance(&ref_indirect.image, &img, exposure)?;
+                if within_radius || name == "probes" {
+                    figures.push(OracleFigure {
+                        file: format!("oracle-{name}-k{kl}.png"),
+                        caption: format!("perfect gather, {name}, k = {kl}: FLIP {:.4}", stats.flip),
+                        image: img.clone(),
+                        radiance: true,
+                    });
+                }
+                entries.push(GiOracleEntry {
+                    blend: name.into(),
+                    within_radius,
+                    errors: ref_indirect.annotate(stats, &display(&img, exposure)),
+                    rmse_denoised: denoised_rmse(
+                        &ref_indirect.image,
+                        &ref_halves,
+                        &img,
+                        Some(&halves.each_ref().map(|o| f(o))),
+                    ),
+                });
+            }
+        }
+        rows.push(GiOracleRow {
+            layers: r.layers,
+            confidence: image.mean_confidence(OracleImages::variant(kl, false)),
+            confidence_within_radius: image.mean_confidence(OracleImages::variant(kl, true)),
+            gpu_rmse_denoised: denoised_rmse(&ref_indirect.image, &ref_halves, &r.indirect, None),
+            entries,
+        });
+    }
+    let oracle = GiOracle {
+        noise,
+        radius,
+        probe_twin_error,
+        by_layers: rows,
+    };
+    Ok((oracle, figures))
+}
+
+/// An image of `--oracle` for the report.
+struct OracleFigure {
+    file: String,
+    caption: String,
+    image: ImageBuf,
+    /// Tonemapped as radiance (else shown as it is).
+    radiance: bool,
+}
+
+/// RMSE between `test` and `reference` with the Monte Carlo noise of both taken out: the mean
+/// squared difference less each image's variance, estimated from its two halves as
+/// mean((a − b)²) / 4 (the variance of their mean). 0 when the noise explains it all.
+fn denoised_rmse(
+    reference: &ImageBuf,
+    ref_halves: &[ImageBuf; 2],
+    test: &ImageBuf,
+    test_halves: Option<&[ImageBuf; 2]>,
+) -> f32 {
+    let mse = |a: &ImageBuf, b: &ImageBuf| {
+        let n = a.data.len().max(1) as f64;
+        a.data
+            .iter()
+            .zip(&b.data)
+            .map(|(x, y)| ((x - y) as f64).powi(2))
+            .sum::<f64>()
+            / n
+    };
+    let variance = |h: &[ImageBuf; 2]| mse(&h[0], &h[1]) / 4.0;
+    let noise = variance(ref_halves) + test_halves.map_or(0.0, variance);
+    (mse(reference, test) - noise).max(0.0).sqrt() as f32
 }
 
 pub(crate) fn render_settings(s: &EvalSettings, layers: u32, radiosity: &RadiositySettings) -> RenderSettings {
@@ -307,8 +550,8 @@ fn write_gi_report(
     dir: &Path,
     s: &EvalSettings,
     out: &GiEval,
-    main: &GiResult,
-    one: Option<&GiResult>,
+    (main, one): (&GiResult, Option<&GiResult>),
+    oracle: &[OracleFigure],
     (ref_total, ref_indirect): (&ImageBuf, &ImageBuf),
     exposure: f32,
 ) -> Result<()> {
@@ -351,6 +594,22 @@ fn write_gi_report(
                     )?,
                     map(&o.indirect_map, "flip-indirect-k1.png", "FLIP error, k = 1".into())?,
                 ]),
+        );
+    }
+    if !oracle.is_empty() {
+        let figures = oracle
+            .iter()
+            .map(|f| match f.radiance {
+                true => fig(&f.image, &f.file, f.caption.clone()),
+                false => map(&f.image, &f.file, f.caption.clone()),
+            })
+            .collect::<Result<Vec<_>>>()?;
+        sections.push(
+            Section::new("A perfect gather (`--oracle`)")
+                .text(
+                    "The path tracer's light from the surfaces the layers hold (within the gather's radius), c the share of paths they hold, and the GPU's probes for the rest: `paper` c·Ê + (1 − c)·E_probe, `renderer` the GPU's blend rule, `alone` Ê, `probes` E_probe.",
+                )
+                .figures(figures),
         );
     }
     write_report(

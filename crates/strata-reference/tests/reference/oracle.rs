@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use strata_reference::oracle::{
-    oracle_alone, oracle_blend, OracleImages, ScreenOracleSettings, ORACLE_CHANNELS, ORACLE_VARIANTS,
+    gathered_irradiance, paper_blend, OracleImages, ScreenOracleSettings, ORACLE_CHANNELS, ORACLE_VARIANTS,
 };
 use strata_reference::{Estimator, GiSettings, Reference};
 use strata_scene::{Camera, ImageBuf, Material, Scene};
@@ -178,6 +178,37 @@ fn oracle_confidence_is_the_form_factor_of_what_the_layers_hold() {
                     };
                     let at =
                         format!("blocker {with_blocker}, r {radius}, pixel ({px}, {py}), F(Q) {fq:.4}, F(B) {fb:.4}");
+                    // the seen directions' SH moments: Y00 · c, and for the tile alone the
+                    // y band, 0.4886 · ∫_Q ω_y cos θ / π dω = 0.4886 · ∫_Q h³ / (π r⁵) dA
+                    let v1 = OracleImages::variant(1, false);
+                    let sh = &img.seen_sh[v1].data[9 * i..9 * i + 9];
+                    assert!(
+                        (sh[0] - 0.282_095 * c(1, false)).abs() < 1e-5,
+                        "{at}: Y00 moment {}",
+                        sh[0]
+                    );
+                    if !with_blocker && radius > 1.0 {
+                        let (steps, hh) = (100, 1.0f32);
+                        let da = (1.0 / steps as f32).powi(2);
+                        let mut want = 0.0;
+                        for a in 0..steps {
+                            for b in 0..steps {
+                                let q = Vec3::new(
+                                    -0.5 + (a as f32 + 0.5) / steps as f32,
+                                    hh,
+                                    -0.5 + (b as f32 + 0.5) / steps as f32,
+                                );
+                                let r = (q - x).length();
+                                want += hh.powi(3) / (std::f32::consts::PI * r.powi(5)) * da;
+                            }
+                        }
+                        assert!(
+                            (sh[1] - 0.488_603 * want).abs() < 0.015,
+                            "{at}: y-band moment {} against {}",
+                            sh[1],
+                            0.488_603 * want
+                        );
+                    }
                     if radius < 1.0 {
                         assert_eq!((c(1, true), c(2, true)), (0.0, 0.0), "{at}");
                     } else {
@@ -204,18 +235,31 @@ fn oracle_confidence_is_the_form_factor_of_what_the_layers_hold() {
     }
 }
 
-/// DGB §3.2's blend with a perfect gather, and screen space alone.
+/// DGB §3.2's blend with a perfect gather is E_seen + (1 − c)·E_probe, and screen space
+/// alone Ê = E_seen / c, at every pixel of a two-pixel oracle image.
 #[test]
 fn oracle_blend_fills_what_the_layers_miss_with_the_probes() {
-    let (seen, albedo, e) = (
-        Vec3::new(0.2, 0.1, 0.05),
-        Vec3::new(0.5, 0.5, 0.25),
-        Vec3::new(2.0, 4.0, 8.0),
-    );
     let pi = std::f32::consts::PI;
-    let b = oracle_blend(seen, 0.25, albedo, e);
-    assert!((b - (seen + 0.75 * albedo * e / pi)).abs().max_element() < 1e-6);
-    assert_eq!(oracle_blend(seen, 1.0, albedo, e), seen);
-    assert_eq!(oracle_alone(seen, 0.5), seen * 2.0);
-    assert_eq!(oracle_alone(seen, 0.0), Vec3::ZERO);
+    let (albedo, e_seen, c) = (Vec3::new(0.5, 0.5, 0.25), Vec3::new(1.0, 0.5, 0.25), 0.25);
+    let seen = albedo * e_seen / pi;
+    assert!((gathered_irradiance(seen, c, albedo) - e_seen / c).abs().max_element() < 1e-6);
+    assert_eq!(gathered_irradiance(seen, 0.0, albedo), Vec3::ZERO);
+    // pixel 0 as above, pixel 1 without a surface
+    let mut means = ImageBuf::new(2, 1, ORACLE_CHANNELS);
+    means.data[3..6].copy_from_slice(&albedo.to_array());
+    let v = OracleImages::variant(2, true);
+    let block = (ORACLE_CHANNELS as usize - 12) / ORACLE_VARIANTS.len();
+    let o = 12 + block * v;
+    means.data[o..o + 3].copy_from_slice(&seen.to_array());
+    means.data[o + 3] = c;
+    let img = OracleImages::from_means(&means);
+    let mut e_probe = ImageBuf::new(2, 1, 3);
+    e_probe.data.fill(2.0);
+    let blend = img.blend(v, &e_probe, paper_blend);
+    let want = seen + (1.0 - c) * albedo * 2.0 / pi;
+    assert!((Vec3::from_slice(&blend.data[..3]) - want).abs().max_element() < 1e-6);
+    assert_eq!(&blend.data[3..], &[0.0; 3]);
+    let alone = img.alone(v);
+    assert!((Vec3::from_slice(&alone.data[..3]) - seen / c).abs().max_element() < 1e-6);
+    assert_eq!(img.mean_confidence(v), 0.25 as f64);
 }
