@@ -1257,6 +1257,103 @@ fn eval_gi_reports_indirect_and_full_errors() {
     assert_one_line_error(&o, &["open-sky", "fill", "sky"]);
 }
 
+/// `eval --technique gi --oracle`: DGB's blend with a perfect gather beside the GPU's, for
+/// k = 1 and 2 (the report evaluates both). The second layer holds at least what the first
+/// does, every blend of the rule is reported against the same reference, the CPU twin of the
+/// probe field the control variate reads follows the GPU's, and the report shows the images.
+/// `--oracle` splits the light by 1 or 2 layers only, and only `eval --technique gi` reads it.
+#[test]
+fn eval_gi_oracle_reports_a_perfect_gather_beside_the_gpu() {
+    let cache = scratch("gi-oracle-cache");
+    let report = scratch("gi-oracle-report");
+    let _ = std::fs::remove_dir_all(&cache);
+    let _ = std::fs::remove_dir_all(&report);
+    let args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "eval",
+            "--scene",
+            "cornell",
+            "--technique",
+            "gi",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--ref-spp",
+            "64",
+            "--bounces",
+            "2",
+            "--warmup",
+            "2",
+            "--json",
+            "--quiet",
+            "--cache",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.push(cache.to_str().unwrap().into());
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let run = |extra: &[&str]| strata(&args(extra).iter().map(String::as_str).collect::<Vec<_>>());
+    let v = json_of(&run(&[
+        "--layers",
+        "2",
+        "--oracle",
+        "--report",
+        report.to_str().unwrap(),
+    ]));
+    let o = &v["oracle"];
+    assert!(o["noise"]["spp"].as_u64().unwrap() >= 2, "{o}");
+    assert!(o["probe_twin_error"].as_f64().unwrap() < 0.01, "{o}");
+    let rows = o["by_layers"].as_array().expect("by_layers");
+    assert_eq!(
+        rows.iter().map(|r| r["layers"].as_u64().unwrap()).collect::<Vec<_>>(),
+        [1, 2]
+    );
+    let c = |r: &serde_json::Value, key: &str| r[key].as_f64().unwrap();
+    for r in rows {
+        assert!(c(r, "confidence") > 0.0 && c(r, "confidence") <= 1.0, "{r}");
+        assert!(c(r, "confidence_within_radius") <= c(r, "confidence"), "{r}");
+        let names: Vec<(&str, bool)> = r["entries"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| (e["blend"].as_str().unwrap(), e["within_radius"].as_bool().unwrap()))
+            .collect();
+        for blend in ["paper", "renderer", "detail", "alone"] {
+            for within in [false, true] {
+                assert!(names.contains(&(blend, within)), "{blend} {within}: {names:?}");
+            }
+        }
+        assert!(names.contains(&("probes", false)), "{names:?}");
+        for e in r["entries"].as_array().unwrap() {
+            let flip = e["errors"]["flip"].as_f64().unwrap();
+            assert!(flip > 0.0 && flip < 1.0, "{e}");
+            assert!(
+                e["rmse_denoised"].as_f64().unwrap() <= e["errors"]["rmse"].as_f64().unwrap(),
+                "{e}"
+            );
+        }
+    }
+    assert!(c(&rows[1], "confidence") >= c(&rows[0], "confidence"), "{rows:?}");
+    for f in [
+        "oracle-paper-k2.png",
+        "oracle-detail-k1.png",
+        "oracle-confidence-k2.png",
+        "oracle-probes-k2.png",
+    ] {
+        assert!(report.join(f).exists(), "{f} in the report");
+    }
+    assert_one_line_error(
+        &run(&["--layers", "3", "--oracle"]),
+        &["--layers 3", "--oracle", "1..=2"],
+    );
+    let o = strata(&["eval", "--scene", "cornell", "--technique", "ao", "--oracle", "--json"]);
+    assert_one_line_error(&o, &["--oracle", "gi"]);
+}
+
 #[test]
 fn bench_radiosity_and_reflections_time_their_passes() {
     let o = strata(&[

@@ -267,7 +267,6 @@ fn oracle_rows<'a>(
     (reference, ref_indirect): (&strata_reference::Converged, &RefImage),
     results: impl Iterator<Item = &'a GiResult>,
 ) -> Result<(GiOracle, Vec<OracleFigure>)> {
-    use std::f32::consts::{FRAC_1_PI, PI};
     use strata_reference::oracle::{paper_blend, OracleImages, ScreenOracleSettings};
     let (w, h) = (s.scene.width, s.scene.height);
     let min_separation = s.deep.min_separation.unwrap_or(scene.settings.min_separation);
@@ -289,14 +288,24 @@ fn oracle_rows<'a>(
     let probe_e = results.last().and_then(|r| r.probe_irradiance.clone());
     // the renderer's blend rule, with a perfect gather
     let renderer = |e_hat: Vec3, c: f32, e_probe: Vec3| probe_blend(e_hat, c, e_probe, one_sided);
-    // the image the oracle's noise is measured on: the renderer's rule, k layers, within r
-    let shown_blend = |means: &ImageBuf| {
+    // the images the oracle's noise is measured on (k layers, within r): the renderer's
+    // rule and the control variate with probes, the seen light and screen space alone
+    // without (the alone image's noise grows as 1/c, so it would hold the rule up forever
+    // where the layers see little)
+    let noisy = |means: &ImageBuf| -> Vec<ImageBuf> {
         let img = OracleImages::from_means(means);
         let v = OracleImages::variant(k, true);
-        match &probe_e {
-            Some(e) => img.blend(v, e, renderer),
-            None => img.alone(v),
+        match (&probe_e, field) {
+            (Some(e), Some(f)) => vec![img.blend(v, e, renderer), detail_blend(&img, v, f, camera.eye)],
+            (Some(e), None) => vec![img.blend(v, e, renderer)],
+            _ => vec![img.seen[v].clone()],
         }
+    };
+    let shown_blend = |means: &ImageBuf| noisy(means).swap_remove(0);
+    // at least 64 paths per half before the first noise measure
+    let rule = &strata_reference::ConvergeRule {
+        first_spp: rule.first_spp.max(64),
+        ..*rule
     };
     let description = format!(
         "v1 screen oracle {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
@@ -309,7 +318,13 @@ fn oracle_rows<'a>(
             h,
             &estimator,
             rule,
-            |a, b| half_flip(&shown_blend(a), &shown_blend(b), shown),
+            |a, b| {
+                let (a, b) = (noisy(a), noisy(b));
+                a.iter()
+                    .zip(&b)
+                    .map(|(a, b)| half_flip(a, b, shown))
+                    .fold(0.0, f64::max)
+            },
         )
     });
     let noise = RefImage::of(&converged, shown_blend, shown)?.noise;
@@ -367,21 +382,7 @@ fn oracle_rows<'a>(
                 let eye = camera.eye;
                 blends.push((
                     "detail",
-                    Box::new(move |o: &OracleImages| {
-                        o.per_pixel(v, |seen, _, albedo, i| {
-                            let p = Vec3::from_slice(&o.position.data[3 * i..3 * i + 3]);
-                            let n = Vec3::from_slice(&o.normal.data[3 * i..3 * i + 3]);
-                            if albedo == Vec3::ZERO || n == Vec3::ZERO {
-                                return Vec3::ZERO;
-                            }
-                            let view = (eye - p).normalize_or_zero();
-                            let l = field.radiance_sh(p, n, view);
-                            let moments = &o.seen_sh[v].data[9 * i..9 * i + 9];
-                            let e_probe_seen: Vec3 = l.iter().zip(moments).map(|(li, m)| *li * *m).sum::<Vec3>() * PI;
-                            let e = field.irradiance(p, n, view) - e_probe_seen;
-                            (seen + albedo * FRAC_1_PI * e).max(Vec3::ZERO)
-                        })
-                    }),
+                    Box::new(move |o: &OracleImages| detail_blend(o, v, field, eye)),
                 ));
             }
             blends.push(("alone", Box::new(move |o: &OracleImages| o.alone(v))));
@@ -431,6 +432,32 @@ fn oracle_rows<'a>(
         by_layers: rows,
     };
     Ok((oracle, figures))
+}
+
+/// The control variate of `--set probe-detail=on` with a perfect gather, as indirect
+/// radiance: ρ/π·max(E_probe + E_seen − ∫_seen L_probe cos, 0), L_probe the probe field's
+/// order-2 SH radiance at the receiver (the CPU twin of the GPU's field) integrated over the
+/// seen directions through the oracle's SH moments.
+fn detail_blend(
+    o: &strata_reference::oracle::OracleImages,
+    v: usize,
+    field: &strata_scene::probes::IrradianceProbes,
+    eye: Vec3,
+) -> ImageBuf {
+    use std::f32::consts::{FRAC_1_PI, PI};
+    o.per_pixel(v, |seen, _, albedo, i| {
+        let p = Vec3::from_slice(&o.position.data[3 * i..3 * i + 3]);
+        let n = Vec3::from_slice(&o.normal.data[3 * i..3 * i + 3]);
+        if albedo == Vec3::ZERO || n == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        let view = (eye - p).normalize_or_zero();
+        let l = field.radiance_sh(p, n, view);
+        let moments = &o.seen_sh[v].data[9 * i..9 * i + 9];
+        let e_probe_seen: Vec3 = l.iter().zip(moments).map(|(li, m)| *li * *m).sum::<Vec3>() * PI;
+        let e = field.irradiance(p, n, view) - e_probe_seen;
+        (seen + albedo * FRAC_1_PI * e).max(Vec3::ZERO)
+    })
 }
 
 /// An image of `--oracle` for the report.
