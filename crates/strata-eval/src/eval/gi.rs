@@ -367,7 +367,7 @@ fn oracle_rows<'a>(
         let mut entries = Vec::new();
         for within_radius in [false, true] {
             let v = OracleImages::variant(kl, within_radius);
-            let mut blends: Vec<(&str, Box<dyn Fn(&OracleImages) -> ImageBuf>)> = Vec::new();
+            let mut blends: Vec<(&str, OracleBlend)> = Vec::new();
             if let Some(e) = r.probe_irradiance.clone() {
                 let e2 = e.clone();
                 blends.push(("paper", Box::new(move |o: &OracleImages| o.blend(v, &e, paper_blend))));
@@ -412,7 +412,7 @@ fn oracle_rows<'a>(
                         &ref_indirect.image,
                         &ref_halves,
                         &img,
-                        Some(&halves.each_ref().map(|o| f(o))),
+                        Some(&halves.each_ref().map(&f)),
                     ),
                 });
             }
@@ -459,6 +459,9 @@ fn detail_blend(
         (seen + albedo * FRAC_1_PI * e).max(Vec3::ZERO)
     })
 }
+
+/// One of `--oracle`'s images, made from the oracle's means (or one half's).
+type OracleBlend<'a> = Box<dyn Fn(&strata_reference::oracle::OracleImages) -> ImageBuf + 'a>;
 
 /// An image of `--oracle` for the report.
 struct OracleFigure {

@@ -80,8 +80,8 @@ fn oracle_variants_nest() {
             for var in 0..ORACLE_VARIANTS.len() {
                 let c = img.confidence[var].data[i];
                 assert!((0.0..=1.0).contains(&c), "{name} pixel {i}: c = {c}");
-                for ch in 0..3 {
-                    assert!(img.seen[var].data[3 * i + ch] <= total[ch] * (1.0 + 1e-5) + 1e-7);
+                for (seen, t) in img.seen[var].data[3 * i..3 * i + 3].iter().zip(total) {
+                    assert!(*seen <= t * (1.0 + 1e-5) + 1e-7, "{name} pixel {i}: seen {seen} of {t}");
                 }
             }
             for (a, b) in pairs {
@@ -261,5 +261,5 @@ fn oracle_blend_fills_what_the_layers_miss_with_the_probes() {
     assert_eq!(&blend.data[3..], &[0.0; 3]);
     let alone = img.alone(v);
     assert!((Vec3::from_slice(&alone.data[..3]) - seen / c).abs().max_element() < 1e-6);
-    assert_eq!(img.mean_confidence(v), 0.25 as f64);
+    assert_eq!(img.mean_confidence(v), 0.25_f64);
 }
