@@ -26,7 +26,9 @@
 //! The estimator shares the path tracer's paths ([`Reference::gi_pixel_paths`]): its
 //! total is [`crate::Estimator::Gi`]'s indirect light with the same seed, bit for bit.
 //! Each path's indirect light arrives through its first bounce, so sorting paths by
-//! where that bounce landed splits the indirect light exactly.
+//! where that bounce landed splits the indirect light exactly. At a Lambertian receiver
+//! the paths are cosine-distributed, so c is the cosine-weighted share; at a glossy one
+//! they follow its BRDF, and c weights the directions by it.
 
 use glam::Vec3;
 use strata_scene::{Camera, ImageBuf};
