@@ -604,7 +604,7 @@ pub struct EvalArgs {
     pub fig10: bool,
     /// gi: also evaluate DGB's blend with a *perfect* gather over 1 and k ≤ 2 layers: the path
     /// tracer's light from the surfaces the layers hold, c the share of paths they hold, and
-    /// the GPU's probes for the rest (`docs/radiosity.md` § "The screen-space oracle"). Its
+    /// the GPU's probes for the rest (`docs/radiosity.md` § "A perfect gather"). Its
     /// paths are traced and cached like the reference's.
     #[arg(long)]
     pub oracle: bool,

@@ -517,8 +517,9 @@ pub struct GiEval {
 /// (`strata_reference::oracle`), path-traced along paths independent of the reference's.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GiOracle {
-    /// The oracle's own noise: its two halves' blended images compared (k = `layers`, the
-    /// radius-bounded blend, or screen space alone without probes).
+    /// The oracle's own noise: its two halves' images compared, for k = `layers` within the
+    /// radius: the renderer's blend (without probes, the seen light). Its convergence rule
+    /// also waits for the control variate's image.
     pub noise: RefNoise,
     /// The gather's world-space radius of the bounded rows.
     pub radius: f32,
