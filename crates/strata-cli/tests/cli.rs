@@ -1328,6 +1328,22 @@ fn eval_gi_oracle_reports_a_perfect_gather_beside_the_gpu() {
             }
         }
         assert!(names.contains(&("probes", false)), "{names:?}");
+        // the renderer's rule on the GPU's own (E_dgb, c) is the GPU's image
+        let gpu = r["entries"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["blend"] == "gpu")
+            .expect("gpu entry");
+        let own = match r["layers"].as_u64() {
+            Some(2) => &v,
+            _ => &v["layers_1"],
+        };
+        let (a, b) = (gpu["errors"]["rmse"].as_f64().unwrap(), own["rmse"].as_f64().unwrap());
+        assert!((a - b).abs() <= 0.02 * b, "recomposed RMSE {a} against the GPU's {b}");
+        for blend in ["gpu-gather-oracle-c", "oracle-gather-gpu-c"] {
+            assert!(names.contains(&(blend, true)), "{blend}: {names:?}");
+        }
         for e in r["entries"].as_array().unwrap() {
             let flip = e["errors"]["flip"].as_f64().unwrap();
             assert!(flip > 0.0 && flip < 1.0, "{e}");

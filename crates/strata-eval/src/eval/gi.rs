@@ -53,6 +53,9 @@ struct GiResult {
     indirect_map: ImageBuf,
     /// The probes' irradiance the GPU blended with (`--oracle` with probes).
     probe_irradiance: Option<ImageBuf>,
+    /// The GPU's gathered irradiance E_dgb (RGB) and confidence c (A), as compose reads
+    /// them (`--oracle`).
+    gathered: Option<ImageBuf>,
 }
 
 /// The path tracer's GI of `camera` with `bounces` indirect bounces, converged under
@@ -165,6 +168,10 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
         let (indirect_stats, indirect_map) = compare_radiance(&ref_indirect.image, &indirect, exposure)?;
         let full_stats = ref_total.annotate(full_stats, &display(&full, exposure));
         let indirect_stats = ref_indirect.annotate(indirect_stats, &display(&indirect, exposure));
+        let gathered = match g.oracle {
+            true => Some(r.read_target(&gpu, "indirect")?),
+            false => None,
+        };
         let probe_irradiance = match g.oracle && probes.is_some() {
             true => Some(rgb(&r.read_target(&gpu, "probe-irradiance")?)),
             false => None,
@@ -180,6 +187,7 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
             full_map,
             indirect_map,
             probe_irradiance,
+            gathered,
         })
     };
     let k = s.deep.layers;
@@ -267,6 +275,7 @@ fn oracle_rows<'a>(
     (reference, ref_indirect): (&strata_reference::Converged, &RefImage),
     results: impl Iterator<Item = &'a GiResult>,
 ) -> Result<(GiOracle, Vec<OracleFigure>)> {
+    use std::f32::consts::FRAC_1_PI;
     use strata_reference::oracle::{paper_blend, OracleImages, ScreenOracleSettings};
     let (w, h) = (s.scene.width, s.scene.height);
     let min_separation = s.deep.min_separation.unwrap_or(scene.settings.min_separation);
@@ -383,6 +392,47 @@ fn oracle_rows<'a>(
                 blends.push((
                     "detail",
                     Box::new(move |o: &OracleImages| detail_blend(o, v, field, eye)),
+                ));
+            }
+            // which half of the GPU's blend keeps it from the perfect gather's: the GPU's
+            // gathered E with the oracle's c, and the oracle's Ê with the GPU's c, both
+            // by the renderer's rule; `gpu` recomposes the GPU's own pair
+            if let (Some(e), Some(g)) = (&r.probe_irradiance, &r.gathered) {
+                // (E_dgb, c) of the GPU and E_probe at pixel i
+                fn gathered(g: &ImageBuf, i: usize) -> (Vec3, f32) {
+                    (Vec3::from_slice(&g.data[4 * i..4 * i + 3]), g.data[4 * i + 3])
+                }
+                fn probe(e: &ImageBuf, i: usize) -> Vec3 {
+                    Vec3::from_slice(&e.data[3 * i..3 * i + 3])
+                }
+                let (e1, g1) = (e.clone(), g.clone());
+                blends.push((
+                    "gpu",
+                    Box::new(move |o: &OracleImages| {
+                        o.per_pixel(v, |_, _, albedo, i| {
+                            let (eg, cg) = gathered(&g1, i);
+                            albedo * FRAC_1_PI * renderer(eg, cg, probe(&e1, i))
+                        })
+                    }),
+                ));
+                let (e2, g2) = (e.clone(), g.clone());
+                blends.push((
+                    "gpu-gather-oracle-c",
+                    Box::new(move |o: &OracleImages| {
+                        o.per_pixel(v, |_, c, albedo, i| {
+                            albedo * FRAC_1_PI * renderer(gathered(&g2, i).0, c, probe(&e2, i))
+                        })
+                    }),
+                ));
+                let (e3, g3) = (e.clone(), g.clone());
+                blends.push((
+                    "oracle-gather-gpu-c",
+                    Box::new(move |o: &OracleImages| {
+                        o.per_pixel(v, |seen, c, albedo, i| {
+                            let e_hat = strata_reference::oracle::gathered_irradiance(seen, c, albedo);
+                            albedo * FRAC_1_PI * renderer(e_hat, gathered(&g3, i).1, probe(&e3, i))
+                        })
+                    }),
                 ));
             }
             blends.push(("alone", Box::new(move |o: &OracleImages| o.alone(v))));
