@@ -19,8 +19,10 @@ pub mod converged;
 pub mod environment;
 pub mod probes;
 
-/// Most channels an entry may have (converged GI halves hold 6: direct and indirect RGB).
-const MAX_CHANNELS: u32 = 8;
+/// Most channels an entry may have: the widest estimator's, the screen oracle's means
+/// (converged GI halves hold 6: direct and indirect RGB). `store` refuses wider images, so
+/// nothing is stored that `load` would then reject.
+const MAX_CHANNELS: u32 = strata_reference::oracle::ORACLE_CHANNELS;
 
 const MAGIC: &[u8; 10] = b"STRATAREF2";
 /// Magic + width, height, channels + checksum.
@@ -89,6 +91,12 @@ impl RefCache {
     pub fn store(&self, key: &str, img: &ImageBuf, description: &str) -> Result<PathBuf> {
         if !valid_key(key) {
             bail!("reference cache: invalid key {key:?}: use ASCII letters, digits, '-' or '_'");
+        }
+        if !(1..=MAX_CHANNELS).contains(&img.channels) {
+            bail!(
+                "reference cache: image has {} channels: expected 1 to {MAX_CHANNELS}",
+                img.channels
+            );
         }
         let expected = img.width as usize * img.height as usize * img.channels as usize;
         if img.data.len() != expected {
@@ -487,6 +495,41 @@ mod tests {
         let mut short = sample();
         short.data.pop();
         assert!(cache.store("abc", &short, "").is_err());
+        let wide = ImageBuf::new(2, 2, MAX_CHANNELS + 1);
+        let e = format!("{:#}", cache.store("wide", &wide, "").unwrap_err());
+        assert!(e.contains(&format!("expected 1 to {MAX_CHANNELS}")), "{e}");
+        assert!(cache.load("wide").is_none());
+    }
+
+    /// Every estimator's means are stored and read back: the screen oracle's 64 channels were
+    /// once refused on loading, so its converged images were recomputed on every run.
+    #[test]
+    fn every_estimators_channel_count_round_trips() {
+        use strata_reference::{oracle::ScreenOracleSettings, Estimator};
+        let tmp = TempDir::new("channels");
+        let cache = RefCache::new(&tmp.0);
+        for estimator in [
+            Estimator::AoBinary(Default::default()),
+            Estimator::Obscurance(Default::default()),
+            Estimator::Gi(Default::default()),
+            Estimator::ScreenOracle(ScreenOracleSettings {
+                gi: Default::default(),
+                min_separation: 0.1,
+                radius: 1.0,
+            }),
+        ] {
+            let n = estimator.channels();
+            let mut img = ImageBuf::new(3, 2, n);
+            for (i, v) in img.data.iter_mut().enumerate() {
+                *v = i as f32 * 0.5 - 1.0;
+            }
+            let key = format!("est{n}");
+            cache.store(&key, &img, "").unwrap();
+            let back = cache
+                .load(&key)
+                .unwrap_or_else(|| panic!("{estimator:?}: not read back"));
+            assert_eq!((back.channels, back.data), (n, img.data), "{estimator:?}");
+        }
     }
 
     #[test]
