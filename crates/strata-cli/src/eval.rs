@@ -246,6 +246,13 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                         "    k={}: c {:.3} ({:.3} within r); GPU's denoised RMSE {:.5}",
                         row.layers, row.confidence, row.confidence_within_radius, row.gpu_rmse_denoised
                     );
+                    if let Some(g) = &row.gather {
+                        let [r, gr, b] = g.irradiance_ratio;
+                        println!(
+                            "      the GPU's gather: c {:.3}; E_dgb / perfect Ê (R, G, B) {r:.3} {gr:.3} {b:.3} over {} px with c ≥ {}",
+                            g.confidence, g.pixels, g.min_confidence
+                        );
+                    }
                     for x in &row.entries {
                         println!(
                             "      {:<8} {:<9} indirect FLIP {:.4} RMSE {:.5} (denoised {:.5}) mean ×{:.3}",

@@ -1313,8 +1313,33 @@ fn eval_gi_oracle_reports_a_perfect_gather_beside_the_gpu() {
         [1, 2]
     );
     let c = |r: &serde_json::Value, key: &str| r[key].as_f64().unwrap();
+    // the renderer's rule on the GPU's own gathered pair is the GPU's image
+    let recomposed = |v: &serde_json::Value| {
+        for r in v["oracle"]["by_layers"].as_array().unwrap() {
+            let gpu = r["entries"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|e| e["blend"] == "gpu")
+                .expect("gpu entry");
+            let own = match r["layers"].as_u64() {
+                Some(2) => v,
+                _ => &v["layers_1"],
+            };
+            let (a, b) = (gpu["errors"]["rmse"].as_f64().unwrap(), own["rmse"].as_f64().unwrap());
+            assert!((a - b).abs() <= 0.02 * b, "recomposed RMSE {a} against the GPU's {b}");
+        }
+    };
+    recomposed(&v);
     for r in rows {
         assert!(c(r, "confidence") > 0.0 && c(r, "confidence") <= 1.0, "{r}");
+        // the GPU's gather against the perfect one over the receivers both see
+        let g = &r["gather"];
+        assert!(c(g, "confidence") > 0.0 && c(g, "confidence") <= 1.0, "{g}");
+        assert!(g["pixels"].as_u64().unwrap() > 0, "{g}");
+        for x in g["irradiance_ratio"].as_array().unwrap() {
+            assert!(x.as_f64().unwrap() > 0.0 && x.as_f64().unwrap().is_finite(), "{g}");
+        }
         assert!(c(r, "confidence_within_radius") <= c(r, "confidence"), "{r}");
         let names: Vec<(&str, bool)> = r["entries"]
             .as_array()
@@ -1328,19 +1353,6 @@ fn eval_gi_oracle_reports_a_perfect_gather_beside_the_gpu() {
             }
         }
         assert!(names.contains(&("probes", false)), "{names:?}");
-        // the renderer's rule on the GPU's own (E_dgb, c) is the GPU's image
-        let gpu = r["entries"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|e| e["blend"] == "gpu")
-            .expect("gpu entry");
-        let own = match r["layers"].as_u64() {
-            Some(2) => &v,
-            _ => &v["layers_1"],
-        };
-        let (a, b) = (gpu["errors"]["rmse"].as_f64().unwrap(), own["rmse"].as_f64().unwrap());
-        assert!((a - b).abs() <= 0.02 * b, "recomposed RMSE {a} against the GPU's {b}");
         for blend in ["gpu-gather-oracle-c", "oracle-gather-gpu-c"] {
             assert!(names.contains(&(blend, true)), "{blend}: {names:?}");
         }
@@ -1361,6 +1373,13 @@ fn eval_gi_oracle_reports_a_perfect_gather_beside_the_gpu() {
         "oracle-probes-k2.png",
     ] {
         assert!(report.join(f).exists(), "{f} in the report");
+    }
+    // with the probes' control variate compose runs another rule, and the `gpu` rows follow
+    // it (the gathered term is no irradiance then: no `gather`)
+    let d = json_of(&run(&["--layers", "2", "--oracle", "--set", "probe-detail=on"]));
+    recomposed(&d);
+    for r in d["oracle"]["by_layers"].as_array().unwrap() {
+        assert!(r.get("gather").is_none(), "{r}");
     }
     assert_one_line_error(
         &run(&["--layers", "3", "--oracle"]),

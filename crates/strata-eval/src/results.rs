@@ -542,7 +542,25 @@ pub struct GiOracleRow {
     /// The GPU image's RMSE for this k with the reference's Monte Carlo noise taken out,
     /// beside the entries' `rmse_denoised`.
     pub gpu_rmse_denoised: f32,
+    /// The GPU's gather against the perfect one over the same receivers (with DGB's blend:
+    /// with `probe-detail` the gathered term is not an irradiance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gather: Option<GiGatherAgreement>,
     pub entries: Vec<GiOracleEntry>,
+}
+
+/// How the GPU's gathered irradiance E_dgb and confidence compare with the perfect gather's
+/// Ê and c (k layers, within the radius).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GiGatherAgreement {
+    /// The GPU's mean confidence over the pixels with a surface (beside the row's
+    /// `confidence_within_radius`).
+    pub confidence: f64,
+    /// Σ E_dgb / Σ Ê per RGB channel over the pixels where the perfect gather's c ≥
+    /// `min_confidence` and the GPU's gather found something.
+    pub irradiance_ratio: [f64; 3],
+    pub min_confidence: f32,
+    pub pixels: u32,
 }
 
 /// One blend of the perfect gather.

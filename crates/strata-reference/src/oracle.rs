@@ -149,6 +149,15 @@ pub struct OracleImages {
     pub seen_sh: Vec<ImageBuf>,
 }
 
+/// [`OracleImages::gather_agreement`]'s result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GatherAgreement {
+    /// Σ E_gathered / Σ Ê per RGB channel.
+    pub irradiance_ratio: [f64; 3],
+    /// The pixels compared.
+    pub pixels: u32,
+}
+
 impl OracleImages {
     /// Splits a [`ORACLE_CHANNELS`]-channel image of means.
     pub fn from_means(means: &ImageBuf) -> Self {
@@ -217,6 +226,32 @@ impl OracleImages {
             }
         }
         sum / n.max(1) as f64
+    }
+
+    /// How a real gather's irradiance `gathered` (RGB, its confidence in the fourth channel
+    /// when it has one) compares with the perfect gather's Ê over the same receivers: per
+    /// channel Σ E_gathered / Σ Ê over the pixels where the variant's c ≥ `min_c` and the
+    /// real gather found something (c > 0), with the number of those pixels. `None` where
+    /// there are none.
+    pub fn gather_agreement(&self, variant: usize, gathered: &ImageBuf, min_c: f32) -> Option<GatherAgreement> {
+        let n = gathered.channels as usize;
+        let (mut sum_gpu, mut sum_oracle, mut pixels) = (glam::DVec3::ZERO, glam::DVec3::ZERO, 0u32);
+        for i in 0..(self.total.width * self.total.height) as usize {
+            let c = self.confidence[variant].data[i];
+            let a = Vec3::from_slice(&self.albedo.data[3 * i..3 * i + 3]);
+            let g = &gathered.data[n * i..n * i + n];
+            let found = n < 4 || g[3] > 0.0;
+            if c >= min_c && found && a.min_element() > 0.0 {
+                let seen = Vec3::from_slice(&self.seen[variant].data[3 * i..3 * i + 3]);
+                sum_oracle += gathered_irradiance(seen, c, a).as_dvec3();
+                sum_gpu += Vec3::from_slice(&g[..3]).as_dvec3();
+                pixels += 1;
+            }
+        }
+        (pixels > 0 && sum_oracle.min_element() > 0.0).then(|| GatherAgreement {
+            irradiance_ratio: (sum_gpu / sum_oracle).to_array(),
+            pixels,
+        })
     }
 
     /// `f`(seen radiance, c, albedo, pixel index) → radiance at every pixel of a variant.

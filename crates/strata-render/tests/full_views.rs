@@ -6,7 +6,7 @@ mod common;
 
 use common::frozen;
 use strata_render::frame::FrameCameras;
-use strata_render::passes::radiosity::{irradiance_cpu, RadiositySettings};
+use strata_render::passes::radiosity::{irradiance_cpu, probe_detail_blend, RadiositySettings};
 use strata_render::passes::tonemap::tonemap;
 use strata_render::{GpuContext, RenderSettings, Renderer};
 use strata_scene::probes::IrradianceProbes;
@@ -571,10 +571,10 @@ fn probe_detail_gather_and_blend_match_cpu_twin() {
     let points = common::surface_points(&gpu, &r);
     assert!(points.len() > n / 2, "the box fills the frame");
     for s in &points {
-        let c = detail.data[s.i * 4 + 3];
+        let at = |img: &ImageBuf| glam::Vec3::from_slice(&img.data[s.i * 4..s.i * 4 + 3]);
+        let want = probe_detail_blend(at(&detail), detail.data[s.i * 4 + 3], at(&probe));
         for ch in 0..3 {
-            let want = (probe.data[s.i * 4 + ch] + c * detail.data[s.i * 4 + ch]).max(0.0);
-            let got = blended.data[s.i * 4 + ch];
+            let (want, got) = (want[ch], blended.data[s.i * 4 + ch]);
             assert!(
                 (got - want).abs() <= 2e-3 * want.abs() + 1e-3,
                 "pixel ({}, {}) channel {ch}: blended {got} vs {want}",
@@ -624,7 +624,7 @@ fn one_sided_blend_matches_cpu_twin() {
         let y = Vec3::from(LUMINANCE);
         let (mut darker, mut brighter) = (0usize, 0usize);
         for s in &points {
-            let at = |img: &ImageBuf| Vec3::from_slice(&img.data[s.i * 4..s.i * 4 + 3]);
+            let at = |img: &ImageBuf| glam::Vec3::from_slice(&img.data[s.i * 4..s.i * 4 + 3]);
             let (g, ep, got) = (at(&gather), at(&probe), at(&blended));
             let c = gather.data[s.i * 4 + 3];
             let want = probe_blend(g, c, ep, true);

@@ -10,7 +10,7 @@ use strata_reference::gi::{GiSettings, OneBounceSettings};
 use strata_reference::{Estimator, Reference};
 use strata_render::frame::FrameCameras;
 use strata_render::passes::lighting::LightingSettings;
-use strata_render::passes::radiosity::{probe_blend, RadiositySettings};
+use strata_render::passes::radiosity::{probe_blend, probe_detail_blend, RadiositySettings};
 use strata_render::{GpuContext, GpuOptions, RenderSettings, Renderer};
 use strata_scene::{Camera, ImageBuf, Scene};
 
@@ -18,7 +18,9 @@ use super::{figure, flicker, half_flip, noise_warnings, write_report, EvalSettin
 use crate::cache::{scene_fingerprint, RefCache};
 use crate::metrics::{compare_radiance, display};
 use crate::report::Section;
-use crate::results::{EvalResult, Fig10, Fig10Row, GiErrors, GiEval, GiOracle, GiOracleEntry, GiOracleRow};
+use crate::results::{
+    EvalResult, Fig10, Fig10Row, GiErrors, GiEval, GiGatherAgreement, GiOracle, GiOracleEntry, GiOracleRow,
+};
 
 /// Default cap on the path tracer's samples per pixel (`--ref-spp`).
 pub const DEFAULT_CAP: u32 = 32_768;
@@ -220,7 +222,16 @@ pub fn run(s: &EvalSettings, rs: &RadiositySettings, g: &GiEvalSettings) -> Resu
             &scene,
             camera,
             (g.bounces, rs.radius.unwrap_or(scene.settings.radiosity_radius)),
-            (rs.one_sided_confidence, probes.as_ref()),
+            (
+                match rs.probe_detail && probes.is_some() {
+                    true => Compose::Detail,
+                    false => Compose::Blend {
+                        one_sided: rs.one_sided_confidence,
+                    },
+                },
+                rs.one_sided_confidence,
+                probes.as_ref(),
+            ),
             &rule,
             (&converged, &ref_indirect),
             results.iter().chain([&main]),
@@ -270,7 +281,7 @@ fn oracle_rows<'a>(
     scene: &Scene,
     camera: Camera,
     (bounces, radius): (u32, f32),
-    (one_sided, field): (bool, Option<&strata_scene::probes::IrradianceProbes>),
+    (compose, one_sided, field): (Compose, bool, Option<&strata_scene::probes::IrradianceProbes>),
     rule: &strata_reference::ConvergeRule,
     (reference, ref_indirect): (&strata_reference::Converged, &RefImage),
     results: impl Iterator<Item = &'a GiResult>,
@@ -394,11 +405,11 @@ fn oracle_rows<'a>(
                     Box::new(move |o: &OracleImages| detail_blend(o, v, field, eye)),
                 ));
             }
-            // which half of the GPU's blend keeps it from the perfect gather's: the GPU's
-            // gathered E with the oracle's c, and the oracle's Ê with the GPU's c, both
-            // by the renderer's rule; `gpu` recomposes the GPU's own pair
+            // which half of the GPU's pair keeps it from the perfect gather: the GPU's
+            // gathered term with the oracle's c, and the oracle's term with the GPU's c, both
+            // by the rule compose ran; `gpu` recomposes the GPU's own pair
             if let (Some(e), Some(g)) = (&r.probe_irradiance, &r.gathered) {
-                // (E_dgb, c) of the GPU and E_probe at pixel i
+                // (gathered term, c) of the GPU and E_probe at pixel i
                 fn gathered(g: &ImageBuf, i: usize) -> (Vec3, f32) {
                     (Vec3::from_slice(&g.data[4 * i..4 * i + 3]), g.data[4 * i + 3])
                 }
@@ -411,7 +422,7 @@ fn oracle_rows<'a>(
                     Box::new(move |o: &OracleImages| {
                         o.per_pixel(v, |_, _, albedo, i| {
                             let (eg, cg) = gathered(&g1, i);
-                            albedo * FRAC_1_PI * renderer(eg, cg, probe(&e1, i))
+                            albedo * FRAC_1_PI * compose.apply(eg, cg, probe(&e1, i))
                         })
                     }),
                 ));
@@ -420,17 +431,18 @@ fn oracle_rows<'a>(
                     "gpu-gather-oracle-c",
                     Box::new(move |o: &OracleImages| {
                         o.per_pixel(v, |_, c, albedo, i| {
-                            albedo * FRAC_1_PI * renderer(gathered(&g2, i).0, c, probe(&e2, i))
+                            albedo * FRAC_1_PI * compose.apply(gathered(&g2, i).0, c, probe(&e2, i))
                         })
                     }),
                 ));
                 let (e3, g3) = (e.clone(), g.clone());
+                let eye = camera.eye;
                 blends.push((
                     "oracle-gather-gpu-c",
                     Box::new(move |o: &OracleImages| {
                         o.per_pixel(v, |seen, c, albedo, i| {
-                            let e_hat = strata_reference::oracle::gathered_irradiance(seen, c, albedo);
-                            albedo * FRAC_1_PI * renderer(e_hat, gathered(&g3, i).1, probe(&e3, i))
+                            let term = compose.oracle_term(o, v, (seen, c, albedo), field.map(|f| (f, eye)), i);
+                            albedo * FRAC_1_PI * compose.apply(term, gathered(&g3, i).1, probe(&e3, i))
                         })
                     }),
                 ));
@@ -467,11 +479,28 @@ fn oracle_rows<'a>(
                 });
             }
         }
+        // the gather's irradiance over the receivers both see (with DGB's blend, where the
+        // gathered term is E_dgb)
+        let gather = match (compose, &r.gathered) {
+            (Compose::Blend { .. }, Some(g)) => {
+                let v = OracleImages::variant(kl, true);
+                image
+                    .gather_agreement(v, g, GATHER_MIN_CONFIDENCE)
+                    .map(|a| GiGatherAgreement {
+                        confidence: mean_confidence_of(g, &image.albedo),
+                        irradiance_ratio: a.irradiance_ratio,
+                        min_confidence: GATHER_MIN_CONFIDENCE,
+                        pixels: a.pixels,
+                    })
+            }
+            _ => None,
+        };
         rows.push(GiOracleRow {
             layers: r.layers,
             confidence: image.mean_confidence(OracleImages::variant(kl, false)),
             confidence_within_radius: image.mean_confidence(OracleImages::variant(kl, true)),
             gpu_rmse_denoised: denoised_rmse(&ref_indirect.image, &ref_halves, &r.indirect, None),
+            gather,
             entries,
         });
     }
@@ -494,20 +523,94 @@ fn detail_blend(
     field: &strata_scene::probes::IrradianceProbes,
     eye: Vec3,
 ) -> ImageBuf {
-    use std::f32::consts::{FRAC_1_PI, PI};
-    o.per_pixel(v, |seen, _, albedo, i| {
-        let p = Vec3::from_slice(&o.position.data[3 * i..3 * i + 3]);
-        let n = Vec3::from_slice(&o.normal.data[3 * i..3 * i + 3]);
-        if albedo == Vec3::ZERO || n == Vec3::ZERO {
-            return Vec3::ZERO;
+    use std::f32::consts::FRAC_1_PI;
+    o.per_pixel(v, |seen, _, albedo, i| match probe_split(o, v, field, eye, i) {
+        Some((e_probe, e_probe_seen)) if albedo != Vec3::ZERO => {
+            (seen + albedo * FRAC_1_PI * (e_probe - e_probe_seen)).max(Vec3::ZERO)
         }
-        let view = (eye - p).normalize_or_zero();
-        let l = field.radiance_sh(p, n, view);
-        let moments = &o.seen_sh[v].data[9 * i..9 * i + 9];
-        let e_probe_seen: Vec3 = l.iter().zip(moments).map(|(li, m)| *li * *m).sum::<Vec3>() * PI;
-        let e = field.irradiance(p, n, view) - e_probe_seen;
-        (seen + albedo * FRAC_1_PI * e).max(Vec3::ZERO)
+        _ => Vec3::ZERO,
     })
+}
+
+/// The CPU twin's probe irradiance at pixel `i`'s receiver and the part of it that arrives
+/// from the directions variant `v` sees, ∫_seen L_probe cos (L_probe the field's order-2 SH
+/// radiance, through the oracle's SH moments); `None` where the pixel has no surface.
+fn probe_split(
+    o: &strata_reference::oracle::OracleImages,
+    v: usize,
+    field: &strata_scene::probes::IrradianceProbes,
+    eye: Vec3,
+    i: usize,
+) -> Option<(Vec3, Vec3)> {
+    let p = Vec3::from_slice(&o.position.data[3 * i..3 * i + 3]);
+    let n = Vec3::from_slice(&o.normal.data[3 * i..3 * i + 3]);
+    if n == Vec3::ZERO {
+        return None;
+    }
+    let view = (eye - p).normalize_or_zero();
+    let l = field.radiance_sh(p, n, view);
+    let moments = &o.seen_sh[v].data[9 * i..9 * i + 9];
+    let seen: Vec3 = l.iter().zip(moments).map(|(li, m)| *li * *m).sum::<Vec3>() * std::f32::consts::PI;
+    Some((field.irradiance(p, n, view), seen))
+}
+
+/// The perfect gather's c from which `--oracle` compares the GPU's gathered irradiance with
+/// its Ê (below it Ê = E_seen / c is mostly noise).
+const GATHER_MIN_CONFIDENCE: f32 = 0.1;
+
+/// The mean of `gathered`'s fourth channel (the GPU's confidence) over the pixels whose
+/// `albedo` is not black.
+fn mean_confidence_of(gathered: &ImageBuf, albedo: &ImageBuf) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0u32);
+    for (g, a) in gathered.data.chunks_exact(4).zip(albedo.data.chunks_exact(3)) {
+        if a.iter().any(|v| *v > 0.0) {
+            sum += g[3] as f64;
+            n += 1;
+        }
+    }
+    sum / n.max(1) as f64
+}
+
+/// The rule compose ran on the GPU's gathered pair (its `indirect` target: the gathered term
+/// and c) and the probes' irradiance, for the `gpu*` rows of `--oracle`.
+#[derive(Clone, Copy, Debug)]
+enum Compose {
+    /// DGB Fig. 9's c·E_dgb + (1 − c)·E_probe ([`probe_blend`]); the gathered term is E_dgb.
+    Blend { one_sided: bool },
+    /// `--set probe-detail=on`: max(E_probe + c·detail, 0) ([`probe_detail_blend`]); the
+    /// gathered term is detail = Ê[B] − Ê[L_probe].
+    Detail,
+}
+
+impl Compose {
+    fn apply(self, term: Vec3, c: f32, e_probe: Vec3) -> Vec3 {
+        match self {
+            Compose::Blend { one_sided } => probe_blend(term, c, e_probe, one_sided),
+            Compose::Detail => probe_detail_blend(term, c, e_probe),
+        }
+    }
+
+    /// The perfect gather's counterpart of the GPU's gathered term at pixel `i`, from its
+    /// seen radiance, c and albedo: Ê = E_seen / c, or with `Detail` (E_seen − ∫_seen
+    /// L_probe cos) / c (the CPU twin of the probe field seen from `eye`).
+    fn oracle_term(
+        self,
+        o: &strata_reference::oracle::OracleImages,
+        v: usize,
+        (seen, c, albedo): (Vec3, f32, Vec3),
+        field: Option<(&strata_scene::probes::IrradianceProbes, Vec3)>,
+        i: usize,
+    ) -> Vec3 {
+        let e_hat = strata_reference::oracle::gathered_irradiance(seen, c, albedo);
+        match (self, field) {
+            (Compose::Detail, Some((field, eye))) if c > 0.0 => {
+                let probe_seen = probe_split(o, v, field, eye, i).map_or(Vec3::ZERO, |(_, s)| s);
+                e_hat - probe_seen / c
+            }
+            (Compose::Detail, _) => Vec3::ZERO,
+            (Compose::Blend { .. }, _) => e_hat,
+        }
+    }
 }
 
 /// One of `--oracle`'s images, made from the oracle's means (or one half's).

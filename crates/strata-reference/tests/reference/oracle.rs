@@ -263,3 +263,43 @@ fn oracle_blend_fills_what_the_layers_miss_with_the_probes() {
     assert!((Vec3::from_slice(&alone.data[..3]) - seen / c).abs().max_element() < 1e-6);
     assert_eq!(img.mean_confidence(v), 0.25_f64);
 }
+
+/// `gather_agreement`: Σ E_gathered / Σ Ê per channel over the pixels where the perfect
+/// gather's c reaches the threshold, the receiver has a surface and the real gather found
+/// something; the other pixels do not count.
+#[test]
+fn gather_agreement_compares_only_the_receivers_both_gathers_see() {
+    let pi = std::f32::consts::PI;
+    let albedo = Vec3::new(0.5, 0.5, 0.25);
+    let v = OracleImages::variant(1, true);
+    let block = (ORACLE_CHANNELS as usize - 12) / ORACLE_VARIANTS.len();
+    let o = 12 + block * v;
+    // pixel i: (c, Ê, the real gather's E and c)
+    let pixels = [
+        (0.5, Vec3::new(2.0, 4.0, 6.0), Vec3::new(1.0, 3.0, 6.0), 0.3),
+        (0.2, Vec3::new(2.0, 4.0, 2.0), Vec3::new(1.0, 1.0, 4.0), 0.1),
+        // below the threshold
+        (0.05, Vec3::splat(1.0), Vec3::splat(100.0), 0.5),
+        // the real gather found nothing
+        (0.8, Vec3::splat(1.0), Vec3::splat(100.0), 0.0),
+    ];
+    let n = pixels.len() as u32;
+    let mut means = ImageBuf::new(n, 1, ORACLE_CHANNELS);
+    let mut gathered = ImageBuf::new(n, 1, 4);
+    for (i, (c, e_hat, e_gpu, c_gpu)) in pixels.into_iter().enumerate() {
+        let m = &mut means.data[i * ORACLE_CHANNELS as usize..][..ORACLE_CHANNELS as usize];
+        m[3..6].copy_from_slice(&albedo.to_array());
+        m[o..o + 3].copy_from_slice(&(albedo / pi * e_hat * c).to_array());
+        m[o + 3] = c;
+        gathered.data[4 * i..4 * i + 4].copy_from_slice(&e_gpu.extend(c_gpu).to_array());
+    }
+    let img = OracleImages::from_means(&means);
+    let a = img.gather_agreement(v, &gathered, 0.1).expect("two pixels compare");
+    assert_eq!(a.pixels, 2);
+    let want = [2.0 / 4.0, 4.0 / 8.0, 10.0 / 8.0];
+    for (got, want) in a.irradiance_ratio.iter().zip(want) {
+        assert!((got - want).abs() < 1e-5, "{:?} against {want:?}", a.irradiance_ratio);
+    }
+    // a threshold above every pixel's c leaves nothing to compare
+    assert!(img.gather_agreement(v, &gathered, 0.9).is_none());
+}

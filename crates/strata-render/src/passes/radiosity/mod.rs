@@ -251,6 +251,13 @@ pub fn probe_blend(e_dgb: Vec3, c: f32, e_probe: Vec3, one_sided: bool) -> Vec3 
     c * e_dgb + (1.0 - c) * e_probe
 }
 
+/// The composite of [`RadiositySettings::probe_detail`]: E = max(E_probe + c·detail, 0), with
+/// `detail` = Ê[B] − Ê[L_probe] the gather's output (the probes' irradiance `e_probe`
+/// already × AO's factor). CPU twin of compose.wgsl's `use_probes == 2`.
+pub fn probe_detail_blend(detail: Vec3, c: f32, e_probe: Vec3) -> Vec3 {
+    (e_probe + c.clamp(0.0, 1.0) * detail).max(Vec3::ZERO)
+}
+
 /// How AO's visibility AV modulates the light probes' irradiance in the composite
 /// (DGB Fig. 9: E = c·E_dgb + (1 − c)·AV·E_probe). The discriminants are compose.wgsl's
 /// `use_ao` values.
