@@ -570,9 +570,11 @@ pub struct GiOracleEntry {
     /// the one-sided confidence (listed when it is on); `detail`: E_probe + E_seen − the
     /// probes' own light over the seen directions (the control variate of `--set
     /// probe-detail=on`, with the CPU twin of the probe field); `alone`: Ê, screen space
-    /// alone; `probes`: E_probe alone (c = 0), the same for every k; `gpu`: the renderer's
-    /// rule on the GPU's own gathered E and c (its image, recomposed); `gpu-gather-oracle-c`
-    /// and `oracle-gather-gpu-c`: that rule with one half of the pair the oracle's.
+    /// alone; `probes`: E_probe alone (c = 0), the same for every k; `gpu`: the rule compose
+    /// ran (DGB's blend, or with `probe-detail` the control variate) on the GPU's own
+    /// gathered term and c (its image, recomposed with the path tracer's albedo);
+    /// `gpu-gather-oracle-c` and `oracle-gather-gpu-c`: that rule with one half of the pair
+    /// the oracle's.
     pub blend: String,
     /// Only paths whose first bounce lies within the gather's radius count as seen.
     pub within_radius: bool,
