@@ -234,12 +234,13 @@ pub fn run(a: &EvalArgs) -> Result<()> {
                 run.scene, i.flip, i.rmse, i.mae, i.mean_ratio.unwrap_or(f32::NAN), f.flip, f.rmse, run.ref_spp, e.ref_bounces, noise(i), noise(f)
             );
             if let Some(o) = &e.oracle {
+                let twin = match o.probe_twin_error {
+                    Some(e) => format!("; probe twin off by {:.2} %", 100.0 * e),
+                    None => "; no probes".into(),
+                };
                 println!(
-                    "  perfect gather (oracle, {} spp, noise FLIP {:.4}; r = {:.3}; probe twin off by {:.2} %):",
-                    o.noise.spp,
-                    o.noise.flip,
-                    o.radius,
-                    100.0 * o.probe_twin_error.unwrap_or(0.0)
+                    "  perfect gather (oracle, {} spp, noise FLIP {:.4}; r = {:.3}{twin}):",
+                    o.noise.spp, o.noise.flip, o.radius,
                 );
                 for row in &o.by_layers {
                     println!(

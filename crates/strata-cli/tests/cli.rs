@@ -1381,6 +1381,18 @@ fn eval_gi_oracle_reports_a_perfect_gather_beside_the_gpu() {
     for r in d["oracle"]["by_layers"].as_array().unwrap() {
         assert!(r.get("gather").is_none(), "{r}");
     }
+    // without probes the oracle converges on the seen light: its own cache entry (two
+    // halves), not the one converged on the blends; the reference's is shared
+    let bins = || {
+        std::fs::read_dir(&cache)
+            .unwrap()
+            .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "bin"))
+            .count()
+    };
+    let before = bins();
+    let n = json_of(&run(&["--layers", "2", "--oracle", "--no-probes"]));
+    assert!(n["oracle"].get("probe_twin_error").is_none(), "{}", n["oracle"]);
+    assert_eq!(bins(), before + 2, "a new oracle entry for the seen-light criterion");
     assert_one_line_error(
         &run(&["--layers", "3", "--oracle"]),
         &["--layers 3", "--oracle", "1..=2"],

@@ -327,8 +327,15 @@ fn oracle_rows<'a>(
         first_spp: rule.first_spp.max(64),
         ..*rule
     };
+    // what the convergence measured is part of the entry: an oracle converged on the seen
+    // light alone is not converged for the blends with probes, nor the other way round
+    let criterion = match (&probe_e, field) {
+        (Some(_), Some(_)) => "renderer+detail",
+        (Some(_), None) => "renderer",
+        _ => "seen",
+    };
     let description = format!(
-        "v1 screen oracle {} {camera:?} {w}x{h} {estimator:?} {rule:?}",
+        "v1 screen oracle {} {camera:?} {w}x{h} {estimator:?} {rule:?} criterion={criterion} k={k}",
         scene_fingerprint(scene, s.scene.frame),
     );
     let converged = RefCache::new(&s.cache).converged(s.no_cache, &description, &estimator, || {
